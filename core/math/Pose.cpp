@@ -1,0 +1,54 @@
+#include "core/math/Pose.h"
+
+#include <cmath>
+
+namespace mirage {
+
+Pose Pose::fromMatrix(const glm::dmat4& m) {
+    return fromRotationTranslation(glm::dmat3(m), glm::dvec3(m[3]));
+}
+
+Pose Pose::fromRotationTranslation(const glm::dmat3& r, const glm::dvec3& t) {
+    Pose p;
+    // quat_cast followed by normalisation is a projection onto the nearest rotation for the
+    // nearly-orthonormal matrices we get from composed transforms.
+    p.rotation = glm::normalize(glm::quat_cast(r));
+    p.translation = t;
+    return p;
+}
+
+glm::dmat4 Pose::matrix() const {
+    glm::dmat4 m(glm::mat3_cast(rotation));
+    m[3] = glm::dvec4(translation, 1.0);
+    return m;
+}
+
+Pose Pose::operator*(const Pose& o) const {
+    Pose p;
+    p.rotation = glm::normalize(rotation * o.rotation);
+    p.translation = rotation * o.translation + translation;
+    return p;
+}
+
+Pose Pose::inverse() const {
+    Pose p;
+    p.rotation = glm::conjugate(rotation);
+    p.translation = -(p.rotation * translation);
+    return p;
+}
+
+bool Pose::isFinite() const {
+    for (int i = 0; i < 4; ++i)
+        if (!std::isfinite(rotation[i])) return false;
+    for (int i = 0; i < 3; ++i)
+        if (!std::isfinite(translation[i])) return false;
+    return true;
+}
+
+double rotationAngleBetween(const glm::dquat& a, const glm::dquat& b) {
+    // |w| of the relative rotation; abs() because q and -q are the same rotation.
+    double w = std::abs(glm::dot(glm::normalize(a), glm::normalize(b)));
+    return 2.0 * std::acos(std::min(1.0, w));
+}
+
+}  // namespace mirage

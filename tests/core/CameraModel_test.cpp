@@ -1,0 +1,92 @@
+// The camera models match OpenCV's projectPoints (pinhole and fisheye) and invert exactly,
+// including far off-axis fish-eye rays.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <opencv2/calib3d.hpp>
+
+#include "core/camera/CameraModel.h"
+
+namespace mirage {
+namespace {
+
+CameraIntrinsics pinhole() {
+    CameraIntrinsics c;
+    c.width = 640;
+    c.height = 480;
+    c.fx = 530;
+    c.fy = 528;
+    c.cx = 321.5;
+    c.cy = 242.0;
+    c.distortion = {-0.28, 0.09, 0.001, -0.0005, -0.01};
+    return c;
+}
+
+CameraIntrinsics fisheye() {
+    CameraIntrinsics c;
+    c.width = 1280;
+    c.height = 960;
+    c.model = DistortionModel::KannalaBrandt;
+    c.fx = 340;
+    c.fy = 340;
+    c.cx = 640;
+    c.cy = 480;
+    c.distortion = {0.03, -0.006, 0.001, -0.0002};
+    return c;
+}
+
+TEST(CameraModel, PinholeMatchesOpenCV) {
+    auto cam = pinhole();
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    std::vector<cv::Point3d> pts;
+    for (int i = 0; i < 200; ++i) pts.push_back({u(rng), u(rng), 1.0 + u(rng)});
+    cv::Matx33d K(cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+    std::vector<cv::Point2d> ref;
+    cv::projectPoints(pts, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, cam.distortion, ref);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        auto px = cam.project({pts[i].x, pts[i].y, pts[i].z});
+        ASSERT_TRUE(px);
+        EXPECT_NEAR(px->x, ref[i].x, 1e-6);
+        EXPECT_NEAR(px->y, ref[i].y, 1e-6);
+        auto ray = cam.unproject(*px);
+        ASSERT_TRUE(ray);
+        glm::dvec3 dir = glm::normalize(glm::dvec3(pts[i].x, pts[i].y, pts[i].z));
+        EXPECT_NEAR(glm::length(*ray - dir), 0.0, 1e-7);
+    }
+    EXPECT_FALSE(cam.project({0, 0, -1}));  // behind the camera
+    EXPECT_FALSE(cam.project({0, 0, 0}));
+}
+
+TEST(CameraModel, FisheyeMatchesOpenCVAndInvertsOffAxis) {
+    auto cam = fisheye();
+    cv::Matx33d K(cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+    for (double thetaDeg : {0.0, 10.0, 45.0, 70.0, 85.0, 89.0}) {
+        double th = thetaDeg * CV_PI / 180;
+        cv::Point3d p(std::sin(th) * 0.6, std::sin(th) * 0.8, std::cos(th));
+        std::vector<cv::Point3d> in{p};
+        std::vector<cv::Point2d> ref;
+        cv::fisheye::projectPoints(in, ref, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                                   cam.distortion);
+        auto px = cam.project({p.x, p.y, p.z});
+        ASSERT_TRUE(px);
+        EXPECT_NEAR(px->x, ref[0].x, 1e-6) << thetaDeg;
+        EXPECT_NEAR(px->y, ref[0].y, 1e-6) << thetaDeg;
+        auto ray = cam.unproject(*px);
+        ASSERT_TRUE(ray) << thetaDeg;
+        EXPECT_NEAR(glm::length(*ray - glm::dvec3(p.x, p.y, p.z)), 0.0, 1e-8) << thetaDeg;
+    }
+    // Beyond 90 degrees the model is not trusted: no projection, no NaN.
+    EXPECT_FALSE(cam.project({1, 0, -0.5}));
+}
+
+TEST(CameraModel, InvalidIntrinsicsDetected) {
+    auto cam = pinhole();
+    EXPECT_TRUE(cam.isValid());
+    cam.fx = std::nan("");
+    EXPECT_FALSE(cam.isValid());
+}
+
+}  // namespace
+}  // namespace mirage
