@@ -263,6 +263,32 @@ TEST(SceneLoader, ShowcaseGlbHasTheSameContent) {
     checkShowcase(s);
 }
 
+TEST(SceneLoader, GltfAndGlbGiveIdenticalGeometryAndTextures) {
+    Scene a = loadScene(goodScene("showcase.gltf")), b = loadScene(goodScene("showcase.glb"));
+    ASSERT_EQ(a.meshes.size(), b.meshes.size());
+    for (size_t m = 0; m < a.meshes.size(); ++m) {
+        ASSERT_EQ(a.meshes[m].primitives.size(), b.meshes[m].primitives.size());
+        for (size_t p = 0; p < a.meshes[m].primitives.size(); ++p) {
+            const Primitive &x = a.meshes[m].primitives[p], &y = b.meshes[m].primitives[p];
+            EXPECT_EQ(x.positions, y.positions);
+            EXPECT_EQ(x.normals, y.normals);
+            EXPECT_EQ(x.tangents, y.tangents);
+            EXPECT_EQ(x.uv0, y.uv0);
+            EXPECT_EQ(x.uv1, y.uv1);
+            EXPECT_EQ(x.indices, y.indices);
+            EXPECT_EQ(x.material, y.material);
+        }
+    }
+    ASSERT_EQ(a.textures.size(), b.textures.size());
+    for (size_t t = 0; t < a.textures.size(); ++t)
+        EXPECT_EQ(a.textures[t].pixels, b.textures[t].pixels);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    for (size_t n = 0; n < a.nodes.size(); ++n) {
+        EXPECT_EQ(a.nodes[n].world, b.nodes[n].world);
+        EXPECT_EQ(a.nodes[n].origin, b.nodes[n].origin);
+    }
+}
+
 TEST(SceneLoader, LoadFromMemoryMatchesLoadFromFile) {
     Scene s =
         loadSceneFromMemory(readFile(goodScene("showcase.glb")), "in-memory.glb", goodScene(""));
