@@ -452,6 +452,45 @@ TEST(SessionCorrupt, SessionJsonErrorsAreClear) {
     EXPECT_NE(readError(dir / "nonexistent").find("not a folder"), std::string::npos);
 }
 
+TEST(SessionCorrupt, RandomDamageNeverCrashes) {
+    // Flipped bytes, cut files and garbage rows: readers report and keep going, never crash,
+    // never loop, never claim more frames than were written.
+    const fs::path dir = test::outputDir("session_random_damage");
+    writeSession(dir, 6, false);
+    const std::string mkv = readFileBytes(dir / "main.mkv");
+    const std::string csv = readFileBytes(dir / "frames.csv");
+    cv::RNG rng(12345);
+    for (int trial = 0; trial < 150; ++trial) {
+        std::string damaged = mkv;
+        const int flips = 1 + rng.uniform(0, 8);
+        for (int k = 0; k < flips; ++k)
+            damaged[size_t(rng.uniform(0, int(damaged.size())))] = char(rng.uniform(0, 256));
+        if (trial % 3 == 0) damaged.resize(size_t(rng.uniform(0, int(damaged.size()))));
+        std::ofstream(dir / "main.mkv", std::ios::binary) << damaged;  // no fsync: fast
+        try {
+            const MatroskaScan scan = scanMatroska(dir / "main.mkv");
+            EXPECT_LE(scan.completeFrames, 6) << "trial " << trial;
+        } catch (const FileError&) {
+            // Damaged EBML header: "not a Matroska file" is the right answer.
+        }
+        std::string rows = csv;
+        for (int k = 0; k < 3; ++k)
+            rows[size_t(rng.uniform(0, int(rows.size())))] = "0,.-e\n#x9"[rng.uniform(0, 9)];
+        std::ofstream(dir / "frames.csv", std::ios::binary) << rows;
+        SessionReadReport report;
+        const Session s = readSession(dir, &report);
+        EXPECT_LE(report.framesReadable, 6);
+        if (trial % 25 == 0) {
+            // Decoding damaged JPEG data must not crash either (FFmpeg conceals errors).
+            auto src = openCameraFrames(s, "main");
+            cv::Mat f;
+            int n = 0;
+            while (src->read(f)) ++n;
+            EXPECT_LE(n, report.framesReadable);
+        }
+    }
+}
+
 TEST(Matroska, ScannerCountsFfmpegWrittenFiles) {
     // A file from another muxer (FFmpeg through OpenCV) is scanned the same way.
     const fs::path dir = test::outputDir("matroska_ffmpeg");
