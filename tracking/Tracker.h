@@ -35,9 +35,10 @@ struct TrackedFrame {
     double detectMs = 0, poseMs = 0, filterMs = 0;
 };
 
-// Sharpness of an 8-bit grey image: the 99.5th percentile of the gradient magnitude (intensity
-// levels per pixel) divided by the 1..99 % intensity range; about 1 / (edge width in pixels).
-// 0 for an image without contrast.
+// Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
+// percentile of the directional derivative (intensity levels per pixel), the smallest of the four
+// (motion blur along one direction lowers that one only), divided by the 1..99 % intensity
+// range; about 1 / (edge width in pixels). 0 for an image without contrast.
 double imageSharpness(const cv::Mat& grey);
 
 class Tracker {
@@ -45,6 +46,12 @@ public:
     Tracker(Board board, CameraIntrinsics camera, TrackerOptions options = {});
 
     TrackedFrame process(const cv::Mat& image, double t);
+    // A pose known from elsewhere (the last pose of a previous run, another sensor) acts as the
+    // previous ok pose at time t: it may decide the planar ambiguity of the next frames.
+    void seedPrior(const Pose& T_world_camera, double t) {
+        lastOk_ = T_world_camera;
+        lastOkT_ = t;
+    }
     // A frame that could not be read (corrupt, truncated video): reported lost, filter reset.
     TrackedFrame markLost(double t, const std::string& reason);
 
