@@ -120,16 +120,17 @@ FrameReport CalibrationSession::processFrame(const cv::Mat& image, const std::st
         return rep;
     }
     rep.boardFound = true;
-    rep.corners = d.view.imagePoints;
-    rep.motionPx = meanCornerMotion(previousCorners_, rep.corners);
-    previousCorners_ = rep.corners;
+    rep.view = d.view;
+    const auto& corners = rep.view.imagePoints;
+    rep.motionPx = meanCornerMotion(previousCorners_, corners);
+    previousCorners_ = corners;
     if (rep.motionPx >= 0 && rep.motionPx < options_.stillMotionPx) {
         ++stillCount_;
     } else {
         stillCount_ = 0;
         heldSinceCapture_ = false;
     }
-    rep.sharpness = laplacianVariance(grey, cv::boundingRect(rep.corners));
+    rep.sharpness = laplacianVariance(grey, cv::boundingRect(corners));
     // The reference decays (~30 frames) so a change of scene or lighting is followed.
     recentSharpest_ = std::max(rep.sharpness, recentSharpest_ * 0.97);
     estimateTilt(d.view, rep.tiltDeg, rep.tiltDirectionDeg);
@@ -141,7 +142,7 @@ FrameReport CalibrationSession::processFrame(const cv::Mat& image, const std::st
     } else if (rep.sharpness <
                std::max(options_.minSharpness, options_.blurFraction * recentSharpest_)) {
         rep.decision = CaptureDecision::Blurred;
-    } else if (!isNovel(signatureOf(rep.corners, rep.tiltDeg, rep.tiltDirectionDeg))) {
+    } else if (!isNovel(signatureOf(corners, rep.tiltDeg, rep.tiltDirectionDeg))) {
         rep.decision = CaptureDecision::Similar;
     } else {
         addView(std::move(d.view));

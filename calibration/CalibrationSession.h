@@ -54,7 +54,7 @@ const char* captureDecisionName(CaptureDecision d);
 
 struct FrameReport {
     bool boardFound = false;
-    std::vector<cv::Point2f> corners;  // pixels, when found
+    CalibrationView view;  // the detection (imagePoints in pixels), when found
     CaptureDecision decision = CaptureDecision::NoBoard;
     double motionPx = -1;  // mean corner motion since the previous frame, < 0 if unknown
     double sharpness = 0;  // Laplacian variance over the board

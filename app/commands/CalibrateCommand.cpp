@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "app/Command.h"
 #include "app/wizard/CalibrationWizard.h"
@@ -138,16 +140,47 @@ void writeSynthetic(const CalibrateArgs& a) {
     po.marginPx = 12;
     const auto poses = calib::sampleBoardPoses(cam, board, a.syntheticViews, po, rng);
     fs::create_directories(a.writeSynthetic);
+    const calib::ChessboardRenderer hiRes(cam, 3);
     for (size_t i = 0; i < poses.size(); ++i) {
-        const cv::Mat img = calib::renderChessboard(cam, board, poses[i], 3);
+        const cv::Mat img = hiRes.render(board, poses[i]);
         const auto path = fs::path(a.writeSynthetic) / fmt::format("view_{:02}.png", i);
         if (!cv::imwrite(path.string(), img)) throw FileError(path.string(), "cannot write");
+    }
+    // A video of the board moving from pose to pose (motion-blurred while it moves), holding
+    // still at each, with one pose first held out of focus: what the wizard's auto-capture sees.
+    const calib::ChessboardRenderer renderer(cam, 2);
+    const auto videoPath = (fs::path(a.writeSynthetic) / "sequence.avi").string();
+    cv::VideoWriter video(videoPath, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 15.0,
+                          cv::Size(cam.width, cam.height), false);
+    if (!video.isOpened()) throw FileError(videoPath, "cannot open for writing (MJPG/AVI)");
+    auto emit = [&](const calib::BoardPose& pose, double blurSigma) {
+        cv::Mat img = renderer.render(board, pose);
+        if (blurSigma > 0) cv::GaussianBlur(img, img, cv::Size(), blurSigma);
+        cv::Mat n(img.size(), CV_16S);
+        cv::randn(n, 0, 1.5);  // sensor noise, 8-bit units
+        img.convertTo(img, CV_16S);
+        img += n;
+        img.convertTo(img, CV_8U);
+        video.write(img);
+    };
+    for (size_t i = 0; i < poses.size(); ++i) {
+        if (i > 0)
+            for (int k = 1; k <= 5; ++k) {
+                const double t = k / 6.0;
+                calib::BoardPose p;
+                p.rvec = poses[i - 1].rvec * (1 - t) + poses[i].rvec * t;
+                p.tvec = poses[i - 1].tvec * (1 - t) + poses[i].tvec * t;
+                emit(p, 2.5);
+            }
+        if (i == 1)
+            for (int k = 0; k < 5; ++k) emit(poses[i], 3.0);  // still but out of focus
+        for (int k = 0; k < 6; ++k) emit(poses[i], 0.0);
     }
     CameraCalibration truth;
     truth.intrinsics = cam;
     saveCalibration(fs::path(a.writeSynthetic) / "truth.yaml", truth);
-    spdlog::info("wrote {} views of chessboard:9x6:0.025 and truth.yaml into {}", poses.size(),
-                 a.writeSynthetic);
+    spdlog::info("wrote {} views of chessboard:9x6:0.025, sequence.avi and truth.yaml into {}",
+                 poses.size(), a.writeSynthetic);
 }
 
 const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
