@@ -68,7 +68,7 @@ void runBatch(const CalibrateArgs& a) {
     o.calibration.fixK3 = a.fixK3;
     o.source.videoStep = a.videoStep;
     const auto result = calib::runBatchCalibration(a.inputs, target, o);
-    CameraCalibration cal = result.calibration.calibration;
+    CameraCalibration cal = calib::calibrationForFile(result.calibration);
 
     std::string extrinsicReport;
     if (!a.mainCalib.empty()) {

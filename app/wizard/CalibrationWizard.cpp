@@ -168,7 +168,7 @@ void saveCalibrationFile(const WizardOptions& o, const calib::CalibrationSession
         status = "nothing to save yet";
         return;
     }
-    const auto& cal = s.result()->calibration;
+    const auto cal = calib::calibrationForFile(*s.result());
     saveCalibration(o.output, cal);
     status = cal.reliable ? "saved " + o.output
                           : "saved " + o.output + " marked UNRELIABLE: " + cal.unreliableReason;
