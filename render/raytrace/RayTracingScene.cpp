@@ -80,35 +80,35 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
                         std::to_string(t.width) + "x" + std::to_string(t.height) + " RGBA8");
 
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (size_t ni = 0; ni < scene.nodes.size(); ++ni) {
-        const Node& node = scene.nodes[ni];
-        if (!included(node.origin)) continue;
-        if (node.light >= 0) {
-            if (node.light >= int(scene.lights.size()))
-                throw Error("scene node '" + node.name + "': light index out of range");
-            const Light& l = scene.lights[size_t(node.light)];
-            PunctualLight pl;
-            pl.type = l.type;
-            pl.position = glm::vec3(node.world * glm::dvec4(0, 0, 0, 1));
-            glm::dvec3 dir = glm::dmat3(node.world) * glm::dvec3(0, 0, -1);
-            if (!(glm::length(dir) > 0))
-                throw Error("scene node '" + node.name + "': degenerate light transform");
-            pl.direction = glm::vec3(glm::normalize(dir));
-            pl.intensity = l.color * l.intensity;
-            pl.cosInner = std::cos(std::clamp(l.innerConeAngle, 0.0f, kPi / 2));
-            pl.cosOuter = std::cos(std::clamp(l.outerConeAngle, 0.0f, kPi / 2));
-            pl.origin = node.origin;
-            if (!isFiniteVec(pl.position) || !isFiniteVec(pl.intensity) ||
-                maxComponent(pl.intensity) < 0)
-                throw Error("scene light '" + l.name +
-                            "': non-finite or negative position/intensity");
-            lights_.push_back(pl);
-        }
-        if (node.mesh < 0) continue;
-        if (node.mesh >= int(scene.meshes.size()))
+    // Lights and meshes reachable from the scene's roots, with world transforms and origins.
+    for (const LightInstance& li : scene.lightInstances()) {
+        if (!included(li.origin)) continue;
+        const Node& node = scene.nodes[size_t(li.node)];
+        if (li.light < 0 || li.light >= int(scene.lights.size()))
+            throw Error("scene node '" + node.name + "': light index out of range");
+        const Light& l = scene.lights[size_t(li.light)];
+        PunctualLight pl;
+        pl.type = l.type;
+        pl.position = glm::vec3(li.position);
+        if (!(glm::length(li.direction) > 0))
+            throw Error("scene node '" + node.name + "': degenerate light transform");
+        pl.direction = glm::vec3(glm::normalize(li.direction));
+        pl.intensity = l.color * l.intensity;
+        pl.cosInner = std::cos(std::clamp(l.innerConeAngle, 0.0f, kPi / 2));
+        pl.cosOuter = std::cos(std::clamp(l.outerConeAngle, 0.0f, kPi / 2));
+        pl.origin = li.origin;
+        if (!isFiniteVec(pl.position) || !isFiniteVec(pl.intensity) ||
+            std::min(pl.intensity.x, std::min(pl.intensity.y, pl.intensity.z)) < 0)
+            throw Error("scene light '" + l.name + "': non-finite or negative position/intensity");
+        lights_.push_back(pl);
+    }
+    for (const MeshInstance& mi : scene.meshInstances()) {
+        if (!included(mi.origin)) continue;
+        const Node& node = scene.nodes[size_t(mi.node)];
+        if (mi.mesh < 0 || mi.mesh >= int(scene.meshes.size()))
             throw Error("scene node '" + node.name + "': mesh index out of range");
-        const Mesh& mesh = scene.meshes[size_t(node.mesh)];
-        glm::dmat4 world = node.world;
+        const Mesh& mesh = scene.meshes[size_t(mi.mesh)];
+        glm::dmat4 world = mi.world;
         glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
         bool flipWinding = glm::determinant(glm::dmat3(world)) < 0;
         for (const Primitive& prim : mesh.primitives) {
@@ -117,7 +117,7 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
                 throw Error(where + ": index count is not a multiple of 3");
             if (prim.indices.empty()) continue;
             Geometry g;
-            g.origin = node.origin;
+            g.origin = mi.origin;
             g.material = prim.material >= 0 ? prim.material : int(materials_.size()) - 1;
             if (g.material >= int(materials_.size()))
                 throw Error(where + ": material index " + std::to_string(prim.material) +
@@ -251,21 +251,36 @@ const ShadingMaterial& RayTracingScene::material(const SurfaceHit& hit) const {
 }
 
 glm::vec3 RayTracingScene::sampleTexture(int texture, glm::vec2 uv) const {
-    // Bilinear, repeat wrap, sRGB-decoded per texel before filtering.
+    // Bilinear with the glTF sampler's wrap modes; sRGB-encoded texels are decoded before
+    // filtering.
     const Texture& t = textures_[size_t(texture)];
     float x = uv.x * float(t.width) - 0.5f, y = uv.y * float(t.height) - 0.5f;
     if (!std::isfinite(x) || !std::isfinite(y)) return glm::vec3(1.0f);
     float fx = std::floor(x), fy = std::floor(y);
     float ax = x - fx, ay = y - fy;
-    auto wrap = [](long v, int n) { return int(((v % n) + n) % n); };
+    auto wrap = [](long v, int n, Texture::Wrap mode) {
+        switch (mode) {
+            case Texture::Wrap::ClampToEdge:
+                return int(std::clamp<long>(v, 0, n - 1));
+            case Texture::Wrap::MirroredRepeat: {
+                long period = 2L * n, m = ((v % period) + period) % period;
+                return int(m < n ? m : period - 1 - m);
+            }
+            case Texture::Wrap::Repeat:
+                break;
+        }
+        return int(((v % n) + n) % n);
+    };
     const auto& lut = srgbTable();
     glm::vec3 out(0.0f);
     for (int dy = 0; dy < 2; ++dy)
         for (int dx = 0; dx < 2; ++dx) {
-            int px = wrap(long(fx) + dx, t.width), py = wrap(long(fy) + dy, t.height);
+            int px = wrap(long(fx) + dx, t.width, t.wrapS),
+                py = wrap(long(fy) + dy, t.height, t.wrapT);
             const unsigned char* c = &t.pixels[(size_t(py) * size_t(t.width) + size_t(px)) * 4];
             float w = (dx ? ax : 1 - ax) * (dy ? ay : 1 - ay);
-            out += w * glm::vec3(lut[c[0]], lut[c[1]], lut[c[2]]);
+            out += w * (t.srgb ? glm::vec3(lut[c[0]], lut[c[1]], lut[c[2]])
+                               : glm::vec3(c[0], c[1], c[2]) / 255.0f);
         }
     return out;
 }

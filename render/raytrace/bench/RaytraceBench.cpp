@@ -25,22 +25,26 @@ struct Fixture {
     Fixture() {
         // A tabletop-like scene of ~150k triangles: floor, table, spheres and boxes.
         addObject(scene, "floor", floorPrimitive(8.0f), lambert(glm::vec3(0.6f)), glm::dmat4(1.0));
-        addObject(scene, "table", boxPrimitive({-1.0f, 0.7f, -0.6f}, {1.0f, 0.75f, 0.6f}), lambert(glm::vec3(0.5f)),
-                  glm::dmat4(1.0));
+        addObject(scene, "table", boxPrimitive({-1.0f, 0.7f, -0.6f}, {1.0f, 0.75f, 0.6f}),
+                  lambert(glm::vec3(0.5f)), glm::dmat4(1.0));
         Rng rng(1, 2);
         for (int i = 0; i < 12; ++i) {
             glm::dvec3 c(rng.uniform() * 1.6 - 0.8, 0.9, rng.uniform() * 1.0 - 0.5);
             if (i % 2)
-                addObject(scene, "ball" + std::to_string(i), spherePrimitive(0.08f + 0.06f * rng.uniform(), 128, 64),
-                          glass(1.5f), translate(c));
+                addObject(scene, "ball" + std::to_string(i),
+                          spherePrimitive(0.08f + 0.06f * rng.uniform(), 128, 64), glass(1.5f),
+                          translate(c));
             else
-                addObject(scene, "box" + std::to_string(i), boxPrimitive(glm::vec3(-0.08f), glm::vec3(0.08f)),
+                addObject(scene, "box" + std::to_string(i),
+                          boxPrimitive(glm::vec3(-0.08f), glm::vec3(0.08f)),
                           lambert(glm::vec3(0.7f, 0.3f, 0.2f)), translate(c));
         }
         Light spot;
         spot.type = Light::Type::Spot;
         spot.intensity = 20.0f;
-        addLight(scene, "spot", spot, glm::inverse(glm::lookAt(glm::dvec3(0.5, 2.5, 1), glm::dvec3(0, 0.75, 0), glm::dvec3(0, 1, 0))));
+        addLight(scene, "spot", spot,
+                 glm::inverse(glm::lookAt(glm::dvec3(0.5, 2.5, 1), glm::dvec3(0, 0.75, 0),
+                                          glm::dvec3(0, 1, 0))));
         addCameraNode(scene, "cam", {0, 1.6, 2.0}, {0, 0.8, 0}, 0.8f);
         rt = std::make_unique<RayTracingScene>(scene, SceneSubset::All, device);
         camera = cameraFromNode(scene, "cam", 640, 480);
@@ -48,11 +52,13 @@ struct Fixture {
         for (int y = 0; y < 480; ++y)
             for (int x = 0; x < 640; ++x) {
                 coherentO.push_back(glm::vec3(camera.T_world_camera.translation));
-                coherentD.push_back(glm::normalize(R * glm::vec3(*camera.intrinsics.unproject({double(x), double(y)}))));
+                coherentD.push_back(glm::normalize(
+                    R * glm::vec3(*camera.intrinsics.unproject({double(x), double(y)}))));
             }
         auto b = rt->sceneBounds();
         for (int i = 0; i < 640 * 480; ++i) {
-            glm::vec3 o = b.centre + 0.5f * b.radius * (sampleUniformSphere(rng.uniform2()) * rng.uniform());
+            glm::vec3 o =
+                b.centre + 0.5f * b.radius * (sampleUniformSphere(rng.uniform2()) * rng.uniform());
             incoherentO.push_back(o);
             incoherentD.push_back(sampleUniformSphere(rng.uniform2()));
         }
@@ -64,12 +70,16 @@ Fixture& fixture() {
     return f;
 }
 
-const std::vector<glm::vec3>& origins(bool coherent) { return coherent ? fixture().coherentO : fixture().incoherentO; }
-const std::vector<glm::vec3>& directions(bool coherent) { return coherent ? fixture().coherentD : fixture().incoherentD; }
+const std::vector<glm::vec3>& origins(bool coherent) {
+    return coherent ? fixture().coherentO : fixture().incoherentO;
+}
+const std::vector<glm::vec3>& directions(bool coherent) {
+    return coherent ? fixture().coherentD : fixture().incoherentD;
+}
 
 void setRate(benchmark::State& state, size_t raysPerIteration) {
-    state.counters["Mrays/s"] = benchmark::Counter(double(raysPerIteration) * double(state.iterations()) / 1e6,
-                                                   benchmark::Counter::kIsRate);
+    state.counters["Mrays/s"] = benchmark::Counter(
+        double(raysPerIteration) * double(state.iterations()) / 1e6, benchmark::Counter::kIsRate);
 }
 
 void BM_EmbreeIntersect1(benchmark::State& state) {
@@ -110,7 +120,8 @@ void BM_EmbreeIntersect16(benchmark::State& state) {
         unsigned hits = 0;
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
-        ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+        ctx.flags =
+            coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
         for (size_t base = 0; base + 16 <= O.size(); base += 16) {
             alignas(64) RTCRayHit16 rh;
             for (int k = 0; k < 16; ++k) {
@@ -155,7 +166,8 @@ void BM_RayTracingSceneOccluded(benchmark::State& state) {
     const auto& D = directions(coherent);
     for (auto _ : state) {
         unsigned hits = 0;
-        for (size_t i = 0; i < O.size(); ++i) hits += f.rt->occluded(O[i], D[i], std::numeric_limits<float>::infinity());
+        for (size_t i = 0; i < O.size(); ++i)
+            hits += f.rt->occluded(O[i], D[i], std::numeric_limits<float>::infinity());
         benchmark::DoNotOptimize(hits);
     }
     setRate(state, O.size());
@@ -171,13 +183,22 @@ void BM_RenderOnePass(benchmark::State& state) {
     st.photonsPerPass = 20000;
     st.caustics = state.range(0) == 1;
     for (auto _ : state) benchmark::DoNotOptimize(render(*f.rt, cam, st).passes);
-    state.counters["paths/s"] = benchmark::Counter(160.0 * 120.0 * double(state.iterations()), benchmark::Counter::kIsRate);
+    state.counters["paths/s"] =
+        benchmark::Counter(160.0 * 120.0 * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 BENCHMARK(BM_EmbreeIntersect1)->ArgName("coherent")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EmbreeIntersect16)->ArgName("coherent")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_RayTracingSceneIntersect)->ArgName("coherent")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_RayTracingSceneOccluded)->ArgName("coherent")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RayTracingSceneIntersect)
+    ->ArgName("coherent")
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RayTracingSceneOccluded)
+    ->ArgName("coherent")
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RenderOnePass)->ArgName("caustics")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
