@@ -13,11 +13,11 @@ function(mirage_scene_fuzz_target target)
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR})
   target_link_libraries(${target} PRIVATE mirage_core)
   target_compile_definitions(${target} PRIVATE MIRAGE_FUZZ_BASE_DIR="${_scene_data}/good")
-  # Under sanitizers, compile tinygltf + stb_image into the executable so they are instrumented.
+  # Under sanitizers, compile tinygltf into the executable so they are instrumented.
   if(MIRAGE_SANITIZE OR MIRAGE_LIBFUZZER)
     target_sources(${target} PRIVATE ${_fuzz_dir}/InstrumentedTinyGltf.cpp)
     set_source_files_properties(${_fuzz_dir}/InstrumentedTinyGltf.cpp PROPERTIES COMPILE_OPTIONS "-w")
-    target_link_libraries(${target} PRIVATE nlohmann_json::nlohmann_json)  # stb includes come via mirage_core
+    target_link_libraries(${target} PRIVATE nlohmann_json::nlohmann_json)
   endif()
 endfunction()
 
