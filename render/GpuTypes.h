@@ -40,9 +40,9 @@ struct GpuLightBlock {
 };
 
 struct GpuVpl {
-    glm::vec4 positionReal, normal, flux;
+    glm::vec4 positionReal, normal, flux, tangent;
 };
-static_assert(sizeof(GpuVpl) == 48);
+static_assert(sizeof(GpuVpl) == 64);
 
 struct GpuMaterial {
     glm::vec4 baseColor, emissive, params;

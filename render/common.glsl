@@ -49,7 +49,14 @@ struct GpuVpl {
     vec4 positionReal;  // xyz world position; w = 1 if light, surface q are real, else 0
     vec4 normal;        // xyz unit normal at q (facing the light); w = 1 valid, 0 unused slot
     vec4 flux;          // rgb = reflected power (W) the VPL emits (cosine lobe); w unused
+    vec4 tangent;       // xyz unit tangent; with cross(normal, tangent): the ISM paraboloid frame
 };
+
+// Paraboloid coordinates (unit disc) of unit direction w around a VPL's normal (z axis).
+vec2 paraboloidUv(GpuVpl V, vec3 w) {
+    vec3 b = cross(V.normal.xyz, V.tangent.xyz);
+    return vec2(dot(w, V.tangent.xyz), dot(w, b)) / (1.0 + dot(w, V.normal.xyz));
+}
 
 // Materials (std430 SSBO, binding 3).
 struct GpuMaterial {
@@ -59,15 +66,19 @@ struct GpuMaterial {
 };
 
 // glTF KHR_lights_punctual spot cone and range window (the spec's recommended falloff).
-float spotAttenuation(GpuLight L, vec3 lightToPoint) {
-    if (int(L.directionType.w) != LIGHT_SPOT) return 1.0;
-    float cd = dot(normalize(L.directionType.xyz), lightToPoint);
-    float a = clamp(cd * L.cone.z + L.cone.w, 0.0, 1.0);
+// Lights are passed by index, never copied: a GpuLight is 464 bytes and llvmpipe copies it per
+// pixel if a shader takes it by value.
+float spotAttenuation(int li, vec3 lightToPoint) {
+    if (int(lights[li].directionType.w) != LIGHT_SPOT) return 1.0;
+    vec4 cone = lights[li].cone;
+    float cd = dot(lights[li].directionType.xyz, lightToPoint);
+    float a = clamp(cd * cone.z + cone.w, 0.0, 1.0);
     return a * a;
 }
-float rangeWindow(GpuLight L, float dist) {
-    if (L.positionRange.w <= 0.0) return 1.0;
-    float r = dist / L.positionRange.w;
+float rangeWindow(int li, float dist) {
+    float range = lights[li].positionRange.w;
+    if (range <= 0.0) return 1.0;
+    float r = dist / range;
     return clamp(1.0 - r * r * r * r, 0.0, 1.0);
 }
 

@@ -5,41 +5,43 @@
 
 // Distance stored in the shadow maps: Euclidean (m) for point/spot lights, along the light
 // direction from the ortho frustum's eye (positionRange.xyz) for directional lights.
-float lightDistance(GpuLight L, vec3 p) {
-    if (int(L.directionType.w) == LIGHT_DIRECTIONAL)
-        return dot(p - L.positionRange.xyz, normalize(L.directionType.xyz));
-    return length(p - L.positionRange.xyz);
+float lightDistance(int li, vec3 p) {
+    if (int(lights[li].directionType.w) == LIGHT_DIRECTIONAL)
+        return dot(p - lights[li].positionRange.xyz, lights[li].directionType.xyz);
+    return length(p - lights[li].positionRange.xyz);
 }
 
 // Direction to the light (unit) and the incident irradiance on a surface facing it
 // (W/m^2 before the cosine): I / d^2 with the spot cone and range window for point/spot lights.
-void incidentLight(GpuLight L, vec3 p, out vec3 wi, out vec3 irradiance) {
-    if (int(L.directionType.w) == LIGHT_DIRECTIONAL) {
-        wi = -normalize(L.directionType.xyz);
-        irradiance = L.radiantIntensity.rgb;
+void incidentLight(int li, vec3 p, out vec3 wi, out vec3 irradiance) {
+    if (int(lights[li].directionType.w) == LIGHT_DIRECTIONAL) {
+        wi = -lights[li].directionType.xyz;
+        irradiance = lights[li].radiantIntensity.rgb;
         return;
     }
-    vec3 d = L.positionRange.xyz - p;
+    vec3 d = lights[li].positionRange.xyz - p;
     float dist2 = max(dot(d, d), 1e-8);
     float dist = sqrt(dist2);
     wi = d / dist;
-    irradiance = L.radiantIntensity.rgb * spotAttenuation(L, -wi) * rangeWindow(L, dist) / dist2;
+    irradiance = lights[li].radiantIntensity.rgb * spotAttenuation(li, -wi) *
+                 rangeWindow(li, dist) / dist2;
 }
 
 // Fraction of the light reaching p (0..1) from one shadow atlas: the layer whose frustum holds
 // p, 2x2 percentage-closer filtered. Bias grows with the texel footprint and the slope.
-float shadowVisibility(sampler2DArray map, GpuLight L, vec3 p, float NdotL) {
-    if (L.shadow.y == 0) return 1.0;
-    for (int f = 0; f < L.shadow.y; ++f) {
-        vec4 c = L.viewProj[f] * vec4(p, 1.0);
+float shadowVisibility(sampler2DArray map, int li, vec3 p, float NdotL) {
+    ivec4 sh = lights[li].shadow;
+    if (sh.y == 0) return 1.0;
+    for (int f = 0; f < sh.y; ++f) {
+        vec4 c = lights[li].viewProj[f] * vec4(p, 1.0);
         if (c.w <= 0.0) continue;
         vec3 ndc = c.xyz / c.w;
         if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) continue;
-        float d = lightDistance(L, p);
+        float d = lightDistance(li, p);
         ivec2 size = textureSize(map, 0).xy;
-        float extent = int(L.directionType.w) == LIGHT_DIRECTIONAL
-                           ? 2.0 * L.radiantIntensity.w
-                           : 2.0 * L.radiantIntensity.w * d;
+        float tanOrExtent = lights[li].radiantIntensity.w;
+        float extent = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
+                                                                            : 2.0 * tanOrExtent * d;
         float texel = extent / float(size.x);
         float bias = params.y + 1.5 * texel / max(NdotL, 0.2);
         vec2 t = (ndc.xy * 0.5 + 0.5) * vec2(size) - 0.5;
@@ -48,7 +50,7 @@ float shadowVisibility(sampler2DArray map, GpuLight L, vec3 p, float NdotL) {
         float v[4];
         for (int k = 0; k < 4; ++k) {
             ivec2 q = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), size - 1);
-            float stored = texelFetch(map, ivec3(q, L.shadow.x + f), 0).r;
+            float stored = texelFetch(map, ivec3(q, sh.x + f), 0).r;
             v[k] = d - bias <= stored ? 1.0 : 0.0;
         }
         return mix(mix(v[0], v[1], fr.x), mix(v[2], v[3], fr.x), fr.y);

@@ -33,16 +33,16 @@ void main() {
     vec3 v = normalize(cameraPos.xyz - p);
     vec3 rv = vec3(0.0), r = vec3(0.0);
     for (int li = 0; li < counts.x; ++li) {
-        GpuLight L = lights[li];
         vec3 wi, E;
-        incidentLight(L, p, wi, E);
+        incidentLight(li, p, wi, E);
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, A.rgb, A.a, N.w) * E;
-        float visAll = shadowVisibility(shadowAll, L, p, NdotL);
+        float visAll = shadowVisibility(shadowAll, li, p, NdotL);
         rv += c * visAll;
-        if (L.shadow.w == 1 && pReal) {
-            float visReal = L.shadow.z == 1 ? shadowVisibility(shadowReal, L, p, NdotL) : visAll;
+        ivec4 sh = lights[li].shadow;
+        if (sh.w == 1 && pReal) {
+            float visReal = sh.z == 1 ? shadowVisibility(shadowReal, li, p, NdotL) : visAll;
             r += c * visReal;
         }
     }

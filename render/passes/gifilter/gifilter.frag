@@ -43,7 +43,12 @@ void main() {
             if (int(Q.w + 0.5) == ORIGIN_NONE) continue;
             vec3 nq = texelFetch(gNormal, q, 0).xyz;
             float planeDist = abs(dot(Q.xyz - P.xyz, n)) / max(0.01 * camDist, 1e-4);
-            float w = exp(-planeDist * planeDist) * pow(max(dot(n, nq), 0.0), 16.0);
+            float c = max(dot(n, nq), 0.0);
+            c *= c;
+            c *= c;
+            c *= c;
+            c *= c;  // cos^16: ~0.5 at 17 degrees
+            float w = c / (1.0 + planeDist * planeDist * 4.0);
             sumRv += w * texelFetch(indirectRv, q, 0).rgb;
             sumR += w * texelFetch(indirectR, q, 0).rgb;
             wsum += w;

@@ -16,11 +16,7 @@ layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;
 
 // Distance (m) of the nearest splatted point in direction w from the VPL, +inf if none.
-float ismDistance(usampler2D atlas, int vplIndex, vec3 n, vec3 w) {
-    vec3 t = normalize(abs(n.y) < 0.99 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
-    vec3 b = cross(n, t);
-    float z = dot(w, n);
-    vec2 puv = vec2(dot(w, t), dot(w, b)) / (1.0 + z);
+float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
     int tile = flags.z, perRow = flags.w;
     ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
     ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
@@ -55,10 +51,11 @@ void main() {
         if (cosQ <= 0.0 || cosP <= 0.0) continue;
         vec3 c = diffuse * V.flux.rgb / PI * cosQ * cosP / max(dist2, clamp2);
         float bias = 0.02 + 0.03 * dist;
-        bool visAll = dist - bias <= ismDistance(ismAll, i, V.normal.xyz, w);
+        vec2 puv = paraboloidUv(V, w);
+        bool visAll = dist - bias <= ismDistance(ismAll, i, puv);
         if (visAll) rv += c;
         if (V.positionReal.w > 0.5 && pReal) {
-            bool visReal = dist - bias <= ismDistance(ismReal, i, V.normal.xyz, w);
+            bool visReal = dist - bias <= ismDistance(ismReal, i, puv);
             if (visReal) r += c;
         }
     }

@@ -22,11 +22,9 @@ void splat(int vplIndex, vec3 p, bool real) {
     float dist = length(d);
     if (dist < 1e-4) return;
     vec3 w = d / dist;
-    vec3 t = normalize(abs(n.y) < 0.99 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
-    vec3 b = cross(n, t);
     float z = dot(w, n);
     if (z <= 0.0) return;  // behind the VPL's cosine lobe: never lit by it
-    vec2 uv = vec2(dot(w, t), dot(w, b)) / (1.0 + z);  // paraboloid, unit disc
+    vec2 uv = paraboloidUv(v, w);
     int tile = flags.z, perRow = flags.w;
     ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
     vec2 texel = (uv * 0.5 + 0.5) * float(tile);

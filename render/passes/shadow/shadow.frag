@@ -17,20 +17,19 @@ layout(location = 2) out vec4 outNormal;     // xyz world normal facing the ligh
 layout(location = 3) out vec4 outPosition;   // xyz world position (m), w = 1
 
 void main() {
-    GpuLight L = lights[lightIndex];
-    outDistance = lightDistance(L, worldPos);
+    const int li = lightIndex;
+    outDistance = lightDistance(li, worldPos);
     GpuMaterial m = materials[materialIndex];
-    vec3 toLight = int(L.directionType.w) == LIGHT_DIRECTIONAL ? -normalize(L.directionType.xyz)
-                                                               : normalize(L.positionRange.xyz - worldPos);
+    bool directional = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL;
+    vec3 toLight = directional ? -lights[li].directionType.xyz
+                               : normalize(lights[li].positionRange.xyz - worldPos);
     vec3 n = normalize(worldNormal);
     if (!allFinite(n)) n = toLight;
     if (dot(n, toLight) < 0.0) n = -n;
-    float dist = length(L.positionRange.xyz - worldPos);
-    float atten = int(L.directionType.w) == LIGHT_DIRECTIONAL
-                      ? 1.0
-                      : spotAttenuation(L, -toLight) * rangeWindow(L, dist);
+    float dist = length(lights[li].positionRange.xyz - worldPos);
+    float atten = directional ? 1.0 : spotAttenuation(li, -toLight) * rangeWindow(li, dist);
     vec3 diffuseAlbedo = m.baseColor.rgb * (1.0 - clamp(m.params.x, 0.0, 1.0));
-    outFlux = vec4(L.radiantIntensity.rgb * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
+    outFlux = vec4(lights[li].radiantIntensity.rgb * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
     outNormal = vec4(n, 0.0);
     outPosition = vec4(worldPos, 1.0);
 }

@@ -28,30 +28,34 @@ void main() {
     v.positionReal = vec4(0.0);
     v.normal = vec4(0.0, 1.0, 0.0, 0.0);  // w = 0: unused slot
     v.flux = vec4(0.0);
+    v.tangent = vec4(1.0, 0.0, 0.0, 0.0);
     for (int li = 0; li < counts.x; ++li) {
         ivec4 r = lightVplFirst[li];
         if (r.z == 0 || id < r.x || id >= r.x + r.y) continue;
-        GpuLight L = lights[li];
+        ivec4 sh = lights[li].shadow;
+        int type = int(lights[li].directionType.w);
         int local = id - r.x;
-        int layers = max(L.shadow.y, 1);
+        int layers = max(sh.y, 1);
         int layer = local % layers;
         int perLayer = max(r.y / layers, 1);
         int k = local / layers;
         if (k >= perLayer) break;  // remainder of a count not divisible by the layers
         vec2 uv = vec2((float(k) + 0.5) / float(perLayer), radicalInverse2(uint(k)));
-        vec3 tc = vec3(uv, float(L.shadow.x + layer));
+        vec3 tc = vec3(uv, float(sh.x + layer));
         vec4 pos = textureLod(rsmPosition, tc, 0.0);
         if (pos.w < 0.5) break;  // the sample sees no geometry
         vec4 flux = textureLod(rsmFlux, tc, 0.0);
         vec2 ndc = uv * 2.0 - 1.0;
-        float t = L.radiantIntensity.w;  // tan(half fov), or ortho half extent (m) for dir.
+        float t = lights[li].radiantIntensity.w;  // tan(half fov), or ortho half extent (m) for dir.
         float cell = (2.0 * t) * (2.0 * t) / float(perLayer);
-        float weight = int(L.directionType.w) == LIGHT_DIRECTIONAL
+        float weight = type == LIGHT_DIRECTIONAL
                            ? cell
                            : cell / pow(1.0 + t * t * dot(ndc, ndc), 1.5);
-        v.positionReal = vec4(pos.xyz, (L.shadow.w == 1 && flux.a > 0.5) ? 1.0 : 0.0);
+        v.positionReal = vec4(pos.xyz, (sh.w == 1 && flux.a > 0.5) ? 1.0 : 0.0);
         v.normal = vec4(normalize(textureLod(rsmNormal, tc, 0.0).xyz), 1.0);
         v.flux = vec4(flux.rgb * weight, 0.0);
+        vec3 n = v.normal.xyz;
+        v.tangent = vec4(normalize(abs(n.y) < 0.99 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0))), 0.0);
         if (!allFinite(v.flux.rgb) || !allFinite(v.normal.xyz)) v.normal.w = 0.0;
         break;
     }
