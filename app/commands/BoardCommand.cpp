@@ -1,0 +1,62 @@
+// `mirage board`: a printable planar AprilTag board (PDF or PNG) and its board file beside it
+// (docs/tracking.md).
+#include <filesystem>
+#include <memory>
+
+#include "app/Command.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "tracking/BoardImage.h"
+#include "tracking/BoardLayout.h"
+
+namespace mirage::app {
+namespace {
+
+struct BoardArgs {
+    tracking::BoardLayout layout;
+    std::string output;
+    std::string json;
+    double dpi = 300;
+};
+
+const CommandRegistrar reg("board", [](CLI::App& parent) {
+    auto* cmd = parent.add_subcommand(
+        "board", "Write a printable AprilTag board (PDF or PNG) and its board file (.json)");
+    auto a = std::make_shared<BoardArgs>();
+    cmd->add_option("--rows", a->layout.rows, "Tag rows")->capture_default_str();
+    cmd->add_option("--cols", a->layout.cols, "Tag columns")->capture_default_str();
+    cmd->add_option("--tag-size", a->layout.tagSize,
+                    "Metres between a tag's detection corners (outer black border)")
+        ->capture_default_str();
+    cmd->add_option("--gap", a->layout.gap, "Metres between neighbouring tags")
+        ->capture_default_str();
+    cmd->add_option("--first-id", a->layout.firstId, "Id of the top-left tag (row-major)")
+        ->capture_default_str();
+    cmd->add_option("--margin", a->layout.margin, "Metres of white around the grid")
+        ->capture_default_str();
+    cmd->add_option("--family", a->layout.family, "AprilTag family")->capture_default_str();
+    cmd->add_option("-o,--output", a->output, "board.pdf (vector) or board.png")->required();
+    cmd->add_option("--json", a->json, "Board file to write (default: output with .json)");
+    cmd->add_option("--dpi", a->dpi, "PNG resolution in dots per inch")->capture_default_str();
+    cmd->callback([a] {
+        const std::filesystem::path out(a->output);
+        const tracking::Board board = a->layout.makeBoard();
+        std::string ext = out.extension().string();
+        for (auto& ch : ext) ch = char(std::tolower(ch));
+        if (ext == ".pdf")
+            tracking::writeBoardPdf(out, board);
+        else if (ext == ".png")
+            tracking::writeBoardPng(out, board, a->dpi);
+        else
+            throw Error("mirage board: output '" + a->output + "' must end in .pdf or .png");
+        std::filesystem::path json = a->json.empty()
+                                         ? std::filesystem::path(out).replace_extension(".json")
+                                         : std::filesystem::path(a->json);
+        board.save(json);
+        spdlog::info("wrote {} ({:.1f} x {:.1f} mm, print at 100 %) and {}", out.string(),
+                     board.sheet->width * 1000, board.sheet->height * 1000, json.string());
+    });
+});
+
+}  // namespace
+}  // namespace mirage::app
