@@ -48,6 +48,22 @@ TEST(CalibrationFile, ReadsOpenCvSampleKeys) {
     EXPECT_FALSE(c.T_parent_camera.has_value());
 }
 
+TEST(CalibrationFile, ReadsAFileWrittenByOpenCv) {
+    const CameraCalibration c = loadCalibration(calibDir() / "opencv_tutorial_camera_charuco.yml");
+    EXPECT_EQ(c.intrinsics.width, 640);
+    EXPECT_NEAR(c.intrinsics.fx, 452.51072219637672, 1e-10);
+    EXPECT_NEAR(c.intrinsics.cy, 277.75155919135995, 1e-10);
+    ASSERT_EQ(c.intrinsics.distortion.size(), 5u);
+    EXPECT_NEAR(c.intrinsics.distortion[4], 2.9542589406810080, 1e-12);
+    EXPECT_NEAR(c.avgReprojectionError, 0.18234905535936044, 1e-12);
+    // The same values as OpenCV's own reader sees.
+    cv::FileStorage fs((calibDir() / "opencv_tutorial_camera_charuco.yml").string(),
+                       cv::FileStorage::READ);
+    cv::Mat k;
+    fs["camera_matrix"] >> k;
+    EXPECT_EQ(c.intrinsics.fy, k.at<double>(1, 1));
+}
+
 TEST(CalibrationFile, ReadsCamelCaseKeys) {
     const CameraCalibration c = loadCalibration(calibDir() / "camelcase_style.yaml");
     EXPECT_EQ(c.intrinsics.width, 1280);
@@ -200,6 +216,8 @@ TEST(CalibrationFile, BadFilesNameTheKey) {
     EXPECT_NE(loadError(bad / "extrinsic_without_parent.yaml").find("extrinsic_parent"),
               std::string::npos);
     EXPECT_NE(loadError(bad / "rational_model.yaml").find("coefficient 6"), std::string::npos);
+    EXPECT_NE(loadError(bad / "opencv_tutorial_camera_params_no_size.yml").find("image_width"),
+              std::string::npos);
     EXPECT_NE(loadError(bad / "does_not_exist.yaml").find("not found"), std::string::npos);
 }
 
