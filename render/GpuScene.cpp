@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/Error.h"
+#include "core/Log.h"
 #include "core/image/ImageIO.h"
 
 namespace mirage::render {
@@ -135,58 +136,59 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         glVertexArrayAttribBinding(vao_.id(), 1, 0);
     }
 
-    // Instances and lights straight from the node list (Node::world and Node::origin are the
-    // loader's: world-from-node with the REAL/VIRTUAL flag inherited from parents).
+    // Instances and lights reachable from the scene's roots (Scene::meshInstances /
+    // lightInstances: world-from-node with the REAL/VIRTUAL flag inherited from parents).
     glm::vec3 lo(1e30f), hi(-1e30f);
-    for (const Node& node : scene.nodes) {
-        glm::mat4 world(node.world);
+    for (const MeshInstance& inst : scene.meshInstances()) {
+        const glm::mat4 world(inst.world);
+        const std::string& nodeName = scene.nodes[size_t(inst.node)].name;
         if (!finite(world))
-            throw Error("scene '" + scene.source.string() + "': node '" + node.name +
+            throw Error("scene '" + scene.source.string() + "': node '" + nodeName +
                         "' has a non-finite transform");
-        if (node.mesh >= 0 && size_t(node.mesh) < meshRanges.size()) {
-            const float scale =
-                std::max({glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])),
-                          glm::length(glm::vec3(world[2]))});
-            for (const Range& r : meshRanges[size_t(node.mesh)]) {
-                DrawItem d;
-                d.name = node.name;
-                d.model = world;
-                d.normalMatrix = glm::inverseTranspose(world);
-                d.material = r.material;
-                d.origin = node.origin;
-                d.baseVertex = r.baseVertex;
-                d.firstIndex = r.firstIndex;
-                d.indexCount = r.count;
-                d.bounds.center = glm::vec3(world * glm::vec4(r.center, 1.0f));
-                d.bounds.radius = r.radius * scale;
-                lo = glm::min(lo, d.bounds.center - glm::vec3(d.bounds.radius));
-                hi = glm::max(hi, d.bounds.center + glm::vec3(d.bounds.radius));
-                draws_.push_back(d);
-            }
+        if (inst.mesh < 0 || size_t(inst.mesh) >= meshRanges.size()) continue;
+        const float scale =
+            std::max({glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])),
+                      glm::length(glm::vec3(world[2]))});
+        for (const Range& r : meshRanges[size_t(inst.mesh)]) {
+            DrawItem d;
+            d.name = nodeName;
+            d.model = world;
+            d.normalMatrix = glm::inverseTranspose(world);
+            d.material = r.material;
+            d.origin = inst.origin;
+            d.baseVertex = r.baseVertex;
+            d.firstIndex = r.firstIndex;
+            d.indexCount = r.count;
+            d.bounds.center = glm::vec3(world * glm::vec4(r.center, 1.0f));
+            d.bounds.radius = r.radius * scale;
+            lo = glm::min(lo, d.bounds.center - glm::vec3(d.bounds.radius));
+            hi = glm::max(hi, d.bounds.center + glm::vec3(d.bounds.radius));
+            draws_.push_back(d);
         }
-        if (node.light >= 0 && size_t(node.light) < scene.lights.size()) {
-            const Light& l = scene.lights[size_t(node.light)];
-            SceneLight s;
-            s.name = l.name.empty() ? node.name : l.name;
-            s.type = l.type == Light::Type::Point  ? kLightPoint
-                     : l.type == Light::Type::Spot ? kLightSpot
-                                                   : kLightDirectional;
-            s.position = glm::vec3(world * glm::vec4(0, 0, 0, 1));
-            s.direction = glm::normalize(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
-            s.radiantIntensity = l.color * l.intensity;
-            s.range = l.range;
-            const float outer = std::clamp(l.outerConeAngle, 1e-3f, 1.5707f);
-            const float inner = std::clamp(l.innerConeAngle, 0.0f, outer);
-            s.outerAngle = outer;
-            s.cosOuter = std::cos(outer);
-            s.cosInner = std::cos(inner);
-            s.origin = node.origin;
-            if (lights_.size() >= size_t(kMaxLights))
-                throw Error("scene '" + scene.source.string() + "' has more than " +
-                            std::to_string(kMaxLights) +
-                            " lights; the real-time renderer supports at most that many");
-            lights_.push_back(s);
-        }
+    }
+    for (const LightInstance& inst : scene.lightInstances()) {
+        if (inst.light < 0 || size_t(inst.light) >= scene.lights.size()) continue;
+        const Light& l = scene.lights[size_t(inst.light)];
+        SceneLight s;
+        s.name = l.name.empty() ? scene.nodes[size_t(inst.node)].name : l.name;
+        s.type = l.type == Light::Type::Point  ? kLightPoint
+                 : l.type == Light::Type::Spot ? kLightSpot
+                                               : kLightDirectional;
+        s.position = glm::vec3(inst.position);
+        s.direction = glm::normalize(glm::vec3(inst.direction));
+        s.radiantIntensity = l.color * l.intensity;
+        s.range = l.range;
+        const float outer = std::clamp(l.outerConeAngle, 1e-3f, 1.5707f);
+        const float inner = std::clamp(l.innerConeAngle, 0.0f, outer);
+        s.outerAngle = outer;
+        s.cosOuter = std::cos(outer);
+        s.cosInner = std::cos(inner);
+        s.origin = inst.origin;
+        if (lights_.size() >= size_t(kMaxLights))
+            throw Error("scene '" + scene.source.string() + "' has more than " +
+                        std::to_string(kMaxLights) +
+                        " lights; the real-time renderer supports at most that many");
+        lights_.push_back(s);
     }
     if (!draws_.empty()) {
         bounds_.center = 0.5f * (lo + hi);
@@ -250,9 +252,11 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         hasEnvironment_ = true;
         environmentOrigin_ = scene.environment.origin;
     } else if (scene.environment.kind == Environment::Kind::Fisheye) {
-        throw Error("scene '" + scene.source.string() +
-                    "': a fish-eye environment must be converted to an equirectangular map "
-                    "first (the real-time renderer reads equirectangular, linear images)");
+        // The fish-eye mapping lives with the tracking module; until it provides an
+        // equirectangular conversion the real-time renderer lights without it (and says so).
+        spdlog::warn("scene '{}': fish-eye environment not used by the real-time renderer yet "
+                     "(convert it to an equirectangular map)",
+                     scene.source.string());
     }
     if (envSH_.empty()) envSH_.assign(9, glm::vec3(0.0f));
 }

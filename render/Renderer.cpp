@@ -309,6 +309,10 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     return report_;
 }
 
+const gl::Texture& Renderer::compositeTexture() const {
+    return composite_->srgb();
+}
+
 cv::Mat Renderer::compositeLinear() const {
     const gl::Texture& t = composite_->linear();
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);

@@ -65,6 +65,10 @@ public:
     // top row first. Throws mirage::Error if the frame did not produce it.
     cv::Mat readBuffer(Resource r) const;
 
+    // The composite as an sRGB8 texture (camera size, memory row 0 = image top row), e.g. to
+    // blit into a window (flip vertically: GL windows put row 0 at the bottom).
+    const gl::Texture& compositeTexture() const;
+
     const CameraProjection& projection() const { return projection_; }
     const FramePlan& plan() const { return ctx_->plan; }
     const GpuScene& gpuScene() const { return *scene_; }

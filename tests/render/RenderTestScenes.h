@@ -98,6 +98,7 @@ inline void addLight(Scene& s, Light::Type type, glm::vec3 pos, glm::vec3 dir, f
     n.local = n.world = m;
     n.origin = origin;
     s.nodes.push_back(n);
+    s.roots.push_back(int(s.nodes.size()) - 1);
 }
 
 // T_world_camera of an OpenCV camera at `eye` looking at `target` (+Y world up).
