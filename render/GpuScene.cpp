@@ -254,9 +254,10 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
     } else if (scene.environment.kind == Environment::Kind::Fisheye) {
         // The fish-eye mapping lives with the tracking module; until it provides an
         // equirectangular conversion the real-time renderer lights without it (and says so).
-        spdlog::warn("scene '{}': fish-eye environment not used by the real-time renderer yet "
-                     "(convert it to an equirectangular map)",
-                     scene.source.string());
+        spdlog::warn(
+            "scene '{}': fish-eye environment not used by the real-time renderer yet "
+            "(convert it to an equirectangular map)",
+            scene.source.string());
     }
     if (envSH_.empty()) envSH_.assign(9, glm::vec3(0.0f));
 }

@@ -101,6 +101,22 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     passes_.push_back(std::move(filter));
     passes_.push_back(std::move(composite));
     for (auto& p : passes_) timers_.emplace_back(std::string("timer ") + p->name());
+    // Prime every query once: on llvmpipe the very first GL_TIME_ELAPSED result of a process can
+    // be garbage (seen: 3.4e6 ms), which would spoil the first frame's report.
+    {
+        gl::Texture scratch = gl::Texture::create2D("timer priming", 8, 8, GL_RGBA8);
+        gl::Framebuffer fb("timer priming fbo");
+        fb.attachColor(0, scratch);
+        fb.finalize(1);
+        fb.bind();
+        for (gl::TimerQuery& t : timers_) {
+            t.begin();
+            glClear(GL_COLOR_BUFFER_BIT);
+            t.end();
+            (void)t.elapsedMs();
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
 
     cameraImage_ =
         gl::Texture::create2D("camera image", camera.width, camera.height, GL_SRGB8_ALPHA8);
