@@ -350,6 +350,12 @@ TEST_F(RealtimeRenderer, VirtualColourBleedsOntoRealFloor) {
     Renderer r(scene, cam);
     r.render({pose, {}, false});
     cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
+    // For inspection (linear EXR; PNG is sRGB-encoded).
+    const auto out = test::outputDir("realtime_bleed");
+    writeLinearRgb(out / "L_rv.exr", rv);
+    writeLinearRgb(out / "L_r.exr", lr);
+    writeLinearRgb(out / "L_rv.png", rv);
+    writeLinearRgb(out / "L_r.png", lr);
     cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
     cv::Mat cover = r.coverage();
     double sumR = 0, sumG = 0;
