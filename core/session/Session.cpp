@@ -26,6 +26,16 @@ int Session::cameraIndex(const std::string& name) const {
     return -1;
 }
 
+CameraCalibration loadSessionCalibration(const Session& s, const std::string& camera) {
+    const SessionCamera* c = s.camera(camera);
+    const std::string json = (s.dir / "session.json").string();
+    if (!c) throw FileError(json, "no camera named '" + camera + "'");
+    if (c->calibration.empty())
+        throw FileError(
+            json, "camera '" + camera + "' names no calibration file (set cameras[].calibration)");
+    return loadCalibration(s.path(c->calibration));
+}
+
 void writeSessionJson(const Session& s) {
     json j;
     j["format"] = s.format;

@@ -14,6 +14,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/Error.h"
+#include "core/camera/CalibrationFile.h"
 #include "core/session/AtomicFile.h"
 #include "core/session/MatroskaScanner.h"
 #include "core/session/MatroskaWriter.h"
@@ -148,6 +149,12 @@ TEST(Session, MkvRoundTrip) {
     auto env = openCameraFrames(s, "env");
     expectFramesMatch(readAll(*env), idx, kEnvW, kEnvH, 1, 28.0);
     EXPECT_THROW(openCameraFrames(s, "nope"), FileError);
+    // Calibration through the session: missing file, no file named, then a real one.
+    EXPECT_THROW(loadSessionCalibration(s, "main"), FileError);
+    EXPECT_THROW(loadSessionCalibration(s, "env"), FileError);
+    EXPECT_THROW(loadSessionCalibration(s, "nope"), FileError);
+    fs::copy_file(test::testDataDir() / "calib" / "opencv_sample_style.yaml", dir / "main.yaml");
+    EXPECT_EQ(loadSessionCalibration(s, "main").intrinsics.width, 640);
 
     // The plain-video path reads the same file, with FFmpeg's frame times (ms ticks).
     auto plain = openFrames(dir / "main.mkv");
