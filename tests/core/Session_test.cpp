@@ -194,6 +194,26 @@ TEST(Session, ImageSequenceRoundTripIsLossless) {
     expectFramesMatch(readAll(*main), {0, 1, 3, 4}, kMainW, kMainH, 0, 99.0);
 }
 
+TEST(Session, FsyncEachFrameWritesTheSameSession) {
+    for (const bool sequence : {false, true}) {
+        const fs::path dir =
+            test::outputDir(std::string("session_fsync_") + (sequence ? "png" : "mkv"));
+        SessionWriter::Options o;
+        o.fsyncEachFrame = true;
+        o.imageSequence = sequence;
+        Session meta;
+        meta.board = "";
+        SessionWriter w(dir, meta, o);
+        for (int i = 0; i < 3; ++i) w.append({syntheticFrame(i, kMainW, kMainH)}, {}, std::nullopt);
+        w.close();
+        SessionReadReport report;
+        const Session s = readSession(dir, &report);
+        EXPECT_TRUE(report.ok()) << allWarnings(report);
+        expectFramesMatch(readAll(*openCameraFrames(s, "main")), {0, 1, 2}, kMainW, kMainH, 0,
+                          sequence ? 99.0 : 28.0);
+    }
+}
+
 TEST(Session, WriterNeverOverwritesASession) {
     const fs::path dir = test::outputDir("session_no_overwrite");
     writeSession(dir, 1, false);
