@@ -480,6 +480,16 @@ TEST(SessionCorrupt, MissingFramesCsvFallsBackToTheVideo) {
     EXPECT_FALSE(s.frames[3].groundTruth.has_value());
 }
 
+TEST(SessionCorrupt, FramesCsvWithoutHeaderFallsBackToTheVideo) {
+    const fs::path dir = test::outputDir("session_empty_csv");
+    writeSession(dir, 3, false);
+    std::ofstream(dir / "frames.csv", std::ios::trunc);  // crash before the header was written
+    SessionReadReport report;
+    const Session s = readSession(dir, &report);
+    EXPECT_TRUE(contains(report, "no header line")) << allWarnings(report);
+    EXPECT_EQ(s.frames.size(), 3u);
+}
+
 TEST(SessionCorrupt, MissingVideoKeepsTheSessionReadable) {
     const fs::path dir = test::outputDir("session_no_env");
     writeSession(dir, 4, false);
