@@ -26,8 +26,20 @@ enum class Origin { Virtual, Real };
 struct Texture {
     std::string name;
     int width = 0, height = 0;
-    int components = 4;               // always RGBA8 after loading
+    int components = 4;                 // always RGBA8 after loading
     std::vector<unsigned char> pixels;  // row-major, top row first, RGBA8
+    // How the stored bytes are encoded: true when a material uses the texture as baseColor or
+    // emissive (sRGB-encoded colour), false for data textures (normal, metallic-roughness,
+    // transmission), which are linear. A texture used both ways is reported as sRGB with a
+    // warning (Scene::warnings).
+    bool srgb = false;
+    // glTF sampler state (defaults = glTF's when a texture has no sampler).
+    enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
+    Wrap wrapS = Wrap::Repeat, wrapT = Wrap::Repeat;
+    enum class Filter { Linear, Nearest };
+    Filter magFilter = Filter::Linear;
+    Filter minFilter = Filter::Linear;
+    bool mipmaps = true;  // false when the sampler's minFilter is NEAREST or LINEAR
 };
 
 struct TextureRef {
@@ -39,13 +51,14 @@ struct TextureRef {
 struct Material {
     std::string name;
     // PBR metallic-roughness.
-    glm::vec4 baseColor{1.0f};  // linear RGBA
+    glm::vec4 baseColor{1.0f};    // linear RGBA
     TextureRef baseColorTexture;  // sRGB-encoded
     float metallic = 1.0f, roughness = 1.0f;
     TextureRef metallicRoughnessTexture;  // linear; G = roughness, B = metallic
     TextureRef normalTexture;             // linear, tangent space
     float normalScale = 1.0f;
-    glm::vec3 emissive{0.0f};  // linear, multiplied by emissiveStrength
+    // Linear; KHR_materials_emissive_strength is already folded in (emissiveFactor * strength).
+    glm::vec3 emissive{0.0f};
     TextureRef emissiveTexture;  // sRGB-encoded
     bool doubleSided = false;
     enum class AlphaMode { Opaque, Mask, Blend } alphaMode = AlphaMode::Opaque;
@@ -58,7 +71,8 @@ struct Material {
     // KHR_materials_volume: thickness in the mesh's local units; Beer-Lambert attenuation:
     // after distance d inside, light keeps attenuationColor^(d / attenuationDistance).
     float thickness = 0.0f;
-    glm::vec3 attenuationColor{1.0f};
+    TextureRef thicknessTexture;       // G channel, multiplies thickness
+    glm::vec3 attenuationColor{1.0f};  // linear
     float attenuationDistance = std::numeric_limits<float>::infinity();  // metres
     // mirage extras (docs/scene.md), filled as features arrive:
     float roughnessVariation = 0.0f;  // extras.mirage.roughness_variation (rough refraction)
@@ -85,18 +99,24 @@ struct Light {
     enum class Type { Point, Spot, Directional };
     std::string name;
     Type type = Type::Point;
-    glm::vec3 color{1.0f};   // linear
-    float intensity = 1.0f;  // candela (point, spot) or lux (directional)
-    float range = 0.0f;      // metres; 0 = infinite
+    glm::vec3 color{1.0f};                       // linear
+    float intensity = 1.0f;                      // candela (point, spot) or lux (directional)
+    float range = 0.0f;                          // metres; 0 = infinite
     float innerConeAngle = 0.0f;                 // radians
     float outerConeAngle = 0.7853981633974483f;  // radians
 };
 
 struct CameraNodeInfo {
     std::string name;
-    float yfov = 0.8f;  // radians, vertical
+    enum class Projection { Perspective, Orthographic };
+    Projection projection = Projection::Perspective;
+    float yfov = 0.8f;         // radians, vertical (perspective)
     float aspectRatio = 0.0f;  // 0 = use the output's
+    // Metres. glTF's "no zfar" (infinite projection) is reported as 1000 m so that consumers
+    // can always build a finite projection; `infiniteFar` says it was absent.
     float znear = 0.01f, zfar = 1000.0f;
+    bool infiniteFar = false;
+    float xmag = 1.0f, ymag = 1.0f;  // orthographic half-extents, metres
 };
 
 struct Node {
@@ -144,16 +164,22 @@ struct Scene {
     std::vector<Light> lights;
     std::vector<CameraNodeInfo> cameras;
     std::vector<Node> nodes;
-    std::vector<int> roots;
+    std::vector<int> roots;  // root nodes of the glTF scene in use (the default scene)
     Environment environment;
+    // Non-fatal problems found while loading (skipped point/line primitives, unknown optional
+    // extensions, ...); each is also logged as a warning.
+    std::vector<std::string> warnings;
 
+    // Instances of the nodes reachable from `roots`, in depth-first order.
     std::vector<MeshInstance> meshInstances() const;
     std::vector<LightInstance> lightInstances() const;
     // Index of the node called `name` that holds a camera; throws mirage::Error listing the
-    // camera nodes there are when none matches.
+    // camera nodes there are when none matches. An empty name picks the first camera node
+    // (lowest index) reachable from the roots.
     int findCameraNode(const std::string& name) const;
     // The material of a primitive, the glTF default material for -1.
     const Material& material(int index) const;
+    // True when any mesh or light instance is virtual (something to composite).
     bool hasVirtual() const;
 };
 
