@@ -68,8 +68,13 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
         if (glm::dot(normal, 0.5 * (a + b) - centroid) < 0) normal = -normal;  // points outward
         // Search +-range across the edge: within the black border cell inside and the white
         // quiet-zone cell outside.
-        const double cell = len / cellsAtBorder;
-        const double range = std::clamp(0.45 * cell, 1.0, 4.0);
+        // Cell size across this edge: the tag's extent along the normal (to the opposite edge)
+        // over the cells at the border. Under foreshortening it is smaller than along the edge,
+        // and a profile longer than one cell would reach the data bits and bias the levels.
+        const glm::dvec2 oppositeMid =
+            0.5 * (t.corners[size_t((k + 2) % 4)] + t.corners[size_t((k + 3) % 4)]);
+        const double cell = std::abs(glm::dot(normal, 0.5 * (a + b) - oppositeMid)) / cellsAtBorder;
+        const double range = std::clamp(0.45 * cell, 0.75, 4.0);
         const double step = 0.25;
         const int nProfile = int(2 * range / step) + 1;
         const int nSamples = std::clamp(int(len / 2), 6, 40);
