@@ -189,6 +189,12 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image) {
     if (grey.empty()) return out;
     image_u8_t im{grey.cols, grey.rows, int(grey.step[0]), grey.data};
     zarray_t* dets = apriltag_detector_detect(detector_, &im);
+    if (zarray_size(dets) == 0 && options_.fullResolutionRetry && options_.decimate > 1.0f) {
+        apriltag_detections_destroy(dets);
+        detector_->quad_decimate = 1.0f;
+        dets = apriltag_detector_detect(detector_, &im);
+        detector_->quad_decimate = options_.decimate;
+    }
     out.reserve(size_t(zarray_size(dets)));
     for (int i = 0; i < zarray_size(dets); ++i) {
         apriltag_detection_t* d = nullptr;
