@@ -111,7 +111,9 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
             pts.push_back(base + normal * bestT);
             weights.push_back(contrast);
         }
-        if (pts.size() < 4) return;
+        // Most samples must have found the edge (a clean black-to-white step), else the border is
+        // occluded, damaged or next to dark surroundings: keep libapriltag's corners.
+        if (pts.size() < 4 || 5 * pts.size() < 3 * size_t(nSamples)) return;
         // Weighted total-least-squares line through the edge points.
         double wsum = 0;
         glm::dvec2 mean(0.0);
@@ -129,6 +131,15 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
         }
         const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
         lines[size_t(k)] = {mean, {std::cos(angle), std::sin(angle)}};
+        // The edge points must lie on a line (RMS distance under 0.3 px): a curved or broken
+        // edge (lens blur across a fold, a partial occluder) is not refined.
+        const glm::dvec2 n(-std::sin(angle), std::cos(angle));
+        double res = 0;
+        for (size_t i = 0; i < pts.size(); ++i) {
+            const double dist = glm::dot(pts[i] - mean, n);
+            res += weights[i] * dist * dist;
+        }
+        if (std::sqrt(res / wsum) > 0.3) return;
     }
     std::array<glm::dvec2, 4> refined;
     for (int k = 0; k < 4; ++k) {
