@@ -68,8 +68,13 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
         if (glm::dot(normal, 0.5 * (a + b) - centroid) < 0) normal = -normal;  // points outward
         // Search +-range across the edge: within the black border cell inside and the white
         // quiet-zone cell outside.
-        const double cell = len / cellsAtBorder;
-        const double range = std::clamp(0.45 * cell, 1.0, 4.0);
+        // Cell size across this edge: the tag's extent along the normal (to the opposite edge)
+        // over the cells at the border. Under foreshortening it is smaller than along the edge,
+        // and a profile longer than one cell would reach the data bits and bias the levels.
+        const glm::dvec2 oppositeMid =
+            0.5 * (t.corners[size_t((k + 2) % 4)] + t.corners[size_t((k + 3) % 4)]);
+        const double cell = std::abs(glm::dot(normal, 0.5 * (a + b) - oppositeMid)) / cellsAtBorder;
+        const double range = std::clamp(0.45 * cell, 0.75, 4.0);
         const double step = 0.25;
         const int nProfile = int(2 * range / step) + 1;
         const int nSamples = std::clamp(int(len / 2), 6, 40);
@@ -106,7 +111,9 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
             pts.push_back(base + normal * bestT);
             weights.push_back(contrast);
         }
-        if (pts.size() < 4) return;
+        // Most samples must have found the edge (a clean black-to-white step), else the border is
+        // occluded, damaged or next to dark surroundings: keep libapriltag's corners.
+        if (pts.size() < 4 || 5 * pts.size() < 3 * size_t(nSamples)) return;
         // Weighted total-least-squares line through the edge points.
         double wsum = 0;
         glm::dvec2 mean(0.0);
@@ -124,6 +131,15 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
         }
         const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
         lines[size_t(k)] = {mean, {std::cos(angle), std::sin(angle)}};
+        // The edge points must lie on a line (RMS distance under 0.3 px): a curved or broken
+        // edge (lens blur across a fold, a partial occluder) is not refined.
+        const glm::dvec2 n(-std::sin(angle), std::cos(angle));
+        double res = 0;
+        for (size_t i = 0; i < pts.size(); ++i) {
+            const double dist = glm::dot(pts[i] - mean, n);
+            res += weights[i] * dist * dist;
+        }
+        if (std::sqrt(res / wsum) > 0.3) return;
     }
     std::array<glm::dvec2, 4> refined;
     for (int k = 0; k < 4; ++k) {
@@ -184,6 +200,12 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image) {
     if (grey.empty()) return out;
     image_u8_t im{grey.cols, grey.rows, int(grey.step[0]), grey.data};
     zarray_t* dets = apriltag_detector_detect(detector_, &im);
+    if (zarray_size(dets) == 0 && options_.fullResolutionRetry && options_.decimate > 1.0f) {
+        apriltag_detections_destroy(dets);
+        detector_->quad_decimate = 1.0f;
+        dets = apriltag_detector_detect(detector_, &im);
+        detector_->quad_decimate = options_.decimate;
+    }
     out.reserve(size_t(zarray_size(dets)));
     for (int i = 0; i < zarray_size(dets); ++i) {
         apriltag_detection_t* d = nullptr;

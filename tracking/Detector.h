@@ -21,6 +21,9 @@ struct DetectorOptions {
     // 3x faster; the corners are then snapped back to full-resolution edges (refineEdges), so
     // accuracy drops little, but tags under ~25 px may be missed. libapriltag default: 2.
     float decimate = 2.0f;
+    // When decimating finds no tag at all, search once more at full resolution: small or distant
+    // tags are then still found, at the full-resolution cost only in frames that need it.
+    bool fullResolutionRetry = true;
     // Gaussian blur sigma (pixels) before quad search; 0 = none. ~0.8 helps on noisy images.
     float blurSigma = 0.0f;
     // Snap quad edges to strong full-resolution gradients (only used when decimate > 1).

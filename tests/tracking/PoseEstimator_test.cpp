@@ -106,6 +106,84 @@ TEST(PoseEstimator, FisheyeViewIncludingImageEdges) {
     EXPECT_LT(r.transErrRel, 0.005);
 }
 
+// Detections made by projecting a board's corners (plus Gaussian pixel noise): tests the pose
+// stage alone, for boards the sheet renderer cannot draw (non-planar) and for faked outliers.
+std::vector<TagDetection> projectedDetections(const Board& b, const CameraIntrinsics& cam,
+                                              const Pose& T_world_camera, double sigmaPx,
+                                              uint64_t seed) {
+    cv::RNG rng(seed);
+    std::vector<TagDetection> out;
+    const Pose T_cw = T_world_camera.inverse();
+    for (const auto& t : b.tags) {
+        TagDetection d;
+        d.id = t.id;
+        bool ok = true;
+        auto w = t.cornersInWorld();
+        for (int k = 0; k < 4; ++k) {
+            auto p = cam.project(T_cw * w[size_t(k)]);
+            if (!p || p->x < 0 || p->y < 0 || p->x > cam.width - 1 || p->y > cam.height - 1) {
+                ok = false;
+                break;
+            }
+            d.corners[size_t(k)] = *p + glm::dvec2(rng.gaussian(sigmaPx), rng.gaussian(sigmaPx));
+        }
+        if (ok) out.push_back(d);
+    }
+    return out;
+}
+
+TEST(PoseEstimator, NonPlanarBoardAndOutlierTag) {
+    // Two boards at a right angle: the table board and a copy standing up along the far edge
+    // (tags 24-47 on the plane z = -0.1, printed side facing +Z: page down = world -Y).
+    BoardLayout upright;
+    upright.firstId = 24;
+    upright.T_world_sheet =
+        Pose::fromRotationTranslation(glm::dmat3(1, 0, 0, 0, -1, 0, 0, 0, -1), {0.0, 0.1, -0.1});
+    Board b = BoardLayout().makeBoard();
+    for (const auto& t : upright.makeBoard().tags) b.tags.push_back(t);
+    ASSERT_FALSE(b.isPlanar());
+    const auto cam = testing::pinholeCamera();
+    const Pose T = lookAt({0.1, 0.35, 0.35}, {0, 0.05, -0.05}, glm::dvec3(0, 1, 0));
+    auto dets = projectedDetections(b, cam, T, 0.05, 1);
+    ASSERT_GT(dets.size(), 20u);
+    // One tag detected at a wrong place (a reflection, a second printout): must be rejected.
+    const int wrongId = dets[3].id;
+    for (auto& c : dets[3].corners) c += glm::dvec2(25.0, -12.0);
+    PoseEstimator pe(b, cam);
+    const PoseEstimate e = pe.estimate(dets);
+    ASSERT_EQ(e.state, TrackingState::Ok) << e.reason;
+    EXPECT_NE(std::find(e.tagsRejected.begin(), e.tagsRejected.end(), wrongId),
+              e.tagsRejected.end());
+    EXPECT_LT(glm::degrees(rotationAngleBetween(e.pose->rotation, T.rotation)), 0.05);
+    EXPECT_LT(glm::length(e.pose->translation - T.translation), 0.0005);
+}
+
+// The reported covariance matches the spread of poses over noise draws (Monte Carlo, as mrcal
+// checks its uncertainties): the predicted position std is within a factor 1.5 of the observed.
+TEST(PoseEstimator, CovarianceMatchesMonteCarloSpread) {
+    const Board& b = scene().board;
+    const auto cam = testing::pinholeCamera();
+    const Pose T = lookAt({0.08, 0.3, 0.22}, {0, 0, 0});
+    PoseEstimator pe(b, cam);
+    std::vector<glm::dvec3> positions;
+    double predictedVar = 0;
+    for (int i = 0; i < 60; ++i) {
+        const PoseEstimate e = pe.estimate(projectedDetections(b, cam, T, 0.2, 100 + i));
+        ASSERT_EQ(e.state, TrackingState::Ok);
+        positions.push_back(e.pose->translation);
+        predictedVar += (e.covariance[21] + e.covariance[28] + e.covariance[35]) / 60.0;
+    }
+    glm::dvec3 mean(0.0);
+    for (const auto& p : positions) mean += p / double(positions.size());
+    double observedVar = 0;
+    for (const auto& p : positions)
+        observedVar += glm::dot(p - mean, p - mean) / (positions.size() - 1);
+    const double ratio = std::sqrt(predictedVar / observedVar);
+    RecordProperty("covariance_std_ratio", std::to_string(ratio));
+    EXPECT_GT(ratio, 1 / 1.5);
+    EXPECT_LT(ratio, 1.5);
+}
+
 TEST(PoseEstimator, NoBoardTagsGivesNoTags) {
     PoseEstimator pe(scene().board, testing::pinholeCamera());
     EXPECT_EQ(pe.estimate({}).state, TrackingState::NoTags);

@@ -14,7 +14,7 @@
 namespace mirage::tracking {
 namespace {
 
-std::filesystem::path makeSession(const std::string& name, int frames) {
+std::filesystem::path makeSession(const std::string& name, int frames, bool mkv = false) {
     const auto dir = test::outputDir("track_" + name) / "session";
     const Board board = BoardLayout().makeBoard();
     const BoardRaster tex = renderBoard(board, 8000, false);
@@ -22,7 +22,7 @@ std::filesystem::path makeSession(const std::string& name, int frames) {
     Session meta;
     meta.cameras = {{"main", "", "main.yaml", "main"}};
     SessionWriter::Options opt;
-    opt.imageSequence = true;  // lossless PNG: the accuracy figures are the tracker's own
+    opt.imageSequence = !mkv;  // lossless PNG: the accuracy figures are the tracker's own
     {
         SessionWriter w(dir, meta, opt);
         for (int i = 0; i < frames; ++i) {
@@ -98,6 +98,26 @@ TEST(TrackCommand, SyntheticSessionMeetsAccuracyWithAFrameOfNoise) {
     for (size_t i = 1; i < rows.size(); ++i)
         if (rows[i][2] == "ok") rotMax = std::max(rotMax, std::stod(rows[i][25]));
     EXPECT_LT(rotMax, 0.3);
+}
+
+// A recording cut short (crash while writing): the frames lost are counted, the rest tracked.
+TEST(TrackCommand, TruncatedVideoCountsLostFramesAndContinues) {
+    const auto dir = makeSession("truncated", 8, true);
+    const auto video = dir / "main.mkv";
+    ASSERT_TRUE(std::filesystem::exists(video));
+    const auto size = std::filesystem::file_size(video);
+    std::filesystem::resize_file(video, size * 6 / 10);
+    const auto csv = dir.parent_path() / "poses.csv";
+    const auto r = test::runMirage({"track", dir.string(), "-o", csv.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const auto rows = readCsv(csv);
+    ASSERT_GE(rows.size(), 3u);  // header + some frames
+    ASSERT_LT(rows.size(), 9u);  // not all 8 frames survived
+    for (size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i][2], "ok") << rows[i][3];
+    const int lost = 8 - int(rows.size() - 1);
+    EXPECT_NE(r.output.find("frames: 8 (" + std::to_string(lost) + " unreadable"),
+              std::string::npos)
+        << r.output;
 }
 
 TEST(TrackCommand, BadInputNamesTheFile) {
