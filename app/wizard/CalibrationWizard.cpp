@@ -266,7 +266,7 @@ int runCalibrationWizard(const WizardOptions& o) {
             ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
 
         ImGui::SetNextWindowPos({0, 0});
-        ImGui::SetNextWindowSize({660, 530});
+        ImGui::SetNextWindowSize({660, 540});
         ImGui::Begin("Camera", nullptr, fixed);
         if (!camTex.empty()) {
             const float scale = std::min(640.f / float(current.cols), 480.f / float(current.rows));
@@ -277,8 +277,8 @@ int runCalibrationWizard(const WizardOptions& o) {
                     rep.tiltDeg);
         ImGui::End();
 
-        ImGui::SetNextWindowPos({0, 530});
-        ImGui::SetNextWindowSize({330, 270});
+        ImGui::SetNextWindowPos({0, 540});
+        ImGui::SetNextWindowSize({330, 260});
         ImGui::Begin("Undistorted preview", nullptr, fixed);
         ImGui::Checkbox("show", &showUndistorted);
         if (session.result() && showUndistorted && !undistTex.empty())
@@ -288,8 +288,8 @@ int runCalibrationWizard(const WizardOptions& o) {
                                so.calibration.minViews);
         ImGui::End();
 
-        ImGui::SetNextWindowPos({330, 530});
-        ImGui::SetNextWindowSize({330, 270});
+        ImGui::SetNextWindowPos({330, 540});
+        ImGui::SetNextWindowSize({330, 260});
         ImGui::Begin("Coverage and tilts", nullptr, fixed);
         drawCoverage(session, {300, 130});
         ImGui::Text("cells covered: %.0f%%", 100 * session.coverage().coveredFraction());
