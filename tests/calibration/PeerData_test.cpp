@@ -114,8 +114,8 @@ TEST(PeerData, OpenCvFisheyeMatchesReference) {
     EXPECT_NEAR(k.coeff(2), 0.00605760088590183, 2e-4);
     EXPECT_NEAR(k.coeff(3), -0.00374209380722371, 2e-4);
     EXPECT_NEAR(r.calibration.avgReprojectionError, 0.263782587133546, 1e-3);
-    std::printf("fisheye: fx %.6f fy %.6f cx %.6f cy %.6f D %.7f %.7f %.7f %.7f RMS %.9f\n",
-                k.fx, k.fy, k.cx, k.cy, k.coeff(0), k.coeff(1), k.coeff(2), k.coeff(3),
+    std::printf("fisheye: fx %.6f fy %.6f cx %.6f cy %.6f D %.7f %.7f %.7f %.7f RMS %.9f\n", k.fx,
+                k.fy, k.cx, k.cy, k.coeff(0), k.coeff(1), k.coeff(2), k.coeff(3),
                 r.calibration.avgReprojectionError);
     std::printf("fisheye 1-sigma: fx %.4f fy %.4f cx %.4f cy %.4f\n",
                 r.calibration.stdDeviations[0], r.calibration.stdDeviations[1],
