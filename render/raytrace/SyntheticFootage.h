@@ -20,8 +20,8 @@ namespace mirage::raytrace {
 struct CameraPathOptions {
     double duration = 3.0;                             // seconds, whole path
     glm::dvec3 target{0.0, 0.0, 0.0};                  // the orbit looks at this world point
-    double radius = 0.55;                              // orbit radius (metres, horizontal)
-    double height = 0.40;                              // camera height above the target (metres)
+    double radius = 0.42;                              // orbit radius (metres, horizontal)
+    double height = 0.32;                              // camera height above the target (metres)
     double orbitStartDeg = -30.0, orbitEndDeg = 30.0;  // orbit azimuth about world +Y; 0 = +Z side
     double orbitFraction = 0.5, shakeFraction = 0.3;   // of the duration; the pan takes the rest
     double shakeTranslation = 0.004;                   // metres (amplitude of each axis)
