@@ -313,6 +313,19 @@ void boardTilt(const cv::Vec3d& rvec, double& tiltDeg, double& directionDeg) {
     directionDeg = std::atan2(sgn * n[1], sgn * n[0]) * kRadToDeg;
 }
 
+CameraCalibration calibrationForFile(const CalibrationResult& result) {
+    CameraCalibration c = result.calibration;
+    const bool allFiniteStd = std::all_of(c.stdDeviations.begin(), c.stdDeviations.end(),
+                                          [](double v) { return std::isfinite(v); });
+    if (!allFiniteStd) {
+        c.stdDeviations.clear();
+        c.reliable = false;
+        c.unreliableReason += std::string(c.unreliableReason.empty() ? "" : "; ") +
+                              "standard deviations omitted: some parameters are unobservable";
+    }
+    return c;
+}
+
 int CalibrationResult::usedViewCount() const {
     return int(
         std::count_if(views.begin(), views.end(), [](const auto& v) { return !v.rejected; }));

@@ -92,6 +92,11 @@ struct CalibrationResult {
 CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size imageSize,
                             const CalibrationOptions& options);
 
+// What goes into the calibration file: the result's calibration, with standard deviations left
+// out (and the reason saying so) when some are not finite (an unobservable parameter): the file
+// format holds finite numbers only, and such a result is always marked unreliable.
+CameraCalibration calibrationForFile(const CalibrationResult& result);
+
 // Parameter names in the order of the standard deviations ("fx", "fy", "cx", "cy", "k1", ...).
 std::vector<std::string> parameterNames(DistortionModel model);
 

@@ -103,48 +103,63 @@ CalibrationView projectView(const CameraIntrinsics& camera, const ChessboardGeom
     return view;
 }
 
-cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,
-                         const BoardPose& pose, int supersample) {
+ChessboardRenderer::ChessboardRenderer(const CameraIntrinsics& camera, int supersample)
+    : camera_(camera), n_(std::max(1, supersample)) {
+    rays_.resize(size_t(camera.width) * size_t(camera.height) * size_t(n_ * n_));
+    size_t k = 0;
+    for (int y = 0; y < camera.height; ++y)
+        for (int x = 0; x < camera.width; ++x)
+            for (int sy = 0; sy < n_; ++sy)
+                for (int sx = 0; sx < n_; ++sx) {
+                    // Pixel (x, y) covers [x - 0.5, x + 0.5] (OpenCV: centres at integers).
+                    const glm::dvec2 px{x - 0.5 + (sx + 0.5) / n_, y - 0.5 + (sy + 0.5) / n_};
+                    const auto ray = camera.unproject(px);
+                    rays_[k++] = ray ? cv::Vec3f(float(ray->x), float(ray->y), float(ray->z))
+                                     : cv::Vec3f(0, 0, 0);
+                }
+}
+
+cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardPose& pose) const {
     cv::Matx33d R;
     cv::Rodrigues(pose.rvec, R);
     const cv::Matx33d Rt = R.t();
     const cv::Vec3d origin = -(Rt * pose.tvec);  // camera centre in board coordinates
     const double sq = board.squareMetres;
-    cv::Mat img(camera.height, camera.width, CV_8UC1);
-    const int n = std::max(1, supersample);
-    for (int y = 0; y < camera.height; ++y) {
+    cv::Mat img(camera_.height, camera_.width, CV_8UC1);
+    size_t k = 0;
+    for (int y = 0; y < camera_.height; ++y) {
         auto* row = img.ptr<uint8_t>(y);
-        for (int x = 0; x < camera.width; ++x) {
+        for (int x = 0; x < camera_.width; ++x) {
             double sum = 0;
-            for (int sy = 0; sy < n; ++sy)
-                for (int sx = 0; sx < n; ++sx) {
-                    const glm::dvec2 px{x - 0.5 + (sx + 0.5) / n, y - 0.5 + (sy + 0.5) / n};
-                    double value = 110;
-                    if (const auto ray = camera.unproject(px)) {
-                        const cv::Vec3d d = Rt * cv::Vec3d(ray->x, ray->y, ray->z);
-                        if (std::abs(d[2]) > 1e-12) {
-                            const double s = -origin[2] / d[2];
-                            if (s > 0) {
-                                const double bx = origin[0] + s * d[0], by = origin[1] + s * d[1];
-                                // Squares span [-sq, cols*sq] x [-sq, rows*sq]; margin 1 square.
-                                const double gx = bx / sq + 1, gy = by / sq + 1;
-                                if (gx >= -1 && gy >= -1 && gx < board.cols + 2 &&
-                                    gy < board.rows + 2) {
-                                    value = 230;
-                                    if (gx >= 0 && gy >= 0 && gx < board.cols + 1 &&
-                                        gy < board.rows + 1 &&
-                                        ((int(std::floor(gx)) + int(std::floor(gy))) & 1) == 0)
-                                        value = 25;
-                                }
-                            }
+            for (int s = 0; s < n_ * n_; ++s) {
+                const cv::Vec3f& r = rays_[k++];
+                double value = 110;
+                const cv::Vec3d d = Rt * cv::Vec3d(r[0], r[1], r[2]);
+                if (std::abs(d[2]) > 1e-12) {
+                    const double t = -origin[2] / d[2];
+                    if (t > 0) {
+                        // Squares span [-sq, cols*sq] x [-sq, rows*sq]; margin of 1 square.
+                        const double gx = (origin[0] + t * d[0]) / sq + 1;
+                        const double gy = (origin[1] + t * d[1]) / sq + 1;
+                        if (gx >= -1 && gy >= -1 && gx < board.cols + 2 && gy < board.rows + 2) {
+                            value = 230;
+                            if (gx >= 0 && gy >= 0 && gx < board.cols + 1 && gy < board.rows + 1 &&
+                                ((int(std::floor(gx)) + int(std::floor(gy))) & 1) == 0)
+                                value = 25;
                         }
                     }
-                    sum += value;
                 }
-            row[x] = cv::saturate_cast<uint8_t>(sum / (n * n));
+                sum += value;
+            }
+            row[x] = cv::saturate_cast<uint8_t>(sum / (n_ * n_));
         }
     }
     return img;
+}
+
+cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,
+                         const BoardPose& pose, int supersample) {
+    return ChessboardRenderer(camera, supersample).render(board, pose);
 }
 
 }  // namespace mirage::calib

@@ -51,10 +51,24 @@ CalibrationView projectView(const CameraIntrinsics& camera, const ChessboardGeom
                             const BoardPose& pose, double noisePx, std::mt19937& rng,
                             const std::string& name);
 
-// Renders the board at `pose` as an 8-bit grey image (sRGB-encoded values: black squares 25,
-// white 230, background 110), with a white margin of one square around the pattern as printed
-// boards have. Pixels whose ray misses the board show the background.
+// Renders boards as 8-bit grey images (sRGB-encoded values: black squares 25, white 230,
+// background 110), with a white margin of one square around the pattern as printed boards have.
+// Pixels whose ray misses the board show the background. The camera rays of all sub-pixel
+// samples (supersample x supersample per pixel) are computed once per renderer, so rendering a
+// pose costs only the ray-plane intersections.
+class ChessboardRenderer {
+public:
+    ChessboardRenderer(const CameraIntrinsics& camera, int supersample = 3);
+    cv::Mat render(const ChessboardGeometry& board, const BoardPose& pose) const;
+
+private:
+    CameraIntrinsics camera_;
+    int n_;
+    std::vector<cv::Vec3f> rays_;  // unit rays, camera frame; zero where unprojection failed
+};
+
+// One-off convenience (builds a renderer).
 cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,
-                         const BoardPose& pose, int supersample = 4);
+                         const BoardPose& pose, int supersample = 3);
 
 }  // namespace mirage::calib

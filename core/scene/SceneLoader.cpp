@@ -1306,6 +1306,8 @@ private:
                 if (static_cast<size_t>(child) == i)
                     fail(name + " lists itself as a child; the node graph must be a tree");
                 Node& c = scene_.nodes[static_cast<size_t>(child)];
+                if (c.parent == static_cast<int>(i))
+                    fail(name + " lists node " + std::to_string(child) + " twice in 'children'");
                 if (c.parent >= 0)
                     fail("node " + std::to_string(child) + " is a child of both node " +
                          std::to_string(c.parent) + " and node " + std::to_string(i) +

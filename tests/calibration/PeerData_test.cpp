@@ -15,7 +15,9 @@
 namespace mirage::calib {
 namespace {
 
-std::filesystem::path peerDir() { return test::dataDir() / "peer" / "calib"; }
+std::filesystem::path peerDir() {
+    return test::dataDir() / "peer" / "calib";
+}
 
 std::vector<CalibrationView> loadCalib1(cv::Size& size) {
     std::ifstream in(peerDir() / "calib1.dat");

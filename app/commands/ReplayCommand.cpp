@@ -1,0 +1,314 @@
+// `mirage replay SESSION --scene SCENE -o OUT`: composites a scene's virtual objects into a
+// recorded (or synthetic) session with the real-time renderer (render/Renderer.h).
+//
+// Output: OUT.mkv (MJPEG in Matroska, one cluster per frame: Ctrl-C or a crash leaves every
+// finished frame playable) or, for any other OUT, a folder of PNG frames (frame_000000.png,
+// sRGB 8-bit). Beside it a per-frame CSV (OUT with .csv, or OUT/frames.csv for a folder):
+//   frame,t,state,reason,decode_ms,tracking_ms,<pass>_ms...,gpu_ms,readback_ms,encode_ms,
+//   frame_ms,tx,ty,tz,qw,qx,qy,qz
+// where <pass>_ms are the GL timer-query times of the renderer's passes (0 when skipped) and the
+// pose is T_world_camera (OpenCV axes). Headless by default; --window shows the result as it goes.
+//
+// Camera poses: --poses POSES.csv (the `mirage track` format) when given; otherwise the session's
+// ground-truth poses from frames.csv (synthetic sessions have them). A frame without a pose is
+// "lost": the camera frame passes through unchanged and temporal history is reset.
+#include <unistd.h>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "app/Command.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/camera/CalibrationFile.h"
+#include "core/gl/Context.h"
+#include "core/image/ImageIO.h"
+#include "core/scene/Scene.h"
+#include "core/session/MatroskaWriter.h"
+#include "core/session/Session.h"
+#include "render/Renderer.h"
+
+namespace mirage::app {
+namespace {
+
+std::atomic<bool> gInterrupted{false};
+extern "C" void onSigint(int) {
+    gInterrupted = true;
+}
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct PoseRow {
+    std::string state, reason;
+    std::optional<Pose> pose;
+};
+
+// Reads a `mirage track` CSV: frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz (header required).
+std::map<int, PoseRow> readPosesCsv(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    if (!in) throw FileError(path.string(), "cannot open the poses file");
+    std::string line;
+    if (!std::getline(in, line)) throw FileError(path.string(), "empty poses file (no header)");
+    std::vector<std::string> header;
+    {
+        std::stringstream ss(line);
+        std::string c;
+        while (std::getline(ss, c, ',')) header.push_back(c);
+    }
+    auto col = [&](const std::string& name) {
+        for (size_t i = 0; i < header.size(); ++i)
+            if (header[i] == name) return int(i);
+        throw FileError(path.string(),
+                        "header has no column '" + name +
+                            "' (expected frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz)");
+    };
+    const int cFrame = col("frame"), cState = col("state"), cReason = col("reason");
+    const int cP[7] = {col("tx"), col("ty"), col("tz"), col("qw"), col("qx"), col("qy"), col("qz")};
+    std::map<int, PoseRow> rows;
+    int lineNo = 1;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (line.empty()) continue;
+        std::vector<std::string> f;
+        std::stringstream ss(line);
+        std::string c;
+        while (std::getline(ss, c, ',')) f.push_back(c);
+        f.resize(header.size());
+        PoseRow r;
+        r.state = f[size_t(cState)];
+        r.reason = f[size_t(cReason)];
+        try {
+            const int frame = std::stoi(f[size_t(cFrame)]);
+            if (!f[size_t(cP[0])].empty()) {
+                double v[7];
+                for (int i = 0; i < 7; ++i) v[i] = std::stod(f[size_t(cP[i])]);
+                Pose p;
+                p.translation = {v[0], v[1], v[2]};
+                p.rotation = glm::normalize(glm::dquat(v[3], v[4], v[5], v[6]));
+                if (p.isFinite()) r.pose = p;
+            }
+            rows[frame] = r;
+        } catch (const std::exception&) {
+            throw FileError(path.string(), "line " + std::to_string(lineNo) +
+                                               ": cannot parse frame number or pose numbers");
+        }
+    }
+    return rows;
+}
+
+void progress(int done, int total, double fps) {
+    if (!isatty(STDERR_FILENO)) {
+        if (total > 0 && (done % std::max(1, total / 10) == 0 || done == total))
+            spdlog::info("replay: {}/{} frames, {:.1f} frames/s", done, total, fps);
+        return;
+    }
+    const int width = 30;
+    const int filled = total > 0 ? width * done / total : 0;
+    std::fprintf(stderr, "\r[%s%s] %d/%d frames  %.1f frames/s ",
+                 std::string(size_t(filled), '#').c_str(),
+                 std::string(size_t(width - filled), '-').c_str(), done, total, fps);
+    std::fflush(stderr);
+}
+
+struct ReplayArgs {
+    std::string session, scene, output, poses;
+    int vpls = 256;
+    int maxFrames = -1;
+    int start = 0;
+    float exposure = 1.0f;
+    int jpegQuality = 92;
+    bool window = false;
+    bool verbose = false;
+};
+
+void runReplay(const ReplayArgs& a) {
+    SessionReadReport readReport;
+    Session session = readSession(a.session, &readReport);
+    for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
+    const SessionCamera* main = nullptr;
+    for (const auto& c : session.cameras)
+        if (c.role == "main") main = &c;
+    if (!main && !session.cameras.empty()) main = &session.cameras.front();
+    if (!main) throw FileError(a.session, "the session lists no camera");
+    if (main->calibration.empty())
+        throw FileError(a.session, "camera '" + main->name +
+                                       "' has no calibration file; calibrate it (mirage calibrate) "
+                                       "and name the YAML in session.json");
+    const CameraCalibration calib = loadCalibration(session.path(main->calibration));
+    Scene scene = loadScene(a.scene);
+    if (!scene.hasVirtual())
+        spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
+
+    std::map<int, PoseRow> poses;
+    const bool useTracked = !a.poses.empty();
+    if (useTracked)
+        poses = readPosesCsv(a.poses);
+    else
+        spdlog::info(
+            "replay: camera poses from the session's ground truth (frames.csv); pass "
+            "--poses POSES.csv (mirage track) for tracked poses");
+
+    gl::ContextOptions copt;
+    copt.width = calib.intrinsics.width;
+    copt.height = calib.intrinsics.height;
+    copt.title = "mirage replay";
+    gl::Context ctx = a.window ? gl::Context::window(copt) : gl::Context::headless(copt);
+    render::RendererOptions ropt;
+    ropt.vplCount = a.vpls;
+    ropt.exposure = a.exposure;
+    render::Renderer renderer(scene, calib.intrinsics, ropt);
+
+    // Output.
+    const std::filesystem::path out = a.output;
+    const bool mkv = out.extension() == ".mkv";
+    std::filesystem::path csvPath =
+        mkv ? std::filesystem::path(out).replace_extension(".csv") : out / "frames.csv";
+    std::unique_ptr<MatroskaWriter> video;
+    if (mkv) {
+        if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+        video = std::make_unique<MatroskaWriter>(out, session.fps, a.jpegQuality);
+    } else {
+        std::filesystem::create_directories(out);
+    }
+    std::ofstream csv(csvPath);
+    if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
+    const char* passes[] = {"gbuffer", "shadow",   "vpl",      "ism",
+                            "direct",  "indirect", "gifilter", "composite"};
+    csv << "frame,t,state,reason,decode_ms,tracking_ms";
+    for (const char* p : passes) csv << "," << p << "_ms";
+    csv << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz\n";
+
+    auto frames = openCameraFrames(session, main->name);
+    const int listed = int(session.frames.size());
+    const int total = a.maxFrames >= 0 ? std::min(a.maxFrames, listed - a.start) : listed - a.start;
+    std::signal(SIGINT, onSigint);
+    cv::Mat bgr;
+    for (int i = 0; i < a.start && frames->read(bgr); ++i) {
+    }
+    const auto tStart = Clock::now();
+    bool lastLost = true;
+    int done = 0;
+    for (int k = 0; k < total && !gInterrupted; ++k) {
+        const FrameRecord& rec = session.frames[size_t(a.start + k)];
+        const auto t0 = Clock::now();
+        if (!frames->read(bgr)) {
+            spdlog::warn("replay: the video ends after {} frames", a.start + k);
+            break;
+        }
+        const double decodeMs = msSince(t0);
+        const auto t1 = Clock::now();
+        PoseRow pr;
+        if (useTracked) {
+            auto it = poses.find(rec.index);
+            if (it != poses.end())
+                pr = it->second;
+            else
+                pr = {"lost", "no row in the poses file", std::nullopt};
+            if (pr.state != "ok" && pr.state != "tracking") pr.pose.reset();
+        } else if (rec.groundTruth) {
+            pr = {"ground_truth", "", rec.groundTruth};
+        } else {
+            pr = {"lost", "no ground-truth pose in frames.csv", std::nullopt};
+        }
+        const double trackingMs = msSince(t1);
+        std::map<std::string, double> passMs;
+        double gpuMs = 0, readbackMs = 0;
+        cv::Mat result;
+        if (pr.pose) {
+            const render::FrameReport& rep =
+                renderer.render({*pr.pose, bgr, /*resetHistory=*/lastLost});
+            for (const auto& p : rep.passes) passMs[p.name] = p.gpuMs;
+            gpuMs = rep.totalGpuMs;
+            if (a.verbose && k == 0) spdlog::info("frame {}:\n{}", rec.index, rep.summary());
+            const auto t2 = Clock::now();
+            result = renderer.compositeSrgb();
+            readbackMs = msSince(t2);
+            if (a.window) {
+                GLuint fbo = 0;
+                glCreateFramebuffers(1, &fbo);
+                glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0,
+                                          renderer.compositeTexture().id(), 0);
+                const int w = calib.intrinsics.width, h = calib.intrinsics.height;
+                glBlitNamedFramebuffer(fbo, 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
+                                       GL_NEAREST);
+                glDeleteFramebuffers(1, &fbo);
+            }
+        } else {
+            result = bgr;  // tracking lost: the footage passes through, history resets
+        }
+        lastLost = !pr.pose;
+        const auto t3 = Clock::now();
+        const double t = rec.timestamps.empty() ? k / session.fps : rec.timestamps.front();
+        if (video)
+            video->append(result, t);
+        else
+            writeBgr8(out / cv::format("frame_%06d.png", rec.index), result);
+        const double encodeMs = msSince(t3);
+        if (a.window) {
+            ctx.swapBuffers();
+            ctx.pollEvents();
+            if (ctx.shouldClose()) gInterrupted = true;
+        }
+        csv << rec.index << "," << t << "," << pr.state << "," << pr.reason << "," << decodeMs
+            << "," << trackingMs;
+        for (const char* p : passes) csv << "," << passMs[p];
+        csv << "," << gpuMs << "," << readbackMs << "," << encodeMs << "," << msSince(t0);
+        if (pr.pose) {
+            const Pose& p = *pr.pose;
+            csv << "," << p.translation.x << "," << p.translation.y << "," << p.translation.z << ","
+                << p.rotation.w << "," << p.rotation.x << "," << p.rotation.y << ","
+                << p.rotation.z;
+        } else {
+            csv << ",,,,,,,";
+        }
+        csv << "\n";
+        csv.flush();
+        ++done;
+        progress(done, total, done / std::max(1e-9, msSince(tStart) * 1e-3));
+    }
+    if (isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
+    if (video) video->close();
+    std::signal(SIGINT, SIG_DFL);
+    if (gInterrupted)
+        spdlog::warn("replay: interrupted after {} frames; {} is playable", done, a.output);
+    spdlog::info("replay: {} frames -> {} (timings: {})", done, a.output, csvPath.string());
+}
+
+const CommandRegistrar reg("replay", [](CLI::App& parent) {
+    auto args = std::make_shared<ReplayArgs>();
+    auto* cmd = parent.add_subcommand(
+        "replay",
+        "Composite a scene's virtual objects into a recorded session (real-time renderer)");
+    cmd->add_option("session", args->session, "Session folder")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    cmd->add_option("--scene", args->scene,
+                    "Scene (.gltf/.glb) with real proxies and virtual objects")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", args->output, "OUT.mkv (MJPEG video) or a folder for PNG frames")
+        ->required();
+    cmd->add_option("--poses", args->poses,
+                    "Camera poses CSV from `mirage track` (default: the session's ground truth)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
+        ->check(CLI::Range(0, 16384));
+    cmd->add_option("--frames", args->maxFrames, "Replay at most N frames");
+    cmd->add_option("--start", args->start, "First frame")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units");
+    cmd->add_flag("--window", args->window, "Show the result in a window (needs a display)");
+    cmd->add_flag("-v,--verbose", args->verbose, "Log which passes ran and why");
+    cmd->callback([args] { runReplay(*args); });
+});
+
+}  // namespace
+}  // namespace mirage::app

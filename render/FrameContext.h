@@ -1,0 +1,110 @@
+#pragma once
+// Everything one frame's passes share: the scene on the GPU, the camera (intrinsics + pose),
+// the per-frame plan (which lights cast shadows, which need a real-only shadow map, whether
+// VPLs are needed), the uniform buffers, and the frame's resources as published by the passes
+// that wrote them (a pass may only read what an earlier pass published or what was imported).
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/gl/Objects.h"
+#include "core/math/Pose.h"
+#include "render/CameraProjection.h"
+#include "render/GpuScene.h"
+#include "render/GpuTypes.h"
+
+namespace mirage::render {
+
+// Frame resources. Buffers named L_* are linear HDR radiance (RGBA16F, rgb used).
+enum class Resource {
+    CameraImage,     // imported: the camera frame, sRGB8 texture sampled as linear (image size)
+    GBuffer,         // position/origin, normal/roughness, albedo/metallic, depth (canvas size)
+    ShadowMaps,      // per light layer: distance to the nearest occluder (all geometry)
+    ShadowMapsReal,  // the same with real occluders only (only for lights that need it)
+    ReflectiveShadowMaps,     // per light layer: flux/origin, normal, position (for VPLs)
+    Vpls,                     // SSBO of GpuVpl
+    ImperfectShadowMaps,      // r32ui atlas, one paraboloid tile per VPL (all occluders)
+    ImperfectShadowMapsReal,  // the same with real points only
+    DirectRv,
+    DirectR,  // direct + environment + emission, routed (canvas size)
+    IndirectRv,
+    IndirectR,  // interleaved VPL gather, unfiltered (canvas size)
+    LRv,
+    LR,         // the two GI solutions, filtered and temporally smoothed
+    Composite,  // final image (camera image size): linear RGBA32F + sRGB8
+};
+const char* resourceName(Resource r);
+
+struct RendererOptions {
+    int vplCount = 256;                  // total VPLs per frame, split over the lights with RSMs
+    int shadowMapSize = 512;             // texels per side of each shadow / RSM layer
+    int ismTileSize = 64;                // texels per side of one VPL's imperfect shadow map
+    int ismPointsPerVpl = 1024;          // surface points splatted into each VPL's ISM
+    int interleave = 4;                  // K: each pixel gathers vplCount / K^2 VPLs
+    float vplDistanceClamp = 0.1f;       // metres: VPL distance below this is clamped (no spikes)
+    float shadowBias = 0.01f;            // metres, at 1 m distance (scaled with distance)
+    float temporalBlend = 0.8f;          // history weight for the VPL lighting (0 = off)
+    float exposure = 1.0f;               // rendered linear radiance -> camera linear units
+    float alphaMax = 8.0f;               // cap of alpha = CI / L_r
+    float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
+    float nearM = 0.01f, farM = 100.0f;  // camera clip planes (metres)
+    bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
+};
+
+struct LightPlan {
+    bool castsShadow = false;        // some caster inside the light's cone
+    bool needsRealOnlyMap = false;   // a virtual caster in the cone of a REAL light
+    bool reachesVirtual = false;     // a virtual object inside the light's cone
+    bool hasRsm = false;             // VPLs are placed from this light
+    int firstLayer = 0, layers = 0;  // in the shadow / RSM atlases
+    int firstVpl = 0, vplCount = 0;
+    std::string reason;
+};
+
+struct FramePlan {
+    std::vector<LightPlan> lights;
+    int shadowLayers = 0;
+    bool needVpls = false;
+    bool needRealOnlyShadows = false;
+    bool needRealOnlyIsm = false;
+    std::string vplReason;
+};
+
+class FrameContext {
+public:
+    FrameContext(const GpuScene& scene, const CameraProjection& projection,
+                 const RendererOptions& options);
+
+    const GpuScene& scene;
+    const CameraProjection& projection;
+    const RendererOptions& options;
+
+    Pose T_world_camera;  // OpenCV camera axes
+    FramePlan plan;
+    GpuFrame frame{};  // uploaded to the FrameBlock UBO before the passes run
+    GpuLightBlock lightBlock{};
+    int frameIndex = 0;
+    bool historyValid = false;
+
+    gl::Buffer frameUbo, lightUbo;
+    gl::VertexArray emptyVao;  // for full-screen triangles
+
+    void publish(Resource r, const gl::Texture* tex);  // tex may be null for buffer resources
+    bool has(Resource r) const { return published_.count(r) != 0; }
+    const gl::Texture& texture(Resource r) const;  // throws (a bug) if not published
+    void clearResources() { published_.clear(); }
+
+    const gl::Texture& blackTexture() const { return black_; }          // 1x1 RGBA16F zero
+    const gl::Texture& farShadowTexture() const { return farShadow_; }  // 1x1 array, 1e30
+
+    int canvasWidth() const { return projection.canvasWidth; }
+    int canvasHeight() const { return projection.canvasHeight; }
+    void bindFrameBlocks() const;
+
+private:
+    std::map<Resource, const gl::Texture*> published_;
+    gl::Texture black_, farShadow_;
+};
+
+}  // namespace mirage::render

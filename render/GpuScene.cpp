@@ -1,0 +1,283 @@
+#include "render/GpuScene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <glm/gtc/matrix_inverse.hpp>
+#include <opencv2/core.hpp>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/image/ImageIO.h"
+
+namespace mirage::render {
+namespace {
+
+struct Vertex {
+    glm::vec3 position;  // mesh-local
+    glm::vec3 normal;    // mesh-local
+};
+
+GpuMaterial toGpu(const Material& m) {
+    GpuMaterial g;
+    g.baseColor = m.baseColor;
+    g.emissive = glm::vec4(m.emissive, m.roughness);
+    g.params = glm::vec4(m.metallic, 0, 0, 0);
+    return g;
+}
+
+bool finite(const glm::mat4& m) {
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            if (!std::isfinite(m[c][r])) return false;
+    return true;
+}
+
+// SH9 basis (real, orthonormal), order L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22.
+void shBasis(const glm::vec3& d, float out[9]) {
+    out[0] = 0.282095f;
+    out[1] = 0.488603f * d.y;
+    out[2] = 0.488603f * d.z;
+    out[3] = 0.488603f * d.x;
+    out[4] = 1.092548f * d.x * d.y;
+    out[5] = 1.092548f * d.y * d.z;
+    out[6] = 0.315392f * (3.0f * d.z * d.z - 1.0f);
+    out[7] = 1.092548f * d.x * d.z;
+    out[8] = 0.546274f * (d.x * d.x - d.y * d.y);
+}
+
+}  // namespace
+
+std::vector<glm::vec3> GpuScene::projectEquirectToSH(const cv::Mat& img, float intensity,
+                                                     double rotationYDeg) {
+    MR_CHECK(img.type() == CV_32FC3, "environment image must be linear RGB float");
+    std::vector<glm::vec3> sh(9, glm::vec3(0.0f));
+    const double rot = rotationYDeg * 3.14159265358979 / 180.0;
+    // Sub-sample large maps: SH9 is very low frequency, 256 columns are plenty.
+    const int step = std::max(1, img.cols / 256);
+    double weightSum = 0.0;
+    for (int y = 0; y < img.rows; y += step) {
+        const double lat = (0.5 - (y + 0.5) / img.rows) * 3.14159265358979;  // +pi/2 = +Y
+        const double dOmega = std::cos(lat) * (3.14159265358979 / img.rows) *
+                              (2.0 * 3.14159265358979 / img.cols) * step * step;
+        const auto* row = img.ptr<cv::Vec3f>(y);
+        for (int x = 0; x < img.cols; x += step) {
+            const double phi = ((x + 0.5) / img.cols - 0.5) * 2.0 * 3.14159265358979 + rot;
+            glm::vec3 d(float(std::cos(lat) * std::sin(phi)), float(std::sin(lat)),
+                        float(-std::cos(lat) * std::cos(phi)));
+            glm::vec3 c(row[x][0], row[x][1], row[x][2]);
+            if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) continue;
+            float b[9];
+            shBasis(d, b);
+            for (int i = 0; i < 9; ++i) sh[size_t(i)] += c * (b[i] * float(dOmega));
+            weightSum += dOmega;
+        }
+    }
+    // Normalise the quadrature to exactly 4 pi so a constant map gives exact irradiance.
+    const float norm = weightSum > 0 ? float(4.0 * 3.14159265358979 / weightSum) : 0.0f;
+    for (auto& c : sh) c *= norm * intensity;
+    return sh;
+}
+
+GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
+    // Materials: slot 0 is the glTF default material, slot i+1 is scene.materials[i].
+    std::vector<GpuMaterial> mats;
+    mats.push_back(toGpu(Material()));  // glTF default: white, metallic 1, roughness 1
+    for (const Material& m : scene.materials) mats.push_back(toGpu(m));
+    materials_ = gl::Buffer("scene materials", mats.size() * sizeof(GpuMaterial), mats.data());
+
+    // Geometry: one buffer for all primitives; remember each primitive's range.
+    std::vector<Vertex> verts;
+    std::vector<uint32_t> idx;
+    struct Range {
+        GLint baseVertex;
+        GLuint firstIndex;
+        GLsizei count;
+        int material;
+        glm::vec3 center;
+        float radius;
+    };
+    std::vector<std::vector<Range>> meshRanges(scene.meshes.size());
+    for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+        for (const Primitive& p : scene.meshes[mi].primitives) {
+            if (p.positions.empty() || p.indices.empty()) continue;
+            Range r{GLint(verts.size()), GLuint(idx.size()), GLsizei(p.indices.size()),
+                    p.material + 1,      glm::vec3(0.0f),    0.0f};
+            glm::vec3 lo(1e30f), hi(-1e30f);
+            for (size_t i = 0; i < p.positions.size(); ++i) {
+                glm::vec3 n = i < p.normals.size() ? p.normals[i] : glm::vec3(0, 1, 0);
+                verts.push_back({p.positions[i], n});
+                lo = glm::min(lo, p.positions[i]);
+                hi = glm::max(hi, p.positions[i]);
+            }
+            for (uint32_t i : p.indices) {
+                if (i >= p.positions.size())
+                    throw Error("scene '" + scene.source.string() + "': mesh '" +
+                                scene.meshes[mi].name + "' has an index out of range");
+                idx.push_back(i);
+            }
+            if (r.material < 0 || r.material >= int(mats.size())) r.material = 0;
+            r.center = 0.5f * (lo + hi);
+            r.radius = 0.5f * glm::length(hi - lo);
+            meshRanges[mi].push_back(r);
+        }
+    }
+    if (!verts.empty()) {
+        vertices_ = gl::Buffer("scene vertices", verts.size() * sizeof(Vertex), verts.data(), 0);
+        indices_ = gl::Buffer("scene indices", idx.size() * sizeof(uint32_t), idx.data(), 0);
+        glVertexArrayVertexBuffer(vao_.id(), 0, vertices_.id(), 0, sizeof(Vertex));
+        glVertexArrayElementBuffer(vao_.id(), indices_.id());
+        glEnableVertexArrayAttrib(vao_.id(), 0);
+        glEnableVertexArrayAttrib(vao_.id(), 1);
+        glVertexArrayAttribFormat(vao_.id(), 0, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, position));
+        glVertexArrayAttribFormat(vao_.id(), 1, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, normal));
+        glVertexArrayAttribBinding(vao_.id(), 0, 0);
+        glVertexArrayAttribBinding(vao_.id(), 1, 0);
+    }
+
+    // Instances and lights reachable from the scene's roots (Scene::meshInstances /
+    // lightInstances: world-from-node with the REAL/VIRTUAL flag inherited from parents).
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (const MeshInstance& inst : scene.meshInstances()) {
+        const glm::mat4 world(inst.world);
+        const std::string& nodeName = scene.nodes[size_t(inst.node)].name;
+        if (!finite(world))
+            throw Error("scene '" + scene.source.string() + "': node '" + nodeName +
+                        "' has a non-finite transform");
+        if (inst.mesh < 0 || size_t(inst.mesh) >= meshRanges.size()) continue;
+        const float scale =
+            std::max({glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])),
+                      glm::length(glm::vec3(world[2]))});
+        for (const Range& r : meshRanges[size_t(inst.mesh)]) {
+            DrawItem d;
+            d.name = nodeName;
+            d.model = world;
+            d.normalMatrix = glm::inverseTranspose(world);
+            d.material = r.material;
+            d.origin = inst.origin;
+            d.baseVertex = r.baseVertex;
+            d.firstIndex = r.firstIndex;
+            d.indexCount = r.count;
+            d.bounds.center = glm::vec3(world * glm::vec4(r.center, 1.0f));
+            d.bounds.radius = r.radius * scale;
+            lo = glm::min(lo, d.bounds.center - glm::vec3(d.bounds.radius));
+            hi = glm::max(hi, d.bounds.center + glm::vec3(d.bounds.radius));
+            draws_.push_back(d);
+        }
+    }
+    for (const LightInstance& inst : scene.lightInstances()) {
+        if (inst.light < 0 || size_t(inst.light) >= scene.lights.size()) continue;
+        const Light& l = scene.lights[size_t(inst.light)];
+        SceneLight s;
+        s.name = l.name.empty() ? scene.nodes[size_t(inst.node)].name : l.name;
+        s.type = l.type == Light::Type::Point  ? kLightPoint
+                 : l.type == Light::Type::Spot ? kLightSpot
+                                               : kLightDirectional;
+        s.position = glm::vec3(inst.position);
+        s.direction = glm::normalize(glm::vec3(inst.direction));
+        s.radiantIntensity = l.color * l.intensity;
+        s.range = l.range;
+        const float outer = std::clamp(l.outerConeAngle, 1e-3f, 1.5707f);
+        const float inner = std::clamp(l.innerConeAngle, 0.0f, outer);
+        s.outerAngle = outer;
+        s.cosOuter = std::cos(outer);
+        s.cosInner = std::cos(inner);
+        s.origin = inst.origin;
+        if (lights_.size() >= size_t(kMaxLights))
+            throw Error("scene '" + scene.source.string() + "' has more than " +
+                        std::to_string(kMaxLights) +
+                        " lights; the real-time renderer supports at most that many");
+        lights_.push_back(s);
+    }
+    if (!draws_.empty()) {
+        bounds_.center = 0.5f * (lo + hi);
+        bounds_.radius = 0.5f * glm::length(hi - lo);
+    }
+
+    // Surface point pool for imperfect shadow maps: area-weighted samples over all triangles
+    // (world space), shuffled so that any contiguous or strided subset covers the scene.
+    std::vector<GpuSurfacePoint> pts;
+    {
+        struct Tri {
+            glm::vec3 a, b, c;
+            float real;
+        };
+        std::vector<Tri> tris;
+        std::vector<double> cdf;
+        double total = 0.0;
+        for (const DrawItem& d : draws_) {
+            for (GLsizei i = 0; i + 2 < d.indexCount; i += 3) {
+                auto P = [&](GLsizei k) {
+                    return glm::vec3(
+                        d.model *
+                        glm::vec4(
+                            verts[size_t(d.baseVertex) + idx[d.firstIndex + size_t(k)]].position,
+                            1.0f));
+                };
+                Tri t{P(i), P(i + 1), P(i + 2), d.origin == Origin::Real ? 1.0f : 0.0f};
+                total += 0.5 * glm::length(glm::cross(t.b - t.a, t.c - t.a));
+                tris.push_back(t);
+                cdf.push_back(total);
+            }
+        }
+        surfaceArea_ = float(total);
+        if (total > 0 && surfacePoints > 0) {
+            std::mt19937 rng(12345);
+            std::uniform_real_distribution<float> U(0.0f, 1.0f);
+            for (int i = 0; i < surfacePoints; ++i) {
+                // Stratified over the area CDF so small objects still get their share.
+                double target = (i + U(rng)) / surfacePoints * total;
+                size_t k = size_t(std::lower_bound(cdf.begin(), cdf.end(), target) - cdf.begin());
+                k = std::min(k, tris.size() - 1);
+                float u = U(rng), v = U(rng);
+                if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
+                const Tri& t = tris[k];
+                glm::vec3 p = t.a + u * (t.b - t.a) + v * (t.c - t.a);
+                pts.push_back({glm::vec4(p, t.real)});
+                if (t.real == 0.0f) pointsHaveVirtual_ = true;
+            }
+            std::shuffle(pts.begin(), pts.end(), rng);
+        }
+    }
+    surfacePointCount_ = int(pts.size());
+    if (pts.empty()) pts.push_back({glm::vec4(0.0f)});
+    points_ = gl::Buffer("ism surface points", pts.size() * sizeof(GpuSurfacePoint), pts.data());
+
+    // Environment light.
+    if (scene.environment.kind == Environment::Kind::Equirectangular) {
+        cv::Mat env = readLinearRgb(scene.environment.image);
+        envSH_ =
+            projectEquirectToSH(env, scene.environment.intensity, scene.environment.rotationYDeg);
+        hasEnvironment_ = true;
+        environmentOrigin_ = scene.environment.origin;
+    } else if (scene.environment.kind == Environment::Kind::Fisheye) {
+        // The fish-eye mapping lives with the tracking module; until it provides an
+        // equirectangular conversion the real-time renderer lights without it (and says so).
+        spdlog::warn(
+            "scene '{}': fish-eye environment not used by the real-time renderer yet "
+            "(convert it to an equirectangular map)",
+            scene.source.string());
+    }
+    if (envSH_.empty()) envSH_.assign(9, glm::vec3(0.0f));
+}
+
+bool GpuScene::hasVirtual() const {
+    for (const DrawItem& d : draws_)
+        if (d.origin == Origin::Virtual) return true;
+    for (const SceneLight& l : lights_)
+        if (l.origin == Origin::Virtual) return true;
+    return false;
+}
+
+void GpuScene::bindGeometry() const {
+    vao_.bind();
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, materials_.id());
+}
+
+void GpuScene::drawItem(const DrawItem& d) const {
+    glDrawElementsBaseVertex(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(size_t(d.firstIndex) * 4), d.baseVertex);
+}
+
+}  // namespace mirage::render

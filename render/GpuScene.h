@@ -1,0 +1,92 @@
+#pragma once
+// A mirage::Scene uploaded to the GPU for the real-time renderer: one vertex/index buffer for all
+// meshes, one draw item per (mesh instance, primitive) with its world matrix and REAL/VIRTUAL
+// origin, the materials as a storage buffer, the lights in world space (each REAL or VIRTUAL),
+// a pool of surface sample points for imperfect shadow maps, and the environment light as SH9
+// irradiance coefficients. World frame = glTF (metres, +Y up).
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <opencv2/core.hpp>
+
+#include "core/gl/Objects.h"
+#include "core/scene/Scene.h"
+#include "render/GpuTypes.h"
+
+namespace mirage::render {
+
+struct BoundingSphere {
+    glm::vec3 center{0.0f};
+    float radius = 0.0f;  // metres
+};
+
+struct DrawItem {
+    std::string name;              // node name, for reports
+    glm::mat4 model{1.0f};         // world-from-mesh
+    glm::mat4 normalMatrix{1.0f};  // inverse transpose of model (upper 3x3 used)
+    int material = 0;              // index into the material buffer (0 = glTF default)
+    Origin origin = Origin::Virtual;
+    GLint baseVertex = 0;
+    GLuint firstIndex = 0;
+    GLsizei indexCount = 0;
+    BoundingSphere bounds;  // world
+};
+
+struct SceneLight {
+    std::string name;
+    int type = kLightPoint;
+    glm::vec3 position{0.0f};                // world (metres)
+    glm::vec3 direction{0.0f, 0.0f, -1.0f};  // world unit vector the light shines along
+    glm::vec3 radiantIntensity{1.0f};        // colour * intensity: W/sr (point, spot), W/m^2 (dir.)
+    float range = 0.0f;                      // metres, 0 = infinite
+    float cosOuter = 0.0f, cosInner = 1.0f;
+    float outerAngle = 0.785398f;  // radians
+    Origin origin = Origin::Virtual;
+};
+
+class GpuScene {
+public:
+    // Uploads everything; `surfacePoints` is the size of the ISM point pool. The environment map
+    // (equirectangular, linear) is read from scene.environment.image when the scene has one;
+    // throws mirage::FileError if it cannot be read.
+    explicit GpuScene(const Scene& scene, int surfacePoints = 16384);
+
+    const std::vector<DrawItem>& draws() const { return draws_; }
+    const std::vector<SceneLight>& lights() const { return lights_; }
+    const BoundingSphere& bounds() const { return bounds_; }
+    bool hasVirtual() const;
+    bool hasEnvironment() const { return hasEnvironment_; }
+    Origin environmentOrigin() const { return environmentOrigin_; }
+    // Radiance SH9 coefficients of the environment (linear RGB, intensity applied), in world axes.
+    const std::vector<glm::vec3>& environmentSH() const { return envSH_; }
+    int surfacePointCount() const { return surfacePointCount_; }
+    bool surfacePointsHaveVirtual() const { return pointsHaveVirtual_; }
+    float surfaceArea() const { return surfaceArea_; }  // m^2, all triangles
+
+    // Binds the vertex array and the material buffer; then drawItem() per item.
+    void bindGeometry() const;
+    void drawItem(const DrawItem& d) const;
+    const gl::Buffer& materialBuffer() const { return materials_; }
+    const gl::Buffer& surfacePointBuffer() const { return points_; }
+
+    // Radiance SH9 of an equirectangular linear RGB float image (CV_32FC3, top row = +Y up,
+    // u = 0.5 looks down -Z, as in glTF/three.js). Exposed for tests.
+    static std::vector<glm::vec3> projectEquirectToSH(const cv::Mat& linearRgb, float intensity,
+                                                      double rotationYDeg);
+
+private:
+    std::vector<DrawItem> draws_;
+    std::vector<SceneLight> lights_;
+    BoundingSphere bounds_;
+    gl::Buffer vertices_, indices_, materials_, points_;
+    gl::VertexArray vao_;
+    bool hasEnvironment_ = false;
+    Origin environmentOrigin_ = Origin::Real;
+    std::vector<glm::vec3> envSH_;
+    int surfacePointCount_ = 0;
+    bool pointsHaveVirtual_ = false;
+    float surfaceArea_ = 0.0f;
+};
+
+}  // namespace mirage::render

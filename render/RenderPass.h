@@ -1,0 +1,30 @@
+#pragma once
+// A render pass of the real-time renderer: declares the frame resources it reads and writes,
+// decides per frame whether the scene needs it (and says why), allocates its targets in
+// resize(), and records GL work in execute() without allocating. Shaders live beside the pass
+// (render/passes/<pass>/) and are embedded at build time.
+#include <string>
+#include <vector>
+
+#include "render/FrameContext.h"
+
+namespace mirage::render {
+
+struct PassDecision {
+    bool run = true;
+    std::string reason;  // e.g. "2 lights have casters in their cone" / "no virtual object lit"
+};
+
+class RenderPass {
+public:
+    virtual ~RenderPass() = default;
+    virtual const char* name() const = 0;
+    virtual std::vector<Resource> reads() const = 0;
+    virtual std::vector<Resource> writes() const = 0;
+    virtual PassDecision decide(const FrameContext& ctx) const = 0;
+    // (Re)allocates targets for ctx's canvas / plan; called when they change.
+    virtual void resize(const FrameContext& ctx) = 0;
+    virtual void execute(FrameContext& ctx) = 0;
+};
+
+}  // namespace mirage::render

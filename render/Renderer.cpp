@@ -1,0 +1,370 @@
+#include "render/Renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/Error.h"
+#include "render/passes/composite/CompositePass.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/gifilter/GiFilterPass.h"
+#include "render/passes/indirect/IndirectLightPass.h"
+#include "render/passes/ism/IsmPass.h"
+#include "render/passes/shadow/ShadowPass.h"
+#include "render/passes/vpl/VplPass.h"
+
+namespace mirage::render {
+namespace {
+
+// Does the sphere touch the light's cone of influence (spot cone, range)?
+bool inLightCone(const SceneLight& l, const BoundingSphere& s) {
+    if (l.type == kLightDirectional) return true;
+    const glm::vec3 d = s.center - l.position;
+    const float dist = glm::length(d);
+    if (dist <= s.radius) return true;
+    if (l.range > 0.0f && dist - s.radius > l.range) return false;
+    if (l.type == kLightPoint) return true;
+    const float angle = std::acos(std::clamp(glm::dot(d / dist, l.direction), -1.0f, 1.0f));
+    const float halfAngle = std::asin(std::clamp(s.radius / dist, 0.0f, 1.0f));
+    return angle - halfAngle <= l.outerAngle;
+}
+
+// Sphere against the six planes of a view-projection frustum (Gribb & Hartmann).
+bool inFrustum(const glm::mat4& vp, const BoundingSphere& s) {
+    const glm::mat4 m = glm::transpose(vp);
+    const glm::vec4 planes[6] = {m[3] + m[0], m[3] - m[0], m[3] + m[1],
+                                 m[3] - m[1], m[3] + m[2], m[3] - m[2]};
+    for (const glm::vec4& p : planes) {
+        const float len = glm::length(glm::vec3(p));
+        if (len <= 0) continue;
+        if ((glm::dot(glm::vec3(p), s.center) + p.w) / len < -s.radius) return false;
+    }
+    return true;
+}
+
+glm::vec3 anyPerpendicular(const glm::vec3& d) {
+    return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+}
+
+}  // namespace
+
+bool FrameReport::ran(const std::string& pass) const {
+    for (const PassReport& p : passes)
+        if (p.name == pass) return p.ran;
+    return false;
+}
+
+std::string FrameReport::summary() const {
+    std::ostringstream s;
+    for (const PassReport& p : passes)
+        s << fmt::format("{:<10} {:<7} {:7.2f} ms  {}\n", p.name, p.ran ? "ran" : "skipped",
+                         p.gpuMs, p.reason);
+    s << fmt::format("{:<10} {:<7} {:7.2f} ms\n", "total", "", totalGpuMs);
+    return s.str();
+}
+
+Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererOptions options)
+    : options_(options) {
+    if (options_.vplCount < 0 || options_.vplCount > 16384)
+        throw Error("VPL count " + std::to_string(options_.vplCount) +
+                    " is out of range (0..16384)");
+    if (options_.interleave < 1 || options_.interleave > 8)
+        throw Error("interleave must be 1..8, got " + std::to_string(options_.interleave));
+    if (options_.shadowMapSize < 16 || options_.shadowMapSize > 4096)
+        throw Error("shadow map size must be 16..4096");
+    if (options_.ismTileSize < 8 || options_.ismTileSize > 256)
+        throw Error("ISM tile size must be 8..256");
+    scene_ = std::make_unique<GpuScene>(scene, 16384);
+    projection_ = CameraProjection::make(camera);
+    ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
+
+    auto gbuffer = std::make_unique<GBufferPass>();
+    auto shadow = std::make_unique<ShadowPass>();
+    auto vpl = std::make_unique<VplPass>(*shadow);
+    auto ism = std::make_unique<IsmPass>(*vpl);
+    auto direct = std::make_unique<DirectLightPass>(*gbuffer);
+    auto indirect = std::make_unique<IndirectLightPass>(*gbuffer, *vpl);
+    auto filter = std::make_unique<GiFilterPass>(*gbuffer);
+    auto composite = std::make_unique<CompositePass>(*gbuffer);
+    composite_ = composite.get();
+    passes_.push_back(std::move(gbuffer));
+    passes_.push_back(std::move(shadow));
+    passes_.push_back(std::move(vpl));
+    passes_.push_back(std::move(ism));
+    passes_.push_back(std::move(direct));
+    passes_.push_back(std::move(indirect));
+    passes_.push_back(std::move(filter));
+    passes_.push_back(std::move(composite));
+    for (auto& p : passes_) timers_.emplace_back(std::string("timer ") + p->name());
+    // Prime every query once: on llvmpipe the very first GL_TIME_ELAPSED result of a process can
+    // be garbage (seen: 3.4e6 ms), which would spoil the first frame's report.
+    {
+        gl::Texture scratch = gl::Texture::create2D("timer priming", 8, 8, GL_RGBA8);
+        gl::Framebuffer fb("timer priming fbo");
+        fb.attachColor(0, scratch);
+        fb.finalize(1);
+        fb.bind();
+        for (gl::TimerQuery& t : timers_) {
+            t.begin();
+            glClear(GL_COLOR_BUFFER_BIT);
+            t.end();
+            (void)t.elapsedMs();
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
+
+    cameraImage_ =
+        gl::Texture::create2D("camera image", camera.width, camera.height, GL_SRGB8_ALPHA8);
+    cameraImage_.setFilter(GL_NEAREST, GL_NEAREST);
+    uploadCameraImage(cv::Mat());
+    planFrame(FrameInput{});
+    for (auto& p : passes_) p->resize(*ctx_);
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::uploadCameraImage(const cv::Mat& bgr) {
+    const int w = projection_.camera.width, h = projection_.camera.height;
+    cv::Mat rgba;
+    if (bgr.empty()) {
+        rgba = cv::Mat(h, w, CV_8UC4, cv::Scalar(0, 0, 0, 255));
+    } else {
+        if (bgr.cols != w || bgr.rows != h || bgr.type() != CV_8UC3)
+            throw Error(
+                fmt::format("camera image is {}x{} (type {}), but the calibration is for "
+                            "{}x{} 8-bit BGR; use the calibration of this camera mode",
+                            bgr.cols, bgr.rows, bgr.type(), w, h));
+        cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
+    }
+    if (!rgba.isContinuous()) rgba = rgba.clone();
+    cameraImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+}
+
+void Renderer::planFrame(const FrameInput& input) {
+    FrameContext& c = *ctx_;
+    const GpuScene& s = *scene_;
+    FramePlan plan;
+    const BoundingSphere& B = s.bounds();
+    const float R = std::max(B.radius, 0.01f);
+
+    // Camera.
+    c.T_world_camera = input.T_world_camera;
+    const glm::mat4 view(input.T_world_camera.inverse().matrix());
+    const glm::mat4 proj = projection_.projectionMatrix(options_.nearM, options_.farM);
+    const glm::mat4 viewProj = proj * view;
+    const glm::vec3 camPos(input.T_world_camera.translation);
+
+    bool virtualInView = false;
+    for (const DrawItem& d : s.draws())
+        if (d.origin == Origin::Virtual && inFrustum(viewProj, d.bounds)) virtualInView = true;
+
+    // Lights: matrices, caster tests, routing flags.
+    c.lightBlock = GpuLightBlock{};
+    int layer = 0;
+    bool anyReachesVirtual = false, anyCaster = false;
+    for (size_t i = 0; i < s.lights().size(); ++i) {
+        const SceneLight& l = s.lights()[i];
+        GpuLight& g = c.lightBlock.lights[i];
+        LightPlan lp;
+        bool real = false, virt = false;
+        for (const DrawItem& d : s.draws()) {
+            if (!inLightCone(l, d.bounds)) continue;
+            (d.origin == Origin::Real ? real : virt) = true;
+        }
+        lp.castsShadow = real || virt;
+        lp.reachesVirtual = virt;
+        lp.needsRealOnlyMap = lp.castsShadow && virt && real && l.origin == Origin::Real;
+        anyReachesVirtual = anyReachesVirtual || virt;
+        anyCaster = anyCaster || lp.castsShadow;
+
+        g.positionRange = glm::vec4(l.position, l.range);
+        g.directionType = glm::vec4(l.direction, float(l.type));
+        const float scale = 1.0f / std::max(0.001f, l.cosInner - l.cosOuter);
+        g.cone = glm::vec4(l.cosOuter, l.cosInner, scale, -l.cosOuter * scale);
+        g.radiantIntensity = glm::vec4(l.radiantIntensity, 1.0f);
+        const float farL = glm::length(B.center - l.position) + R + 0.1f;
+        const float nearL = std::clamp(farL * 1e-4f, 0.005f, 0.05f);
+        if (l.type == kLightSpot) {
+            const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
+            g.radiantIntensity.w = std::tan(half);
+            g.viewProj[0] =
+                glm::perspective(2.0f * half, 1.0f, nearL, farL) *
+                glm::lookAt(l.position, l.position + l.direction, anyPerpendicular(l.direction));
+            lp.layers = 1;
+        } else if (l.type == kLightPoint) {
+            const glm::vec3 dirs[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                       {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+            const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
+                                      {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+            g.radiantIntensity.w = 1.0f;
+            for (int f = 0; f < 6; ++f)
+                g.viewProj[f] = glm::perspective(glm::half_pi<float>(), 1.0f, nearL, farL) *
+                                glm::lookAt(l.position, l.position + dirs[f], ups[f]);
+            lp.layers = 6;
+        } else {
+            const glm::vec3 eye = B.center - l.direction * (2.0f * R + 1.0f);
+            g.positionRange = glm::vec4(eye, 0.0f);
+            g.radiantIntensity.w = R;
+            g.viewProj[0] = glm::ortho(-R, R, -R, R, 0.0f, 4.0f * R + 2.0f) *
+                            glm::lookAt(eye, B.center, anyPerpendicular(l.direction));
+            lp.layers = 1;
+        }
+        if (!lp.castsShadow) lp.layers = 0;
+        lp.firstLayer = layer;
+        layer += lp.layers;
+        g.shadow = glm::ivec4(lp.firstLayer, lp.layers, lp.needsRealOnlyMap ? 1 : 0,
+                              l.origin == Origin::Real ? 1 : 0);
+        plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
+        plan.lights.push_back(lp);
+    }
+    plan.shadowLayers = layer;
+
+    // VPLs: needed when the virtual objects change the indirect light that can be seen.
+    if (options_.vplCount <= 0) {
+        plan.vplReason = "VPL count is 0";
+    } else if (!anyCaster) {
+        plan.vplReason = "no light reaches any geometry";
+    } else if (!options_.cullPasses) {
+        plan.needVpls = true;
+        plan.vplReason = "pass culling off";
+    } else if (anyReachesVirtual) {
+        plan.needVpls = true;
+        plan.vplReason = "a light reaches a virtual object";
+    } else if (virtualInView) {
+        plan.needVpls = true;
+        plan.vplReason = "a virtual object in view receives bounced light";
+    } else {
+        plan.vplReason = "no light reaches a virtual object and none is in view";
+    }
+    if (plan.needVpls) {
+        int withRsm = 0;
+        for (LightPlan& lp : plan.lights) withRsm += lp.castsShadow;
+        int first = 0, k = 0;
+        for (LightPlan& lp : plan.lights) {
+            if (!lp.castsShadow) continue;
+            lp.hasRsm = true;
+            lp.firstVpl = first;
+            lp.vplCount = ++k == withRsm ? options_.vplCount - first : options_.vplCount / withRsm;
+            first += lp.vplCount;
+        }
+        plan.needRealOnlyIsm = s.surfacePointsHaveVirtual();
+    }
+    c.plan = plan;
+
+    // Frame uniforms.
+    GpuFrame& f = c.frame;
+    f.viewMatrix = view;
+    f.projMatrix = proj;
+    f.viewProj = viewProj;
+    f.prevViewProj = prevViewProj_;
+    f.cameraPos = glm::vec4(camPos, 1.0f);
+    f.prevCameraPos = glm::vec4(prevCameraPos_, 1.0f);
+    f.canvas =
+        glm::vec4(projection_.canvasWidth, projection_.canvasHeight,
+                  1.0f / float(projection_.canvasWidth), 1.0f / float(projection_.canvasHeight));
+    f.counts =
+        glm::ivec4(int(s.lights().size()), options_.vplCount, options_.interleave, c.frameIndex);
+    const int envFlag = !s.hasEnvironment()                     ? kOriginNone
+                        : s.environmentOrigin() == Origin::Real ? kOriginReal
+                                                                : kOriginVirtual;
+    c.historyValid = !input.resetHistory && lastRanFilter_ && c.frameIndex > 0;
+    f.flags = glm::ivec4(envFlag, c.historyValid ? 1 : 0, options_.ismTileSize,
+                         IsmPass::tilesPerRow(options_.vplCount));
+    f.params = glm::vec4(options_.vplDistanceClamp, options_.shadowBias * 0.1f,
+                         options_.temporalBlend, float(options_.ismPointsPerVpl));
+    for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);
+    f.exposure = glm::vec4(options_.exposure, options_.alphaMax, options_.alphaFadeLr, 0.0f);
+    c.frameUbo.upload(&f, sizeof(GpuFrame));
+    c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
+    prevViewProj_ = viewProj;
+    prevCameraPos_ = camPos;
+}
+
+const FrameReport& Renderer::render(const FrameInput& input) {
+    if (!input.T_world_camera.isFinite())
+        throw Error(
+            "camera pose is not finite; pass resetHistory and skip the frame when "
+            "tracking is lost");
+    uploadCameraImage(input.cameraImage);
+    planFrame(input);
+    FrameContext& c = *ctx_;
+    c.clearResources();
+    c.publish(Resource::CameraImage, &cameraImage_);
+    report_ = FrameReport{};
+    std::vector<bool> ran(passes_.size(), false);
+    for (size_t i = 0; i < passes_.size(); ++i) {
+        RenderPass& p = *passes_[i];
+        PassReport r;
+        r.name = p.name();
+        PassDecision d = p.decide(c);
+        r.reason = d.reason;
+        if (d.run) {
+            for (Resource res : p.reads())
+                MR_CHECK(c.has(res), std::string("pass ") + p.name() + " reads " +
+                                         resourceName(res) + ", which no earlier pass wrote");
+            p.resize(c);  // no-op unless the plan's sizes changed (shadow layers, VPL count)
+            timers_[i].begin();
+            p.execute(c);
+            timers_[i].end();
+            r.ran = ran[i] = true;
+        }
+        report_.passes.push_back(r);
+    }
+    for (size_t i = 0; i < passes_.size(); ++i) {
+        if (!ran[i]) continue;
+        report_.passes[i].gpuMs = timers_[i].elapsedMs();
+        report_.totalGpuMs += report_.passes[i].gpuMs;
+    }
+    lastRanFilter_ = report_.ran("gifilter");
+    ++c.frameIndex;
+    return report_;
+}
+
+const gl::Texture& Renderer::compositeTexture() const {
+    return composite_->srgb();
+}
+
+cv::Mat Renderer::compositeLinear() const {
+    const gl::Texture& t = composite_->linear();
+    auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
+    cv::Mat rgba(t.height(), t.width(), CV_32FC4, px.data()), rgb;
+    cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);
+    return rgb;
+}
+
+cv::Mat Renderer::compositeSrgb() const {
+    const gl::Texture& t = composite_->srgb();
+    auto px = t.read<unsigned char>(GL_RGBA, GL_UNSIGNED_BYTE, 4);
+    cv::Mat rgba(t.height(), t.width(), CV_8UC4, px.data()), bgr;
+    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+    return bgr;
+}
+
+cv::Mat Renderer::coverage() const {
+    const gl::Texture& t = composite_->linear();
+    auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
+    cv::Mat out(t.height(), t.width(), CV_8U);
+    for (int y = 0; y < t.height(); ++y)
+        for (int x = 0; x < t.width(); ++x) {
+            const float a = px[(size_t(y) * t.width() + x) * 4 + 3];
+            out.at<uint8_t>(y, x) = a > 0.75f ? 2 : a > 0.25f ? 1 : 0;
+        }
+    return out;
+}
+
+cv::Mat Renderer::readBuffer(Resource r) const {
+    if (!ctx_->has(r))
+        throw Error(std::string("buffer ") + resourceName(r) + " was not produced this frame");
+    const gl::Texture& t = ctx_->texture(r);
+    auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
+    cv::Mat rgba(t.height(), t.width(), CV_32FC4, px.data()), rgb;
+    cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);
+    return rgb;
+}
+
+}  // namespace mirage::render

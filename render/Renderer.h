@@ -1,0 +1,96 @@
+#pragma once
+// The real-time renderer: differential instant radiosity (Knecht et al. 2010, 2013 Sec. 3.1)
+// compositing a scene's virtual objects into camera footage. A frame is a list of explicit
+// passes (render/passes/<pass>/), each declaring what it reads and writes; the renderer plans
+// the frame from the scene (which lights cast shadows, which need real-only visibility, whether
+// VPLs are needed), runs only the passes the frame needs, times each with a GL timer query and
+// reports which ran and why. Needs a current GL 4.5 context (core/gl/Context.h).
+//
+// Frame, in order: gbuffer -> shadow (+RSM) -> vpl -> ism -> direct -> indirect -> gifilter
+// -> composite. The specular passes (reflection/refraction G-buffers) and caustic maps slot in
+// between ism and composite, publishing into the same LRv / LR resources.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera/CameraModel.h"
+#include "core/gl/Objects.h"
+#include "core/math/Pose.h"
+#include "core/scene/Scene.h"
+#include "render/CameraProjection.h"
+#include "render/FrameContext.h"
+#include "render/GpuScene.h"
+#include "render/RenderPass.h"
+
+namespace mirage::render {
+
+struct FrameInput {
+    Pose T_world_camera;        // camera pose (OpenCV camera axes), world = glTF frame
+    cv::Mat cameraImage;        // 8-bit BGR, sRGB-encoded, camera size; empty = black footage
+    bool resetHistory = false;  // a cut, a seek or tracking loss: drop temporal history
+};
+
+struct PassReport {
+    std::string name;
+    bool ran = false;
+    std::string reason;
+    double gpuMs = 0.0;  // GL_TIME_ELAPSED of the pass (0 when skipped)
+};
+
+struct FrameReport {
+    std::vector<PassReport> passes;
+    double totalGpuMs = 0.0;
+    bool ran(const std::string& pass) const;
+    std::string summary() const;  // one line per pass: "name: ran|skipped (reason) x.xx ms"
+};
+
+class Renderer {
+public:
+    Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererOptions options = {});
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    // Renders and composites one frame; blocks until its timer queries are available.
+    const FrameReport& render(const FrameInput& input);
+
+    // Readbacks (camera image size, top row first). Linear RGB float (CV_32FC3) / sRGB 8-bit
+    // BGR (CV_8UC3) / coverage (CV_8U: 0 empty, 1 real, 2 virtual).
+    cv::Mat compositeLinear() const;
+    cv::Mat compositeSrgb() const;
+    cv::Mat coverage() const;
+    // Any canvas-size linear buffer of this frame (LRv, LR, DirectRv, ...) as CV_32FC3 RGB,
+    // top row first. Throws mirage::Error if the frame did not produce it.
+    cv::Mat readBuffer(Resource r) const;
+
+    // The composite as an sRGB8 texture (camera size, memory row 0 = image top row), e.g. to
+    // blit into a window (flip vertically: GL windows put row 0 at the bottom).
+    const gl::Texture& compositeTexture() const;
+
+    const CameraProjection& projection() const { return projection_; }
+    const FramePlan& plan() const { return ctx_->plan; }
+    const GpuScene& gpuScene() const { return *scene_; }
+    const RendererOptions& options() const { return options_; }
+    const FrameReport& lastReport() const { return report_; }
+
+private:
+    void planFrame(const FrameInput& input);
+    void uploadCameraImage(const cv::Mat& bgr);
+
+    RendererOptions options_;
+    std::unique_ptr<GpuScene> scene_;
+    CameraProjection projection_;
+    std::unique_ptr<FrameContext> ctx_;
+    std::vector<std::unique_ptr<RenderPass>> passes_;
+    std::vector<gl::TimerQuery> timers_;
+    class CompositePass* composite_ = nullptr;
+    gl::Texture cameraImage_;
+    FrameReport report_;
+    glm::mat4 prevViewProj_{1.0f};
+    glm::vec3 prevCameraPos_{0.0f};
+    bool lastRanFilter_ = false;
+};
+
+}  // namespace mirage::render

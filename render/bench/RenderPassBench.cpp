@@ -1,0 +1,100 @@
+// Per-pass GPU time of the real-time renderer (GL_TIME_ELAPSED queries), on a table-top scene:
+// a real floor and real box (proxies), a virtual box and a virtual sphere, a real spot light and
+// a real environment. Arguments: width, height, VPL count, sphere subdivisions (triangles).
+// Reported time = the frame's total GPU time (manual time); counters = per-pass ms (mean over the
+// iterations; use --benchmark_repetitions and the median aggregate for figures).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "core/gl/Context.h"
+#include "render/Renderer.h"
+#include "tests/render/RenderTestScenes.h"
+
+namespace {
+
+using namespace mirage;
+
+void addSphere(Scene& s, glm::vec3 c, float r, int segments, int material, Origin origin) {
+    Primitive p;
+    const int rings = segments, sectors = 2 * segments;
+    for (int i = 0; i <= rings; ++i)
+        for (int j = 0; j <= sectors; ++j) {
+            const float th = float(M_PI) * i / rings, ph = 2.0f * float(M_PI) * j / sectors;
+            glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+            p.positions.push_back(c + r * n);
+            p.normals.push_back(n);
+        }
+    for (int i = 0; i < rings; ++i)
+        for (int j = 0; j < sectors; ++j) {
+            uint32_t a = uint32_t(i * (sectors + 1) + j), b = a + uint32_t(sectors + 1);
+            p.indices.insert(p.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
+        }
+    p.material = material;
+    test::addMeshNode(s, "sphere", std::move(p), origin);
+}
+
+Scene benchScene(int sphereSegments) {
+    Scene s;
+    int white = test::addMaterial(s, glm::vec3(0.75f));
+    int wood = test::addMaterial(s, {0.55f, 0.35f, 0.2f}, 0.6f);
+    int red = test::addMaterial(s, {0.8f, 0.1f, 0.1f});
+    int blue = test::addMaterial(s, {0.1f, 0.2f, 0.8f}, 0.3f);
+    test::addFloor(s, "table", 0.0f, 2.0f, wood, Origin::Real);
+    test::addBox(s, "real box", {-0.6f, 0.0f, -0.5f}, {-0.3f, 0.3f, -0.2f}, white, Origin::Real);
+    test::addBox(s, "virtual box", {0.1f, 0.0f, -0.2f}, {0.35f, 0.25f, 0.05f}, red,
+                 Origin::Virtual);
+    addSphere(s, {-0.1f, 0.15f, 0.2f}, 0.15f, sphereSegments, blue, Origin::Virtual);
+    test::addLight(s, Light::Type::Spot, {0.6f, 1.4f, 0.6f},
+                   glm::normalize(glm::vec3(-0.6f, -1.4f, -0.6f)), 6.0f, Origin::Real, 0.9f, 0.7f);
+    return s;
+}
+
+gl::Context& context() {
+    static gl::Context ctx = gl::Context::headless();
+    return ctx;
+}
+
+void BM_Frame(benchmark::State& state) {
+    context();
+    const int w = int(state.range(0)), h = int(state.range(1));
+    render::RendererOptions opt;
+    opt.vplCount = int(state.range(2));
+    Scene scene = benchScene(int(state.range(3)));
+    CameraIntrinsics cam;
+    cam.width = w;
+    cam.height = h;
+    cam.fx = cam.fy = 0.9 * w;
+    cam.cx = (w - 1) * 0.5;
+    cam.cy = (h - 1) * 0.5;
+    render::Renderer r(scene, cam, opt);
+    const Pose pose = test::lookAtPose({0.0, 1.0, 1.6}, {0.0, 0.1, 0.0});
+    cv::Mat footage(h, w, CV_8UC3, cv::Scalar(90, 110, 130));
+    r.render({pose, footage, false});  // warm-up: shader compile, first allocations
+    std::map<std::string, double> sums;
+    for (auto _ : state) {
+        const render::FrameReport& rep = r.render({pose, footage, false});
+        for (const auto& p : rep.passes) sums[p.name] += p.gpuMs;
+        state.SetIterationTime(rep.totalGpuMs * 1e-3);
+    }
+    for (const auto& [name, ms] : sums)
+        state.counters[name + "_ms"] = benchmark::Counter(ms / double(state.iterations()));
+    size_t tris = 0;
+    for (const auto& m : scene.meshes)
+        for (const auto& p : m.primitives) tris += p.indices.size() / 3;
+    state.counters["triangles"] = double(tris);
+}
+
+void args(benchmark::internal::Benchmark* b) {
+    for (auto [w, h] : {std::pair{640, 480}, std::pair{1024, 768}})
+        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32});
+    b->Args({640, 480, 256, 128});  // ~65k more triangles
+    b->Args({320, 240, 256, 32});
+}
+
+}  // namespace
+
+BENCHMARK(BM_Frame)->Apply(args)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK_MAIN();

@@ -1,0 +1,59 @@
+#version 450 core
+#include "common.glsl"
+#include "lighting.glsl"
+// Direct light, environment light and emission, routed into the two GI solutions
+// (DESIGN.md "Real and virtual"; Knecht 2010's decision flags):
+//   L_rv: every light, visibility against all occluders;
+//   L_r : only if the light and p are real, visibility against real occluders only.
+// The environment map is real (captured) unless the scene says otherwise; it is not shadowed.
+in vec2 uv;
+layout(binding = 0) uniform sampler2D gPosition;  // xyz world, w = origin
+layout(binding = 1) uniform sampler2D gNormal;
+layout(binding = 2) uniform sampler2D gAlbedo;
+layout(binding = 3) uniform sampler2D gEmissive;
+layout(binding = 4) uniform sampler2DArray shadowAll;
+layout(binding = 5) uniform sampler2DArray shadowReal;
+layout(location = 0) out vec4 outRv;  // linear radiance
+layout(location = 1) out vec4 outR;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 P = texelFetch(gPosition, px, 0);
+    int origin = int(P.w + 0.5);
+    if (origin == ORIGIN_NONE) {
+        outRv = vec4(0.0);
+        outR = vec4(0.0);
+        return;
+    }
+    bool pReal = origin == ORIGIN_REAL;
+    vec3 p = P.xyz;
+    vec4 N = texelFetch(gNormal, px, 0);
+    vec3 n = N.xyz;
+    vec4 A = texelFetch(gAlbedo, px, 0);
+    vec3 v = normalize(cameraPos.xyz - p);
+    vec3 rv = vec3(0.0), r = vec3(0.0);
+    for (int li = 0; li < counts.x; ++li) {
+        vec3 wi, E;
+        incidentLight(li, p, wi, E);
+        float NdotL = dot(n, wi);
+        if (NdotL <= 0.0) continue;
+        vec3 c = brdfCos(n, v, wi, A.rgb, A.a, N.w) * E;
+        float visAll = shadowVisibility(shadowAll, li, p, NdotL);
+        rv += c * visAll;
+        ivec4 sh = lights[li].shadow;
+        if (sh.w == 1 && pReal) {
+            float visReal = sh.z == 1 ? shadowVisibility(shadowReal, li, p, NdotL) : visAll;
+            r += c * visReal;
+        }
+    }
+    if (flags.x != 0) {
+        vec3 env = A.rgb * (1.0 - A.a) / PI * shIrradiance(n);
+        rv += env;
+        if (flags.x == ORIGIN_REAL && pReal) r += env;
+    }
+    vec3 e = texelFetch(gEmissive, px, 0).rgb;
+    rv += e;
+    if (pReal) r += e;
+    outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
+    outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
+}

@@ -1,0 +1,66 @@
+#include "render/passes/gbuffer/GBufferPass.h"
+
+#include "render/Shaders.h"
+
+namespace mirage::render {
+
+GBufferPass::GBufferPass()
+    : program_("gbuffer", {{GL_VERTEX_SHADER, "passes/gbuffer/gbuffer.vert",
+                            shaders::source("passes/gbuffer/gbuffer.vert")},
+                           {GL_FRAGMENT_SHADER, "passes/gbuffer/gbuffer.frag",
+                            shaders::source("passes/gbuffer/gbuffer.frag")}}) {
+    locModel_ = program_.uniformLocation("model");
+    locNormal_ = program_.uniformLocation("normalMatrix");
+    locMaterial_ = program_.uniformLocation("materialIndex");
+    locOrigin_ = program_.uniformLocation("origin");
+}
+
+PassDecision GBufferPass::decide(const FrameContext& ctx) const {
+    if (ctx.scene.draws().empty()) return {false, "the scene has no geometry"};
+    return {true, std::to_string(ctx.scene.draws().size()) + " draws"};
+}
+
+void GBufferPass::resize(const FrameContext& ctx) {
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    position_ = gl::Texture::create2D("gbuffer position", w, h, GL_RGBA32F);
+    normal_ = gl::Texture::create2D("gbuffer normal", w, h, GL_RGBA16F);
+    albedo_ = gl::Texture::create2D("gbuffer albedo", w, h, GL_RGBA16F);
+    emissive_ = gl::Texture::create2D("gbuffer emissive", w, h, GL_RGBA16F);
+    depth_ = gl::Texture::create2D("gbuffer depth", w, h, GL_DEPTH_COMPONENT32F);
+    for (gl::Texture* t : {&position_, &normal_, &albedo_, &emissive_})
+        t->setFilter(GL_NEAREST, GL_NEAREST);
+    fbo_ = gl::Framebuffer("gbuffer fbo");
+    fbo_.attachColor(0, position_);
+    fbo_.attachColor(1, normal_);
+    fbo_.attachColor(2, albedo_);
+    fbo_.attachColor(3, emissive_);
+    fbo_.attachDepth(depth_);
+    fbo_.finalize(4);
+}
+
+void GBufferPass::execute(FrameContext& ctx) {
+    fbo_.bind();
+    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
+    const float zero[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 4; ++i) glClearBufferfv(GL_COLOR, i, zero);
+    const float one = 1.0f;
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    program_.use();
+    ctx.bindFrameBlocks();
+    ctx.scene.bindGeometry();
+    for (const DrawItem& d : ctx.scene.draws()) {
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
+        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
+        glUniform1i(locMaterial_, d.material);
+        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
+        ctx.scene.drawItem(d);
+    }
+    glDisable(GL_DEPTH_TEST);
+    ctx.publish(Resource::GBuffer, &position_);
+}
+
+}  // namespace mirage::render

@@ -1,0 +1,24 @@
+#version 450 core
+#include "common.glsl"
+// Deferred G-buffer, all linear: world position + origin, world normal + roughness,
+// base colour + metallic, emitted radiance.
+layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+uniform int materialIndex;
+uniform int origin;  // ORIGIN_REAL or ORIGIN_VIRTUAL
+in vec3 worldPos;
+in vec3 worldNormal;
+layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
+layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
+layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
+layout(location = 3) out vec4 gEmissive;  // rgb linear emitted radiance
+void main() {
+    GpuMaterial m = materials[materialIndex];
+    vec3 n = normalize(worldNormal);
+    if (!allFinite(n)) n = vec3(0.0, 1.0, 0.0);
+    // Shade the side the camera sees (proxies are often single quads seen from either side).
+    if (dot(n, cameraPos.xyz - worldPos) < 0.0) n = -n;
+    gPosition = vec4(worldPos, float(origin));
+    gNormal = vec4(n, clamp(m.emissive.w, 0.02, 1.0));
+    gAlbedo = vec4(m.baseColor.rgb, clamp(m.params.x, 0.0, 1.0));
+    gEmissive = vec4(m.emissive.rgb, 0.0);
+}

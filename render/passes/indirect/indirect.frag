@@ -1,0 +1,65 @@
+#version 450 core
+#include "common.glsl"
+// One indirect bounce from the VPLs with interleaved sampling (Keller & Heidrich 2001): pixel
+// (x, y) gathers only VPLs i = g, g + K^2, ... with g = (x mod K) + K (y mod K), scaled by K^2;
+// the geometry-aware filter then recombines the K x K groups. Visibility from the imperfect
+// shadow maps. Routing (DESIGN.md): a VPL at q lights p in L_rv always; in L_r only if the light,
+// q and p are all real, with visibility against real points only. Diffuse receivers.
+in vec2 uv;
+layout(std430, binding = 2) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = 0) uniform sampler2D gPosition;
+layout(binding = 1) uniform sampler2D gNormal;
+layout(binding = 2) uniform sampler2D gAlbedo;
+layout(binding = 3) uniform usampler2D ismAll;
+layout(binding = 4) uniform usampler2D ismReal;
+layout(location = 0) out vec4 outRv;
+layout(location = 1) out vec4 outR;
+
+// Distance (m) of the nearest splatted point in direction w from the VPL, +inf if none.
+float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
+    int tile = flags.z, perRow = flags.w;
+    ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
+    ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
+    return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 P = texelFetch(gPosition, px, 0);
+    int origin = int(P.w + 0.5);
+    outRv = vec4(0.0);
+    outR = vec4(0.0);
+    if (origin == ORIGIN_NONE) return;
+    bool pReal = origin == ORIGIN_REAL;
+    vec3 p = P.xyz;
+    vec3 n = texelFetch(gNormal, px, 0).xyz;
+    vec4 A = texelFetch(gAlbedo, px, 0);
+    vec3 diffuse = A.rgb * (1.0 - A.a) / PI;
+    int K = max(counts.z, 1);
+    int group = (px.x % K) + K * (px.y % K);
+    float clamp2 = params.x * params.x;
+    vec3 rv = vec3(0.0), r = vec3(0.0);
+    for (int i = group; i < counts.y; i += K * K) {
+        GpuVpl V = vpls[i];
+        if (V.normal.w < 0.5) continue;
+        vec3 d = p - V.positionReal.xyz;
+        float dist2 = dot(d, d);
+        if (dist2 < 1e-10) continue;
+        float dist = sqrt(dist2);
+        vec3 w = d / dist;
+        float cosQ = dot(V.normal.xyz, w), cosP = dot(n, -w);
+        if (cosQ <= 0.0 || cosP <= 0.0) continue;
+        vec3 c = diffuse * V.flux.rgb / PI * cosQ * cosP / max(dist2, clamp2);
+        float bias = 0.02 + 0.03 * dist;
+        vec2 puv = paraboloidUv(V, w);
+        bool visAll = dist - bias <= ismDistance(ismAll, i, puv);
+        if (visAll) rv += c;
+        if (V.positionReal.w > 0.5 && pReal) {
+            bool visReal = dist - bias <= ismDistance(ismReal, i, puv);
+            if (visReal) r += c;
+        }
+    }
+    float scale = float(K * K);
+    outRv = vec4(allFinite(rv) ? rv * scale : vec3(0.0), 1.0);
+    outR = vec4(allFinite(r) ? r * scale : vec3(0.0), 1.0);
+}

@@ -1,0 +1,61 @@
+#include "render/passes/ism/IsmPass.h"
+
+#include <cmath>
+
+#include "render/Shaders.h"
+#include "render/passes/vpl/VplPass.h"
+
+namespace mirage::render {
+
+IsmPass::IsmPass(const VplPass& vpls)
+    : vpls_(vpls),
+      program_("ism", {{GL_COMPUTE_SHADER, "passes/ism/ism.comp",
+                        shaders::source("passes/ism/ism.comp")}}) {}
+
+int IsmPass::tilesPerRow(int vplCount) {
+    return std::max(1, int(std::ceil(std::sqrt(double(std::max(vplCount, 1))))));
+}
+
+PassDecision IsmPass::decide(const FrameContext& ctx) const {
+    if (!ctx.plan.needVpls) return {false, "no VPLs this frame"};
+    return {true, std::to_string(ctx.options.vplCount) + " VPLs x " +
+                      std::to_string(ctx.options.ismPointsPerVpl) + " points" +
+                      (ctx.plan.needRealOnlyIsm ? ", plus a real-only atlas"
+                                                : ", no virtual points: one atlas")};
+}
+
+void IsmPass::resize(const FrameContext& ctx) {
+    const int size = tilesPerRow(ctx.options.vplCount) * ctx.options.ismTileSize;
+    if (size == allocatedSize_) return;
+    all_ = gl::Texture::create2D("ism atlas", size, size, GL_R32UI);
+    real_ = gl::Texture::create2D("ism atlas real-only", size, size, GL_R32UI);
+    all_.setFilter(GL_NEAREST, GL_NEAREST);
+    real_.setFilter(GL_NEAREST, GL_NEAREST);
+    allocatedSize_ = size;
+}
+
+void IsmPass::execute(FrameContext& ctx) {
+    const GLuint far = 0x7F800000u;  // +inf as float bits: nothing splatted
+    glClearTexImage(all_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &far);
+    if (ctx.plan.needRealOnlyIsm)
+        glClearTexImage(real_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &far);
+    program_.use();
+    ctx.bindFrameBlocks();
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.vplBuffer().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingIsmPoints,
+                     ctx.scene.surfacePointBuffer().id());
+    glBindImageTexture(0, all_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(1, real_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glUniform1i(program_.uniformLocation("pointCount"), ctx.scene.surfacePointCount());
+    glUniform1i(program_.uniformLocation("writeReal"), ctx.plan.needRealOnlyIsm ? 1 : 0);
+    const float perVpl = float(std::max(1, ctx.options.ismPointsPerVpl));
+    glUniform1f(program_.uniformLocation("pointRadius"),
+                std::sqrt(ctx.scene.surfaceArea() / (3.14159265f * perVpl)));
+    const long long invocations = (long long)ctx.options.vplCount * ctx.options.ismPointsPerVpl;
+    glDispatchCompute(GLuint((invocations + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    ctx.publish(Resource::ImperfectShadowMaps, &all_);
+    ctx.publish(Resource::ImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? &real_ : &all_);
+}
+
+}  // namespace mirage::render

@@ -1,0 +1,105 @@
+#include "render/passes/shadow/ShadowPass.h"
+
+#include "render/Shaders.h"
+
+namespace mirage::render {
+
+ShadowPass::ShadowPass()
+    : program_("shadow", {{GL_VERTEX_SHADER, "passes/shadow/shadow.vert",
+                           shaders::source("passes/shadow/shadow.vert")},
+                          {GL_FRAGMENT_SHADER, "passes/shadow/shadow.frag",
+                           shaders::source("passes/shadow/shadow.frag")}}),
+      fbo_("shadow fbo") {
+    locModel_ = program_.uniformLocation("model");
+    locNormal_ = program_.uniformLocation("normalMatrix");
+    locViewProj_ = program_.uniformLocation("lightViewProj");
+    locLight_ = program_.uniformLocation("lightIndex");
+    locMaterial_ = program_.uniformLocation("materialIndex");
+    locOrigin_ = program_.uniformLocation("origin");
+}
+
+PassDecision ShadowPass::decide(const FrameContext& ctx) const {
+    if (ctx.plan.shadowLayers == 0) return {false, "no light has a shadow caster in its cone"};
+    int n = 0, real = 0;
+    for (const LightPlan& l : ctx.plan.lights) {
+        n += l.castsShadow;
+        real += l.needsRealOnlyMap;
+    }
+    return {true, std::to_string(n) + " light(s) with casters in the cone, " +
+                      std::to_string(ctx.plan.shadowLayers) + " layer(s); " + std::to_string(real) +
+                      " need a real-only map" + (ctx.plan.needVpls ? "; RSMs for VPLs" : "")};
+}
+
+void ShadowPass::resize(const FrameContext& ctx) {
+    const int layers = std::max(1, ctx.plan.shadowLayers), s = ctx.options.shadowMapSize;
+    if (layers == allocatedLayers_ && s == allocatedSize_) return;
+    distance_ = gl::Texture::create2DArray("shadow distance", s, s, layers, GL_R32F);
+    distanceReal_ = gl::Texture::create2DArray("shadow distance real-only", s, s, layers, GL_R32F);
+    rsmFlux_ = gl::Texture::create2DArray("rsm flux", s, s, layers, GL_RGBA16F);
+    rsmNormal_ = gl::Texture::create2DArray("rsm normal", s, s, layers, GL_RGBA16F);
+    rsmPosition_ = gl::Texture::create2DArray("rsm position", s, s, layers, GL_RGBA32F);
+    for (gl::Texture* t : {&distance_, &distanceReal_, &rsmFlux_, &rsmNormal_, &rsmPosition_})
+        t->setFilter(GL_NEAREST, GL_NEAREST);
+    depth_ = gl::Texture::create2D("shadow depth", s, s, GL_DEPTH_COMPONENT32F);
+    allocatedLayers_ = layers;
+    allocatedSize_ = s;
+}
+
+void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm) {
+    const LightPlan& lp = ctx.plan.lights[size_t(light)];
+    const int atlasLayer = lp.firstLayer + layer;
+    fbo_.attachColorLayer(0, realOnly ? distanceReal_ : distance_, atlasLayer);
+    const int colorCount = rsm ? 4 : 1;
+    if (rsm) {
+        fbo_.attachColorLayer(1, rsmFlux_, atlasLayer);
+        fbo_.attachColorLayer(2, rsmNormal_, atlasLayer);
+        fbo_.attachColorLayer(3, rsmPosition_, atlasLayer);
+    } else {
+        for (int i = 1; i < 4; ++i)
+            glNamedFramebufferTexture(fbo_.id(), GLenum(GL_COLOR_ATTACHMENT0 + i), 0, 0);
+    }
+    fbo_.attachDepth(depth_);
+    fbo_.finalize(colorCount);
+    const float far[4] = {1e30f, 0, 0, 0}, zero[4] = {0, 0, 0, 0}, one = 1.0f;
+    glClearBufferfv(GL_COLOR, 0, far);
+    for (int i = 1; i < colorCount; ++i) glClearBufferfv(GL_COLOR, i, zero);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    const glm::mat4& vp = ctx.lightBlock.lights[light].viewProj[layer];
+    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
+    glUniform1i(locLight_, light);
+    for (const DrawItem& d : ctx.scene.draws()) {
+        if (realOnly && d.origin != Origin::Real) continue;
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
+        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
+        glUniform1i(locMaterial_, d.material);
+        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
+        ctx.scene.drawItem(d);
+    }
+}
+
+void ShadowPass::execute(FrameContext& ctx) {
+    fbo_.bind();
+    glViewport(0, 0, allocatedSize_, allocatedSize_);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    program_.use();
+    ctx.bindFrameBlocks();
+    ctx.scene.bindGeometry();
+    for (size_t i = 0; i < ctx.plan.lights.size(); ++i) {
+        const LightPlan& lp = ctx.plan.lights[i];
+        if (!lp.castsShadow) continue;
+        for (int layer = 0; layer < lp.layers; ++layer) {
+            renderLayer(ctx, int(i), layer, false, ctx.plan.needVpls && lp.hasRsm);
+            if (lp.needsRealOnlyMap) renderLayer(ctx, int(i), layer, true, false);
+        }
+    }
+    glDisable(GL_DEPTH_TEST);
+    ctx.publish(Resource::ShadowMaps, &distance_);
+    ctx.publish(Resource::ShadowMapsReal,
+                ctx.plan.needRealOnlyShadows ? &distanceReal_ : &distance_);
+    if (ctx.plan.needVpls) ctx.publish(Resource::ReflectiveShadowMaps, &rsmFlux_);
+}
+
+}  // namespace mirage::render

@@ -1,0 +1,35 @@
+#version 450 core
+#include "common.glsl"
+#include "lighting.glsl"
+// Writes the occluder distance of one shadow layer and, for reflective shadow maps (Dachsbacher
+// & Stamminger 2005), what a VPL there needs: the reflected radiant intensity per unit solid
+// angle of the light (flux / steradian, linear RGB), the surface normal facing the light, the
+// world position and whether the surface is real.
+layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+uniform int lightIndex;
+uniform int materialIndex;
+uniform int origin;
+in vec3 worldPos;
+in vec3 worldNormal;
+layout(location = 0) out float outDistance;  // metres from the light (see lightDistance)
+layout(location = 1) out vec4 outFlux;       // rgb W/sr * albedo (W/m^2 * albedo for dir.), a = real
+layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light
+layout(location = 3) out vec4 outPosition;   // xyz world position (m), w = 1
+
+void main() {
+    const int li = lightIndex;
+    outDistance = lightDistance(li, worldPos);
+    GpuMaterial m = materials[materialIndex];
+    bool directional = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL;
+    vec3 toLight = directional ? -lights[li].directionType.xyz
+                               : normalize(lights[li].positionRange.xyz - worldPos);
+    vec3 n = normalize(worldNormal);
+    if (!allFinite(n)) n = toLight;
+    if (dot(n, toLight) < 0.0) n = -n;
+    float dist = length(lights[li].positionRange.xyz - worldPos);
+    float atten = directional ? 1.0 : spotAttenuation(li, -toLight) * rangeWindow(li, dist);
+    vec3 diffuseAlbedo = m.baseColor.rgb * (1.0 - clamp(m.params.x, 0.0, 1.0));
+    outFlux = vec4(lights[li].radiantIntensity.rgb * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
+    outNormal = vec4(n, 0.0);
+    outPosition = vec4(worldPos, 1.0);
+}

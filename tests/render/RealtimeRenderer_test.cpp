@@ -1,0 +1,424 @@
+// The real-time renderer on llvmpipe, against closed forms and the routing rules of differential
+// instant radiosity (DESIGN.md "Real and virtual"). Small images so the suite stays fast.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/Error.h"
+#include "core/gl/Context.h"
+#include "core/image/ImageIO.h"
+#include "render/Renderer.h"
+#include "tests/render/RenderTestScenes.h"
+#include "tests/support/TestSupport.h"
+
+namespace mirage::render {
+namespace {
+
+using test::addBox;
+using test::addFloor;
+using test::addLight;
+using test::addMaterial;
+using test::lookAtPose;
+using test::smallCamera;
+
+class RealtimeRenderer : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        context_ = std::make_unique<gl::Context>(gl::Context::headless());
+    }
+    static void TearDownTestSuite() { context_.reset(); }
+    static std::unique_ptr<gl::Context> context_;
+};
+std::unique_ptr<gl::Context> RealtimeRenderer::context_;
+
+// Independent CPU evaluation of the shading model (Lambert + GGX/Smith-Schlick/Schlick, glTF
+// metallic-roughness) for the closed-form checks.
+glm::dvec3 brdfCos(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::dvec3 base, double metallic,
+                   double roughness) {
+    const double NL = std::max(glm::dot(n, l), 0.0), NV = std::max(glm::dot(n, v), 1e-4);
+    if (NL <= 0) return glm::dvec3(0);
+    const glm::dvec3 h = glm::normalize(l + v);
+    const double NH = std::max(glm::dot(n, h), 0.0), VH = std::max(glm::dot(v, h), 0.0);
+    const double a = std::max(roughness * roughness, 1e-3), a2 = a * a;
+    const double dd = NH * NH * (a2 - 1) + 1;
+    const double D = a2 / (M_PI * dd * dd), k = a / 2;
+    const double G = NL / (NL * (1 - k) + k) * NV / (NV * (1 - k) + k);
+    const glm::dvec3 F0 = glm::mix(glm::dvec3(0.04), base, metallic);
+    const glm::dvec3 F = F0 + (1.0 - F0) * std::pow(1 - VH, 5.0);
+    return ((1.0 - F) * (1 - metallic) * base / M_PI + D * G * F / (4 * NL * NV)) * NL;
+}
+
+// World point on the plane y = 0 seen by pixel (x, y) of a pinhole camera, if any.
+std::optional<glm::dvec3> floorHit(const CameraIntrinsics& cam, const Pose& T_world_camera, int x,
+                                   int y) {
+    auto ray = cam.unproject(glm::dvec2(x, y));
+    if (!ray) return std::nullopt;
+    const glm::dvec3 d = T_world_camera.rotationMatrix() * *ray;
+    const glm::dvec3 o = T_world_camera.translation;
+    if (d.y >= -1e-9) return std::nullopt;
+    return o + d * (-o.y / d.y);
+}
+
+bool allFinite(const cv::Mat& m) {
+    return cv::checkRange(m, true, nullptr, -1e30, 1e30);
+}
+
+struct SpotScene {
+    Scene scene;
+    glm::dvec3 lightPos{0, 2, 0};
+    double intensity = 8.0, outer = 0.6, inner = 0.5, albedo = 0.8;
+    Pose pose = lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
+    CameraIntrinsics cam = smallCamera();
+    SpotScene() {
+        int m = addMaterial(scene, glm::vec3(float(albedo)));
+        addFloor(scene, "floor", 0.0f, 4.0f, m, Origin::Real);
+        addLight(scene, Light::Type::Spot, glm::vec3(lightPos), {0, -1, 0}, float(intensity),
+                 Origin::Real, float(outer), float(inner));
+    }
+    // Closed-form radiance (linear) of the lit floor at p, inside the inner cone.
+    glm::dvec3 expected(glm::dvec3 p, double intensityScale = 1.0) const {
+        const glm::dvec3 l = lightPos - p;
+        const double d2 = glm::dot(l, l);
+        return brdfCos({0, 1, 0}, glm::normalize(pose.translation - p), glm::normalize(l),
+                       glm::dvec3(albedo), 0.0, 1.0) *
+               (intensity * intensityScale / d2);
+    }
+    double coneAngle(glm::dvec3 p) const {
+        return std::acos(glm::dot(glm::normalize(p - lightPos), glm::dvec3(0, -1, 0)));
+    }
+};
+
+// The image of a lit plane matches the closed-form irradiance from a spot light (E = I cos / d^2
+// through the BRDF), inside the inner cone, and is black outside the outer cone.
+TEST_F(RealtimeRenderer, SpotLitPlaneMatchesClosedForm) {
+    SpotScene s;
+    Renderer r(s.scene, s.cam);
+    const FrameReport& rep = r.render({s.pose, {}, false});
+    EXPECT_TRUE(rep.ran("gbuffer"));
+    EXPECT_TRUE(rep.ran("direct"));
+    cv::Mat rv = r.readBuffer(Resource::DirectRv), lr = r.readBuffer(Resource::DirectR);
+    int inside = 0, outside = 0;
+    for (int y = 0; y < s.cam.height; ++y)
+        for (int x = 0; x < s.cam.width; ++x) {
+            auto p = floorHit(s.cam, s.pose, x, y);
+            if (!p || std::abs(p->x) > 1.9 || std::abs(p->z) > 1.9) continue;
+            const double angle = s.coneAngle(*p);
+            const cv::Vec3f got = rv.at<cv::Vec3f>(y, x);
+            if (angle < s.inner - 0.03) {
+                const glm::dvec3 e = s.expected(*p);
+                ASSERT_NEAR(got[0], e.x, 0.01 * e.x + 1e-4) << "pixel " << x << "," << y;
+                ASSERT_NEAR(got[1], e.y, 0.01 * e.y + 1e-4);
+                ASSERT_NEAR(lr.at<cv::Vec3f>(y, x)[0], got[0], 1e-6);  // all real: L_r == L_rv
+                ++inside;
+            } else if (angle > s.outer + 0.03) {
+                ASSERT_EQ(got[0], 0.0f);
+                ++outside;
+            }
+        }
+    EXPECT_GT(inside, 500);
+    EXPECT_GT(outside, 500);
+}
+
+// The comparison used above catches a broken render: a 30 % too bright light and a light 30 cm
+// off both fall far below the PSNR the correct render reaches against the closed form.
+TEST_F(RealtimeRenderer, ClosedFormComparisonFailsOnBrokenRender) {
+    SpotScene s;
+    cv::Mat expected(s.cam.height, s.cam.width, CV_32FC3, cv::Scalar(0, 0, 0));
+    cv::Mat mask(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
+    for (int y = 0; y < s.cam.height; ++y)
+        for (int x = 0; x < s.cam.width; ++x) {
+            auto p = floorHit(s.cam, s.pose, x, y);
+            if (!p || std::abs(p->x) > 1.9 || std::abs(p->z) > 1.9 || s.coneAngle(*p) > s.inner)
+                continue;
+            glm::dvec3 e = s.expected(*p);
+            expected.at<cv::Vec3f>(y, x) = cv::Vec3f(float(e.x), float(e.y), float(e.z));
+            mask.at<uint8_t>(y, x) = 255;
+        }
+    auto renderMasked = [&](const Scene& scene, const Pose& pose) {
+        Renderer r(scene, s.cam);
+        r.render({pose, {}, false});
+        cv::Mat got = r.readBuffer(Resource::DirectRv), out(got.size(), got.type(), cv::Scalar(0));
+        got.copyTo(out, mask);
+        return out;
+    };
+    double peak = 0;  // the brightest expected radiance (linear)
+    cv::minMaxLoc(expected.reshape(1), nullptr, &peak);
+    const double good = test::psnr(renderMasked(s.scene, s.pose), expected, peak);
+    EXPECT_GT(good, 45.0);
+    std::printf("closed-form PSNR %.1f dB\n", good);
+    Scene bright = s.scene;
+    bright.lights[0].intensity *= 1.3f;
+    EXPECT_LT(test::psnr(renderMasked(bright, s.pose), expected, peak), 30.0);
+    Scene shifted = s.scene;  // the light 30 cm off its calibrated position
+    shifted.nodes[1].world[3].x += 0.3;
+    EXPECT_LT(test::psnr(renderMasked(shifted, s.pose), expected, peak), 30.0);
+}
+
+// A virtual box's shadow on the real floor appears only in L_rv; L_r keeps the unshadowed light,
+// so the composite darkens the camera image there and leaves it unchanged elsewhere.
+TEST_F(RealtimeRenderer, VirtualShadowOnlyInLrv) {
+    SpotScene s;
+    s.lightPos = {1.2, 2.0, 0.0};
+    s.scene = Scene{};
+    int white = addMaterial(s.scene, glm::vec3(float(s.albedo)));
+    addFloor(s.scene, "floor", 0.0f, 4.0f, white, Origin::Real);
+    const glm::vec3 lo(-0.2f, 0.0f, -0.2f), hi(0.2f, 0.4f, 0.2f);
+    addBox(s.scene, "virtual box", lo, hi, white, Origin::Virtual);
+    const glm::dvec3 axis = glm::normalize(glm::dvec3(-0.6, 0, 0) - s.lightPos);
+    addLight(s.scene, Light::Type::Spot, glm::vec3(s.lightPos), glm::vec3(axis), 8.0f, Origin::Real,
+             1.0f, 0.9f);
+    RendererOptions opt;
+    opt.vplCount = 64;
+    Renderer r(s.scene, s.cam, opt);
+    // Footage: the real world alone, as the camera would see it (L_r, sRGB-encoded).
+    r.render({s.pose, {}, false});
+    cv::Mat footage = linearRgbToSrgbBgr8(r.readBuffer(Resource::LR));
+    const FrameReport& rep = r.render({s.pose, footage, false});
+    EXPECT_TRUE(rep.ran("shadow"));
+    EXPECT_TRUE(rep.ran("vpl")) << rep.summary();
+    EXPECT_TRUE(r.plan().lights[0].needsRealOnlyMap);
+    cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
+    cv::Mat comp = r.compositeLinear(), cover = r.coverage();
+    cv::Mat ci = srgbBgr8ToLinearRgb(footage);
+
+    // Segment p -> light against the box (slab test), shrunk/grown to stay off the penumbra.
+    auto blocked = [&](glm::dvec3 p, double grow) {
+        glm::dvec3 d = s.lightPos - p, l = glm::dvec3(lo) - grow, h = glm::dvec3(hi) + grow;
+        double t0 = 0, t1 = 1;
+        for (int i = 0; i < 3; ++i) {
+            if (std::abs(d[i]) < 1e-12) {
+                if (p[i] < l[i] || p[i] > h[i]) return false;
+                continue;
+            }
+            double a = (l[i] - p[i]) / d[i], b = (h[i] - p[i]) / d[i];
+            t0 = std::max(t0, std::min(a, b));
+            t1 = std::min(t1, std::max(a, b));
+        }
+        return t0 <= t1;
+    };
+    int shadowed = 0, lit = 0;
+    for (int y = 0; y < s.cam.height; ++y)
+        for (int x = 0; x < s.cam.width; ++x) {
+            if (cover.at<uint8_t>(y, x) != 1) continue;
+            auto p = floorHit(s.cam, s.pose, x, y);
+            if (!p || s.coneAngle(*p) > 0.85) continue;
+            const float rv = drv.at<cv::Vec3f>(y, x)[0], rr = dr.at<cv::Vec3f>(y, x)[0];
+            if (blocked(*p, -0.04)) {  // well inside the shadow
+                EXPECT_LT(rv, 0.05f * rr) << x << "," << y;
+                EXPECT_GT(rr, 0.05f);
+                EXPECT_LT(comp.at<cv::Vec3f>(y, x)[0], 0.6f * ci.at<cv::Vec3f>(y, x)[0]);
+                ++shadowed;
+            } else if (!blocked(*p, 0.06)) {  // well outside
+                EXPECT_NEAR(rv, rr, 1e-4f);
+                ++lit;
+            }
+        }
+    EXPECT_GT(shadowed, 30);
+    EXPECT_GT(lit, 1000);
+    // Away from the box, the composite is the footage (within the VPL bleeding it adds).
+    cv::Mat realMask = cover == 1;
+    EXPECT_GT(test::psnr(comp.clone().setTo(0, ~realMask), ci.clone().setTo(0, ~realMask), 1.0),
+              20.0);
+    // The box itself shows L_rv.
+    EXPECT_GT(cv::countNonZero(cover == 2), 100);
+}
+
+// With only real objects, routing puts everything in both solutions: L_rv == L_r (VPLs, ISMs
+// and shadows included, pass culling off) and the composite reproduces the camera image.
+TEST_F(RealtimeRenderer, RealOnlySceneCompositeEqualsFootage) {
+    SpotScene s;
+    int red = addMaterial(s.scene, {0.8f, 0.1f, 0.1f});
+    addBox(s.scene, "real box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f}, red, Origin::Real);
+    RendererOptions opt;
+    opt.cullPasses = false;
+    opt.vplCount = 64;
+    Renderer r(s.scene, s.cam, opt);
+    cv::Mat footage(s.cam.height, s.cam.width, CV_8UC3);
+    cv::randu(footage, 0, 255);
+    const FrameReport& rep = r.render({s.pose, footage, false});
+    ASSERT_TRUE(rep.ran("vpl")) << rep.summary();
+    ASSERT_TRUE(rep.ran("ism"));
+    ASSERT_TRUE(rep.ran("gifilter"));
+    cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
+    EXPECT_LE(cv::norm(rv, lr, cv::NORM_INF), 1e-6);
+    EXPECT_GT(cv::norm(rv, cv::NORM_INF), 0.1);  // something was lit
+    EXPECT_GT(test::psnr(r.compositeSrgb(), footage, 255.0), 50.0);
+}
+
+// A black real surface (L_r = 0) and a virtual light on a surface real light does not reach:
+// alpha stays finite (fades to 1 where L_r ~ 0), the composite is finite and bounded.
+TEST_F(RealtimeRenderer, ZeroLrIsGuarded) {
+    Scene scene;
+    int black = addMaterial(scene, glm::vec3(0.0f));
+    int grey = addMaterial(scene, glm::vec3(0.5f));
+    addFloor(scene, "black floor", 0.0f, 4.0f, black, Origin::Real);
+    addFloor(scene, "grey tile", 0.001f, 1.0f, grey, Origin::Real, 0.8f, 0.0f);
+    addLight(scene, Light::Type::Spot, {0, 2, 0}, {0, -1, 0}, 20.0f, Origin::Virtual, 1.0f, 0.9f);
+    const CameraIntrinsics cam = smallCamera();
+    const Pose pose = lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
+    Renderer r(scene, cam);
+    cv::Mat footage(cam.height, cam.width, CV_8UC3, cv::Scalar(40, 90, 140));
+    r.render({pose, footage, false});
+    cv::Mat comp = r.compositeLinear(), lr = r.readBuffer(Resource::DirectR),
+            rv = r.readBuffer(Resource::DirectRv);
+    ASSERT_TRUE(allFinite(comp));
+    EXPECT_EQ(cv::norm(lr, cv::NORM_INF), 0.0);  // a virtual light never reaches L_r
+    EXPECT_GT(cv::norm(rv, cv::NORM_INF), 0.5);  // but lights the grey tile in L_rv
+    cv::Mat ci = srgbBgr8ToLinearRgb(footage);
+    double maxRv = cv::norm(rv, cv::NORM_INF);
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float v = comp.at<cv::Vec3f>(y, x)[c];
+                ASSERT_GE(v, 0.0f);
+                ASSERT_LE(v, ci.at<cv::Vec3f>(y, x)[c] + maxRv + 1e-3) << x << "," << y;
+            }
+}
+
+// A very bright light and a virtual object crossing the near plane: no NaN or Inf in any buffer.
+TEST_F(RealtimeRenderer, BrightLightAndNearPlaneStayFinite) {
+    Scene scene;
+    int white = addMaterial(scene, glm::vec3(0.9f));
+    addFloor(scene, "floor", 0.0f, 4.0f, white, Origin::Real);
+    addLight(scene, Light::Type::Point, {0.3f, 1.0f, 0.0f}, {0, -1, 0}, 1e7f, Origin::Real);
+    const Pose pose = lookAtPose({0, 1.0, 2.0}, {0, 0, 0});
+    // A virtual box whose front part is behind the camera: it crosses the near plane.
+    addBox(scene, "near box", {-0.3f, 0.7f, 1.6f}, {0.3f, 1.3f, 2.4f}, white, Origin::Virtual);
+    const CameraIntrinsics cam = smallCamera();
+    Renderer r(scene, cam);
+    cv::Mat footage(cam.height, cam.width, CV_8UC3, cv::Scalar(200, 200, 200));
+    const FrameReport& rep = r.render({pose, footage, false});
+    ASSERT_TRUE(rep.ran("vpl")) << rep.summary();
+    for (Resource b : {Resource::DirectRv, Resource::DirectR, Resource::LRv, Resource::LR})
+        EXPECT_TRUE(allFinite(r.readBuffer(b))) << resourceName(b);
+    EXPECT_TRUE(allFinite(r.compositeLinear()));
+    EXPECT_GT(cv::countNonZero(r.coverage() == 2), 50);
+    cv::Mat srgb = r.compositeSrgb();
+    double maxVal = 0;
+    cv::minMaxLoc(srgb.reshape(1), nullptr, &maxVal);
+    EXPECT_EQ(maxVal, 255.0);
+}
+
+// Passes run only when the scene needs them, and say why.
+TEST_F(RealtimeRenderer, ReportsWhichPassesRanAndWhy) {
+    SpotScene s;
+    {
+        Renderer r(s.scene, s.cam);
+        const FrameReport& rep = r.render({s.pose, {}, false});
+        EXPECT_TRUE(rep.ran("shadow"));
+        EXPECT_FALSE(rep.ran("vpl"));
+        EXPECT_FALSE(rep.ran("ism"));
+        EXPECT_FALSE(rep.ran("indirect"));
+        EXPECT_TRUE(rep.ran("composite"));
+        EXPECT_NE(rep.summary().find("no light reaches a virtual object"), std::string::npos)
+            << rep.summary();
+        for (const PassReport& p : rep.passes) EXPECT_FALSE(p.reason.empty()) << p.name;
+    }
+    {
+        Scene up = s.scene;  // the spot light turned to the sky: no caster in its cone
+        int m = addMaterial(up, glm::vec3(0.5f));
+        addBox(up, "virtual box", {-0.1f, 0.0f, -0.1f}, {0.1f, 0.2f, 0.1f}, m, Origin::Virtual);
+        up.nodes[1].world = glm::dmat4(1.0);            // node -Z = world -Z, light at the origin
+        up.nodes[1].world[3] = glm::dvec4(0, 5, 0, 1);  // outside the floor's bounds
+        up.nodes[1].world[2] = glm::dvec4(0, -1, 0, 0);
+        up.nodes[1].world[1] = glm::dvec4(0, 0, 1, 0);
+        Renderer r(up, s.cam);
+        const FrameReport& rep = r.render({s.pose, {}, false});
+        EXPECT_FALSE(rep.ran("shadow")) << rep.summary();
+        EXPECT_NE(rep.summary().find("no light has a shadow caster"), std::string::npos);
+        EXPECT_FALSE(rep.ran("vpl"));
+    }
+}
+
+// VPLs on a lit virtual red wall bleed red onto the real white floor: in L_rv only.
+TEST_F(RealtimeRenderer, VirtualColourBleedsOntoRealFloor) {
+    Scene scene;
+    int white = addMaterial(scene, glm::vec3(0.8f));
+    int red = addMaterial(scene, {0.9f, 0.05f, 0.05f});
+    addFloor(scene, "floor", 0.0f, 4.0f, white, Origin::Real);
+    addBox(scene, "red wall", {0.3f, 0.0f, -0.6f}, {0.5f, 0.8f, 0.6f}, red, Origin::Virtual);
+    addLight(scene, Light::Type::Spot, {-0.8f, 1.2f, 0.0f},
+             glm::normalize(glm::vec3(0.4f, 0.3f, 0.0f) - glm::vec3(-0.8f, 1.2f, 0.0f)), 10.0f,
+             Origin::Real, 1.0f, 0.9f);
+    const CameraIntrinsics cam = smallCamera();
+    const Pose pose = lookAtPose({-0.5, 1.6, 2.2}, {0.1, 0.0, 0.0});
+    Renderer r(scene, cam);
+    r.render({pose, {}, false});
+    cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
+    // For inspection (linear EXR; PNG is sRGB-encoded).
+    const auto out = test::outputDir("realtime_bleed");
+    writeLinearRgb(out / "L_rv.exr", rv);
+    writeLinearRgb(out / "L_r.exr", lr);
+    writeLinearRgb(out / "L_rv.png", rv);
+    writeLinearRgb(out / "L_r.png", lr);
+    cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
+    cv::Mat cover = r.coverage();
+    double sumR = 0, sumG = 0;
+    int n = 0;
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            auto p = floorHit(cam, pose, x, y);
+            if (!p || cover.at<uint8_t>(y, x) != 1) continue;
+            if (p->x < 0.0 || p->x > 0.28 || std::abs(p->z) > 0.4) continue;
+            // Indirect difference only (direct light is not shadowed there).
+            cv::Vec3f d = (rv.at<cv::Vec3f>(y, x) - drv.at<cv::Vec3f>(y, x)) -
+                          (lr.at<cv::Vec3f>(y, x) - dr.at<cv::Vec3f>(y, x));
+            sumR += d[0];
+            sumG += d[1];
+            ++n;
+        }
+    ASSERT_GT(n, 50);
+    EXPECT_GT(sumR / n, 0.005);
+    EXPECT_GT(sumR, 4.0 * std::abs(sumG));
+}
+
+// Temporal smoothing: history is used on the next frame of a static view and dropped on a
+// reset (cut or tracking loss); a static scene converges to the same image either way.
+TEST_F(RealtimeRenderer, TemporalHistoryUsedAndReset) {
+    SpotScene s;
+    int m = addMaterial(s.scene, {0.2f, 0.7f, 0.2f});
+    addBox(s.scene, "virtual box", {-0.2f, 0.0f, -0.2f}, {0.2f, 0.4f, 0.2f}, m, Origin::Virtual);
+    Renderer r(s.scene, s.cam);
+    r.render({s.pose, {}, false});
+    EXPECT_NE(r.lastReport().summary().find("history reset"), std::string::npos);
+    cv::Mat first = r.readBuffer(Resource::LRv);
+    r.render({s.pose, {}, false});
+    EXPECT_NE(r.lastReport().summary().find("history used"), std::string::npos);
+    cv::Mat second = r.readBuffer(Resource::LRv);
+    EXPECT_GT(test::psnr(first, second, 1.0), 50.0);  // static: nothing to flicker
+    r.render({s.pose, {}, true});
+    EXPECT_NE(r.lastReport().summary().find("history reset"), std::string::npos);
+    // A moving camera reprojects history without producing NaN.
+    for (int i = 0; i < 3; ++i) {
+        Pose p = lookAtPose({0.1 * i, 2.5, 2.5}, {0, 0, 0});
+        r.render({p, {}, false});
+        EXPECT_TRUE(allFinite(r.readBuffer(Resource::LRv)));
+    }
+}
+
+// Constant environment radiance Le on a Lambertian plane: L = albedo * Le (irradiance pi Le).
+TEST_F(RealtimeRenderer, ConstantEnvironmentGivesAlbedoTimesRadiance) {
+    const auto dir = test::outputDir("realtime_env");
+    cv::Mat env(32, 64, CV_32FC3, cv::Scalar(0.7, 0.7, 0.7));
+    writeLinearRgb(dir / "env.exr", env);
+    Scene scene;
+    int m = addMaterial(scene, glm::vec3(0.5f));
+    addFloor(scene, "floor", 0.0f, 4.0f, m, Origin::Real);
+    scene.environment.kind = Environment::Kind::Equirectangular;
+    scene.environment.image = dir / "env.exr";
+    const CameraIntrinsics cam = smallCamera();
+    Renderer r(scene, cam);
+    r.render({lookAtPose({0, 2.5, 2.5}, {0, 0, 0}), {}, false});
+    cv::Mat rv = r.readBuffer(Resource::DirectRv);
+    // Lambert part 0.5 * 0.7 = 0.35 (plus (1-F) weighting: F0 = 0.04 -> within 5 %).
+    const cv::Vec3f c = rv.at<cv::Vec3f>(cam.height / 2, cam.width / 2);
+    EXPECT_NEAR(c[0], 0.35, 0.35 * 0.05);
+}
+
+}  // namespace
+}  // namespace mirage::render

@@ -1,0 +1,122 @@
+#pragma once
+// Scenes built in code for the real-time renderer tests (small, analytic). World = glTF frame
+// (metres, +Y up); camera poses are T_world_camera with OpenCV axes.
+#include <cmath>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "core/camera/CameraModel.h"
+#include "core/math/Pose.h"
+#include "core/scene/Scene.h"
+
+namespace mirage::test {
+
+inline int addMaterial(Scene& s, glm::vec3 albedo, float roughness = 1.0f, float metallic = 0.0f) {
+    Material m;
+    m.name = "m" + std::to_string(s.materials.size());
+    m.baseColor = glm::vec4(albedo, 1.0f);
+    m.roughness = roughness;
+    m.metallic = metallic;
+    s.materials.push_back(m);
+    return int(s.materials.size()) - 1;
+}
+
+inline void addMeshNode(Scene& s, const std::string& name, Primitive prim, Origin origin,
+                        const glm::dmat4& world = glm::dmat4(1.0)) {
+    Mesh mesh;
+    mesh.name = name;
+    mesh.primitives.push_back(std::move(prim));
+    s.meshes.push_back(std::move(mesh));
+    Node n;
+    n.name = name;
+    n.mesh = int(s.meshes.size()) - 1;
+    n.local = n.world = world;
+    n.origin = origin;
+    s.nodes.push_back(n);
+    s.roots.push_back(int(s.nodes.size()) - 1);
+}
+
+// Horizontal square at height y, normal +Y, side `size` centred at (cx, y, cz).
+inline void addFloor(Scene& s, const std::string& name, float y, float size, int material,
+                     Origin origin, float cx = 0.0f, float cz = 0.0f) {
+    Primitive p;
+    const float h = size * 0.5f;
+    p.positions = {
+        {cx - h, y, cz - h}, {cx + h, y, cz - h}, {cx + h, y, cz + h}, {cx - h, y, cz + h}};
+    p.normals.assign(4, glm::vec3(0, 1, 0));
+    p.indices = {0, 2, 1, 0, 3, 2};
+    p.material = material;
+    addMeshNode(s, name, std::move(p), origin);
+}
+
+// Axis-aligned box with outward normals (24 vertices, flat faces).
+inline void addBox(Scene& s, const std::string& name, glm::vec3 lo, glm::vec3 hi, int material,
+                   Origin origin) {
+    Primitive p;
+    auto face = [&](glm::vec3 n, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+        uint32_t base = uint32_t(p.positions.size());
+        p.positions.insert(p.positions.end(), {a, b, c, d});
+        p.normals.insert(p.normals.end(), {n, n, n, n});
+        p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    };
+    const glm::vec3 L = lo, H = hi;
+    face({0, 1, 0}, {L.x, H.y, L.z}, {L.x, H.y, H.z}, {H.x, H.y, H.z}, {H.x, H.y, L.z});
+    face({0, -1, 0}, {L.x, L.y, L.z}, {H.x, L.y, L.z}, {H.x, L.y, H.z}, {L.x, L.y, H.z});
+    face({1, 0, 0}, {H.x, L.y, L.z}, {H.x, H.y, L.z}, {H.x, H.y, H.z}, {H.x, L.y, H.z});
+    face({-1, 0, 0}, {L.x, L.y, L.z}, {L.x, L.y, H.z}, {L.x, H.y, H.z}, {L.x, H.y, L.z});
+    face({0, 0, 1}, {L.x, L.y, H.z}, {H.x, L.y, H.z}, {H.x, H.y, H.z}, {L.x, H.y, H.z});
+    face({0, 0, -1}, {L.x, L.y, L.z}, {L.x, H.y, L.z}, {H.x, H.y, L.z}, {H.x, L.y, L.z});
+    p.material = material;
+    addMeshNode(s, name, std::move(p), origin);
+}
+
+// A light node at `pos` shining along `dir` (the node's -Z axis is turned onto dir).
+inline void addLight(Scene& s, Light::Type type, glm::vec3 pos, glm::vec3 dir, float intensity,
+                     Origin origin, float outer = 0.6f, float inner = 0.5f,
+                     glm::vec3 color = glm::vec3(1.0f)) {
+    Light l;
+    l.name = "light" + std::to_string(s.lights.size());
+    l.type = type;
+    l.intensity = intensity;
+    l.color = color;
+    l.outerConeAngle = outer;
+    l.innerConeAngle = inner;
+    s.lights.push_back(l);
+    const glm::dvec3 z = -glm::normalize(glm::dvec3(dir));  // node +Z = -dir
+    const glm::dvec3 up = std::abs(z.y) < 0.99 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+    const glm::dvec3 x = glm::normalize(glm::cross(up, z));
+    const glm::dvec3 y = glm::cross(z, x);
+    glm::dmat4 m(1.0);
+    m[0] = glm::dvec4(x, 0);
+    m[1] = glm::dvec4(y, 0);
+    m[2] = glm::dvec4(z, 0);
+    m[3] = glm::dvec4(glm::dvec3(pos), 1);
+    Node n;
+    n.name = l.name;
+    n.light = int(s.lights.size()) - 1;
+    n.local = n.world = m;
+    n.origin = origin;
+    s.nodes.push_back(n);
+    s.roots.push_back(int(s.nodes.size()) - 1);
+}
+
+// T_world_camera of an OpenCV camera at `eye` looking at `target` (+Y world up).
+inline Pose lookAtPose(glm::dvec3 eye, glm::dvec3 target) {
+    const glm::dvec3 z = glm::normalize(target - eye);
+    const glm::dvec3 x = glm::normalize(glm::cross(z, glm::dvec3(0, 1, 0)));
+    const glm::dvec3 y = glm::cross(z, x);
+    return Pose::fromRotationTranslation(glm::dmat3(x, y, z), eye);
+}
+
+inline CameraIntrinsics smallCamera(int w = 160, int h = 120, double f = 130.0) {
+    CameraIntrinsics c;
+    c.width = w;
+    c.height = h;
+    c.fx = c.fy = f;
+    c.cx = (w - 1) * 0.5;
+    c.cy = (h - 1) * 0.5;
+    return c;
+}
+
+}  // namespace mirage::test
