@@ -420,5 +420,43 @@ TEST_F(RealtimeRenderer, ConstantEnvironmentGivesAlbedoTimesRadiance) {
     EXPECT_NEAR(c[0], 0.35, 0.35 * 0.05);
 }
 
+// Base colour textures are sRGB-decoded and mapped with glTF's UV convention ((0,0) = top left
+// of the image): a 2x2 checker on the floor under a constant environment.
+TEST_F(RealtimeRenderer, BaseColorTextureIsDecodedAndMapped) {
+    const auto dir = test::outputDir("realtime_texture");
+    cv::Mat env(16, 32, CV_32FC3, cv::Scalar(0.7, 0.7, 0.7));
+    writeLinearRgb(dir / "env.exr", env);
+    Scene scene;
+    Texture tex;
+    tex.name = "checker";
+    tex.width = tex.height = 2;
+    tex.srgb = true;
+    // Row 0 (v = 0): encoded 188 (linear 0.503), 0; row 1: 0, 188.
+    tex.pixels = {188, 188, 188, 255, 0, 0, 0, 255, 0, 0, 0, 255, 188, 188, 188, 255};
+    scene.textures.push_back(tex);
+    int m = addMaterial(scene, glm::vec3(1.0f));
+    scene.materials[size_t(m)].baseColorTexture.texture = 0;
+    addFloor(scene, "floor", 0.0f, 4.0f, m, Origin::Real);
+    auto& prim = scene.meshes.back().primitives[0];
+    for (const glm::vec3& p : prim.positions) prim.uv0.push_back({(p.x + 2) / 4, (p.z + 2) / 4});
+    scene.environment.kind = Environment::Kind::Equirectangular;
+    scene.environment.image = dir / "env.exr";
+    const CameraIntrinsics cam = smallCamera();
+    const Pose pose = lookAtPose({0, 4.0, 0.5}, {0, 0, 0});
+    Renderer r(scene, cam);
+    r.render({pose, {}, false});
+    cv::Mat rv = r.readBuffer(Resource::DirectRv);
+    auto at = [&](glm::dvec3 w) {
+        auto px = cam.project(pose.inverse() * w);
+        EXPECT_TRUE(px.has_value());
+        return rv.at<cv::Vec3f>(int(std::lround(px->y)), int(std::lround(px->x)))[0];
+    };
+    const float lit = 0.7f * srgbToLinear(188.0f / 255.0f);
+    EXPECT_NEAR(at({-1, 0, -1}), lit, 0.02);  // u, v = 0.25: texel (0, 0)
+    EXPECT_NEAR(at({1, 0, -1}), 0.0, 0.02);   // texel (1, 0)
+    EXPECT_NEAR(at({-1, 0, 1}), 0.0, 0.02);   // texel (0, 1)
+    EXPECT_NEAR(at({1, 0, 1}), lit, 0.02);
+}
+
 }  // namespace
 }  // namespace mirage::render
