@@ -50,6 +50,10 @@ struct RendererOptions {
     float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
     float nearM = 0.01f, farM = 100.0f;  // camera clip planes (metres)
     bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
+    // glFinish around every pass so each timer query holds only its pass's work. llvmpipe defers
+    // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
+    // without this a pass's time can show up in the next pass's query. For benchmarks.
+    bool syncPasses = false;
 };
 
 struct LightPlan {

@@ -62,6 +62,7 @@ void BM_Frame(benchmark::State& state) {
     const int w = int(state.range(0)), h = int(state.range(1));
     render::RendererOptions opt;
     opt.vplCount = int(state.range(2));
+    opt.syncPasses = true;  // per-pass attribution (see RendererOptions::syncPasses)
     Scene scene = benchScene(int(state.range(3)));
     CameraIntrinsics cam;
     cam.width = w;
