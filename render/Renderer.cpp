@@ -76,6 +76,8 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
                     " is out of range (0..16384)");
     if (options_.interleave < 1 || options_.interleave > 8)
         throw Error("interleave must be 1..8, got " + std::to_string(options_.interleave));
+    if (options_.indirectScale != 1 && options_.indirectScale != 2)
+        throw Error("indirectScale must be 1 or 2, got " + std::to_string(options_.indirectScale));
     if (options_.shadowMapSize < 16 || options_.shadowMapSize > 4096)
         throw Error("shadow map size must be 16..4096");
     if (options_.ismTileSize < 8 || options_.ismTileSize > 256)
