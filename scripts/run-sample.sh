@@ -7,5 +7,5 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${MIRAGE_BUILD_DIR:-$root/build}"
 out="$root/out/sample"
 mkdir -p "$out"
-"$build/app/mirage" info
+
 "$root/scripts/sample-job.sh" "$build/app/mirage" "$root/data" "$out"

@@ -1,8 +1,19 @@
 #!/usr/bin/env bash
 # The main job on the bundled sample, given the mirage binary, the data folder and an output
-# folder. Kept apart from run-sample.sh so that a test can run exactly what the README runs.
+# folder: track the camera in the sample session from its AprilTag board, then composite the
+# tabletop scene's virtual objects into the footage with the tracked poses. Kept apart from
+# run-sample.sh so that a test can run exactly what the README runs.
 set -euo pipefail
 mirage="$1"; data="$2"; out="$3"
 mkdir -p "$out"
-"$mirage" info
-echo "sample job: no renderer yet"
+session="$data/sessions/sample"
+scene="$data/scenes/tabletop/tabletop.gltf"
+
+"$mirage" track "$session" -o "$out/poses.csv"
+"$mirage" replay "$session" --scene "$scene" --poses "$out/poses.csv" -o "$out/replay.mkv"
+
+echo
+echo "sample job done:"
+echo "  composited video:        $out/replay.mkv"
+echo "  per-frame timings/state: $out/replay.csv"
+echo "  tracked camera poses:    $out/poses.csv"

@@ -24,6 +24,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/Command.h"
+#include "core/Csv.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/camera/CalibrationFile.h"
@@ -58,12 +59,7 @@ std::map<int, PoseRow> readPosesCsv(const std::filesystem::path& path) {
     if (!in) throw FileError(path.string(), "cannot open the poses file");
     std::string line;
     if (!std::getline(in, line)) throw FileError(path.string(), "empty poses file (no header)");
-    std::vector<std::string> header;
-    {
-        std::stringstream ss(line);
-        std::string c;
-        while (std::getline(ss, c, ',')) header.push_back(c);
-    }
+    const std::vector<std::string> header = splitCsvLine(line);
     auto col = [&](const std::string& name) {
         for (size_t i = 0; i < header.size(); ++i)
             if (header[i] == name) return int(i);
@@ -78,10 +74,8 @@ std::map<int, PoseRow> readPosesCsv(const std::filesystem::path& path) {
     while (std::getline(in, line)) {
         ++lineNo;
         if (line.empty()) continue;
-        std::vector<std::string> f;
-        std::stringstream ss(line);
-        std::string c;
-        while (std::getline(ss, c, ',')) f.push_back(c);
+        // The reason column is quoted when it holds commas ("11 tag(s), RMS 0.17 px").
+        std::vector<std::string> f = splitCsvLine(line);
         f.resize(header.size());
         PoseRow r;
         r.state = f[size_t(cState)];
