@@ -6,8 +6,10 @@
 //
 // Relative to the main camera: from N simultaneous view pairs of the same board, each pair gives
 // T_main_camera_i = T_main_board_i * (T_camera_board_i)^-1 (board poses from PnP on undistorted
-// points). The estimate is the mean (rotations: normalised sum of sign-aligned quaternions, the
-// chordal L2 mean; translations: arithmetic mean); the spread over pairs is its uncertainty.
+// points). Their mean (rotations: normalised sum of sign-aligned quaternions, the chordal L2
+// mean; translations: arithmetic mean) starts a joint Levenberg-Marquardt refinement of
+// T_camera_main and every pair's board pose over both cameras' reprojection errors (intrinsics
+// fixed), whose covariance gives the reported 1-sigma uncertainty.
 // Pairs whose pose is an outlier (rotation or translation off the first mean by more than 3x the
 // median deviation, and more than 1 degree / 10 mm) are dropped.
 //
@@ -27,8 +29,11 @@ struct StereoExtrinsics {
     Pose T_main_camera;
     int pairCount = 0;                 // pairs used
     std::vector<std::string> skipped;  // "name: reason"
-    double rotationSpreadDeg = 0;      // RMS angle of the per-pair rotations about the mean
-    double translationSpreadM = 0;     // RMS distance of the per-pair translations to the mean
+    // 1-sigma uncertainty of the refined pose: norm of the rotation vector's deviations
+    // (degrees) and of the translation's (metres).
+    double rotationStdDeg = 0, translationStdM = 0;
+    double rotationSpreadDeg = 0;   // RMS angle of the per-pair rotations about the mean
+    double translationSpreadM = 0;  // RMS distance of the per-pair translations to the mean
     // Board corners seen by the main camera carried into this camera through T_main_camera:
     // RMS distance to where this camera saw them (pixels). Small = consistent.
     double transferRmsPx = 0;

@@ -77,6 +77,9 @@ void runBatch(const CalibrateArgs& a) {
                 "--main-calib needs --main-input: the main camera's frames taken at the "
                 "same moments as INPUT (paired by order)");
         const auto mainCal = loadCalibration(a.mainCalib);
+        if (!mainCal.reliable)
+            spdlog::warn("{} is marked unreliable ({}); the extrinsics inherit its errors",
+                         a.mainCalib, mainCal.unreliableReason);
         const auto ext = calib::extrinsicsFromPairedInputs(mainCal.intrinsics, a.mainInputs,
                                                            cal.intrinsics, a.inputs, target);
         cal.T_parent_camera = ext.T_main_camera;

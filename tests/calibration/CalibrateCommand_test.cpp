@@ -9,7 +9,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "calibration/Extrinsics.h"
 #include "calibration/SyntheticViews.h"
+
+#include <opencv2/calib3d.hpp>
 #include "core/camera/CalibrationFile.h"
 #include "tests/support/TestSupport.h"
 
@@ -185,6 +188,70 @@ TEST(CalibrateCommand, BadInputsAreNamedAndNoFileIsWritten) {
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.output.find("COLSxROWS"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace mirage::calib
+
+namespace mirage::calib {
+namespace {
+
+// Extrinsics end to end: a fish-eye camera beside the pinhole main camera, simultaneous frames
+// of the same boards, `--main-calib` + `--main-input`: the file carries T_main_camera.
+TEST(CalibrateCommand, FisheyeExtrinsicsRelativeToMainCamera) {
+    const auto dir = test::outputDir("calibrate_extrinsics");
+    const auto mainDir = dir / "main", fishDir = dir / "fish";
+    fs::create_directories(mainDir);
+    fs::create_directories(fishDir);
+    const auto mainCam = camera();
+    CameraIntrinsics fish;
+    fish.width = 640;
+    fish.height = 480;
+    fish.model = DistortionModel::KannalaBrandt;
+    fish.fx = fish.fy = 230;
+    fish.cx = 321;
+    fish.cy = 238;
+    fish.distortion = {0.02, -0.01, 0.004, -0.001};
+    // T_main_fish: 6 cm to the right, turned 15 degrees to the right (about +Y).
+    const cv::Vec3d rMainFish(0, 15 * 0.017453292519943295, 0), tMainFish(0.06, 0, 0);
+    cv::Vec3d rFishMain, tFishMain;
+    {
+        cv::Matx33d R;
+        cv::Rodrigues(rMainFish, R);
+        cv::Rodrigues(R.t(), rFishMain);
+        tFishMain = -(R.t() * tMainFish);
+    }
+    const ChessboardRenderer mainRenderer(mainCam, 2), fishRenderer(fish, 2);
+    const auto poses = tiltedPoses(12);
+    for (size_t i = 0; i < poses.size(); ++i) {
+        BoardPose fp;
+        cv::composeRT(poses[i].rvec, poses[i].tvec, rFishMain, tFishMain, fp.rvec, fp.tvec);
+        char name[32];
+        std::snprintf(name, sizeof name, "f_%02zu.png", i);
+        cv::imwrite((mainDir / name).string(), mainRenderer.render(kBoard, poses[i]));
+        cv::imwrite((fishDir / name).string(), fishRenderer.render(kBoard, fp));
+    }
+    // The main camera's calibration (its truth, as if calibrated before).
+    CameraCalibration mainCal;
+    mainCal.intrinsics = mainCam;
+    saveCalibration(dir / "main.yaml", mainCal);
+    const auto out = dir / "fish.yaml";
+    const auto r =
+        test::runMirage({"calibrate", "--batch", fishDir.string(), "--model", "fisheye", "--board",
+                         "chessboard:9x6:0.025", "-o", out.string(), "--main-calib",
+                         (dir / "main.yaml").string(), "--main-input", mainDir.string()});
+    ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 2) << r.output;
+    EXPECT_NE(r.output.find("T_main_camera"), std::string::npos) << r.output;
+    const auto cal = loadCalibration(out);
+    ASSERT_TRUE(cal.T_parent_camera.has_value());
+    EXPECT_EQ(cal.extrinsicParent, "main");
+    EXPECT_NEAR(cal.T_parent_camera->translation.x, 0.06, 0.003) << r.output;
+    EXPECT_NEAR(cal.T_parent_camera->translation.y, 0.0, 0.003);
+    EXPECT_NEAR(cal.T_parent_camera->translation.z, 0.0, 0.003);
+    const Pose truth = poseFromCv(rMainFish, tMainFish);
+    // The fish-eye intrinsics come from these small boards (16 % of the image): their principal
+    // point error (about 1.5 px at f = 230 px, 0.4 deg) dominates the rotation error here.
+    EXPECT_LT(rotationAngleBetween(cal.T_parent_camera->rotation, truth.rotation) * 57.3, 0.6);
 }
 
 }  // namespace

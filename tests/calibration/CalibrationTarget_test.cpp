@@ -5,6 +5,7 @@
 #include <random>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include "calibration/CalibrationTarget.h"
 #include "calibration/Extrinsics.h"
 #include "calibration/SyntheticViews.h"
@@ -155,6 +156,17 @@ TEST(CalibrationTarget, AprilTagBoardViewsCalibrate) {
             ++n;
         }
         views.push_back(d.view);
+        if (i == 0) {
+            // The camera's pose in the world from this image alone (true intrinsics): the
+            // board file's world, through the sheet frame.
+            const auto path = test::outputDir("tagboard_world") / "view0.png";
+            ASSERT_TRUE(cv::imwrite(path.string(), img));
+            const auto w = poseFromWorldBoard(cam, path.string(), target);
+            EXPECT_LT(glm::length(w.T_world_camera.translation - T_world_camera.translation),
+                      0.003);
+            EXPECT_LT(rotationAngleBetween(w.T_world_camera.rotation, T_world_camera.rotation),
+                      0.5 * 0.0174533);
+        }
     }
     const double rms = std::sqrt(err2 / double(n));
     std::printf("AprilTag corner RMS against projection: %.3f px over %zu corners\n", rms, n);
