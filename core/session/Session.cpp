@@ -241,8 +241,11 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     }
     report.framesReadable = int(s.frames.size());
 
-    for (const auto& w : report.warnings) spdlog::warn("session {}: {}", dir.string(), w);
-    if (reportOut) *reportOut = std::move(report);
+    // A caller that asks for the report shows it its own way; otherwise nothing is lost.
+    if (reportOut)
+        *reportOut = std::move(report);
+    else
+        for (const auto& w : report.warnings) spdlog::warn("session {}: {}", dir.string(), w);
     return s;
 }
 

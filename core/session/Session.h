@@ -66,7 +66,8 @@ struct SessionReadReport {
 
 // Reads session.json and frames.csv. Throws mirage::FileError when the folder is not a session
 // at all (no or unparseable session.json, wrong format, newer version, no cameras); otherwise
-// keeps what is there and lists what is missing in the report (and logs it as warnings).
+// keeps what is there and lists what is missing in the report (logged as warnings instead when
+// no report is asked for).
 Session readSession(const std::filesystem::path& dir, SessionReadReport* report = nullptr);
 
 // The calibration of one camera of a session (its `calibration` file). Throws FileError if the
