@@ -10,11 +10,15 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
+#include "tracking/Detector.h"
 
 namespace mirage::calib {
 
 struct CalibrationTarget::TagState {
     tracking::Board board;
+    // Full resolution quad search: calibration wants every tag, small ones included, and the
+    // corners as exact as the detector's edge refinement makes them.
+    std::unique_ptr<tracking::Detector> detector;
     // Per tag id: its 4 detection corners in the board plane frame (metres, z = 0), in
     // libapriltag's corner order.
     std::map<int, std::array<cv::Point3f, 4>> cornersInBoard;
@@ -56,6 +60,10 @@ CalibrationTarget CalibrationTarget::tagBoard(const tracking::Board& board) {
     const Pose T_board_world = t.T_world_board_.inverse();
     t.tags_ = std::make_unique<TagState>();
     t.tags_->board = board;
+    tracking::DetectorOptions opts;
+    opts.family = board.family;
+    opts.decimate = 1.0f;
+    t.tags_->detector = std::make_unique<tracking::Detector>(opts);
     for (const auto& tag : board.tags) {
         std::array<cv::Point3f, 4> corners;
         const auto world = tag.cornersInWorld();
@@ -108,10 +116,27 @@ TargetDetection CalibrationTarget::detect(const cv::Mat& image, const std::strin
     if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
     TargetDetection d;
     d.view.name = name;
-    if (kind_ == Kind::TagBoard)
-        throw Error(
-            "AprilTag board detection is not available yet in this build; use a "
-            "chessboard (chessboard:COLSxROWS:SQUARE_METRES)");
+    if (kind_ == Kind::TagBoard) {
+        // Tags of this board only (ids it lists); each gives its 4 corners. Partial views are
+        // fine, unlike a chessboard: the board may leave the image.
+        for (const auto& det : tags_->detector->detect(grey)) {
+            const auto it = tags_->cornersInBoard.find(det.id);
+            if (it == tags_->cornersInBoard.end()) continue;
+            for (size_t c = 0; c < 4; ++c) {
+                d.view.imagePoints.emplace_back(float(det.corners[c].x), float(det.corners[c].y));
+                d.view.boardPoints.push_back(it->second[c]);
+            }
+        }
+        const size_t tags = d.view.imagePoints.size() / 4;
+        if (tags < 2) {
+            d.reason = fmt::format("{} of the board's tags detected (at least 2 needed)", tags);
+            d.view.imagePoints.clear();
+            d.view.boardPoints.clear();
+            return d;
+        }
+        d.found = true;
+        return d;
+    }
     const cv::Size pattern(chessboard_.cols, chessboard_.rows);
     std::vector<cv::Point2f> corners;
     // The classic detector is ~100x faster than the sector-based one (1 ms against 0.4 s at

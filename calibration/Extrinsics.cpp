@@ -92,20 +92,25 @@ StereoExtrinsics estimateStereoExtrinsics(const CameraIntrinsics& main,
     if (pairs.empty()) throw Error("extrinsics: no view pair shows the board in both cameras");
     Pose mean = meanPose(pairs);
     // Drop pairs far from the first mean (a mis-detection or a frame out of sync), then re-mean.
-    std::vector<double> dt;
-    for (const auto& p : pairs)
+    // Single-view PnP depth is noisy for small or steep boards, so the limits are relative to
+    // the median deviation, with floors of 1 degree and 10 mm.
+    std::vector<double> dt, da;
+    for (const auto& p : pairs) {
         dt.push_back(glm::length(p.T_main_camera.translation - mean.translation));
-    std::vector<double> sorted = dt;
-    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
-    const double medianDt = sorted[sorted.size() / 2];
+        da.push_back(rotationAngleBetween(p.T_main_camera.rotation, mean.rotation) * kRadToDeg);
+    }
+    auto medianOf = [](std::vector<double> v) {
+        std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    };
+    const double limitT = std::max(3 * medianOf(dt), 0.010);
+    const double limitA = std::max(3 * medianOf(da), 1.0);
     std::vector<PairPose> kept;
     for (size_t k = 0; k < pairs.size(); ++k) {
-        const double angle =
-            rotationAngleBetween(pairs[k].T_main_camera.rotation, mean.rotation) * kRadToDeg;
-        if (pairs.size() >= 3 && (angle > 3.0 || dt[k] > 3 * medianDt + 1e-3))
+        if (pairs.size() >= 3 && (da[k] > limitA || dt[k] > limitT))
             e.skipped.push_back(
                 fmt::format("{}: outlier pair ({:.2f} deg, {:.1f} mm from the mean)",
-                            cameraViews[pairs[k].index].name, angle, 1000 * dt[k]));
+                            cameraViews[pairs[k].index].name, da[k], 1000 * dt[k]));
         else
             kept.push_back(pairs[k]);
     }

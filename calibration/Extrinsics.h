@@ -8,8 +8,8 @@
 // T_main_camera_i = T_main_board_i * (T_camera_board_i)^-1 (board poses from PnP on undistorted
 // points). The estimate is the mean (rotations: normalised sum of sign-aligned quaternions, the
 // chordal L2 mean; translations: arithmetic mean); the spread over pairs is its uncertainty.
-// Pairs whose pose is an outlier (rotation > 3 deg or translation > 3x the median deviation from
-// the first mean) are dropped.
+// Pairs whose pose is an outlier (rotation or translation off the first mean by more than 3x the
+// median deviation, and more than 1 degree / 10 mm) are dropped.
 //
 // Frames: camera frames are OpenCV's (+X right, +Y down, +Z forward), metres. T_a_b maps points
 // from frame b into frame a.

@@ -42,6 +42,8 @@ struct RendererOptions {
     int ismTileSize = 64;                // texels per side of one VPL's imperfect shadow map
     int ismPointsPerVpl = 1024;          // surface points splatted into each VPL's ISM
     int interleave = 4;                  // K: each pixel gathers vplCount / K^2 VPLs
+    int indirectScale = 2;               // VPL gather at 1/scale resolution per axis (1 or 2); the
+                                         // geometry-aware filter upsamples it to full resolution
     float vplDistanceClamp = 0.1f;       // metres: VPL distance below this is clamped (no spikes)
     float shadowBias = 0.01f;            // metres, at 1 m distance (scaled with distance)
     float temporalBlend = 0.8f;          // history weight for the VPL lighting (0 = off)
@@ -50,6 +52,10 @@ struct RendererOptions {
     float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
     float nearM = 0.01f, farM = 100.0f;  // camera clip planes (metres)
     bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
+    // glFinish around every pass so each timer query holds only its pass's work. llvmpipe defers
+    // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
+    // without this a pass's time can show up in the next pass's query. For benchmarks.
+    bool syncPasses = false;
 };
 
 struct LightPlan {

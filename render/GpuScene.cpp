@@ -17,6 +17,7 @@ namespace {
 struct Vertex {
     glm::vec3 position;  // mesh-local
     glm::vec3 normal;    // mesh-local
+    glm::vec2 uv;        // the UV set the base colour texture uses (glTF: (0,0) = top left)
 };
 
 GpuMaterial toGpu(const Material& m) {
@@ -81,6 +82,26 @@ std::vector<glm::vec3> GpuScene::projectEquirectToSH(const cv::Mat& img, float i
 }
 
 GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
+    // Textures (baseColor ones are sRGB-encoded: GL decodes them to linear when sampled).
+    white_ = gl::Texture::create2D("white 1x1", 1, 1, GL_RGBA8);
+    const unsigned char whitePx[4] = {255, 255, 255, 255};
+    white_.upload(GL_RGBA, GL_UNSIGNED_BYTE, whitePx);
+    for (const Texture& t : scene.textures) {
+        if (t.width <= 0 || t.height <= 0 ||
+            t.pixels.size() != size_t(t.width) * size_t(t.height) * 4) {
+            textures_.push_back(gl::Texture());
+            continue;
+        }
+        int levels = 1;
+        while ((std::max(t.width, t.height) >> levels) > 0) ++levels;
+        gl::Texture g = gl::Texture::create2D("scene texture " + t.name, t.width, t.height,
+                                              t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, levels);
+        g.upload(GL_RGBA, GL_UNSIGNED_BYTE, t.pixels.data());
+        glGenerateTextureMipmap(g.id());
+        g.setWrap(GL_REPEAT);
+        textures_.push_back(std::move(g));
+    }
+
     // Materials: slot 0 is the glTF default material, slot i+1 is scene.materials[i].
     std::vector<GpuMaterial> mats;
     mats.push_back(toGpu(Material()));  // glTF default: white, metallic 1, roughness 1
@@ -95,6 +116,7 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         GLuint firstIndex;
         GLsizei count;
         int material;
+        int texture;
         glm::vec3 center;
         float radius;
     };
@@ -102,12 +124,24 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
         for (const Primitive& p : scene.meshes[mi].primitives) {
             if (p.positions.empty() || p.indices.empty()) continue;
-            Range r{GLint(verts.size()), GLuint(idx.size()), GLsizei(p.indices.size()),
-                    p.material + 1,      glm::vec3(0.0f),    0.0f};
+            Range r{GLint(verts.size()),
+                    GLuint(idx.size()),
+                    GLsizei(p.indices.size()),
+                    p.material + 1,
+                    -1,
+                    glm::vec3(0.0f),
+                    0.0f};
+            const Material& mat = scene.material(p.material);
+            const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
+            if (mat.baseColorTexture.valid() &&
+                size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
+                uvs.size() == p.positions.size())
+                r.texture = mat.baseColorTexture.texture;
             glm::vec3 lo(1e30f), hi(-1e30f);
             for (size_t i = 0; i < p.positions.size(); ++i) {
                 glm::vec3 n = i < p.normals.size() ? p.normals[i] : glm::vec3(0, 1, 0);
-                verts.push_back({p.positions[i], n});
+                glm::vec2 uv = i < uvs.size() ? uvs[i] : glm::vec2(0.0f);
+                verts.push_back({p.positions[i], n, uv});
                 lo = glm::min(lo, p.positions[i]);
                 hi = glm::max(hi, p.positions[i]);
             }
@@ -130,10 +164,13 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         glVertexArrayElementBuffer(vao_.id(), indices_.id());
         glEnableVertexArrayAttrib(vao_.id(), 0);
         glEnableVertexArrayAttrib(vao_.id(), 1);
+        glEnableVertexArrayAttrib(vao_.id(), 2);
         glVertexArrayAttribFormat(vao_.id(), 0, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, position));
         glVertexArrayAttribFormat(vao_.id(), 1, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, normal));
+        glVertexArrayAttribFormat(vao_.id(), 2, 2, GL_FLOAT, GL_FALSE, offsetof(Vertex, uv));
         glVertexArrayAttribBinding(vao_.id(), 0, 0);
         glVertexArrayAttribBinding(vao_.id(), 1, 0);
+        glVertexArrayAttribBinding(vao_.id(), 2, 0);
     }
 
     // Instances and lights reachable from the scene's roots (Scene::meshInstances /
@@ -155,6 +192,7 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
             d.model = world;
             d.normalMatrix = glm::inverseTranspose(world);
             d.material = r.material;
+            d.baseColorTexture = r.texture;
             d.origin = inst.origin;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
@@ -273,6 +311,12 @@ bool GpuScene::hasVirtual() const {
 void GpuScene::bindGeometry() const {
     vao_.bind();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, materials_.id());
+}
+
+void GpuScene::bindMaterialTextures(const DrawItem& d, GLuint unit) const {
+    const bool has = d.baseColorTexture >= 0 && size_t(d.baseColorTexture) < textures_.size() &&
+                     textures_[size_t(d.baseColorTexture)].id() != 0;
+    glBindTextureUnit(unit, has ? textures_[size_t(d.baseColorTexture)].id() : white_.id());
 }
 
 void GpuScene::drawItem(const DrawItem& d) const {

@@ -26,6 +26,7 @@ struct DrawItem {
     glm::mat4 model{1.0f};         // world-from-mesh
     glm::mat4 normalMatrix{1.0f};  // inverse transpose of model (upper 3x3 used)
     int material = 0;              // index into the material buffer (0 = glTF default)
+    int baseColorTexture = -1;     // index into the uploaded textures, -1 = none
     Origin origin = Origin::Virtual;
     GLint baseVertex = 0;
     GLuint firstIndex = 0;
@@ -66,6 +67,8 @@ public:
 
     // Binds the vertex array and the material buffer; then drawItem() per item.
     void bindGeometry() const;
+    // Binds the draw's base colour texture (or a white 1x1) to texture unit `unit`.
+    void bindMaterialTextures(const DrawItem& d, GLuint unit) const;
     void drawItem(const DrawItem& d) const;
     const gl::Buffer& materialBuffer() const { return materials_; }
     const gl::Buffer& surfacePointBuffer() const { return points_; }
@@ -81,6 +84,8 @@ private:
     BoundingSphere bounds_;
     gl::Buffer vertices_, indices_, materials_, points_;
     gl::VertexArray vao_;
+    std::vector<gl::Texture> textures_;  // scene.textures: sRGB8_ALPHA8 or RGBA8, mipmapped
+    gl::Texture white_;
     bool hasEnvironment_ = false;
     Origin environmentOrigin_ = Origin::Real;
     std::vector<glm::vec3> envSH_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -75,6 +76,8 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
                     " is out of range (0..16384)");
     if (options_.interleave < 1 || options_.interleave > 8)
         throw Error("interleave must be 1..8, got " + std::to_string(options_.interleave));
+    if (options_.indirectScale != 1 && options_.indirectScale != 2)
+        throw Error("indirectScale must be 1 or 2, got " + std::to_string(options_.indirectScale));
     if (options_.shadowMapSize < 16 || options_.shadowMapSize > 4096)
         throw Error("shadow map size must be 16..4096");
     if (options_.ismTileSize < 8 || options_.ismTileSize > 256)
@@ -308,8 +311,10 @@ const FrameReport& Renderer::render(const FrameInput& input) {
                 MR_CHECK(c.has(res), std::string("pass ") + p.name() + " reads " +
                                          resourceName(res) + ", which no earlier pass wrote");
             p.resize(c);  // no-op unless the plan's sizes changed (shadow layers, VPL count)
+            if (options_.syncPasses) glFinish();
             timers_[i].begin();
             p.execute(c);
+            if (options_.syncPasses) glFinish();
             timers_[i].end();
             r.ran = ran[i] = true;
         }
@@ -354,6 +359,16 @@ cv::Mat Renderer::coverage() const {
             const float a = px[(size_t(y) * t.width() + x) * 4 + 3];
             out.at<uint8_t>(y, x) = a > 0.75f ? 2 : a > 0.25f ? 1 : 0;
         }
+    return out;
+}
+
+cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
+    const Resource r = realOnly ? Resource::ImperfectShadowMapsReal : Resource::ImperfectShadowMaps;
+    if (!ctx_->has(r)) throw Error("no imperfect shadow map was rendered this frame");
+    const gl::Texture& t = ctx_->texture(r);
+    auto bits = t.read<uint32_t>(GL_RED_INTEGER, GL_UNSIGNED_INT, 1);
+    cv::Mat out(t.height(), t.width(), CV_32F);
+    std::memcpy(out.data, bits.data(), bits.size() * 4);  // float bits were stored
     return out;
 }
 

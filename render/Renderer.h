@@ -64,6 +64,9 @@ public:
     // Any canvas-size linear buffer of this frame (LRv, LR, DirectRv, ...) as CV_32FC3 RGB,
     // top row first. Throws mirage::Error if the frame did not produce it.
     cv::Mat readBuffer(Resource r) const;
+    // The imperfect shadow map atlas of this frame (all points, or real points only) as CV_32F
+    // distances in metres, +inf where no point was splatted. Throws if no ISM ran.
+    cv::Mat readIsmAtlas(bool realOnly) const;
 
     // The composite as an sRGB8 texture (camera size, memory row 0 = image top row), e.g. to
     // blit into a window (flip vertically: GL windows put row 0 at the bottom).

@@ -12,7 +12,6 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "calibration/BatchCalibration.h"
 #include "calibration/CalibrationSession.h"
@@ -21,33 +20,28 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/capture/V4l2Camera.h"
 #include "core/gl/Context.h"
 #include "core/gl/Objects.h"
 
 namespace mirage::app {
 namespace {
 
-// A live V4L2 camera through OpenCV's V4L2 backend.
+// A live V4L2 camera (core/capture: mode choice, YUYV/MJPEG decoding, timestamps) as a
+// calibration frame source.
 class LiveCameraSource final : public calib::FrameSource {
 public:
-    explicit LiveCameraSource(const std::string& device) : device_(device) {
-        if (!capture_.open(device, cv::CAP_V4L2) || !capture_.isOpened())
-            throw FileError(device,
-                            "cannot open the camera (is it connected, and are you in the "
-                            "'video' group?)");
-    }
+    explicit LiveCameraSource(const std::string& device) : camera_(device, CaptureRequest{}) {}
     bool next(calib::InputFrame& f) override {
-        if (!capture_.read(f.bgr) || f.bgr.empty())
-            throw FileError(device_, "the camera stopped delivering frames");
+        if (!camera_.read(f.bgr)) return false;
         f.name = fmt::format("frame {}", index_++);
-        f.timeSeconds = glfwGetTime();
+        f.timeSeconds = camera_.lastTimestamp().value_or(0.0);
         return true;
     }
     bool isLive() const override { return true; }
 
 private:
-    std::string device_;
-    cv::VideoCapture capture_;
+    V4l2Camera camera_;
     int index_ = 0;
 };
 
@@ -272,7 +266,7 @@ int runCalibrationWizard(const WizardOptions& o) {
             ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
 
         ImGui::SetNextWindowPos({0, 0});
-        ImGui::SetNextWindowSize({660, 530});
+        ImGui::SetNextWindowSize({660, 540});
         ImGui::Begin("Camera", nullptr, fixed);
         if (!camTex.empty()) {
             const float scale = std::min(640.f / float(current.cols), 480.f / float(current.rows));
@@ -283,8 +277,8 @@ int runCalibrationWizard(const WizardOptions& o) {
                     rep.tiltDeg);
         ImGui::End();
 
-        ImGui::SetNextWindowPos({0, 530});
-        ImGui::SetNextWindowSize({330, 270});
+        ImGui::SetNextWindowPos({0, 540});
+        ImGui::SetNextWindowSize({330, 260});
         ImGui::Begin("Undistorted preview", nullptr, fixed);
         ImGui::Checkbox("show", &showUndistorted);
         if (session.result() && showUndistorted && !undistTex.empty())
@@ -294,8 +288,8 @@ int runCalibrationWizard(const WizardOptions& o) {
                                so.calibration.minViews);
         ImGui::End();
 
-        ImGui::SetNextWindowPos({330, 530});
-        ImGui::SetNextWindowSize({330, 270});
+        ImGui::SetNextWindowPos({330, 540});
+        ImGui::SetNextWindowSize({330, 260});
         ImGui::Begin("Coverage and tilts", nullptr, fixed);
         drawCoverage(session, {300, 130});
         ImGui::Text("cells covered: %.0f%%", 100 * session.coverage().coveredFraction());

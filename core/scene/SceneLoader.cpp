@@ -430,6 +430,15 @@ public:
 private:
     [[noreturn]] void fail(const std::string& problem) const { throw FileError(file_, problem); }
 
+    // A double from the file as a float; values beyond float's range (converting them would be
+    // undefined behaviour) and non-finite values are errors naming `what`.
+    float toFloat(double v, const std::string& what) const {
+        if (!std::isfinite(v) ||
+            std::abs(v) > static_cast<double>(std::numeric_limits<float>::max()))
+            fail(what + " is " + std::to_string(v) + ", outside the range of a float");
+        return static_cast<float>(v);
+    }
+
     void warn(const std::string& message) {
         spdlog::warn("{}: {}", file_, message);
         scene_.warnings.push_back(message);
@@ -724,7 +733,9 @@ private:
         const tinygltf::Value& v = object.Get(key);
         if (!v.IsNumber()) fail(what + " field '" + key + "' must be a number");
         double x = v.GetNumberAsDouble();
-        if (!std::isfinite(x) || x < lo || x > hi)
+        // Every such field ends up in a float, so the float range bounds it too.
+        const double floatMax = static_cast<double>(std::numeric_limits<float>::max());
+        if (!std::isfinite(x) || x < lo || x > hi || std::abs(x) > floatMax)
             fail(what + " field '" + key + "' is " + std::to_string(x) + "; it must be in [" +
                  std::to_string(lo) + ", " +
                  (std::isinf(hi) ? std::string("inf") : std::to_string(hi)) + "]");
@@ -815,7 +826,7 @@ private:
                            name + " normalTexture", false, &src.normalTexture.extensions);
             if (!std::isfinite(src.normalTexture.scale))
                 fail(name + " normalTexture.scale must be finite");
-            m.normalScale = static_cast<float>(src.normalTexture.scale);
+            m.normalScale = toFloat(src.normalTexture.scale, name + " normalTexture.scale");
             m.emissiveTexture =
                 textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord,
                            name + " emissiveTexture", true, &src.emissiveTexture.extensions);
@@ -848,7 +859,7 @@ private:
                      "; expected OPAQUE, MASK or BLEND");
             if (!std::isfinite(src.alphaCutoff) || src.alphaCutoff < 0)
                 fail(name + " alphaCutoff must be a finite number >= 0");
-            m.alphaCutoff = static_cast<float>(src.alphaCutoff);
+            m.alphaCutoff = toFloat(src.alphaCutoff, name + " alphaCutoff");
 
             if (const tinygltf::Value* ext =
                     extension(src.extensions, "KHR_materials_transmission", name)) {
@@ -1150,17 +1161,17 @@ private:
                 for (int c = 0; c < 3; ++c) {
                     if (src.color[static_cast<size_t>(c)] < 0)
                         fail(name + " color must not be negative");
-                    l.color[c] = static_cast<float>(src.color[static_cast<size_t>(c)]);
+                    l.color[c] = toFloat(src.color[static_cast<size_t>(c)], name + " color");
                 }
             }
             if (!std::isfinite(src.intensity) || src.intensity < 0)
                 fail(name +
                      " intensity must be a finite number >= 0 (candela for point/spot, lux for "
                      "directional)");
-            l.intensity = static_cast<float>(src.intensity);
+            l.intensity = toFloat(src.intensity, name + " intensity");
             if (!std::isfinite(src.range) || src.range < 0)
                 fail(name + " range must be a finite number > 0 (omit it for unlimited range)");
-            l.range = static_cast<float>(src.range);
+            l.range = toFloat(src.range, name + " range");
             if (l.type == Light::Type::Spot) {
                 const double inner = src.spot.innerConeAngle, outer = src.spot.outerConeAngle;
                 if (!std::isfinite(inner) || !std::isfinite(outer) || inner < 0 ||
@@ -1195,12 +1206,13 @@ private:
                 if (!std::isfinite(p.zfar) || p.zfar < 0 || (p.zfar > 0 && p.zfar <= p.znear))
                     fail(name +
                          " perspective.zfar must be greater than znear (or absent for infinite)");
-                c.yfov = static_cast<float>(p.yfov);
-                c.aspectRatio = static_cast<float>(p.aspectRatio);
-                c.znear = static_cast<float>(p.znear);
+                c.yfov = toFloat(p.yfov, name + " yfov");
+                c.aspectRatio = toFloat(p.aspectRatio, name + " aspectRatio");
+                c.znear = toFloat(p.znear, name + " znear");
                 c.infiniteFar = p.zfar == 0;
-                c.zfar = c.infiniteFar ? std::max(1000.0f, c.znear * 1000.0f)
-                                       : static_cast<float>(p.zfar);
+                c.zfar = c.infiniteFar ? toFloat(std::min(std::max(1000.0, p.znear * 1000.0), 1e30),
+                                                 name + " znear * 1000")
+                                       : toFloat(p.zfar, name + " zfar");
             } else if (src.type == "orthographic") {
                 const auto& o = src.orthographic;
                 if (!std::isfinite(o.xmag) || !std::isfinite(o.ymag) || o.xmag == 0 || o.ymag == 0)
@@ -1209,10 +1221,10 @@ private:
                     o.zfar <= o.znear)
                     fail(name + " orthographic needs 0 <= znear < zfar");
                 c.projection = CameraNodeInfo::Projection::Orthographic;
-                c.xmag = static_cast<float>(o.xmag);
-                c.ymag = static_cast<float>(o.ymag);
-                c.znear = static_cast<float>(o.znear);
-                c.zfar = static_cast<float>(o.zfar);
+                c.xmag = toFloat(o.xmag, name + " xmag");
+                c.ymag = toFloat(o.ymag, name + " ymag");
+                c.znear = toFloat(o.znear, name + " znear");
+                c.zfar = toFloat(o.zfar, name + " zfar");
             } else {
                 fail(name + " has type " + quote(src.type) +
                      "; expected perspective or orthographic");

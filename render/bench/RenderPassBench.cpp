@@ -1,15 +1,19 @@
 // Per-pass GPU time of the real-time renderer (GL_TIME_ELAPSED queries), on a table-top scene:
 // a real floor and real box (proxies), a virtual box and a virtual sphere, a real spot light and
-// a real environment. Arguments: width, height, VPL count, sphere subdivisions (triangles).
+// a real environment. Arguments: width, height, VPL count, sphere subdivisions (triangles),
+// indirect (VPL gather) resolution divisor.
 // Reported time = the frame's total GPU time (manual time); counters = per-pass ms (mean over the
 // iterations; use --benchmark_repetitions and the median aggregate for figures).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <memory>
 
 #include "core/gl/Context.h"
+#include "core/image/ImageIO.h"
 #include "render/Renderer.h"
 #include "tests/render/RenderTestScenes.h"
 
@@ -62,6 +66,9 @@ void BM_Frame(benchmark::State& state) {
     const int w = int(state.range(0)), h = int(state.range(1));
     render::RendererOptions opt;
     opt.vplCount = int(state.range(2));
+    opt.syncPasses = true;
+    opt.indirectScale =
+        int(state.range(4));  // per-pass attribution (see RendererOptions::syncPasses)
     Scene scene = benchScene(int(state.range(3)));
     CameraIntrinsics cam;
     cam.width = w;
@@ -73,6 +80,16 @@ void BM_Frame(benchmark::State& state) {
     const Pose pose = test::lookAtPose({0.0, 1.0, 1.6}, {0.0, 0.1, 0.0});
     cv::Mat footage(h, w, CV_8UC3, cv::Scalar(90, 110, 130));
     r.render({pose, footage, false});  // warm-up: shader compile, first allocations
+    // MIRAGE_BENCH_DUMP=<folder>: also write this configuration's images (sRGB PNG; L_rv, L_r
+    // tone-mapped by exposure 1) for a look at what was timed.
+    if (const char* dump = std::getenv("MIRAGE_BENCH_DUMP")) {
+        const std::filesystem::path d(dump);
+        std::filesystem::create_directories(d);
+        const std::string tag = cv::format("%dx%d_%dvpl", w, h, opt.vplCount);
+        writeBgr8(d / ("composite_" + tag + ".png"), r.compositeSrgb());
+        writeLinearRgb(d / ("Lrv_" + tag + ".png"), r.readBuffer(render::Resource::LRv));
+        writeLinearRgb(d / ("Lr_" + tag + ".png"), r.readBuffer(render::Resource::LR));
+    }
     std::map<std::string, double> sums;
     for (auto _ : state) {
         const render::FrameReport& rep = r.render({pose, footage, false});
@@ -89,9 +106,10 @@ void BM_Frame(benchmark::State& state) {
 
 void args(benchmark::internal::Benchmark* b) {
     for (auto [w, h] : {std::pair{640, 480}, std::pair{1024, 768}})
-        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32});
-    b->Args({640, 480, 256, 128});  // ~65k more triangles
-    b->Args({320, 240, 256, 32});
+        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32, 2});
+    b->Args({640, 480, 256, 32, 1});   // VPL gather at full resolution
+    b->Args({640, 480, 256, 128, 2});  // ~65k more triangles
+    b->Args({320, 240, 256, 32, 2});
 }
 
 }  // namespace

@@ -428,7 +428,7 @@ RenderResult render(const RayTracingScene& scene, const RenderCamera& camera,
                                    : std::max<long long>(20000, (long long)width * height / 2);
     float r1 = settings.initialPhotonRadius > 0
                    ? settings.initialPhotonRadius
-                   : 0.03f * std::max(emitter.meanTargetRadius(), 1e-3f);
+                   : 0.1f * std::max(emitter.meanTargetRadius(), 1e-3f);
 
     const size_t pixels = size_t(width) * size_t(height);
     std::vector<glm::dvec3> sum(pixels, glm::dvec3(0.0));

@@ -41,7 +41,7 @@ struct RenderSettings {
     int threads = 0;    // 0 = std::thread::hardware_concurrency()
     int maxDepth = 64;  // path vertices; Russian roulette ends most paths much earlier
     // Photon mapping (caustics). 0 = automatic: photons = max(20000, pixels / 2) per pass;
-    // initial radius = 0.03 x the mean bounding radius of the specular objects.
+    // initial radius = 0.1 x the mean bounding radius of the specular objects.
     int photonsPerPass = 0;
     float initialPhotonRadius = 0.0f;  // metres
     float radiusAlpha = 2.0f / 3.0f;   // Knaus-Zwicker radius reduction (0..1)

@@ -7,6 +7,7 @@
 #include <random>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "calibration/SyntheticViews.h"
 #include "core/camera/CalibrationFile.h"
@@ -81,6 +82,32 @@ TEST(CalibrateCommand, BatchWritesCalibrationReportAndRos) {
     EXPECT_TRUE(fs::exists(ros));
 }
 
+// A video input: frames sampled (--video-step), named "video.avi#N" in the report.
+TEST(CalibrateCommand, BatchFromVideo) {
+    const auto dir = test::outputDir("calibrate_video");
+    const auto videoPath = dir / "board.avi";
+    {
+        const ChessboardRenderer renderer(camera(), 2);
+        cv::VideoWriter video(videoPath.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0,
+                              cv::Size(640, 480), false);
+        ASSERT_TRUE(video.isOpened());
+        for (const auto& pose : tiltedPoses(8)) {
+            const cv::Mat img = renderer.render(kBoard, pose);
+            video.write(img);
+            video.write(img);  // every second frame is sampled below
+        }
+    }
+    const auto out = dir / "cam.yaml";
+    const auto r =
+        test::runMirage({"calibrate", "--batch", videoPath.string(), "--board",
+                         "chessboard:9x6:0.025", "-o", out.string(), "--video-step", "2"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("board.avi#14"), std::string::npos) << r.output;
+    const auto cal = loadCalibration(out);
+    EXPECT_EQ(cal.viewCount, 8);
+    EXPECT_NEAR(cal.intrinsics.fx, camera().fx, 0.01 * camera().fx);
+}
+
 TEST(CalibrateCommand, FrontoParallelViewsGiveAnUnreliableFileNotAConfidentOne) {
     const auto dir = test::outputDir("calibrate_fronto");
     const auto images = dir / "images";
@@ -133,6 +160,14 @@ TEST(CalibrateCommand, BadInputsAreNamedAndNoFileIsWritten) {
     r = run({(dir / "corrupt.png").string()});
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_NE(r.output.find("corrupt.png"), std::string::npos) << r.output;
+    // Not a video although it says so.
+    {
+        std::ofstream f(dir / "broken.mp4");
+        f << "not a video";
+    }
+    r = run({(dir / "broken.mp4").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("broken.mp4"), std::string::npos) << r.output;
     // Mixed sizes: both files named.
     cv::imwrite((dir / "a_big.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(110)));
     cv::imwrite((dir / "b_small.png").string(), cv::Mat(240, 320, CV_8UC1, cv::Scalar(110)));

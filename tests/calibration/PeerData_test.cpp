@@ -64,8 +64,11 @@ TEST(PeerData, OpenCvCalib1MatchesBouguetReference) {
     EXPECT_NEAR(r.calibration.avgReprojectionError, 0.13889, 1e-3);
     EXPECT_EQ(r.usedViewCount(), 7);
     EXPECT_TRUE(r.calibration.reliable) << r.calibration.unreliableReason;
-    RecordProperty("fx", std::to_string(k.fx));
-    RecordProperty("rms", std::to_string(r.calibration.avgReprojectionError));
+    std::printf("calib1: fx %.5f fy %.5f cx %.5f cy %.5f k %.5f %.5f %.5f %.5f RMS %.5f\n", k.fx,
+                k.fy, k.cx, k.cy, k.coeff(0), k.coeff(1), k.coeff(2), k.coeff(3),
+                r.calibration.avgReprojectionError);
+    const auto& sd = r.calibration.stdDeviations;
+    std::printf("calib1 1-sigma: fx %.4f fy %.4f cx %.4f cy %.4f\n", sd[0], sd[1], sd[2], sd[3]);
 }
 
 std::vector<CalibrationView> loadFisheye() {
@@ -111,6 +114,12 @@ TEST(PeerData, OpenCvFisheyeMatchesReference) {
     EXPECT_NEAR(k.coeff(2), 0.00605760088590183, 2e-4);
     EXPECT_NEAR(k.coeff(3), -0.00374209380722371, 2e-4);
     EXPECT_NEAR(r.calibration.avgReprojectionError, 0.263782587133546, 1e-3);
+    std::printf("fisheye: fx %.6f fy %.6f cx %.6f cy %.6f D %.7f %.7f %.7f %.7f RMS %.9f\n", k.fx,
+                k.fy, k.cx, k.cy, k.coeff(0), k.coeff(1), k.coeff(2), k.coeff(3),
+                r.calibration.avgReprojectionError);
+    std::printf("fisheye 1-sigma: fx %.4f fy %.4f cx %.4f cy %.4f\n",
+                r.calibration.stdDeviations[0], r.calibration.stdDeviations[1],
+                r.calibration.stdDeviations[2], r.calibration.stdDeviations[3]);
     // OpenCV's "standard errors" are 3 sigma (EstimateUncertainties); ours are 1 sigma.
     const auto& sd = r.calibration.stdDeviations;
     EXPECT_NEAR(sd[0], 1.3425 / 3, 0.1 * 1.3425 / 3);

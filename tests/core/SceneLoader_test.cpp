@@ -463,6 +463,8 @@ const std::vector<BadCase>& badCases() {
         {"light_index_out_of_range.gltf", {"node 0", "light 2"}},
         {"camera_index_out_of_range.gltf", {"node 0", "camera 1"}},
         {"spot_cone_inverted.gltf", {"light 0", "innerConeAngle < outerConeAngle"}},
+        {"light_intensity_beyond_float.gltf",
+         {"light 0 intensity", "outside the range of a float"}},
         {"real_not_bool.gltf", {"node 0", "extras.mirage.real"}},
         {"environment_image_missing.gltf", {"environment", "nowhere.hdr"}},
         {"attribute_count_mismatch.gltf", {"NORMAL", "2 elements", "POSITION has 3"}},

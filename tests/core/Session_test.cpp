@@ -14,6 +14,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/Error.h"
+#include "core/camera/CalibrationFile.h"
 #include "core/session/AtomicFile.h"
 #include "core/session/MatroskaScanner.h"
 #include "core/session/MatroskaWriter.h"
@@ -148,6 +149,12 @@ TEST(Session, MkvRoundTrip) {
     auto env = openCameraFrames(s, "env");
     expectFramesMatch(readAll(*env), idx, kEnvW, kEnvH, 1, 28.0);
     EXPECT_THROW(openCameraFrames(s, "nope"), FileError);
+    // Calibration through the session: missing file, no file named, then a real one.
+    EXPECT_THROW(loadSessionCalibration(s, "main"), FileError);
+    EXPECT_THROW(loadSessionCalibration(s, "env"), FileError);
+    EXPECT_THROW(loadSessionCalibration(s, "nope"), FileError);
+    fs::copy_file(test::testDataDir() / "calib" / "opencv_sample_style.yaml", dir / "main.yaml");
+    EXPECT_EQ(loadSessionCalibration(s, "main").intrinsics.width, 640);
 
     // The plain-video path reads the same file, with FFmpeg's frame times (ms ticks).
     auto plain = openFrames(dir / "main.mkv");
@@ -185,6 +192,26 @@ TEST(Session, ImageSequenceRoundTripIsLossless) {
     EXPECT_TRUE(contains(report, "1 of 5 listed frames are not in main")) << allWarnings(report);
     auto main = openCameraFrames(s2, "main");
     expectFramesMatch(readAll(*main), {0, 1, 3, 4}, kMainW, kMainH, 0, 99.0);
+}
+
+TEST(Session, FsyncEachFrameWritesTheSameSession) {
+    for (const bool sequence : {false, true}) {
+        const fs::path dir =
+            test::outputDir(std::string("session_fsync_") + (sequence ? "png" : "mkv"));
+        SessionWriter::Options o;
+        o.fsyncEachFrame = true;
+        o.imageSequence = sequence;
+        Session meta;
+        meta.board = "";
+        SessionWriter w(dir, meta, o);
+        for (int i = 0; i < 3; ++i) w.append({syntheticFrame(i, kMainW, kMainH)}, {}, std::nullopt);
+        w.close();
+        SessionReadReport report;
+        const Session s = readSession(dir, &report);
+        EXPECT_TRUE(report.ok()) << allWarnings(report);
+        expectFramesMatch(readAll(*openCameraFrames(s, "main")), {0, 1, 2}, kMainW, kMainH, 0,
+                          sequence ? 99.0 : 28.0);
+    }
 }
 
 TEST(Session, WriterNeverOverwritesASession) {
@@ -451,6 +478,16 @@ TEST(SessionCorrupt, MissingFramesCsvFallsBackToTheVideo) {
     ASSERT_EQ(s.frames.size(), 4u);
     EXPECT_DOUBLE_EQ(s.frames[3].timestamps[0], 3 / 25.0);
     EXPECT_FALSE(s.frames[3].groundTruth.has_value());
+}
+
+TEST(SessionCorrupt, FramesCsvWithoutHeaderFallsBackToTheVideo) {
+    const fs::path dir = test::outputDir("session_empty_csv");
+    writeSession(dir, 3, false);
+    std::ofstream(dir / "frames.csv", std::ios::trunc);  // crash before the header was written
+    SessionReadReport report;
+    const Session s = readSession(dir, &report);
+    EXPECT_TRUE(contains(report, "no header line")) << allWarnings(report);
+    EXPECT_EQ(s.frames.size(), 3u);
 }
 
 TEST(SessionCorrupt, MissingVideoKeepsTheSessionReadable) {

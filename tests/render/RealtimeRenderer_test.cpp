@@ -377,6 +377,75 @@ TEST_F(RealtimeRenderer, VirtualColourBleedsOntoRealFloor) {
     EXPECT_GT(sumR, 4.0 * std::abs(sumG));
 }
 
+// The imperfect shadow maps get the boxes' points (floor VPLs do not see the floor itself: it
+// lies in their horizon), and the real-only atlas holds fewer (the virtual box is left out).
+TEST_F(RealtimeRenderer, ImperfectShadowMapsAreFilled) {
+    SpotScene s;
+    int m = addMaterial(s.scene, glm::vec3(0.5f));
+    addBox(s.scene, "virtual box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.6f, 0.3f}, m, Origin::Virtual);
+    addBox(s.scene, "real box", {0.5f, 0.0f, -0.3f}, {0.9f, 0.6f, 0.3f}, m, Origin::Real);
+    RendererOptions opt;
+    opt.vplCount = 16;
+    Renderer r(s.scene, s.cam, opt);
+    r.render({s.pose, {}, false});
+    ASSERT_TRUE(r.plan().needRealOnlyIsm);
+    cv::Mat all = r.readIsmAtlas(false), real = r.readIsmAtlas(true);
+    const int tile = opt.ismTileSize;
+    int coveredAll = 0, coveredReal = 0;
+    for (int y = 0; y < all.rows; ++y)
+        for (int x = 0; x < all.cols; ++x) {
+            coveredAll += std::isfinite(all.at<float>(y, x));
+            coveredReal += std::isfinite(real.at<float>(y, x));
+            if (std::isfinite(all.at<float>(y, x)) && std::isfinite(real.at<float>(y, x))) {
+                ASSERT_LE(all.at<float>(y, x), real.at<float>(y, x));  // min over a superset
+            }
+        }
+    std::printf("ISM coverage: %.1f %% (all), %.1f %% (real only) of %d tiles\n",
+                100.0 * coveredAll / (16.0 * tile * tile),
+                100.0 * coveredReal / (16.0 * tile * tile), 16);
+    EXPECT_GT(coveredAll, 16 * tile * tile / 20);
+    EXPECT_GT(coveredReal, 16 * tile * tile / 100);
+    EXPECT_LT(coveredReal, coveredAll);
+}
+
+// A virtual plate between a lit real wall and the real floor blocks the bounced light in L_rv
+// (ISM over all points) but not in L_r (ISM over real points only).
+TEST_F(RealtimeRenderer, VirtualOccluderBlocksBouncedLightOnlyInLrv) {
+    Scene scene;
+    int white = addMaterial(scene, glm::vec3(0.8f));
+    int red = addMaterial(scene, {0.9f, 0.2f, 0.2f});
+    addFloor(scene, "floor", 0.0f, 4.0f, white, Origin::Real);
+    addBox(scene, "wall", {-1.0f, 0.0f, -0.6f}, {-0.9f, 1.0f, 0.6f}, red, Origin::Real);
+    addBox(scene, "plate", {-0.88f, 0.25f, -0.6f}, {-0.2f, 0.3f, 0.6f}, white, Origin::Virtual);
+    addLight(scene, Light::Type::Spot, {0.5f, 0.6f, 0.0f},
+             glm::normalize(glm::vec3(-0.9f, 0.6f, 0.0f) - glm::vec3(0.5f, 0.6f, 0.0f)), 10.0f,
+             Origin::Real, 0.25f, 0.2f);
+    const CameraIntrinsics cam = smallCamera();
+    const Pose pose = lookAtPose({0.9, 0.12, 0.2}, {-0.6, 0.05, 0.0});
+    Renderer r(scene, cam);
+    const FrameReport& rep = r.render({pose, {}, false});
+    ASSERT_TRUE(rep.ran("ism")) << rep.summary();
+    cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
+    cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
+    cv::Mat cover = r.coverage();
+    double indRv = 0, indR = 0;
+    int n = 0;
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            auto p = floorHit(cam, pose, x, y);
+            if (!p || cover.at<uint8_t>(y, x) != 1) continue;
+            if (p->x < -0.75 || p->x > -0.4 || std::abs(p->z) > 0.3) continue;
+            indRv += rv.at<cv::Vec3f>(y, x)[0] - drv.at<cv::Vec3f>(y, x)[0];
+            indR += lr.at<cv::Vec3f>(y, x)[0] - dr.at<cv::Vec3f>(y, x)[0];
+            ++n;
+        }
+    ASSERT_GT(n, 30);
+    std::printf("bounced light under the plate: L_rv %.4f, L_r %.4f (mean, red)\n", indRv / n,
+                indR / n);
+    EXPECT_GT(indR / n, 0.01);
+    EXPECT_LT(indRv, 0.7 * indR);
+}
+
 // Temporal smoothing: history is used on the next frame of a static view and dropped on a
 // reset (cut or tracking loss); a static scene converges to the same image either way.
 TEST_F(RealtimeRenderer, TemporalHistoryUsedAndReset) {
@@ -418,6 +487,44 @@ TEST_F(RealtimeRenderer, ConstantEnvironmentGivesAlbedoTimesRadiance) {
     // Lambert part 0.5 * 0.7 = 0.35 (plus (1-F) weighting: F0 = 0.04 -> within 5 %).
     const cv::Vec3f c = rv.at<cv::Vec3f>(cam.height / 2, cam.width / 2);
     EXPECT_NEAR(c[0], 0.35, 0.35 * 0.05);
+}
+
+// Base colour textures are sRGB-decoded and mapped with glTF's UV convention ((0,0) = top left
+// of the image): a 2x2 checker on the floor under a constant environment.
+TEST_F(RealtimeRenderer, BaseColorTextureIsDecodedAndMapped) {
+    const auto dir = test::outputDir("realtime_texture");
+    cv::Mat env(16, 32, CV_32FC3, cv::Scalar(0.7, 0.7, 0.7));
+    writeLinearRgb(dir / "env.exr", env);
+    Scene scene;
+    Texture tex;
+    tex.name = "checker";
+    tex.width = tex.height = 2;
+    tex.srgb = true;
+    // Row 0 (v = 0): encoded 188 (linear 0.503), 0; row 1: 0, 188.
+    tex.pixels = {188, 188, 188, 255, 0, 0, 0, 255, 0, 0, 0, 255, 188, 188, 188, 255};
+    scene.textures.push_back(tex);
+    int m = addMaterial(scene, glm::vec3(1.0f));
+    scene.materials[size_t(m)].baseColorTexture.texture = 0;
+    addFloor(scene, "floor", 0.0f, 4.0f, m, Origin::Real);
+    auto& prim = scene.meshes.back().primitives[0];
+    for (const glm::vec3& p : prim.positions) prim.uv0.push_back({(p.x + 2) / 4, (p.z + 2) / 4});
+    scene.environment.kind = Environment::Kind::Equirectangular;
+    scene.environment.image = dir / "env.exr";
+    const CameraIntrinsics cam = smallCamera();
+    const Pose pose = lookAtPose({0, 4.0, 0.5}, {0, 0, 0});
+    Renderer r(scene, cam);
+    r.render({pose, {}, false});
+    cv::Mat rv = r.readBuffer(Resource::DirectRv);
+    auto at = [&](glm::dvec3 w) {
+        auto px = cam.project(pose.inverse() * w);
+        EXPECT_TRUE(px.has_value());
+        return rv.at<cv::Vec3f>(int(std::lround(px->y)), int(std::lround(px->x)))[0];
+    };
+    const float lit = 0.7f * srgbToLinear(188.0f / 255.0f);
+    EXPECT_NEAR(at({-1, 0, -1}), lit, 0.02);  // u, v = 0.25: texel (0, 0)
+    EXPECT_NEAR(at({1, 0, -1}), 0.0, 0.02);   // texel (1, 0)
+    EXPECT_NEAR(at({-1, 0, 1}), 0.0, 0.02);   // texel (0, 1)
+    EXPECT_NEAR(at({1, 0, 1}), lit, 0.02);
 }
 
 }  // namespace

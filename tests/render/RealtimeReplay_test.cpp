@@ -166,6 +166,47 @@ TEST(RealtimeReplay, WritesPlayableVideoAndTimingCsv) {
     EXPECT_NE(rows[2].find("lost"), std::string::npos);
 }
 
+// Ctrl-C (SIGINT) mid-replay leaves a playable MKV holding every finished frame, and a CSV row
+// per frame written.
+TEST(RealtimeReplay, InterruptLeavesPlayableVideo) {
+    const auto dir = test::outputDir("realtime_replay_sigint");
+    writeScene(dir / "scene.gltf");
+    CameraCalibration calib;
+    calib.intrinsics = test::smallCamera(160, 120, 130.0);
+    calib.intrinsics.distortion = {0, 0, 0, 0, 0};
+    const int total = 800;
+    {
+        Session meta;
+        meta.cameras.push_back({"main", "", "main.yaml", "main"});
+        SessionWriter::Options opts;
+        opts.imageSequence = true;
+        SessionWriter w(dir / "session", meta, opts);
+        cv::Mat img(120, 160, CV_8UC3, cv::Scalar(70, 90, 110));
+        for (int i = 0; i < total; ++i)
+            w.append({img}, {i / 30.0}, test::lookAtPose({0.002 * i, 1.4, 1.6}, {0, 0.1, 0}));
+        w.close();
+    }
+    saveCalibration(dir / "session" / "main.yaml", calib);
+    const auto out = dir / "replay.mkv";
+    const std::string cmd = std::string("timeout -s INT 3 '") + MIRAGE_BINARY + "' replay '" +
+                            (dir / "session").string() + "' --scene '" +
+                            (dir / "scene.gltf").string() + "' -o '" + out.string() +
+                            "' --vpls 16 > '" + (dir / "log.txt").string() + "' 2>&1";
+    const int rc = std::system(cmd.c_str());
+    ASSERT_NE(rc, -1);
+    auto frames = openFrames(out);
+    cv::Mat f;
+    int n = 0;
+    while (frames->read(f)) ++n;
+    EXPECT_GE(n, 1);
+    EXPECT_LT(n, total) << "replay finished before the interrupt; make the session longer";
+    std::ifstream csv(std::filesystem::path(out).replace_extension(".csv"));
+    std::string line;
+    int rows = -1;  // header
+    while (std::getline(csv, line)) ++rows;
+    EXPECT_GE(rows, n);
+}
+
 TEST(RealtimeReplay, BadArgumentsFailWithAMessage) {
     const auto dir = test::outputDir("realtime_replay_bad");
     auto r = test::runMirage({"replay", dir.string(), "--scene", (dir / "none.gltf").string(), "-o",

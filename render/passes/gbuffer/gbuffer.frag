@@ -7,6 +7,8 @@ uniform int materialIndex;
 uniform int origin;  // ORIGIN_REAL or ORIGIN_VIRTUAL
 in vec3 worldPos;
 in vec3 worldNormal;
+in vec2 uv;
+layout(binding = 7) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
 layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
@@ -19,6 +21,6 @@ void main() {
     if (dot(n, cameraPos.xyz - worldPos) < 0.0) n = -n;
     gPosition = vec4(worldPos, float(origin));
     gNormal = vec4(n, clamp(m.emissive.w, 0.02, 1.0));
-    gAlbedo = vec4(m.baseColor.rgb, clamp(m.params.x, 0.0, 1.0));
+    gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.params.x, 0.0, 1.0));
     gEmissive = vec4(m.emissive.rgb, 0.0);
 }

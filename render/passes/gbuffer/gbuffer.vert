@@ -3,13 +3,16 @@
 // G-buffer geometry: mesh-local position/normal -> world (metres, glTF axes) -> camera clip.
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
+layout(location = 2) in vec2 inUv;
 uniform mat4 model;         // world-from-mesh
 uniform mat4 normalMatrix;  // inverse transpose of model
 out vec3 worldPos;
 out vec3 worldNormal;
+out vec2 uv;
 void main() {
     vec4 wp = model * vec4(inPosition, 1.0);
     worldPos = wp.xyz;
     worldNormal = mat3(normalMatrix) * inNormal;
+    uv = inUv;
     gl_Position = viewProj * wp;
 }

@@ -44,6 +44,7 @@ void GiFilterPass::execute(FrameContext& ctx) {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     program_.use();
+    glUniform1i(program_.uniformLocation("scale"), ctx.options.indirectScale);
     ctx.bindFrameBlocks();
     glBindTextureUnit(0, gbuffer_.position().id());
     glBindTextureUnit(1, gbuffer_.normal().id());

@@ -14,6 +14,7 @@ layout(binding = 4) uniform sampler2D directRv;
 layout(binding = 5) uniform sampler2D directR;
 layout(binding = 6) uniform sampler2D historyRv;  // rgb filtered indirect, a = camera distance
 layout(binding = 7) uniform sampler2D historyR;
+uniform int scale;  // the indirect buffers are at 1/scale resolution (joint bilateral upsampling)
 layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;
 layout(location = 2) out vec4 outHistoryRv;
@@ -34,14 +35,17 @@ void main() {
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
     int K = max(counts.z, 1);
+    ivec2 lowSize = textureSize(indirectRv, 0);
+    ivec2 centre = px / scale;
     vec3 sumRv = vec3(0.0), sumR = vec3(0.0);
     float wsum = 0.0;
     for (int dy = -K / 2; dy < K - K / 2; ++dy)
         for (int dx = -K / 2; dx < K - K / 2; ++dx) {
-            ivec2 q = clamp(px + ivec2(dx, dy), ivec2(0), size - 1);
-            vec4 Q = texelFetch(gPosition, q, 0);
+            ivec2 q = clamp(centre + ivec2(dx, dy), ivec2(0), lowSize - 1);
+            ivec2 qg = min(q * scale, size - 1);  // the G-buffer pixel that q was shaded at
+            vec4 Q = texelFetch(gPosition, qg, 0);
             if (int(Q.w + 0.5) == ORIGIN_NONE) continue;
-            vec3 nq = texelFetch(gNormal, q, 0).xyz;
+            vec3 nq = texelFetch(gNormal, qg, 0).xyz;
             float planeDist = abs(dot(Q.xyz - P.xyz, n)) / max(0.01 * camDist, 1e-4);
             float c = max(dot(n, nq), 0.0);
             c *= c;

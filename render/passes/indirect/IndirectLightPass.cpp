@@ -35,10 +35,11 @@ void IndirectLightPass::resize(const FrameContext& ctx) {
 
 void IndirectLightPass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
+    glViewport(0, 0, rv_.width(), rv_.height());
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     program_.use();
+    glUniform1i(program_.uniformLocation("scale"), ctx.options.indirectScale);
     ctx.bindFrameBlocks();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.vplBuffer().id());
     glBindTextureUnit(0, gbuffer_.position().id());

@@ -12,6 +12,7 @@ layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gAlbedo;
 layout(binding = 3) uniform usampler2D ismAll;
 layout(binding = 4) uniform usampler2D ismReal;
+uniform int scale;  // this pass runs at 1/scale resolution: pixel px shades G-buffer pixel px*scale
 layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;
 
@@ -25,15 +26,16 @@ float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 P = texelFetch(gPosition, px, 0);
+    ivec2 g = min(px * scale, textureSize(gPosition, 0) - 1);
+    vec4 P = texelFetch(gPosition, g, 0);
     int origin = int(P.w + 0.5);
     outRv = vec4(0.0);
     outR = vec4(0.0);
     if (origin == ORIGIN_NONE) return;
     bool pReal = origin == ORIGIN_REAL;
     vec3 p = P.xyz;
-    vec3 n = texelFetch(gNormal, px, 0).xyz;
-    vec4 A = texelFetch(gAlbedo, px, 0);
+    vec3 n = texelFetch(gNormal, g, 0).xyz;
+    vec4 A = texelFetch(gAlbedo, g, 0);
     vec3 diffuse = A.rgb * (1.0 - A.a) / PI;
     int K = max(counts.z, 1);
     int group = (px.x % K) + K * (px.y % K);

@@ -11,6 +11,8 @@ uniform int materialIndex;
 uniform int origin;
 in vec3 worldPos;
 in vec3 worldNormal;
+in vec2 uv;
+layout(binding = 7) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
 layout(location = 0) out float outDistance;  // metres from the light (see lightDistance)
 layout(location = 1) out vec4 outFlux;       // rgb W/sr * albedo (W/m^2 * albedo for dir.), a = real
 layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light
@@ -28,7 +30,7 @@ void main() {
     if (dot(n, toLight) < 0.0) n = -n;
     float dist = length(lights[li].positionRange.xyz - worldPos);
     float atten = directional ? 1.0 : spotAttenuation(li, -toLight) * rangeWindow(li, dist);
-    vec3 diffuseAlbedo = m.baseColor.rgb * (1.0 - clamp(m.params.x, 0.0, 1.0));
+    vec3 diffuseAlbedo = (m.baseColor.rgb * texture(baseColorMap, uv).rgb) * (1.0 - clamp(m.params.x, 0.0, 1.0));
     outFlux = vec4(lights[li].radiantIntensity.rgb * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
     outNormal = vec4(n, 0.0);
     outPosition = vec4(worldPos, 1.0);

@@ -324,6 +324,11 @@ def bad_cases():
             {"type": "spot", "spot": {"innerConeAngle": 0.8, "outerConeAngle": 0.5}}]}}
         g["nodes"][0]["extensions"] = {"KHR_lights_punctual": {"light": 0}}
     case("spot_cone_inverted", bad_spot)
+    def light_overflow(g):
+        # Finite in JSON (a double) but beyond float range: converting it would be undefined.
+        g["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e300}]}}
+        g["nodes"][0]["extensions"] = {"KHR_lights_punctual": {"light": 0}}
+    case("light_intensity_beyond_float", light_overflow)
     case("real_not_bool", lambda g: g["nodes"][0].update(extras={"mirage": {"real": "yes"}}))
 
     def env_missing(g):
