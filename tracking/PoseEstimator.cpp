@@ -333,8 +333,12 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         return a.support != b.support ? a.support > b.support : a.cost < b.cost;
     });
 
-    double sceneScale = 0;
-    for (const auto& c : candidates) sceneScale = std::max(sceneScale, glm::length(c.translation));
+    // Camera-to-board distance: the scale of "the same translation" when comparing poses (the
+    // world origin may be anywhere relative to the board).
+    double sceneScale = 1e-3;
+    for (const auto& c : candidates)
+        sceneScale =
+            std::max(sceneScale, glm::length(c.translation - obs[0].T_world_tag.translation));
 
     struct Refined {
         Fit fit;

@@ -3,13 +3,18 @@
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <optional>
+
+#include <opencv2/imgproc.hpp>
 
 #include "app/Command.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "tracking/Board.h"
+#include "tracking/EnvironmentMap.h"
 #include "tracking/Tracker.h"
 #include "tracking/TrackingReport.h"
 
@@ -18,6 +23,8 @@ namespace {
 
 struct TrackArgs {
     std::string session, video, calib, board, output, camera = "main";
+    std::string envmap, envCamera;  // environment map output and the session's fish-eye camera
+    int envmapWidth = 512;
     double fps = 30.0;
     bool noFilter = false;
     tracking::TrackerOptions options;
@@ -66,6 +73,35 @@ void run(const TrackArgs& a) {
     tracking::TrackingReport report(a.output, boardCentre(board));
     if (fromSession) report.addUnreadable(readReport.framesListed - readReport.framesReadable);
 
+    // Optional environment map from the session's fish-eye camera, posed by its extrinsic: fixed in
+    // the world, or relative to the main camera (T_world_env = T_world_main * T_main_env, only in
+    // frames where the main camera is tracked ok).
+    std::unique_ptr<FrameSource> envFrames;
+    std::optional<CameraCalibration> envCalib;
+    std::optional<tracking::EnvironmentMap> envMap;
+    int envUpdates = 0;
+    if (!a.envmap.empty()) {
+        if (!fromSession)
+            throw Error("mirage track --envmap needs a session with a fish-eye camera");
+        std::string name = a.envCamera;
+        if (name.empty())
+            for (const auto& c : session.cameras)
+                if (c.role == "environment") name = c.name;
+        const SessionCamera* ec = session.camera(name);
+        if (!ec)
+            throw FileError(a.session,
+                            "no environment camera (role \"environment\" or --env-camera)");
+        if (ec->calibration.empty())
+            throw FileError(a.session, "environment camera '" + name + "' has no calibration file");
+        envCalib = loadCalibration(session.path(ec->calibration));
+        if (!envCalib->T_parent_camera)
+            throw FileError(
+                session.path(ec->calibration).string(),
+                "T_parent_camera missing: the fish-eye's pose (parent main or world) is needed");
+        envFrames = openCameraFrames(session, name);
+        envMap.emplace(a.envmapWidth);
+    }
+
     int i = 0;
     for (;; ++i) {
         cv::Mat bgr;
@@ -99,6 +135,30 @@ void run(const TrackArgs& a) {
             f = tracker.process(bgr, t);
         }
         report.add(frameIndex, f, gt, decodeMs);
+        if (envFrames) {
+            cv::Mat env;
+            if (envFrames->read(env) && !env.empty()) {
+                std::optional<Pose> T_world_env;
+                if (envCalib->extrinsicParent == "world")
+                    T_world_env = *envCalib->T_parent_camera;
+                else if (f.estimate.state == tracking::TrackingState::Ok)
+                    T_world_env = *f.estimate.pose * *envCalib->T_parent_camera;
+                if (T_world_env) {
+                    envMap->update(env, envCalib->intrinsics, *T_world_env);
+                    ++envUpdates;
+                }
+            }
+        }
+    }
+    if (envMap) {
+        writeLinearRgb(a.envmap, envMap->radiance());
+        auto validPath = std::filesystem::path(a.envmap);
+        validPath.replace_filename(validPath.stem().string() + "_valid.png");
+        cv::Mat valid;
+        cv::cvtColor(envMap->validity(), valid, cv::COLOR_GRAY2BGR);
+        writeBgr8(validPath, valid);
+        spdlog::info("environment map {} ({} frames, {:.1f} % of directions seen; validity {})",
+                     a.envmap, envUpdates, 100 * envMap->validFraction(), validPath.string());
     }
     if (report.frames() == 0 && i == 0) spdlog::warn("no frame could be read");
     spdlog::info("wrote {}\n{}", a.output, report.summary());
@@ -117,6 +177,14 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_option("--fps", a->fps, "Frame rate for sources without timestamps")
         ->capture_default_str();
     cmd->add_flag("--no-filter", a->noFilter, "Report the raw per-frame poses");
+    cmd->add_option("--envmap", a->envmap,
+                    "Also build an environment map from the session's fish-eye camera "
+                    "(.exr/.pfm/.hdr linear; validity mask beside it as <name>_valid.png)");
+    cmd->add_option("--env-camera", a->envCamera,
+                    "Session camera for --envmap (default: the "
+                    "one with role environment)");
+    cmd->add_option("--envmap-width", a->envmapWidth, "Equirectangular width (height = width/2)")
+        ->capture_default_str();
     cmd->add_option("--decimate", a->options.detector.decimate, "Detector quad decimation")
         ->capture_default_str();
     cmd->add_option("--threads", a->options.detector.threads, "Detector threads")

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/camera/CameraModel.h"
+#include "core/image/ImageIO.h"
 #include "core/math/Pose.h"
 #include "tracking/BoardLayout.h"
 #include "tracking/SyntheticBoardView.h"
@@ -43,6 +44,39 @@ inline CameraIntrinsics fisheyeCamera(int w = 800, int h = 800) {
     c.model = DistortionModel::KannalaBrandt;
     c.distortion = {0.02, -0.005, 0.001, -0.0002};
     return c;
+}
+
+// A fish-eye whose image circle holds the whole hemisphere (90 degrees reach r = 0.97 w/2).
+inline CameraIntrinsics hemisphereFisheye(int size) {
+    CameraIntrinsics c = fisheyeCamera(size, size);
+    c.fx = c.fy = 0.5 * size / 1.7;
+    return c;
+}
+
+// A known environment: smooth colour gradients plus a bright soft "window" (linear RGB).
+inline glm::dvec3 trueEnvironment(const glm::dvec3& d) {
+    const glm::dvec3 window = glm::normalize(glm::dvec3(0.4, 0.7, -0.6));
+    const double spot = std::exp(-(1.0 - glm::dot(d, window)) * 25.0);
+    return {0.35 + 0.25 * d.x + 0.5 * spot, 0.4 + 0.3 * d.y + 0.4 * spot,
+            0.3 + 0.2 * std::sin(3 * d.z) + 0.3 * spot};
+}
+
+// What a fish-eye camera at T_world_camera records of that environment: each pixel unprojected
+// to a ray, rotated into the world, the environment sampled, encoded to 8-bit sRGB BGR.
+inline cv::Mat renderFisheye(const CameraIntrinsics& cam, const Pose& T_world_camera) {
+    cv::Mat out(cam.height, cam.width, CV_8UC3, cv::Scalar::all(0));
+    const glm::dmat3 R = T_world_camera.rotationMatrix();
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            const auto ray = cam.unproject({x, y});
+            if (!ray) continue;
+            const glm::dvec3 c = trueEnvironment(R * *ray);
+            auto enc = [](double v) {
+                return uint8_t(std::lround(255.0 * linearToSrgb(float(std::clamp(v, 0.0, 1.0)))));
+            };
+            out.at<cv::Vec3b>(y, x) = {enc(c.b), enc(c.g), enc(c.r)};
+        }
+    return out;
 }
 
 }  // namespace mirage::tracking::testing

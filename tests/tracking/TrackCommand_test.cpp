@@ -4,12 +4,15 @@
 #include <fstream>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera/CalibrationFile.h"
+#include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "tests/support/TestSupport.h"
 #include "tests/tracking/SyntheticViews.h"
+#include "tracking/EnvironmentMap.h"
 
 namespace mirage::tracking {
 namespace {
@@ -118,6 +121,66 @@ TEST(TrackCommand, TruncatedVideoCountsLostFramesAndContinues) {
     EXPECT_NE(r.output.find("frames: 8 (" + std::to_string(lost) + " unreadable"),
               std::string::npos)
         << r.output;
+}
+
+// A session with a fish-eye environment camera rigidly mounted on the main camera: the map built
+// from its frames (posed by the tracked main camera and the extrinsic) matches the environment.
+TEST(TrackCommand, EnvironmentMapFromTheSessionsFisheye) {
+    const auto dir = test::outputDir("track_envmap") / "session";
+    const Board board = BoardLayout().makeBoard();
+    const BoardRaster tex = renderBoard(board, 8000, false);
+    const auto cam = testing::pinholeCamera();
+    const auto fish = testing::hemisphereFisheye(240);
+    // The fish-eye looks up: camera +Z (forward) = main camera's -Y (up in the image).
+    const Pose T_main_env =
+        Pose::fromRotationTranslation(glm::dmat3(1, 0, 0, 0, 0, 1, 0, -1, 0), {0.0, -0.02, 0.0});
+    Session meta;
+    meta.cameras = {{"main", "", "main.yaml", "main"}, {"env", "", "env.yaml", "environment"}};
+    SessionWriter::Options opt;
+    opt.imageSequence = true;
+    std::vector<Pose> truths;
+    {
+        SessionWriter w(dir, meta, opt);
+        for (int i = 0; i < 3; ++i) {
+            const Pose T = testing::lookAt(0.35 * glm::dvec3(0.2 * i - 0.2, 0.85, 0.45), {0, 0, 0});
+            cv::Mat grey = renderSyntheticBoardView(board, tex, cam, T), bgr;
+            cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+            w.append({bgr, testing::renderFisheye(fish, T * T_main_env)}, {i / 30.0, i / 30.0}, T);
+        }
+        w.close();
+    }
+    CameraCalibration mainCal, envCal;
+    mainCal.intrinsics = cam;
+    envCal.intrinsics = fish;
+    envCal.T_parent_camera = T_main_env;
+    envCal.extrinsicParent = "main";
+    saveCalibration(dir / "main.yaml", mainCal);
+    saveCalibration(dir / "env.yaml", envCal);
+    board.save(dir / "board.json");
+    const auto out = dir.parent_path();
+    const auto r =
+        test::runMirage({"track", dir.string(), "-o", (out / "p.csv").string(), "--envmap",
+                         (out / "env.exr").string(), "--envmap-width", "128"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const cv::Mat env = readLinearRgb(out / "env.exr");
+    const cv::Mat valid = cv::imread((out / "env_valid.png").string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_EQ(env.cols, 128);
+    ASSERT_EQ(valid.size(), env.size());
+    double err = 0;
+    int n = 0;
+    for (int y = 0; y < env.rows; ++y)
+        for (int x = 0; x < env.cols; ++x) {
+            if (!valid.at<uint8_t>(y, x)) continue;
+            const glm::dvec3 d = EnvironmentMap::direction(x + 0.5, y + 0.5, env.cols, env.rows);
+            const glm::dvec3 want = testing::trueEnvironment(d);
+            const cv::Vec3f got = env.at<cv::Vec3f>(y, x);
+            for (int k = 0; k < 3; ++k) err += std::abs(got[k] - want[k]);
+            n += 3;
+        }
+    ASSERT_GT(n, 3 * 128 * 64 / 4);  // about the upper hemisphere
+    EXPECT_LT(err / n, 0.02);
+    // Straight down was never seen.
+    EXPECT_EQ(valid.at<uint8_t>(63, 64), 0);
 }
 
 TEST(TrackCommand, BadInputNamesTheFile) {
