@@ -35,7 +35,8 @@ void main() {
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
     int K = max(counts.z, 1);
-    ivec2 lowSize = textureSize(indirectRv, 0);
+    ivec2 lowSize = textureSize(indirectRv, 0);  // a multiple of K; deinterleaved (indirect.frag)
+    ivec2 tile = lowSize / K;
     ivec2 centre = px / scale;
     vec3 sumRv = vec3(0.0), sumR = vec3(0.0);
     float wsum = 0.0;
@@ -53,8 +54,9 @@ void main() {
             c *= c;
             c *= c;  // cos^16: ~0.5 at 17 degrees
             float w = c / (1.0 + planeDist * planeDist * 4.0);
-            sumRv += w * texelFetch(indirectRv, q, 0).rgb;
-            sumR += w * texelFetch(indirectR, q, 0).rgb;
+            ivec2 t = (q % K) * tile + q / K;
+            sumRv += w * texelFetch(indirectRv, t, 0).rgb;
+            sumR += w * texelFetch(indirectR, t, 0).rgb;
             wsum += w;
         }
     vec3 iRv = wsum > 1e-6 ? sumRv / wsum : vec3(0.0);
