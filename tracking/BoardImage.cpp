@@ -86,11 +86,16 @@ BoardRaster renderBoard(const Board& board, double pixelsPerMetre, bool caption)
     }
     BoardRaster out;
     out.image.create(rows, cols, CV_8UC1);
-    for (int i = 0; i < rows; ++i)
-        for (int j = 0; j < cols; ++j) {
-            const float lin = std::clamp(white.at<float>(i, j), 0.0f, 1.0f);
-            out.image.at<uint8_t>(i, j) = uint8_t(std::lround(255.0f * linearToSrgb(lin)));
-        }
+    // Linear coverage -> sRGB 8-bit through a 4096-entry table (exact to the 8-bit output).
+    std::vector<uint8_t> encode(4097);
+    for (int k = 0; k <= 4096; ++k)
+        encode[size_t(k)] = uint8_t(std::lround(255.0f * linearToSrgb(float(k) / 4096.0f)));
+    for (int i = 0; i < rows; ++i) {
+        const float* src = white.ptr<float>(i);
+        uint8_t* dst = out.image.ptr<uint8_t>(i);
+        for (int j = 0; j < cols; ++j)
+            dst[j] = encode[size_t(std::lround(4096.0f * std::clamp(src[j], 0.0f, 1.0f)))];
+    }
     if (caption && !sh.caption.empty() && sh.scaleBarThickness > 0) {
         // Caption under the scale bar, about 2.5 mm tall.
         const double textH = 0.0025 * sy;

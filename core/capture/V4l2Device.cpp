@@ -15,6 +15,7 @@
 #include <libv4l2.h>
 
 #include "core/Error.h"
+#include "core/capture/CaptureFormat.h"
 
 namespace mirage {
 
@@ -268,22 +269,28 @@ bool V4l2Device::dequeue(RawFrame& frame, int timeoutMs) {
         m.queuedIndex = -1;
         if (xioctl(m.fd, VIDIOC_QBUF, &buf) != 0) m.fail("cannot requeue buffer", errno);
     }
-    pollfd p{m.fd, POLLIN, 0};
-    int r;
-    do {
-        r = ::poll(&p, 1, timeoutMs);
-    } while (r < 0 && errno == EINTR);
-    if (r < 0) m.fail("waiting for a frame failed", errno);
-    if (r == 0)
-        throw Error(name() + ": no frame for " + std::to_string(timeoutMs) +
-                    " ms (camera unplugged or stalled?)");
+    // poll() can wake without a buffer being ready (EAGAIN on DQBUF): wait again until the
+    // deadline.
+    const double deadline = steadySeconds() + timeoutMs / 1000.0;
     v4l2_buffer buf{};
-    buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    buf.memory = V4L2_MEMORY_MMAP;
-    if (xioctl(m.fd, VIDIOC_DQBUF, &buf) != 0) {
-        if (errno == EAGAIN) throw Error(name() + ": frame signalled but not ready");
-        m.fail("cannot dequeue a frame (camera unplugged?)", errno);
+    for (;;) {
+        const int leftMs = std::max(0, int((deadline - steadySeconds()) * 1000.0));
+        pollfd p{m.fd, POLLIN, 0};
+        int r;
+        do {
+            r = ::poll(&p, 1, leftMs);
+        } while (r < 0 && errno == EINTR);
+        if (r < 0) m.fail("waiting for a frame failed", errno);
+        if (r == 0)
+            throw Error(name() + ": no frame for " + std::to_string(timeoutMs) +
+                        " ms (camera unplugged or stalled?)");
+        buf = v4l2_buffer{};
+        buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+        buf.memory = V4L2_MEMORY_MMAP;
+        if (xioctl(m.fd, VIDIOC_DQBUF, &buf) == 0) break;
+        if (errno != EAGAIN) m.fail("cannot dequeue a frame (camera unplugged?)", errno);
     }
+    if (buf.index >= m.buffers.size()) throw Error(name() + ": driver returned an unknown buffer");
     m.queuedIndex = int(buf.index);
     frame.format = m.mode.format;
     frame.width = m.mode.width;

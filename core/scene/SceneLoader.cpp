@@ -9,9 +9,10 @@
 #include <set>
 #include <sstream>
 
-#include <stb_image.h>
 #include <tiny_gltf.h>
 #include <glm/gtc/quaternion.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
 #include "core/Log.h"
@@ -28,7 +29,7 @@ constexpr uint64_t kMaxFileBytes = 2ull << 30;
 // Deeper JSON than this is no glTF anyone writes; refusing it keeps tinygltf's recursive
 // conversion of extras/extensions from exhausting the stack on hostile input.
 constexpr int kMaxJsonDepth = 64;
-// Texture limits: 8192 x 8192 RGBA8 = 256 MiB decoded.
+// Texture limits: 8192 x 8192 RGBA8 = 256 MiB decoded (a side may reach 16384 if the area fits).
 constexpr int kMaxImageSide = 16384;
 constexpr uint64_t kMaxImagePixels = 8192ull * 8192ull;
 // An accessor without a bufferView (all zeros, maybe with sparse overrides) has no data bounding
@@ -124,6 +125,52 @@ bool fsWriteWholeFile(std::string* err, const std::string&, const std::vector<un
 }
 
 // ---- images: PNG/JPEG only (what core glTF allows), decoded to RGBA8 ------------------------
+// Pixels are decoded by OpenCV (Debian's libpng / libjpeg-turbo, maintained and hardened) rather
+// than stb_image. The size is read from the header first so that a hostile header cannot make
+// the decoder allocate gigabytes.
+
+uint32_t bigEndian(const unsigned char* p, int bytes) {
+    uint32_t v = 0;
+    for (int i = 0; i < bytes; ++i) v = (v << 8) | p[i];
+    return v;
+}
+
+// Width and height from a PNG IHDR or a JPEG SOFn segment; false if the header is malformed.
+bool imageHeaderSize(const unsigned char* bytes, size_t size, bool png, uint32_t& width,
+                     uint32_t& height) {
+    if (png) {
+        if (size < 24 || std::memcmp(bytes + 12, "IHDR", 4) != 0) return false;
+        width = bigEndian(bytes + 16, 4);
+        height = bigEndian(bytes + 20, 4);
+        return true;
+    }
+    size_t pos = 2;  // after SOI
+    while (pos + 4 <= size) {
+        if (bytes[pos] != 0xFF) return false;
+        const unsigned char marker = bytes[pos + 1];
+        if (marker == 0xFF) {  // fill byte
+            ++pos;
+            continue;
+        }
+        if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {  // no length field
+            pos += 2;
+            continue;
+        }
+        if (marker == 0xD9 || marker == 0xDA) return false;  // end or scan before any frame
+        const size_t length = bigEndian(bytes + pos + 2, 2);
+        if (length < 2 || pos + 2 + length > size) return false;
+        const bool startOfFrame =
+            marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+        if (startOfFrame) {
+            if (length < 7) return false;
+            height = bigEndian(bytes + pos + 5, 2);
+            width = bigEndian(bytes + pos + 7, 2);
+            return true;
+        }
+        pos += 2 + length;
+    }
+    return false;
+}
 
 bool decodeRgba8(const unsigned char* bytes, size_t size, int& width, int& height,
                  std::vector<unsigned char>& pixels, std::string& why) {
@@ -131,33 +178,71 @@ bool decodeRgba8(const unsigned char* bytes, size_t size, int& width, int& heigh
         why = "its data is " + std::to_string(size) + " bytes (not a PNG or JPEG image)";
         return false;
     }
-    static const unsigned char kPng[4] = {0x89, 'P', 'N', 'G'};
+    static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
     static const unsigned char kJpeg[3] = {0xFF, 0xD8, 0xFF};
-    if (std::memcmp(bytes, kPng, 4) != 0 && std::memcmp(bytes, kJpeg, 3) != 0) {
+    const bool png = std::memcmp(bytes, kPng, 8) == 0;
+    if (!png && std::memcmp(bytes, kJpeg, 3) != 0) {
         why = "it is neither PNG nor JPEG (the image formats core glTF allows)";
         return false;
     }
-    int w = 0, h = 0, channels = 0;
-    if (!stbi_info_from_memory(bytes, static_cast<int>(size), &w, &h, &channels)) {
-        why = std::string("it cannot be decoded (") + stbi_failure_reason() + ")";
+    uint32_t w = 0, h = 0;
+    if (!imageHeaderSize(bytes, size, png, w, h)) {
+        why = std::string("its ") + (png ? "PNG" : "JPEG") + " header is malformed";
         return false;
     }
-    if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
-        static_cast<uint64_t>(w) * static_cast<uint64_t>(h) > kMaxImagePixels) {
+    auto tooLarge = [&](uint64_t ww, uint64_t hh) {
+        return ww == 0 || hh == 0 || ww > kMaxImageSide || hh > kMaxImageSide ||
+               ww * hh > kMaxImagePixels;
+    };
+    if (tooLarge(w, h)) {
         why = "it is " + std::to_string(w) + "x" + std::to_string(h) +
-              " pixels; mirage accepts at most 8192x8192 (64 Mpixel) textures";
+              " pixels; mirage accepts 1x1 up to 8192x8192 (64 Mpixel) textures";
         return false;
     }
-    unsigned char* decoded =
-        stbi_load_from_memory(bytes, static_cast<int>(size), &w, &h, &channels, 4);
-    if (!decoded) {
-        why = std::string("it cannot be decoded (") + stbi_failure_reason() + ")";
+    cv::Mat decoded;
+    try {
+        const cv::Mat encoded(1, static_cast<int>(size), CV_8U, const_cast<unsigned char*>(bytes));
+        decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+        decoded.release();
+    }
+    if (decoded.empty() ||
+        tooLarge(static_cast<uint64_t>(decoded.cols), static_cast<uint64_t>(decoded.rows))) {
+        why = std::string("its ") + (png ? "PNG" : "JPEG") + " data cannot be decoded";
         return false;
     }
-    pixels.assign(decoded, decoded + static_cast<size_t>(w) * static_cast<size_t>(h) * 4);
-    stbi_image_free(decoded);
-    width = w;
-    height = h;
+    if (decoded.depth() == CV_16U) decoded.convertTo(decoded, CV_8U, 1.0 / 257.0);
+    if (decoded.depth() != CV_8U) {
+        why = "it decodes to an unsupported pixel depth";
+        return false;
+    }
+    cv::Mat rgba;
+    switch (decoded.channels()) {
+        case 1:
+            cv::cvtColor(decoded, rgba, cv::COLOR_GRAY2RGBA);
+            break;
+        case 3:
+            cv::cvtColor(decoded, rgba, cv::COLOR_BGR2RGBA);
+            break;
+        case 4:
+            cv::cvtColor(decoded, rgba, cv::COLOR_BGRA2RGBA);
+            break;
+        case 2: {  // grey + alpha
+            std::vector<cv::Mat> ga;
+            cv::split(decoded, ga);
+            cv::merge(std::vector<cv::Mat>{ga[0], ga[0], ga[0], ga[1]}, rgba);
+            break;
+        }
+        default:
+            why = "it has " + std::to_string(decoded.channels()) + " channels";
+            return false;
+    }
+    width = rgba.cols;
+    height = rgba.rows;
+    pixels.resize(static_cast<size_t>(width) * static_cast<size_t>(height) * 4);
+    for (int y = 0; y < height; ++y)
+        std::memcpy(pixels.data() + static_cast<size_t>(y) * static_cast<size_t>(width) * 4,
+                    rgba.ptr(y), static_cast<size_t>(width) * 4);
     return true;
 }
 
@@ -344,6 +429,15 @@ public:
 
 private:
     [[noreturn]] void fail(const std::string& problem) const { throw FileError(file_, problem); }
+
+    // A double from the file as a float; values beyond float's range (converting them would be
+    // undefined behaviour) and non-finite values are errors naming `what`.
+    float toFloat(double v, const std::string& what) const {
+        if (!std::isfinite(v) ||
+            std::abs(v) > static_cast<double>(std::numeric_limits<float>::max()))
+            fail(what + " is " + std::to_string(v) + ", outside the range of a float");
+        return static_cast<float>(v);
+    }
 
     void warn(const std::string& message) {
         spdlog::warn("{}: {}", file_, message);
@@ -639,7 +733,9 @@ private:
         const tinygltf::Value& v = object.Get(key);
         if (!v.IsNumber()) fail(what + " field '" + key + "' must be a number");
         double x = v.GetNumberAsDouble();
-        if (!std::isfinite(x) || x < lo || x > hi)
+        // Every such field ends up in a float, so the float range bounds it too.
+        const double floatMax = static_cast<double>(std::numeric_limits<float>::max());
+        if (!std::isfinite(x) || x < lo || x > hi || std::abs(x) > floatMax)
             fail(what + " field '" + key + "' is " + std::to_string(x) + "; it must be in [" +
                  std::to_string(lo) + ", " +
                  (std::isinf(hi) ? std::string("inf") : std::to_string(hi)) + "]");
@@ -730,7 +826,7 @@ private:
                            name + " normalTexture", false, &src.normalTexture.extensions);
             if (!std::isfinite(src.normalTexture.scale))
                 fail(name + " normalTexture.scale must be finite");
-            m.normalScale = static_cast<float>(src.normalTexture.scale);
+            m.normalScale = toFloat(src.normalTexture.scale, name + " normalTexture.scale");
             m.emissiveTexture =
                 textureRef(src.emissiveTexture.index, src.emissiveTexture.texCoord,
                            name + " emissiveTexture", true, &src.emissiveTexture.extensions);
@@ -763,7 +859,7 @@ private:
                      "; expected OPAQUE, MASK or BLEND");
             if (!std::isfinite(src.alphaCutoff) || src.alphaCutoff < 0)
                 fail(name + " alphaCutoff must be a finite number >= 0");
-            m.alphaCutoff = static_cast<float>(src.alphaCutoff);
+            m.alphaCutoff = toFloat(src.alphaCutoff, name + " alphaCutoff");
 
             if (const tinygltf::Value* ext =
                     extension(src.extensions, "KHR_materials_transmission", name)) {
@@ -1065,17 +1161,17 @@ private:
                 for (int c = 0; c < 3; ++c) {
                     if (src.color[static_cast<size_t>(c)] < 0)
                         fail(name + " color must not be negative");
-                    l.color[c] = static_cast<float>(src.color[static_cast<size_t>(c)]);
+                    l.color[c] = toFloat(src.color[static_cast<size_t>(c)], name + " color");
                 }
             }
             if (!std::isfinite(src.intensity) || src.intensity < 0)
                 fail(name +
                      " intensity must be a finite number >= 0 (candela for point/spot, lux for "
                      "directional)");
-            l.intensity = static_cast<float>(src.intensity);
+            l.intensity = toFloat(src.intensity, name + " intensity");
             if (!std::isfinite(src.range) || src.range < 0)
                 fail(name + " range must be a finite number > 0 (omit it for unlimited range)");
-            l.range = static_cast<float>(src.range);
+            l.range = toFloat(src.range, name + " range");
             if (l.type == Light::Type::Spot) {
                 const double inner = src.spot.innerConeAngle, outer = src.spot.outerConeAngle;
                 if (!std::isfinite(inner) || !std::isfinite(outer) || inner < 0 ||
@@ -1110,12 +1206,13 @@ private:
                 if (!std::isfinite(p.zfar) || p.zfar < 0 || (p.zfar > 0 && p.zfar <= p.znear))
                     fail(name +
                          " perspective.zfar must be greater than znear (or absent for infinite)");
-                c.yfov = static_cast<float>(p.yfov);
-                c.aspectRatio = static_cast<float>(p.aspectRatio);
-                c.znear = static_cast<float>(p.znear);
+                c.yfov = toFloat(p.yfov, name + " yfov");
+                c.aspectRatio = toFloat(p.aspectRatio, name + " aspectRatio");
+                c.znear = toFloat(p.znear, name + " znear");
                 c.infiniteFar = p.zfar == 0;
-                c.zfar = c.infiniteFar ? std::max(1000.0f, c.znear * 1000.0f)
-                                       : static_cast<float>(p.zfar);
+                c.zfar = c.infiniteFar ? toFloat(std::min(std::max(1000.0, p.znear * 1000.0), 1e30),
+                                                 name + " znear * 1000")
+                                       : toFloat(p.zfar, name + " zfar");
             } else if (src.type == "orthographic") {
                 const auto& o = src.orthographic;
                 if (!std::isfinite(o.xmag) || !std::isfinite(o.ymag) || o.xmag == 0 || o.ymag == 0)
@@ -1124,10 +1221,10 @@ private:
                     o.zfar <= o.znear)
                     fail(name + " orthographic needs 0 <= znear < zfar");
                 c.projection = CameraNodeInfo::Projection::Orthographic;
-                c.xmag = static_cast<float>(o.xmag);
-                c.ymag = static_cast<float>(o.ymag);
-                c.znear = static_cast<float>(o.znear);
-                c.zfar = static_cast<float>(o.zfar);
+                c.xmag = toFloat(o.xmag, name + " xmag");
+                c.ymag = toFloat(o.ymag, name + " ymag");
+                c.znear = toFloat(o.znear, name + " znear");
+                c.zfar = toFloat(o.zfar, name + " zfar");
             } else {
                 fail(name + " has type " + quote(src.type) +
                      "; expected perspective or orthographic");
@@ -1221,6 +1318,8 @@ private:
                 if (static_cast<size_t>(child) == i)
                     fail(name + " lists itself as a child; the node graph must be a tree");
                 Node& c = scene_.nodes[static_cast<size_t>(child)];
+                if (c.parent == static_cast<int>(i))
+                    fail(name + " lists node " + std::to_string(child) + " twice in 'children'");
                 if (c.parent >= 0)
                     fail("node " + std::to_string(child) + " is a child of both node " +
                          std::to_string(c.parent) + " and node " + std::to_string(i) +

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <istream>
 #include <optional>
 
 #include "core/Error.h"
@@ -34,7 +35,7 @@ struct Element {
 
 class Cursor {
 public:
-    Cursor(std::ifstream& in, uint64_t fileSize) : in_(in), fileSize_(fileSize) {}
+    Cursor(std::istream& in, uint64_t fileSize) : in_(in), fileSize_(fileSize) {}
     uint64_t fileSize() const { return fileSize_; }
 
     // Reads an element header at `pos`; nullopt if it does not fit in the file or is invalid.
@@ -98,19 +99,24 @@ private:
             if (first & (0x80 >> i)) return i + 1;
         return 0;
     }
-    std::ifstream& in_;
+    std::istream& in_;
     uint64_t fileSize_;
 };
 
 }  // namespace
 
 MatroskaScan scanMatroska(const std::filesystem::path& path) {
-    MatroskaScan r;
     std::error_code ec;
     const uint64_t fileSize = std::filesystem::file_size(path, ec);
     if (ec) throw FileError(path.string(), "cannot open video: " + ec.message());
     std::ifstream in(path, std::ios::binary);
     if (!in) throw FileError(path.string(), "cannot open video for reading");
+    return scanMatroska(in, fileSize, path.string());
+}
+
+MatroskaScan scanMatroska(std::istream& in, uint64_t fileSize, const std::string& name) {
+    const std::filesystem::path path(name);  // for messages only
+    MatroskaScan r;
     if (fileSize == 0) {
         r.problem = "the file is empty (recording stopped before the first frame)";
         r.truncated = true;
@@ -218,6 +224,9 @@ MatroskaScan scanMatroska(const std::filesystem::path& path) {
                 if (track != 0 && (videoTrack == 0 || track == videoTrack)) ++r.completeFrames;
                 q = b->end(segEnd);
             }
+            // A cluster of known size that runs past the end of the file was cut, even when
+            // the cut falls between two of its children.
+            if (e->size != kUnknown && clusterEnd > fileSize) r.truncated = true;
             if (r.truncated) break;
             p = e->size == kUnknown ? q : clusterEnd;
             continue;

@@ -3,7 +3,9 @@
 // that are completely on disk. Used to check a session's video against frames.csv and to detect
 // a file that was cut short (crash, full disk, partial copy). Handles Segments and Clusters of
 // unknown size (live/crash-interrupted files) and files written by other muxers (ffmpeg).
+#include <cstdint>
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 
 namespace mirage {
@@ -19,5 +21,7 @@ struct MatroskaScan {
 // Throws FileError if the file cannot be opened or is not Matroska at all (no EBML header with
 // DocType matroska/webm). Damage after the header is reported in the result, not thrown.
 MatroskaScan scanMatroska(const std::filesystem::path& path);
+// The same on `size` bytes of a seekable stream; `name` is used in error messages.
+MatroskaScan scanMatroska(std::istream& in, uint64_t size, const std::string& name);
 
 }  // namespace mirage

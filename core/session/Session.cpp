@@ -26,6 +26,16 @@ int Session::cameraIndex(const std::string& name) const {
     return -1;
 }
 
+CameraCalibration loadSessionCalibration(const Session& s, const std::string& camera) {
+    const SessionCamera* c = s.camera(camera);
+    const std::string json = (s.dir / "session.json").string();
+    if (!c) throw FileError(json, "no camera named '" + camera + "'");
+    if (c->calibration.empty())
+        throw FileError(
+            json, "camera '" + camera + "' names no calibration file (set cameras[].calibration)");
+    return loadCalibration(s.path(c->calibration));
+}
+
 void writeSessionJson(const Session& s) {
     json j;
     j["format"] = s.format;
@@ -176,9 +186,11 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     for (const auto& c : s.cameras) names.push_back(c.name);
     std::vector<FrameRecord> rows;
     const auto csvPath = s.path(s.framesFile);
+    bool haveFrameList = false;
     if (std::filesystem::is_regular_file(csvPath)) {
         try {
             rows = readFramesCsv(csvPath, s.fps, names, report.warnings);
+            haveFrameList = true;
         } catch (const FileError& e) {
             report.warnings.push_back(std::string(e.what()) +
                                       "; frames taken from the main video alone");
@@ -187,7 +199,7 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
         report.warnings.push_back(s.framesFile +
                                   " is missing; frames taken from the main video alone");
     }
-    if (rows.empty() && !std::filesystem::is_regular_file(csvPath)) {
+    if (!haveFrameList) {
         // No frame list: one row per frame of the main camera, times from the frame rate.
         const FrameInventory& main = inventories[0];
         std::vector<int> indices;

@@ -69,6 +69,11 @@ struct SessionReadReport {
 // keeps what is there and lists what is missing in the report (and logs it as warnings).
 Session readSession(const std::filesystem::path& dir, SessionReadReport* report = nullptr);
 
+// The calibration of one camera of a session (its `calibration` file). Throws FileError if the
+// camera does not exist, names no calibration file, or the file is missing or invalid.
+struct CameraCalibration;
+CameraCalibration loadSessionCalibration(const Session& s, const std::string& camera);
+
 // Writes session.json (atomically). Used by SessionWriter; exposed for tools that edit sessions.
 void writeSessionJson(const Session& s);
 

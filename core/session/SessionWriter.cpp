@@ -12,10 +12,12 @@
 #include <cstring>
 #include <ctime>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
 #include "core/image/ImageIO.h"
+#include "core/session/AtomicFile.h"
 #include "core/session/FramesCsv.h"
 #include "core/session/MatroskaWriter.h"
 #include "core/session/Session.h"
@@ -154,7 +156,17 @@ void SessionWriter::append(const std::vector<cv::Mat>& images,
             std::snprintf(name, sizeof name, "%06d.png", row.index);
             cv::Mat bgr = img;
             if (img.channels() == 1) cv::cvtColor(img, bgr, cv::COLOR_GRAY2BGR);
-            writeBgr8(s.path(s.cameras[c].video) / name, bgr);  // temp + rename
+            const auto file = s.path(s.cameras[c].video) / name;
+            if (m.opts.fsyncEachFrame) {
+                // Encoded in memory, then temp + fsync + rename + folder fsync.
+                std::vector<uint8_t> png;
+                if (!cv::imencode(".png", bgr, png))
+                    throw FileError(file.string(), "PNG encoding failed");
+                writeFileAtomically(
+                    file, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+            } else {
+                writeBgr8(file, bgr);  // temp + rename
+            }
         }
     }
     // 3: then the row, in one write so a crash never leaves half a row... except a torn write

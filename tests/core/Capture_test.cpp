@@ -180,8 +180,9 @@ TEST(CaptureFormat, FrameClockPrefersTheDriverClock) {
 }
 
 // A short recorded video to pose as a camera.
-fs::path recordedVideo() {
-    const fs::path dir = test::outputDir("capture_source");
+// Each test gets its own copy: ctest may run tests in parallel processes.
+fs::path recordedVideo(const std::string& name) {
+    const fs::path dir = test::outputDir(name);
     SessionWriter::Options o;
     o.fps = 20;
     o.imageSequence = true;  // lossless: the camera path's own loss is what is measured
@@ -194,7 +195,7 @@ fs::path recordedVideo() {
 }
 
 TEST(V4l2Camera, PipelineOverARecordedVideo) {
-    const fs::path video = recordedVideo();
+    const fs::path video = recordedVideo("capture_source_pipeline");
     for (const Fmt fmt : {Fmt::Yuyv, Fmt::Mjpeg}) {
         VideoFileCaptureDevice::Options o;
         o.fps = 20;
@@ -238,7 +239,7 @@ TEST(V4l2Camera, ClearErrorsWithoutADevice) {
 }
 
 TEST(SessionRecorder, LiveRecordingReplaysExactly) {
-    const fs::path video = recordedVideo();
+    const fs::path video = recordedVideo("capture_source_recorder");
     VideoFileCaptureDevice::Options o;
     o.fps = 20;
     o.startSeconds = 7.0;

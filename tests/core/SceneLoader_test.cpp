@@ -6,6 +6,8 @@
 #include <fstream>
 #include <set>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "core/Error.h"
 #include "core/scene/Scene.h"
 #include "tests/support/TestSupport.h"
@@ -261,6 +263,32 @@ TEST(SceneLoader, ShowcaseGlbHasTheSameContent) {
     checkShowcase(s);
 }
 
+TEST(SceneLoader, GltfAndGlbGiveIdenticalGeometryAndTextures) {
+    Scene a = loadScene(goodScene("showcase.gltf")), b = loadScene(goodScene("showcase.glb"));
+    ASSERT_EQ(a.meshes.size(), b.meshes.size());
+    for (size_t m = 0; m < a.meshes.size(); ++m) {
+        ASSERT_EQ(a.meshes[m].primitives.size(), b.meshes[m].primitives.size());
+        for (size_t p = 0; p < a.meshes[m].primitives.size(); ++p) {
+            const Primitive &x = a.meshes[m].primitives[p], &y = b.meshes[m].primitives[p];
+            EXPECT_EQ(x.positions, y.positions);
+            EXPECT_EQ(x.normals, y.normals);
+            EXPECT_EQ(x.tangents, y.tangents);
+            EXPECT_EQ(x.uv0, y.uv0);
+            EXPECT_EQ(x.uv1, y.uv1);
+            EXPECT_EQ(x.indices, y.indices);
+            EXPECT_EQ(x.material, y.material);
+        }
+    }
+    ASSERT_EQ(a.textures.size(), b.textures.size());
+    for (size_t t = 0; t < a.textures.size(); ++t)
+        EXPECT_EQ(a.textures[t].pixels, b.textures[t].pixels);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    for (size_t n = 0; n < a.nodes.size(); ++n) {
+        EXPECT_EQ(a.nodes[n].world, b.nodes[n].world);
+        EXPECT_EQ(a.nodes[n].origin, b.nodes[n].origin);
+    }
+}
+
 TEST(SceneLoader, LoadFromMemoryMatchesLoadFromFile) {
     Scene s =
         loadSceneFromMemory(readFile(goodScene("showcase.glb")), "in-memory.glb", goodScene(""));
@@ -329,6 +357,68 @@ TEST(SceneLoader, TriangleFanWithUnsignedIntIndicesAllReal) {
     EXPECT_EQ(s.meshInstances().at(0).origin, Origin::Real);
 }
 
+// Textures in the formats glTF allows, encoded here by OpenCV and embedded as data URIs: JPEG
+// (lossy: compared with a tolerance), 16-bit grey PNG (reduced to 8 bits), grey+alpha PNG.
+std::string texturedTriangle(
+    const std::vector<std::pair<std::string, std::vector<unsigned char>>>& images) {
+    std::vector<unsigned char> buf;
+    append(buf, std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1});  // pos + uv
+    std::string imageList, textureList;
+    for (size_t i = 0; i < images.size(); ++i) {
+        imageList += (i ? "," : "") + std::string(R"({"uri":"data:)") + images[i].first +
+                     ";base64," + base64(images[i].second) + "\"}";
+        textureList += (i ? "," : "") + std::string(R"({"source":)") + std::to_string(i) + "}";
+    }
+    return R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+      "meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1},"material":0}]}],
+      "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+      "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},
+                   {"bufferView":0,"byteOffset":36,"componentType":5126,"count":3,"type":"VEC2"}],
+      "bufferViews":[{"buffer":0,"byteLength":60}],
+      "buffers":[{"byteLength":60,"uri":"data:application/octet-stream;base64,)" +
+           base64(buf) + R"("}],"images":[)" + imageList + "],\"textures\":[" + textureList + "]}";
+}
+
+std::vector<unsigned char> encode(const std::string& ext, const cv::Mat& image) {
+    std::vector<unsigned char> bytes;
+    EXPECT_TRUE(cv::imencode(ext, image, bytes));
+    return bytes;
+}
+
+TEST(SceneLoader, TextureFormatsDecodeToRgba8) {
+    cv::Mat bgr(8, 8, CV_8UC3, cv::Scalar(40, 120, 200));  // B, G, R
+    cv::Mat grey16(2, 3, CV_16UC1, cv::Scalar(65535));
+    grey16.at<uint16_t>(1, 2) = 257 * 100;
+    cv::Mat greyAlpha(1, 2, CV_8UC4, cv::Scalar(77, 77, 77, 128));  // written by OpenCV as RGBA
+    Scene s = loadSceneFromMemory(texturedTriangle({{"image/jpeg", encode(".jpg", bgr)},
+                                                    {"image/png", encode(".png", grey16)},
+                                                    {"image/png", encode(".png", greyAlpha)}}),
+                                  "formats.gltf", ".");
+    ASSERT_EQ(s.textures.size(), 3u);
+    const Texture& jpeg = s.textures[0];
+    ASSERT_EQ(jpeg.width, 8);
+    ASSERT_EQ(jpeg.height, 8);
+    EXPECT_TRUE(jpeg.srgb);
+    for (size_t p = 0; p < 64; ++p) {  // RGBA order after loading; JPEG is lossy
+        EXPECT_NEAR(jpeg.pixels[p * 4 + 0], 200, 3);
+        EXPECT_NEAR(jpeg.pixels[p * 4 + 1], 120, 3);
+        EXPECT_NEAR(jpeg.pixels[p * 4 + 2], 40, 3);
+        EXPECT_EQ(jpeg.pixels[p * 4 + 3], 255);
+    }
+    const Texture& g16 = s.textures[1];
+    ASSERT_EQ(g16.width, 3);
+    ASSERT_EQ(g16.height, 2);
+    EXPECT_EQ(g16.pixels[0], 255);
+    EXPECT_EQ(g16.pixels[(1 * 3 + 2) * 4 + 0], 100);  // row 1, column 2: top row first
+    EXPECT_EQ(g16.pixels[(1 * 3 + 2) * 4 + 1], 100);
+    EXPECT_EQ(g16.pixels[(1 * 3 + 2) * 4 + 3], 255);
+    const Texture& ga = s.textures[2];
+    ASSERT_EQ(ga.pixels.size(), 8u);
+    EXPECT_EQ(ga.pixels[0], 77);
+    EXPECT_EQ(ga.pixels[3], 128);
+    EXPECT_FALSE(ga.srgb);  // unused by any material: data by default
+}
+
 // ---- bad files ---------------------------------------------------------------------------------
 
 struct BadCase {
@@ -368,9 +458,13 @@ const std::vector<BadCase>& badCases() {
         {"unknown_required_extension.gltf", {"extensionsRequired", "KHR_draco_mesh_compression"}},
         {"missing_image.gltf", {"image 0", "no_such_image.png"}},
         {"image_not_png.gltf", {"image 0", "neither PNG nor JPEG"}},
+        {"image_too_large.gltf", {"image 0", "100000x100000", "8192x8192"}},
+        {"duplicate_child.gltf", {"node 0", "node 1 twice"}},
         {"light_index_out_of_range.gltf", {"node 0", "light 2"}},
         {"camera_index_out_of_range.gltf", {"node 0", "camera 1"}},
         {"spot_cone_inverted.gltf", {"light 0", "innerConeAngle < outerConeAngle"}},
+        {"light_intensity_beyond_float.gltf",
+         {"light 0 intensity", "outside the range of a float"}},
         {"real_not_bool.gltf", {"node 0", "extras.mirage.real"}},
         {"environment_image_missing.gltf", {"environment", "nowhere.hdr"}},
         {"attribute_count_mismatch.gltf", {"NORMAL", "2 elements", "POSITION has 3"}},

@@ -7,12 +7,14 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "core/Error.h"
+#include "core/camera/CalibrationFile.h"
 #include "core/session/AtomicFile.h"
 #include "core/session/MatroskaScanner.h"
 #include "core/session/MatroskaWriter.h"
@@ -147,6 +149,12 @@ TEST(Session, MkvRoundTrip) {
     auto env = openCameraFrames(s, "env");
     expectFramesMatch(readAll(*env), idx, kEnvW, kEnvH, 1, 28.0);
     EXPECT_THROW(openCameraFrames(s, "nope"), FileError);
+    // Calibration through the session: missing file, no file named, then a real one.
+    EXPECT_THROW(loadSessionCalibration(s, "main"), FileError);
+    EXPECT_THROW(loadSessionCalibration(s, "env"), FileError);
+    EXPECT_THROW(loadSessionCalibration(s, "nope"), FileError);
+    fs::copy_file(test::testDataDir() / "calib" / "opencv_sample_style.yaml", dir / "main.yaml");
+    EXPECT_EQ(loadSessionCalibration(s, "main").intrinsics.width, 640);
 
     // The plain-video path reads the same file, with FFmpeg's frame times (ms ticks).
     auto plain = openFrames(dir / "main.mkv");
@@ -184,6 +192,26 @@ TEST(Session, ImageSequenceRoundTripIsLossless) {
     EXPECT_TRUE(contains(report, "1 of 5 listed frames are not in main")) << allWarnings(report);
     auto main = openCameraFrames(s2, "main");
     expectFramesMatch(readAll(*main), {0, 1, 3, 4}, kMainW, kMainH, 0, 99.0);
+}
+
+TEST(Session, FsyncEachFrameWritesTheSameSession) {
+    for (const bool sequence : {false, true}) {
+        const fs::path dir =
+            test::outputDir(std::string("session_fsync_") + (sequence ? "png" : "mkv"));
+        SessionWriter::Options o;
+        o.fsyncEachFrame = true;
+        o.imageSequence = sequence;
+        Session meta;
+        meta.board = "";
+        SessionWriter w(dir, meta, o);
+        for (int i = 0; i < 3; ++i) w.append({syntheticFrame(i, kMainW, kMainH)}, {}, std::nullopt);
+        w.close();
+        SessionReadReport report;
+        const Session s = readSession(dir, &report);
+        EXPECT_TRUE(report.ok()) << allWarnings(report);
+        expectFramesMatch(readAll(*openCameraFrames(s, "main")), {0, 1, 2}, kMainW, kMainH, 0,
+                          sequence ? 99.0 : 28.0);
+    }
 }
 
 TEST(Session, WriterNeverOverwritesASession) {
@@ -285,6 +313,58 @@ TEST(SessionCrashSafety, SigkillMidRecording) {
         ASSERT_GE(completed, 6 + trial);
         expectEveryRowDecodable(dir, completed);
     }
+}
+
+TEST(SessionCrashSafety, EveryPrefixOfTheVideoIsReadable) {
+    // The muxer only appends, so whatever a crash leaves is a prefix of the unclosed file.
+    // Check every prefix: the scanner counts exactly the clusters that are complete, and
+    // FFmpeg (through the frame source) decodes exactly those, each to the right image.
+    const fs::path dir = test::outputDir("matroska_prefixes");
+    std::vector<size_t> sizeAfter;  // file size after each completed frame
+    std::string full;
+    {
+        MatroskaWriter w(dir / "full.mkv", 30, 90);
+        for (int i = 0; i < 4; ++i) {
+            w.append(syntheticFrame(i, 48, 32), i / 30.0);
+            full = readFileBytes(dir / "full.mkv");
+            sizeAfter.push_back(full.size());
+        }
+        std::ofstream(dir / "unclosed.mkv", std::ios::binary) << full;
+    }  // close() patches sizes in full.mkv; unclosed.mkv is the crash state
+    const fs::path cut = dir / "cut.mkv";
+    int decodeChecks = 0;
+    for (size_t len = 0; len <= full.size(); ++len) {
+        int expected = 0;
+        while (expected < 4 && sizeAfter[size_t(expected)] <= len) ++expected;
+        MatroskaScan scan;
+        try {
+            std::istringstream prefix(full.substr(0, len));
+            scan = scanMatroska(prefix, len, "prefix");
+        } catch (const FileError&) {
+            // Only a prefix shorter than the EBML header may be "not Matroska".
+            EXPECT_LT(len, 40u);
+            continue;
+        }
+        ASSERT_EQ(scan.completeFrames, expected) << "prefix of " << len << " bytes";
+        // Cut inside a frame's cluster: reported as truncated; cut at a frame boundary: not.
+        if (len >= sizeAfter[0]) {
+            const bool atBoundary =
+                std::find(sizeAfter.begin(), sizeAfter.end(), len) != sizeAfter.end();
+            EXPECT_EQ(scan.truncated, !atBoundary) << "prefix of " << len;
+        }
+        // Decode at every frame boundary, just before and after it, and every 401 bytes.
+        bool near = len % 401 == 0;
+        for (size_t b : sizeAfter) near = near || (len + 1 >= b && len <= b + 1);
+        if (!near || expected == 0) continue;
+        ++decodeChecks;
+        std::ofstream(cut, std::ios::binary | std::ios::trunc) << full.substr(0, len);
+        auto src = openFrames(cut);
+        const auto frames = readAll(*src);
+        std::vector<int> idx;
+        for (int i = 0; i < expected; ++i) idx.push_back(i);
+        expectFramesMatch(frames, idx, 48, 32, 0, 26.0);
+    }
+    EXPECT_GT(decodeChecks, 10);
 }
 
 TEST(SessionCrashSafety, ExitWithoutClose) {
@@ -400,6 +480,16 @@ TEST(SessionCorrupt, MissingFramesCsvFallsBackToTheVideo) {
     EXPECT_FALSE(s.frames[3].groundTruth.has_value());
 }
 
+TEST(SessionCorrupt, FramesCsvWithoutHeaderFallsBackToTheVideo) {
+    const fs::path dir = test::outputDir("session_empty_csv");
+    writeSession(dir, 3, false);
+    std::ofstream(dir / "frames.csv", std::ios::trunc);  // crash before the header was written
+    SessionReadReport report;
+    const Session s = readSession(dir, &report);
+    EXPECT_TRUE(contains(report, "no header line")) << allWarnings(report);
+    EXPECT_EQ(s.frames.size(), 3u);
+}
+
 TEST(SessionCorrupt, MissingVideoKeepsTheSessionReadable) {
     const fs::path dir = test::outputDir("session_no_env");
     writeSession(dir, 4, false);
@@ -450,6 +540,45 @@ TEST(SessionCorrupt, SessionJsonErrorsAreClear) {
     fs::remove(dir / "session.json");
     EXPECT_NE(readError(dir).find("not a mirage session"), std::string::npos);
     EXPECT_NE(readError(dir / "nonexistent").find("not a folder"), std::string::npos);
+}
+
+TEST(SessionCorrupt, RandomDamageNeverCrashes) {
+    // Flipped bytes, cut files and garbage rows: readers report and keep going, never crash,
+    // never loop, never claim more frames than were written.
+    const fs::path dir = test::outputDir("session_random_damage");
+    writeSession(dir, 6, false);
+    const std::string mkv = readFileBytes(dir / "main.mkv");
+    const std::string csv = readFileBytes(dir / "frames.csv");
+    cv::RNG rng(12345);
+    for (int trial = 0; trial < 150; ++trial) {
+        std::string damaged = mkv;
+        const int flips = 1 + rng.uniform(0, 8);
+        for (int k = 0; k < flips; ++k)
+            damaged[size_t(rng.uniform(0, int(damaged.size())))] = char(rng.uniform(0, 256));
+        if (trial % 3 == 0) damaged.resize(size_t(rng.uniform(0, int(damaged.size()))));
+        std::ofstream(dir / "main.mkv", std::ios::binary) << damaged;  // no fsync: fast
+        try {
+            const MatroskaScan scan = scanMatroska(dir / "main.mkv");
+            EXPECT_LE(scan.completeFrames, 6) << "trial " << trial;
+        } catch (const FileError&) {
+            // Damaged EBML header: "not a Matroska file" is the right answer.
+        }
+        std::string rows = csv;
+        for (int k = 0; k < 3; ++k)
+            rows[size_t(rng.uniform(0, int(rows.size())))] = "0,.-e\n#x9"[rng.uniform(0, 9)];
+        std::ofstream(dir / "frames.csv", std::ios::binary) << rows;
+        SessionReadReport report;
+        const Session s = readSession(dir, &report);
+        EXPECT_LE(report.framesReadable, 6);
+        if (trial % 25 == 0) {
+            // Decoding damaged JPEG data must not crash either (FFmpeg conceals errors).
+            auto src = openCameraFrames(s, "main");
+            cv::Mat f;
+            int n = 0;
+            while (src->read(f)) ++n;
+            EXPECT_LE(n, report.framesReadable);
+        }
+    }
 }
 
 TEST(Matroska, ScannerCountsFfmpegWrittenFiles) {

@@ -13,11 +13,11 @@ function(mirage_scene_fuzz_target target)
   target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR})
   target_link_libraries(${target} PRIVATE mirage_core)
   target_compile_definitions(${target} PRIVATE MIRAGE_FUZZ_BASE_DIR="${_scene_data}/good")
-  # Under sanitizers, compile tinygltf + stb_image into the executable so they are instrumented.
+  # Under sanitizers, compile tinygltf into the executable so they are instrumented.
   if(MIRAGE_SANITIZE OR MIRAGE_LIBFUZZER)
     target_sources(${target} PRIVATE ${_fuzz_dir}/InstrumentedTinyGltf.cpp)
     set_source_files_properties(${_fuzz_dir}/InstrumentedTinyGltf.cpp PROPERTIES COMPILE_OPTIONS "-w")
-    target_link_libraries(${target} PRIVATE nlohmann_json::nlohmann_json)  # stb includes come via mirage_core
+    target_link_libraries(${target} PRIVATE nlohmann_json::nlohmann_json)
   endif()
 endfunction()
 
@@ -38,8 +38,13 @@ if(MIRAGE_LIBFUZZER)
   endif()
   # Coverage instrumentation for the code under test; the fuzz executable links libFuzzer's main.
   target_compile_options(mirage_core PRIVATE -fsanitize=fuzzer-no-link)
+  # Debian 12's clang 14 lacks what libstdc++ 12 needs for std::source_location (core/Error.h).
+  if(CMAKE_CXX_COMPILER_VERSION VERSION_LESS 15)
+    set(_shim "SHELL:-include ${_fuzz_dir}/SourceLocationShim.h")
+    target_compile_options(mirage_core PRIVATE ${_shim})
+  endif()
   add_executable(scene_loader_libfuzzer ${_fuzz_dir}/SceneLoaderFuzz.cpp)
   mirage_scene_fuzz_target(scene_loader_libfuzzer)
-  target_compile_options(scene_loader_libfuzzer PRIVATE -fsanitize=fuzzer)
+  target_compile_options(scene_loader_libfuzzer PRIVATE -fsanitize=fuzzer ${_shim})
   target_link_options(scene_loader_libfuzzer PRIVATE -fsanitize=fuzzer)
 endif()

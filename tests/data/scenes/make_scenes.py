@@ -306,6 +306,15 @@ def bad_cases():
         g["images"] = [{"uri": data_uri(b"this is not an image at all", "image/png")}]
         g["textures"] = [{"source": 0}]
     case("image_not_png", not_png)
+    def huge_png(g):
+        # A valid PNG signature and IHDR claiming 100000 x 100000 pixels (no pixel data needed:
+        # the loader must refuse from the header, before any decoder allocates 40 GB).
+        ihdr = struct.pack(">IIBBBBB", 100000, 100000, 8, 6, 0, 0, 0)
+        png = b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + b"IHDR" + ihdr + struct.pack(">I", zlib.crc32(b"IHDR" + ihdr))
+        g["images"] = [{"uri": data_uri(png, "image/png")}]
+        g["textures"] = [{"source": 0}]
+    case("image_too_large", huge_png)
+    case("duplicate_child", lambda g: g.update(nodes=[{"children": [1, 1]}, {"mesh": 0}]))
     case("light_index_out_of_range", lambda g: g["nodes"][0].update(
         extensions={"KHR_lights_punctual": {"light": 2}}))
     case("camera_index_out_of_range", lambda g: g["nodes"][0].update(camera=1))
@@ -315,6 +324,11 @@ def bad_cases():
             {"type": "spot", "spot": {"innerConeAngle": 0.8, "outerConeAngle": 0.5}}]}}
         g["nodes"][0]["extensions"] = {"KHR_lights_punctual": {"light": 0}}
     case("spot_cone_inverted", bad_spot)
+    def light_overflow(g):
+        # Finite in JSON (a double) but beyond float range: converting it would be undefined.
+        g["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e300}]}}
+        g["nodes"][0]["extensions"] = {"KHR_lights_punctual": {"light": 0}}
+    case("light_intensity_beyond_float", light_overflow)
     case("real_not_bool", lambda g: g["nodes"][0].update(extras={"mirage": {"real": "yes"}}))
 
     def env_missing(g):

@@ -1,0 +1,164 @@
+// `mirage render SCENE --camera NODE -o OUT`: reference images from the Embree renderer
+// (docs/reference-renderer.md). OUT by extension: .exr/.pfm linear RGB float, .png tone-mapped
+// (exposure x linear, then sRGB-encoded, clamped).
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "app/Command.h"
+#include "app/commands/TerminalProgress.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/image/ImageIO.h"
+#include "core/scene/Scene.h"
+#include "render/raytrace/DifferentialRendering.h"
+
+namespace mirage::app {
+namespace {
+
+struct RenderArgs {
+    std::string scene, camera, output, mode = "rv", cameraImage;
+    int spp = 64, width = 640, height = 0, threads = 0, photons = 0, maxDepth = 64;
+    double seconds = 0.0;
+    uint64_t seed = 1;
+    float exposure = 1.0f;
+    bool saveBuffers = false;
+};
+
+void writeImage(const std::filesystem::path& path, const cv::Mat& linearRgb, float exposure) {
+    writeLinearRgb(path, linearRgb, exposure);
+    spdlog::info("wrote {}", path.string());
+}
+
+void run(const RenderArgs& a) {
+    const std::filesystem::path out(a.output);
+    std::string ext = out.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext != ".exr" && ext != ".pfm" && ext != ".png")
+        throw Error("mirage render: output '" + a.output +
+                    "' must end in .exr or .pfm (linear) or .png (tone-mapped)");
+    if (a.mode != "rv" && a.mode != "r" && a.mode != "composite")
+        throw Error("mirage render: --mode must be rv, r or composite (got '" + a.mode + "')");
+    if (a.spp < 1) throw Error("mirage render: --spp must be >= 1");
+    if (a.seconds < 0) throw Error("mirage render: --seconds must be >= 0");
+    if (a.width < 1 || a.height < 0)
+        throw Error("mirage render: --width/--height must be positive");
+
+    Scene scene = loadScene(a.scene);
+    int height = a.height;
+    if (height == 0) {
+        // Follow the camera's aspect ratio when the file gives one, else 4:3.
+        int node = scene.findCameraNode(a.camera);
+        float aspect = scene.cameras[size_t(scene.nodes[size_t(node)].camera)].aspectRatio;
+        height = std::max(1, int(std::lround(a.width / (aspect > 0 ? aspect : 4.0f / 3.0f))));
+    }
+    raytrace::RenderCamera camera = raytrace::cameraFromNode(scene, a.camera, a.width, height);
+
+    raytrace::RenderSettings st;
+    st.samplesPerPixel = a.seconds > 0 ? std::max(a.spp, 1 << 20) : a.spp;
+    st.maxSeconds = a.seconds;
+    st.seed = a.seed;
+    st.threads = a.threads;
+    st.photonsPerPass = a.photons;
+    st.maxDepth = a.maxDepth;
+    raytrace::EmbreeDevice device(a.threads > 0 ? fmt::format("threads={}", a.threads) : "");
+
+    TerminalProgress bar("render");
+    auto progress = [&](int done, int total, double s) {
+        if (a.seconds > 0)
+            bar.update(s, a.seconds * (a.mode == "composite" ? 2 : 1),
+                       fmt::format("{} passes, {:.1f} s", done, s));
+        else
+            bar.update(done, total, fmt::format("{}/{} passes, {:.1f} s", done, total, s));
+    };
+    spdlog::info("rendering '{}' camera '{}' at {}x{}, {}", a.scene, a.camera, a.width, height,
+                 a.seconds > 0 ? fmt::format("{} s", a.seconds) : fmt::format("{} spp", a.spp));
+
+    cv::Mat result;
+    if (a.mode == "composite") {
+        raytrace::DifferentialImages images =
+            raytrace::renderDifferential(scene, device, camera, st, progress);
+        bar.finish();
+        cv::Mat ci;
+        if (a.cameraImage.empty()) {
+            // Synthetic footage: the camera sees exactly the real-only render.
+            ci = images.realOnly;
+        } else {
+            ci = readLinearRgb(a.cameraImage);
+            if (ci.size() != images.realOnly.size())
+                throw FileError(
+                    a.cameraImage,
+                    fmt::format("camera image is {}x{} but the render is {}x{}; pass "
+                                "--width/--height matching it",
+                                ci.cols, ci.rows, images.realOnly.cols, images.realOnly.rows));
+        }
+        result = raytrace::compositeDifferential(ci, images);
+        if (a.saveBuffers) {
+            auto stem = out.parent_path() / out.stem();
+            writeImage(stem.string() + "_Lr.exr", images.realOnly, 1.0f);
+            writeImage(stem.string() + "_Lrv.exr", images.realAndVirtual, 1.0f);
+            cv::Mat cov;
+            cv::merge(std::vector<cv::Mat>(3, images.virtualCoverage), cov);
+            writeImage(stem.string() + "_coverage.exr", cov, 1.0f);
+        }
+        spdlog::info("L_r: {} passes in {:.1f} s; L_rv: {} passes in {:.1f} s",
+                     images.realStats.passes, images.realStats.seconds, images.mixedStats.passes,
+                     images.mixedStats.seconds);
+    } else {
+        raytrace::RayTracingScene rt(
+            scene, a.mode == "r" ? raytrace::SceneSubset::RealOnly : raytrace::SceneSubset::All,
+            device);
+        raytrace::RenderResult r = raytrace::render(rt, camera, st, progress);
+        bar.finish();
+        spdlog::info("{} passes in {:.1f} s, {} caustic photons", r.passes, r.seconds,
+                     r.photonsStored);
+        if (r.nonFiniteSamples > 0)
+            spdlog::warn("{} samples were NaN/Inf and dropped (a renderer bug; please report)",
+                         r.nonFiniteSamples);
+        result = r.radiance;
+    }
+    writeImage(out, result, ext == ".png" ? a.exposure : 1.0f);
+}
+
+const CommandRegistrar reg("render", [](CLI::App& parent) {
+    auto* cmd = parent.add_subcommand(
+        "render", "Render a glTF camera node with the Embree reference renderer");
+    auto a = std::make_shared<RenderArgs>();
+    cmd->add_option("scene", a->scene, "Scene (.gltf or .glb)")->required();
+    cmd->add_option("--camera", a->camera, "Name of the glTF camera node to render")->required();
+    cmd->add_option("-o,--output", a->output,
+                    "Image: .exr/.pfm (linear RGB) or .png (tone-mapped sRGB)")
+        ->required();
+    cmd->add_option("--spp", a->spp, "Samples (passes) per pixel")->capture_default_str();
+    cmd->add_option("--seconds", a->seconds,
+                    "Time budget instead of --spp (per image; composite renders two)");
+    cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
+    cmd->add_option("--height", a->height,
+                    "Image height (default: from the camera's aspect ratio, else 4:3)");
+    cmd->add_option("--seed", a->seed, "Random seed (same seed = same image)")
+        ->capture_default_str();
+    cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
+        ->capture_default_str();
+    cmd->add_option("--exposure", a->exposure,
+                    "PNG only: multiplies linear radiance before sRGB encoding")
+        ->capture_default_str();
+    cmd->add_option("--mode", a->mode,
+                    "rv = real + virtual (L_rv), r = real only (L_r), composite = differential "
+                    "rendering into "
+                    "--camera-image (default: the real-only render itself)")
+        ->capture_default_str();
+    cmd->add_option("--camera-image", a->cameraImage,
+                    "composite: the camera image (linear .exr/.pfm or sRGB .png)");
+    cmd->add_flag("--save-buffers", a->saveBuffers,
+                  "composite: also write OUT_Lr.exr, OUT_Lrv.exr, OUT_coverage.exr");
+    cmd->add_option("--photons", a->photons, "Caustic photons per pass (0 = automatic)")
+        ->capture_default_str();
+    cmd->add_option("--max-depth", a->maxDepth, "Maximum path vertices")->capture_default_str();
+    cmd->callback([a] { run(*a); });
+});
+
+}  // namespace
+}  // namespace mirage::app

@@ -1,0 +1,420 @@
+#include "app/wizard/CalibrationWizard.h"
+
+#include <epoxy/gl.h>
+
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calibration/BatchCalibration.h"
+#include "calibration/CalibrationSession.h"
+#include "calibration/FrameSource.h"
+#include "calibration/Undistorter.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/camera/CalibrationFile.h"
+#include "core/capture/V4l2Camera.h"
+#include "core/gl/Context.h"
+#include "core/gl/Objects.h"
+
+namespace mirage::app {
+namespace {
+
+// A live V4L2 camera (core/capture: mode choice, YUYV/MJPEG decoding, timestamps) as a
+// calibration frame source.
+class LiveCameraSource final : public calib::FrameSource {
+public:
+    explicit LiveCameraSource(const std::string& device) : camera_(device, CaptureRequest{}) {}
+    bool next(calib::InputFrame& f) override {
+        if (!camera_.read(f.bgr)) return false;
+        f.name = fmt::format("frame {}", index_++);
+        f.timeSeconds = camera_.lastTimestamp().value_or(0.0);
+        return true;
+    }
+    bool isLive() const override { return true; }
+
+private:
+    V4l2Camera camera_;
+    int index_ = 0;
+};
+
+// RAII for the ImGui context and its GLFW/OpenGL3 backends.
+struct ImGuiScope {
+    explicit ImGuiScope(GLFWwindow* window) {
+        IMGUI_CHECKVERSION();
+        ImGui::CreateContext();
+        ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
+        ImGui::StyleColorsDark();
+        ImGui_ImplGlfw_InitForOpenGL(window, true);
+        ImGui_ImplOpenGL3_Init("#version 450");
+    }
+    ~ImGuiScope() {
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+    }
+    ImGuiScope(const ImGuiScope&) = delete;
+    ImGuiScope& operator=(const ImGuiScope&) = delete;
+};
+
+// An RGBA8 texture showing an 8-bit BGR image (sRGB-encoded values shown as they are).
+class ImageTexture {
+public:
+    void show(const cv::Mat& bgr) {
+        if (tex_.id() == 0 || tex_.width() != bgr.cols || tex_.height() != bgr.rows) {
+            tex_ = gl::Texture::create2D("wizard image", bgr.cols, bgr.rows, GL_RGBA8);
+            tex_.setFilter(GL_LINEAR, GL_LINEAR);
+        }
+        cv::cvtColor(bgr, rgba_, cv::COLOR_BGR2RGBA);
+        tex_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba_.data);
+    }
+    ImTextureID id() const {
+        return reinterpret_cast<ImTextureID>(static_cast<uintptr_t>(tex_.id()));
+    }
+    bool empty() const { return tex_.id() == 0; }
+
+private:
+    gl::Texture tex_;
+    cv::Mat rgba_;
+};
+
+cv::Scalar decisionColour(calib::CaptureDecision d) {
+    using D = calib::CaptureDecision;
+    switch (d) {
+        case D::Captured:
+        case D::Held:
+            return {80, 220, 80};
+        case D::Blurred:
+            return {60, 60, 230};
+        case D::Similar:
+            return {220, 160, 60};
+        default:
+            return {40, 220, 240};
+    }
+}
+
+// The camera frame with the overlay: coverage tint per cell, the region to fill next, and the
+// detected corners coloured by the capture decision.
+cv::Mat overlay(const cv::Mat& frame, const calib::CalibrationSession& s,
+                const calib::FrameReport& rep) {
+    cv::Mat img = frame.channels() == 3 ? frame.clone() : cv::Mat();
+    if (img.empty()) cv::cvtColor(frame, img, cv::COLOR_GRAY2BGR);
+    const auto& cov = s.coverage();
+    cv::Mat tint = img.clone();
+    const double cw = double(img.cols) / cov.cols(), ch = double(img.rows) / cov.rows();
+    for (int r = 0; r < cov.rows(); ++r)
+        for (int c = 0; c < cov.cols(); ++c)
+            if (cov.count(c, r) > 0)
+                cv::rectangle(tint, cv::Rect(int(c * cw), int(r * ch), int(cw) + 1, int(ch) + 1),
+                              {60, 200, 60}, cv::FILLED);
+    cv::addWeighted(tint, 0.25, img, 0.75, 0, img);
+    if (s.state() != calib::CalibrationSession::State::Done && !s.views().empty()) {
+        std::string name;
+        const cv::Point2f centre = cov.emptiestRegion(name);
+        const cv::Size2f half(float(1.5 * cw), float(1.5 * ch));
+        cv::rectangle(img,
+                      cv::Rect(cv::Point(int(centre.x - half.width), int(centre.y - half.height)),
+                               cv::Size(int(2 * half.width), int(2 * half.height))),
+                      {0, 200, 255}, 2);
+    }
+    if (rep.boardFound) {
+        const auto colour = decisionColour(rep.decision);
+        const auto& pts = rep.view.imagePoints;
+        for (size_t i = 0; i + 1 < pts.size(); ++i)
+            cv::line(img, pts[i], pts[i + 1], colour * 0.6, 1, cv::LINE_AA);
+        for (const auto& p : pts) cv::circle(img, p, 3, colour, 2, cv::LINE_AA);
+        if (rep.decision == calib::CaptureDecision::Captured)
+            cv::rectangle(img, cv::Rect(0, 0, img.cols, img.rows), {255, 255, 255}, 8);
+    }
+    return img;
+}
+
+void drawCoverage(const calib::CalibrationSession& s, ImVec2 size) {
+    const auto& cov = s.coverage();
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    const ImVec2 p0 = ImGui::GetCursorScreenPos();
+    const float cw = size.x / float(cov.cols()), ch = size.y / float(cov.rows());
+    int maxCount = 1;
+    for (int r = 0; r < cov.rows(); ++r)
+        for (int c = 0; c < cov.cols(); ++c) maxCount = std::max(maxCount, cov.count(c, r));
+    for (int r = 0; r < cov.rows(); ++r)
+        for (int c = 0; c < cov.cols(); ++c) {
+            const int n = cov.count(c, r);
+            const float t = n == 0 ? 0.f : 0.3f + 0.7f * float(n) / float(maxCount);
+            const ImU32 col = n == 0 ? IM_COL32(90, 30, 30, 255)
+                                     : IM_COL32(int(40 * (1 - t)), int(80 + 170 * t), 60, 255);
+            const ImVec2 a(p0.x + c * cw + 1, p0.y + r * ch + 1), b(a.x + cw - 2, a.y + ch - 2);
+            dl->AddRectFilled(a, b, col);
+        }
+    ImGui::Dummy(size);
+}
+
+void saveCalibrationFile(const WizardOptions& o, const calib::CalibrationSession& s,
+                         std::string& status, int& exitCode) {
+    if (!s.result()) {
+        status = "nothing to save yet";
+        return;
+    }
+    const auto cal = calib::calibrationForFile(*s.result());
+    saveCalibration(o.output, cal);
+    status = cal.reliable ? "saved " + o.output
+                          : "saved " + o.output + " marked UNRELIABLE: " + cal.unreliableReason;
+    exitCode = cal.reliable ? 0 : 2;
+    spdlog::info("{}", status);
+}
+
+void saveScreenshot(const std::string& path, GLFWwindow* window) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    cv::Mat rgba(h, w, CV_8UC4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_BACK);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+    cv::Mat bgr;
+    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+    cv::flip(bgr, bgr, 0);  // GL rows start at the bottom
+    std::filesystem::create_directories(std::filesystem::absolute(path).parent_path());
+    if (!cv::imwrite(path, bgr)) throw FileError(path, "cannot write the screenshot");
+    spdlog::info("wrote screenshot {}", path);
+}
+
+}  // namespace
+
+int runCalibrationWizard(const WizardOptions& o) {
+    if (o.board.empty())
+        throw Error("--board is required (a board file or chessboard:COLSxROWS:SQUARE_METRES)");
+    std::unique_ptr<calib::FrameSource> source;
+    bool stillImages = false;
+    if (!o.inputs.empty()) {
+        calib::FrameSourceOptions so;
+        so.allVideoFrames = true;  // stillness is measured between consecutive video frames
+        source = calib::openFrameSource(o.inputs, so);
+        stillImages = std::none_of(o.inputs.begin(), o.inputs.end(),
+                                   [](const std::string& i) { return calib::isVideoFile(i); });
+    } else if (!o.cameraDevice.empty()) {
+        source = std::make_unique<LiveCameraSource>(o.cameraDevice);
+    } else {
+        throw Error(
+            "the wizard needs a source: INPUT... (images, a folder or a video) or "
+            "--camera /dev/videoN; for headless use, --batch");
+    }
+    auto target = calib::CalibrationTarget::parse(o.board);
+    calib::InputFrame frame;
+    if (!source->next(frame)) throw Error("the input holds no frames");
+
+    calib::SessionOptions so;
+    so.calibration.model = o.model;
+    so.calibration.fixK3 = o.fixK3;
+    // Separate photos are each a deliberate, still capture: no stillness over frames needed.
+    if (stillImages) so.stillFrames = 0;
+    calib::CalibrationSession session(std::move(target), frame.bgr.size(), so);
+
+    gl::ContextOptions co;
+    co.width = 1280;
+    co.height = 800;
+    co.title = "mirage calibrate";
+    auto ctx = gl::Context::window(co);
+    ImGuiScope imgui(ctx.glfwWindow());
+    ImageTexture camTex, undistTex;
+    calib::Undistorter undistorter;
+
+    calib::FrameReport rep;
+    cv::Mat current = frame.bgr;
+    bool haveFrame = true, endOfInput = false, paused = false, showUndistorted = true;
+    int framesProcessed = 0, exitCode = 0, screenshotCountdown = -1;
+    std::string status = "source: " + (o.inputs.empty() ? o.cameraDevice : o.inputs.front());
+    std::string lastCaptured;
+
+    while (!ctx.shouldClose()) {
+        ctx.pollEvents();
+        if (haveFrame) {
+            rep = session.processFrame(current, frame.name);
+            ++framesProcessed;
+            if (rep.decision == calib::CaptureDecision::Captured) lastCaptured = frame.name;
+            camTex.show(overlay(current, session, rep));
+            if (session.result() && showUndistorted)
+                undistTex.show(
+                    undistorter.apply(current, session.result()->calibration.intrinsics));
+            haveFrame = false;
+        }
+        const bool screenshotDue =
+            !o.screenshot.empty() &&
+            ((o.screenshotAfterFrames > 0 && framesProcessed >= o.screenshotAfterFrames) ||
+             endOfInput);
+        if (!paused && !endOfInput && !screenshotDue) {
+            if (source->next(frame)) {
+                current = frame.bgr;
+                haveFrame = true;
+            } else {
+                endOfInput = true;
+                status = "end of input: " + std::to_string(framesProcessed) + " frames";
+            }
+        }
+        if (screenshotDue && screenshotCountdown < 0) screenshotCountdown = 2;  // let ImGui lay out
+
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        const ImGuiWindowFlags fixed =
+            ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
+
+        ImGui::SetNextWindowPos({0, 0});
+        ImGui::SetNextWindowSize({660, 540});
+        ImGui::Begin("Camera", nullptr, fixed);
+        if (!camTex.empty()) {
+            const float scale = std::min(640.f / float(current.cols), 480.f / float(current.rows));
+            ImGui::Image(camTex.id(), {float(current.cols) * scale, float(current.rows) * scale});
+        }
+        ImGui::Text("%s | %s | motion %.2f px | sharpness %.0f | tilt %.0f deg", frame.name.c_str(),
+                    calib::captureDecisionName(rep.decision), rep.motionPx, rep.sharpness,
+                    rep.tiltDeg);
+        ImGui::End();
+
+        ImGui::SetNextWindowPos({0, 540});
+        ImGui::SetNextWindowSize({330, 260});
+        ImGui::Begin("Undistorted preview", nullptr, fixed);
+        ImGui::Checkbox("show", &showUndistorted);
+        if (session.result() && showUndistorted && !undistTex.empty())
+            ImGui::Image(undistTex.id(), {270, 270.f * float(current.rows) / float(current.cols)});
+        else
+            ImGui::TextWrapped("Appears after the first calibration (%d views).",
+                               so.calibration.minViews);
+        ImGui::End();
+
+        ImGui::SetNextWindowPos({330, 540});
+        ImGui::SetNextWindowSize({330, 260});
+        ImGui::Begin("Coverage and tilts", nullptr, fixed);
+        drawCoverage(session, {300, 130});
+        ImGui::Text("cells covered: %.0f%%", 100 * session.coverage().coveredFraction());
+        const auto& tilts = session.tilts();
+        for (int b = 0; b < calib::TiltCoverage::BinCount; ++b) {
+            const auto bin = calib::TiltCoverage::Bin(b);
+            ImGui::TextColored(
+                tilts.count(bin) ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(1, 0.5f, 0.4f, 1), "%-16s %d",
+                calib::TiltCoverage::binName(bin), tilts.count(bin));
+            if (b % 2 == 0 && b + 1 < calib::TiltCoverage::BinCount) ImGui::SameLine(160);
+        }
+        ImGui::Text("largest tilt: %.0f deg", tilts.maxTiltDeg());
+        ImGui::End();
+
+        ImGui::SetNextWindowPos({660, 0});
+        ImGui::SetNextWindowSize({620, 800});
+        ImGui::Begin("Calibration", nullptr, fixed);
+        const bool done = session.state() == calib::CalibrationSession::State::Done;
+        ImGui::TextColored(done ? ImVec4(0.4f, 1, 0.4f, 1) : ImVec4(1, 0.85f, 0.3f, 1), "%s",
+                           done ? "DONE" : "COLLECTING");
+        ImGui::SameLine();
+        ImGui::Text("| %s | %s model | %zu views", session.target().description().c_str(),
+                    o.model == DistortionModel::KannalaBrandt ? "fisheye" : "pinhole",
+                    session.views().size());
+        ImGui::Separator();
+        ImGui::PushTextWrapPos(0);
+        ImGui::TextColored({0.6f, 0.85f, 1, 1}, "Next: %s", session.advice().c_str());
+        ImGui::PopTextWrapPos();
+        ImGui::Separator();
+        if (ImGui::Button(paused ? "Resume" : "Pause")) paused = !paused;
+        ImGui::SameLine();
+        if (ImGui::Button("Capture now") && rep.boardFound) session.addView(rep.view);
+        ImGui::SameLine();
+        ImGui::BeginDisabled(o.output.empty() || !session.result());
+        if (ImGui::Button("Save")) {
+            try {
+                saveCalibrationFile(o, session, status, exitCode);
+            } catch (const Error& e) {
+                status = e.what();
+            }
+        }
+        ImGui::EndDisabled();
+        ImGui::SameLine();
+        ImGui::TextWrapped("%s", o.output.empty() ? "(-o not given)" : o.output.c_str());
+        ImGui::TextWrapped("%s", status.c_str());
+        ImGui::Separator();
+        if (const auto& r = session.result()) {
+            const auto& c = r->calibration;
+            const auto& in = c.intrinsics;
+            ImGui::Text("RMS reprojection error: %.3f px   views used: %d", c.avgReprojectionError,
+                        r->usedViewCount());
+            if (!c.reliable) {
+                ImGui::PushTextWrapPos(0);
+                ImGui::TextColored({1, 0.4f, 0.4f, 1}, "UNRELIABLE: %s",
+                                   c.unreliableReason.c_str());
+                ImGui::PopTextWrapPos();
+            }
+            if (ImGui::BeginTable("params", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {
+                ImGui::TableSetupColumn("parameter");
+                ImGui::TableSetupColumn("value");
+                ImGui::TableSetupColumn("std dev (1 sigma)");
+                ImGui::TableHeadersRow();
+                for (size_t i = 0; i < r->parameterNames.size(); ++i) {
+                    const double v = i == 0   ? in.fx
+                                     : i == 1 ? in.fy
+                                     : i == 2 ? in.cx
+                                     : i == 3 ? in.cy
+                                              : in.coeff(i - 4);
+                    ImGui::TableNextRow();
+                    ImGui::TableNextColumn();
+                    ImGui::TextUnformatted(r->parameterNames[i].c_str());
+                    ImGui::TableNextColumn();
+                    ImGui::Text("%.5f", v);
+                    ImGui::TableNextColumn();
+                    ImGui::Text("%.5f", i < c.stdDeviations.size() ? c.stdDeviations[i] : -1.0);
+                }
+                ImGui::EndTable();
+            }
+        } else if (!session.calibrationError().empty()) {
+            ImGui::TextWrapped("calibration failed: %s", session.calibrationError().c_str());
+        }
+        const auto unmet = session.unmetTargets();
+        if (!unmet.empty()) {
+            ImGui::Text("Not done yet:");
+            for (const auto& u : unmet) ImGui::BulletText("%s", u.c_str());
+        }
+        ImGui::Separator();
+        ImGui::Text("Views (RMS px, tilt deg):");
+        ImGui::BeginChild("views", {0, 0}, true);
+        std::optional<size_t> drop;
+        for (size_t i = 0; i < session.views().size(); ++i) {
+            const auto& r = session.result();
+            const bool rejected = r && r->views[i].rejected;
+            ImGui::PushID(int(i));
+            if (ImGui::SmallButton("drop")) drop = i;
+            ImGui::SameLine();
+            if (rejected)
+                ImGui::TextColored({1, 0.4f, 0.4f, 1}, "%-22s OUTLIER: %s",
+                                   session.views()[i].name.c_str(),
+                                   r->views[i].rejectReason.c_str());
+            else if (r)
+                ImGui::Text("%-22s %.3f  %4.0f", session.views()[i].name.c_str(), r->views[i].rmsPx,
+                            r->views[i].tiltDeg);
+            else
+                ImGui::Text("%-22s", session.views()[i].name.c_str());
+            ImGui::PopID();
+        }
+        ImGui::EndChild();
+        if (drop) session.dropView(*drop);
+        ImGui::End();
+
+        ImGui::Render();
+        int fw = 0, fh = 0;
+        glfwGetFramebufferSize(ctx.glfwWindow(), &fw, &fh);
+        glViewport(0, 0, fw, fh);
+        glClearColor(0.1f, 0.1f, 0.12f, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (screenshotCountdown >= 0 && screenshotCountdown-- == 0) {
+            saveScreenshot(o.screenshot, ctx.glfwWindow());
+            break;
+        }
+        ctx.swapBuffers();
+    }
+    return exitCode;
+}
+
+}  // namespace mirage::app

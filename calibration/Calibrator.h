@@ -1,0 +1,119 @@
+#pragma once
+// Intrinsic calibration of one camera from views of a planar board (docs/calibration.md).
+//
+// Models (core/camera/CameraModel.h):
+//  - pinhole + Brown-Conrady (k1, k2, p1, p2, k3): cv::calibrateCameraExtended, which also gives
+//    per-parameter standard deviations and per-view errors;
+//  - OpenCV fisheye (Kannala-Brandt k1..k4): cv::fisheye::calibrate with
+//    CALIB_RECOMPUTE_EXTRINSIC | CALIB_FIX_SKEW. cv::fisheye reports no uncertainty, so the
+//    standard deviations are computed here the way calibrateCameraExtended does it for the
+//    pinhole model: Cov = (J^T J)^-1 * sigma^2 with J the Jacobian of all residuals (pixels) with
+//    respect to all parameters (intrinsics + 6 per view) and sigma^2 = sum(r^2) / (2N - P).
+//
+// Views whose RMS error is far above the median are dropped one at a time (worst first) with a
+// recalibration after each drop. The result is marked unreliable, with the reason, when the data
+// cannot pin the parameters down: too few views, all views fronto-parallel (the focal length is
+// then unobservable: the board's image only scales with f/distance), or standard deviations that
+// are large relative to the values. Callers must never present an unreliable result as a
+// confident number (the calibration file carries `reliable: false` and the reason).
+//
+// Units: pixels for image points, errors and standard deviations of fx, fy, cx, cy; metres for
+// board points; degrees for tilts. Board points lie in the board's z = 0 plane.
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera/CalibrationFile.h"
+#include "core/camera/CameraModel.h"
+
+namespace mirage::calib {
+
+// One image's detected board corners and the board points they correspond to.
+struct CalibrationView {
+    std::string name;                      // file name or "frame N": used in reports
+    std::vector<cv::Point2f> imagePoints;  // pixels, (0,0) = centre of the top-left pixel
+    std::vector<cv::Point3f> boardPoints;  // metres, board frame (z = 0)
+};
+
+struct CalibrationOptions {
+    DistortionModel model = DistortionModel::BrownConrady;
+    // Pinhole only: keep k3 at 0 (fits k1, k2, p1, p2), for narrow-angle lenses and datasets
+    // calibrated that way (OpenCV's calib1 reference uses it).
+    bool fixK3 = false;
+
+    // Outlier views: a view is dropped when its RMS error exceeds outlierFactor * median AND
+    // outlierMinErrorPx (so a clean set with median 0.1 px does not lose a 0.35 px view).
+    double outlierFactor = 3.0;
+    double outlierMinErrorPx = 0.5;
+    double maxRejectedFraction = 0.3;  // never drop more than this share of the views
+
+    // Reliability. Fewer views than this, or a largest board tilt below minMaxTiltDeg, or a
+    // relative focal-length standard deviation above maxRelativeFocalStd, or a principal-point
+    // standard deviation above maxPrincipalPointStd (fraction of the image width) marks the
+    // result unreliable.
+    int minViews = 3;
+    double minMaxTiltDeg = 10.0;
+    double maxRelativeFocalStd = 0.02;
+    double maxPrincipalPointStd = 0.02;
+
+    int maxIterations = 100;
+};
+
+// What happened to one input view.
+struct ViewResult {
+    std::string name;
+    int pointCount = 0;
+    double rmsPx = -1;      // RMS reprojection error of this view (pixels), < 0 if not computed
+    bool rejected = false;  // dropped as an outlier (or unusable)
+    std::string rejectReason;
+    // Board pose in the camera: T_camera_board as Rodrigues vector + translation (metres).
+    cv::Vec3d rvec, tvec;
+    // Angle between the board normal and the optical axis (degrees; 0 = fronto-parallel), and
+    // the direction of the tilt in the image (degrees, atan2 of the normal's y and x).
+    double tiltDeg = 0, tiltDirectionDeg = 0;
+};
+
+struct CalibrationResult {
+    CameraCalibration calibration;  // intrinsics, RMS, std devs, per-view errors (used views)
+    std::vector<std::string> parameterNames;  // matching calibration.stdDeviations
+    std::vector<ViewResult> views;            // every input view, input order
+    std::vector<std::string> warnings;        // things worth saying that do not make it unreliable
+    double maxTiltDeg = 0;                    // over the used views
+
+    int usedViewCount() const;
+    // Standard deviation of fx / fx (and fy / fy): the relative focal uncertainty, or +inf.
+    double relativeFocalStd() const;
+};
+
+// Calibrates. Throws mirage::Error if there is nothing to calibrate from (no view with at least
+// 4 points after validation) or the solver produces no finite result; the message says why and
+// what to do. Otherwise returns a result that is either reliable or says why it is not.
+CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size imageSize,
+                            const CalibrationOptions& options);
+
+// What goes into the calibration file: the result's calibration, with standard deviations left
+// out (and the reason saying so) when some are not finite (an unobservable parameter): the file
+// format holds finite numbers only, and such a result is always marked unreliable.
+CameraCalibration calibrationForFile(const CalibrationResult& result);
+
+// Parameter names in the order of the standard deviations ("fx", "fy", "cx", "cy", "k1", ...).
+std::vector<std::string> parameterNames(DistortionModel model);
+
+// Projects board points with intrinsics and a board pose T_camera_board (either model).
+std::vector<cv::Point2f> projectBoardPoints(const std::vector<cv::Point3f>& boardPoints,
+                                            const CameraIntrinsics& intrinsics,
+                                            const cv::Vec3d& rvec, const cv::Vec3d& tvec);
+
+// Board pose T_camera_board from the view's points with known intrinsics (solvePnP on
+// undistorted points, so it works for both models). Returns false if it fails.
+bool estimateBoardPose(const CalibrationView& view, const CameraIntrinsics& intrinsics,
+                       cv::Vec3d& rvec, cv::Vec3d& tvec);
+
+// Tilt of a board with pose rvec (T_camera_board): degrees off fronto-parallel and direction.
+void boardTilt(const cv::Vec3d& rvec, double& tiltDeg, double& directionDeg);
+
+cv::Mat cameraMatrix(const CameraIntrinsics& intrinsics);      // 3x3 CV_64F
+cv::Mat distortionVector(const CameraIntrinsics& intrinsics);  // 1xN CV_64F
+
+}  // namespace mirage::calib

@@ -1,0 +1,203 @@
+#include "calibration/Extrinsics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "calibration/FrameSource.h"
+#include "core/Error.h"
+
+namespace mirage::calib {
+namespace {
+constexpr double kRadToDeg = 57.29577951308232;
+
+struct PairPose {
+    Pose T_main_camera;
+    size_t index;
+};
+
+Pose meanPose(const std::vector<PairPose>& poses) {
+    glm::dquat sum(0, 0, 0, 0);
+    glm::dvec3 t(0.0);
+    const glm::dquat ref = poses.front().T_main_camera.rotation;
+    for (const auto& p : poses) {
+        glm::dquat q = p.T_main_camera.rotation;
+        if (glm::dot(q, ref) < 0) q = -q;  // q and -q are the same rotation
+        sum += q;
+        t += p.T_main_camera.translation;
+    }
+    Pose m;
+    m.rotation = glm::normalize(sum);
+    m.translation = t / double(poses.size());
+    return m;
+}
+
+double rmsPixels(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
+    double s = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        const cv::Point2f d = a[i] - b[i];
+        s += double(d.x) * d.x + double(d.y) * d.y;
+    }
+    return std::sqrt(s / double(std::max<size_t>(1, a.size())));
+}
+
+void toCv(const Pose& p, cv::Vec3d& rvec, cv::Vec3d& tvec) {
+    const glm::dmat3 m = p.rotationMatrix();
+    cv::Matx33d R;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R(r, c) = m[c][r];
+    cv::Rodrigues(R, rvec);
+    tvec = cv::Vec3d(p.translation.x, p.translation.y, p.translation.z);
+}
+
+}  // namespace
+
+Pose poseFromCv(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
+    cv::Matx33d R;
+    cv::Rodrigues(rvec, R);
+    glm::dmat3 m;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m[c][r] = R(r, c);
+    return Pose::fromRotationTranslation(m, {tvec[0], tvec[1], tvec[2]});
+}
+
+StereoExtrinsics estimateStereoExtrinsics(const CameraIntrinsics& main,
+                                          const std::vector<CalibrationView>& mainViews,
+                                          const CameraIntrinsics& camera,
+                                          const std::vector<CalibrationView>& cameraViews) {
+    if (mainViews.size() != cameraViews.size())
+        throw Error(
+            fmt::format("extrinsics: {} main-camera views but {} views of the other "
+                        "camera; they must be taken in pairs",
+                        mainViews.size(), cameraViews.size()));
+    StereoExtrinsics e;
+    std::vector<PairPose> pairs;
+    std::vector<Pose> mainBoard(mainViews.size());
+    for (size_t i = 0; i < mainViews.size(); ++i) {
+        cv::Vec3d rm, tm, rc, tc;
+        if (!estimateBoardPose(mainViews[i], main, rm, tm)) {
+            e.skipped.push_back(mainViews[i].name + ": no board pose in the main camera");
+            continue;
+        }
+        if (!estimateBoardPose(cameraViews[i], camera, rc, tc)) {
+            e.skipped.push_back(cameraViews[i].name + ": no board pose in this camera");
+            continue;
+        }
+        mainBoard[i] = poseFromCv(rm, tm);
+        pairs.push_back({mainBoard[i] * poseFromCv(rc, tc).inverse(), i});
+    }
+    if (pairs.empty()) throw Error("extrinsics: no view pair shows the board in both cameras");
+    Pose mean = meanPose(pairs);
+    // Drop pairs far from the first mean (a mis-detection or a frame out of sync), then re-mean.
+    // Single-view PnP depth is noisy for small or steep boards, so the limits are relative to
+    // the median deviation, with floors of 1 degree and 10 mm.
+    std::vector<double> dt, da;
+    for (const auto& p : pairs) {
+        dt.push_back(glm::length(p.T_main_camera.translation - mean.translation));
+        da.push_back(rotationAngleBetween(p.T_main_camera.rotation, mean.rotation) * kRadToDeg);
+    }
+    auto medianOf = [](std::vector<double> v) {
+        std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    };
+    const double limitT = std::max(3 * medianOf(dt), 0.010);
+    const double limitA = std::max(3 * medianOf(da), 1.0);
+    std::vector<PairPose> kept;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+        if (pairs.size() >= 3 && (da[k] > limitA || dt[k] > limitT))
+            e.skipped.push_back(
+                fmt::format("{}: outlier pair ({:.2f} deg, {:.1f} mm from the mean)",
+                            cameraViews[pairs[k].index].name, da[k], 1000 * dt[k]));
+        else
+            kept.push_back(pairs[k]);
+    }
+    mean = meanPose(kept);
+    e.T_main_camera = mean;
+    e.pairCount = int(kept.size());
+    double rot2 = 0, tr2 = 0, transfer2 = 0;
+    size_t transferN = 0;
+    const Pose T_camera_main = mean.inverse();
+    for (const auto& p : kept) {
+        const double a = rotationAngleBetween(p.T_main_camera.rotation, mean.rotation) * kRadToDeg;
+        rot2 += a * a;
+        const double d = glm::length(p.T_main_camera.translation - mean.translation);
+        tr2 += d * d;
+        cv::Vec3d rvec, tvec;
+        toCv(T_camera_main * mainBoard[p.index], rvec, tvec);
+        const auto& v = cameraViews[p.index];
+        const auto projected = projectBoardPoints(v.boardPoints, camera, rvec, tvec);
+        const double r = rmsPixels(projected, v.imagePoints);
+        transfer2 += r * r * double(v.imagePoints.size());
+        transferN += v.imagePoints.size();
+    }
+    e.rotationSpreadDeg = std::sqrt(rot2 / double(kept.size()));
+    e.translationSpreadM = std::sqrt(tr2 / double(kept.size()));
+    e.transferRmsPx = std::sqrt(transfer2 / double(std::max<size_t>(1, transferN)));
+    return e;
+}
+
+StereoExtrinsics extrinsicsFromPairedInputs(const CameraIntrinsics& main,
+                                            const std::vector<std::string>& mainInputs,
+                                            const CameraIntrinsics& camera,
+                                            const std::vector<std::string>& cameraInputs,
+                                            const CalibrationTarget& target) {
+    FrameSourceOptions so;
+    so.allVideoFrames = true;  // pairing by order needs every frame of both
+    auto mainSource = openFrameSource(mainInputs, so);
+    auto camSource = openFrameSource(cameraInputs, so);
+    std::vector<CalibrationView> mv, cv_;
+    InputFrame a, b;
+    while (true) {
+        const bool ga = mainSource->next(a), gb = camSource->next(b);
+        if (ga != gb)
+            throw Error(
+                "extrinsics: --main-input and INPUT hold different numbers of frames; "
+                "they must be taken in pairs");
+        if (!ga) break;
+        auto da = target.detect(a.bgr, a.name), db = target.detect(b.bgr, b.name);
+        if (da.found && db.found) {
+            mv.push_back(std::move(da.view));
+            cv_.push_back(std::move(db.view));
+        }
+    }
+    if (mv.empty()) throw Error("extrinsics: no frame pair shows the board in both cameras");
+    return estimateStereoExtrinsics(main, mv, camera, cv_);
+}
+
+WorldPose poseFromWorldBoard(const CameraIntrinsics& camera, const std::string& imagePath,
+                             const CalibrationTarget& target) {
+    const cv::Mat img = cv::imread(imagePath, cv::IMREAD_COLOR);
+    if (img.empty()) throw FileError(imagePath, "cannot be read as an image");
+    if (img.cols != camera.width || img.rows != camera.height)
+        throw FileError(imagePath, fmt::format("is {}x{} but the calibration is for {}x{}",
+                                               img.cols, img.rows, camera.width, camera.height));
+    const auto d = target.detect(img, imagePath);
+    if (!d.found) throw FileError(imagePath, d.reason);
+    cv::Vec3d rvec, tvec;
+    if (!estimateBoardPose(d.view, camera, rvec, tvec))
+        throw FileError(imagePath, "board pose could not be estimated");
+    WorldPose w;
+    // T_world_camera = T_world_board * T_board_camera.
+    w.T_world_camera = target.worldFromBoard() * poseFromCv(rvec, tvec).inverse();
+    w.rmsPx =
+        rmsPixels(projectBoardPoints(d.view.boardPoints, camera, rvec, tvec), d.view.imagePoints);
+    return w;
+}
+
+std::string formatExtrinsics(const StereoExtrinsics& e) {
+    const auto& t = e.T_main_camera.translation;
+    const auto& q = e.T_main_camera.rotation;
+    std::string s = "extrinsics relative to the main camera (T_main_camera):\n";
+    s += fmt::format("  translation (m): {:.5f} {:.5f} {:.5f}\n", t.x, t.y, t.z);
+    s += fmt::format("  rotation (qw qx qy qz): {:.6f} {:.6f} {:.6f} {:.6f}\n", q.w, q.x, q.y, q.z);
+    s +=
+        fmt::format("  pairs used: {}; spread: {:.3f} deg, {:.2f} mm; transfer RMS {:.3f} px\n",
+                    e.pairCount, e.rotationSpreadDeg, 1000 * e.translationSpreadM, e.transferRmsPx);
+    for (const auto& k : e.skipped) s += "  skipped " + k + "\n";
+    return s;
+}
+
+}  // namespace mirage::calib

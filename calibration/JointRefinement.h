@@ -1,0 +1,38 @@
+#pragma once
+// Joint Levenberg-Marquardt refinement of the intrinsics and every view's board pose, and the
+// covariance of the intrinsics at the optimum. Used by the Calibrator:
+//  - for the fish-eye model after cv::fisheye::calibrate, whose alternating scheme (intrinsics
+//    step, then each view's pose re-estimated on its own) can stall at its initial guess when a
+//    view is steeply tilted or far off axis; the joint step minimises the same reprojection error
+//    over all parameters at once and only accepts steps that lower it;
+//  - for both models' standard deviations: Cov = (J^T J)^-1 * sigma^2, J the Jacobian of all
+//    residuals (pixels) w.r.t. all free parameters (intrinsics + 6 per view), sigma^2 =
+//    sum(r^2) / (2N - P). The same formula as calibrateCameraExtended's, computed here because
+//    cv::fisheye reports none.
+// Jacobians come from cv::projectPoints / cv::fisheye::projectPoints (analytic).
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calibration/Calibrator.h"
+
+namespace mirage::calib {
+
+struct JointProblem {
+    std::vector<const CalibrationView*> views;
+    CameraIntrinsics intrinsics;          // fx fy cx cy + distortion (5 pinhole, 4 fish-eye)
+    std::vector<cv::Vec3d> rvecs, tvecs;  // T_camera_board per view
+    std::vector<bool> fixedIntrinsics;    // per intrinsic parameter (8 or 9); empty = all free
+
+    int intrinsicCount() const;
+    double cost() const;  // sum of squared residuals (pixels^2), +inf if not finite
+};
+
+// Runs LM until converged or maxIterations; returns the final RMS (pixels per point).
+double refineJointly(JointProblem& problem, int maxIterations);
+
+// 1-sigma standard deviations of the intrinsics (fx fy cx cy distortion...), 0 for fixed ones,
+// +inf for all when the normal equations are singular (an unobservable parameter).
+std::vector<double> intrinsicStdDeviations(const JointProblem& problem);
+
+}  // namespace mirage::calib

@@ -1,0 +1,74 @@
+#pragma once
+// Synthetic board views with known intrinsics and poses: for tests (recover known parameters,
+// Monte-Carlo uncertainty checks) and for trying the wizard without a camera
+// (`mirage calibrate --write-synthetic DIR`). The images are rendered by ray casting every
+// sub-pixel through the exact camera model (CameraIntrinsics::unproject) onto the board plane,
+// so they are exact up to the 4x4 supersampling.
+#include <random>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calibration/Calibrator.h"
+#include "core/camera/CameraModel.h"
+
+namespace mirage::calib {
+
+// An OpenCV chessboard: cols x rows INNER corners, squares of squareMetres. Corner (i, j) lies at
+// (i * square, j * square, 0) in the board frame, listed row by row (OpenCV's detection order).
+struct ChessboardGeometry {
+    int cols = 9, rows = 6;
+    double squareMetres = 0.025;
+    std::vector<cv::Point3f> corners() const;
+};
+
+// Board pose T_camera_board (Rodrigues + metres).
+struct BoardPose {
+    cv::Vec3d rvec, tvec;
+};
+
+struct PoseSamplerOptions {
+    double minDistance = 0.35, maxDistance = 0.7;  // metres, camera to board centre
+    double minTiltDeg = 15, maxTiltDeg = 45;       // board tilt off fronto-parallel
+    double maxRollDeg = 20;                        // rotation about the board normal
+    // The board centre is placed on the ray through a random pixel; this fraction of the image
+    // (around its centre) is where those pixels are drawn.
+    double imageSpread = 0.7;
+    bool requireFullyVisible = true;  // retry until every corner projects inside the image
+    int marginPx = 6;                 // ... at least this far from the border
+};
+
+// Random board poses that face the camera (their normal within the tilt range of the ray to the
+// board centre). Deterministic for a given rng state.
+std::vector<BoardPose> sampleBoardPoses(const CameraIntrinsics& camera,
+                                        const ChessboardGeometry& board, int count,
+                                        const PoseSamplerOptions& options, std::mt19937& rng);
+
+// The ideal corners of `board` at `pose`, plus isotropic Gaussian noise of noisePx (pixels) per
+// coordinate. Corners that fall outside the image (or behind the camera) are left out, the way a
+// detector would not report them.
+CalibrationView projectView(const CameraIntrinsics& camera, const ChessboardGeometry& board,
+                            const BoardPose& pose, double noisePx, std::mt19937& rng,
+                            const std::string& name);
+
+// Renders boards as 8-bit grey images (sRGB-encoded values: black squares 25, white 230,
+// background 110), with a white margin of one square around the pattern as printed boards have.
+// Pixels whose ray misses the board show the background. The camera rays of all sub-pixel
+// samples (supersample x supersample per pixel) are computed once per renderer, so rendering a
+// pose costs only the ray-plane intersections.
+class ChessboardRenderer {
+public:
+    ChessboardRenderer(const CameraIntrinsics& camera, int supersample = 3);
+    cv::Mat render(const ChessboardGeometry& board, const BoardPose& pose) const;
+
+private:
+    CameraIntrinsics camera_;
+    int n_;
+    std::vector<cv::Vec3f> rays_;  // unit rays, camera frame; zero where unprojection failed
+};
+
+// One-off convenience (builds a renderer).
+cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,
+                         const BoardPose& pose, int supersample = 3);
+
+}  // namespace mirage::calib

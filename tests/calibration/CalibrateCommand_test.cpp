@@ -1,0 +1,191 @@
+// `mirage calibrate --batch` end to end: rendered board images in, a calibration file, report
+// and ROS export out; bad inputs give clear messages and no file; unobservable data gives a file
+// marked unreliable (exit code 2), never a confident one.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <random>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "calibration/SyntheticViews.h"
+#include "core/camera/CalibrationFile.h"
+#include "tests/support/TestSupport.h"
+
+namespace mirage::calib {
+namespace {
+namespace fs = std::filesystem;
+
+CameraIntrinsics camera() {
+    CameraIntrinsics c;
+    c.width = 640;
+    c.height = 480;
+    c.fx = 520;
+    c.fy = 518;
+    c.cx = 322.5;
+    c.cy = 238;
+    c.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
+    return c;
+}
+
+const ChessboardGeometry kBoard{9, 6, 0.025};
+
+// Renders `poses` into dir/view_NN.png.
+void writeViews(const fs::path& dir, const std::vector<BoardPose>& poses) {
+    const ChessboardRenderer renderer(camera(), 3);
+    for (size_t i = 0; i < poses.size(); ++i) {
+        char name[32];
+        std::snprintf(name, sizeof name, "view_%02zu.png", i);
+        ASSERT_TRUE(cv::imwrite((dir / name).string(), renderer.render(kBoard, poses[i])));
+    }
+}
+
+std::vector<BoardPose> tiltedPoses(int n) {
+    std::mt19937 rng(17);
+    PoseSamplerOptions po;
+    po.minDistance = 0.3;
+    po.maxDistance = 0.5;
+    po.marginPx = 12;
+    po.imageSpread = 0.9;
+    return sampleBoardPoses(camera(), kBoard, n, po, rng);
+}
+
+TEST(CalibrateCommand, BatchWritesCalibrationReportAndRos) {
+    const auto dir = test::outputDir("calibrate_batch");
+    const auto images = dir / "images";
+    fs::create_directories(images);
+    writeViews(images, tiltedPoses(10));
+    // A frame without the board is reported, not fatal.
+    cv::imwrite((images / "zz_empty.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(110)));
+    const auto out = dir / "cam.yaml", ros = dir / "cam_ros.yaml";
+    const auto r =
+        test::runMirage({"calibrate", "--batch", images.string(), "--board", "chessboard:9x6:0.025",
+                         "-o", out.string(), "--ros", ros.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("RMS reprojection error"), std::string::npos);
+    EXPECT_NE(r.output.find("zz_empty.png"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("verdict: reliable"), std::string::npos);
+    const auto cal = loadCalibration(out);
+    const auto truth = camera();
+    EXPECT_TRUE(cal.reliable);
+    EXPECT_EQ(cal.viewCount, 10);
+    EXPECT_NEAR(cal.intrinsics.fx, truth.fx, 0.01 * truth.fx);
+    EXPECT_NEAR(cal.intrinsics.fy, truth.fy, 0.01 * truth.fy);
+    EXPECT_NEAR(cal.intrinsics.cx, truth.cx, 4.0);
+    EXPECT_NEAR(cal.intrinsics.cy, truth.cy, 4.0);
+    EXPECT_NEAR(cal.intrinsics.coeff(0), truth.coeff(0), 0.02);
+    EXPECT_EQ(cal.stdDeviations.size(), 9u);
+    EXPECT_EQ(cal.perViewErrors.size(), 10u);
+    EXPECT_LT(cal.avgReprojectionError, 0.3);
+    EXPECT_TRUE(fs::exists(dir / "cam.yaml.report.txt"));
+    EXPECT_TRUE(fs::exists(ros));
+}
+
+// A video input: frames sampled (--video-step), named "video.avi#N" in the report.
+TEST(CalibrateCommand, BatchFromVideo) {
+    const auto dir = test::outputDir("calibrate_video");
+    const auto videoPath = dir / "board.avi";
+    {
+        const ChessboardRenderer renderer(camera(), 2);
+        cv::VideoWriter video(videoPath.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0,
+                              cv::Size(640, 480), false);
+        ASSERT_TRUE(video.isOpened());
+        for (const auto& pose : tiltedPoses(8)) {
+            const cv::Mat img = renderer.render(kBoard, pose);
+            video.write(img);
+            video.write(img);  // every second frame is sampled below
+        }
+    }
+    const auto out = dir / "cam.yaml";
+    const auto r =
+        test::runMirage({"calibrate", "--batch", videoPath.string(), "--board",
+                         "chessboard:9x6:0.025", "-o", out.string(), "--video-step", "2"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("board.avi#14"), std::string::npos) << r.output;
+    const auto cal = loadCalibration(out);
+    EXPECT_EQ(cal.viewCount, 8);
+    EXPECT_NEAR(cal.intrinsics.fx, camera().fx, 0.01 * camera().fx);
+}
+
+TEST(CalibrateCommand, FrontoParallelViewsGiveAnUnreliableFileNotAConfidentOne) {
+    const auto dir = test::outputDir("calibrate_fronto");
+    const auto images = dir / "images";
+    fs::create_directories(images);
+    std::vector<BoardPose> poses;
+    for (int i = 0; i < 6; ++i) {
+        BoardPose p;
+        p.rvec = cv::Vec3d(0, 0, 0.04 * i);
+        p.tvec = cv::Vec3d(-0.12 + 0.025 * i, -0.07 + 0.015 * i, 0.42 + 0.02 * i);
+        poses.push_back(p);
+    }
+    writeViews(images, poses);
+    const auto out = dir / "cam.yaml", ros = dir / "ros.yaml";
+    const auto r =
+        test::runMirage({"calibrate", "--batch", images.string(), "--board", "chessboard:9x6:0.025",
+                         "-o", out.string(), "--ros", ros.string()});
+    if (r.exitCode == 1) {
+        // Refusing outright is acceptable too, but then no file may exist.
+        EXPECT_FALSE(fs::exists(out)) << r.output;
+        return;
+    }
+    ASSERT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("UNRELIABLE"), std::string::npos) << r.output;
+    const auto cal = loadCalibration(out);
+    EXPECT_FALSE(cal.reliable);
+    EXPECT_NE(cal.unreliableReason.find("fronto-parallel"), std::string::npos)
+        << cal.unreliableReason;
+    EXPECT_FALSE(fs::exists(ros));  // ROS camera_info cannot say "unreliable"
+}
+
+TEST(CalibrateCommand, BadInputsAreNamedAndNoFileIsWritten) {
+    const auto dir = test::outputDir("calibrate_bad");
+    const auto out = dir / "cam.yaml";
+    const std::vector<std::string> common = {"--board", "chessboard:9x6:0.025", "-o", out.string()};
+    auto run = [&](std::vector<std::string> inputs) {
+        std::vector<std::string> args = {"calibrate", "--batch"};
+        args.insert(args.end(), inputs.begin(), inputs.end());
+        args.insert(args.end(), common.begin(), common.end());
+        return test::runMirage(args);
+    };
+    // Missing file.
+    auto r = run({(dir / "missing.png").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("missing.png"), std::string::npos) << r.output;
+    // Corrupt image.
+    {
+        std::ofstream f(dir / "corrupt.png");
+        f << "not a png";
+    }
+    r = run({(dir / "corrupt.png").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("corrupt.png"), std::string::npos) << r.output;
+    // Not a video although it says so.
+    {
+        std::ofstream f(dir / "broken.mp4");
+        f << "not a video";
+    }
+    r = run({(dir / "broken.mp4").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("broken.mp4"), std::string::npos) << r.output;
+    // Mixed sizes: both files named.
+    cv::imwrite((dir / "a_big.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(110)));
+    cv::imwrite((dir / "b_small.png").string(), cv::Mat(240, 320, CV_8UC1, cv::Scalar(110)));
+    r = run({(dir / "a_big.png").string(), (dir / "b_small.png").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("a_big.png"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("b_small.png"), std::string::npos) << r.output;
+    // No board anywhere.
+    r = run({(dir / "a_big.png").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("found in none"), std::string::npos) << r.output;
+    // Malformed board spec.
+    r = test::runMirage({"calibrate", "--batch", (dir / "a_big.png").string(), "--board",
+                         "chessboard:9x6", "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.output.find("COLSxROWS"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace mirage::calib

@@ -1,0 +1,162 @@
+// The wizard's logic without a window: auto-capture decisions on rendered frames (still, moving,
+// blurred, similar, held), recalibration after captures, coverage, tilt bins, advice and the
+// "done" state.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <opencv2/imgproc.hpp>
+
+#include "calibration/CalibrationSession.h"
+#include "calibration/SyntheticViews.h"
+
+namespace mirage::calib {
+namespace {
+
+CameraIntrinsics camera() {
+    CameraIntrinsics c;
+    c.width = 640;
+    c.height = 480;
+    c.fx = 520;
+    c.fy = 518;
+    c.cx = 322.5;
+    c.cy = 238;
+    c.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
+    return c;
+}
+
+const ChessboardGeometry kBoard{9, 6, 0.025};
+
+std::vector<BoardPose> poses(int n, unsigned seed) {
+    std::mt19937 rng(seed);
+    PoseSamplerOptions po;
+    po.minDistance = 0.3;
+    po.maxDistance = 0.5;
+    po.marginPx = 12;
+    po.imageSpread = 0.9;
+    return sampleBoardPoses(camera(), kBoard, n, po, rng);
+}
+
+TEST(CalibrationSession, AutoCaptureNeedsStillSharpAndNewViews) {
+    const auto cam = camera();
+    const ChessboardRenderer renderer(cam, 2);
+    const auto p = poses(2, 1);
+    const cv::Mat a = renderer.render(kBoard, p[0]);
+    const cv::Mat b = renderer.render(kBoard, p[1]);
+    cv::Mat bBlurred;
+    cv::GaussianBlur(b, bBlurred, cv::Size(), 3.0);
+
+    SessionOptions o;
+    o.stillFrames = 3;
+    CalibrationSession s(CalibrationTarget::chessboard(kBoard), {cam.width, cam.height}, o);
+    using D = CaptureDecision;
+    auto decide = [&](const cv::Mat& img) { return s.processFrame(img, "f").decision; };
+    // First sight: no motion known yet; then still frames accumulate.
+    EXPECT_EQ(decide(a), D::Moving);
+    EXPECT_EQ(decide(a), D::Moving);
+    EXPECT_EQ(decide(a), D::Moving);
+    EXPECT_EQ(decide(a), D::Captured);
+    EXPECT_EQ(decide(a), D::Held);  // stays still: no second capture of the same view
+    EXPECT_EQ(s.views().size(), 1u);
+    // A new pose, out of focus: still but blurred, never captured.
+    EXPECT_EQ(decide(bBlurred), D::Moving);
+    for (int i = 0; i < 3; ++i) decide(bBlurred);
+    EXPECT_EQ(decide(bBlurred), D::Blurred);
+    EXPECT_EQ(s.views().size(), 1u);
+    // Back into focus (the corners barely move): captured.
+    EXPECT_EQ(decide(b), D::Captured);
+    EXPECT_EQ(s.views().size(), 2u);
+    // The first pose again: still and sharp, but nothing new.
+    for (int i = 0; i < 4; ++i) decide(a);
+    EXPECT_EQ(decide(a), D::Similar);
+    EXPECT_EQ(s.views().size(), 2u);
+    // No board at all.
+    EXPECT_EQ(decide(cv::Mat(cam.height, cam.width, CV_8UC1, cv::Scalar(110))), D::NoBoard);
+}
+
+TEST(CalibrationSession, CollectsUntilDoneWithAdviceOnTheWay) {
+    const auto cam = camera();
+    std::mt19937 rng(2);
+    SessionOptions o;
+    CalibrationSession s(CalibrationTarget::chessboard(kBoard), {cam.width, cam.height}, o);
+    EXPECT_NE(s.advice().find("Hold the board"), std::string::npos);
+    // Fronto-parallel views first: the advice must ask for tilt, and the result is not done.
+    for (int i = 0; i < 4; ++i) {
+        BoardPose p;
+        p.rvec = cv::Vec3d(0, 0, 0.05 * i);
+        p.tvec = cv::Vec3d(-0.1 + 0.02 * i, -0.06 + 0.01 * i, 0.45);
+        s.addView(projectView(cam, kBoard, p, 0.1, rng, "fronto" + std::to_string(i)));
+    }
+    EXPECT_EQ(s.state(), CalibrationSession::State::Collecting);
+    EXPECT_NE(s.advice().find("Tilt"), std::string::npos) << s.advice();
+    ASSERT_TRUE(s.result() || !s.calibrationError().empty());
+    if (s.result()) {
+        EXPECT_FALSE(s.result()->calibration.reliable);
+    }
+    EXPECT_EQ(s.tilts().count(TiltCoverage::Fronto), 4);
+    // Tilted views all over the image: reaches Done.
+    const auto p = poses(16, 3);
+    for (size_t i = 0; i < p.size() && s.state() != CalibrationSession::State::Done; ++i)
+        s.addView(projectView(cam, kBoard, p[i], 0.1, rng, "tilted" + std::to_string(i)));
+    EXPECT_EQ(s.state(), CalibrationSession::State::Done)
+        << (s.unmetTargets().empty() ? "" : s.unmetTargets().front());
+    EXPECT_TRUE(s.unmetTargets().empty());
+    EXPECT_NE(s.advice().find("Done"), std::string::npos);
+    EXPECT_GT(s.coverage().coveredFraction(), o.doneCoverage);
+    ASSERT_TRUE(s.result());
+    EXPECT_NEAR(s.result()->calibration.intrinsics.fx, cam.fx, 0.01 * cam.fx);
+    // Dropping views until too few falls back to collecting.
+    while (s.views().size() > 5) s.dropView(0);
+    EXPECT_EQ(s.state(), CalibrationSession::State::Collecting);
+}
+
+TEST(CalibrationSession, OutlierViewIsFlaggedInTheSession) {
+    const auto cam = camera();
+    std::mt19937 rng(5);
+    CalibrationSession s(CalibrationTarget::chessboard(kBoard), {cam.width, cam.height}, {});
+    const auto p = poses(10, 6);
+    for (size_t i = 0; i < p.size(); ++i) {
+        auto v = projectView(cam, kBoard, p[i], 0.1, rng, "v" + std::to_string(i));
+        if (i == 7) std::reverse(v.imagePoints.begin(), v.imagePoints.begin() + 20);
+        s.addView(v);
+    }
+    ASSERT_TRUE(s.result());
+    EXPECT_TRUE(s.result()->views[7].rejected);
+    EXPECT_NE(s.advice().find("outlier"), std::string::npos) << s.advice();
+}
+
+TEST(CoverageMap, CountsCellsAndNamesTheEmptiestRegion) {
+    CoverageMap m({640, 480}, 8, 6);
+    std::vector<cv::Point2f> pts;
+    for (float x = 5; x < 320; x += 20)
+        for (float y = 5; y < 480; y += 20) pts.emplace_back(x, y);  // left half only
+    m.add(pts);
+    EXPECT_NEAR(m.coveredFraction(), 0.5, 1e-9);
+    std::string name;
+    const auto c = m.emptiestRegion(name);
+    EXPECT_GT(c.x, 320);
+    EXPECT_NE(name.find("right"), std::string::npos) << name;
+}
+
+TEST(TiltCoverage, BinsByDirection) {
+    EXPECT_EQ(TiltCoverage::binOf(5, 0, 15), TiltCoverage::Fronto);
+    EXPECT_EQ(TiltCoverage::binOf(30, 0, 15), TiltCoverage::FacingRight);
+    EXPECT_EQ(TiltCoverage::binOf(30, 90, 15), TiltCoverage::FacingDown);
+    EXPECT_EQ(TiltCoverage::binOf(30, 180, 15), TiltCoverage::FacingLeft);
+    EXPECT_EQ(TiltCoverage::binOf(30, -90, 15), TiltCoverage::FacingUp);
+}
+
+TEST(CaptureGate, SharpnessDropsWithBlurAndMotionIsMeasured) {
+    const auto cam = camera();
+    const ChessboardRenderer renderer(cam, 2);
+    const cv::Mat img = renderer.render(kBoard, poses(1, 9)[0]);
+    cv::Mat blurred;
+    cv::GaussianBlur(img, blurred, cv::Size(), 2.0);
+    const cv::Rect roi(0, 0, img.cols, img.rows);
+    EXPECT_GT(laplacianVariance(img, roi), 3 * laplacianVariance(blurred, roi));
+    EXPECT_NEAR(meanCornerMotion({{0, 0}, {1, 1}}, {{3, 4}, {1, 1}}), 2.5, 1e-9);
+    EXPECT_LT(meanCornerMotion({{0, 0}}, {}), 0);
+}
+
+}  // namespace
+}  // namespace mirage::calib

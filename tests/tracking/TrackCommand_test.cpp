@@ -1,0 +1,141 @@
+// End to end: a synthetic session (rendered board views with ground truth) through `mirage track`.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/camera/CalibrationFile.h"
+#include "core/session/Session.h"
+#include "tests/support/TestSupport.h"
+#include "tests/tracking/SyntheticViews.h"
+
+namespace mirage::tracking {
+namespace {
+
+std::filesystem::path makeSession(const std::string& name, int frames, bool mkv = false) {
+    const auto dir = test::outputDir("track_" + name) / "session";
+    const Board board = BoardLayout().makeBoard();
+    const BoardRaster tex = renderBoard(board, 8000, false);
+    const auto cam = testing::pinholeCamera();
+    Session meta;
+    meta.cameras = {{"main", "", "main.yaml", "main"}};
+    SessionWriter::Options opt;
+    opt.imageSequence = !mkv;  // lossless PNG: the accuracy figures are the tracker's own
+    {
+        SessionWriter w(dir, meta, opt);
+        for (int i = 0; i < frames; ++i) {
+            // Orbit at 0.35 m, 50-60 degrees elevation.
+            const double a = glm::radians(-40.0 + 80.0 * i / std::max(1, frames - 1));
+            const double el = glm::radians(55.0 + 5.0 * std::sin(a));
+            const glm::dvec3 eye = 0.35 * glm::dvec3(std::cos(el) * std::sin(a), std::sin(el),
+                                                     std::cos(el) * std::cos(a));
+            const Pose T = testing::lookAt(eye, {0, 0, 0});
+            cv::Mat grey = renderSyntheticBoardView(board, tex, cam, T), bgr;
+            cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+            if (name == "noise" && i == frames / 2) cv::randu(bgr, 0, 256);  // a frame of noise
+            w.append({bgr}, {i / 30.0}, T);
+        }
+        w.close();
+    }
+    CameraCalibration calib;
+    calib.intrinsics = cam;
+    saveCalibration(dir / "main.yaml", calib);
+    board.save(dir / "board.json");
+    return dir;
+}
+
+std::vector<std::vector<std::string>> readCsv(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::vector<std::vector<std::string>> rows;
+    std::string line;
+    while (std::getline(in, line)) {
+        std::vector<std::string> cols;
+        std::string cur;
+        bool quoted = false;
+        for (char c : line) {
+            if (c == '"')
+                quoted = !quoted;
+            else if (c == ',' && !quoted) {
+                cols.push_back(cur);
+                cur.clear();
+            } else
+                cur += c;
+        }
+        cols.push_back(cur);
+        rows.push_back(cols);
+    }
+    return rows;
+}
+
+TEST(TrackCommand, SyntheticSessionMeetsAccuracyWithAFrameOfNoise) {
+    const auto dir = makeSession("noise", 12);
+    const auto csv = dir.parent_path() / "poses.csv";
+    const auto r = test::runMirage({"track", dir.string(), "-o", csv.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const auto rows = readCsv(csv);
+    ASSERT_EQ(rows.size(), 13u);
+    const std::vector<std::string> head = {"frame", "t",  "state", "reason", "tx",   "ty",    "tz",
+                                           "qw",    "qx", "qy",    "qz",     "tags", "rms_px"};
+    for (size_t i = 0; i < head.size(); ++i) EXPECT_EQ(rows[0][i], head[i]);
+    int ok = 0;
+    for (size_t i = 1; i < rows.size(); ++i) {
+        if (i - 1 == 6) {
+            EXPECT_EQ(rows[i][2], "no_tags") << rows[i][3];
+            EXPECT_TRUE(rows[i][4].empty());
+        } else {
+            EXPECT_EQ(rows[i][2], "ok") << rows[i][3];
+            ok += rows[i][2] == "ok";
+        }
+    }
+    EXPECT_EQ(ok, 11);
+    // The summary states the ground-truth errors; the accuracy goal holds on these views.
+    EXPECT_NE(r.output.find("ground truth"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("wrong-but-ok frames (> 2 deg or > 2 %): 0"), std::string::npos)
+        << r.output;
+    double rotMax = 0;
+    for (size_t i = 1; i < rows.size(); ++i)
+        if (rows[i][2] == "ok") rotMax = std::max(rotMax, std::stod(rows[i][25]));
+    EXPECT_LT(rotMax, 0.3);
+}
+
+// A recording cut short (crash while writing): the frames lost are counted, the rest tracked.
+TEST(TrackCommand, TruncatedVideoCountsLostFramesAndContinues) {
+    const auto dir = makeSession("truncated", 8, true);
+    const auto video = dir / "main.mkv";
+    ASSERT_TRUE(std::filesystem::exists(video));
+    const auto size = std::filesystem::file_size(video);
+    std::filesystem::resize_file(video, size * 6 / 10);
+    const auto csv = dir.parent_path() / "poses.csv";
+    const auto r = test::runMirage({"track", dir.string(), "-o", csv.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const auto rows = readCsv(csv);
+    ASSERT_GE(rows.size(), 3u);  // header + some frames
+    ASSERT_LT(rows.size(), 9u);  // not all 8 frames survived
+    for (size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i][2], "ok") << rows[i][3];
+    const int lost = 8 - int(rows.size() - 1);
+    EXPECT_NE(r.output.find("frames: 8 (" + std::to_string(lost) + " unreadable"),
+              std::string::npos)
+        << r.output;
+}
+
+TEST(TrackCommand, BadInputNamesTheFile) {
+    const auto out = test::outputDir("track_bad");
+    auto r = test::runMirage({"track", "--video", (out / "none.mkv").string(), "--calib",
+                              (out / "none.yaml").string(), "--board",
+                              (test::dataDir() / "boards" / "board_4x6_a4.json").string(), "-o",
+                              (out / "p.csv").string()});
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.output.find("none"), std::string::npos) << r.output;
+    std::ofstream(out / "bad.json") << "{\"tags\": [{\"id\": 1}]}";
+    const auto dir = makeSession("badboard", 1);
+    r = test::runMirage({"track", dir.string(), "--board", (out / "bad.json").string(), "-o",
+                         (out / "p.csv").string()});
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.output.find("bad.json"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("tags[0].size"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mirage::tracking

@@ -1,0 +1,85 @@
+#pragma once
+// Camera pose from the tags of a board seen in one frame (docs/tracking.md, "Pose").
+//
+// Per tag: detection corners unprojected with the camera model (Brown-Conrady or Kannala-Brandt),
+// IPPE on the square tag (cv::solvePnPGeneric, SOLVEPNP_IPPE_SQUARE) gives two candidate poses.
+// Candidates are scored on all tags, the best few refined by Levenberg-Marquardt on the pixel
+// reprojection error of all corners of the inlier tags, tags that do not fit are rejected, and the
+// planar two-fold ambiguity is resolved by the ratio of the reprojection errors of the best pose
+// and the best distinct alternative, or else by closeness to the previous pose. If neither
+// settles it, the state is `ambiguous`, never `ok`.
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera/CameraModel.h"
+#include "core/math/Pose.h"
+#include "tracking/Board.h"
+#include "tracking/Detector.h"
+
+namespace mirage::tracking {
+
+enum class TrackingState { Ok, NoTags, TagsTooSmall, TooBlurred, Ambiguous, Lost };
+// "ok", "no_tags", "tags_too_small", "too_blurred", "ambiguous", "lost" (the CSV spelling).
+const char* trackingStateName(TrackingState s);
+
+struct PoseEstimatorOptions {
+    // Tags whose shortest side is below this (pixels) are not used: their corners are too
+    // imprecise for a trustworthy pose. If all tags are that small: state tags_too_small.
+    double minTagSidePx = 10.0;
+    // Candidate scoring: a tag supports a candidate pose if its corners reproject within
+    // max(candidateInlierPx, 15 % of its side).
+    double candidateInlierPx = 4.0;
+    // After refinement a tag is an outlier if its corner RMS exceeds
+    // max(outlierTagRmsPx, 4 x the median tag RMS); it is dropped and the pose refined again.
+    double outlierTagRmsPx = 1.5;
+    // The final RMS over all used corners must be below this, else state lost.
+    double maxRmsPx = 2.0;
+    // Planar ambiguity: the alternative pose must reproject at least this many times worse
+    // (RMS ratio) AND by at least ambiguityMinGapPx more, else the frame is ambiguous...
+    double ambiguityRatio = 2.0;
+    double ambiguityMinGapPx = 0.3;
+    // ...unless a previous pose decides: the chosen pose must be within priorMaxRotationDeg of it
+    // and the alternative at least twice as far from it as the chosen one.
+    double priorMaxRotationDeg = 15.0;
+    // Corners of fish-eye rays more than this far off the optical axis are not used for the IPPE
+    // initialisation (normalised coordinates explode near 90 degrees); LM still uses them.
+    double maxInitAngleDeg = 75.0;
+};
+
+struct PoseEstimate {
+    TrackingState state = TrackingState::NoTags;
+    std::string reason;             // human-readable why (also for ok: what was used)
+    std::optional<Pose> pose;       // T_world_camera; set when state is ok (and for ambiguous, the
+                                    // lower-error guess, which must not be used as tracking output)
+    std::vector<int> tagsUsed;      // board tag ids in the final fit
+    std::vector<int> tagsRejected;  // ids detected but rejected as outliers or too small
+    double rmsPx = -1;              // reprojection RMS over the used corners (pixels)
+    double alternativeRmsPx = -1;   // RMS of the best distinct alternative pose (-1: none)
+    // 6x6 covariance (row-major) of (rotation vector of a world-frame perturbation of the
+    // camera's orientation, radians; camera centre in the world, metres): J^T J inverse scaled by
+    // the residual variance. All zero when not computed.
+    std::array<double, 36> covariance{};
+};
+
+class PoseEstimator {
+public:
+    PoseEstimator(Board board, CameraIntrinsics camera, PoseEstimatorOptions options = {});
+
+    // detections: all tags found in the frame (ids not on the board are ignored).
+    // prior: the previous frame's T_world_camera, if tracked.
+    PoseEstimate estimate(const std::vector<TagDetection>& detections,
+                          const std::optional<Pose>& prior = std::nullopt) const;
+
+    const Board& board() const { return board_; }
+    const CameraIntrinsics& camera() const { return camera_; }
+    const PoseEstimatorOptions& options() const { return options_; }
+
+private:
+    Board board_;
+    CameraIntrinsics camera_;
+    PoseEstimatorOptions options_;
+};
+
+}  // namespace mirage::tracking

@@ -1,0 +1,69 @@
+#pragma once
+// Frame-by-frame camera tracking: detection, pose, state with a reason, temporal filtering.
+// One Tracker per video stream (it keeps the previous pose for the planar ambiguity and the
+// filter state). Frames are 8-bit BGR (sRGB-encoded, as cameras deliver them) or grey.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "tracking/Detector.h"
+#include "tracking/PoseEstimator.h"
+#include "tracking/PoseFilter.h"
+
+namespace mirage::tracking {
+
+struct TrackerOptions {
+    DetectorOptions detector;
+    PoseEstimatorOptions pose;
+    OneEuroOptions filter;
+    bool filterEnabled = true;
+    // The previous ok pose helps decide the planar ambiguity only if it is this recent (seconds).
+    double priorMaxAgeS = 0.5;
+    // When no tag is found, an image whose sharpness (strongest gradients over the intensity
+    // range, about 1 / edge width in pixels) is below this is reported too_blurred, not no_tags.
+    double minSharpness = 0.12;
+};
+
+struct TrackedFrame {
+    double t = 0;                  // seconds
+    PoseEstimate estimate;         // state, reason, raw pose, RMS, covariance, tags
+    std::optional<Pose> filtered;  // T_world_camera after the temporal filter (state ok only)
+    std::vector<TagDetection> detections;
+    double sharpness = -1;  // computed only when no tag was found
+    double detectMs = 0, poseMs = 0, filterMs = 0;
+};
+
+// Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
+// percentile of the directional derivative (intensity levels per pixel), the smallest of the four
+// (motion blur along one direction lowers that one only), divided by the 1..99 % intensity
+// range; about 1 / (edge width in pixels). 0 for an image without contrast.
+double imageSharpness(const cv::Mat& grey);
+
+class Tracker {
+public:
+    Tracker(Board board, CameraIntrinsics camera, TrackerOptions options = {});
+
+    TrackedFrame process(const cv::Mat& image, double t);
+    // A pose known from elsewhere (the last pose of a previous run, another sensor) acts as the
+    // previous ok pose at time t: it may decide the planar ambiguity of the next frames.
+    void seedPrior(const Pose& T_world_camera, double t) {
+        lastOk_ = T_world_camera;
+        lastOkT_ = t;
+    }
+    // A frame that could not be read (corrupt, truncated video): reported lost, filter reset.
+    TrackedFrame markLost(double t, const std::string& reason);
+
+    const PoseEstimator& estimator() const { return estimator_; }
+
+private:
+    TrackerOptions options_;
+    Detector detector_;
+    PoseEstimator estimator_;
+    PoseFilter filter_;
+    std::optional<Pose> lastOk_;
+    double lastOkT_ = 0;
+};
+
+}  // namespace mirage::tracking

@@ -1,0 +1,58 @@
+#pragma once
+// Per-frame CSV of tracking results and the run's summary (`mirage track`, docs/tracking.md).
+//
+// CSV columns (one row per frame, header first; poses are T_world_camera as tx,ty,tz,qw,qx,qy,qz,
+// metres, OpenCV camera axes, glTF world):
+//   frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz,tags,rms_px,
+//   raw_tx,raw_ty,raw_tz,raw_qw,raw_qx,raw_qy,raw_qz,std_rot_deg,std_pos_m,alt_rms_px,
+//   detect_ms,pose_ms,gt_rot_err_deg,gt_pos_err_m
+// tx..qz is the filtered pose (the raw one with filtering off), raw_* the single-frame estimate.
+// Non-ok rows leave the pose columns empty. `tags` lists the used tag ids separated by spaces.
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/math/Pose.h"
+#include "tracking/Tracker.h"
+
+namespace mirage::tracking {
+
+struct ErrorStats {
+    int count = 0;
+    double median = 0, p95 = 0, max = 0;
+};
+ErrorStats errorStats(std::vector<double> values);
+
+class TrackingReport {
+public:
+    // Opens the CSV (throws FileError if it cannot be written). boardCentre: world point whose
+    // distance to the camera normalises translation errors (percent of distance).
+    TrackingReport(const std::filesystem::path& csvPath, glm::dvec3 boardCentre);
+
+    void add(int frameIndex, const TrackedFrame& f, const std::optional<Pose>& groundTruth,
+             double decodeMs);
+    void addUnreadable(int count) { unreadable_ += count; }
+
+    // Human-readable summary (several lines).
+    std::string summary() const;
+    int frames() const { return frames_; }
+    int okFrames() const { return stateCount_[0]; }
+    // ok frames whose pose is off by more than 2 degrees or 2 % of the distance (needs truth).
+    int wrongButOk() const { return wrongOk_; }
+    ErrorStats rotationErrorDeg() const { return errorStats(rotErrDeg_); }
+    ErrorStats translationErrorRel() const { return errorStats(posErrRel_); }
+
+private:
+    std::ofstream csv_;
+    std::filesystem::path path_;
+    glm::dvec3 boardCentre_;
+    int frames_ = 0, withTags_ = 0, unreadable_ = 0, wrongOk_ = 0;
+    std::array<int, 6> stateCount_{};
+    std::vector<double> rms_, decodeMs_, detectMs_, poseMs_, filterMs_;
+    std::vector<double> rotErrDeg_, posErrM_, posErrRel_;  // raw estimate vs truth
+    std::vector<double> rotErrFiltDeg_, posErrFiltRel_;    // filtered vs truth
+};
+
+}  // namespace mirage::tracking
