@@ -154,12 +154,18 @@ void runReplay(const ReplayArgs& a) {
 
     std::map<int, PoseRow> poses;
     const bool useTracked = !a.poses.empty();
-    if (useTracked)
+    std::unique_ptr<tracking::Tracker> tracker;
+    if (useTracked) {
         poses = readPosesCsv(a.poses);
-    else
-        spdlog::info(
-            "replay: camera poses from the session's ground truth (frames.csv); pass "
-            "--poses POSES.csv (mirage track) for tracked poses");
+    } else if (!a.groundTruth && !session.board.empty() &&
+               std::filesystem::exists(session.path(session.board))) {
+        tracker = std::make_unique<tracking::Tracker>(
+            tracking::Board::load(session.path(session.board)), calib.intrinsics);
+        spdlog::info("replay: tracking the camera on {}", session.path(session.board).string());
+    } else {
+        spdlog::info("replay: camera poses from the session's ground truth (frames.csv){}",
+                     a.groundTruth ? "" : " (the session has no board file to track)");
+    }
 
     gl::ContextOptions copt;
     copt.width = calib.intrinsics.width;
