@@ -9,9 +9,11 @@
 // where <pass>_ms are the GL timer-query times of the renderer's passes (0 when skipped) and the
 // pose is T_world_camera (OpenCV axes). Headless by default; --window shows the result as it goes.
 //
-// Camera poses: --poses POSES.csv (the `mirage track` format) when given; otherwise the session's
-// ground-truth poses from frames.csv (synthetic sessions have them). A frame without a pose is
-// "lost": the camera frame passes through unchanged and temporal history is reset.
+// Camera poses, in this order: --poses POSES.csv (the `mirage track` format); --ground-truth (the
+// session's frames.csv poses); otherwise live tracking (tracking::Tracker on the session's board
+// and calibration) when the session has a board file, else the ground truth as a fallback. A frame
+// without a pose is "lost": the camera frame passes through unchanged and temporal history is
+// reset on the next tracked frame.
 #include <unistd.h>
 #include <atomic>
 #include <chrono>
@@ -34,6 +36,7 @@
 #include "core/session/MatroskaWriter.h"
 #include "core/session/Session.h"
 #include "render/Renderer.h"
+#include "tracking/Tracker.h"
 
 namespace mirage::app {
 namespace {
@@ -122,6 +125,7 @@ struct ReplayArgs {
     int jpegQuality = 92;
     bool window = false;
     bool verbose = false;
+    bool groundTruth = false;
 };
 
 void runReplay(const ReplayArgs& a) {
@@ -144,12 +148,18 @@ void runReplay(const ReplayArgs& a) {
 
     std::map<int, PoseRow> poses;
     const bool useTracked = !a.poses.empty();
-    if (useTracked)
+    std::unique_ptr<tracking::Tracker> tracker;
+    if (useTracked) {
         poses = readPosesCsv(a.poses);
-    else
-        spdlog::info(
-            "replay: camera poses from the session's ground truth (frames.csv); pass "
-            "--poses POSES.csv (mirage track) for tracked poses");
+    } else if (!a.groundTruth && !session.board.empty() &&
+               std::filesystem::exists(session.path(session.board))) {
+        tracker = std::make_unique<tracking::Tracker>(
+            tracking::Board::load(session.path(session.board)), calib.intrinsics);
+        spdlog::info("replay: tracking the camera on {}", session.path(session.board).string());
+    } else {
+        spdlog::info("replay: camera poses from the session's ground truth (frames.csv){}",
+                     a.groundTruth ? "" : " (the session has no board file to track)");
+    }
 
     gl::ContextOptions copt;
     copt.width = calib.intrinsics.width;
@@ -201,7 +211,14 @@ void runReplay(const ReplayArgs& a) {
         const double decodeMs = msSince(t0);
         const auto t1 = Clock::now();
         PoseRow pr;
-        if (useTracked) {
+        const double tFrame = rec.timestamps.empty() ? k / session.fps : rec.timestamps.front();
+        if (tracker) {
+            tracking::TrackedFrame tf = tracker->process(bgr, tFrame);
+            pr.state = tracking::trackingStateName(tf.estimate.state);
+            pr.reason = tf.estimate.reason;
+            if (tf.estimate.state == tracking::TrackingState::Ok)
+                pr.pose = tf.filtered ? tf.filtered : tf.estimate.pose;
+        } else if (useTracked) {
             auto it = poses.find(rec.index);
             if (it != poses.end())
                 pr = it->second;
@@ -241,7 +258,7 @@ void runReplay(const ReplayArgs& a) {
         }
         lastLost = !pr.pose;
         const auto t3 = Clock::now();
-        const double t = rec.timestamps.empty() ? k / session.fps : rec.timestamps.front();
+        const double t = tFrame;
         if (video)
             video->append(result, t);
         else
@@ -252,8 +269,11 @@ void runReplay(const ReplayArgs& a) {
             ctx.pollEvents();
             if (ctx.shouldClose()) gInterrupted = true;
         }
-        csv << rec.index << "," << t << "," << pr.state << "," << pr.reason << "," << decodeMs
-            << "," << trackingMs;
+        std::string reason = pr.reason;  // keep the CSV's columns: no commas or newlines inside
+        for (char& ch : reason)
+            if (ch == ',' || ch == '\n') ch = ';';
+        csv << rec.index << "," << t << "," << pr.state << "," << reason << "," << decodeMs << ","
+            << trackingMs;
         for (const char* p : passes) csv << "," << passMs[p];
         csv << "," << gpuMs << "," << readbackMs << "," << encodeMs << "," << msSince(t0);
         if (pr.pose) {
@@ -299,6 +319,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_option("--frames", args->maxFrames, "Replay at most N frames");
     cmd->add_option("--start", args->start, "First frame")->check(CLI::NonNegativeNumber);
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units");
+    cmd->add_flag("--ground-truth", args->groundTruth,
+                  "Use the session's ground-truth poses (frames.csv) instead of tracking");
     cmd->add_flag("--window", args->window, "Show the result in a window (needs a display)");
     cmd->add_flag("-v,--verbose", args->verbose, "Log which passes ran and why");
     cmd->callback([args] { runReplay(*args); });

@@ -1,6 +1,6 @@
 // Per-pass GPU time of the real-time renderer (GL_TIME_ELAPSED queries), on a table-top scene:
 // a real floor and real box (proxies), a virtual box and a virtual sphere, a real spot light and
-// a real environment. Arguments: width, height, VPL count, sphere subdivisions (triangles),
+// no environment map. Arguments: width, height, VPL count, sphere subdivisions (triangles),
 // indirect (VPL gather) resolution divisor.
 // Reported time = the frame's total GPU time (manual time); counters = per-pass ms (mean over the
 // iterations; use --benchmark_repetitions and the median aggregate for figures).

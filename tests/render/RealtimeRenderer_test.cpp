@@ -64,6 +64,22 @@ std::optional<glm::dvec3> floorHit(const CameraIntrinsics& cam, const Pose& T_wo
     return o + d * (-o.y / d.y);
 }
 
+// Does the segment a -> b pass through the axis-aligned box [lo, hi] (slab test)?
+bool segmentHitsBox(glm::dvec3 a, glm::dvec3 b, glm::dvec3 lo, glm::dvec3 hi) {
+    const glm::dvec3 d = b - a;
+    double t0 = 0, t1 = 1;
+    for (int i = 0; i < 3; ++i) {
+        if (std::abs(d[i]) < 1e-12) {
+            if (a[i] < lo[i] || a[i] > hi[i]) return false;
+            continue;
+        }
+        const double u = (lo[i] - a[i]) / d[i], v = (hi[i] - a[i]) / d[i];
+        t0 = std::max(t0, std::min(u, v));
+        t1 = std::min(t1, std::max(u, v));
+    }
+    return t0 <= t1;
+}
+
 bool allFinite(const cv::Mat& m) {
     return cv::checkRange(m, true, nullptr, -1e30, 1e30);
 }
@@ -122,6 +138,61 @@ TEST_F(RealtimeRenderer, SpotLitPlaneMatchesClosedForm) {
         }
     EXPECT_GT(inside, 500);
     EXPECT_GT(outside, 500);
+}
+
+// Point light (cube shadow map) and directional light (orthographic shadow map): the floor
+// matches the closed form where lit, and a real box's shadow (under the point light: the -Y cube
+// face; under the directional light: offset along the light direction) is dark in both solutions.
+TEST_F(RealtimeRenderer, PointAndDirectionalLightsMatchClosedForm) {
+    const CameraIntrinsics cam = smallCamera();
+    const Pose pose = lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
+    for (Light::Type type : {Light::Type::Point, Light::Type::Directional}) {
+        Scene scene;
+        int m = addMaterial(scene, glm::vec3(0.6f));
+        addFloor(scene, "floor", 0.0f, 4.0f, m, Origin::Real);
+        addBox(scene, "box", {-0.15f, 0.6f, -0.15f}, {0.15f, 0.7f, 0.15f}, m, Origin::Real);
+        const glm::dvec3 lightPos(0, 1.5, 0);
+        const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, -1.0, 0.2));
+        const float intensity = type == Light::Type::Point ? 5.0f : 2.0f;
+        addLight(scene, type, glm::vec3(lightPos), glm::vec3(dir), intensity, Origin::Real);
+        Renderer r(scene, cam);
+        const FrameReport& rep = r.render({pose, {}, false});
+        ASSERT_TRUE(rep.ran("shadow"));
+        EXPECT_EQ(r.plan().lights[0].layers, type == Light::Type::Point ? 6 : 1);
+        cv::Mat rv = r.readBuffer(Resource::DirectRv), lr = r.readBuffer(Resource::DirectR);
+        cv::Mat cover = r.coverage();
+        int lit = 0, shadowed = 0;
+        for (int y = 0; y < cam.height; ++y)
+            for (int x = 0; x < cam.width; ++x) {
+                auto p = floorHit(cam, pose, x, y);
+                if (!p || cover.at<uint8_t>(y, x) != 1 || std::abs(p->x) > 1.8 ||
+                    std::abs(p->z) > 1.8)
+                    continue;
+                if (segmentHitsBox(pose.translation, *p, {-0.17, 0.58, -0.17}, {0.17, 0.72, 0.17}))
+                    continue;  // the camera sees the box there, not the floor
+                // Where does the ray from p towards the light cross the box's height (y=0.65)?
+                const glm::dvec3 toL =
+                    type == Light::Type::Point ? glm::normalize(lightPos - *p) : -dir;
+                const glm::dvec3 c = *p + toL * (0.65 / toL.y);
+                const double m2 = std::max(std::abs(c.x), std::abs(c.z));
+                const glm::dvec3 v = glm::normalize(pose.translation - *p);
+                glm::dvec3 e = type == Light::Type::Point
+                                   ? brdfCos({0, 1, 0}, v, toL, glm::dvec3(0.6), 0, 1) *
+                                         (5.0 / glm::dot(lightPos - *p, lightPos - *p))
+                                   : brdfCos({0, 1, 0}, v, toL, glm::dvec3(0.6), 0, 1) * 2.0;
+                const float got = rv.at<cv::Vec3f>(y, x)[0];
+                if (m2 > 0.2) {
+                    ASSERT_NEAR(got, e.x, 0.02 * e.x + 1e-4) << x << "," << y;
+                    ++lit;
+                } else if (m2 < 0.1) {
+                    ASSERT_LT(got, 0.05 * e.x) << x << "," << y;
+                    ASSERT_LT(lr.at<cv::Vec3f>(y, x)[0], 0.05 * e.x);
+                    ++shadowed;
+                }
+            }
+        EXPECT_GT(lit, 2000);
+        EXPECT_GT(shadowed, 20);
+    }
 }
 
 // The comparison used above catches a broken render: a 30 % too bright light and a light 30 cm

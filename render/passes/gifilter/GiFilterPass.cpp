@@ -7,6 +7,10 @@ namespace mirage::render {
 
 GiFilterPass::GiFilterPass(const GBufferPass& gbuffer)
     : gbuffer_(gbuffer),
+      deinterleave_("gi deinterleave",
+                    {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
+                     {GL_FRAGMENT_SHADER, "passes/gifilter/deinterleave.frag",
+                      shaders::source("passes/gifilter/deinterleave.frag")}}),
       program_("gifilter",
                {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                 {GL_FRAGMENT_SHADER, "passes/gifilter/gifilter.frag",
@@ -22,7 +26,17 @@ PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
 }
 
 void GiFilterPass::resize(const FrameContext& ctx) {
-    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight(), s = ctx.options.indirectScale;
+    lowRv_ = gl::Texture::create2D("indirect L_rv filtered", (w + s - 1) / s, (h + s - 1) / s,
+                                   GL_RGBA16F);
+    lowR_ = gl::Texture::create2D("indirect L_r filtered", (w + s - 1) / s, (h + s - 1) / s,
+                                  GL_RGBA16F);
+    lowRv_.setFilter(GL_NEAREST, GL_NEAREST);
+    lowR_.setFilter(GL_NEAREST, GL_NEAREST);
+    lowFbo_ = gl::Framebuffer("gi deinterleave fbo");
+    lowFbo_.attachColor(0, lowRv_);
+    lowFbo_.attachColor(1, lowR_);
+    lowFbo_.finalize(2);
     rv_ = gl::Texture::create2D("L_rv", w, h, GL_RGBA16F);
     r_ = gl::Texture::create2D("L_r", w, h, GL_RGBA16F);
     for (int i = 0; i < 2; ++i) {
@@ -39,6 +53,20 @@ void GiFilterPass::resize(const FrameContext& ctx) {
 
 void GiFilterPass::execute(FrameContext& ctx) {
     const int write = current_, read = 1 - current_;
+    lowFbo_.bind();
+    glViewport(0, 0, lowRv_.width(), lowRv_.height());
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    deinterleave_.use();
+    glUniform1i(deinterleave_.uniformLocation("scale"), ctx.options.indirectScale);
+    ctx.bindFrameBlocks();
+    glBindTextureUnit(0, gbuffer_.position().id());
+    glBindTextureUnit(1, gbuffer_.normal().id());
+    glBindTextureUnit(2, ctx.texture(Resource::IndirectRv).id());
+    glBindTextureUnit(3, ctx.texture(Resource::IndirectR).id());
+    ctx.emptyVao.bind();
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+
     fbo_[write].bind();
     glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
     glDisable(GL_DEPTH_TEST);
@@ -48,8 +76,8 @@ void GiFilterPass::execute(FrameContext& ctx) {
     ctx.bindFrameBlocks();
     glBindTextureUnit(0, gbuffer_.position().id());
     glBindTextureUnit(1, gbuffer_.normal().id());
-    glBindTextureUnit(2, ctx.texture(Resource::IndirectRv).id());
-    glBindTextureUnit(3, ctx.texture(Resource::IndirectR).id());
+    glBindTextureUnit(2, lowRv_.id());
+    glBindTextureUnit(3, lowR_.id());
     glBindTextureUnit(4, ctx.texture(Resource::DirectRv).id());
     glBindTextureUnit(5, ctx.texture(Resource::DirectR).id());
     glBindTextureUnit(6, historyRv_[read].id());

@@ -1,6 +1,7 @@
 #pragma once
-// Geometry-aware + temporal filter of the VPL light, summed with direct light into LRv / LR.
-// Keeps two history buffers (ping-pong) between frames.
+// Geometry-aware + temporal filter of the VPL light, summed with direct light into LRv / LR:
+// de-interleave at gather resolution (deinterleave.frag), then joint bilateral upsampling,
+// temporal smoothing and the sum (gifilter.frag). Keeps two history buffers (ping-pong).
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -22,7 +23,10 @@ public:
 
 private:
     const GBufferPass& gbuffer_;
-    gl::Program program_;
+    gl::Program deinterleave_;  // K x K geometry-aware filter at gather resolution
+    gl::Program program_;       // upsampling + temporal + sum with direct light
+    gl::Texture lowRv_, lowR_;
+    gl::Framebuffer lowFbo_;
     gl::Texture rv_, r_;
     gl::Texture historyRv_[2], historyR_[2];
     gl::Framebuffer fbo_[2];

@@ -1,14 +1,14 @@
 #version 450 core
 #include "common.glsl"
-// Geometry-aware filter of the interleaved indirect light (a K x K window holds one pixel of
-// every VPL group; neighbours count only if their position and normal match p's, so light does
-// not bleed across edges), temporal smoothing against VPL flicker (history reprojected with last
+// Joint bilateral upsampling of the filtered indirect light (deinterleave.frag, gather
+// resolution) to full resolution: the 2 x 2 gather pixels around p, weighted bilinearly and by
+// geometry (position / normal match with p), temporal smoothing against VPL flicker (history reprojected with last
 // frame's camera, rejected where the surface there is at a different distance; off after a cut
 // or tracking loss), and the sum with direct light: the GI solutions L_rv and L_r (linear).
 in vec2 uv;
 layout(binding = 0) uniform sampler2D gPosition;
 layout(binding = 1) uniform sampler2D gNormal;
-layout(binding = 2) uniform sampler2D indirectRv;
+layout(binding = 2) uniform sampler2D indirectRv;  // filtered, gather resolution
 layout(binding = 3) uniform sampler2D indirectR;
 layout(binding = 4) uniform sampler2D directRv;
 layout(binding = 5) uniform sampler2D directR;
@@ -34,29 +34,32 @@ void main() {
     }
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
-    int K = max(counts.z, 1);
     ivec2 lowSize = textureSize(indirectRv, 0);
-    ivec2 centre = px / scale;
+    vec2 f = (vec2(px) + 0.5) / float(scale) - 0.5;  // p in gather pixel coordinates
+    ivec2 c0 = ivec2(floor(f));
+    vec2 fr = f - vec2(c0);
     vec3 sumRv = vec3(0.0), sumR = vec3(0.0);
     float wsum = 0.0;
-    for (int dy = -K / 2; dy < K - K / 2; ++dy)
-        for (int dx = -K / 2; dx < K - K / 2; ++dx) {
-            ivec2 q = clamp(centre + ivec2(dx, dy), ivec2(0), lowSize - 1);
-            ivec2 qg = min(q * scale, size - 1);  // the G-buffer pixel that q was shaded at
-            vec4 Q = texelFetch(gPosition, qg, 0);
-            if (int(Q.w + 0.5) == ORIGIN_NONE) continue;
-            vec3 nq = texelFetch(gNormal, qg, 0).xyz;
-            float planeDist = abs(dot(Q.xyz - P.xyz, n)) / max(0.01 * camDist, 1e-4);
-            float c = max(dot(n, nq), 0.0);
-            c *= c;
-            c *= c;
-            c *= c;
-            c *= c;  // cos^16: ~0.5 at 17 degrees
-            float w = c / (1.0 + planeDist * planeDist * 4.0);
-            sumRv += w * texelFetch(indirectRv, q, 0).rgb;
-            sumR += w * texelFetch(indirectR, q, 0).rgb;
-            wsum += w;
-        }
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        ivec2 q = clamp(c0 + o, ivec2(0), lowSize - 1);
+        ivec2 qg = min(q * scale, size - 1);
+        vec4 Q = texelFetch(gPosition, qg, 0);
+        if (int(Q.w + 0.5) == ORIGIN_NONE) continue;
+        vec3 nq = texelFetch(gNormal, qg, 0).xyz;
+        float planeDist = abs(dot(Q.xyz - P.xyz, n)) / max(0.01 * camDist, 1e-4);
+        float cs = max(dot(n, nq), 0.0);
+        cs *= cs;
+        cs *= cs;
+        cs *= cs;
+        cs *= cs;
+        float geom = cs / (1.0 + planeDist * planeDist * 4.0);
+        float bil = (o.x == 1 ? fr.x : 1.0 - fr.x) * (o.y == 1 ? fr.y : 1.0 - fr.y);
+        float w = geom * (bil + 1e-3);  // a rejected bilinear tap leaves the others in charge
+        sumRv += w * texelFetch(indirectRv, q, 0).rgb;
+        sumR += w * texelFetch(indirectR, q, 0).rgb;
+        wsum += w;
+    }
     vec3 iRv = wsum > 1e-6 ? sumRv / wsum : vec3(0.0);
     vec3 iR = wsum > 1e-6 ? sumR / wsum : vec3(0.0);
     if (flags.y == 1 && params.z > 0.0) {

@@ -1,5 +1,7 @@
 #include "render/passes/indirect/IndirectLightPass.h"
 
+#include <algorithm>
+
 #include "render/Shaders.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/vpl/VplPass.h"
@@ -23,8 +25,14 @@ PassDecision IndirectLightPass::decide(const FrameContext& ctx) const {
 }
 
 void IndirectLightPass::resize(const FrameContext& ctx) {
-    rv_ = gl::Texture::create2D("indirect L_rv", ctx.canvasWidth(), ctx.canvasHeight(), GL_RGBA16F);
-    r_ = gl::Texture::create2D("indirect L_r", ctx.canvasWidth(), ctx.canvasHeight(), GL_RGBA16F);
+    // Gather resolution: canvas / indirectScale, rounded up to a multiple of K so that the
+    // deinterleaved layout (K x K tiles, tile g holding the pixels of VPL group g) is exact.
+    const int s = ctx.options.indirectScale, k = std::max(1, ctx.options.interleave);
+    const int lowW = (ctx.canvasWidth() + s - 1) / s, lowH = (ctx.canvasHeight() + s - 1) / s;
+    const int w = (lowW + k - 1) / k * k, h = (lowH + k - 1) / k * k;
+    if (w == rv_.width() && h == rv_.height()) return;
+    rv_ = gl::Texture::create2D("indirect L_rv (deinterleaved)", w, h, GL_RGBA16F);
+    r_ = gl::Texture::create2D("indirect L_r (deinterleaved)", w, h, GL_RGBA16F);
     rv_.setFilter(GL_NEAREST, GL_NEAREST);
     r_.setFilter(GL_NEAREST, GL_NEAREST);
     fbo_ = gl::Framebuffer("indirect fbo");
@@ -35,7 +43,6 @@ void IndirectLightPass::resize(const FrameContext& ctx) {
 
 void IndirectLightPass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glViewport(0, 0, rv_.width(), rv_.height());
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     program_.use();
@@ -48,7 +55,19 @@ void IndirectLightPass::execute(FrameContext& ctx) {
     glBindTextureUnit(3, ctx.texture(Resource::ImperfectShadowMaps).id());
     glBindTextureUnit(4, ctx.texture(Resource::ImperfectShadowMapsReal).id());
     ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    // One draw per VPL group into its tile: the group is uniform over the draw, so every pixel
+    // walks the same VPL list (uniform loads; on llvmpipe divergent SSBO gathers are far slower).
+    const int k = std::max(1, ctx.options.interleave);
+    const int tw = rv_.width() / k, th = rv_.height() / k;
+    const GLint locGroup = program_.uniformLocation("group");
+    const GLint locTile = program_.uniformLocation("tileOrigin");
+    for (int gy = 0; gy < k; ++gy)
+        for (int gx = 0; gx < k; ++gx) {
+            glViewport(gx * tw, gy * th, tw, th);
+            glUniform2i(locGroup, gx, gy);
+            glUniform2i(locTile, gx * tw, gy * th);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
     ctx.publish(Resource::IndirectRv, &rv_);
     ctx.publish(Resource::IndirectR, &r_);
 }

@@ -1,8 +1,10 @@
 #version 450 core
 #include "common.glsl"
-// One indirect bounce from the VPLs with interleaved sampling (Keller & Heidrich 2001): pixel
-// (x, y) gathers only VPLs i = g, g + K^2, ... with g = (x mod K) + K (y mod K), scaled by K^2;
-// the geometry-aware filter then recombines the K x K groups. Visibility from the imperfect
+// One indirect bounce from the VPLs with interleaved sampling (Keller & Heidrich 2001): gather
+// pixel q = (x, y) sums only VPLs i = g, g + K^2, ... with g = (x mod K) + K (y mod K), scaled by
+// K^2; the geometry-aware filter then recombines the K x K groups. The output is DEINTERLEAVED:
+// tile (x mod K, y mod K) of the target holds group g's pixels at (x / K, y / K), and each tile is
+// one draw with `group` uniform. Visibility from the imperfect
 // shadow maps. Routing (DESIGN.md): a VPL at q lights p in L_rv always; in L_r only if the light,
 // q and p are all real, with visibility against real points only. Diffuse receivers.
 in vec2 uv;
@@ -12,7 +14,9 @@ layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gAlbedo;
 layout(binding = 3) uniform usampler2D ismAll;
 layout(binding = 4) uniform usampler2D ismReal;
-uniform int scale;  // this pass runs at 1/scale resolution: pixel px shades G-buffer pixel px*scale
+uniform int scale;  // gather pixel q shades G-buffer pixel q * scale
+uniform ivec2 group;       // (x mod K, y mod K) of this draw's pixels
+uniform ivec2 tileOrigin;  // where this group's tile starts in the target
 layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;
 
@@ -25,8 +29,9 @@ float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    ivec2 g = min(px * scale, textureSize(gPosition, 0) - 1);
+    int K = max(counts.z, 1);
+    ivec2 q = (ivec2(gl_FragCoord.xy) - tileOrigin) * K + group;  // interleaved gather pixel
+    ivec2 g = min(q * scale, textureSize(gPosition, 0) - 1);
     vec4 P = texelFetch(gPosition, g, 0);
     int origin = int(P.w + 0.5);
     outRv = vec4(0.0);
@@ -37,11 +42,10 @@ void main() {
     vec3 n = texelFetch(gNormal, g, 0).xyz;
     vec4 A = texelFetch(gAlbedo, g, 0);
     vec3 diffuse = A.rgb * (1.0 - A.a) / PI;
-    int K = max(counts.z, 1);
-    int group = (px.x % K) + K * (px.y % K);
+    int first = group.x + K * group.y;
     float clamp2 = params.x * params.x;
     vec3 rv = vec3(0.0), r = vec3(0.0);
-    for (int i = group; i < counts.y; i += K * K) {
+    for (int i = first; i < counts.y; i += K * K) {
         GpuVpl V = vpls[i];
         if (V.normal.w < 0.5) continue;
         vec3 d = p - V.positionReal.xyz;
@@ -61,7 +65,7 @@ void main() {
             if (visReal) r += c;
         }
     }
-    float scale = float(K * K);
-    outRv = vec4(allFinite(rv) ? rv * scale : vec3(0.0), 1.0);
-    outR = vec4(allFinite(r) ? r * scale : vec3(0.0), 1.0);
+    float groupScale = float(K * K);
+    outRv = vec4(allFinite(rv) ? rv * groupScale : vec3(0.0), 1.0);
+    outR = vec4(allFinite(r) ? r * groupScale : vec3(0.0), 1.0);
 }
