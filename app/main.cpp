@@ -23,8 +23,9 @@ int& commandExitCode() {
 
 int main(int argc, char** argv) {
     using namespace mirage;
-    CLI::App cli{"mirage: virtual glass, mirrors and translucent objects composited into real "
-                 "camera footage"};
+    CLI::App cli{
+        "mirage: virtual glass, mirrors and translucent objects composited into real "
+        "camera footage"};
     cli.set_version_flag("--version", std::string("mirage ") + MIRAGE_VERSION);
     std::string logLevel = "info";
     cli.add_option("--log-level", logLevel, "trace, debug, info, warn, error, off")

@@ -26,12 +26,11 @@ private:
     std::string file_;
 };
 
-[[noreturn]] void checkFailed(const char* expr, const std::string& msg,
-                              std::source_location where);
+[[noreturn]] void checkFailed(const char* expr, const std::string& msg, std::source_location where);
 
 }  // namespace mirage
 
-#define MR_CHECK(cond, msg)                                                             \
-    do {                                                                                \
+#define MR_CHECK(cond, msg)                                                                \
+    do {                                                                                   \
         if (!(cond)) ::mirage::checkFailed(#cond, (msg), std::source_location::current()); \
     } while (0)

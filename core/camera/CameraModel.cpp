@@ -83,8 +83,9 @@ std::optional<glm::dvec3> CameraIntrinsics::unproject(const glm::dvec2& pixel) c
             const double f =
                 theta * (1 + t2 * (coeff(0) + t2 * (coeff(1) + t2 * (coeff(2) + t2 * coeff(3))))) -
                 thetaD;
-            const double df = 1 + t2 * (3 * coeff(0) +
-                                        t2 * (5 * coeff(1) + t2 * (7 * coeff(2) + t2 * 9 * coeff(3))));
+            const double df =
+                1 +
+                t2 * (3 * coeff(0) + t2 * (5 * coeff(1) + t2 * (7 * coeff(2) + t2 * 9 * coeff(3))));
             if (std::abs(df) < 1e-12) break;
             const double step = f / df;
             theta -= step;

@@ -41,7 +41,8 @@ struct CameraIntrinsics {
     glm::dvec2 distortNormalized(const glm::dvec2& xy) const;
 
     // Largest angle off the optical axis (radians) the model is trusted at: 90 deg for fish-eye
-    // (the polynomial is only monotonic over the calibrated range), or the corner angle for pinhole.
+    // (the polynomial is only monotonic over the calibrated range), or the corner angle for
+    // pinhole.
     double maxFisheyeTheta = 1.5707963267948966;
 
     double coeff(size_t i) const { return i < distortion.size() ? distortion[i] : 0.0; }

@@ -36,8 +36,8 @@ void requireVersion45(const char* how) {
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
     if (major * 10 + minor < 45)
-        throw Error(std::string("OpenGL 4.5 core is required but the ") + how +
-                    " context is " + std::to_string(major) + "." + std::to_string(minor) +
+        throw Error(std::string("OpenGL 4.5 core is required but the ") + how + " context is " +
+                    std::to_string(major) + "." + std::to_string(minor) +
                     " (install Mesa 22+: apt-get install libgl1-mesa-dri libegl-mesa0)");
 }
 
@@ -75,8 +75,8 @@ Context Context::headless(const ContextOptions& opts) {
         throw Error(
             "headless OpenGL needs EGL's surfaceless platform (EGL_MESA_platform_surfaceless); "
             "install Mesa's EGL: apt-get install libegl-mesa0 libgl1-mesa-dri");
-    impl->display = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY,
-                                             nullptr);
+    impl->display =
+        eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
     EGLint major = 0, minor = 0;
     if (impl->display == EGL_NO_DISPLAY || !eglInitialize(impl->display, &major, &minor))
         throw Error("could not initialise an EGL surfaceless display (EGL error 0x" +
@@ -116,14 +116,14 @@ bool Context::displayAvailable() {
 
 Context Context::window(const ContextOptions& opts) {
     std::call_once(glfwInitOnce, [] {
-        glfwSetErrorCallback([](int code, const char* desc) {
-            spdlog::warn("GLFW error {}: {}", code, desc);
-        });
+        glfwSetErrorCallback(
+            [](int code, const char* desc) { spdlog::warn("GLFW error {}: {}", code, desc); });
         glfwReady = glfwInit() == GLFW_TRUE;
     });
     if (!glfwReady)
-        throw Error("could not open a window: GLFW failed to initialise (no display?); "
-                    "run headless instead");
+        throw Error(
+            "could not open a window: GLFW failed to initialise (no display?); "
+            "run headless instead");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -133,8 +133,8 @@ Context Context::window(const ContextOptions& opts) {
     impl->kind = Kind::Window;
     impl->window = glfwCreateWindow(opts.width, opts.height, opts.title.c_str(), nullptr, nullptr);
     if (!impl->window)
-        throw Error("could not create a 4.5 core OpenGL window (" +
-                    std::to_string(opts.width) + "x" + std::to_string(opts.height) + ")");
+        throw Error("could not create a 4.5 core OpenGL window (" + std::to_string(opts.width) +
+                    "x" + std::to_string(opts.height) + ")");
     Context ctx(std::move(impl));
     ctx.makeCurrent();
     glfwSwapInterval(0);
@@ -154,7 +154,9 @@ Context Context::automatic(const ContextOptions& opts, bool preferWindow) {
     return headless(opts);
 }
 
-Context::Kind Context::kind() const { return impl_->kind; }
+Context::Kind Context::kind() const {
+    return impl_->kind;
+}
 
 void Context::makeCurrent() {
     if (impl_->window) {
@@ -164,7 +166,9 @@ void Context::makeCurrent() {
     }
 }
 
-GLFWwindow* Context::glfwWindow() const { return impl_->window; }
+GLFWwindow* Context::glfwWindow() const {
+    return impl_->window;
+}
 bool Context::shouldClose() const {
     return impl_->window && glfwWindowShouldClose(impl_->window);
 }

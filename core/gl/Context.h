@@ -36,10 +36,10 @@ public:
 
     Kind kind() const;
     void makeCurrent();
-    GLFWwindow* glfwWindow() const;  // nullptr when headless
-    bool shouldClose() const;        // window closed by the user (always false headless)
-    void swapBuffers();              // no-op headless
-    void pollEvents();               // no-op headless
+    GLFWwindow* glfwWindow() const;    // nullptr when headless
+    bool shouldClose() const;          // window closed by the user (always false headless)
+    void swapBuffers();                // no-op headless
+    void pollEvents();                 // no-op headless
     std::string rendererName() const;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     std::string versionString() const;
 

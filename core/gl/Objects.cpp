@@ -5,14 +5,30 @@
 namespace mirage::gl {
 
 namespace detail {
-void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
-void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
-void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
-void deleteRenderbuffer(GLuint id) { glDeleteRenderbuffers(1, &id); }
-void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
-void deleteProgram(GLuint id) { glDeleteProgram(id); }
-void deleteQuery(GLuint id) { glDeleteQueries(1, &id); }
-void deleteSampler(GLuint id) { glDeleteSamplers(1, &id); }
+void deleteBuffer(GLuint id) {
+    glDeleteBuffers(1, &id);
+}
+void deleteTexture(GLuint id) {
+    glDeleteTextures(1, &id);
+}
+void deleteFramebuffer(GLuint id) {
+    glDeleteFramebuffers(1, &id);
+}
+void deleteRenderbuffer(GLuint id) {
+    glDeleteRenderbuffers(1, &id);
+}
+void deleteVertexArray(GLuint id) {
+    glDeleteVertexArrays(1, &id);
+}
+void deleteProgram(GLuint id) {
+    glDeleteProgram(id);
+}
+void deleteQuery(GLuint id) {
+    glDeleteQueries(1, &id);
+}
+void deleteSampler(GLuint id) {
+    glDeleteSamplers(1, &id);
+}
 }  // namespace detail
 
 void label(GLenum identifier, GLuint id, std::string_view text) {
@@ -147,7 +163,9 @@ void Framebuffer::finalize(int colorCount) {
                     std::to_string(status) + ")");
 }
 
-void Framebuffer::bind() const { glBindFramebuffer(GL_FRAMEBUFFER, id()); }
+void Framebuffer::bind() const {
+    glBindFramebuffer(GL_FRAMEBUFFER, id());
+}
 
 // ---- VertexArray / Sampler -------------------------------------------------------------------
 VertexArray::VertexArray(std::string_view lbl) {
@@ -156,7 +174,9 @@ VertexArray::VertexArray(std::string_view lbl) {
     h_ = Handle<detail::deleteVertexArray>(id);
     label(GL_VERTEX_ARRAY, id, lbl);
 }
-void VertexArray::bind() const { glBindVertexArray(id()); }
+void VertexArray::bind() const {
+    glBindVertexArray(id());
+}
 
 Sampler::Sampler(std::string_view lbl, GLenum minFilter, GLenum magFilter, GLenum wrap) {
     GLuint id = 0;
@@ -225,7 +245,9 @@ Program::Program(std::string_view lbl, const std::vector<Stage>& stages, std::st
     label(GL_PROGRAM, prog, lbl);
 }
 
-void Program::use() const { glUseProgram(id()); }
+void Program::use() const {
+    glUseProgram(id());
+}
 GLint Program::uniformLocation(const char* name) const {
     return glGetUniformLocation(id(), name);
 }
@@ -237,8 +259,12 @@ TimerQuery::TimerQuery(std::string_view lbl) {
     h_ = Handle<detail::deleteQuery>(id);
     label(GL_QUERY, id, lbl);
 }
-void TimerQuery::begin() { glBeginQuery(GL_TIME_ELAPSED, h_.id()); }
-void TimerQuery::end() { glEndQuery(GL_TIME_ELAPSED); }
+void TimerQuery::begin() {
+    glBeginQuery(GL_TIME_ELAPSED, h_.id());
+}
+void TimerQuery::end() {
+    glEndQuery(GL_TIME_ELAPSED);
+}
 double TimerQuery::elapsedMs() const {
     GLuint64 ns = 0;
     glGetQueryObjectui64v(h_.id(), GL_QUERY_RESULT, &ns);

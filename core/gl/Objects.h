@@ -145,8 +145,8 @@ private:
 class Program {
 public:
     struct Stage {
-        GLenum type;             // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER, ...
-        std::string name;        // for messages, e.g. "passes/gbuffer/gbuffer.frag"
+        GLenum type;       // GL_VERTEX_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER, ...
+        std::string name;  // for messages, e.g. "passes/gbuffer/gbuffer.frag"
         std::string_view source;
     };
     Program() = default;

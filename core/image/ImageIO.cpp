@@ -39,7 +39,8 @@ void atomicWrite(const std::filesystem::path& path, const cv::Mat& img,
     if (!ok) throw FileError(path.string(), "cannot write image (is the folder writable?)");
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);
-    if (ec) throw FileError(path.string(), "cannot move finished image into place: " + ec.message());
+    if (ec)
+        throw FileError(path.string(), "cannot move finished image into place: " + ec.message());
 }
 }  // namespace
 
@@ -120,7 +121,8 @@ cv::Mat readLinearRgb(const std::filesystem::path& path) {
         return out;
     }
     if (img.depth() != CV_8U)
-        throw FileError(path.string(), "unsupported pixel depth (use 8/16-bit PNG, EXR, PFM or HDR)");
+        throw FileError(path.string(),
+                        "unsupported pixel depth (use 8/16-bit PNG, EXR, PFM or HDR)");
     return srgbBgr8ToLinearRgb(img);
 }
 

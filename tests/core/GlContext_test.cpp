@@ -64,7 +64,8 @@ TEST(GlContext, HeadlessRendersAndReadsBack) {
 TEST(GlContext, BadShaderGivesErrorNamingIt) {
     Context ctx = Context::headless();
     try {
-        Program p("broken", {{GL_FRAGMENT_SHADER, "broken.frag", "#version 450 core\nvoid main() { x = 1; }"}});
+        Program p("broken", {{GL_FRAGMENT_SHADER, "broken.frag",
+                              "#version 450 core\nvoid main() { x = 1; }"}});
         FAIL() << "expected a compile error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("broken.frag"), std::string::npos) << e.what();

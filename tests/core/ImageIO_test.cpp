@@ -10,7 +10,8 @@ namespace {
 cv::Mat gradient() {
     cv::Mat m(16, 24, CV_32FC3);
     for (int y = 0; y < m.rows; ++y)
-        for (int x = 0; x < m.cols; ++x) m.at<cv::Vec3f>(y, x) = {x / 23.0f * 4.0f, y / 15.0f, 0.25f};
+        for (int x = 0; x < m.cols; ++x)
+            m.at<cv::Vec3f>(y, x) = {x / 23.0f * 4.0f, y / 15.0f, 0.25f};
     return m;
 }
 

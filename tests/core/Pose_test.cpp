@@ -10,8 +10,8 @@ namespace {
 TEST(Pose, ComposeAndInverse) {
     Pose a = Pose::fromMatrix(glm::rotate(glm::translate(glm::dmat4(1), {1, 2, 3}), 0.7,
                                           glm::normalize(glm::dvec3(1, 1, 0))));
-    Pose b = Pose::fromMatrix(glm::rotate(glm::translate(glm::dmat4(1), {-0.5, 0, 2}), -1.2,
-                                          glm::dvec3(0, 0, 1)));
+    Pose b = Pose::fromMatrix(
+        glm::rotate(glm::translate(glm::dmat4(1), {-0.5, 0, 2}), -1.2, glm::dvec3(0, 0, 1)));
     glm::dvec3 p(0.3, -0.2, 5.0);
     // T_a_c = T_a_b * T_b_c applied to p equals applying them in turn.
     glm::dvec3 viaCompose = (a * b) * p, inTurn = a * (b * p);

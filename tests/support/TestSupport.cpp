@@ -1,17 +1,21 @@
 #include "tests/support/TestSupport.h"
 
+#include <sys/wait.h>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <sys/wait.h>
 
 #include <opencv2/imgproc.hpp>
 
 namespace mirage::test {
 
-std::filesystem::path dataDir() { return MIRAGE_DATA_DIR; }
-std::filesystem::path testDataDir() { return MIRAGE_TEST_DATA_DIR; }
+std::filesystem::path dataDir() {
+    return MIRAGE_DATA_DIR;
+}
+std::filesystem::path testDataDir() {
+    return MIRAGE_TEST_DATA_DIR;
+}
 
 std::filesystem::path outputDir(const std::string& name) {
     auto p = std::filesystem::path(MIRAGE_TEST_OUTPUT_DIR) / name;
@@ -44,7 +48,8 @@ double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask
     };
     cv::Mat muA = blur(fa), muB = blur(fb);
     cv::Mat muA2 = muA.mul(muA), muB2 = muB.mul(muB), muAB = muA.mul(muB);
-    cv::Mat sA = blur(fa.mul(fa)) - muA2, sB = blur(fb.mul(fb)) - muB2, sAB = blur(fa.mul(fb)) - muAB;
+    cv::Mat sA = blur(fa.mul(fa)) - muA2, sB = blur(fb.mul(fb)) - muB2,
+            sAB = blur(fa.mul(fb)) - muAB;
     cv::Mat num = (2 * muAB + c1).mul(2 * sAB + c2);
     cv::Mat den = (muA2 + muB2 + c1).mul(sA + sB + c2);
     cv::Mat map;
