@@ -282,7 +282,11 @@ void saveCalibration(const std::filesystem::path& path, const CameraCalibration&
     fs << "fisheye_model" << int(in.model == DistortionModel::KannalaBrandt);
     const cv::Mat k = (cv::Mat_<double>(3, 3) << in.fx, 0, in.cx, 0, in.fy, in.cy, 0, 0, 1);
     fs << "camera_matrix" << k;
-    fs << "distortion_coefficients" << column(in.distortion);
+    // No coefficients means no distortion: write the model's full set of zeros, because an empty
+    // matrix is written as a 0x1 node that readers (ours included) reject.
+    std::vector<double> dist = in.distortion;
+    if (dist.empty()) dist.assign(in.model == DistortionModel::KannalaBrandt ? 4 : 5, 0.0);
+    fs << "distortion_coefficients" << column(dist);
     if (c.avgReprojectionError >= 0) fs << "avg_reprojection_error" << c.avgReprojectionError;
     if (!c.perViewErrors.empty()) fs << "per_view_reprojection_errors" << column(c.perViewErrors);
     // mirage's additions (docs/formats.md).

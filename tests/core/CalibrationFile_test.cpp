@@ -28,6 +28,25 @@ std::string loadError(const std::filesystem::path& p) {
     return {};
 }
 
+TEST(CalibrationFile, DistortionFreeCameraRoundTrips) {
+    // An empty coefficient list means "no distortion"; the file written must load again.
+    for (auto model : {DistortionModel::BrownConrady, DistortionModel::KannalaBrandt}) {
+        CameraCalibration c;
+        c.intrinsics.width = 320;
+        c.intrinsics.height = 240;
+        c.intrinsics.fx = c.intrinsics.fy = 300;
+        c.intrinsics.cx = 160;
+        c.intrinsics.cy = 120;
+        c.intrinsics.model = model;
+        const auto path = test::outputDir("calib_no_distortion") / "cam.yaml";
+        saveCalibration(path, c);
+        const CameraCalibration back = loadCalibration(path);
+        EXPECT_EQ(back.intrinsics.model, model);
+        for (double d : back.intrinsics.distortion) EXPECT_EQ(d, 0.0);
+        EXPECT_DOUBLE_EQ(back.intrinsics.fx, 300.0);
+    }
+}
+
 TEST(CalibrationFile, ReadsOpenCvSampleKeys) {
     const CameraCalibration c = loadCalibration(calibDir() / "opencv_sample_style.yaml");
     EXPECT_EQ(c.intrinsics.width, 640);
