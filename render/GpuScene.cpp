@@ -119,6 +119,7 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         int texture;
         glm::vec3 center;
         float radius;
+        bool specular;
     };
     std::vector<std::vector<Range>> meshRanges(scene.meshes.size());
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
@@ -130,8 +131,11 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
                     p.material + 1,
                     -1,
                     glm::vec3(0.0f),
-                    0.0f};
+                    0.0f,
+                    false};
             const Material& mat = scene.material(p.material);
+            // Mirror: metallic ~1 with low roughness; glass: any transmission (rough glass too).
+            r.specular = mat.isMirror() || mat.isTransmissive();
             const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
             if (mat.baseColorTexture.valid() &&
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
@@ -194,6 +198,7 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
             d.material = r.material;
             d.baseColorTexture = r.texture;
             d.origin = inst.origin;
+            d.specular = r.specular;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
             d.indexCount = r.count;
@@ -201,6 +206,7 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
             d.bounds.radius = r.radius * scale;
             lo = glm::min(lo, d.bounds.center - glm::vec3(d.bounds.radius));
             hi = glm::max(hi, d.bounds.center + glm::vec3(d.bounds.radius));
+            if (d.specular) specularDraws_.push_back(int(draws_.size()));
             draws_.push_back(d);
         }
     }

@@ -28,6 +28,9 @@ struct DrawItem {
     int material = 0;              // index into the material buffer (0 = glTF default)
     int baseColorTexture = -1;     // index into the uploaded textures, -1 = none
     Origin origin = Origin::Virtual;
+    // A specular object (mirror or glass): its pixels are shaded from the reflected / refracted
+    // ray hits (GBuf_refl / GBuf_refr, Knecht 2013 Sec. 4.1), not from its own surface.
+    bool specular = false;
     GLint baseVertex = 0;
     GLuint firstIndex = 0;
     GLsizei indexCount = 0;
@@ -55,6 +58,8 @@ public:
 
     const std::vector<DrawItem>& draws() const { return draws_; }
     const std::vector<SceneLight>& lights() const { return lights_; }
+    // Indices into draws() of the specular (mirror / glass) items, in draw order.
+    const std::vector<int>& specularDraws() const { return specularDraws_; }
     const BoundingSphere& bounds() const { return bounds_; }
     bool hasVirtual() const;
     bool hasEnvironment() const { return hasEnvironment_; }
@@ -81,6 +86,7 @@ public:
 private:
     std::vector<DrawItem> draws_;
     std::vector<SceneLight> lights_;
+    std::vector<int> specularDraws_;
     BoundingSphere bounds_;
     gl::Buffer vertices_, indices_, materials_, points_;
     gl::VertexArray vao_;
