@@ -34,6 +34,20 @@ const char* resourceName(Resource r) {
             return "LRv";
         case Resource::LR:
             return "LR";
+        case Resource::BackFaces:
+            return "BackFaces";
+        case Resource::RealSurfaces:
+            return "RealSurfaces";
+        case Resource::ReflectionGBuffer:
+            return "ReflectionGBuffer";
+        case Resource::RefractionGBuffer:
+            return "RefractionGBuffer";
+        case Resource::SpecularRv:
+            return "SpecularRv";
+        case Resource::SpecularR:
+            return "SpecularR";
+        case Resource::Lenv:
+            return "Lenv";
         case Resource::Composite:
             return "Composite";
     }

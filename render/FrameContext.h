@@ -31,8 +31,16 @@ enum class Resource {
     IndirectRv,
     IndirectR,  // interleaved VPL gather, unfiltered (canvas size)
     LRv,
-    LR,         // the two GI solutions, filtered and temporally smoothed
-    Composite,  // final image (camera image size): linear RGBA32F + sRGB8
+    LR,  // the two GI solutions, filtered and temporally smoothed
+    // Specular objects (issue 6, Knecht 2013 Sec. 4.1 / 5.1; docs/specular.md):
+    BackFaces,          // specular objects' back faces: world position + slot, normal (canvas)
+    RealSurfaces,       // nearest REAL surface per pixel (world position + origin), canvas size
+    ReflectionGBuffer,  // GBuf_refl: reflected-ray hits (position/origin, normal, albedo, ...)
+    RefractionGBuffer,  // GBuf_refr: two-interface refracted-ray hits (Wyman 2005)
+    SpecularRv,         // L'_rv (Eq. 3), Fresnel-weighted, canvas size
+    SpecularR,          // L'_r (Eq. 4)
+    Lenv,               // L_env: environment seen where a ray leaves the modelled scene
+    Composite,          // final image (camera image size): linear RGBA32F + sRGB8
 };
 const char* resourceName(Resource r);
 
@@ -51,6 +59,10 @@ struct RendererOptions {
     float alphaMax = 8.0f;               // cap of alpha = CI / L_r
     float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
     float nearM = 0.01f, farM = 100.0f;  // camera clip planes (metres)
+    // Specular objects (docs/specular.md).
+    int refractionMarchSteps = 16;        // back-face depth march steps of the refracted ray
+    float backProjectionEpsilon = 0.02f;  // depth validation: |d - d_gbuf| < eps * d + 0.005 m
+    bool specularVpls = true;             // light GBuf_refl / GBuf_refr hits with the VPLs too
     bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
     // glFinish around every pass so each timer query holds only its pass's work. llvmpipe defers
     // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so

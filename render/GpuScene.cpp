@@ -6,6 +6,7 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
 #include "core/Log.h"
@@ -25,6 +26,15 @@ GpuMaterial toGpu(const Material& m) {
     g.baseColor = m.baseColor;
     g.emissive = glm::vec4(m.emissive, m.roughness);
     g.params = glm::vec4(m.metallic, 0, 0, 0);
+    // KHR_materials_transmission / ior / volume. An infinite (or non-positive) attenuation
+    // distance means no absorption: stored as 0.
+    const float attDist = std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f
+                              ? m.attenuationDistance
+                              : 0.0f;
+    g.transmission = glm::vec4(std::clamp(m.transmission, 0.0f, 1.0f),
+                               std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.5f, attDist,
+                               std::max(m.thickness, 0.0f));
+    g.attenuation = glm::vec4(glm::clamp(m.attenuationColor, 0.0f, 1.0f), m.isMirror() ? 1 : 0);
     return g;
 }
 
@@ -234,6 +244,19 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
                         " lights; the real-time renderer supports at most that many");
         lights_.push_back(s);
     }
+    {
+        std::vector<GpuSpecularDraw> spec;
+        for (int di : specularDraws_) {
+            const DrawItem& d = draws_[size_t(di)];
+            spec.push_back(
+                {glm::ivec4(d.material, d.origin == Origin::Real ? kOriginReal : kOriginVirtual, di,
+                            0),
+                 glm::vec4(d.bounds.center, d.bounds.radius)});
+        }
+        if (spec.empty()) spec.push_back({glm::ivec4(0), glm::vec4(0.0f)});
+        specularBuffer_ =
+            gl::Buffer("specular draws", spec.size() * sizeof(GpuSpecularDraw), spec.data());
+    }
     if (!draws_.empty()) {
         bounds_.center = 0.5f * (lo + hi);
         bounds_.radius = 0.5f * glm::length(hi - lo);
@@ -294,6 +317,25 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         envSH_ =
             projectEquirectToSH(env, scene.environment.intensity, scene.environment.rotationYDeg);
         hasEnvironment_ = true;
+        // The map itself, for what reflected / refracted rays see when they leave the modelled
+        // scene (L_env, Knecht 2013 Sec. 4.1.3): linear RGB x intensity, RGBA16F, bilinear,
+        // repeating in u (longitude), clamped in v. Large maps are halved until <= 2048 wide.
+        cv::Mat m = env;
+        while (m.cols > 2048)
+            cv::resize(m, m, cv::Size(m.cols / 2, std::max(1, m.rows / 2)), 0, 0, cv::INTER_AREA);
+        cv::Mat rgba(m.rows, m.cols, CV_32FC4);
+        for (int y = 0; y < m.rows; ++y)
+            for (int x = 0; x < m.cols; ++x) {
+                cv::Vec3f c = m.at<cv::Vec3f>(y, x) * scene.environment.intensity;
+                for (int k = 0; k < 3; ++k)
+                    if (!std::isfinite(c[k]) || c[k] < 0.0f) c[k] = 0.0f;
+                rgba.at<cv::Vec4f>(y, x) = cv::Vec4f(c[0], c[1], c[2], 1.0f);
+            }
+        envMap_ = gl::Texture::create2D("environment map", m.cols, m.rows, GL_RGBA16F);
+        envMap_.upload(GL_RGBA, GL_FLOAT, rgba.data);
+        glTextureParameteri(envMap_.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+        glTextureParameteri(envMap_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        envRotationRad_ = float(scene.environment.rotationYDeg * 3.14159265358979 / 180.0);
         environmentOrigin_ = scene.environment.origin;
     } else if (scene.environment.kind == Environment::Kind::Fisheye) {
         // The fish-eye mapping lives with the tracking module; until it provides an
@@ -304,6 +346,11 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
             scene.source.string());
     }
     if (envSH_.empty()) envSH_.assign(9, glm::vec3(0.0f));
+    if (envMap_.id() == 0) {
+        envMap_ = gl::Texture::create2D("environment map (none)", 1, 1, GL_RGBA16F);
+        const float zero[4] = {0, 0, 0, 0};
+        envMap_.upload(GL_RGBA, GL_FLOAT, zero);
+    }
 }
 
 bool GpuScene::hasVirtual() const {

@@ -77,6 +77,13 @@ public:
     void drawItem(const DrawItem& d) const;
     const gl::Buffer& materialBuffer() const { return materials_; }
     const gl::Buffer& surfacePointBuffer() const { return points_; }
+    // GpuSpecularDraw per specular slot (a single zero entry when there is none).
+    const gl::Buffer& specularDrawBuffer() const { return specularBuffer_; }
+    // The environment as an equirectangular linear RGBA16F texture (intensity applied; 1x1 black
+    // without an environment). Direction l (world) -> u = 0.5 + atan2(l.x, -l.z) / 2pi after
+    // undoing environmentRotation() about +Y, v = acos(l.y) / pi from the top row.
+    const gl::Texture& environmentMap() const { return envMap_; }
+    float environmentRotation() const { return envRotationRad_; }  // radians about +Y
 
     // Radiance SH9 of an equirectangular linear RGB float image (CV_32FC3, top row = +Y up,
     // u = 0.5 looks down -Z, as in glTF/three.js). Exposed for tests.
@@ -88,7 +95,9 @@ private:
     std::vector<SceneLight> lights_;
     std::vector<int> specularDraws_;
     BoundingSphere bounds_;
-    gl::Buffer vertices_, indices_, materials_, points_;
+    gl::Buffer vertices_, indices_, materials_, points_, specularBuffer_;
+    gl::Texture envMap_;
+    float envRotationRad_ = 0.0f;
     gl::VertexArray vao_;
     std::vector<gl::Texture> textures_;  // scene.textures: sRGB8_ALPHA8 or RGBA8, mipmapped
     gl::Texture white_;

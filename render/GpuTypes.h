@@ -14,6 +14,10 @@ inline constexpr int kOriginNone = 0, kOriginReal = 1, kOriginVirtual = 2;
 // Uniform/storage binding points shared by every pass (named, never magic numbers in passes).
 inline constexpr unsigned kBindingFrame = 0, kBindingLights = 1, kBindingVpls = 2,
                           kBindingMaterials = 3, kBindingIsmPoints = 4;
+// Specular passes (issue 6): the specular draw table (SSBO) and the texture units they use for
+// the environment map. Units 16..23 and buffer bindings 6..7 belong to the impostor tracer.
+inline constexpr unsigned kBindingSpecularDraws = 5;
+inline constexpr unsigned kUnitEnvironmentMap = 15;
 
 struct alignas(16) GpuLight {
     glm::mat4 viewProj[6];
@@ -46,8 +50,20 @@ static_assert(sizeof(GpuVpl) == 64);
 
 struct GpuMaterial {
     glm::vec4 baseColor, emissive, params;
+    // x = transmission (0..1), y = ior, z = attenuation distance (metres, 0 = no absorption),
+    // w = thickness (mesh units; informational, the real-time refraction measures the distance)
+    glm::vec4 transmission;
+    glm::vec4 attenuation;  // rgb = linear attenuation colour (Beer-Lambert), a = 1 if mirror
 };
-static_assert(sizeof(GpuMaterial) == 48);
+static_assert(sizeof(GpuMaterial) == 80);
+
+// One specular (mirror / glass) draw item, indexed by its slot in GpuScene::specularDraws()
+// (std430, binding kBindingSpecularDraws).
+struct GpuSpecularDraw {
+    glm::ivec4 info;   // x = material index, y = ORIGIN_REAL/VIRTUAL, z = draw index, w unused
+    glm::vec4 bounds;  // world bounding sphere: xyz centre, w radius (metres)
+};
+static_assert(sizeof(GpuSpecularDraw) == 32);
 
 // A surface sample for imperfect shadow maps (std430, binding kBindingIsmPoints).
 struct GpuSurfacePoint {

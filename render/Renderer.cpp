@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
+#include "render/passes/backface/BackFacePass.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
@@ -17,6 +18,8 @@
 #include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
 #include "render/passes/shadow/ShadowPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "render/passes/vpl/VplPass.h"
 
 namespace mirage::render {
@@ -82,6 +85,11 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
         throw Error("shadow map size must be 16..4096");
     if (options_.ismTileSize < 8 || options_.ismTileSize > 256)
         throw Error("ISM tile size must be 8..256");
+    if (options_.refractionMarchSteps < 2 || options_.refractionMarchSteps > 128)
+        throw Error("refractionMarchSteps must be 2..128, got " +
+                    std::to_string(options_.refractionMarchSteps));
+    if (!(options_.backProjectionEpsilon > 0.0f) || options_.backProjectionEpsilon > 1.0f)
+        throw Error("backProjectionEpsilon must be in (0, 1] (relative depth tolerance)");
     scene_ = std::make_unique<GpuScene>(scene, 16384);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
@@ -93,7 +101,11 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     auto direct = std::make_unique<DirectLightPass>(*gbuffer);
     auto indirect = std::make_unique<IndirectLightPass>(*gbuffer, *vpl);
     auto filter = std::make_unique<GiFilterPass>(*gbuffer);
+    auto backface = std::make_unique<BackFacePass>(*gbuffer);
+    auto specGbuf = std::make_unique<SpecularGBufferPass>(*gbuffer, *backface);
+    auto specLight = std::make_unique<SpecularLightPass>(*gbuffer, *specGbuf, *vpl);
     auto composite = std::make_unique<CompositePass>(*gbuffer);
+    composite->setSpecular(specGbuf.get(), specLight.get(), backface.get());
     composite_ = composite.get();
     passes_.push_back(std::move(gbuffer));
     passes_.push_back(std::move(shadow));
@@ -102,6 +114,9 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     passes_.push_back(std::move(direct));
     passes_.push_back(std::move(indirect));
     passes_.push_back(std::move(filter));
+    passes_.push_back(std::move(backface));   // specular objects (issue 6): back faces + real
+    passes_.push_back(std::move(specGbuf));   // surfaces, GBuf_refl / GBuf_refr, and their
+    passes_.push_back(std::move(specLight));  // lighting into L'_rv, L'_r, L_env
     passes_.push_back(std::move(composite));
     for (auto& p : passes_) timers_.emplace_back(std::string("timer ") + p->name());
     // Prime every query once: on llvmpipe the very first GL_TIME_ELAPSED result of a process can
@@ -281,7 +296,8 @@ void Renderer::planFrame(const FrameInput& input) {
     f.params = glm::vec4(options_.vplDistanceClamp, options_.shadowBias * 0.1f,
                          options_.temporalBlend, float(options_.ismPointsPerVpl));
     for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);
-    f.exposure = glm::vec4(options_.exposure, options_.alphaMax, options_.alphaFadeLr, 0.0f);
+    f.exposure = glm::vec4(options_.exposure, options_.alphaMax, options_.alphaFadeLr,
+                           s.environmentRotation());
     c.frameUbo.upload(&f, sizeof(GpuFrame));
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
     prevViewProj_ = viewProj;

@@ -39,7 +39,8 @@ layout(std140, binding = 0) uniform FrameBlock {
                            // w = ISM points per VPL
     vec4 envSH[9];         // environment irradiance SH (rgb), already scaled by intensity
     vec4 exposure;         // x = exposure multiplier for rendered radiance, y = alpha max,
-                           // z = L_r threshold below which alpha fades to 1, w unused
+                           // z = L_r threshold below which alpha fades to 1, w = environment
+                           // map rotation about +Y (radians, rotation_y_deg of the scene)
 };
 
 layout(std140, binding = 1) uniform LightBlock { GpuLight lights[MAX_LIGHTS]; };
@@ -63,6 +64,16 @@ struct GpuMaterial {
     vec4 baseColor;   // linear RGBA
     vec4 emissive;    // rgb linear emitted radiance; w = roughness
     vec4 params;      // x = metallic
+    vec4 transmission;  // x = transmission (0..1), y = ior, z = attenuation distance (m, 0 =
+                        // none), w = thickness (mesh units, informational)
+    vec4 attenuation;   // rgb = linear attenuation colour, a = 1 for a perfect mirror
+};
+
+// Specular draw table (std430 SSBO, binding 5), indexed by specular slot (GpuScene::
+// specularDraws() order). The G-buffer stores slot + 1 in gEmissive.a (0 = not specular).
+struct GpuSpecularDraw {
+    ivec4 info;   // x = material index, y = ORIGIN_REAL / ORIGIN_VIRTUAL, z = draw index
+    vec4 bounds;  // world bounding sphere: xyz centre, w radius (metres)
 };
 
 // glTF KHR_lights_punctual spot cone and range window (the spec's recommended falloff).

@@ -1,7 +1,10 @@
 #include "render/passes/composite/CompositePass.h"
 
 #include "render/Shaders.h"
+#include "render/passes/backface/BackFacePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 
 namespace mirage::render {
 
@@ -10,7 +13,10 @@ CompositePass::CompositePass(const GBufferPass& gbuffer)
       program_("composite",
                {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                 {GL_FRAGMENT_SHADER, "passes/composite/composite.frag",
-                 shaders::source("passes/composite/composite.frag")}}) {}
+                 shaders::source("passes/composite/composite.frag")}}) {
+    locHasSpecular_ = program_.uniformLocation("hasSpecular");
+    locEpsilon_ = program_.uniformLocation("depthEpsilon");
+}
 
 PassDecision CompositePass::decide(const FrameContext&) const {
     return {true, "always: the output image"};
@@ -24,6 +30,19 @@ void CompositePass::resize(const FrameContext& ctx) {
     remap_ = gl::Texture::create2D("lens remap", w, h, GL_RG32F);
     remap_.setFilter(GL_NEAREST, GL_NEAREST);
     remap_.upload(GL_RG, GL_FLOAT, p.remap.data());
+    {
+        const int cw = p.canvasWidth, ch = p.canvasHeight;
+        std::vector<glm::vec2> table(size_t(cw) * size_t(ch), glm::vec2(-1e4f));
+        for (int y = 0; y < ch; ++y)
+            for (int x = 0; x < cw; ++x) {
+                const glm::dvec3 ray((x - p.canvasCx) / p.camera.fx, (y - p.canvasCy) / p.camera.fy,
+                                     1.0);
+                if (auto q = p.camera.project(ray)) table[size_t(y) * cw + x] = glm::vec2(*q);
+            }
+        canvasToCamera_ = gl::Texture::create2D("canvas to camera", cw, ch, GL_RG32F);
+        canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
+        canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
+    }
     fbo_ = gl::Framebuffer("composite fbo");
     fbo_.attachColor(0, linear_);
     fbo_.attachColor(1, srgb_);
@@ -50,6 +69,25 @@ void CompositePass::execute(FrameContext& ctx) {
     glBindTextureUnit(
         3, ctx.has(Resource::GBuffer) ? gbuffer_.position().id() : ctx.blackTexture().id());
     glBindTextureUnit(4, remap_.id());
+    const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
+                          ctx.has(Resource::RealSurfaces);
+    glUniform1i(locHasSpecular_, specular ? 1 : 0);
+    glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
+    if (specular) {
+        glBindTextureUnit(5, gbuffer_.emissive().id());
+        glBindTextureUnit(6, specHits_->reflection().position.id());
+        glBindTextureUnit(7, specHits_->refraction().position.id());
+        glBindTextureUnit(8, specHits_->reflection().weight.id());
+        glBindTextureUnit(9, specHits_->refraction().weight.id());
+        glBindTextureUnit(10, specLight_->rv().id());
+        glBindTextureUnit(11, specLight_->r().id());
+        glBindTextureUnit(12, specLight_->rReflection().id());
+        glBindTextureUnit(13, specLight_->env().id());
+        glBindTextureUnit(14, ctx.texture(Resource::RealSurfaces).id());
+        glBindTextureUnit(15, canvasToCamera_.id());
+    } else {
+        for (GLuint u = 5; u <= 15; ++u) glBindTextureUnit(u, ctx.blackTexture().id());
+    }
     ctx.emptyVao.bind();
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDisable(GL_FRAMEBUFFER_SRGB);

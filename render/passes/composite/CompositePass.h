@@ -6,6 +6,9 @@
 namespace mirage::render {
 
 class GBufferPass;
+class BackFacePass;
+class SpecularGBufferPass;
+class SpecularLightPass;
 
 class CompositePass final : public RenderPass {
 public:
@@ -14,6 +17,13 @@ public:
     std::vector<Resource> reads() const override { return {Resource::CameraImage}; }
     std::vector<Resource> writes() const override { return {Resource::Composite}; }
     PassDecision decide(const FrameContext& ctx) const override;
+    // The specular passes whose outputs Eqs. 6-11 composite (pixels showing mirror / glass).
+    void setSpecular(const SpecularGBufferPass* hits, const SpecularLightPass* light,
+                     const BackFacePass* backFaces) {
+        specHits_ = hits;
+        specLight_ = light;
+        backFaces_ = backFaces;
+    }
     void resize(const FrameContext& ctx) override;
     void execute(FrameContext& ctx) override;
 
@@ -24,7 +34,14 @@ public:
 private:
     const GBufferPass& gbuffer_;
     gl::Program program_;
+    const SpecularGBufferPass* specHits_ = nullptr;
+    const SpecularLightPass* specLight_ = nullptr;
+    const BackFacePass* backFaces_ = nullptr;
     gl::Texture linear_, srgb_, remap_;
+    // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
+    // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
+    gl::Texture canvasToCamera_;
+    GLint locHasSpecular_ = -1, locEpsilon_ = -1;
     gl::Framebuffer fbo_;
 };
 

@@ -1,5 +1,6 @@
 #version 450 core
 #include "common.glsl"
+#include "passes/specular/specular.glsl"
 // Differential rendering (Knecht 2013 Eqs. 1-2), one output pixel per camera pixel:
 //   real or empty pixel:  L_final = CI + alpha * (L_rv - L_r),  alpha = CI / L_r per channel
 //   virtual pixel:        L_final = L_rv
@@ -9,14 +10,107 @@
 // fades to 1 below exposure.z (the model's own radiometry is used) and is capped at exposure.y,
 // and the result is clamped to >= 0 and finite. Lens distortion: the L buffers were rendered
 // undistorted on the canvas; `remap` gives each camera pixel's canvas position.
+//
+// Pixels showing a mirror or glass object (the G-buffer's specular slot) are composited by
+// Knecht 2013 Eqs. 6-11 instead (docs/specular.md):
+//   dL' = L'_rv - L'_r                                                        (Eq. 6)
+//   all of p, p_refl, p_refr real:  L' = CI(p) + alpha' dL',  alpha' = CI(p) / (L'_r + L_env)
+//   otherwise:                      L' = L_env + CI_bp + alpha' dL', alpha' = CI_bp / L'_r
+//                                                                     (Eqs. 7, 8, 11)
+//   CI_bp = eta1 CI_r(p_refl) + eta2 T CI_r(p_refr)                   (Eqs. 9, 10)
+// CI(x) back-projects x into the camera image; it is valid when x is inside the frustum and
+// the image and its camera distance matches the nearest REAL surface there within
+// eps * distance + 5 mm (eps = RendererOptions::backProjectionEpsilon, default 2 %): the video
+// only shows real surfaces, so an occluder (ray two of Fig. 2) rejects it, a virtual one does
+// not. A virtual hit contributes CI_r = 0 (its light is all in dL'); a miss contributes 0 (its
+// light is in L_env). Validation per component: where a real hit cannot be back-projected its
+// rendered real radiance (its share of L'_r) stands in — when both fail this is exactly
+// Eq. 9's "otherwise L'_r", and when p is virtual and p_refr is valid the refracted video is
+// used whatever the reflection does (the seed's exception for virtual refractive objects),
+// without taking an unvalidated colour for the reflection. alpha' is guarded like alpha.
 in vec2 uv;
 layout(binding = 0) uniform sampler2D cameraImage;  // sRGB8 texture: samples are linear
 layout(binding = 1) uniform sampler2D lRv;           // canvas, linear
 layout(binding = 2) uniform sampler2D lR;
 layout(binding = 3) uniform sampler2D gPosition;     // canvas, w = origin
 layout(binding = 4) uniform sampler2D remap;         // camera size: canvas pixel (OpenCV conv.)
+layout(binding = 5) uniform sampler2D gEmissive;     // canvas, a = specular slot + 1
+layout(binding = 6) uniform sampler2D reflPosition;  // GBuf_refl: xyz hit, w = origin
+layout(binding = 7) uniform sampler2D refrPosition;  // GBuf_refr
+layout(binding = 8) uniform sampler2D reflWeight;    // eta1 (rgb)
+layout(binding = 9) uniform sampler2D refrWeight;    // eta2 T (rgb)
+layout(binding = 10) uniform sampler2D specRv;       // L'_rv
+layout(binding = 11) uniform sampler2D specR;        // L'_r
+layout(binding = 12) uniform sampler2D specRRefl;    // the reflection's share of L'_r
+layout(binding = 13) uniform sampler2D lEnv;         // L_env
+layout(binding = 14) uniform sampler2D realSurfaces; // nearest real surface, xyz world
+layout(binding = 15) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
+uniform int hasSpecular;
+uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
+
+// alpha for L = CI + alpha dL, guarded where the rendered real radiance is near 0.
+vec3 guardedAlpha(vec3 ci, vec3 r) {
+    vec3 t = smoothstep(vec3(0.0), vec3(exposure.z), r);
+    vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(exposure.y));
+    return mix(vec3(1.0), ratio, t);
+}
+
+// CI(x): the camera image where world point x appears, if the video shows x there.
+bool backProject(vec3 x, out vec3 colour) {
+    colour = vec3(0.0);
+    vec2 cp;
+    if (!projectToCanvas(x, cp)) return false;
+    ivec2 ci = ivec2(floor(cp + 0.5));
+    if (any(lessThan(ci, ivec2(0))) || any(greaterThanEqual(ci, ivec2(canvas.xy)))) return false;
+    vec4 S = texelFetch(realSurfaces, ci, 0);
+    if (int(S.w + 0.5) != ORIGIN_REAL) return false;
+    float dx = length(x - cameraPos.xyz), ds = length(S.xyz - cameraPos.xyz);
+    if (abs(dx - ds) > depthEpsilon * dx + 0.005) return false;
+    vec2 camPx = texture(canvasToCamera, (cp + 0.5) * canvas.zw).xy;
+    ivec2 size = textureSize(cameraImage, 0);
+    if (camPx.x < -0.5 || camPx.y < -0.5 || camPx.x > float(size.x) - 0.5 ||
+        camPx.y > float(size.y) - 0.5)
+        return false;  // outside the video's frustum
+    colour = texelFetch(cameraImage, clamp(ivec2(floor(camPx + 0.5)), ivec2(0), size - 1), 0).rgb;
+    return true;
+}
+
+// Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci.
+vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
+    float ex = exposure.x;
+    vec3 rv = max(texelFetch(specRv, cpi, 0).rgb, vec3(0.0)) * ex;
+    vec3 r = max(texelFetch(specR, cpi, 0).rgb, vec3(0.0)) * ex;
+    vec3 rRefl = clamp(texelFetch(specRRefl, cpi, 0).rgb * ex, vec3(0.0), r);
+    vec3 env = max(texelFetch(lEnv, cpi, 0).rgb, vec3(0.0)) * ex;
+    bool envReal = flags.x == ORIGIN_REAL;
+    bool allReal = pReal;
+    vec3 ciBp = vec3(0.0);
+    for (int k = 0; k < 2; ++k) {
+        vec4 P = k == 0 ? texelFetch(reflPosition, cpi, 0) : texelFetch(refrPosition, cpi, 0);
+        vec3 w = (k == 0 ? texelFetch(reflWeight, cpi, 0) : texelFetch(refrWeight, cpi, 0)).rgb;
+        if (all(lessThanEqual(w, vec3(0.0)))) continue;  // no such component
+        int origin = int(P.w + 0.5);
+        if (origin == ORIGIN_NONE) {  // left the scene: L_env carries it
+            allReal = allReal && envReal;
+            continue;
+        }
+        if (origin != ORIGIN_REAL) {  // virtual hit: CI_r = 0 (Eq. 10)
+            allReal = false;
+            continue;
+        }
+        vec3 c;
+        if (backProject(P.xyz, c)) {
+            ciBp += w * c;
+        } else {
+            ciBp += k == 0 ? rRefl : max(r - rRefl, vec3(0.0));  // rendered real share
+        }
+    }
+    vec3 dL = rv - r;  // Eq. 6
+    if (allReal) return ci + guardedAlpha(ci, r + (envReal ? env : vec3(0.0))) * dL;
+    return env + ciBp + guardedAlpha(ciBp, r) * dL;
+}
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -26,10 +120,15 @@ void main() {
     float coverage = 0.0;
     if (canvasPx.x > -1000.0) {
         vec2 cuv = (canvasPx + 0.5) * canvas.zw;
-        int origin = int(texelFetch(gPosition, ivec2(floor(canvasPx + 0.5)), 0).w + 0.5);
+        ivec2 cpi = ivec2(floor(canvasPx + 0.5));
+        int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
+        int slot = hasSpecular == 1 ? int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1 : -1;
         vec3 rv = max(texture(lRv, cuv).rgb, vec3(0.0)) * exposure.x;
         vec3 r = max(texture(lR, cuv).rgb, vec3(0.0)) * exposure.x;
-        if (origin == ORIGIN_VIRTUAL) {
+        if (slot >= 0 && origin != ORIGIN_NONE) {
+            result = compositeSpecular(cpi, ci, origin == ORIGIN_REAL);
+            coverage = origin == ORIGIN_VIRTUAL ? 1.0 : 0.5;
+        } else if (origin == ORIGIN_VIRTUAL) {
             result = rv;
             coverage = 1.0;
         } else {

@@ -13,6 +13,7 @@ GBufferPass::GBufferPass()
     locNormal_ = program_.uniformLocation("normalMatrix");
     locMaterial_ = program_.uniformLocation("materialIndex");
     locOrigin_ = program_.uniformLocation("origin");
+    locSpecularSlot_ = program_.uniformLocation("specularSlot");
 }
 
 PassDecision GBufferPass::decide(const FrameContext& ctx) const {
@@ -52,7 +53,14 @@ void GBufferPass::execute(FrameContext& ctx) {
     program_.use();
     ctx.bindFrameBlocks();
     ctx.scene.bindGeometry();
-    for (const DrawItem& d : ctx.scene.draws()) {
+    const std::vector<int>& specular = ctx.scene.specularDraws();
+    size_t nextSpecular = 0;  // specularDraws() is in draw order
+    for (size_t di = 0; di < ctx.scene.draws().size(); ++di) {
+        const DrawItem& d = ctx.scene.draws()[di];
+        int slot = -1;
+        if (nextSpecular < specular.size() && specular[nextSpecular] == int(di))
+            slot = int(nextSpecular++);
+        glUniform1i(locSpecularSlot_, slot);
         glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
         glUniform1i(locMaterial_, d.material);

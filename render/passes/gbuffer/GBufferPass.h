@@ -19,13 +19,15 @@ public:
     const gl::Texture& position() const { return position_; }
     const gl::Texture& normal() const { return normal_; }
     const gl::Texture& albedo() const { return albedo_; }
-    const gl::Texture& emissive() const { return emissive_; }
+    const gl::Texture& emissive() const { return emissive_; }  // a = specular slot + 1
+    const gl::Texture& depth() const { return depth_; }
 
 private:
     gl::Program program_;
     gl::Texture position_, normal_, albedo_, emissive_, depth_;
     gl::Framebuffer fbo_;
-    GLint locModel_ = -1, locNormal_ = -1, locMaterial_ = -1, locOrigin_ = -1;
+    GLint locModel_ = -1, locNormal_ = -1, locMaterial_ = -1, locOrigin_ = -1,
+          locSpecularSlot_ = -1;
 };
 
 }  // namespace mirage::render

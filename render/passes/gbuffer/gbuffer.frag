@@ -5,6 +5,7 @@
 layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
 uniform int materialIndex;
 uniform int origin;  // ORIGIN_REAL or ORIGIN_VIRTUAL
+uniform int specularSlot;  // index into GpuScene::specularDraws(), -1 = not specular
 in vec3 worldPos;
 in vec3 worldNormal;
 in vec2 uv;
@@ -12,7 +13,8 @@ layout(binding = 7) uniform sampler2D baseColorMap;  // sRGB texture: samples ar
 layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
-layout(location = 3) out vec4 gEmissive;  // rgb linear emitted radiance
+layout(location = 3) out vec4 gEmissive;  // rgb linear emitted radiance, a = specular slot + 1
+                                          // (0: not a mirror / glass pixel)
 void main() {
     GpuMaterial m = materials[materialIndex];
     vec3 n = normalize(worldNormal);
@@ -22,5 +24,5 @@ void main() {
     gPosition = vec4(worldPos, float(origin));
     gNormal = vec4(n, clamp(m.emissive.w, 0.02, 1.0));
     gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.params.x, 0.0, 1.0));
-    gEmissive = vec4(m.emissive.rgb, 0.0);
+    gEmissive = vec4(m.emissive.rgb, float(specularSlot + 1));
 }

@@ -1,0 +1,91 @@
+#include "render/passes/backface/BackFacePass.h"
+
+#include "render/Shaders.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+
+namespace mirage::render {
+
+BackFacePass::BackFacePass(const GBufferPass& gbuffer)
+    : gbuffer_(gbuffer),
+      program_("backface", {{GL_VERTEX_SHADER, "passes/gbuffer/gbuffer.vert",
+                             shaders::source("passes/gbuffer/gbuffer.vert")},
+                            {GL_FRAGMENT_SHADER, "passes/backface/backface.frag",
+                             shaders::source("passes/backface/backface.frag")}}) {
+    locModel_ = program_.uniformLocation("model");
+    locNormal_ = program_.uniformLocation("normalMatrix");
+    locMode_ = program_.uniformLocation("mode");
+    locSlot_ = program_.uniformLocation("specularSlot");
+}
+
+PassDecision BackFacePass::decide(const FrameContext& ctx) const {
+    const size_t n = ctx.scene.specularDraws().size();
+    if (n == 0) return {false, "no mirror or glass object in the scene"};
+    return {true,
+            std::to_string(n) + " specular draw(s)" +
+                (ctx.scene.hasVirtual() ? " + real-surface depth (virtual objects present)" : "")};
+}
+
+void BackFacePass::resize(const FrameContext& ctx) {
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    if (w == width_ && h == height_) return;
+    width_ = w;
+    height_ = h;
+    position_ = gl::Texture::create2D("backface position", w, h, GL_RGBA32F);
+    normal_ = gl::Texture::create2D("backface normal", w, h, GL_RGBA16F);
+    depth_ = gl::Texture::create2D("backface depth", w, h, GL_DEPTH_COMPONENT32F);
+    realPosition_ = gl::Texture::create2D("real surface position", w, h, GL_RGBA32F);
+    realDepth_ = gl::Texture::create2D("real surface depth", w, h, GL_DEPTH_COMPONENT32F);
+    for (gl::Texture* t : {&position_, &normal_, &realPosition_})
+        t->setFilter(GL_NEAREST, GL_NEAREST);
+    fbo_ = gl::Framebuffer("backface fbo");
+    fbo_.attachColor(0, position_);
+    fbo_.attachColor(1, normal_);
+    fbo_.attachDepth(depth_);
+    fbo_.finalize(2);
+    realFbo_ = gl::Framebuffer("real surface fbo");
+    realFbo_.attachColor(0, realPosition_);
+    realFbo_.attachDepth(realDepth_);
+    realFbo_.finalize(1);
+}
+
+void BackFacePass::execute(FrameContext& ctx) {
+    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);  // back faces are selected by their normal in the shader
+    glDisable(GL_BLEND);
+    program_.use();
+    ctx.bindFrameBlocks();
+    ctx.scene.bindGeometry();
+    const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
+    auto draw = [&](const DrawItem& d, int slot) {
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
+        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
+        glUniform1i(locSlot_, slot);
+        ctx.scene.drawItem(d);
+    };
+
+    fbo_.bind();
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    glUniform1i(locMode_, 0);
+    const std::vector<int>& spec = ctx.scene.specularDraws();
+    for (size_t s = 0; s < spec.size(); ++s) draw(ctx.scene.draws()[size_t(spec[s])], int(s));
+    ctx.publish(Resource::BackFaces, &position_);
+
+    if (ctx.scene.hasVirtual()) {
+        realFbo_.bind();
+        glClearBufferfv(GL_COLOR, 0, zero);
+        glClearBufferfv(GL_DEPTH, 0, &one);
+        glUniform1i(locMode_, 1);
+        for (const DrawItem& d : ctx.scene.draws())
+            if (d.origin == Origin::Real) draw(d, -1);
+        ctx.publish(Resource::RealSurfaces, &realPosition_);
+    } else {
+        ctx.publish(Resource::RealSurfaces, &gbuffer_.position());
+    }
+    glDisable(GL_DEPTH_TEST);
+}
+
+}  // namespace mirage::render

@@ -1,0 +1,47 @@
+#pragma once
+// GBuf_refl and GBuf_refr (Knecht 2013 Sec. 5.1): per camera pixel showing a mirror or glass
+// object, the surface hit by the reflected ray and by the two-interface refracted ray (Wyman
+// 2005, using the back-face pass), with the Fresnel / transmittance weight of each
+// (specular_gbuffer.frag says how; docs/specular.md). Hits come from traceSurroundings (the
+// impostor helper's reflected-scene impostors; a miss-only stand-in until that is merged).
+#include "render/RenderPass.h"
+
+namespace mirage::render {
+
+class GBufferPass;
+class BackFacePass;
+
+// One specular G-buffer: hit position + origin (or the ray direction on a miss), normal +
+// roughness, albedo + metallic, emission + specular-pixel flag, weight + distance inside.
+struct SpecularHitBuffer {
+    gl::Texture position, normal, albedo, emissive, weight;
+    gl::Framebuffer fbo;
+};
+
+class SpecularGBufferPass final : public RenderPass {
+public:
+    SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces);
+    const char* name() const override { return "specgbuf"; }
+    std::vector<Resource> reads() const override {
+        return {Resource::GBuffer, Resource::BackFaces};
+    }
+    std::vector<Resource> writes() const override {
+        return {Resource::ReflectionGBuffer, Resource::RefractionGBuffer};
+    }
+    PassDecision decide(const FrameContext& ctx) const override;
+    void resize(const FrameContext& ctx) override;
+    void execute(FrameContext& ctx) override;
+
+    const SpecularHitBuffer& reflection() const { return refl_; }
+    const SpecularHitBuffer& refraction() const { return refr_; }
+
+private:
+    const GBufferPass& gbuffer_;
+    const BackFacePass& backFaces_;
+    gl::Program program_;
+    SpecularHitBuffer refl_, refr_;
+    GLint locMode_ = -1, locSteps_ = -1;
+    int width_ = 0, height_ = 0;
+};
+
+}  // namespace mirage::render

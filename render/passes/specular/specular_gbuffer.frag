@@ -1,0 +1,189 @@
+#version 450 core
+#include "common.glsl"
+#include "passes/specular/specular.glsl"
+#include "passes/specular/surroundings_fallback.glsl"
+// GBuf_refl (mode 0) and GBuf_refr (mode 1) of Knecht 2013 Sec. 5.1, from the camera's view:
+// for every pixel where the primary G-buffer shows a mirror or glass object (slot > 0), the
+// surface attributes of what the reflected / refracted ray hits, plus the Fresnel weight the
+// radiance from there carries into the pixel.
+//
+// Reflection: r = reflect(-v, n) from the front surface p.
+// Refraction, two interfaces (Wyman 2005): Snell at the front face (n1 = 1 outside, n2 = ior)
+// gives T1; the exit point P2 is where T1 meets the object's back faces, found by marching T1
+// through the back-face buffer (nearest back face per pixel) and refining by bisection — Wyman's
+// distance estimate made exact for whatever the back-face buffer holds; when the march leaves
+// the back faces' footprint the exit is taken on the object's bounding sphere. Snell at the back
+// face (outward normal N2 from the back-face buffer) gives the exit ray T2.
+//  - Total internal reflection at the back face (sin > 1/ior): the light path reflects inside;
+//    we follow ONE internal reflection, T2 = reflect(T1, -N2), leaving from P2 with Fresnel 1
+//    (no second refraction: the approximation is documented in docs/specular.md).
+//  - TIR at the front face (only possible for ior < 1): everything is reflected (F1 = 1).
+//  - ior = 1: T1 = T2 = the view ray and F1 = F2 = 0: the object vanishes except for absorption.
+//  - Grazing views: cos clamped, refract() of GLSL never divides by zero; every output is
+//    checked finite.
+// Weight of the refracted radiance: transmission (1 - F1)(1 - F2) baseColour^2 (the reference
+// tints each crossing by baseColour) x Beer-Lambert attenuationColour^(d / attenuationDistance)
+// with d = |P2 - p| the distance travelled inside (KHR_materials_volume).
+// Weight of the reflected radiance: Fresnel F1 (dielectric) or Schlick(baseColour) (mirror).
+in vec2 uv;
+layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = 5) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
+layout(binding = 0) uniform sampler2D gPosition;
+layout(binding = 1) uniform sampler2D gNormal;
+layout(binding = 2) uniform sampler2D gEmissive;  // a = specular slot + 1
+layout(binding = 3) uniform sampler2D backPosition;  // xyz world, w = slot + 1
+layout(binding = 4) uniform sampler2D backNormal;    // outward
+uniform int mode;        // 0 = reflection, 1 = refraction
+uniform int marchSteps;  // back-face march steps
+layout(location = 0) out vec4 outPosition;  // hit xyz world (m) | ray direction on a miss;
+                                            // w = hit origin (ORIGIN_NONE = miss)
+layout(location = 1) out vec4 outNormal;    // hit unit normal (facing the ray), w = roughness
+layout(location = 2) out vec4 outAlbedo;    // hit linear base colour, a = metallic
+layout(location = 3) out vec4 outEmissive;  // hit emitted radiance, a = 1 on a specular pixel
+layout(location = 4) out vec4 outWeight;    // rgb Fresnel x transmittance weight, a = distance
+                                            // travelled inside (m, refraction)
+
+// Reflection weight of a smooth surface with this material at cos(theta) = cosV.
+vec3 reflectionWeight(GpuMaterial m, float cosV, float transWeight) {
+    vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
+    if (m.attenuation.a > 0.5) return schlickColour(base, cosV);  // perfect mirror
+    float F = fresnelDielectric(cosV, max(m.transmission.y, 1e-3));
+    float opaque = 1.0 - transWeight;
+    float metal = opaque > 0.0 ? min(1.0, clamp(m.params.x, 0.0, 1.0) / opaque) : 0.0;
+    vec3 opaqueF = (1.0 - metal) * vec3(F) + metal * schlickColour(base, cosV);
+    return transWeight * vec3(F) + opaque * opaqueF;
+}
+
+// Exit of a ray inside the object with bounding sphere (c, r): the far intersection.
+vec3 sphereExit(vec3 o, vec3 d, vec4 sphere) {
+    vec3 oc = o - sphere.xyz;
+    float b = dot(oc, d);
+    float cc = dot(oc, oc) - sphere.w * sphere.w;
+    float disc = max(b * b - cc, 0.0);
+    return o + max(-b + sqrt(disc), 0.0) * d;
+}
+
+void writeHit(SurroundingHit h, vec3 dir, vec3 weight, float inside) {
+    if (h.hit && allFinite(h.position)) {
+        outPosition = vec4(h.position, float(h.origin));
+        outNormal = vec4(h.normal, clamp(h.roughness, 0.02, 1.0));
+        outAlbedo = vec4(h.albedo, clamp(h.metallic, 0.0, 1.0));
+        outEmissive = vec4(h.emissive, 1.0);
+    } else {
+        outPosition = vec4(dir, float(ORIGIN_NONE));
+        outNormal = vec4(-dir, 1.0);
+        outAlbedo = vec4(0.0);
+        outEmissive = vec4(0.0, 0.0, 0.0, 1.0);
+    }
+    outWeight = vec4(allFinite(weight) ? max(weight, vec3(0.0)) : vec3(0.0),
+                     isnan(inside) || isinf(inside) ? 0.0 : inside);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    outPosition = vec4(0.0);
+    outNormal = vec4(0.0);
+    outAlbedo = vec4(0.0);
+    outEmissive = vec4(0.0);
+    outWeight = vec4(0.0);
+    int slot = int(texelFetch(gEmissive, px, 0).a + 0.5) - 1;
+    if (slot < 0) return;
+    vec4 P = texelFetch(gPosition, px, 0);
+    vec3 p = P.xyz;
+    vec3 n = texelFetch(gNormal, px, 0).xyz;  // faces the camera (G-buffer convention)
+    vec3 v = cameraPos.xyz - p;
+    float vl = length(v);
+    if (vl < 1e-6 || !allFinite(n)) return;
+    v /= vl;
+    vec3 d = -v;
+    GpuSpecularDraw sd = specularDraws[slot];
+    GpuMaterial m = materials[sd.info.x];
+    float cosV = clamp(dot(n, v), 1e-4, 1.0);  // grazing: clamped, never 0
+    bool mirror = m.attenuation.a > 0.5;
+    float transWeight = mirror ? 0.0 : clamp(m.transmission.x, 0.0, 1.0) *
+                                           (1.0 - clamp(m.params.x, 0.0, 1.0));
+    float eta = max(m.transmission.y, 1e-3);
+    float eps = 1e-4 + 1e-4 * vl;  // ray offset against self-intersection (metres)
+
+    if (mode == 0) {
+        vec3 r = reflect(d, n);
+        SurroundingHit h = traceSurroundings(slot, p + n * eps, r);
+        writeHit(h, r, reflectionWeight(m, cosV, transWeight), 0.0);
+        return;
+    }
+    if (transWeight <= 0.0) {
+        outEmissive.a = 1.0;  // specular pixel, nothing refracted
+        return;
+    }
+    float F1 = fresnelDielectric(cosV, eta);
+    vec3 T1 = refract(d, n, 1.0 / eta);
+    if (F1 >= 1.0 || dot(T1, T1) < 0.5) {  // TIR at the front face (ior < 1): all reflected
+        outEmissive.a = 1.0;
+        return;
+    }
+    T1 = normalize(T1);
+    // March T1 through the back-face buffer: the exit is where the ray's camera distance passes
+    // the stored back face's (same object).
+    float maxLen = 2.0 * sd.bounds.w + 1e-3;
+    int steps = clamp(marchSteps, 2, 128);
+    float prevT = 0.0, hitT = -1.0;
+    for (int i = 1; i <= steps; ++i) {
+        float t = maxLen * float(i) / float(steps);
+        vec3 q = p + T1 * t;
+        vec2 cp;
+        if (!projectToCanvas(q, cp)) break;
+        ivec2 qi = ivec2(floor(cp + 0.5));
+        if (any(lessThan(qi, ivec2(0))) || any(greaterThanEqual(qi, ivec2(canvas.xy)))) break;
+        vec4 B = texelFetch(backPosition, qi, 0);
+        if (int(B.w + 0.5) - 1 != slot) break;  // left the object's back-face footprint
+        if (length(q - cameraPos.xyz) >= length(B.xyz - cameraPos.xyz)) {
+            hitT = t;
+            break;
+        }
+        prevT = t;
+    }
+    vec3 P2, N2;
+    if (hitT > 0.0) {
+        float lo = prevT, hi = hitT;
+        for (int k = 0; k < 6; ++k) {  // bisection on the same crossing test
+            float mid = 0.5 * (lo + hi);
+            vec3 q = p + T1 * mid;
+            vec2 cp;
+            projectToCanvas(q, cp);
+            ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+            vec4 B = texelFetch(backPosition, qi, 0);
+            bool past = int(B.w + 0.5) - 1 != slot ||
+                        length(q - cameraPos.xyz) >= length(B.xyz - cameraPos.xyz);
+            if (past) hi = mid; else lo = mid;
+        }
+        P2 = p + T1 * hi;
+        vec2 cp;
+        projectToCanvas(P2, cp);
+        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+        N2 = texelFetch(backNormal, qi, 0).xyz;
+        if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 != slot || dot(N2, N2) < 0.25)
+            N2 = normalize(P2 - sd.bounds.xyz);
+    } else {
+        P2 = sphereExit(p, T1, sd.bounds);
+        N2 = normalize(P2 - sd.bounds.xyz);
+    }
+    N2 = normalize(N2);
+    if (!allFinite(N2)) N2 = T1;
+    if (dot(N2, T1) < 1e-3) N2 = normalize(N2 + T1 * (1e-3 - dot(N2, T1)));  // leaves outward
+    float inside = length(P2 - p);
+    float cos2 = clamp(dot(T1, N2), 1e-4, 1.0);  // inside, towards the outward normal
+    float F2 = fresnelDielectric(-cos2, eta);     // from the inside: relative ior 1 / eta
+    vec3 T2 = refract(T1, -N2, eta);
+    if (F2 >= 1.0 || dot(T2, T2) < 0.5) {
+        T2 = reflect(T1, -N2);  // TIR: one internal reflection, then out (documented)
+        F2 = 0.0;               // all of it continues along T2
+    }
+    T2 = normalize(T2);
+    vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
+    vec3 absorb = vec3(1.0);
+    if (m.transmission.z > 0.0)
+        absorb = pow(max(m.attenuation.rgb, vec3(1e-6)), vec3(inside / m.transmission.z));
+    vec3 weight = transWeight * (1.0 - F1) * (1.0 - F2) * base * base * absorb;
+    SurroundingHit h = traceSurroundings(slot, P2 + T2 * eps, T2);
+    writeHit(h, T2, weight, inside);
+}

@@ -1,0 +1,131 @@
+#version 450 core
+#include "common.glsl"
+#include "lighting.glsl"
+#include "passes/specular/specular.glsl"
+// Lighting of the reflected / refracted ray hits (GBuf_refl, GBuf_refr) by every light (shadow
+// maps), the environment (SH irradiance) and the VPLs (imperfect shadow maps), routed by
+// Knecht 2013 Eqs. 3-5:
+//   L'_rv = sum_ls  eta1 L_refl(ls) + eta2 T L_refr(ls)                       (Eq. 3)
+//   L'_r  = sum_ls  eta1 L_refl(ls) real(ls, p_refl) + eta2 T L_refr(ls) real(ls, p_refr) (Eq. 4)
+//   real(ls, p) = r(ls) and r(p)                                              (Eq. 5)
+// with visibility against all occluders for L'_rv and real occluders only for L'_r (DESIGN.md
+// routing table). The Fresnel / transmittance weights (eta1, eta2 T) are pre-multiplied (Sec.
+// 5.1). A ray that hit nothing modelled writes the weighted environment radiance into L_env
+// instead (Sec. 4.1.3); L'_rv and L'_r stay untouched there. Linear radiance throughout.
+in vec2 uv;
+layout(std430, binding = 2) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = 0) uniform sampler2D reflPosition;
+layout(binding = 1) uniform sampler2D reflNormal;
+layout(binding = 2) uniform sampler2D reflAlbedo;
+layout(binding = 3) uniform sampler2D reflEmissive;
+layout(binding = 4) uniform sampler2D reflWeight;
+layout(binding = 5) uniform sampler2D refrPosition;
+layout(binding = 6) uniform sampler2D refrNormal;
+layout(binding = 7) uniform sampler2D refrAlbedo;
+layout(binding = 8) uniform sampler2D refrEmissive;
+layout(binding = 9) uniform sampler2D refrWeight;
+layout(binding = 10) uniform sampler2DArray shadowAll;
+layout(binding = 11) uniform sampler2DArray shadowReal;
+layout(binding = 12) uniform usampler2D ismAll;
+layout(binding = 13) uniform usampler2D ismReal;
+layout(binding = 14) uniform sampler2D gPosition;  // primary G-buffer
+layout(binding = 15) uniform sampler2D envMap;
+uniform int useVpls;  // 1 when VPLs (and their ISMs) exist this frame
+layout(location = 0) out vec4 outRv;     // L'_rv
+layout(location = 1) out vec4 outR;      // L'_r
+layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r (for Eq. 9, see
+                                         // composite.frag)
+layout(location = 3) out vec4 outEnv;    // L_env; a = 1 on specular pixels
+
+float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
+    int tile = flags.z, perRow = flags.w;
+    ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
+    ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
+    return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
+}
+
+// Outgoing radiance of hit point x towards the specular surface (unit v), both GI solutions.
+void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, float roughness,
+              vec3 emissive, out vec3 rv, out vec3 r) {
+    rv = vec3(0.0);
+    r = vec3(0.0);
+    for (int li = 0; li < counts.x; ++li) {
+        vec3 wi, E;
+        incidentLight(li, x, wi, E);
+        float NdotL = dot(n, wi);
+        if (NdotL <= 0.0) continue;
+        vec3 c = brdfCos(n, v, wi, albedo, metallic, roughness) * E;
+        float visAll = shadowVisibility(shadowAll, li, x, NdotL);
+        rv += c * visAll;
+        ivec4 sh = lights[li].shadow;
+        if (sh.w == 1 && xReal) {
+            float visReal = sh.z == 1 ? shadowVisibility(shadowReal, li, x, NdotL) : visAll;
+            r += c * visReal;
+        }
+    }
+    if (flags.x != 0) {
+        vec3 env = albedo * (1.0 - metallic) / PI * shIrradiance(n);
+        rv += env;
+        if (flags.x == ORIGIN_REAL && xReal) r += env;
+    }
+    if (useVpls == 1) {
+        vec3 diffuse = albedo * (1.0 - metallic) / PI;
+        float clamp2 = params.x * params.x;
+        for (int i = 0; i < counts.y; ++i) {
+            GpuVpl V = vpls[i];
+            if (V.normal.w < 0.5) continue;
+            vec3 d = x - V.positionReal.xyz;
+            float dist2 = dot(d, d);
+            if (dist2 < 1e-10) continue;
+            float dist = sqrt(dist2);
+            vec3 w = d / dist;
+            float cosQ = dot(V.normal.xyz, w), cosP = dot(n, -w);
+            if (cosQ <= 0.0 || cosP <= 0.0) continue;
+            vec3 c = diffuse * V.flux.rgb / PI * cosQ * cosP / max(dist2, clamp2);
+            float bias = 0.02 + 0.03 * dist;
+            vec2 puv = paraboloidUv(V, w);
+            if (dist - bias <= ismDistance(ismAll, i, puv)) rv += c;
+            if (V.positionReal.w > 0.5 && xReal &&
+                dist - bias <= ismDistance(ismReal, i, puv))
+                r += c;
+        }
+    }
+    rv += emissive;
+    if (xReal) r += emissive;
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    outRv = vec4(0.0);
+    outR = vec4(0.0);
+    outRRefl = vec4(0.0);
+    outEnv = vec4(0.0);
+    if (texelFetch(reflEmissive, px, 0).a < 0.5) return;  // not a specular pixel
+    vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
+    for (int k = 0; k < 2; ++k) {
+        vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
+        vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
+        if (all(lessThanEqual(w, vec3(0.0)))) continue;
+        int origin = int(P.w + 0.5);
+        if (origin == ORIGIN_NONE) {
+            if (dot(P.xyz, P.xyz) > 0.25) env += w * environmentRadiance(envMap, P.xyz);
+            continue;
+        }
+        vec4 N = k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0);
+        vec4 A = k == 0 ? texelFetch(reflAlbedo, px, 0) : texelFetch(refrAlbedo, px, 0);
+        vec3 e = (k == 0 ? texelFetch(reflEmissive, px, 0) : texelFetch(refrEmissive, px, 0)).rgb;
+        // Viewed from the specular surface point p (for the refracted ray the exit point lies
+        // on the same object; its glossy highlights are approximate).
+        vec3 v = normalize(texelFetch(gPosition, px, 0).xyz - P.xyz);
+        if (!allFinite(v)) v = N.xyz;
+        vec3 hrv, hr;
+        shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, e, hrv, hr);
+        rv += w * hrv;
+        r += w * hr;
+        if (k == 0) rRefl = w * hr;
+    }
+    outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
+    outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
+    outRRefl = vec4(allFinite(rRefl) ? rRefl : vec3(0.0), 1.0);
+    outEnv = vec4(allFinite(env) ? env : vec3(0.0), 1.0);
+}
