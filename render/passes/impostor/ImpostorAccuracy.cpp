@@ -103,6 +103,7 @@ std::vector<ExactHit> castExact(const std::vector<ImpostorRay>& rays, const GpuS
             out[i].hit = true;
             out[i].position = h.p;
             out[i].origin = exact.origin(h) == Origin::Real ? kOriginReal : kOriginVirtual;
+            out[i].draw = int(h.geometry);
             break;
         }
     }

@@ -19,6 +19,7 @@ struct ExactHit {
     bool hit = false;
     glm::vec3 position{0.0f};  // world (m)
     int origin = kOriginNone;
+    int draw = -1;  // GpuScene draw index of the surface hit
 };
 
 struct ImpostorAccuracy {

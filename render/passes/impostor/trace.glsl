@@ -166,10 +166,28 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
         }
     }
     if (!found) return false;
+    // Refinement: Newton steps on the tangent plane stored at the current texel (exact for
+    // planar walls), kept inside the bracket [ta, tb]; regula falsi when the plane step leaves it.
+    float t = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : tb;
     for (int s = 0; s < impMode.y; ++s) {
+        ivec3 cur_tex = impCubeTexel(o + t * d - c, obj.range.w);
+        vec4 q = texelFetch(impCubePosition, cur_tex, 0);
+        vec3 n = texelFetch(impCubeNormal, cur_tex, 0).xyz;
+        float dn = dot(d, n);
         float tm = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : 0.5 * (ta + tb);
+        if (q.w > 0.5 && abs(dn) > 1e-4) {
+            float tp = dot(q.xyz - o, n) / dn;
+            if (tp >= ta && tp <= tb) tm = tp;
+        }
+        if (abs(tm - t) < 1e-7 * max(tm, 1.0) && s > 0) break;  // converged
         ivec3 tm_tex;
         float hm = impEnclosingH(c, obj.range.w, o + tm * d, tm_tex);
+        // Behind / in front of the stored tangent plane, consistent with the plane step (c's
+        // side is in front).
+        vec4 qm = texelFetch(impCubePosition, tm_tex, 0);
+        vec3 nm = texelFetch(impCubeNormal, tm_tex, 0).xyz;
+        if (qm.w > 0.5 && dot(nm, nm) > 1e-12)
+            hm = dot(o + tm * d - qm.xyz, nm) * (dot(c - qm.xyz, nm) > 0.0 ? -1.0 : 1.0);
         if (hm < 0.0) {
             ta = tm;
             ha = hm;
@@ -178,11 +196,23 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
             hb = hm;
             tb_tex = tm_tex;
         }
+        t = tm;
     }
-    float t = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : tb;
     if (!(t > 0.0) || t >= tBest) return false;
+    ivec3 final_tex;
+    vec3 x = o + t * d;
+    if (impEnclosingH(c, obj.range.w, x, final_tex) < -IMP_EMPTY) return false;
+    // A distance cube stores one surface per direction from c: a ray that passes over an edge
+    // (a wall's top) lands "behind" it in a direction where the wall is. Accept only points on
+    // the stored surface: within two texel footprints of the texel's point and one footprint of
+    // its tangent plane.
+    vec4 q = texelFetch(impCubePosition, final_tex, 0);
+    vec3 qn = texelFetch(impCubeNormal, final_tex, 0).xyz;
+    float footprint = length(x - c) * 2.0 / impParams.x + 1e-3;
+    if (length(x - q.xyz) > 2.0 * footprint) return false;
+    if (dot(qn, qn) > 1e-12 && abs(dot(x - q.xyz, normalize(qn))) > footprint) return false;
     tBest = t;
-    texel = tb_tex;
+    texel = final_tex;
     return true;
 }
 
@@ -254,8 +284,20 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
     float texelM = 2.0 * max(e.x, e.y) / impParams.y;
     float thickness = abs(rd.z) * dt + 2.0 * texelM;
     if (ha < -IMP_EMPTY && hb > thickness) return false;
+    // Refinement: Newton steps on the tangent plane of the height field at the current estimate
+    // (stored normal, bilinear depth), kept inside the bracket [ta, tb]; regula falsi otherwise.
+    float t = ha > -IMP_EMPTY && hb - ha > 0.0 ? ta + (tb - ta) * ha / (ha - hb) : tb;
     for (int s = 0; s < impMode.y; ++s) {
+        vec2 qc = ro.xy + t * rd.xy;
+        float dq = impDepthAt(I, qc);
+        vec3 n = texelFetch(impNormal, impTexel(I, qc), 0).xyz;
+        vec3 nl = vec3(dot(n, I.axisU.xyz), dot(n, I.axisV.xyz), dot(n, I.axisW.xyz));
+        float dn = dot(rd, nl);
         float tm = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : 0.5 * (ta + tb);
+        if (dq < IMP_EMPTY && abs(dn) > 1e-4) {
+            float tp = dot(vec3(qc, dq) - ro, nl) / dn;
+            if (tp >= ta && tp <= tb) tm = tp;
+        }
         float hm = ro.z + tm * rd.z - impDepthAt(I, ro.xy + tm * rd.xy);
         if (hm < 0.0) {
             ta = tm;
@@ -264,8 +306,8 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
             tb = tm;
             hb = hm;
         }
+        t = tm;
     }
-    float t = ha > -IMP_EMPTY && hb - ha > 0.0 ? ta + (tb - ta) * ha / (ha - hb) : tb;
     if (!(t >= 0.0) || t >= tBest) return false;
     ivec3 tx = impTexel(I, ro.xy + t * rd.xy);
     if (texelFetch(impDepth, tx, 0).g < 0.5) tx = impTexel(I, ro.xy + tb * rd.xy);
