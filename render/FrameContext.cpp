@@ -50,6 +50,8 @@ const char* resourceName(Resource r) {
             return "Lenv";
         case Resource::Composite:
             return "Composite";
+        case Resource::Impostors:
+            return "Impostors";
     }
     return "?";
 }

@@ -40,7 +40,8 @@ enum class Resource {
     SpecularRv,         // L'_rv (Eq. 3), Fresnel-weighted, canvas size
     SpecularR,          // L'_r (Eq. 4)
     Lenv,               // L_env: environment seen where a ray leaves the modelled scene
-    Composite,          // final image (camera image size): linear RGBA32F + sRGB8
+    Composite,  // final image (camera image size): linear RGBA32F + sRGB8
+    Impostors,  // per specular object: reflected-scene impostors + G-buffer cube maps (world)
 };
 const char* resourceName(Resource r);
 
@@ -68,6 +69,11 @@ struct RendererOptions {
     // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
     // without this a pass's time can show up in the next pass's query. For benchmarks.
     bool syncPasses = false;
+
+    // Reflected-scene impostors for specular objects (render/passes/impostor, issue 6).
+    int impostorResolution = 256;          // texels per side of each impostor and cube face
+    int impostorRefineSteps = 4;           // secant refinement steps of the height-field search
+    bool impostorCubeMapBaseline = false;  // true: plain G-buffer cube map, looked up by direction
 };
 
 struct LightPlan {

@@ -3,6 +3,7 @@
 #include "render/Shaders.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/impostor/ImpostorPass.h"
 
 namespace mirage::render {
 namespace {
@@ -26,9 +27,11 @@ void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h) {
 
 }  // namespace
 
-SpecularGBufferPass::SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces)
+SpecularGBufferPass::SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces,
+                                         const ImpostorPass& impostors)
     : gbuffer_(gbuffer),
       backFaces_(backFaces),
+      impostors_(impostors),
       program_("specular gbuffer",
                {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                 {GL_FRAGMENT_SHADER, "passes/specular/specular_gbuffer.frag",
@@ -39,6 +42,7 @@ SpecularGBufferPass::SpecularGBufferPass(const GBufferPass& gbuffer, const BackF
 
 PassDecision SpecularGBufferPass::decide(const FrameContext& ctx) const {
     if (!ctx.has(Resource::BackFaces)) return {false, "no mirror or glass object in the scene"};
+    if (!ctx.has(Resource::Impostors)) return {false, "no impostors of the surroundings"};
     return {true, std::to_string(ctx.scene.specularDraws().size()) +
                       " specular draw(s): reflected and refracted rays"};
 }
@@ -67,6 +71,7 @@ void SpecularGBufferPass::execute(FrameContext& ctx) {
     glBindTextureUnit(3, backFaces_.position().id());
     glBindTextureUnit(4, backFaces_.normal().id());
     glUniform1i(locSteps_, ctx.options.refractionMarchSteps);
+    impostors_.bindForTracing();  // texture units 16..23, storage bindings 6..7
     ctx.emptyVao.bind();
     for (int mode = 0; mode < 2; ++mode) {
         (mode == 0 ? refl_ : refr_).fbo.bind();

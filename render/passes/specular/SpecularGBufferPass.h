@@ -3,13 +3,14 @@
 // object, the surface hit by the reflected ray and by the two-interface refracted ray (Wyman
 // 2005, using the back-face pass), with the Fresnel / transmittance weight of each
 // (specular_gbuffer.frag says how; docs/specular.md). Hits come from traceSurroundings (the
-// impostor helper's reflected-scene impostors; a miss-only stand-in until that is merged).
+// impostor helper's reflected-scene impostors, render/passes/impostor/trace.glsl).
 #include "render/RenderPass.h"
 
 namespace mirage::render {
 
 class GBufferPass;
 class BackFacePass;
+class ImpostorPass;
 
 // One specular G-buffer: hit position + origin (or the ray direction on a miss), normal +
 // roughness, albedo + metallic, emission + specular-pixel flag, weight + distance inside.
@@ -20,10 +21,11 @@ struct SpecularHitBuffer {
 
 class SpecularGBufferPass final : public RenderPass {
 public:
-    SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces);
+    SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces,
+                        const ImpostorPass& impostors);
     const char* name() const override { return "specgbuf"; }
     std::vector<Resource> reads() const override {
-        return {Resource::GBuffer, Resource::BackFaces};
+        return {Resource::GBuffer, Resource::BackFaces, Resource::Impostors};
     }
     std::vector<Resource> writes() const override {
         return {Resource::ReflectionGBuffer, Resource::RefractionGBuffer};
@@ -38,6 +40,7 @@ public:
 private:
     const GBufferPass& gbuffer_;
     const BackFacePass& backFaces_;
+    const ImpostorPass& impostors_;
     gl::Program program_;
     SpecularHitBuffer refl_, refr_;
     GLint locMode_ = -1, locSteps_ = -1;

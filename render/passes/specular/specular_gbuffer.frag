@@ -1,7 +1,7 @@
 #version 450 core
 #include "common.glsl"
 #include "passes/specular/specular.glsl"
-#include "passes/specular/surroundings_fallback.glsl"
+#include "passes/impostor/trace.glsl"
 // GBuf_refl (mode 0) and GBuf_refr (mode 1) of Knecht 2013 Sec. 5.1, from the camera's view:
 // for every pixel where the primary G-buffer shows a mirror or glass object (slot > 0), the
 // surface attributes of what the reflected / refracted ray hits, plus the Fresnel weight the

@@ -1,0 +1,165 @@
+// Specular objects (issue 6) against the Embree reference renderer: for combinations of REAL /
+// VIRTUAL light, specular object, reflected object and refracted object (Knecht 2013 Fig. 2),
+// the real-time composite over the specular object's pixels is compared with the reference
+// differential composite (CI = the reference's real-only render as 8-bit sRGB footage). Also the
+// per-effect figures (reflection only: a mirror; refraction only / both: glass) and a
+// deliberately broken render that must fail the floor. docs/specular.md has the figures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/gl/Context.h"
+#include "core/image/ImageIO.h"
+#include "render/Renderer.h"
+#include "render/raytrace/DifferentialRendering.h"
+#include "render/raytrace/EmbreeDevice.h"
+#include "tests/render/SpecularTestScenes.h"
+#include "tests/support/TestSupport.h"
+
+namespace mirage::render {
+namespace {
+
+double maskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+    cv::Mat d;
+    cv::absdiff(a, b, d);
+    d.convertTo(d, CV_64FC3);
+    cv::multiply(d, d, d);
+    const cv::Scalar sum = cv::sum(d.clone().setTo(0, mask == 0));
+    const double n = 3.0 * cv::countNonZero(mask);
+    const double mse = (sum[0] + sum[1] + sum[2]) / n;
+    return mse <= 0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 / mse);
+}
+
+struct Result {
+    double psnr = 0, ssim = 0;
+    cv::Mat rt, ref, footage;
+};
+
+struct Comparison {
+    test::SpecularScene scene;
+    cv::Mat footage, refSrgb, mask;
+};
+
+Comparison reference(const test::SpecularScene& s, int spp = 48) {
+    Comparison c{s, {}, {}, test::sphereMask(s)};
+    const raytrace::EmbreeDevice device("threads=2");
+    raytrace::RenderSettings st;
+    st.samplesPerPixel = spp;
+    st.threads = 2;
+    st.seed = 3;
+    st.caustics = false;  // the real-time renderer has no caustics yet (later issue)
+    const raytrace::DifferentialImages ref =
+        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
+    EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
+    c.footage = linearRgbToSrgbBgr8(ref.realOnly);
+    c.refSrgb =
+        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(c.footage), ref));
+    return c;
+}
+
+Result realtime(const Comparison& c, const test::SpecularScene& rtScene, RendererOptions opt = {}) {
+    opt.temporalBlend = 0.0f;
+    Renderer r(rtScene.scene, rtScene.cam, opt);
+    r.render({rtScene.pose, c.footage, true});
+    Result out;
+    out.rt = r.compositeSrgb();
+    const cv::Mat lin = r.compositeLinear();
+    EXPECT_TRUE(cv::checkRange(lin)) << "NaN/Inf in the composite";
+    out.psnr = maskedPsnr(out.rt, c.refSrgb, c.mask);
+    out.ssim = test::ssim(out.rt, c.refSrgb, 255.0, c.mask);
+    return out;
+}
+
+void save(const std::string& name, const Comparison& c, const Result& r) {
+    static const auto dir = test::outputDir("specular");
+    cv::Mat side;
+    cv::hconcat(std::vector<cv::Mat>{c.footage, r.rt, c.refSrgb}, side);
+    cv::resize(side, side, cv::Size(), 3.0, 3.0, cv::INTER_NEAREST);
+    writeBgr8(dir / (name + ".png"), side);
+}
+
+// Fig. 2 combinations (light, specular object, reflected object, refracted object; R = real,
+// V = virtual). All 16 take too long for the test budget (each needs two reference renders), so
+// this covering subset is run: every element is real and virtual at least once, every pair of
+// (object, reflected) and (object, refracted) combinations appears, with both light origins.
+const test::SpecularCase kCases[] = {
+    {true, false, true, true},    // virtual glass among real things (the seed's example)
+    {true, false, false, false},  // virtual glass, virtual surroundings
+    {false, false, true, false},  // virtual light, virtual glass, real reflected, virtual refracted
+    {true, true, false, true},    // real glass reflecting a virtual box
+    {true, true, true, false},    // real glass with a virtual box behind it
+    {false, true, false, false},  // virtual light, real glass, virtual surroundings
+};
+
+// Floors over the sphere's pixels, ~1.5 dB / 0.05 below the lowest measured case (llvmpipe,
+// reference 48 spp seed 3, caustics off); docs/specular.md lists the per-case figures.
+constexpr double kMinPsnr = 24.0, kMinSsim = 0.60;
+
+class SpecularFig2 : public ::testing::TestWithParam<test::SpecularCase> {};
+
+TEST_P(SpecularFig2, MatchesReferenceOverTheSpecularObject) {
+    gl::Context context = gl::Context::headless();
+    const test::SpecularCase k = GetParam();
+    const auto s = test::makeSpecularScene(k, test::outputDir("specular_env_" + k.name()));
+    const Comparison c = reference(s);
+    const Result r = realtime(c, s);
+    save(k.name(), c, r);
+    std::cout << "[ specular ] " << k.name() << ": PSNR " << r.psnr << " dB, SSIM " << r.ssim
+              << " over " << cv::countNonZero(c.mask) << " sphere pixels\n";
+    RecordProperty("psnr_db", std::to_string(r.psnr));
+    RecordProperty("ssim", std::to_string(r.ssim));
+    EXPECT_GE(r.psnr, kMinPsnr);
+    EXPECT_GE(r.ssim, kMinSsim);
+}
+
+INSTANTIATE_TEST_SUITE_P(Fig2, SpecularFig2, ::testing::ValuesIn(kCases),
+                         [](const auto& info) { return info.param.name(); });
+
+// Per effect: reflection only (a mirror sphere), both (glass), refraction only (glass, the
+// sphere's central disc where Fresnel reflection is < 5 %). The broken render (the real-time
+// glass with IOR 1.2 instead of 1.5: wrong magnification) must fall below the floor.
+TEST(SpecularAccuracy, PerEffectAndBrokenRenderFails) {
+    gl::Context context = gl::Context::headless();
+    test::SpecularCase k;  // real light, virtual object, real surroundings
+    const auto envDir = test::outputDir("specular_env_effects");
+    {
+        const auto s = test::makeSpecularScene(k, envDir, test::SpecularKind::Mirror);
+        const Comparison c = reference(s);
+        const Result r = realtime(c, s);
+        save("effect_reflection_mirror", c, r);
+        std::cout << "[ specular ] reflection only (mirror): PSNR " << r.psnr << " dB, SSIM "
+                  << r.ssim << "\n";
+        EXPECT_GE(r.psnr, kMinPsnr);
+        EXPECT_GE(r.ssim, kMinSsim);
+    }
+    const auto s = test::makeSpecularScene(k, envDir);
+    Comparison c = reference(s);
+    const Result both = realtime(c, s);
+    std::cout << "[ specular ] both (glass): PSNR " << both.psnr << " dB, SSIM " << both.ssim
+              << "\n";
+    EXPECT_GE(both.psnr, kMinPsnr);
+    EXPECT_GE(both.ssim, kMinSsim);
+    const cv::Mat full = c.mask.clone();
+    c.mask = test::sphereMask(s, 0.4 * s.sphereRadius / glm::length(glm::vec3(0.0f, 0.35f, 1.1f)) *
+                                     s.cam.fx);  // inner disc: radius ~60 %
+    ASSERT_GT(cv::countNonZero(c.mask), 50);
+    const Result refr = realtime(c, s);
+    std::cout << "[ specular ] refraction only (glass centre): PSNR " << refr.psnr << " dB, SSIM "
+              << refr.ssim << "\n";
+    EXPECT_GE(refr.psnr, kMinPsnr);
+    c.mask = full;
+    const auto broken = test::makeSpecularScene(k, envDir, test::SpecularKind::Glass, 1.2f);
+    const Result bad = realtime(c, broken);
+    save("broken_ior_1_2", c, bad);
+    std::cout << "[ specular ] broken (IOR 1.2 for 1.5): PSNR " << bad.psnr << " dB, SSIM "
+              << bad.ssim << "\n";
+    EXPECT_TRUE(bad.psnr < kMinPsnr || bad.ssim < kMinSsim);
+    EXPECT_LT(bad.psnr, both.psnr - 3.0);
+}
+
+}  // namespace
+}  // namespace mirage::render
