@@ -1,7 +1,8 @@
 // Per-pass GPU time of the real-time renderer (GL_TIME_ELAPSED queries), on a table-top scene:
 // a real floor and real box (proxies), a virtual box and a virtual sphere, a real spot light and
 // no environment map. Arguments: width, height, VPL count, sphere subdivisions (triangles),
-// indirect (VPL gather) resolution divisor.
+// indirect (VPL gather) resolution divisor, specular objects (0 none, 1 glass sphere, 2 glass
+// sphere + mirror box).
 // Reported time = the frame's total GPU time (manual time); counters = per-pass ms (mean over the
 // iterations; use --benchmark_repetitions and the median aggregate for figures).
 #include <benchmark/benchmark.h>
@@ -40,12 +41,30 @@ void addSphere(Scene& s, glm::vec3 c, float r, int segments, int material, Origi
     test::addMeshNode(s, "sphere", std::move(p), origin);
 }
 
-Scene benchScene(int sphereSegments) {
+// specular: 0 = the sphere is diffuse blue (the diffuse-only frame), 1 = the sphere is glass
+// (IOR 1.5, light absorption), 2 = glass sphere and the virtual box a mirror (issue 6).
+Scene benchScene(int sphereSegments, int specular = 0) {
     Scene s;
     int white = test::addMaterial(s, glm::vec3(0.75f));
     int wood = test::addMaterial(s, {0.55f, 0.35f, 0.2f}, 0.6f);
     int red = test::addMaterial(s, {0.8f, 0.1f, 0.1f});
     int blue = test::addMaterial(s, {0.1f, 0.2f, 0.8f}, 0.3f);
+    if (specular >= 1) {
+        Material& g = s.materials[size_t(blue)];
+        g.baseColor = glm::vec4(1.0f);
+        g.metallic = 0.0f;
+        g.roughness = 0.0f;
+        g.transmission = 1.0f;
+        g.ior = 1.5f;
+        g.attenuationColor = {0.7f, 0.85f, 1.0f};
+        g.attenuationDistance = 0.3f;
+    }
+    if (specular >= 2) {
+        Material& m = s.materials[size_t(red)];
+        m.baseColor = glm::vec4(0.95f, 0.95f, 0.95f, 1.0f);
+        m.metallic = 1.0f;
+        m.roughness = 0.0f;
+    }
     test::addFloor(s, "table", 0.0f, 2.0f, wood, Origin::Real);
     test::addBox(s, "real box", {-0.6f, 0.0f, -0.5f}, {-0.3f, 0.3f, -0.2f}, white, Origin::Real);
     test::addBox(s, "virtual box", {0.1f, 0.0f, -0.2f}, {0.35f, 0.25f, 0.05f}, red,
@@ -69,7 +88,7 @@ void BM_Frame(benchmark::State& state) {
     opt.syncPasses = true;
     opt.indirectScale =
         int(state.range(4));  // per-pass attribution (see RendererOptions::syncPasses)
-    Scene scene = benchScene(int(state.range(3)));
+    Scene scene = benchScene(int(state.range(3)), state.range(5));
     CameraIntrinsics cam;
     cam.width = w;
     cam.height = h;
@@ -85,7 +104,8 @@ void BM_Frame(benchmark::State& state) {
     if (const char* dump = std::getenv("MIRAGE_BENCH_DUMP")) {
         const std::filesystem::path d(dump);
         std::filesystem::create_directories(d);
-        const std::string tag = cv::format("%dx%d_%dvpl", w, h, opt.vplCount);
+        const std::string tag =
+            cv::format("%dx%d_%dvpl_spec%d", w, h, opt.vplCount, int(state.range(5)));
         writeBgr8(d / ("composite_" + tag + ".png"), r.compositeSrgb());
         writeLinearRgb(d / ("Lrv_" + tag + ".png"), r.readBuffer(render::Resource::LRv));
         writeLinearRgb(d / ("Lr_" + tag + ".png"), r.readBuffer(render::Resource::LR));
@@ -106,10 +126,14 @@ void BM_Frame(benchmark::State& state) {
 
 void args(benchmark::internal::Benchmark* b) {
     for (auto [w, h] : {std::pair{640, 480}, std::pair{1024, 768}})
-        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32, 2});
-    b->Args({640, 480, 256, 32, 1});   // VPL gather at full resolution
-    b->Args({640, 480, 256, 128, 2});  // ~65k more triangles
-    b->Args({320, 240, 256, 32, 2});
+        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32, 2, 0});
+    b->Args({640, 480, 256, 32, 1, 0});   // VPL gather at full resolution
+    b->Args({640, 480, 256, 128, 2, 0});  // ~65k more triangles
+    b->Args({320, 240, 256, 32, 2, 0});
+    // Specular objects (issue 6): the same frame with the sphere glass, and glass + mirror box;
+    // compare with {640, 480, 256, 32, 2, 0} for the extra cost.
+    b->Args({640, 480, 256, 32, 2, 1});
+    b->Args({640, 480, 256, 32, 2, 2});
 }
 
 }  // namespace
