@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 
 #include <opencv2/core.hpp>
@@ -75,7 +76,12 @@ Result realtime(const Comparison& c, const test::SpecularScene& rtScene, Rendere
 }
 
 void save(const std::string& name, const Comparison& c, const Result& r) {
-    static const auto dir = test::outputDir("specular");
+    // Not test::outputDir (which empties the folder): every case of the suite adds its image.
+    static const std::filesystem::path dir = [] {
+        const auto d = std::filesystem::path(MIRAGE_TEST_OUTPUT_DIR) / "specular";
+        std::filesystem::create_directories(d);
+        return d;
+    }();
     cv::Mat side;
     cv::hconcat(std::vector<cv::Mat>{c.footage, r.rt, c.refSrgb}, side);
     cv::resize(side, side, cv::Size(), 3.0, 3.0, cv::INTER_NEAREST);
