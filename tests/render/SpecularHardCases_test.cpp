@@ -280,6 +280,36 @@ TEST(SpecularHardCases, RaysLeavingTheSceneShowTheEnvironment) {
     EXPECT_GT(p, 35.0);
 }
 
+// Analytic: a glass slab (IOR 1.5) and a mirror square facing the camera in a uniform environment
+// of radiance 1 and nothing else. Every ray leaves the scene, so a pixel is its weights times 1:
+// glass = F1 + (1 - F1)(1 - F2) with F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04 at normal incidence
+// (0.9616: the model has no internal bounces; the exact slab gives 1); mirror = Schlick(0.95) =
+// 0.95. Checked at the pixel that looks along the normal.
+TEST(SpecularHardCases, UniformEnvironmentGivesTheFresnelWeights) {
+    gl::Context context = gl::Context::headless();
+    const auto dir = test::outputDir("specular_uniform");
+    cv::Mat one(8, 16, CV_32FC3, cv::Scalar::all(1.0));
+    writeLinearRgb(dir / "one.pfm", one);
+    for (bool mirror : {false, true}) {
+        test::SpecularScene s;
+        s.scene.environment.kind = Environment::Kind::Equirectangular;
+        s.scene.environment.image = dir / "one.pfm";
+        const int mat = mirror ? test::addMirror(s.scene) : test::addGlass(s.scene);
+        test::addBox(s.scene, "slab", {-0.3f, -0.3f, -0.02f}, {0.3f, 0.3f, 0.0f}, mat,
+                     Origin::Virtual);
+        s.pose = test::lookAtPose({0.0, 0.0, 1.0}, {0.0, 0.0, 0.0});
+        Renderer r(s.scene, s.cam, singleFrame());
+        r.render({s.pose, cv::Mat(), true});
+        expectFiniteBuffers(r);
+        const cv::Vec3f px = r.compositeLinear().at<cv::Vec3f>(int(std::lround(s.cam.cy)),
+                                                               int(std::lround(s.cam.cx)));
+        const float F = 0.04f;
+        const float expected = mirror ? 0.95f : F + (1 - F) * (1 - F);
+        for (int k = 0; k < 3; ++k)
+            EXPECT_NEAR(px[k], expected, 2e-3f) << (mirror ? "mirror" : "glass");
+    }
+}
+
 TEST(SpecularHardCases, PassesRunOnlyWithSpecularObjects) {
     gl::Context context = gl::Context::headless();
     test::SpecularScene s;
