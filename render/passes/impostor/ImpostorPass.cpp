@@ -201,6 +201,7 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
     std::vector<GpuImpostorObject> objects;
     std::vector<std::vector<int>> enclosing(specular.size());
     stats_ = ImpostorBuildStats{};
+    kinds_.assign(specular.size(), std::vector<ItemKind>(draws.size(), ItemKind::None));
     stats_.resolution = res;
     stats_.objects = int(specular.size());
     const float margin = 1.0f + 2.0f / float(res);  // a texel of slack around every box
@@ -249,12 +250,14 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
                     selfReach = glm::dot(c - glm::vec3(b.centre), W) + rS;
                 if (selfReach > -b.axisW.w) {
                     enclosing[slot].push_back(int(k));
+                    kinds_[slot][k] = ItemKind::Enclosing;
                     for (const glm::vec3& p : s.points)
                         enclosingReach = std::max(enclosingReach, glm::length(p - c));
                     continue;
                 }
             }
             records.push_back(b);
+            kinds_[slot][k] = s.planar ? ItemKind::Plane : ItemKind::Billboard;
             ++obj.range.y;
             (s.planar ? stats_.planes : stats_.billboards)++;
         }
@@ -393,6 +396,13 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wallStart)
             .count();
     spdlog::info("impostors built: {}", stats_.summary());
+}
+
+ImpostorPass::ItemKind ImpostorPass::itemKind(int slot, int draw) const {
+    if (slot < 0 || size_t(slot) >= kinds_.size() || draw < 0 ||
+        size_t(draw) >= kinds_[size_t(slot)].size())
+        return ItemKind::None;
+    return kinds_[size_t(slot)][size_t(draw)];
 }
 
 void ImpostorPass::bindForTracing() const {

@@ -74,6 +74,9 @@ public:
     bool update(const GpuScene& scene, const RendererOptions& options);
     bool built() const { return builtScene_ != nullptr; }
     const ImpostorBuildStats& buildStats() const { return stats_; }
+    // How draw `draw` is represented for specular object `slot` (None: itself, or not built).
+    enum class ItemKind { None, Billboard, Plane, Enclosing };
+    ItemKind itemKind(int slot, int draw) const;
 
     // Offline: traces `rays` with traceSurroundings() in a compute shader and reads the hits back
     // (blocks). For tests and the accuracy benchmark; needs update() first.
@@ -101,6 +104,7 @@ private:
     int builtResolution_ = 0;
     bool builtThisFrame_ = false;
     ImpostorBuildStats stats_;
+    std::vector<std::vector<ItemKind>> kinds_;  // [slot][draw]
 };
 
 }  // namespace mirage::render
