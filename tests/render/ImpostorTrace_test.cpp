@@ -190,6 +190,34 @@ TEST_F(ImpostorTrace, RefinementReducesErrorAndTheBoundCanFail) {
     EXPECT_LT(a8.medianErrorMm, 10.0);
 }
 
+// Large geometry UNDER the object that is not a single plane (a thick table top: a box the
+// mirror stands on) cannot be a billboard around the table; it goes to the enclosing cube map and
+// is searched along the ray there. Rays from the lower half of the mirror must hit its top face.
+TEST_F(ImpostorTrace, ThickTableUnderTheObjectIsTracedExactly) {
+    Scene s;
+    const int wood = test::addMaterial(s, glm::vec3(0.5f, 0.35f, 0.2f));
+    const int mirror = test::addMaterial(s, glm::vec3(0.95f), 0.0f, 1.0f);
+    test::addBox(s, "table", {-1.0f, -0.05f, -0.6f}, {1.0f, 0.0f, 0.6f}, wood, Origin::Real);
+    test::addUvSphere(s, "mirror", {0.0f, 0.25f, 0.0f}, 0.25f, 16, mirror, Origin::Virtual);
+    GpuScene gpu(s, 64);
+    raytrace::RayTracingScene rt(s, raytrace::SceneSubset::All, *device_);
+    ImpostorPass pass;
+    pass.update(gpu, options(128, 4, false));
+    EXPECT_EQ(pass.itemKind(0, 0), ImpostorPass::ItemKind::Enclosing);
+    std::vector<ImpostorRay> rays;
+    for (const ImpostorRay& r : sampleSpecularSurfaceRays(s, gpu, 800, 5))
+        if (r.origin.y < 0.2f) rays.push_back(r);
+    const auto exact = castExact(rays, gpu, rt);
+    int onTop = 0;
+    for (const ExactHit& e : exact) onTop += e.hit && std::abs(e.position.y) < 1e-4f;
+    ASSERT_GT(onTop, 100);
+    const ImpostorAccuracy a = compareHits(pass.trace(rays), exact);
+    EXPECT_GT(a.hitMissAgreement, 0.97);
+    EXPECT_LT(a.medianErrorMm, 0.5);
+    EXPECT_LT(a.p90ErrorMm, 2.0);
+    EXPECT_GT(a.originAgreement, 0.99);
+}
+
 TEST_F(ImpostorTrace, RendererRunsThePassOnlyWithSpecularObjectsAndCachesIt) {
     RendererOptions o = options(32, 2, false);
     o.vplCount = 16;

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/Error.h"
+#include "core/Log.h"
 #include "render/Shaders.h"
 #include "render/passes/impostor/ImpostorTypes.h"
 
@@ -70,9 +71,9 @@ size_t bytesPerTexel(GLenum f) {
 
 std::string ImpostorBuildStats::summary() const {
     return fmt::format(
-        "{} objects: {} billboards, {} planes, {} enclosing items at {}^2; {:.1f} ms GPU, "
-        "{:.1f} ms wall, {:.1f} MiB",
-        objects, billboards, planes, enclosingItems, resolution, gpuMs, wallMs,
+        "{} objects: {} billboards, {} planes, {} enclosing items at {}^2; captures {:.1f} ms, "
+        "build {:.1f} ms, {:.1f} MiB",
+        objects, billboards, planes, enclosingItems, resolution, captureMs, wallMs,
         double(textureBytes) / (1024.0 * 1024.0));
 }
 
@@ -83,8 +84,7 @@ ImpostorPass::ImpostorPass()
                                      shaders::source("passes/impostor/capture.frag")}}),
       query_("impostor query", {{GL_COMPUTE_SHADER, "passes/impostor/query.comp",
                                  shaders::source("passes/impostor/query.comp")}}),
-      queryTimer_("impostor query timer"),
-      buildTimer_("impostor build timer") {
+      captureFbo_("impostor capture fbo") {
     locModel_ = capture_.uniformLocation("model");
     locNormal_ = capture_.uniformLocation("normalMatrix");
     locViewProj_ = capture_.uniformLocation("captureViewProj");
@@ -102,8 +102,8 @@ PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
     if (builtScene_ != &ctx.scene || builtResolution_ != ctx.options.impostorResolution)
         return {true, fmt::format("build for {} specular object(s) at {}^2 ({})", n,
                                   ctx.options.impostorResolution, method)};
-    return {true, fmt::format("cached ({}; {} refinement steps)", method,
-                              ctx.options.impostorRefineSteps)};
+    return {true, fmt::format("cached ({}, {} refinement steps; built once: {})", method,
+                              ctx.options.impostorRefineSteps, stats_.summary())};
 }
 
 void ImpostorPass::execute(FrameContext& ctx) {
@@ -201,6 +201,7 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
     std::vector<GpuImpostorObject> objects;
     std::vector<std::vector<int>> enclosing(specular.size());
     stats_ = ImpostorBuildStats{};
+    kinds_.assign(specular.size(), std::vector<ItemKind>(draws.size(), ItemKind::None));
     stats_.resolution = res;
     stats_.objects = int(specular.size());
     const float margin = 1.0f + 2.0f / float(res);  // a texel of slack around every box
@@ -249,12 +250,14 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
                     selfReach = glm::dot(c - glm::vec3(b.centre), W) + rS;
                 if (selfReach > -b.axisW.w) {
                     enclosing[slot].push_back(int(k));
+                    kinds_[slot][k] = ItemKind::Enclosing;
                     for (const glm::vec3& p : s.points)
                         enclosingReach = std::max(enclosingReach, glm::length(p - c));
                     continue;
                 }
             }
             records.push_back(b);
+            kinds_[slot][k] = s.planar ? ItemKind::Plane : ItemKind::Billboard;
             ++obj.range.y;
             (s.planar ? stats_.planes : stats_.billboards)++;
         }
@@ -307,9 +310,12 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
     builtScene_ = &scene;
     builtResolution_ = res;
 
-    // Captures.
-    buildTimer_.begin();
-    gl::Framebuffer fbo("impostor capture fbo");
+    // Captures, timed by the wall clock between two glFinish: llvmpipe's GL_TIME_ELAPSED gave
+    // meaningless values for this burst of small render passes, and inside a Renderer frame the
+    // pass timer is running anyway (timer queries cannot nest).
+    glFinish();
+    const auto captureStart = std::chrono::steady_clock::now();
+    gl::Framebuffer& fbo = captureFbo_;
     glViewport(0, 0, res, res);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -380,14 +386,23 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
             drawOne(draws[size_t(b.info.z)]);
         }
     }
-    buildTimer_.end();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDisable(GL_DEPTH_TEST);
-    stats_.gpuMs = buildTimer_.elapsedMs();  // waits: the build is a one-off per session
     glFinish();
+    stats_.captureMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - captureStart)
+            .count();
     stats_.wallMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wallStart)
             .count();
+    spdlog::info("impostors built: {}", stats_.summary());
+}
+
+ImpostorPass::ItemKind ImpostorPass::itemKind(int slot, int draw) const {
+    if (slot < 0 || size_t(slot) >= kinds_.size() || draw < 0 ||
+        size_t(draw) >= kinds_[size_t(slot)].size())
+        return ItemKind::None;
+    return kinds_[size_t(slot)][size_t(draw)];
 }
 
 void ImpostorPass::bindForTracing() const {
@@ -407,8 +422,8 @@ std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& ray
 }
 
 std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& rays,
-                                             double& gpuMs) const {
-    gpuMs = 0.0;
+                                             double& dispatchMs) const {
+    dispatchMs = 0.0;
     if (rays.empty()) return {};
     std::vector<QueryRayGpu> in(rays.size());
     for (size_t i = 0; i < rays.size(); ++i)
@@ -421,14 +436,19 @@ std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& ray
     glUniform1i(locRayCount_, int(rays.size()));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingQueryRays, rayBuf.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingQueryHits, hitBuf.id());
-    queryTimer_.begin();
+    // Timed by the wall clock around dispatch + glFinish: llvmpipe's GL_TIME_ELAPSED does not
+    // cover compute dispatches (it reads 0 ms), and on a software rasteriser the wall clock of
+    // the synchronised dispatch is the GPU time.
+    glFinish();
+    const auto start = std::chrono::steady_clock::now();
     glDispatchCompute(GLuint((rays.size() + 63) / 64), 1, 1);
-    queryTimer_.end();
+    glFinish();
+    dispatchMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     std::vector<QueryHitGpu> out(rays.size());
     glGetNamedBufferSubData(hitBuf.id(), 0, GLsizeiptr(out.size() * sizeof(QueryHitGpu)),
                             out.data());
-    gpuMs = queryTimer_.elapsedMs();
     std::vector<ImpostorHit> hits(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) {
         const QueryHitGpu& q = out[i];

@@ -48,8 +48,9 @@ struct ImpostorBuildStats {
     int billboards = 0;       // depth impostors (all objects)
     int planes = 0;           // planar-item impostors (all objects)
     int enclosingItems = 0;   // (object, item) pairs in the enclosing cube maps
-    double gpuMs = 0.0;       // GL_TIME_ELAPSED of the build (cube maps + impostors)
-    double wallMs = 0.0;      // wall clock of the build including the CPU geometry pass + glFinish
+    double captureMs = 0.0;   // rendering the cube maps + impostors (wall clock between glFinish)
+    double wallMs = 0.0;      // the whole build: geometry readback, classification, allocation,
+                              // captures (wall clock)
     size_t textureBytes = 0;  // GPU memory of all impostor and cube-map textures
     std::string summary() const;
 };
@@ -73,12 +74,16 @@ public:
     bool update(const GpuScene& scene, const RendererOptions& options);
     bool built() const { return builtScene_ != nullptr; }
     const ImpostorBuildStats& buildStats() const { return stats_; }
+    // How draw `draw` is represented for specular object `slot` (None: itself, or not built).
+    enum class ItemKind { None, Billboard, Plane, Enclosing };
+    ItemKind itemKind(int slot, int draw) const;
 
     // Offline: traces `rays` with traceSurroundings() in a compute shader and reads the hits back
     // (blocks). For tests and the accuracy benchmark; needs update() first.
     std::vector<ImpostorHit> trace(const std::vector<ImpostorRay>& rays) const;
-    // The same, timed: GPU milliseconds of the dispatch alone (GL_TIME_ELAPSED).
-    std::vector<ImpostorHit> trace(const std::vector<ImpostorRay>& rays, double& gpuMs) const;
+    // The same, timed: milliseconds of the dispatch alone (wall clock of dispatch + glFinish;
+    // llvmpipe's timer queries do not cover compute).
+    std::vector<ImpostorHit> trace(const std::vector<ImpostorRay>& rays, double& dispatchMs) const;
 
 private:
     void build(const GpuScene& scene, int resolution);
@@ -94,12 +99,12 @@ private:
     gl::Texture captureDepthBuffer_;
     gl::Buffer records_, objects_;
     std::vector<unsigned char> objectBytes_;  // header + objects, re-uploaded with the mode
-    mutable gl::TimerQuery queryTimer_;
-    gl::TimerQuery buildTimer_;
+    gl::Framebuffer captureFbo_;
     const GpuScene* builtScene_ = nullptr;
     int builtResolution_ = 0;
     bool builtThisFrame_ = false;
     ImpostorBuildStats stats_;
+    std::vector<std::vector<ItemKind>> kinds_;  // [slot][draw]
 };
 
 }  // namespace mirage::render
