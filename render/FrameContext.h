@@ -40,7 +40,7 @@ enum class Resource {
     SpecularRv,         // L'_rv (Eq. 3), Fresnel-weighted, canvas size
     SpecularR,          // L'_r (Eq. 4)
     Lenv,               // L_env: environment seen where a ray leaves the modelled scene
-    Composite,  // final image (camera image size): linear RGBA32F + sRGB8
+    Composite,          // final image (camera image size): linear RGBA32F + sRGB8
     Impostors,  // per specular object: reflected-scene impostors + G-buffer cube maps (world)
 };
 const char* resourceName(Resource r);
@@ -64,7 +64,9 @@ struct RendererOptions {
     int refractionMarchSteps = 16;        // back-face depth march steps of the refracted ray
     float backProjectionEpsilon = 0.02f;  // depth validation: |d - d_gbuf| < eps * d + 0.005 m
     bool specularVpls = true;             // light GBuf_refl / GBuf_refr hits with the VPLs too
-    bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
+    int specularVplStride = 4;  // 1, 4 or 16: each hit sums every stride-th VPL (x stride),
+                                // interleaved over 2x2 / 4x4 pixels (cheaper, noisier)
+    bool cullPasses = true;     // run only the passes the scene needs (false: run all; tests)
     // glFinish around every pass so each timer query holds only its pass's work. llvmpipe defers
     // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
     // without this a pass's time can show up in the next pass's query. For benchmarks.

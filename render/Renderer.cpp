@@ -89,6 +89,10 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     if (options_.refractionMarchSteps < 2 || options_.refractionMarchSteps > 128)
         throw Error("refractionMarchSteps must be 2..128, got " +
                     std::to_string(options_.refractionMarchSteps));
+    if (options_.specularVplStride != 1 && options_.specularVplStride != 4 &&
+        options_.specularVplStride != 16)
+        throw Error("specularVplStride must be 1, 4 or 16, got " +
+                    std::to_string(options_.specularVplStride));
     if (!(options_.backProjectionEpsilon > 0.0f) || options_.backProjectionEpsilon > 1.0f)
         throw Error("backProjectionEpsilon must be in (0, 1] (relative depth tolerance)");
     scene_ = std::make_unique<GpuScene>(scene, 16384);

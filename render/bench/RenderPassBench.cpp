@@ -2,7 +2,7 @@
 // a real floor and real box (proxies), a virtual box and a virtual sphere, a real spot light and
 // no environment map. Arguments: width, height, VPL count, sphere subdivisions (triangles),
 // indirect (VPL gather) resolution divisor, specular objects (0 none, 1 glass sphere, 2 glass
-// sphere + mirror box).
+// sphere + mirror box), specularVplStride (1, 4, 16).
 // Reported time = the frame's total GPU time (manual time); counters = per-pass ms (mean over the
 // iterations; use --benchmark_repetitions and the median aggregate for figures).
 #include <benchmark/benchmark.h>
@@ -90,7 +90,8 @@ void BM_Frame(benchmark::State& state) {
     opt.syncPasses = true;
     opt.indirectScale =
         int(state.range(4));  // per-pass attribution (see RendererOptions::syncPasses)
-    Scene scene = benchScene(int(state.range(3)), state.range(5));
+    opt.specularVplStride = int(state.range(6));
+    Scene scene = benchScene(int(state.range(3)), int(state.range(5)));
     CameraIntrinsics cam;
     cam.width = w;
     cam.height = h;
@@ -128,14 +129,17 @@ void BM_Frame(benchmark::State& state) {
 
 void args(benchmark::internal::Benchmark* b) {
     for (auto [w, h] : {std::pair{640, 480}, std::pair{1024, 768}})
-        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32, 2, 0});
-    b->Args({640, 480, 256, 32, 1, 0});   // VPL gather at full resolution
-    b->Args({640, 480, 256, 128, 2, 0});  // ~65k more triangles
-    b->Args({320, 240, 256, 32, 2, 0});
+        for (int vpls : {64, 256, 1024}) b->Args({w, h, vpls, 32, 2, 0, 1});
+    b->Args({640, 480, 256, 32, 1, 0, 1});   // VPL gather at full resolution
+    b->Args({640, 480, 256, 128, 2, 0, 1});  // ~65k more triangles
+    b->Args({320, 240, 256, 32, 2, 0, 1});
     // Specular objects (issue 6): the same frame with the sphere glass, and glass + mirror box;
     // compare with {640, 480, 256, 32, 2, 0} for the extra cost.
-    b->Args({640, 480, 256, 32, 2, 1});
-    b->Args({640, 480, 256, 32, 2, 2});
+    b->Args({640, 480, 256, 32, 2, 1, 1});
+    b->Args({640, 480, 256, 32, 2, 2, 1});
+    b->Args({640, 480, 256, 32, 2, 1, 4});   // glass, VPLs at the hits interleaved 2x2 (default)
+    b->Args({640, 480, 256, 32, 2, 2, 4});   // glass + mirror, default stride
+    b->Args({640, 480, 256, 32, 2, 1, 16});  // ... 4x4
 }
 
 // Time against error of the specular pipeline end to end (issue 6): the composite of a virtual

@@ -149,6 +149,15 @@ TEST(SpecularAccuracy, PerEffectAndBrokenRenderFails) {
               << "\n";
     EXPECT_GE(both.psnr, kMinPsnr);
     EXPECT_GE(both.ssim, kMinSsim);
+    {
+        RendererOptions o;
+        o.specularVplStride = 16;  // the cheapest setting: VPLs at the hits interleaved 4x4
+        const Result cheap = realtime(c, s, o);
+        std::cout << "[ specular ] both (glass), specularVplStride 16: PSNR " << cheap.psnr
+                  << " dB, SSIM " << cheap.ssim << "\n";
+        EXPECT_GE(cheap.psnr, kMinPsnr);
+        EXPECT_GE(cheap.ssim, kMinSsim);
+    }
     const cv::Mat full = c.mask.clone();
     c.mask = test::sphereMask(s, 0.4 * s.sphereRadius / glm::length(glm::vec3(0.0f, 0.35f, 1.1f)) *
                                      s.cam.fx);  // inner disc: radius ~60 %

@@ -17,6 +17,7 @@ SpecularLightPass::SpecularLightPass(const GBufferPass& gbuffer, const SpecularG
                 {GL_FRAGMENT_SHADER, "passes/specular/specular_light.frag",
                  shaders::source("passes/specular/specular_light.frag")}}) {
     locUseVpls_ = program_.uniformLocation("useVpls");
+    locVplStride_ = program_.uniformLocation("vplStride");
 }
 
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
@@ -77,6 +78,7 @@ void SpecularLightPass::execute(FrameContext& ctx) {
     glBindTextureUnit(14, gbuffer_.position().id());
     glBindTextureUnit(kUnitEnvironmentMap, ctx.scene.environmentMap().id());
     glUniform1i(locUseVpls_, vpls ? 1 : 0);
+    glUniform1i(locVplStride_, ctx.options.specularVplStride);
     ctx.emptyVao.bind();
     glDrawArrays(GL_TRIANGLES, 0, 3);
     ctx.publish(Resource::SpecularRv, &rv_);

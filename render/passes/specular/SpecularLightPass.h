@@ -38,7 +38,7 @@ private:
     gl::Program program_;
     gl::Texture rv_, r_, rRefl_, env_;
     gl::Framebuffer fbo_;
-    GLint locUseVpls_ = -1;
+    GLint locUseVpls_ = -1, locVplStride_ = -1;
     int width_ = 0, height_ = 0;
 };
 

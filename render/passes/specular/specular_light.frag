@@ -30,7 +30,8 @@ layout(binding = 12) uniform usampler2D ismAll;
 layout(binding = 13) uniform usampler2D ismReal;
 layout(binding = 14) uniform sampler2D gPosition;  // primary G-buffer
 layout(binding = 15) uniform sampler2D envMap;
-uniform int useVpls;  // 1 when VPLs (and their ISMs) exist this frame
+uniform int useVpls;    // 1 when VPLs (and their ISMs) exist this frame
+uniform int vplStride;  // interleaving: pixel p sums VPLs g, g + stride, ... (g from p), x stride
 layout(location = 0) out vec4 outRv;     // L'_rv
 layout(location = 1) out vec4 outR;      // L'_r
 layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r (for Eq. 9, see
@@ -46,7 +47,7 @@ float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
 
 // Outgoing radiance of hit point x towards the specular surface (unit v), both GI solutions.
 void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, float roughness,
-              vec3 emissive, out vec3 rv, out vec3 r) {
+              vec3 emissive, int firstVpl, out vec3 rv, out vec3 r) {
     rv = vec3(0.0);
     r = vec3(0.0);
     for (int li = 0; li < counts.x; ++li) {
@@ -71,7 +72,9 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
     if (useVpls == 1) {
         vec3 diffuse = albedo * (1.0 - metallic) / PI;
         float clamp2 = params.x * params.x;
-        for (int i = 0; i < counts.y; ++i) {
+        int stride = max(vplStride, 1);
+        vec3 vrv = vec3(0.0), vr = vec3(0.0);
+        for (int i = firstVpl; i < counts.y; i += stride) {
             GpuVpl V = vpls[i];
             if (V.normal.w < 0.5) continue;
             vec3 d = x - V.positionReal.xyz;
@@ -84,11 +87,12 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
             vec3 c = diffuse * V.flux.rgb / PI * cosQ * cosP / max(dist2, clamp2);
             float bias = 0.02 + 0.03 * dist;
             vec2 puv = paraboloidUv(V, w);
-            if (dist - bias <= ismDistance(ismAll, i, puv)) rv += c;
-            if (V.positionReal.w > 0.5 && xReal &&
-                dist - bias <= ismDistance(ismReal, i, puv))
-                r += c;
+            if (dist - bias <= ismDistance(ismAll, i, puv)) vrv += c;
+            if (V.positionReal.w > 0.5 && xReal && dist - bias <= ismDistance(ismReal, i, puv))
+                vr += c;
         }
+        rv += vrv * float(stride);
+        r += vr * float(stride);
     }
     rv += emissive;
     if (xReal) r += emissive;
@@ -119,7 +123,10 @@ void main() {
         vec3 v = normalize(texelFetch(gPosition, px, 0).xyz - P.xyz);
         if (!allFinite(v)) v = N.xyz;
         vec3 hrv, hr;
-        shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, e, hrv, hr);
+        // Interleaved VPL subsets: a 2x2 (stride 4) or 4x4 (16) pixel tile covers every VPL.
+        int st = max(vplStride, 1), side = st >= 16 ? 4 : (st >= 4 ? 2 : 1);
+        int firstVpl = (px.x % side + side * (px.y % side)) % st;
+        shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, e, firstVpl, hrv, hr);
         rv += w * hrv;
         r += w * hr;
         if (k == 0) rRefl = w * hr;
