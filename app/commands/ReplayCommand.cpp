@@ -185,9 +185,9 @@ void runReplay(const ReplayArgs& a) {
     }
     std::ofstream csv(csvPath);
     if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
-    const char* passes[] = {"gbuffer",  "shadow",   "vpl",      "ism",       "impostor",
-                            "direct",   "indirect", "gifilter", "backface",  "specgbuf",
-                            "speclight", "composite"};
+    const char* passes[] = {"gbuffer",  "shadow",   "vpl",       "ism",
+                            "impostor", "direct",   "indirect",  "gifilter",
+                            "backface", "specgbuf", "speclight", "composite"};
     csv << "frame,t,state,reason,decode_ms,tracking_ms";
     for (const char* p : passes) csv << "," << p << "_ms";
     csv << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz\n";
