@@ -57,7 +57,8 @@ Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
     : options_(options),
       detector_(options.detector),
       estimator_(std::move(board), std::move(camera), options.pose),
-      filter_(options.filter) {}
+      filter_(options.filter),
+      oneEuro_(options.oneEuro) {}
 
 TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     TrackedFrame f;
@@ -92,10 +93,16 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     if (f.estimate.state == TrackingState::Ok) {
         lastOk_ = f.estimate.pose;
         lastOkT_ = t;
-        f.filtered =
-            options_.filterEnabled ? filter_.update(*f.estimate.pose, t) : *f.estimate.pose;
+        if (!options_.filterEnabled)
+            f.filtered = *f.estimate.pose;
+        else if (options_.filterKind == FilterKind::OneEuro)
+            f.filtered = oneEuro_.update(*f.estimate.pose, t);
+        else
+            f.filtered = filter_.update(*f.estimate.pose, t, &f.estimate.covariance);
     } else {
-        filter_.reset();  // never smooth across a loss: the next ok pose starts afresh
+        // Never smooth across a loss: the next ok pose starts afresh.
+        filter_.reset();
+        oneEuro_.reset();
     }
     f.filterMs = msSince(t0);
     return f;
@@ -107,6 +114,7 @@ TrackedFrame Tracker::markLost(double t, const std::string& reason) {
     f.estimate.state = TrackingState::Lost;
     f.estimate.reason = reason;
     filter_.reset();
+    oneEuro_.reset();
     return f;
 }
 

@@ -14,10 +14,16 @@
 
 namespace mirage::tracking {
 
+// Temporal filter of the ok poses: the adaptive constant-velocity filter (default) or the One
+// Euro filter (the previous default, kept for comparison; it lags in fast motion).
+enum class FilterKind { Predictive, OneEuro };
+
 struct TrackerOptions {
     DetectorOptions detector;
     PoseEstimatorOptions pose;
-    OneEuroOptions filter;
+    FilterKind filterKind = FilterKind::Predictive;
+    PoseFilterOptions filter;
+    OneEuroOptions oneEuro;
     bool filterEnabled = true;
     // The previous ok pose helps decide the planar ambiguity only if it is this recent (seconds).
     double priorMaxAgeS = 0.5;
@@ -62,6 +68,7 @@ private:
     Detector detector_;
     PoseEstimator estimator_;
     PoseFilter filter_;
+    OneEuroPoseFilter oneEuro_;
     std::optional<Pose> lastOk_;
     double lastOkT_ = 0;
 };

@@ -60,8 +60,9 @@ TEST(Tracker, StaticCameraJitterBeforeAndAfterFiltering) {
         rt * 1e3, ft * 1e3, rr, fr);
     RecordProperty("jitter_translation_mm_raw", std::to_string(rt * 1e3));
     RecordProperty("jitter_translation_mm_filtered", std::to_string(ft * 1e3));
-    EXPECT_LT(ft, rt / 2);
-    EXPECT_LT(fr, rr / 2);
+    // The predictive filter at rest (gain ~0.1): jitter down at least 3x.
+    EXPECT_LT(ft, rt / 3);
+    EXPECT_LT(fr, rr / 3);
 
     // A frame of noise: no_tags, the filter resets, the next ok frame is unfiltered.
     cv::Mat junk(clean.size(), CV_8U);
