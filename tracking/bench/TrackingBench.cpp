@@ -145,6 +145,46 @@ void BM_Mirage(benchmark::State& state) {
     report(state, acc, f.images.size());
 }
 
+// The two stages of BM_Mirage alone: detection (libapriltag + corner refinement), and the pose
+// from precomputed detections.
+void BM_MirageDetect(benchmark::State& state) {
+    const Frames& f = frames(int(state.range(0)));
+    DetectorOptions dopt;
+    dopt.decimate = float(state.range(1));
+    Detector det(dopt);
+    size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(det.detect(f.images[i++ % f.images.size()]));
+}
+
+void BM_MiragePose(benchmark::State& state) {
+    const Frames& f = frames(int(state.range(0)));
+    DetectorOptions dopt;
+    dopt.decimate = float(state.range(1));
+    Detector det(dopt);
+    PoseEstimator pe(f.board, f.cam);
+    std::vector<std::vector<TagDetection>> dets;
+    for (const auto& img : f.images) dets.push_back(det.detect(img));
+    size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(pe.estimate(dets[i++ % dets.size()]));
+}
+
+BENCHMARK(BM_MirageDetect)
+    ->ArgNames({"width", "decimate"})
+    ->Args({640, 2})
+    ->Args({640, 3})
+    ->Args({640, 4})
+    ->Args({1280, 2})
+    ->Args({1280, 3})
+    ->Args({1280, 4})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_MiragePose)
+    ->ArgNames({"width", "decimate"})
+    ->Args({640, 2})
+    ->Args({1280, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 // ---- OpenCV ArUco ----------------------------------------------------------------------------
 
 struct Aruco {
@@ -217,8 +257,12 @@ void BM_Aruco(benchmark::State& state) {
 BENCHMARK(BM_Mirage)
     ->ArgNames({"width", "decimate"})
     ->Args({640, 2})
+    ->Args({640, 3})
+    ->Args({640, 4})
     ->Args({640, 1})
     ->Args({1280, 2})
+    ->Args({1280, 3})
+    ->Args({1280, 4})
     ->Args({1280, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
