@@ -30,6 +30,18 @@ struct TrackerOptions {
     // When no tag is found, an image whose sharpness (strongest gradients over the intensity
     // range, about 1 / edge width in pixels) is below this is reported too_blurred, not no_tags.
     double minSharpness = 0.12;
+    // Region of interest: after an ok frame (at most priorMaxAgeS old), tags are searched only
+    // in the image box of the whole board projected with that pose, grown by roiMarginFraction of
+    // its size plus roiMarginPx on every side (camera motion between frames). If that frame is
+    // then not ok, or the board's box under the new pose is not inside the region (part of the
+    // board may lie outside what was searched), it is detected again on the full image (the
+    // region's origin is aligned to 8 pixels so that libapriltag's decimation and threshold
+    // tiles fall as in a full search); every fullFrameEvery-th frame is
+    // always searched in full. Skipped when the box covers most of the image anyway.
+    bool roiEnabled = true;
+    double roiMarginPx = 32.0;
+    double roiMarginFraction = 0.15;
+    int fullFrameEvery = 30;
 };
 
 struct TrackedFrame {
@@ -39,6 +51,10 @@ struct TrackedFrame {
     std::vector<TagDetection> detections;
     double sharpness = -1;  // computed only when no tag was found
     double detectMs = 0, poseMs = 0, filterMs = 0;
+    // The region searched first (the full image when no region was used), and whether the
+    // full image had to be searched again because the region's result was not ok.
+    cv::Rect searchRegion;
+    bool fullFrameRetry = false;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -64,6 +80,11 @@ public:
     const PoseEstimator& estimator() const { return estimator_; }
 
 private:
+    // Image box of the board projected with T_world_camera, grown by the margins (or not), clipped
+    // to the image; nullopt when a board corner is behind the camera.
+    std::optional<cv::Rect> boardRegion(const Pose& T_world_camera, cv::Size image,
+                                        bool withMargins) const;
+
     TrackerOptions options_;
     Detector detector_;
     PoseEstimator estimator_;
@@ -71,6 +92,7 @@ private:
     OneEuroPoseFilter oneEuro_;
     std::optional<Pose> lastOk_;
     double lastOkT_ = 0;
+    int framesSinceFullSearch_ = 0;
 };
 
 }  // namespace mirage::tracking
