@@ -3,8 +3,8 @@
 // - a real grey floor (planar, 4 m square at y = 0) under everything;
 // - a virtual mirror sphere (r 0.25 m at (0, 0.25, 0)) and a real glass sphere (r 0.15 m at
 //   (0.9, 0.15, 0.8)): the specular objects (slots 0 and 1);
-// - a virtual red box NEAR the mirror (10 cm gap on +X), a real blue box far away on -X, a real
-//   green sphere behind on -Z;
+// - a virtual red box NEAR the mirror (10 cm gap on +X) or, with nearSphere, a finely tessellated
+//   red sphere there; a real blue box far away on -X, a real green sphere behind on -Z;
 // - optionally a real room without a ceiling (one non-planar mesh: four walls 1.5 m high at
 //   +-2 m) that encloses both specular objects. Rays leaving upwards leave the modelled scene.
 #include <cmath>
@@ -53,7 +53,9 @@ inline void addRoomWalls(Scene& s, float half, float h, int material, Origin ori
     addMeshNode(s, "room walls", std::move(p), origin);
 }
 
-inline Scene impostorTestScene(bool withRoom, int sphereSegments = 24) {
+// nearSphere: the near object is a smooth red sphere (r 0.12 m at (0.47, 0.12, 0), 10 cm from the
+// mirror) instead of the red box: curved, so the height-field refinement has work to do.
+inline Scene impostorTestScene(bool withRoom, int sphereSegments = 24, bool nearSphere = false) {
     Scene s;
     const int grey = addMaterial(s, glm::vec3(0.6f));
     const int red = addMaterial(s, glm::vec3(0.8f, 0.1f, 0.1f));
@@ -76,7 +78,11 @@ inline Scene impostorTestScene(bool withRoom, int sphereSegments = 24) {
                 Origin::Virtual);
     addUvSphere(s, "glass sphere", {0.9f, 0.15f, 0.8f}, 0.15f, sphereSegments, glassMat,
                 Origin::Real);
-    addBox(s, "near red box", {0.35f, 0.0f, -0.1f}, {0.55f, 0.3f, 0.1f}, red, Origin::Virtual);
+    if (nearSphere)
+        addUvSphere(s, "near red sphere", {0.47f, 0.12f, 0.0f}, 0.12f, 4 * sphereSegments, red,
+                    Origin::Virtual);
+    else
+        addBox(s, "near red box", {0.35f, 0.0f, -0.1f}, {0.55f, 0.3f, 0.1f}, red, Origin::Virtual);
     addBox(s, "far blue box", {-1.5f, 0.0f, 0.5f}, {-1.1f, 0.6f, 0.9f}, blue, Origin::Real);
     addUvSphere(s, "green sphere", {0.2f, 0.2f, -1.0f}, 0.2f, sphereSegments, green, Origin::Real);
     if (withRoom) addRoomWalls(s, 2.0f, 1.5f, wall, Origin::Real);

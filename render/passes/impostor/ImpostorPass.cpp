@@ -107,7 +107,7 @@ PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
 }
 
 void ImpostorPass::execute(FrameContext& ctx) {
-    builtThisFrame_ = update(ctx.scene, ctx.options);
+    update(ctx.scene, ctx.options);
     ctx.publish(Resource::Impostors, &depth_);
 }
 
@@ -272,6 +272,13 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
     // Textures.
     const int cubeLayers = std::max(1, int(specular.size()) * 12);
     const int impLayers = std::max(1, int(records.size()));
+    GLint maxLayers = 0;
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+    if (std::max(cubeLayers, impLayers) > maxLayers)
+        throw Error(fmt::format(
+            "the scene needs {} impostor layers and {} cube-map layers, but this GL allows {} "
+            "array layers; merge small surrounding meshes or use fewer specular objects",
+            impLayers, cubeLayers, maxLayers));
     cubePosition_ =
         gl::Texture::create2DArray("impostor cube position", res, res, cubeLayers, GL_RGBA32F);
     cubeNormal_ =

@@ -69,8 +69,9 @@ public:
     // (kBindingImpostor* in render/GpuTypes.h). Valid after the pass ran (or update()).
     void bindForTracing() const;
 
-    // Builds the impostors if the scene or the resolution changed (returns true then), and sets
-    // the per-frame mode (refinement steps, baseline). Throws mirage::Error on bad options.
+    // Builds the impostors if the scene (by address) or the resolution changed (returns true
+    // then), and sets the per-frame mode (refinement steps, baseline). Throws mirage::Error on
+    // bad options or when the scene needs more array layers than the GL allows.
     bool update(const GpuScene& scene, const RendererOptions& options);
     bool built() const { return builtScene_ != nullptr; }
     const ImpostorBuildStats& buildStats() const { return stats_; }
@@ -102,7 +103,6 @@ private:
     gl::Framebuffer captureFbo_;
     const GpuScene* builtScene_ = nullptr;
     int builtResolution_ = 0;
-    bool builtThisFrame_ = false;
     ImpostorBuildStats stats_;
     std::vector<std::vector<ItemKind>> kinds_;  // [slot][draw]
 };

@@ -3,7 +3,8 @@
 // (tests/render/ImpostorTestScene.h, with the enclosing room). Each configuration traces the same
 // rays from both specular objects' surfaces (uniform over the outer hemisphere) and compares with
 // exact Embree ray casts (computed once).
-// Arguments: impostor resolution, refinement steps, baseline (1 = cube map).
+// Arguments: impostor resolution, refinement steps, baseline (1 = cube map), near object (0 = the
+// red box, 1 = a finely tessellated red sphere: curved, where refinement matters).
 // Reported time = GPU time of tracing kRays rays in one compute dispatch (GL_TIME_ELAPSED, manual
 // time); counters: hit/miss agreement, origin agreement, median / p90 / mean hit-position error
 // (mm), the one-off build time (ms, wall clock) and texture memory (MiB).
@@ -27,13 +28,18 @@ using namespace mirage;
 
 constexpr int kRaysPerObject = 16384;  // 32768 rays in all (2 specular objects)
 
+gl::Context& context() {
+    static gl::Context ctx = gl::Context::headless();
+    return ctx;
+}
+
 struct Fixture {
-    gl::Context context = gl::Context::headless();
-    Scene scene = test::impostorTestScene(true, 32);
+    Scene scene;
     std::unique_ptr<render::GpuScene> gpu;
     std::vector<render::ImpostorRay> rays;
     std::vector<render::ExactHit> exact;
-    Fixture() {
+    explicit Fixture(bool nearSphere) : scene(test::impostorTestScene(true, 32, nearSphere)) {
+        context();
         gpu = std::make_unique<render::GpuScene>(scene, 64);
         raytrace::EmbreeDevice device;
         raytrace::RayTracingScene rt(scene, raytrace::SceneSubset::All, device);
@@ -42,13 +48,14 @@ struct Fixture {
     }
 };
 
-Fixture& fixture() {
-    static Fixture f;
-    return f;
+Fixture& fixture(bool nearSphere) {
+    static Fixture box(false);
+    static Fixture sphere(true);
+    return nearSphere ? sphere : box;
 }
 
 void BM_Trace(benchmark::State& state) {
-    Fixture& f = fixture();
+    Fixture& f = fixture(state.range(3) != 0);
     render::RendererOptions o;
     o.impostorResolution = int(state.range(0));
     o.impostorRefineSteps = int(state.range(1));
@@ -88,17 +95,18 @@ void BM_Trace(benchmark::State& state) {
 }
 
 void args(benchmark::internal::Benchmark* b) {
-    for (int res : {64, 128, 256, 512}) {
-        b->Args({res, 0, 1});  // cube-map baseline (steps do not apply)
-        for (int steps : {0, 1, 2, 4, 8}) b->Args({res, steps, 0});
-    }
+    for (int nearSphere : {0, 1})
+        for (int res : {64, 128, 256, 512}) {
+            b->Args({res, 0, 1, nearSphere});  // cube-map baseline (steps do not apply)
+            for (int steps : {0, 1, 2, 4, 8}) b->Args({res, steps, 0, nearSphere});
+        }
 }
 
 }  // namespace
 
 BENCHMARK(BM_Trace)
     ->Apply(args)
-    ->ArgNames({"res", "steps", "cube"})
+    ->ArgNames({"res", "steps", "cube", "curved"})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
