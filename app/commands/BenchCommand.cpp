@@ -9,7 +9,7 @@
 //   OUTDIR/bench.md          a markdown table of bench.csv with the command, date and load average
 // A "footage only" row per resolution judges the footage itself (the virtual contribution
 // removed): every real configuration should beat it in the influenced pixels.
-#include <chrono>
+#include <cctype>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +25,7 @@
 #include "core/Log.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
+#include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
 #include "render/evaluation/GroundTruthComposite.h"
@@ -38,7 +39,7 @@ namespace fs = std::filesystem;
 struct BenchArgs {
     std::string session, scene, output;
     std::vector<std::string> knobs;  // NAME=V1,V2,...
-    bool quick = false, listKnobs = false, noBaseline = false;
+    bool quick = false, listKnobs = false, noBaseline = false, images = false;
     int maxFrames = -1, start = 0, repeats = 1;
     float exposure = 1.0f;
 };
@@ -85,6 +86,7 @@ std::string commandLine(const BenchArgs& a) {
     if (a.repeats != 1) s += fmt::format(" --repeat {}", a.repeats);
     if (a.exposure != 1.0f) s += fmt::format(" --exposure {}", a.exposure);
     if (a.noBaseline) s += " --no-baseline";
+    if (a.images) s += " --images";
     return s;
 }
 
@@ -152,7 +154,7 @@ void runBench(const BenchArgs& a) {
                  grid.size(), frames.size(), a.session, calib.intrinsics.width,
                  calib.intrinsics.height, loadBefore);
     std::vector<render::BenchResult> results;
-    std::set<std::pair<int, int>> baselined;
+    std::set<std::pair<int, int>> sizes;
     for (size_t i = 0; i < grid.size(); ++i) {
         const auto& c = grid[i];
         render::BenchResult r =
@@ -162,11 +164,13 @@ void runBench(const BenchArgs& a) {
             "influenced {:.2f} dB, SSIM {:.4f} / {:.4f}",
             i + 1, grid.size(), c.label(), r.medianGpuMs, r.error.psnrFrame, r.error.psnrInfluenced,
             r.error.ssimFrame, r.error.ssimInfluenced);
-        const std::pair<int, int> size{r.config.width, r.config.height};
+        sizes.insert({r.config.width, r.config.height});
         results.push_back(std::move(r));
-        if (!a.noBaseline && baselined.insert(size).second)
-            results.push_back(render::footageBaseline(frames, size.first, size.second));
     }
+    // The footage judged as the composite, once per resolution, after the configurations.
+    if (!a.noBaseline)
+        for (auto it = sizes.rbegin(); it != sizes.rend(); ++it)
+            results.push_back(render::footageBaseline(frames, it->first, it->second));
     const std::string loadAfter = loadAverage();
 
     const std::string preamble = fmt::format(
@@ -190,6 +194,19 @@ void runBench(const BenchArgs& a) {
     render::writeBenchCsv((out / "bench.csv").string(), results);
     render::writeBenchFramesCsv((out / "bench_frames.csv").string(), results);
     render::writeBenchMarkdown((out / "bench.md").string(), results, preamble);
+    if (a.images) {
+        // The first frame of every configuration beside its ground truth (sRGB PNG).
+        fs::create_directories(out / "images");
+        for (const auto& r : results) {
+            std::string name = r.baseline ? "footage " + r.config.label() : r.config.label();
+            for (char& ch : name)
+                if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+            writeBgr8(out / "images" / (name + ".png"), r.firstComposite);
+            writeBgr8(
+                out / "images" / fmt::format("truth_{}x{}.png", r.config.width, r.config.height),
+                r.firstTruth);
+        }
+    }
     spdlog::info("bench: wrote {}, {}, {} (load average {} after)", (out / "bench.csv").string(),
                  (out / "bench_frames.csv").string(), (out / "bench.md").string(), loadAfter);
 }
@@ -207,7 +224,8 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
                     "Scene with the virtual objects (default: the one ground_truth.json names)");
     cmd->add_flag("--quick", a->quick, "A small grid (one resolution, 64/256 VPLs, gather 1/2)");
     cmd->add_option("--knob", a->knobs,
-                    "NAME=V1,V2,...: the values of one knob (repeatable; see --list-knobs)");
+                    "NAME=V1,V2,...: the values of one knob (repeatable; see --list-knobs)")
+        ->allow_extra_args(false);
     cmd->add_flag("--list-knobs", a->listKnobs, "List the knobs and exit");
     cmd->add_option("--frames", a->maxFrames, "Use at most N frames");
     cmd->add_option("--start", a->start, "First frame")->check(CLI::NonNegativeNumber);
@@ -217,6 +235,9 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
                     "Rendered radiance -> camera linear units (the synth's --exposure)")
         ->capture_default_str();
     cmd->add_flag("--no-baseline", a->noBaseline, "Leave out the footage-only rows");
+    cmd->add_flag("--images", a->images,
+                  "Also write each configuration's first composite and the ground truth to "
+                  "OUTDIR/images/ (sRGB PNG)");
     cmd->callback([a] {
         if (!a->listKnobs && a->session.empty())
             throw Error(

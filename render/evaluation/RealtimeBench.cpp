@@ -298,6 +298,10 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
             one.add(composite, f.truth, f.influence);
             fr.error = one.result();
             acc.add(composite, f.truth, f.influence);
+            if (i == 0) {
+                result.firstComposite = composite;
+                result.firstTruth = f.truth;
+            }
             gpu.push_back(fr.gpuMs);
             wall.push_back(fr.wallMs);
             frameResults.push_back(std::move(fr));
@@ -333,6 +337,10 @@ BenchResult footageBaseline(const std::vector<BenchFrame>& allFrames, int width,
         one.add(f.footage, f.truth, f.influence);
         fr.error = one.result();
         acc.add(f.footage, f.truth, f.influence);
+        if (result.frames.empty()) {
+            result.firstComposite = f.footage;
+            result.firstTruth = f.truth;
+        }
         result.frames.push_back(std::move(fr));
     }
     result.error = acc.result();

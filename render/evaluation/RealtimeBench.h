@@ -82,6 +82,8 @@ struct BenchResult {
     double medianGpuMs = 0.0, medianWallMs = 0.0;
     CompositeError error;  // pooled over all frames
     std::vector<BenchFrameResult> frames;
+    cv::Mat firstComposite;  // the first frame's composite (8-bit BGR sRGB), for a look
+    cv::Mat firstTruth;      // and its ground truth at the same size
 };
 
 // Scales a frame set to width x height (same aspect ratio as the session): footage and truth are
