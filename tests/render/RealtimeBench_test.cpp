@@ -6,6 +6,7 @@
 // The command line is run end to end on the bundled scene, with its error paths.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iostream>
 
@@ -16,6 +17,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
+#include "render/Renderer.h"
 #include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/ImageComparison.h"
 #include "render/evaluation/RealtimeBench.h"
@@ -206,6 +208,59 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     std::cout << "[ bench ] 80x60: " << small.error << "\n";
     EXPECT_EQ(small.config.width, 80);
     EXPECT_GE(small.error.psnrInfluenced, kMinPsnrInfluenced);
+}
+
+// Hard cases through the whole ground-truth pipeline (issue 5): a black real table (L_r = 0 where
+// the light falls), a very bright real light (10^5 W/sr: the footage saturates) and a virtual box
+// the camera sits inside of for the first frame (it crosses the near plane). Nothing may be NaN or
+// Inf: the reference's samples, the real-time buffers, the composites, the error figures.
+TEST(RealtimeBench, HardCasesStayFiniteThroughGroundTruthAndBench) {
+    Scene scene;
+    const int black = test::addMaterial(scene, glm::vec3(0.0f));
+    const int grey = test::addMaterial(scene, glm::vec3(0.5f));
+    test::addFloor(scene, "black table", 0.0f, 4.0f, black, Origin::Real);
+    test::addFloor(scene, "grey tile", 0.001f, 0.6f, grey, Origin::Real, 0.8f, 0.0f);
+    test::addBox(scene, "virtual box", {-0.15f, 0.0f, -0.15f}, {0.15f, 0.3f, 0.15f}, grey,
+                 Origin::Virtual);
+    // A large virtual shell around the first camera position (orbit start: azimuth -30 deg,
+    // radius 2.5, height 2.5): the camera is inside it, so its walls cross the near plane.
+    test::addBox(scene, "virtual shell", {-1.35f, 2.4f, 2.07f}, {-1.15f, 2.6f, 2.27f}, grey,
+                 Origin::Virtual);
+    test::addLight(scene, Light::Type::Spot, {0.0f, 2.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, 1e5f,
+                   Origin::Real, 1.0f, 0.9f);
+
+    const fs::path dir = mirage::test::outputDir("bench_hard") / "session";
+    raytrace::SyntheticSessionOptions o = tinySessionOptions();
+    o.seconds = 2.0 / 6.0;  // 2 frames
+    o.samplesPerPixel = 4;
+    raytrace::writeSyntheticSession(scene, dir, o);
+    const Session session = readSession(dir);
+    const auto info = readGroundTruthInfo(dir);
+    ASSERT_TRUE(info.has_value());
+    const CameraCalibration calib = loadSessionCalibration(session, "main");
+    const std::vector<BenchFrame> frames = loadBenchFrames(session, *info, calib.intrinsics);
+    ASSERT_EQ(frames.size(), 2u);
+    const cv::Mat& first = frames[0].influence;
+    EXPECT_GT(cv::countNonZero(first == kInfluenceVirtual), first.total() / 2)
+        << "the camera should start inside the virtual shell";
+
+    gl::Context context = gl::Context::headless();
+    const std::vector<BenchConfig> grid = benchGrid(calib.intrinsics, true, {{"vpls", {"64"}}});
+    const BenchResult r = runBenchConfig(scene, calib.intrinsics, frames, grid[0]);
+    std::cout << "[ bench ] hard cases: " << r.error << "\n";
+    for (double v : {r.error.psnrFrame, r.error.ssimFrame, r.error.psnrInfluenced,
+                     r.error.ssimInfluenced, r.medianGpuMs})
+        EXPECT_FALSE(std::isnan(v));
+    EXPECT_GT(r.error.psnrFrame, 10.0);
+
+    // The linear buffers of the real-time renderer on the same frames.
+    Renderer renderer(scene, calib.intrinsics);
+    for (const auto& f : frames) {
+        renderer.render({f.T_world_camera, f.footage, true});
+        for (const cv::Mat& m : {renderer.compositeLinear(), renderer.readBuffer(Resource::LRv),
+                                 renderer.readBuffer(Resource::LR)})
+            EXPECT_TRUE(cv::checkRange(m, true, nullptr, -1e30, 1e30));
+    }
 }
 
 TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
