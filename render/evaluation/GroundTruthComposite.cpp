@@ -1,6 +1,7 @@
 #include "render/evaluation/GroundTruthComposite.h"
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -137,8 +138,14 @@ cv::Mat influenceMask(const cv::Mat& realOnly, const cv::Mat& realAndVirtual,
     cv::Mat maxDiff;
     cv::reduce(diff, maxDiff, 1, cv::REDUCE_MAX);
     maxDiff = maxDiff.reshape(1, realOnly.rows) * gain;
+    // Averaged over 5x5 pixels before the threshold: a path that bounces off a virtual object
+    // makes L_rv and L_r differ by Monte Carlo noise in isolated pixels all over the image; the
+    // average keeps coherent changes (a shadow, bounced light) and drops that speckle.
+    cv::Mat smoothDiff;
+    cv::boxFilter(maxDiff, smoothDiff, -1, cv::Size(5, 5), cv::Point(-1, -1), true,
+                  cv::BORDER_REPLICATE);
     cv::Mat mask(realOnly.size(), CV_8U, cv::Scalar(kInfluenceNone));
-    mask.setTo(kInfluenceChanged, maxDiff > threshold);
+    mask.setTo(kInfluenceChanged, smoothDiff > threshold);
     // NaN never compares greater, so a broken render cannot mark pixels "untouched" silently:
     // non-finite differences count as changed.
     mask.setTo(kInfluenceChanged, maxDiff != maxDiff);

@@ -64,7 +64,8 @@ void writeGroundTruthFrame(const std::filesystem::path& sessionDir, const Ground
 // The influence mask from the reference renderer's two images of one frame: L_r (real only) and
 // L_rv (real + virtual), linear RGB float (CV_32FC3), and the virtual coverage (CV_32F, [0,1]).
 // `gain` brings rendered radiance into camera linear units (the exposure); a pixel is "changed"
-// where gain * |L_rv - L_r| > threshold in some channel.
+// where gain * max over channels |L_rv - L_r|, averaged over the 5x5 pixels around it, exceeds
+// `threshold` (the average drops isolated Monte Carlo differences, keeps shadows and bounces).
 cv::Mat influenceMask(const cv::Mat& realOnly, const cv::Mat& realAndVirtual,
                       const cv::Mat& virtualCoverage, double gain, double threshold);
 
