@@ -67,8 +67,9 @@ void writeSyntheticSession(const Scene& scene, const fs::path& out,
     if (a.environmentCamera)
         meta.cameras.push_back({"env", "env" + ext, "env.yaml", "environment"});
     meta.board = a.boardFile.empty() ? "" : "board.json";
-    meta.createdBy = fmt::format("mirage synth {} ({}x{}, {} spp, seed {})", a.sceneName, a.width,
-                                 a.height, a.samplesPerPixel, a.seed);
+    meta.createdBy = fmt::format("mirage synth {} ({}x{}, {} spp, seed {})",
+                                 fs::path(a.sceneName).filename().string(), a.width, a.height,
+                                 a.samplesPerPixel, a.seed);
     meta.createdAt = isoNow();
     SessionWriter::Options wopts;
     wopts.fps = a.fps;
