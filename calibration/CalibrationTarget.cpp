@@ -6,6 +6,7 @@
 #include <regex>
 
 #include <fmt/format.h>
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -23,6 +24,49 @@ struct CalibrationTarget::TagState {
     // libapriltag's corner order.
     std::map<int, std::array<cv::Point3f, 4>> cornersInBoard;
 };
+
+struct CalibrationTarget::CharucoState {
+    cv::Ptr<cv::aruco::Dictionary> dictionary;
+    cv::Ptr<cv::aruco::CharucoBoard> board;
+    cv::Ptr<cv::aruco::DetectorParameters> parameters;
+};
+
+namespace {
+
+// cv::aruco's predefined dictionaries by name (the names of cv::aruco::PREDEFINED_DICTIONARY_NAME).
+const std::map<std::string, cv::aruco::PREDEFINED_DICTIONARY_NAME>& arucoDictionaries() {
+    using namespace cv::aruco;
+    static const std::map<std::string, PREDEFINED_DICTIONARY_NAME> names = {
+        {"DICT_4X4_50", DICT_4X4_50},
+        {"DICT_4X4_100", DICT_4X4_100},
+        {"DICT_4X4_250", DICT_4X4_250},
+        {"DICT_4X4_1000", DICT_4X4_1000},
+        {"DICT_5X5_50", DICT_5X5_50},
+        {"DICT_5X5_100", DICT_5X5_100},
+        {"DICT_5X5_250", DICT_5X5_250},
+        {"DICT_5X5_1000", DICT_5X5_1000},
+        {"DICT_6X6_50", DICT_6X6_50},
+        {"DICT_6X6_100", DICT_6X6_100},
+        {"DICT_6X6_250", DICT_6X6_250},
+        {"DICT_6X6_1000", DICT_6X6_1000},
+        {"DICT_7X7_50", DICT_7X7_50},
+        {"DICT_7X7_100", DICT_7X7_100},
+        {"DICT_7X7_250", DICT_7X7_250},
+        {"DICT_7X7_1000", DICT_7X7_1000},
+        {"DICT_ARUCO_ORIGINAL", DICT_ARUCO_ORIGINAL},
+        {"DICT_APRILTAG_16h5", DICT_APRILTAG_16h5},
+        {"DICT_APRILTAG_25h9", DICT_APRILTAG_25h9},
+        {"DICT_APRILTAG_36h10", DICT_APRILTAG_36h10},
+        {"DICT_APRILTAG_36h11", DICT_APRILTAG_36h11},
+    };
+    return names;
+}
+
+// ChArUco corners needed in one view: fewer than this (or all on one line) constrain a homography
+// poorly, and OpenCV's own ChArUco calibration asks for at least 4 per view.
+constexpr size_t kMinCharucoCorners = 6;
+
+}  // namespace
 
 CalibrationTarget::CalibrationTarget(CalibrationTarget&&) noexcept = default;
 CalibrationTarget& CalibrationTarget::operator=(CalibrationTarget&&) noexcept = default;
@@ -78,11 +122,72 @@ CalibrationTarget CalibrationTarget::tagBoard(const tracking::Board& board) {
     return t;
 }
 
+CalibrationTarget CalibrationTarget::charuco(const CharucoGeometry& g) {
+    const auto& dicts = arucoDictionaries();
+    const auto dict = dicts.find(g.dictionary);
+    if (dict == dicts.end()) {
+        std::string known;
+        for (const auto& [name, id] : dicts) known += (known.empty() ? "" : ", ") + name;
+        throw Error(
+            fmt::format("ChArUco board: unknown dictionary '{}' (known: {})", g.dictionary, known));
+    }
+    if (g.squaresX < 3 || g.squaresY < 3)
+        throw Error(
+            fmt::format("ChArUco board {}x{}: need at least 3x3 squares", g.squaresX, g.squaresY));
+    if (!(g.squareMetres > 0) || !std::isfinite(g.squareMetres) || !(g.markerMetres > 0) ||
+        !(g.markerMetres < g.squareMetres))
+        throw Error(fmt::format(
+            "ChArUco board: square {} m and marker {} m: both must be positive and the marker "
+            "smaller than the square (e.g. charuco:5x7:0.04:0.02)",
+            g.squareMetres, g.markerMetres));
+    CalibrationTarget t;
+    t.kind_ = Kind::Charuco;
+    t.charucoGeometry_ = g;
+    t.charuco_ = std::make_unique<CharucoState>();
+    t.charuco_->dictionary = cv::aruco::getPredefinedDictionary(dict->second);
+    const int markers = (g.squaresX * g.squaresY) / 2;
+    if (markers > t.charuco_->dictionary->bytesList.rows)
+        throw Error(fmt::format("ChArUco board {}x{} needs {} markers; {} has only {}", g.squaresX,
+                                g.squaresY, markers, g.dictionary,
+                                t.charuco_->dictionary->bytesList.rows));
+    t.charuco_->board =
+        cv::aruco::CharucoBoard::create(g.squaresX, g.squaresY, float(g.squareMetres),
+                                        float(g.markerMetres), t.charuco_->dictionary);
+    t.charuco_->parameters = cv::aruco::DetectorParameters::create();
+    // Marker corners only seed the ChArUco corners, which interpolateCornersCharuco refines on
+    // the chessboard's saddle points: refining the markers' own corners too adds nothing.
+    t.charuco_->parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
+    for (const cv::Point3f& p : t.charuco_->board->chessboardCorners) t.allPoints_.push_back(p);
+    return t;
+}
+
+cv::Mat CalibrationTarget::drawCharuco(int pixelsPerSquare, int marginPx) const {
+    if (kind_ != Kind::Charuco) throw Error("drawCharuco: this target is not a ChArUco board");
+    const auto& g = charucoGeometry_;
+    cv::Mat image;
+    charuco_->board->draw(
+        {g.squaresX * pixelsPerSquare + 2 * marginPx, g.squaresY * pixelsPerSquare + 2 * marginPx},
+        image, marginPx, 1);
+    return image;
+}
+
 CalibrationTarget CalibrationTarget::parse(const std::string& spec) {
     static const std::regex chess(R"(chessboard:(\d+)x(\d+):([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?))");
     std::smatch m;
     if (std::regex_match(spec, m, chess))
         return chessboard({std::stoi(m[1]), std::stoi(m[2]), std::stod(m[3])});
+    static const std::regex charucoSpec(
+        R"(charuco:(\d+)x(\d+):([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?):([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?)(?::(\w+))?)");
+    if (std::regex_match(spec, m, charucoSpec)) {
+        CharucoGeometry g{std::stoi(m[1]), std::stoi(m[2]), std::stod(m[3]), std::stod(m[4])};
+        if (m[5].matched) g.dictionary = m[5];
+        return charuco(g);
+    }
+    if (spec.rfind("charuco", 0) == 0)
+        throw Error(fmt::format(
+            "--board '{}': expected charuco:SQUARESXxSQUARESY:SQUARE_METRES:MARKER_METRES[:DICT] "
+            "counting SQUARES, e.g. charuco:5x7:0.04:0.02:DICT_6X6_250",
+            spec));
     if (spec.rfind("chessboard", 0) == 0)
         throw Error(
             fmt::format("--board '{}': expected chessboard:COLSxROWS:SQUARE_METRES with "
@@ -95,6 +200,11 @@ std::string CalibrationTarget::description() const {
     if (kind_ == Kind::Chessboard)
         return fmt::format("chessboard {}x{} inner corners, {:.1f} mm squares", chessboard_.cols,
                            chessboard_.rows, 1000 * chessboard_.squareMetres);
+    if (kind_ == Kind::Charuco)
+        return fmt::format("ChArUco {}x{} squares, {:.1f} mm squares, {:.1f} mm {} markers",
+                           charucoGeometry_.squaresX, charucoGeometry_.squaresY,
+                           1000 * charucoGeometry_.squareMetres,
+                           1000 * charucoGeometry_.markerMetres, charucoGeometry_.dictionary);
     return fmt::format("{} board with {} tags", tags_->board.family, tags_->board.tags.size());
 }
 
@@ -116,6 +226,41 @@ TargetDetection CalibrationTarget::detect(const cv::Mat& image, const std::strin
     if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
     TargetDetection d;
     d.view.name = name;
+    if (kind_ == Kind::Charuco) {
+        // Markers first, then the chessboard corners between them: interpolated through the
+        // markers' homographies and refined to sub-pixel saddle points. Partial views are fine.
+        std::vector<std::vector<cv::Point2f>> markerCorners, rejected;
+        std::vector<int> markerIds;
+        cv::aruco::detectMarkers(grey, charuco_->dictionary, markerCorners, markerIds,
+                                 charuco_->parameters, rejected);
+        if (markerIds.empty()) {
+            d.reason = "no ChArUco markers found";
+            return d;
+        }
+        // Markers the detector missed, looked for again where the board says they must be.
+        cv::aruco::refineDetectedMarkers(grey, charuco_->board, markerCorners, markerIds, rejected);
+        std::vector<cv::Point2f> corners;
+        std::vector<int> ids;
+        cv::aruco::interpolateCornersCharuco(markerCorners, markerIds, grey, charuco_->board,
+                                             corners, ids);
+        if (ids.size() < kMinCharucoCorners) {
+            d.reason = fmt::format("{} ChArUco corners found (at least {} needed)", ids.size(),
+                                   kMinCharucoCorners);
+            return d;
+        }
+        // OpenCV 4.6's ChArUco refinement returns corners in a pixel-CORNER convention (it calls
+        // cornerSubPix on p - 0.5 and adds 0.5 back), half a pixel off the pixel-CENTRE
+        // convention of everything else here (cv::calibrateCamera, cv::projectPoints,
+        // docs/conventions.md). Measured on rendered boards: +0.50 px in x and y in every view
+        // (tests/calibration/Charuco_test.cpp), which would bias the principal point.
+        const cv::Point2f toPixelCentres(0.5f, 0.5f);
+        for (size_t i = 0; i < ids.size(); ++i) {
+            d.view.imagePoints.push_back(corners[i] - toPixelCentres);
+            d.view.boardPoints.push_back(charuco_->board->chessboardCorners[size_t(ids[i])]);
+        }
+        d.found = true;
+        return d;
+    }
     if (kind_ == Kind::TagBoard) {
         // Tags of this board only (ids it lists); each gives its 4 corners. Partial views are
         // fine, unlike a chessboard: the board may leave the image.

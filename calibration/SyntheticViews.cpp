@@ -157,6 +157,43 @@ cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardP
     return img;
 }
 
+cv::Mat ChessboardRenderer::renderTexture(const cv::Mat& texture, double metresPerTexel,
+                                          const cv::Point2d& boardOriginTexel,
+                                          const BoardPose& pose) const {
+    MR_CHECK(texture.type() == CV_8UC1 && metresPerTexel > 0, "texture must be 8-bit grey");
+    cv::Matx33d R;
+    cv::Rodrigues(pose.rvec, R);
+    const cv::Matx33d Rt = R.t();
+    const cv::Vec3d origin = -(Rt * pose.tvec);  // camera centre in board coordinates
+    cv::Mat img(camera_.height, camera_.width, CV_8UC1);
+    size_t k = 0;
+    for (int y = 0; y < camera_.height; ++y) {
+        auto* row = img.ptr<uint8_t>(y);
+        for (int x = 0; x < camera_.width; ++x) {
+            double sum = 0;
+            for (int s = 0; s < n_ * n_; ++s) {
+                const cv::Vec3f& r = rays_[k++];
+                double value = 110;
+                const cv::Vec3d d = Rt * cv::Vec3d(r[0], r[1], r[2]);
+                if (std::abs(d[2]) > 1e-12) {
+                    const double t = -origin[2] / d[2];
+                    if (t > 0) {
+                        const double u = std::floor((origin[0] + t * d[0]) / metresPerTexel +
+                                                    boardOriginTexel.x);
+                        const double v = std::floor((origin[1] + t * d[1]) / metresPerTexel +
+                                                    boardOriginTexel.y);
+                        if (u >= 0 && v >= 0 && u < texture.cols && v < texture.rows)
+                            value = texture.at<uint8_t>(int(v), int(u));
+                    }
+                }
+                sum += value;
+            }
+            row[x] = cv::saturate_cast<uint8_t>(sum / (n_ * n_));
+        }
+    }
+    return img;
+}
+
 cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,
                          const BoardPose& pose, int supersample) {
     return ChessboardRenderer(camera, supersample).render(board, pose);

@@ -60,6 +60,12 @@ class ChessboardRenderer {
 public:
     ChessboardRenderer(const CameraIntrinsics& camera, int supersample = 3);
     cv::Mat render(const ChessboardGeometry& board, const BoardPose& pose) const;
+    // Any printed planar pattern (8-bit grey texture, row 0 at the top): texel (u, v) covers the
+    // board-frame square [x0 + u*s, x0 + (u+1)*s) x [y0 + v*s, y0 + (v+1)*s) (metres, s =
+    // metresPerTexel, (x0, y0) = boardOriginTexel scaled by -s), nearest texel per sub-pixel.
+    // Outside the texture: the background (110).
+    cv::Mat renderTexture(const cv::Mat& texture, double metresPerTexel,
+                          const cv::Point2d& boardOriginTexel, const BoardPose& pose) const;
 
 private:
     CameraIntrinsics camera_;

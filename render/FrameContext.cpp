@@ -36,6 +36,8 @@ const char* resourceName(Resource r) {
             return "LR";
         case Resource::Composite:
             return "Composite";
+        case Resource::Impostors:
+            return "Impostors";
     }
     return "?";
 }

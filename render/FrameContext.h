@@ -33,6 +33,7 @@ enum class Resource {
     LRv,
     LR,         // the two GI solutions, filtered and temporally smoothed
     Composite,  // final image (camera image size): linear RGBA32F + sRGB8
+    Impostors,  // per specular object: reflected-scene impostors + G-buffer cube maps (world)
 };
 const char* resourceName(Resource r);
 
@@ -56,6 +57,11 @@ struct RendererOptions {
     // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
     // without this a pass's time can show up in the next pass's query. For benchmarks.
     bool syncPasses = false;
+
+    // Reflected-scene impostors for specular objects (render/passes/impostor, issue 6).
+    int impostorResolution = 256;          // texels per side of each impostor and cube face
+    int impostorRefineSteps = 4;           // secant refinement steps of the height-field search
+    bool impostorCubeMapBaseline = false;  // true: plain G-buffer cube map, looked up by direction
 };
 
 struct LightPlan {

@@ -14,11 +14,12 @@
 namespace mirage::render {
 namespace {
 
-struct Vertex {
+struct Vertex {  // = GpuSceneVertex (GpuScene.h), layout checked below
     glm::vec3 position;  // mesh-local
     glm::vec3 normal;    // mesh-local
     glm::vec2 uv;        // the UV set the base colour texture uses (glTF: (0,0) = top left)
 };
+static_assert(sizeof(Vertex) == sizeof(GpuSceneVertex));
 
 GpuMaterial toGpu(const Material& m) {
     GpuMaterial g;

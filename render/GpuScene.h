@@ -21,6 +21,14 @@ struct BoundingSphere {
     float radius = 0.0f;  // metres
 };
 
+// One vertex of GpuScene::vertexBuffer() (mesh-local; 32 bytes, tightly packed).
+struct GpuSceneVertex {
+    glm::vec3 position;  // mesh-local (metres)
+    glm::vec3 normal;    // mesh-local
+    glm::vec2 uv;        // the UV set the base colour texture uses
+};
+static_assert(sizeof(GpuSceneVertex) == 32);
+
 struct DrawItem {
     std::string name;              // node name, for reports
     glm::mat4 model{1.0f};         // world-from-mesh
@@ -77,6 +85,10 @@ public:
     void drawItem(const DrawItem& d) const;
     const gl::Buffer& materialBuffer() const { return materials_; }
     const gl::Buffer& surfacePointBuffer() const { return points_; }
+    // Vertex buffer (GpuSceneVertex below, mesh-local) and uint32 index buffer of all draws, e.g.
+    // for a pass that needs the geometry on the CPU once (impostor planes and boxes).
+    const gl::Buffer& vertexBuffer() const { return vertices_; }
+    const gl::Buffer& indexBuffer() const { return indices_; }
 
     // Radiance SH9 of an equirectangular linear RGB float image (CV_32FC3, top row = +Y up,
     // u = 0.5 looks down -Z, as in glTF/three.js). Exposed for tests.

@@ -15,6 +15,20 @@ inline constexpr int kOriginNone = 0, kOriginReal = 1, kOriginVirtual = 2;
 inline constexpr unsigned kBindingFrame = 0, kBindingLights = 1, kBindingVpls = 2,
                           kBindingMaterials = 3, kBindingIsmPoints = 4;
 
+// Reflected-scene impostors (render/passes/impostor/trace.glsl, issue 6): the ONLY units and
+// binding points traceSurroundings() uses; consumer shaders must leave them alone. trace.glsl
+// spells the same numbers in its layout(binding = N) qualifiers.
+inline constexpr unsigned kBindingImpostorCubePosition = 16,  // sampler2DArray, RGBA32F
+    kBindingImpostorCubeNormal = 17,                          // sampler2DArray, RGBA16F
+    kBindingImpostorCubeAlbedo = 18,                          // sampler2DArray, RGBA8
+    kBindingImpostorCubeEmissive = 19,                        // sampler2DArray, RGBA16F
+    kBindingImpostorDepth = 20,                               // sampler2DArray, RG32F
+    kBindingImpostorNormal = 21,                              // sampler2DArray, RGBA16F
+    kBindingImpostorAlbedo = 22,                              // sampler2DArray, RGBA8
+    kBindingImpostorEmissive = 23,                            // sampler2DArray, RGBA16F
+    kBindingImpostorRecords = 6,                              // SSBO of GpuImpostor
+    kBindingImpostorObjects = 7;                              // SSBO: header + GpuImpostorObject
+
 struct alignas(16) GpuLight {
     glm::mat4 viewProj[6];
     glm::vec4 positionRange;

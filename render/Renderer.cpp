@@ -14,6 +14,7 @@
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
+#include "render/passes/impostor/ImpostorPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
 #include "render/passes/shadow/ShadowPass.h"
@@ -90,6 +91,9 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     auto shadow = std::make_unique<ShadowPass>();
     auto vpl = std::make_unique<VplPass>(*shadow);
     auto ism = std::make_unique<IsmPass>(*vpl);
+    // Reflected-scene impostors of the specular objects' surroundings (issue 6): the specular
+    // passes (GBuf_refl / GBuf_refr) take a reference to it and call bindForTracing().
+    auto impostor = std::make_unique<ImpostorPass>();
     auto direct = std::make_unique<DirectLightPass>(*gbuffer);
     auto indirect = std::make_unique<IndirectLightPass>(*gbuffer, *vpl);
     auto filter = std::make_unique<GiFilterPass>(*gbuffer);
@@ -99,6 +103,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     passes_.push_back(std::move(shadow));
     passes_.push_back(std::move(vpl));
     passes_.push_back(std::move(ism));
+    passes_.push_back(std::move(impostor));
     passes_.push_back(std::move(direct));
     passes_.push_back(std::move(indirect));
     passes_.push_back(std::move(filter));

@@ -187,6 +187,10 @@ Detector& Detector::operator=(Detector&& o) noexcept {
 }
 
 std::vector<TagDetection> Detector::detect(const cv::Mat& image) {
+    return detect(image, cv::Rect(0, 0, image.cols, image.rows));
+}
+
+std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect& roiIn) {
     MR_CHECK(detector_ != nullptr, "detect() on a moved-from Detector");
     cv::Mat grey;
     if (image.type() == CV_8UC1)
@@ -198,7 +202,10 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image) {
                     std::to_string(image.type()) + ")");
     std::vector<TagDetection> out;
     if (grey.empty()) return out;
-    image_u8_t im{grey.cols, grey.rows, int(grey.step[0]), grey.data};
+    const cv::Rect roi = roiIn & cv::Rect(0, 0, grey.cols, grey.rows);
+    if (roi.width < 8 || roi.height < 8) return out;
+    // A view of the region (rows keep the full image's stride): libapriltag reads only it.
+    image_u8_t im{roi.width, roi.height, int(grey.step[0]), grey.ptr<uint8_t>(roi.y) + roi.x};
     zarray_t* dets = apriltag_detector_detect(detector_, &im);
     if (zarray_size(dets) == 0 && options_.fullResolutionRetry && options_.decimate > 1.0f) {
         apriltag_detections_destroy(dets);
@@ -215,11 +222,13 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image) {
         t.id = d->id;
         t.hamming = d->hamming;
         t.decisionMargin = d->decision_margin;
-        t.centre = {d->c[0], d->c[1]};
         // libapriltag puts pixel centres at +0.5 (its corner coordinates have the image origin at
         // the top-left pixel's corner); mirage uses OpenCV's convention (centres at integers).
-        for (int k = 0; k < 4; ++k) t.corners[size_t(k)] = {d->p[k][0] - 0.5, d->p[k][1] - 0.5};
-        t.centre -= glm::dvec2(0.5);
+        // Coordinates in the region are moved to the full image.
+        const glm::dvec2 shift(roi.x - 0.5, roi.y - 0.5);
+        t.centre = glm::dvec2(d->c[0], d->c[1]) + shift;
+        for (int k = 0; k < 4; ++k)
+            t.corners[size_t(k)] = glm::dvec2(d->p[k][0], d->p[k][1]) + shift;
         if (options_.refineCorners) refineCorners(grey, family_->widthAtBorder(), t);
         out.push_back(t);
     }

@@ -69,6 +69,10 @@ public:
     // Detects tags in an 8-bit image: CV_8UC1 grey, or CV_8UC3 BGR (converted to grey). Throws
     // mirage::Error on another type. Not thread-safe: one Detector per thread.
     std::vector<TagDetection> detect(const cv::Mat& image);
+    // The same, searching for quads only inside `roi` (pixels, clipped to the image; no copy):
+    // the cost of libapriltag scales with the area searched. Corners are in full-image pixels
+    // and refined on the full image.
+    std::vector<TagDetection> detect(const cv::Mat& image, const cv::Rect& roi);
 
     const DetectorOptions& options() const { return options_; }
 

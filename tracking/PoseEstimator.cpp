@@ -168,9 +168,10 @@ Fit refine(const CameraIntrinsics& cam, const Pose& start,
                 lambda *= 10;
                 continue;
             }
-            // Predicted decrease of the Gauss-Newton model; below 1e-10 of the cost we are done.
+            // Predicted decrease of the Gauss-Newton model; below 1e-6 of the cost we are done (the
+            // remaining step moves the pose by ~1e-3 of its noise).
             const double predicted = -(2 * g.dot(dx) + dx.dot(A * dx));
-            if (predicted < 1e-10 * cost + 1e-20) {
+            if (predicted < 1e-6 * cost + 1e-20) {
                 converged = true;
                 break;
             }
@@ -207,15 +208,27 @@ Fit refine(const CameraIntrinsics& cam, const Pose& start,
     return f;
 }
 
+// Corner RMS of one tag (as rmsOf(residuals(...)) for that tag alone, without allocating: it is
+// called for every candidate pose and tag).
 double tagRms(const CameraIntrinsics& cam, const Pose& T_world_camera, const Observation& o) {
-    std::vector<double> r;
-    residuals(cam, T_world_camera, {&o}, r);
-    return rmsOf(r);
+    const Pose T_camera_world = T_world_camera.inverse();
+    double s = 0;
+    for (int k = 0; k < 4; ++k) {
+        const auto px = cam.project(T_camera_world * o.world[size_t(k)]);
+        if (px) {
+            const glm::dvec2 d = *px - o.pixels[size_t(k)];
+            s += glm::dot(d, d);
+        } else {
+            s += 2 * kMissPenaltyPx * kMissPenaltyPx;
+        }
+    }
+    return std::sqrt(s / 4.0);
 }
 
-bool samePose(const Pose& a, const Pose& b, double scale) {
-    return rotationAngleBetween(a.rotation, b.rotation) < glm::radians(1.0) &&
-           glm::length(a.translation - b.translation) < 0.02 * scale;
+bool samePose(const Pose& a, const Pose& b, double scale, double maxDeg = 1.0,
+              double maxRel = 0.02) {
+    return rotationAngleBetween(a.rotation, b.rotation) < glm::radians(maxDeg) &&
+           glm::length(a.translation - b.translation) < maxRel * scale;
 }
 
 }  // namespace
@@ -273,10 +286,19 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         return out;
     }
 
-    // 2. Candidates: both IPPE solutions of every tag, as T_world_camera.
+    // 2. Candidates: both IPPE solutions of each of the largest tags (their corners are the most
+    // precise; a few are enough to contain the right pose even with an outlier tag among them),
+    // as T_world_camera.
+    std::vector<const Observation*> initTags;
+    for (const auto& o : obs) initTags.push_back(&o);
+    std::sort(initTags.begin(), initTags.end(),
+              [](const Observation* a, const Observation* b) { return a->sidePx > b->sidePx; });
+    if (initTags.size() > size_t(options_.maxInitTags))
+        initTags.resize(size_t(options_.maxInitTags));
     std::vector<Pose> candidates;
     const double maxInitZ = std::cos(glm::radians(options_.maxInitAngleDeg));
-    for (const auto& o : obs) {
+    for (const Observation* op : initTags) {
+        const Observation& o = *op;
         std::vector<cv::Point2d> img;
         for (const auto& p : o.pixels) {
             const auto ray = camera_.unproject(p);
@@ -381,8 +403,15 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     // test below (most candidates of a multi-tag view converge to the same pose).
     int refinements = 0;
     for (size_t i = 0; i < scored.size() && refined.size() < 3 && refinements < 4; ++i) {
+        // A candidate that explains fewer than half as many tags as the best one cannot win and
+        // is no serious alternative (the classic flip of the largest tag is checked below).
+        if (2 * scored[i].support < scored[0].support) break;
         bool dup = false;
-        for (const auto& r : refined) dup = dup || samePose(r.fit.pose, scored[i].pose, sceneScale);
+        // An unrefined candidate near an already refined pose would converge to it: single-tag
+        // IPPE poses scatter by a few degrees around the multi-tag optimum (the flipped
+        // solution of a tilted tag lies tens of degrees away).
+        for (const auto& r : refined)
+            dup = dup || samePose(r.fit.pose, scored[i].pose, sceneScale, 5.0, 0.05);
         if (dup) continue;
         ++refinements;
         Refined r = refineWithRejection(scored[i].pose);

@@ -46,6 +46,9 @@ struct PoseEstimatorOptions {
     // Corners of fish-eye rays more than this far off the optical axis are not used for the IPPE
     // initialisation (normalised coordinates explode near 90 degrees); LM still uses them.
     double maxInitAngleDeg = 75.0;
+    // Initial candidates come from the IPPE solutions of this many tags, the largest in the
+    // image (all tags still score them and enter the refinement).
+    int maxInitTags = 6;
 };
 
 struct PoseEstimate {

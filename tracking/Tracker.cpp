@@ -57,7 +57,37 @@ Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
     : options_(options),
       detector_(options.detector),
       estimator_(std::move(board), std::move(camera), options.pose),
-      filter_(options.filter) {}
+      filter_(options.filter),
+      oneEuro_(options.oneEuro) {}
+
+std::optional<cv::Rect> Tracker::boardRegion(const Pose& T_world_camera, cv::Size image,
+                                             bool withMargins) const {
+    const Pose T_camera_world = T_world_camera.inverse();
+    double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+    for (const auto& tag : estimator_.board().tags) {
+        for (const auto& c : tag.cornersInWorld()) {
+            const glm::dvec3 Xc = T_camera_world * c;
+            if (!(Xc.z > 1e-3)) return std::nullopt;  // the board reaches behind the camera
+            const auto px = estimator_.camera().project(Xc);
+            if (!px) return std::nullopt;
+            x0 = std::min(x0, px->x);
+            y0 = std::min(y0, px->y);
+            x1 = std::max(x1, px->x);
+            y1 = std::max(y1, px->y);
+        }
+    }
+    const double mx =
+        withMargins ? options_.roiMarginPx + options_.roiMarginFraction * (x1 - x0) : 0.0;
+    const double my =
+        withMargins ? options_.roiMarginPx + options_.roiMarginFraction * (y1 - y0) : 0.0;
+    // Origin aligned down to 8 pixels (libapriltag's decimation and threshold tiles).
+    const int bx0 = std::max(0, int(std::floor(x0 - mx)) / 8 * 8);
+    const int by0 = std::max(0, int(std::floor(y0 - my)) / 8 * 8);
+    const int bx1 = std::min(image.width, int(std::ceil(x1 + mx)));
+    const int by1 = std::min(image.height, int(std::ceil(y1 + my)));
+    if (bx1 <= bx0 || by1 <= by0) return cv::Rect();
+    return cv::Rect(bx0, by0, bx1 - bx0, by1 - by0);
+}
 
 TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     TrackedFrame f;
@@ -67,14 +97,43 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
     else
         grey = image;
-    auto t0 = std::chrono::steady_clock::now();
-    f.detections = detector_.detect(grey);
-    f.detectMs = msSince(t0);
-
-    t0 = std::chrono::steady_clock::now();
     std::optional<Pose> prior;
     if (lastOk_ && t - lastOkT_ <= options_.priorMaxAgeS && t >= lastOkT_) prior = lastOk_;
+
+    const cv::Rect full(0, 0, grey.cols, grey.rows);
+    f.searchRegion = full;
+    if (options_.roiEnabled && prior && ++framesSinceFullSearch_ < options_.fullFrameEvery) {
+        const auto r = boardRegion(*prior, grey.size(), true);
+        // Not worth it when the box covers most of the image.
+        if (r && r->area() > 0 && r->area() < 0.7 * full.area()) f.searchRegion = *r;
+    }
+    if (f.searchRegion == full) framesSinceFullSearch_ = 0;
+
+    auto t0 = std::chrono::steady_clock::now();
+    f.detections = detector_.detect(grey, f.searchRegion);
+    f.detectMs = msSince(t0);
+    t0 = std::chrono::steady_clock::now();
     f.estimate = estimator_.estimate(f.detections, prior);
+    f.poseMs = msSince(t0);
+    bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
+    if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
+        const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
+        retry = !now || (*now & f.searchRegion) != *now;
+    }
+    if (retry) {
+        // The region missed the board or part of it (fast motion, occlusion): search the whole
+        // image before giving up or using fewer tags than the frame shows.
+        f.fullFrameRetry = true;
+        framesSinceFullSearch_ = 0;
+        t0 = std::chrono::steady_clock::now();
+        f.detections = detector_.detect(grey);
+        f.detectMs += msSince(t0);
+        t0 = std::chrono::steady_clock::now();
+        f.estimate = estimator_.estimate(f.detections, prior);
+        f.poseMs += msSince(t0);
+    }
+
+    t0 = std::chrono::steady_clock::now();
     if (f.estimate.state == TrackingState::NoTags) {
         f.sharpness = imageSharpness(grey);
         if (f.sharpness > 0 && f.sharpness < options_.minSharpness) {
@@ -86,16 +145,22 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
             f.estimate.reason = buf;
         }
     }
-    f.poseMs = msSince(t0);
+    f.poseMs += msSince(t0);
 
     t0 = std::chrono::steady_clock::now();
     if (f.estimate.state == TrackingState::Ok) {
         lastOk_ = f.estimate.pose;
         lastOkT_ = t;
-        f.filtered =
-            options_.filterEnabled ? filter_.update(*f.estimate.pose, t) : *f.estimate.pose;
+        if (!options_.filterEnabled)
+            f.filtered = *f.estimate.pose;
+        else if (options_.filterKind == FilterKind::OneEuro)
+            f.filtered = oneEuro_.update(*f.estimate.pose, t);
+        else
+            f.filtered = filter_.update(*f.estimate.pose, t, &f.estimate.covariance);
     } else {
-        filter_.reset();  // never smooth across a loss: the next ok pose starts afresh
+        // Never smooth across a loss: the next ok pose starts afresh.
+        filter_.reset();
+        oneEuro_.reset();
     }
     f.filterMs = msSince(t0);
     return f;
@@ -107,6 +172,7 @@ TrackedFrame Tracker::markLost(double t, const std::string& reason) {
     f.estimate.state = TrackingState::Lost;
     f.estimate.reason = reason;
     filter_.reset();
+    oneEuro_.reset();
     return f;
 }
 

@@ -14,16 +14,34 @@
 
 namespace mirage::tracking {
 
+// Temporal filter of the ok poses: the adaptive constant-velocity filter (default) or the One
+// Euro filter (the previous default, kept for comparison; it lags in fast motion).
+enum class FilterKind { Predictive, OneEuro };
+
 struct TrackerOptions {
     DetectorOptions detector;
     PoseEstimatorOptions pose;
-    OneEuroOptions filter;
+    FilterKind filterKind = FilterKind::Predictive;
+    PoseFilterOptions filter;
+    OneEuroOptions oneEuro;
     bool filterEnabled = true;
     // The previous ok pose helps decide the planar ambiguity only if it is this recent (seconds).
     double priorMaxAgeS = 0.5;
     // When no tag is found, an image whose sharpness (strongest gradients over the intensity
     // range, about 1 / edge width in pixels) is below this is reported too_blurred, not no_tags.
     double minSharpness = 0.12;
+    // Region of interest: after an ok frame (at most priorMaxAgeS old), tags are searched only
+    // in the image box of the whole board projected with that pose, grown by roiMarginFraction of
+    // its size plus roiMarginPx on every side (camera motion between frames). If that frame is
+    // then not ok, or the board's box under the new pose is not inside the region (part of the
+    // board may lie outside what was searched), it is detected again on the full image (the
+    // region's origin is aligned to 8 pixels so that libapriltag's decimation and threshold
+    // tiles fall as in a full search); every fullFrameEvery-th frame is
+    // always searched in full. Skipped when the box covers most of the image anyway.
+    bool roiEnabled = true;
+    double roiMarginPx = 32.0;
+    double roiMarginFraction = 0.15;
+    int fullFrameEvery = 30;
 };
 
 struct TrackedFrame {
@@ -33,6 +51,10 @@ struct TrackedFrame {
     std::vector<TagDetection> detections;
     double sharpness = -1;  // computed only when no tag was found
     double detectMs = 0, poseMs = 0, filterMs = 0;
+    // The region searched first (the full image when no region was used), and whether the
+    // full image had to be searched again because the region's result was not ok.
+    cv::Rect searchRegion;
+    bool fullFrameRetry = false;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -58,12 +80,19 @@ public:
     const PoseEstimator& estimator() const { return estimator_; }
 
 private:
+    // Image box of the board projected with T_world_camera, grown by the margins (or not), clipped
+    // to the image; nullopt when a board corner is behind the camera.
+    std::optional<cv::Rect> boardRegion(const Pose& T_world_camera, cv::Size image,
+                                        bool withMargins) const;
+
     TrackerOptions options_;
     Detector detector_;
     PoseEstimator estimator_;
     PoseFilter filter_;
+    OneEuroPoseFilter oneEuro_;
     std::optional<Pose> lastOk_;
     double lastOkT_ = 0;
+    int framesSinceFullSearch_ = 0;
 };
 
 }  // namespace mirage::tracking

@@ -93,8 +93,9 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
         if (f.filtered) {
             rotErrFiltDeg_.push_back(
                 glm::degrees(rotationAngleBetween(f.filtered->rotation, groundTruth->rotation)));
-            posErrFiltRel_.push_back(
-                glm::length(f.filtered->translation - groundTruth->translation) / dist);
+            const double filtErr = glm::length(f.filtered->translation - groundTruth->translation);
+            posErrFiltM_.push_back(filtErr);
+            posErrFiltRel_.push_back(filtErr / dist);
         }
         if (rotErr > 2.0 || posErr / dist > 0.02) ++wrongOk_;
         std::snprintf(b, sizeof b, "%.5f,%.6f", rotErr, posErr);
@@ -143,11 +144,14 @@ std::string TrackingReport::summary() const {
                       100 * tr.max);
         s += b;
         if (!rotErrFiltDeg_.empty()) {
-            const ErrorStats rf = errorStats(rotErrFiltDeg_), tf = errorStats(posErrFiltRel_);
+            const ErrorStats rf = errorStats(rotErrFiltDeg_), tf = errorStats(posErrFiltM_),
+                             tfr = errorStats(posErrFiltRel_);
             std::snprintf(b, sizeof b,
-                          "ground truth, filtered: rotation error median %.4f deg, max %.4f; "
-                          "translation median %.3f %%, max %.3f %%\n",
-                          rf.median, rf.max, 100 * tf.median, 100 * tf.max);
+                          "ground truth, filtered: rotation error median %.4f deg, p95 %.4f, "
+                          "max %.4f; translation error median %.5f m (%.3f %% of distance), p95 "
+                          "%.5f m, max %.5f m (%.3f %%)\n",
+                          rf.median, rf.p95, rf.max, tf.median, 100 * tfr.median, tf.p95, tf.max,
+                          100 * tfr.max);
             s += b;
         }
         std::snprintf(b, sizeof b, "wrong-but-ok frames (> 2 deg or > 2 %%): %d\n", wrongOk_);

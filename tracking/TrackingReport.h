@@ -51,8 +51,8 @@ private:
     int frames_ = 0, withTags_ = 0, unreadable_ = 0, wrongOk_ = 0;
     std::array<int, 6> stateCount_{};
     std::vector<double> rms_, decodeMs_, detectMs_, poseMs_, filterMs_;
-    std::vector<double> rotErrDeg_, posErrM_, posErrRel_;  // raw estimate vs truth
-    std::vector<double> rotErrFiltDeg_, posErrFiltRel_;    // filtered vs truth
+    std::vector<double> rotErrDeg_, posErrM_, posErrRel_;              // raw estimate vs truth
+    std::vector<double> rotErrFiltDeg_, posErrFiltM_, posErrFiltRel_;  // filtered vs truth
 };
 
 }  // namespace mirage::tracking

@@ -60,7 +60,9 @@ void writeText(const std::string& path, const std::string& text) {
 }
 
 void runBatch(const CalibrateArgs& a) {
-    if (a.board.empty()) throw Error("--board is required (a board file or chessboard:9x6:0.025)");
+    if (a.board.empty())
+        throw Error(
+            "--board is required (a board file, chessboard:9x6:0.025 or charuco:5x7:0.04:0.02)");
     if (a.output.empty()) throw Error("-o CAM.yaml is required");
     const auto target = calib::CalibrationTarget::parse(a.board);
     calib::BatchOptions o;
@@ -193,7 +195,8 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
     cmd->add_flag("--batch", a->batch, "Headless: calibrate from INPUT... and write -o");
     cmd->add_option("inputs", a->inputs, "Image files, folders of images, or videos");
     cmd->add_option("--board", a->board,
-                    "Board file (JSON) or chessboard:COLSxROWS:SQUARE_METRES (inner corners)");
+                    "Board file (JSON), chessboard:COLSxROWS:SQUARE_METRES (inner corners) or "
+                    "charuco:SQUARESXxSQUARESY:SQUARE_M:MARKER_M[:DICT] (squares)");
     cmd->add_option("-o,--output", a->output, "Calibration file to write (OpenCV YAML)");
     cmd->add_option("--model", a->model, "pinhole (Brown-Conrady) or fisheye (Kannala-Brandt)")
         ->capture_default_str();

@@ -27,6 +27,7 @@ struct TrackArgs {
     int envmapWidth = 512;
     double fps = 30.0;
     bool noFilter = false;
+    std::string filter = "predictive";
     tracking::TrackerOptions options;
 };
 
@@ -69,6 +70,11 @@ void run(const TrackArgs& a) {
     const tracking::Board board = tracking::Board::load(boardPath);
     tracking::TrackerOptions opt = a.options;
     opt.filterEnabled = !a.noFilter;
+    if (a.filter == "one-euro")
+        opt.filterKind = tracking::FilterKind::OneEuro;
+    else if (a.filter != "predictive")
+        throw Error("mirage track --filter: expected predictive or one-euro, got '" + a.filter +
+                    "'");
     tracking::Tracker tracker(board, calib.intrinsics, opt);
     tracking::TrackingReport report(a.output, boardCentre(board));
     if (fromSession) report.addUnreadable(readReport.framesListed - readReport.framesReadable);
@@ -177,6 +183,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_option("--fps", a->fps, "Frame rate for sources without timestamps")
         ->capture_default_str();
     cmd->add_flag("--no-filter", a->noFilter, "Report the raw per-frame poses");
+    cmd->add_option("--filter", a->filter,
+                    "Temporal filter: predictive (adaptive constant velocity) or one-euro")
+        ->capture_default_str();
     cmd->add_option("--envmap", a->envmap,
                     "Also build an environment map from the session's fish-eye camera "
                     "(.exr/.pfm/.hdr linear; validity mask beside it as <name>_valid.png)");

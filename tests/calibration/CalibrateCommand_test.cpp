@@ -11,6 +11,7 @@
 
 #include "calibration/Extrinsics.h"
 #include "calibration/SyntheticViews.h"
+#include "tests/support/TestCameras.h"
 
 #include <opencv2/calib3d.hpp>
 #include "core/camera/CalibrationFile.h"
@@ -21,15 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 CameraIntrinsics camera() {
-    CameraIntrinsics c;
-    c.width = 640;
-    c.height = 480;
-    c.fx = 520;
-    c.fy = 518;
-    c.cx = 322.5;
-    c.cy = 238;
-    c.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
-    return c;
+    return test::distortedWebcam640();
 }
 
 const ChessboardGeometry kBoard{9, 6, 0.025};
@@ -204,14 +197,8 @@ TEST(CalibrateCommand, FisheyeExtrinsicsRelativeToMainCamera) {
     fs::create_directories(mainDir);
     fs::create_directories(fishDir);
     const auto mainCam = camera();
-    CameraIntrinsics fish;
-    fish.width = 640;
-    fish.height = 480;
-    fish.model = DistortionModel::KannalaBrandt;
-    fish.fx = fish.fy = 230;
-    fish.cx = 321;
-    fish.cy = 238;
-    fish.distortion = {0.02, -0.01, 0.004, -0.001};
+    const CameraIntrinsics fish =
+        test::fisheyeCamera(640, 480, 230, 230, 321, 238, {0.02, -0.01, 0.004, -0.001});
     // T_main_fish: 6 cm to the right, turned 15 degrees to the right (about +Y).
     const cv::Vec3d rMainFish(0, 15 * 0.017453292519943295, 0), tMainFish(0.06, 0, 0);
     cv::Vec3d rFishMain, tFishMain;

@@ -9,20 +9,13 @@
 
 #include "calibration/CalibrationSession.h"
 #include "calibration/SyntheticViews.h"
+#include "tests/support/TestCameras.h"
 
 namespace mirage::calib {
 namespace {
 
 CameraIntrinsics camera() {
-    CameraIntrinsics c;
-    c.width = 640;
-    c.height = 480;
-    c.fx = 520;
-    c.fy = 518;
-    c.cx = 322.5;
-    c.cy = 238;
-    c.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
-    return c;
+    return test::distortedWebcam640();
 }
 
 const ChessboardGeometry kBoard{9, 6, 0.025};

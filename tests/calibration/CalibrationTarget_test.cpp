@@ -10,6 +10,7 @@
 #include "calibration/Extrinsics.h"
 #include "calibration/SyntheticViews.h"
 #include "core/Error.h"
+#include "tests/support/TestCameras.h"
 #include "tests/support/TestSupport.h"
 #include "tracking/BoardImage.h"
 #include "tracking/SyntheticBoardView.h"
@@ -45,14 +46,7 @@ TEST(CalibrationTarget, RefusesBadSpecs) {
 // exact camera model, so this measures the detector (and proves the renderer's pixel
 // convention: a half-pixel shift would show as a mean offset of 0.5 px).
 TEST(CalibrationTarget, DetectsRenderedChessboardAccurately) {
-    CameraIntrinsics cam;
-    cam.width = 640;
-    cam.height = 480;
-    cam.fx = 520;
-    cam.fy = 518;
-    cam.cx = 322.5;
-    cam.cy = 238;
-    cam.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
+    const CameraIntrinsics cam = test::distortedWebcam640();
     const ChessboardGeometry board{9, 6, 0.025};
     const auto target = CalibrationTarget::chessboard(board);
     std::mt19937 rng(4);
@@ -115,14 +109,8 @@ TEST(CalibrationTarget, AprilTagBoardViewsCalibrate) {
     const auto target = CalibrationTarget::parse(boardPath.string());
     EXPECT_EQ(target.kind(), CalibrationTarget::Kind::TagBoard);
     EXPECT_EQ(target.allBoardPoints().size(), 4 * board.tags.size());
-    CameraIntrinsics cam;
-    cam.width = 640;
-    cam.height = 480;
-    cam.fx = 520;
-    cam.fy = 518;
-    cam.cx = 322.5;
-    cam.cy = 238;
-    cam.distortion = {-0.2, 0.05, 0.0005, -0.0005, 0.0};
+    const CameraIntrinsics cam =
+        test::pinholeCamera(640, 480, 520, 518, 322.5, 238, {-0.2, 0.05, 0.0005, -0.0005, 0.0});
     const auto texture = tracking::renderBoard(board, 4000.0, false);
     // Poses of the sheet's centre region: a 3x3 proxy grid spanning +-s around the centre.
     const double s = 0.09;

@@ -12,33 +12,17 @@
 #include "calibration/Calibrator.h"
 #include "calibration/SyntheticViews.h"
 #include "core/Error.h"
+#include "tests/support/TestCameras.h"
 
 namespace mirage::calib {
 namespace {
 
 CameraIntrinsics pinholeCamera() {
-    CameraIntrinsics c;
-    c.width = 640;
-    c.height = 480;
-    c.fx = 520;
-    c.fy = 518;
-    c.cx = 322.5;
-    c.cy = 238.0;
-    c.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
-    return c;
+    return test::distortedWebcam640();
 }
 
 CameraIntrinsics fisheyeCamera() {
-    CameraIntrinsics c;
-    c.width = 1280;
-    c.height = 800;
-    c.model = DistortionModel::KannalaBrandt;
-    c.fx = 560;
-    c.fy = 561;
-    c.cx = 630;
-    c.cy = 395;
-    c.distortion = {0.02, -0.01, 0.004, -0.001};
-    return c;
+    return test::fisheyeCamera(1280, 800, 560, 561, 630, 395, {0.02, -0.01, 0.004, -0.001});
 }
 
 std::vector<CalibrationView> makeViews(const CameraIntrinsics& cam, const ChessboardGeometry& b,

@@ -9,6 +9,7 @@
 #include "calibration/Extrinsics.h"
 #include "calibration/SyntheticViews.h"
 #include "core/Error.h"
+#include "tests/support/TestCameras.h"
 #include "tests/support/TestSupport.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -19,27 +20,11 @@ namespace {
 constexpr double kDeg = 0.017453292519943295;
 
 CameraIntrinsics mainCamera() {
-    CameraIntrinsics c;
-    c.width = 640;
-    c.height = 480;
-    c.fx = 520;
-    c.fy = 518;
-    c.cx = 322.5;
-    c.cy = 238;
-    c.distortion = {-0.25, 0.08, 0.0008, -0.0006, -0.01};
-    return c;
+    return test::distortedWebcam640();
 }
 
 CameraIntrinsics fisheyeCamera() {
-    CameraIntrinsics c;
-    c.width = 1280;
-    c.height = 800;
-    c.model = DistortionModel::KannalaBrandt;
-    c.fx = c.fy = 380;
-    c.cx = 640;
-    c.cy = 400;
-    c.distortion = {0.02, -0.01, 0.004, -0.001};
-    return c;
+    return test::fisheyeCamera(1280, 800, 380, 380, 640, 400, {0.02, -0.01, 0.004, -0.001});
 }
 
 TEST(Extrinsics, FisheyeRelativeToPinholeMainCamera) {

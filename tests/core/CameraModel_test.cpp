@@ -7,33 +7,18 @@
 #include <opencv2/calib3d.hpp>
 
 #include "core/camera/CameraModel.h"
+#include "tests/support/TestCameras.h"
 
 namespace mirage {
 namespace {
 
 CameraIntrinsics pinhole() {
-    CameraIntrinsics c;
-    c.width = 640;
-    c.height = 480;
-    c.fx = 530;
-    c.fy = 528;
-    c.cx = 321.5;
-    c.cy = 242.0;
-    c.distortion = {-0.28, 0.09, 0.001, -0.0005, -0.01};
-    return c;
+    return test::pinholeCamera(640, 480, 530, 528, 321.5, 242.0,
+                               {-0.28, 0.09, 0.001, -0.0005, -0.01});
 }
 
 CameraIntrinsics fisheye() {
-    CameraIntrinsics c;
-    c.width = 1280;
-    c.height = 960;
-    c.model = DistortionModel::KannalaBrandt;
-    c.fx = 340;
-    c.fy = 340;
-    c.cx = 640;
-    c.cy = 480;
-    c.distortion = {0.03, -0.006, 0.001, -0.0002};
-    return c;
+    return test::fisheyeCamera(1280, 960, 340, 340, 640, 480, {0.03, -0.006, 0.001, -0.0002});
 }
 
 TEST(CameraModel, PinholeMatchesOpenCV) {

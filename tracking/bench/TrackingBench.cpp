@@ -15,6 +15,7 @@
 #include "tests/tracking/SyntheticViews.h"
 #include "tracking/Detector.h"
 #include "tracking/PoseEstimator.h"
+#include "tracking/Tracker.h"
 
 namespace mirage::tracking {
 namespace {
@@ -47,6 +48,32 @@ const Frames& frames(int width) {
             f->truth.push_back(T);
             ++i;
         }
+    }
+    return *f;
+}
+
+// A video: 60 frames at 30 fps of a closed orbit around the board (one turn in 2 s, 180 deg/s,
+// camera 0.45-0.65 m from the board centre, height and aim wobbling), so that cycling over the
+// frames is continuous motion. Used to measure mirage's Tracker with its region of interest
+// (the previous pose predicts where the board is) against per-frame ArUco on the same frames.
+const Frames& sequence(int width) {
+    static std::map<int, std::unique_ptr<Frames>> cache;
+    auto& f = cache[width];
+    if (f) return *f;
+    f = std::make_unique<Frames>();
+    const int height = width == 640 ? 480 : 720;
+    f->cam = testing::pinholeCamera(width, height, width == 640 ? 600 : 1000);
+    f->board = BoardLayout().makeBoard();
+    const BoardRaster tex = renderBoard(f->board, 8000, false);
+    const int n = 60;
+    for (int i = 0; i < n; ++i) {
+        const double a = 2 * M_PI * i / n;
+        const double r = 0.45 + 0.1 * std::sin(2 * a), h = 0.3 + 0.05 * std::cos(3 * a);
+        const glm::dvec3 eye(r * std::sin(a), h, r * std::cos(a));
+        const glm::dvec3 target(0.02 * std::sin(3 * a), 0, 0.02 * std::cos(2 * a));
+        const Pose T = testing::lookAt(eye, target, {0, 1, 0}, 0.1 * std::sin(a));
+        f->images.push_back(renderSyntheticBoardView(f->board, tex, f->cam, T));
+        f->truth.push_back(T);
     }
     return *f;
 }
@@ -145,6 +172,86 @@ void BM_Mirage(benchmark::State& state) {
     report(state, acc, f.images.size());
 }
 
+// The two stages of BM_Mirage alone: detection (libapriltag + corner refinement), and the pose
+// from precomputed detections.
+void BM_MirageDetect(benchmark::State& state) {
+    const Frames& f = frames(int(state.range(0)));
+    DetectorOptions dopt;
+    dopt.decimate = float(state.range(1));
+    Detector det(dopt);
+    size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(det.detect(f.images[i++ % f.images.size()]));
+}
+
+void BM_MiragePose(benchmark::State& state) {
+    const Frames& f = frames(int(state.range(0)));
+    DetectorOptions dopt;
+    dopt.decimate = float(state.range(1));
+    Detector det(dopt);
+    PoseEstimator pe(f.board, f.cam);
+    std::vector<std::vector<TagDetection>> dets;
+    for (const auto& img : f.images) dets.push_back(det.detect(img));
+    size_t i = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(pe.estimate(dets[i++ % dets.size()]));
+}
+
+BENCHMARK(BM_MirageDetect)
+    ->ArgNames({"width", "decimate"})
+    ->Args({640, 2})
+    ->Args({640, 3})
+    ->Args({640, 4})
+    ->Args({1280, 2})
+    ->Args({1280, 3})
+    ->Args({1280, 4})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_MiragePose)
+    ->ArgNames({"width", "decimate"})
+    ->Args({640, 2})
+    ->Args({1280, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// mirage's Tracker over the video (frames in order, cycling): region of interest on (arg 1) or
+// off. Accuracy of the raw per-frame poses over one pass after a first pass to warm up.
+void BM_MirageTrack(benchmark::State& state) {
+    const Frames& f = sequence(int(state.range(0)));
+    TrackerOptions opt;
+    opt.roiEnabled = state.range(1) != 0;
+    Tracker tracker(f.board, f.cam, opt);
+    Accuracy acc;
+    const double dt = 1.0 / 30.0;
+    size_t i = 0;
+    int retries = 0;
+    for (; i < f.images.size(); ++i) tracker.process(f.images[i], double(i) * dt);
+    for (size_t v = 0; v < f.images.size(); ++v, ++i) {
+        const TrackedFrame t = tracker.process(f.images[v], double(i) * dt);
+        acc.visibleTags += visibleTags(f, v);
+        for (const auto& d : t.detections)
+            if (f.board.find(d.id)) {
+                ++acc.foundTags;
+                addCorners(f, v, d.id, d.corners, acc);
+            }
+        if (t.estimate.state == TrackingState::Ok) addPose(f, v, *t.estimate.pose, acc);
+        retries += t.fullFrameRetry;
+    }
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(tracker.process(f.images[i % f.images.size()], double(i) * dt));
+        ++i;
+    }
+    report(state, acc, f.images.size());
+    state.counters["full_retries"] = retries;
+}
+
+BENCHMARK(BM_MirageTrack)
+    ->ArgNames({"width", "roi"})
+    ->Args({640, 1})
+    ->Args({640, 0})
+    ->Args({1280, 1})
+    ->Args({1280, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 // ---- OpenCV ArUco ----------------------------------------------------------------------------
 
 struct Aruco {
@@ -213,12 +320,51 @@ void BM_Aruco(benchmark::State& state) {
     report(state, acc, f.images.size());
 }
 
+// ArUco per frame over the same video as BM_MirageTrack.
+void BM_ArucoTrack(benchmark::State& state) {
+    const Frames& f = sequence(int(state.range(0)));
+    Aruco a;
+    a.params->cornerRefinementMethod = int(state.range(1));
+    Accuracy acc;
+    std::vector<std::vector<cv::Point2f>> corners;
+    std::vector<int> ids;
+    for (size_t v = 0; v < f.images.size(); ++v) {
+        cv::aruco::detectMarkers(f.images[v], a.dict, corners, ids, a.params);
+        acc.visibleTags += visibleTags(f, v);
+        for (size_t i = 0; i < ids.size(); ++i)
+            if (f.board.find(ids[i])) {
+                ++acc.foundTags;
+                addCorners(f, v, ids[i], toMirageOrder(corners[i]), acc);
+            }
+        if (auto p = arucoPose(f, ids, corners)) addPose(f, v, *p, acc);
+    }
+    size_t i = 0;
+    for (auto _ : state) {
+        cv::aruco::detectMarkers(f.images[i++ % f.images.size()], a.dict, corners, ids, a.params);
+        benchmark::DoNotOptimize(arucoPose(f, ids, corners));
+    }
+    report(state, acc, f.images.size());
+}
+
+BENCHMARK(BM_ArucoTrack)
+    ->ArgNames({"width", "refine"})
+    ->Args({640, cv::aruco::CORNER_REFINE_NONE})
+    ->Args({640, cv::aruco::CORNER_REFINE_APRILTAG})
+    ->Args({1280, cv::aruco::CORNER_REFINE_NONE})
+    ->Args({1280, cv::aruco::CORNER_REFINE_APRILTAG})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 // Args: image width, then decimation (mirage) or ArUco's corner refinement method.
 BENCHMARK(BM_Mirage)
     ->ArgNames({"width", "decimate"})
     ->Args({640, 2})
+    ->Args({640, 3})
+    ->Args({640, 4})
     ->Args({640, 1})
     ->Args({1280, 2})
+    ->Args({1280, 3})
+    ->Args({1280, 4})
     ->Args({1280, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -1,0 +1,475 @@
+#include "render/passes/impostor/ImpostorPass.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "render/Shaders.h"
+#include "render/passes/impostor/ImpostorTypes.h"
+
+namespace mirage::render {
+namespace {
+
+// Storage bindings of the offline query shader (query.comp); it runs outside frames.
+constexpr unsigned kBindingQueryRays = 4, kBindingQueryHits = 5;
+constexpr int kCoarseSamples = 8;  // linear-search samples per impostor box (trace.glsl)
+constexpr float kEmptyDepth = 1e30f;
+
+struct QueryRayGpu {
+    glm::vec4 origin, direction;
+};
+struct QueryHitGpu {
+    glm::vec4 positionHit, normalOrigin, albedoRough, emissiveMetal;
+};
+
+// Cube faces: the same table as impFaceForward / impFaceUp in trace.glsl.
+const glm::vec3 kFaceForward[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+const glm::vec3 kFaceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
+                              {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+
+void orthonormalBasis(const glm::vec3& w, glm::vec3& u, glm::vec3& v) {
+    const glm::vec3 a = std::abs(w.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+    u = glm::normalize(glm::cross(a, w));
+    v = glm::cross(w, u);
+}
+
+// World -> clip of an impostor box: x, y, z in [-1, 1] over centre +- extent along U, V, W
+// (z = -1 at the face nearest the specular object, so GL_LESS keeps the surface facing it).
+glm::mat4 boxViewProj(const GpuImpostor& b, float renderExtentW) {
+    glm::mat4 m(0.0f);
+    const glm::vec3 c(b.centre);
+    const glm::vec3 axes[3] = {glm::vec3(b.axisU), glm::vec3(b.axisV), glm::vec3(b.axisW)};
+    const float ext[3] = {b.axisU.w, b.axisV.w, renderExtentW};
+    for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 3; ++col) m[col][r] = axes[r][col] / ext[r];
+        m[3][r] = -glm::dot(axes[r], c) / ext[r];
+    }
+    m[3][3] = 1.0f;
+    return m;
+}
+
+size_t bytesPerTexel(GLenum f) {
+    switch (f) {
+        case GL_RGBA32F:
+            return 16;
+        case GL_RGBA16F:
+        case GL_RG32F:
+            return 8;
+        default:
+            return 4;
+    }
+}
+
+}  // namespace
+
+std::string ImpostorBuildStats::summary() const {
+    return fmt::format(
+        "{} objects: {} billboards, {} planes, {} enclosing items at {}^2; captures {:.1f} ms, "
+        "build {:.1f} ms, {:.1f} MiB",
+        objects, billboards, planes, enclosingItems, resolution, captureMs, wallMs,
+        double(textureBytes) / (1024.0 * 1024.0));
+}
+
+ImpostorPass::ImpostorPass()
+    : capture_("impostor capture", {{GL_VERTEX_SHADER, "passes/impostor/capture.vert",
+                                     shaders::source("passes/impostor/capture.vert")},
+                                    {GL_FRAGMENT_SHADER, "passes/impostor/capture.frag",
+                                     shaders::source("passes/impostor/capture.frag")}}),
+      query_("impostor query", {{GL_COMPUTE_SHADER, "passes/impostor/query.comp",
+                                 shaders::source("passes/impostor/query.comp")}}),
+      captureFbo_("impostor capture fbo") {
+    locModel_ = capture_.uniformLocation("model");
+    locNormal_ = capture_.uniformLocation("normalMatrix");
+    locViewProj_ = capture_.uniformLocation("captureViewProj");
+    locMaterial_ = capture_.uniformLocation("materialIndex");
+    locOrigin_ = capture_.uniformLocation("origin");
+    locCaptureDepth_ = capture_.uniformLocation("captureDepth");
+    locDepthAxis_ = capture_.uniformLocation("depthAxis");
+    locRayCount_ = query_.uniformLocation("rayCount");
+}
+
+PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
+    const size_t n = ctx.scene.specularDraws().size();
+    if (n == 0) return {false, "no specular object"};
+    const char* method = ctx.options.impostorCubeMapBaseline ? "cube-map baseline" : "impostors";
+    if (builtScene_ != &ctx.scene || builtResolution_ != ctx.options.impostorResolution)
+        return {true, fmt::format("build for {} specular object(s) at {}^2 ({})", n,
+                                  ctx.options.impostorResolution, method)};
+    return {true, fmt::format("cached ({}, {} refinement steps; built once: {})", method,
+                              ctx.options.impostorRefineSteps, stats_.summary())};
+}
+
+void ImpostorPass::execute(FrameContext& ctx) {
+    update(ctx.scene, ctx.options);
+    ctx.publish(Resource::Impostors, &depth_);
+}
+
+bool ImpostorPass::update(const GpuScene& scene, const RendererOptions& o) {
+    if (o.impostorResolution < 8 || o.impostorResolution > 2048)
+        throw Error(
+            fmt::format("impostorResolution must be 8..2048 texels, got {}", o.impostorResolution));
+    if (o.impostorRefineSteps < 0 || o.impostorRefineSteps > 64)
+        throw Error(
+            fmt::format("impostorRefineSteps must be 0..64, got {}", o.impostorRefineSteps));
+    bool rebuilt = false;
+    if (builtScene_ != &scene || builtResolution_ != o.impostorResolution) {
+        build(scene, o.impostorResolution);
+        rebuilt = true;
+    }
+    uploadMode(o);
+    return rebuilt;
+}
+
+void ImpostorPass::uploadMode(const RendererOptions& o) {
+    GpuImpostorHeader h{};
+    h.mode = glm::ivec4(o.impostorCubeMapBaseline ? 1 : 0, o.impostorRefineSteps, stats_.objects,
+                        kCoarseSamples);
+    h.params = glm::vec4(float(builtResolution_), float(builtResolution_), 0.0f, 0.0f);
+    std::memcpy(objectBytes_.data(), &h, sizeof(h));
+    objects_.upload(objectBytes_.data(), sizeof(h));
+}
+
+void ImpostorPass::build(const GpuScene& scene, int res) {
+    const auto wallStart = std::chrono::steady_clock::now();
+    const std::vector<DrawItem>& draws = scene.draws();
+    const std::vector<int>& specular = scene.specularDraws();
+
+    // The geometry on the CPU once: planes and tight boxes need the vertices.
+    std::vector<GpuSceneVertex> verts;
+    std::vector<uint32_t> indices;
+    if (scene.vertexBuffer().id() != 0) {
+        verts.resize(scene.vertexBuffer().size() / sizeof(GpuSceneVertex));
+        indices.resize(scene.indexBuffer().size() / sizeof(uint32_t));
+        glGetNamedBufferSubData(scene.vertexBuffer().id(), 0,
+                                GLsizeiptr(verts.size() * sizeof(GpuSceneVertex)), verts.data());
+        glGetNamedBufferSubData(scene.indexBuffer().id(), 0,
+                                GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data());
+    }
+    auto worldPoints = [&](const DrawItem& d) {
+        std::vector<glm::vec3> pts;
+        pts.reserve(size_t(d.indexCount));
+        for (GLsizei i = 0; i < d.indexCount; ++i) {
+            const size_t vi = size_t(d.baseVertex) + indices[d.firstIndex + size_t(i)];
+            pts.push_back(glm::vec3(d.model * glm::vec4(verts[vi].position, 1.0f)));
+        }
+        return pts;
+    };
+    // Per draw: its world points and, if all are on one plane, that plane.
+    struct DrawShape {
+        std::vector<glm::vec3> points;
+        bool planar = false;
+        glm::vec3 normal{0.0f};
+        glm::vec3 lo{1e30f}, hi{-1e30f};
+    };
+    std::vector<DrawShape> shapes(draws.size());
+    for (size_t k = 0; k < draws.size(); ++k) {
+        DrawShape& s = shapes[k];
+        s.points = worldPoints(draws[k]);
+        for (const glm::vec3& p : s.points) {
+            s.lo = glm::min(s.lo, p);
+            s.hi = glm::max(s.hi, p);
+        }
+        // Normal of the largest triangle, then every point within a tolerance of its plane.
+        float bestArea = 0.0f;
+        for (size_t i = 0; i + 2 < s.points.size(); i += 3) {
+            const glm::vec3 n =
+                glm::cross(s.points[i + 1] - s.points[i], s.points[i + 2] - s.points[i]);
+            const float a = glm::length(n);
+            if (a > bestArea && std::isfinite(a)) {
+                bestArea = a;
+                s.normal = n / a;
+            }
+        }
+        if (bestArea <= 0.0f) continue;
+        const float size = glm::length(s.hi - s.lo);
+        const float tol = 1e-4f * size + 1e-6f;
+        const float d0 = glm::dot(s.normal, s.points[0]);
+        s.planar = std::all_of(s.points.begin(), s.points.end(), [&](const glm::vec3& p) {
+            return std::abs(glm::dot(s.normal, p) - d0) <= tol;
+        });
+    }
+
+    // Impostor records per specular object.
+    std::vector<GpuImpostor> records;
+    std::vector<GpuImpostorObject> objects;
+    std::vector<std::vector<int>> enclosing(specular.size());
+    stats_ = ImpostorBuildStats{};
+    kinds_.assign(specular.size(), std::vector<ItemKind>(draws.size(), ItemKind::None));
+    stats_.resolution = res;
+    stats_.objects = int(specular.size());
+    const float margin = 1.0f + 2.0f / float(res);  // a texel of slack around every box
+    for (size_t slot = 0; slot < specular.size(); ++slot) {
+        const DrawItem& self = draws[size_t(specular[slot])];
+        const glm::vec3 c = self.bounds.center;
+        const float rS = self.bounds.radius;
+        GpuImpostorObject obj{};
+        obj.centre = glm::vec4(c, rS);
+        obj.range = glm::ivec4(int(records.size()), 0, int(slot) * 12, -1);
+        float enclosingReach = 0.0f;
+        for (size_t k = 0; k < draws.size(); ++k) {
+            if (int(k) == specular[slot] || draws[k].indexCount == 0) continue;
+            const DrawShape& s = shapes[k];
+            if (s.points.empty()) continue;
+            GpuImpostor b{};
+            glm::vec3 W, U, V;
+            if (s.planar) {
+                W = s.normal;
+                if (glm::dot(s.points[0] - c, W) < 0.0f) W = -W;
+            } else {
+                const glm::vec3 toItem = 0.5f * (s.lo + s.hi) - c;
+                const float len = glm::length(toItem);
+                W = len > 1e-6f ? toItem / len : glm::vec3(0, 0, 1);
+            }
+            orthonormalBasis(W, U, V);
+            glm::vec3 lo(1e30f), hi(-1e30f);
+            for (const glm::vec3& p : s.points) {
+                const glm::vec3 q(glm::dot(p, U), glm::dot(p, V), glm::dot(p, W));
+                lo = glm::min(lo, q);
+                hi = glm::max(hi, q);
+            }
+            const glm::vec3 mid = 0.5f * (lo + hi), ext = 0.5f * (hi - lo) * margin;
+            b.centre = glm::vec4(U * mid.x + V * mid.y + W * mid.z, 0.0f);
+            b.axisU = glm::vec4(U, std::max(ext.x, 1e-5f));
+            b.axisV = glm::vec4(V, std::max(ext.y, 1e-5f));
+            b.axisW = glm::vec4(W, s.planar ? 0.0f : std::max(ext.z, 1e-5f));
+            b.info = glm::ivec4(int(records.size()), s.planar ? 1 : 0, int(k), 0);
+            if (!s.planar) {
+                // A billboard is only valid when the whole item is on the far side of the object:
+                // every point of the specular object must lie in front of the box's near face.
+                float selfReach = -1e30f;
+                for (const glm::vec3& p : shapes[size_t(specular[slot])].points)
+                    selfReach = std::max(selfReach, glm::dot(p - glm::vec3(b.centre), W));
+                if (shapes[size_t(specular[slot])].points.empty())
+                    selfReach = glm::dot(c - glm::vec3(b.centre), W) + rS;
+                if (selfReach > -b.axisW.w) {
+                    enclosing[slot].push_back(int(k));
+                    kinds_[slot][k] = ItemKind::Enclosing;
+                    for (const glm::vec3& p : s.points)
+                        enclosingReach = std::max(enclosingReach, glm::length(p - c));
+                    continue;
+                }
+            }
+            records.push_back(b);
+            kinds_[slot][k] = s.planar ? ItemKind::Plane : ItemKind::Billboard;
+            ++obj.range.y;
+            (s.planar ? stats_.planes : stats_.billboards)++;
+        }
+        if (!enclosing[slot].empty()) {
+            obj.range.w = int(slot) * 12 + 6;
+            obj.params = glm::vec4(enclosingReach + rS, 0.0f, 0.0f, 0.0f);
+            stats_.enclosingItems += int(enclosing[slot].size());
+        }
+        objects.push_back(obj);
+    }
+
+    // Textures.
+    const int cubeLayers = std::max(1, int(specular.size()) * 12);
+    const int impLayers = std::max(1, int(records.size()));
+    GLint maxLayers = 0;
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+    if (std::max(cubeLayers, impLayers) > maxLayers)
+        throw Error(fmt::format(
+            "the scene needs {} impostor layers and {} cube-map layers, but this GL allows {} "
+            "array layers; merge small surrounding meshes or use fewer specular objects",
+            impLayers, cubeLayers, maxLayers));
+    cubePosition_ =
+        gl::Texture::create2DArray("impostor cube position", res, res, cubeLayers, GL_RGBA32F);
+    cubeNormal_ =
+        gl::Texture::create2DArray("impostor cube normal", res, res, cubeLayers, GL_RGBA16F);
+    cubeAlbedo_ =
+        gl::Texture::create2DArray("impostor cube albedo", res, res, cubeLayers, GL_RGBA8);
+    cubeEmissive_ =
+        gl::Texture::create2DArray("impostor cube emissive", res, res, cubeLayers, GL_RGBA16F);
+    depth_ = gl::Texture::create2DArray("impostor depth", res, res, impLayers, GL_RG32F);
+    normal_ = gl::Texture::create2DArray("impostor normal", res, res, impLayers, GL_RGBA16F);
+    albedo_ = gl::Texture::create2DArray("impostor albedo", res, res, impLayers, GL_RGBA8);
+    emissive_ = gl::Texture::create2DArray("impostor emissive", res, res, impLayers, GL_RGBA16F);
+    for (gl::Texture* t : {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_, &normal_,
+                           &albedo_, &emissive_})
+        t->setFilter(GL_NEAREST, GL_NEAREST);
+    depth_.setFilter(GL_LINEAR, GL_LINEAR);  // bilinear height field (trace.glsl impDepthAt)
+    captureDepthBuffer_ =
+        gl::Texture::create2D("impostor capture depth", res, res, GL_DEPTH_COMPONENT32F);
+    stats_.textureBytes = 0;
+    for (const gl::Texture* t : {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
+                                 &depth_, &normal_, &albedo_, &emissive_})
+        stats_.textureBytes +=
+            size_t(res) * size_t(res) * size_t(t->layers()) * bytesPerTexel(t->format());
+
+    // Records and objects.
+    if (records.empty()) records.push_back(GpuImpostor{});  // a non-empty buffer to bind
+    records_ =
+        gl::Buffer("impostor records", records.size() * sizeof(GpuImpostor), records.data(), 0);
+    objectBytes_.assign(
+        sizeof(GpuImpostorHeader) + std::max<size_t>(1, objects.size()) * sizeof(GpuImpostorObject),
+        0);
+    if (!objects.empty())
+        std::memcpy(objectBytes_.data() + sizeof(GpuImpostorHeader), objects.data(),
+                    objects.size() * sizeof(GpuImpostorObject));
+    objects_ = gl::Buffer("impostor objects", objectBytes_.size(), objectBytes_.data());
+    builtScene_ = &scene;
+    builtResolution_ = res;
+
+    // Captures, timed by the wall clock between two glFinish: llvmpipe's GL_TIME_ELAPSED gave
+    // meaningless values for this burst of small render passes, and inside a Renderer frame the
+    // pass timer is running anyway (timer queries cannot nest).
+    glFinish();
+    const auto captureStart = std::chrono::steady_clock::now();
+    gl::Framebuffer& fbo = captureFbo_;
+    glViewport(0, 0, res, res);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    capture_.use();
+    scene.bindGeometry();
+    auto drawOne = [&](const DrawItem& d) {
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
+        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
+        glUniform1i(locMaterial_, d.material);
+        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
+        scene.bindMaterialTextures(d, 7);
+        scene.drawItem(d);
+    };
+    auto target = [&](const gl::Texture& a, const gl::Texture& n, const gl::Texture& al,
+                      const gl::Texture& e, int layer, const glm::vec4& clear0) {
+        fbo.attachColorLayer(0, a, layer);
+        fbo.attachColorLayer(1, n, layer);
+        fbo.attachColorLayer(2, al, layer);
+        fbo.attachColorLayer(3, e, layer);
+        fbo.attachDepth(captureDepthBuffer_);
+        fbo.finalize(4);
+        fbo.bind();
+        const float zero[4] = {0, 0, 0, 0};
+        glClearBufferfv(GL_COLOR, 0, &clear0[0]);
+        for (int i = 1; i < 4; ++i) glClearBufferfv(GL_COLOR, i, zero);
+        const float one = 1.0f;
+        glClearBufferfv(GL_DEPTH, 0, &one);
+    };
+    const BoundingSphere& B = scene.bounds();
+    glUniform1i(locCaptureDepth_, 0);
+    for (size_t slot = 0; slot < specular.size(); ++slot) {
+        const glm::vec3 c = draws[size_t(specular[slot])].bounds.center;
+        const float farM = glm::length(c - B.center) + B.radius + 1.0f;
+        const float nearM = std::clamp(farM * 1e-5f, 1e-4f, 1e-3f);
+        const glm::mat4 proj = glm::perspective(glm::half_pi<float>(), 1.0f, nearM, farM);
+        for (int kind = 0; kind < 2; ++kind) {  // 0: baseline (all but self), 1: enclosing
+            if (kind == 1 && enclosing[slot].empty()) continue;
+            for (int f = 0; f < 6; ++f) {
+                target(cubePosition_, cubeNormal_, cubeAlbedo_, cubeEmissive_,
+                       int(slot) * 12 + kind * 6 + f, glm::vec4(0.0f));
+                const glm::mat4 vp = proj * glm::lookAt(c, c + kFaceForward[f], kFaceUp[f]);
+                glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
+                if (kind == 0) {
+                    for (size_t k = 0; k < draws.size(); ++k)
+                        if (int(k) != specular[slot]) drawOne(draws[k]);
+                } else {
+                    for (int k : enclosing[slot]) drawOne(draws[size_t(k)]);
+                }
+            }
+        }
+    }
+    glUniform1i(locCaptureDepth_, 1);
+    for (size_t slot = 0; slot < specular.size(); ++slot) {
+        const GpuImpostorObject& obj = objects[slot];
+        for (int i = 0; i < obj.range.y; ++i) {
+            const GpuImpostor& b = records[size_t(obj.range.x + i)];
+            target(depth_, normal_, albedo_, emissive_, b.info.x,
+                   glm::vec4(kEmptyDepth, 0.0f, 0.0f, 0.0f));
+            // Planar items: a thin slab around the plane (depth is only the coverage there).
+            const float extW =
+                b.info.y == 1 ? std::max(1e-4f, 1e-3f * std::max(b.axisU.w, b.axisV.w)) : b.axisW.w;
+            const glm::mat4 vp = boxViewProj(b, extW);
+            glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
+            const glm::vec3 W(b.axisW);
+            glUniform4f(locDepthAxis_, W.x, W.y, W.z, -glm::dot(W, glm::vec3(b.centre)));
+            drawOne(draws[size_t(b.info.z)]);
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDisable(GL_DEPTH_TEST);
+    glFinish();
+    stats_.captureMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - captureStart)
+            .count();
+    stats_.wallMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wallStart)
+            .count();
+    spdlog::info("impostors built: {}", stats_.summary());
+}
+
+ImpostorPass::ItemKind ImpostorPass::itemKind(int slot, int draw) const {
+    if (slot < 0 || size_t(slot) >= kinds_.size() || draw < 0 ||
+        size_t(draw) >= kinds_[size_t(slot)].size())
+        return ItemKind::None;
+    return kinds_[size_t(slot)][size_t(draw)];
+}
+
+void ImpostorPass::bindForTracing() const {
+    MR_CHECK(built(), "ImpostorPass::bindForTracing before the impostors were built");
+    const gl::Texture* units[8] = {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
+                                   &depth_,        &normal_,     &albedo_,     &emissive_};
+    static_assert(kBindingImpostorEmissive - kBindingImpostorCubePosition == 7);
+    for (unsigned i = 0; i < 8; ++i)
+        glBindTextureUnit(kBindingImpostorCubePosition + i, units[i]->id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords, records_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects, objects_.id());
+}
+
+std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& rays) const {
+    double ms = 0.0;
+    return trace(rays, ms);
+}
+
+std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& rays,
+                                             double& dispatchMs) const {
+    dispatchMs = 0.0;
+    if (rays.empty()) return {};
+    std::vector<QueryRayGpu> in(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i)
+        in[i] = {glm::vec4(rays[i].origin, float(rays[i].specularSlot)),
+                 glm::vec4(rays[i].direction, 0.0f)};
+    gl::Buffer rayBuf("impostor query rays", in.size() * sizeof(QueryRayGpu), in.data(), 0);
+    gl::Buffer hitBuf("impostor query hits", in.size() * sizeof(QueryHitGpu), nullptr, 0);
+    bindForTracing();
+    query_.use();
+    glUniform1i(locRayCount_, int(rays.size()));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingQueryRays, rayBuf.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingQueryHits, hitBuf.id());
+    // Timed by the wall clock around dispatch + glFinish: llvmpipe's GL_TIME_ELAPSED does not
+    // cover compute dispatches (it reads 0 ms), and on a software rasteriser the wall clock of
+    // the synchronised dispatch is the GPU time.
+    glFinish();
+    const auto start = std::chrono::steady_clock::now();
+    glDispatchCompute(GLuint((rays.size() + 63) / 64), 1, 1);
+    glFinish();
+    dispatchMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<QueryHitGpu> out(rays.size());
+    glGetNamedBufferSubData(hitBuf.id(), 0, GLsizeiptr(out.size() * sizeof(QueryHitGpu)),
+                            out.data());
+    std::vector<ImpostorHit> hits(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const QueryHitGpu& q = out[i];
+        ImpostorHit& h = hits[i];
+        h.hit = q.positionHit.w > 0.5f;
+        h.position = glm::vec3(q.positionHit);
+        h.normal = glm::vec3(q.normalOrigin);
+        h.origin = int(q.normalOrigin.w + 0.5f);
+        h.albedo = glm::vec3(q.albedoRough);
+        h.roughness = q.albedoRough.w;
+        h.emissive = glm::vec3(q.emissiveMetal);
+        h.metallic = q.emissiveMetal.w;
+    }
+    return hits;
+}
+
+}  // namespace mirage::render

@@ -1,0 +1,364 @@
+// Reflected / refracted ray tracing against a specular object's surroundings (issue 6; Knecht 2013
+// Sec. 3.2 / 4.1, Popescu et al. 2006 reflected-scene impostors). #include after common.glsl.
+//
+//   SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir);
+//
+// specularSlot indexes GpuScene::specularDraws(); the object's own geometry is not in its
+// impostors. rayOrigin / rayDir are world (metres), rayDir unit. Built by ImpostorPass, bound by
+// ImpostorPass::bindForTracing(). Uses ONLY texture units 16..23 and storage-buffer bindings 6..7
+// (mirrored by the kBindingImpostor* constants of render/GpuTypes.h).
+//
+// Two methods, chosen by RendererOptions::impostorCubeMapBaseline (header mode.x):
+// - baseline: a G-buffer cube map rendered from the object's bounding-sphere centre c, looked up
+//   by the ray DIRECTION only (classic environment mapping: exact only for a ray starting at c or
+//   for infinitely distant surroundings).
+// - impostors: one box-bounded depth impostor per surrounding draw item (a billboard facing c,
+//   storing per texel the offset of the surface from the billboard plane plus G-buffer
+//   attributes); the ray is clipped to the box, a coarse linear search finds the first crossing
+//   of the height field and `refineSteps` secant (regula falsi) steps refine it; nearest hit
+//   wins. Planar items (floors, table tops, walls) are impostors whose plane IS the item's plane:
+//   intersected exactly, attributes looked up. Non-planar items that enclose the object or reach
+//   behind the billboard plane seen from c (a room) go to a depth cube map from c, searched the
+//   same way along the ray (distance impostor). See docs/impostors.md.
+#ifndef MIRAGE_IMPOSTOR_TRACE_GLSL
+#define MIRAGE_IMPOSTOR_TRACE_GLSL
+
+// Mirrors kBindingImpostor* in render/GpuTypes.h.
+layout(binding = 16) uniform sampler2DArray impCubePosition;  // xyz world (m), w = origin (0 empty)
+layout(binding = 17) uniform sampler2DArray impCubeNormal;    // xyz world normal, w = roughness
+layout(binding = 18) uniform sampler2DArray impCubeAlbedo;    // rgb linear base colour, a = metallic
+layout(binding = 19) uniform sampler2DArray impCubeEmissive;  // rgb linear emitted radiance
+layout(binding = 20) uniform sampler2DArray impDepth;     // r = offset along axisW (m), g = origin;
+                                                          // r = 1e30, g = 0 where empty (linear)
+layout(binding = 21) uniform sampler2DArray impNormal;    // xyz world normal, w = roughness
+layout(binding = 22) uniform sampler2DArray impAlbedo;    // rgb linear base colour, a = metallic
+layout(binding = 23) uniform sampler2DArray impEmissive;  // rgb linear emitted radiance
+
+struct GpuImpostor {
+    vec4 centre;  // xyz world box centre
+    vec4 axisU;   // xyz unit, w = half extent (m)
+    vec4 axisV;   // xyz unit, w = half extent (m)
+    vec4 axisW;   // xyz unit away from the specular object / plane normal, w = half extent
+    ivec4 info;   // x = layer, y = kind (0 billboard, 1 plane), z = draw index
+};
+struct GpuImpostorObject {
+    vec4 centre;  // xyz bounding-sphere centre (cube-map centre), w = radius (m)
+    ivec4 range;  // x = first impostor, y = count, z = baseline cube layer, w = enclosing cube
+                  // layer (-1 = no enclosing items)
+    vec4 params;  // x = enclosing search distance (m)
+};
+layout(std430, binding = 6) readonly buffer ImpostorRecords { GpuImpostor impostors[]; };
+layout(std430, binding = 7) readonly buffer ImpostorObjects {
+    ivec4 impMode;   // x = 1 baseline cube map, y = refinement steps, z = objects, w = coarse samples
+    vec4 impParams;  // x = cube resolution, y = impostor resolution
+    GpuImpostorObject impObjects[];
+};
+
+struct SurroundingHit {
+    bool hit;        // false: the ray leaves the modelled scene (the consumer uses L_env)
+    vec3 position;   // world, metres
+    vec3 normal;     // world unit normal, facing the ray origin
+    vec3 albedo;     // linear base colour
+    float roughness;
+    float metallic;
+    vec3 emissive;   // linear emitted radiance
+    int origin;      // ORIGIN_REAL or ORIGIN_VIRTUAL
+};
+
+const float IMP_EMPTY = 1e29;  // depth values above this are "no surface"
+
+SurroundingHit impNoHit() {
+    SurroundingHit h;
+    h.hit = false;
+    h.position = vec3(0.0);
+    h.normal = vec3(0.0, 1.0, 0.0);
+    h.albedo = vec3(0.0);
+    h.roughness = 1.0;
+    h.metallic = 0.0;
+    h.emissive = vec3(0.0);
+    h.origin = ORIGIN_NONE;
+    return h;
+}
+
+// Cube faces as rendered by ImpostorPass: forward axis and the up vector given to lookAt.
+vec3 impFaceForward(int f) {
+    return f == 0 ? vec3(1, 0, 0)
+         : f == 1 ? vec3(-1, 0, 0)
+         : f == 2 ? vec3(0, 1, 0)
+         : f == 3 ? vec3(0, -1, 0)
+         : f == 4 ? vec3(0, 0, 1)
+                  : vec3(0, 0, -1);
+}
+vec3 impFaceUp(int f) {
+    return f == 2 ? vec3(0, 0, 1) : f == 3 ? vec3(0, 0, -1) : vec3(0, -1, 0);
+}
+
+// Texel of a cube (6 layers from `firstLayer`) in world direction d (need not be unit).
+ivec3 impCubeTexel(vec3 d, int firstLayer) {
+    vec3 a = abs(d);
+    int f = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1)
+          : a.y >= a.z               ? (d.y >= 0.0 ? 2 : 3)
+                                     : (d.z >= 0.0 ? 4 : 5);
+    vec3 F = impFaceForward(f);
+    vec3 S = normalize(cross(F, impFaceUp(f)));
+    vec3 U = cross(S, F);
+    float z = max(dot(d, F), 1e-20);
+    vec2 ndc = clamp(vec2(dot(d, S), dot(d, U)) / z, -1.0, 1.0);
+    int res = int(impParams.x);
+    ivec2 px = clamp(ivec2((ndc * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
+    return ivec3(px, firstLayer + f);
+}
+
+void impFillFromCube(inout SurroundingHit h, ivec3 t, vec3 rayOrigin) {
+    vec4 n = texelFetch(impCubeNormal, t, 0);
+    vec4 a = texelFetch(impCubeAlbedo, t, 0);
+    vec3 nn = dot(n.xyz, n.xyz) > 1e-12 ? normalize(n.xyz) : vec3(0.0, 1.0, 0.0);
+    if (dot(nn, rayOrigin - h.position) < 0.0) nn = -nn;
+    h.normal = nn;
+    h.roughness = n.w;
+    h.albedo = a.rgb;
+    h.metallic = a.a;
+    h.emissive = texelFetch(impCubeEmissive, t, 0).rgb;
+}
+
+// Baseline: the stored surface in direction rayDir from the cube centre (direction only).
+SurroundingHit impTraceCube(GpuImpostorObject obj, vec3 o, vec3 d) {
+    SurroundingHit h = impNoHit();
+    ivec3 t = impCubeTexel(d, obj.range.z);
+    vec4 p = texelFetch(impCubePosition, t, 0);
+    if (p.w < 0.5) return h;
+    h.hit = true;
+    h.position = p.xyz;
+    h.origin = int(p.w + 0.5);
+    impFillFromCube(h, t, o);
+    return h;
+}
+
+// Signed distance of ray point x behind the enclosing cube's stored surface (>= 0: behind).
+float impEnclosingH(vec3 c, int layer, vec3 x, out ivec3 texel) {
+    vec3 r = x - c;
+    float len = length(r);
+    texel = impCubeTexel(len > 1e-9 ? r : vec3(0.0, 0.0, 1.0), layer);
+    vec4 p = texelFetch(impCubePosition, texel, 0);
+    if (p.w < 0.5) return -1e30;
+    return len - length(p.xyz - c);
+}
+
+// Enclosing items (distance impostor from c): first crossing along the ray within tBest.
+bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
+                       out ivec3 texel) {
+    texel = ivec3(0);
+    if (obj.range.w < 0) return false;
+    vec3 c = obj.centre.xyz;
+    float t1 = min(obj.params.x, tBest);
+    int n = max(impMode.w, 1) * 2;
+    ivec3 ta_tex, tb_tex;
+    float ta = 0.0, ha = impEnclosingH(c, obj.range.w, o, ta_tex);
+    float tb = 0.0, hb = ha;
+    bool found = false;
+    for (int i = 1; i <= n && !found; ++i) {
+        tb = t1 * float(i) / float(n);
+        hb = impEnclosingH(c, obj.range.w, o + tb * d, tb_tex);
+        if (ha < 0.0 && hb >= 0.0) found = true;
+        else {
+            ta = tb;
+            ha = hb;
+        }
+    }
+    if (!found) return false;
+    // Refinement: Newton steps on the tangent plane stored at the current texel (exact for
+    // planar walls), kept inside the bracket [ta, tb]; regula falsi when the plane step leaves it.
+    float t = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : tb;
+    for (int s = 0; s < impMode.y; ++s) {
+        ivec3 cur_tex = impCubeTexel(o + t * d - c, obj.range.w);
+        vec4 q = texelFetch(impCubePosition, cur_tex, 0);
+        vec3 n = texelFetch(impCubeNormal, cur_tex, 0).xyz;
+        float dn = dot(d, n);
+        float tm = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : 0.5 * (ta + tb);
+        if (q.w > 0.5 && abs(dn) > 1e-4) {
+            float tp = dot(q.xyz - o, n) / dn;
+            if (tp >= ta && tp <= tb) tm = tp;
+        }
+        if (abs(tm - t) < 1e-7 * max(tm, 1.0) && s > 0) break;  // converged
+        ivec3 tm_tex;
+        float hm = impEnclosingH(c, obj.range.w, o + tm * d, tm_tex);
+        // Behind / in front of the stored tangent plane, consistent with the plane step (c's
+        // side is in front).
+        vec4 qm = texelFetch(impCubePosition, tm_tex, 0);
+        vec3 nm = texelFetch(impCubeNormal, tm_tex, 0).xyz;
+        if (qm.w > 0.5 && dot(nm, nm) > 1e-12)
+            hm = dot(o + tm * d - qm.xyz, nm) * (dot(c - qm.xyz, nm) > 0.0 ? -1.0 : 1.0);
+        if (hm < 0.0) {
+            ta = tm;
+            ha = hm;
+        } else {
+            tb = tm;
+            hb = hm;
+            tb_tex = tm_tex;
+        }
+        t = tm;
+    }
+    if (!(t > 0.0) || t >= tBest) return false;
+    ivec3 final_tex;
+    vec3 x = o + t * d;
+    if (impEnclosingH(c, obj.range.w, x, final_tex) < -IMP_EMPTY) return false;
+    // A distance cube stores one surface per direction from c: a ray that passes over an edge
+    // (a wall's top) lands "behind" it in a direction where the wall is. Accept only points on
+    // the stored surface: within two texel footprints of the texel's point and one footprint of
+    // its tangent plane.
+    vec4 q = texelFetch(impCubePosition, final_tex, 0);
+    vec3 qn = texelFetch(impCubeNormal, final_tex, 0).xyz;
+    float footprint = length(x - c) * 2.0 / impParams.x + 1e-3;
+    if (length(x - q.xyz) > 2.0 * footprint) return false;
+    if (dot(qn, qn) > 1e-12 && abs(dot(x - q.xyz, normalize(qn))) > footprint) return false;
+    tBest = t;
+    texel = final_tex;
+    return true;
+}
+
+// Height-field offset along axisW at box-local (u, v) metres, bilinear; > IMP_EMPTY if empty.
+float impDepthAt(GpuImpostor I, vec2 q) {
+    vec2 uv = q / vec2(I.axisU.w, I.axisV.w) * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1e30;
+    return textureLod(impDepth, vec3(uv, float(I.info.x)), 0.0).r;
+}
+ivec3 impTexel(GpuImpostor I, vec2 q) {
+    vec2 uv = q / vec2(I.axisU.w, I.axisV.w) * 0.5 + 0.5;
+    int res = int(impParams.y);
+    return ivec3(clamp(ivec2(uv * float(res)), ivec2(0), ivec2(res - 1)), I.info.x);
+}
+
+// One impostor: nearest hit closer than tBest; on success updates tBest and the texel.
+bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 texel) {
+    texel = ivec3(0);
+    vec3 rel = o - I.centre.xyz;
+    vec3 ro = vec3(dot(rel, I.axisU.xyz), dot(rel, I.axisV.xyz), dot(rel, I.axisW.xyz));
+    vec3 rd = vec3(dot(d, I.axisU.xyz), dot(d, I.axisV.xyz), dot(d, I.axisW.xyz));
+    vec3 e = vec3(I.axisU.w, I.axisV.w, I.axisW.w);
+    if (I.info.y == 1) {
+        // Planar item: exact ray-plane intersection; parallel rays never hit it.
+        if (abs(rd.z) < 1e-7) return false;
+        float t = -ro.z / rd.z;
+        if (!(t > 1e-6) || t >= tBest) return false;
+        vec2 q = ro.xy + t * rd.xy;
+        if (any(greaterThan(abs(q), e.xy))) return false;
+        ivec3 tx = impTexel(I, q);
+        if (texelFetch(impDepth, tx, 0).g < 0.5) return false;  // a hole in the item
+        tBest = t;
+        texel = tx;
+        return true;
+    }
+    // Clip the ray to the box (slabs); an axis the ray is parallel to must contain the origin.
+    float t0 = 0.0, t1 = tBest;
+    for (int i = 0; i < 3; ++i) {
+        if (abs(rd[i]) < 1e-9) {
+            if (abs(ro[i]) > e[i]) return false;
+            continue;
+        }
+        float a = (-e[i] - ro[i]) / rd[i], b = (e[i] - ro[i]) / rd[i];
+        t0 = max(t0, min(a, b));
+        t1 = min(t1, max(a, b));
+    }
+    if (!(t0 < t1)) return false;
+    // Coarse linear search for the first step from in front of the stored surface (seen from the
+    // specular object) to behind it: h = ray offset along W - stored offset.
+    int n = max(impMode.w, 1);
+    float dt = (t1 - t0) / float(n);
+    float ta = t0;
+    float ha = ro.z + ta * rd.z - impDepthAt(I, ro.xy + ta * rd.xy);
+    float tb = ta, hb = ha;
+    bool found = false;
+    for (int i = 1; i <= n && !found; ++i) {
+        tb = t0 + dt * float(i);
+        hb = ro.z + tb * rd.z - impDepthAt(I, ro.xy + tb * rd.xy);
+        if (ha < 0.0 && hb >= 0.0) found = true;
+        else {
+            ta = tb;
+            ha = hb;
+        }
+    }
+    if (!found) return false;
+    // A depth impostor stores one layer: a ray that enters the silhouette far behind the front
+    // surface passes behind the item. Accept only a crossing within one coarse step's travel
+    // along W plus two texels.
+    float texelM = 2.0 * max(e.x, e.y) / impParams.y;
+    float thickness = abs(rd.z) * dt + 2.0 * texelM;
+    if (ha < -IMP_EMPTY && hb > thickness) return false;
+    // Refinement: Newton steps on the tangent plane of the height field at the current estimate
+    // (stored normal, bilinear depth), kept inside the bracket [ta, tb]; regula falsi otherwise.
+    float t = ha > -IMP_EMPTY && hb - ha > 0.0 ? ta + (tb - ta) * ha / (ha - hb) : tb;
+    for (int s = 0; s < impMode.y; ++s) {
+        vec2 qc = ro.xy + t * rd.xy;
+        float dq = impDepthAt(I, qc);
+        vec3 n = texelFetch(impNormal, impTexel(I, qc), 0).xyz;
+        vec3 nl = vec3(dot(n, I.axisU.xyz), dot(n, I.axisV.xyz), dot(n, I.axisW.xyz));
+        float dn = dot(rd, nl);
+        float tm = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : 0.5 * (ta + tb);
+        if (dq < IMP_EMPTY && abs(dn) > 1e-4) {
+            float tp = dot(vec3(qc, dq) - ro, nl) / dn;
+            if (tp >= ta && tp <= tb) tm = tp;
+        }
+        float hm = ro.z + tm * rd.z - impDepthAt(I, ro.xy + tm * rd.xy);
+        if (hm < 0.0) {
+            ta = tm;
+            ha = hm;
+        } else {
+            tb = tm;
+            hb = hm;
+        }
+        t = tm;
+    }
+    if (!(t >= 0.0) || t >= tBest) return false;
+    ivec3 tx = impTexel(I, ro.xy + t * rd.xy);
+    if (texelFetch(impDepth, tx, 0).g < 0.5) tx = impTexel(I, ro.xy + tb * rd.xy);
+    if (texelFetch(impDepth, tx, 0).g < 0.5) return false;
+    tBest = t;
+    texel = tx;
+    return true;
+}
+
+SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir) {
+    SurroundingHit h = impNoHit();
+    if (specularSlot < 0 || specularSlot >= impMode.z) return h;
+    if (!allFinite(rayOrigin) || !allFinite(rayDir) || dot(rayDir, rayDir) < 1e-12) return h;
+    vec3 d = normalize(rayDir);
+    GpuImpostorObject obj = impObjects[specularSlot];
+    if (impMode.x == 1) return impTraceCube(obj, rayOrigin, d);
+
+    float tBest = 1e30;
+    int best = -1;  // impostor index, or -2 = enclosing cube
+    ivec3 bestTexel = ivec3(0);
+    ivec3 tx;
+    if (impTraceEnclosing(obj, rayOrigin, d, tBest, tx)) {
+        best = -2;
+        bestTexel = tx;
+    }
+    for (int k = 0; k < obj.range.y; ++k) {
+        int idx = obj.range.x + k;
+        if (impTraceOne(impostors[idx], rayOrigin, d, tBest, tx)) {
+            best = idx;
+            bestTexel = tx;
+        }
+    }
+    if (best == -1) return h;
+    h.hit = true;
+    h.position = rayOrigin + tBest * d;
+    if (best == -2) {
+        h.origin = int(texelFetch(impCubePosition, bestTexel, 0).w + 0.5);
+        impFillFromCube(h, bestTexel, rayOrigin);
+        return h;
+    }
+    vec4 n = texelFetch(impNormal, bestTexel, 0);
+    vec4 a = texelFetch(impAlbedo, bestTexel, 0);
+    vec3 nn = dot(n.xyz, n.xyz) > 1e-12 ? normalize(n.xyz) : -d;
+    if (dot(nn, d) > 0.0) nn = -nn;
+    h.normal = nn;
+    h.roughness = n.w;
+    h.albedo = a.rgb;
+    h.metallic = a.a;
+    h.emissive = texelFetch(impEmissive, bestTexel, 0).rgb;
+    h.origin = int(texelFetch(impDepth, bestTexel, 0).g + 0.5);
+    return h;
+}
+
+#endif
