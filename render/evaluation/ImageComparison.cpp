@@ -111,8 +111,28 @@ void CompositeErrorAccumulator::add(const cv::Mat& gotSrgb8, const cv::Mat& trut
                                     const cv::Mat& influence) {
     if (gotSrgb8.type() != CV_8UC3)
         throw Error("composite comparison: expects 8-bit BGR (sRGB) images");
-    frame.add(gotSrgb8, truthSrgb8, 255.0);
-    influenced.add(gotSrgb8, truthSrgb8, 255.0, influence);
+    checkPair(gotSrgb8, truthSrgb8, influence);
+    // The error maps once, summed over the frame and over the influenced pixels.
+    const cv::Mat se = squaredErrorMap(gotSrgb8, truthSrgb8, 255.0);
+    const cv::Mat s = ssimPerPixel(gotSrgb8, truthSrgb8, 255.0);
+    frame.channels = influenced.channels = 3;
+    frame.squaredError += cv::sum(se)[0];
+    frame.ssimSum += cv::sum(s)[0];
+    frame.pixels += double(gotSrgb8.total());
+    const cv::Mat off = influence == 0;
+    influenced.squaredError += cv::sum(se.clone().setTo(0, off))[0];
+    influenced.ssimSum += cv::sum(s.clone().setTo(0, off))[0];
+    influenced.pixels += cv::countNonZero(influence);
+}
+
+void CompositeErrorAccumulator::merge(const CompositeErrorAccumulator& other) {
+    for (auto [mine, theirs] :
+         {std::pair{&frame, &other.frame}, {&influenced, &other.influenced}}) {
+        mine->squaredError += theirs->squaredError;
+        mine->ssimSum += theirs->ssimSum;
+        mine->pixels += theirs->pixels;
+        mine->channels = theirs->channels;
+    }
 }
 
 CompositeError CompositeErrorAccumulator::result() const {

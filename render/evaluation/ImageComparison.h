@@ -50,6 +50,7 @@ struct CompositeErrorAccumulator {
     // got, truth: 8-bit BGR sRGB of equal size; influence: CV_8U (nonzero = the virtual objects
     // change the pixel), same size.
     void add(const cv::Mat& gotSrgb8, const cv::Mat& truthSrgb8, const cv::Mat& influence);
+    void merge(const CompositeErrorAccumulator& other);  // adds another's sums (frames pooled)
     CompositeError result() const;
 };
 

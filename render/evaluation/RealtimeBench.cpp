@@ -297,7 +297,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
             CompositeErrorAccumulator one;
             one.add(composite, f.truth, f.influence);
             fr.error = one.result();
-            acc.add(composite, f.truth, f.influence);
+            acc.merge(one);
             if (i == 0) {
                 result.firstComposite = composite;
                 result.firstTruth = f.truth;
@@ -336,7 +336,7 @@ BenchResult footageBaseline(const std::vector<BenchFrame>& allFrames, int width,
         CompositeErrorAccumulator one;
         one.add(f.footage, f.truth, f.influence);
         fr.error = one.result();
-        acc.add(f.footage, f.truth, f.influence);
+        acc.merge(one);
         if (result.frames.empty()) {
             result.firstComposite = f.footage;
             result.firstTruth = f.truth;
