@@ -5,7 +5,16 @@ function(mirage_module name)
   cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   # Benchmarks and tools live beside their module but are not part of the library.
-  list(FILTER sources EXCLUDE REGEX ".*/(bench|tools)/.*")
+  # Matched on the path relative to the module, so a checkout under e.g. /work/wt/bench/ keeps its
+  # sources.
+  set(kept "")
+  foreach(src IN LISTS sources)
+    file(RELATIVE_PATH rel ${CMAKE_CURRENT_SOURCE_DIR} ${src})
+    if(NOT rel MATCHES "(^|/)(bench|tools)/")
+      list(APPEND kept ${src})
+    endif()
+  endforeach()
+  set(sources ${kept})
   # A module that has no sources yet still builds (a generated empty unit keeps the target valid).
   set(stub ${CMAKE_CURRENT_BINARY_DIR}/${name}_module.cpp)
   if(NOT EXISTS ${stub})

@@ -1,0 +1,251 @@
+// `mirage bench SESSION -o OUTDIR`: speed against error of the real-time renderer (DESIGN.md,
+// "Ground truth, and how every effect is judged"; docs/bench.md). Runs the renderer over the
+// frames of a synthetic session (made with `mirage synth --ground-truth-composite`) at the
+// ground-truth poses, for a grid of knobs (render/evaluation/RealtimeBench.h), and writes:
+//   OUTDIR/bench.csv         one row per configuration: median GPU ms per pass and in total (GL
+//                            timer queries, syncPasses), median wall ms, PSNR/SSIM over the whole
+//                            frame and over the influenced pixels (pooled over frames)
+//   OUTDIR/bench_frames.csv  the same per configuration and frame
+//   OUTDIR/bench.md          a markdown table of bench.csv with the command, date and load average
+// A "footage only" row per resolution judges the footage itself (the virtual contribution
+// removed): every real configuration should beat it in the influenced pixels.
+#include <cctype>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "app/Command.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/camera/CalibrationFile.h"
+#include "core/gl/Context.h"
+#include "core/image/ImageIO.h"
+#include "core/scene/Scene.h"
+#include "core/session/Session.h"
+#include "render/evaluation/GroundTruthComposite.h"
+#include "render/evaluation/RealtimeBench.h"
+
+namespace mirage::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BenchArgs {
+    std::string session, scene, output;
+    std::vector<std::string> knobs;  // NAME=V1,V2,...
+    bool quick = false, listKnobs = false, noBaseline = false, images = false;
+    int maxFrames = -1, start = 0, repeats = 1;
+    float exposure = 1.0f;
+};
+
+std::string loadAverage() {
+    std::ifstream in("/proc/loadavg");
+    double a = 0, b = 0, c = 0;
+    if (!(in >> a >> b >> c)) return "unknown";
+    return fmt::format("{:.2f} {:.2f} {:.2f}", a, b, c);
+}
+
+std::string utcNow() {
+    std::time_t t = std::time(nullptr);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
+    return buf;
+}
+
+std::map<std::string, std::vector<std::string>> parseKnobs(const std::vector<std::string>& specs) {
+    std::map<std::string, std::vector<std::string>> out;
+    for (const auto& spec : specs) {
+        const size_t eq = spec.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+            throw Error(
+                "mirage bench: --knob expects NAME=VALUE[,VALUE...] (e.g. vpls=64,256), "
+                "got '" +
+                spec + "'; --list-knobs lists the knobs");
+        std::vector<std::string> values;
+        std::stringstream ss(spec.substr(eq + 1));
+        for (std::string v; std::getline(ss, v, ',');)
+            if (!v.empty()) values.push_back(v);
+        out[spec.substr(0, eq)] = values;
+    }
+    return out;
+}
+
+std::string commandLine(const BenchArgs& a) {
+    std::string s = "mirage bench " + a.session + " -o " + a.output;
+    if (!a.scene.empty()) s += " --scene " + a.scene;
+    if (a.quick) s += " --quick";
+    for (const auto& k : a.knobs) s += " --knob " + k;
+    if (a.start > 0) s += fmt::format(" --start {}", a.start);
+    if (a.maxFrames >= 0) s += fmt::format(" --frames {}", a.maxFrames);
+    if (a.repeats != 1) s += fmt::format(" --repeat {}", a.repeats);
+    if (a.exposure != 1.0f) s += fmt::format(" --exposure {}", a.exposure);
+    if (a.noBaseline) s += " --no-baseline";
+    if (a.images) s += " --images";
+    return s;
+}
+
+void runBench(const BenchArgs& a) {
+    if (a.listKnobs) {
+        for (const auto& k : render::benchKnobs())
+            std::printf("%-16s %s\n", k.name.c_str(), k.help.c_str());
+        return;
+    }
+    if (a.output.empty()) throw Error("mirage bench: -o OUTDIR is required");
+    if (a.repeats < 1) throw Error("mirage bench: --repeat must be >= 1");
+    const auto overrides = parseKnobs(a.knobs);
+
+    SessionReadReport readReport;
+    const Session session = readSession(a.session, &readReport);
+    for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
+    const std::optional<render::GroundTruthInfo> gt = render::readGroundTruthInfo(session.dir);
+    if (!gt)
+        throw FileError(fs::path(a.session) / render::kGroundTruthFile,
+                        "the session has no ground-truth composite; make it with `mirage synth "
+                        "SCENE -o SESSION --ground-truth-composite` (docs/bench.md)");
+    const SessionCamera* main = session.cameras.empty() ? nullptr : &session.cameras.front();
+    for (const auto& c : session.cameras)
+        if (c.role == "main") main = &c;
+    if (!main || main->calibration.empty())
+        throw FileError(a.session, "the main camera has no calibration file in session.json");
+    const CameraCalibration calib = loadCalibration(session.path(main->calibration));
+
+    const std::string scenePath = a.scene.empty() ? gt->scene : a.scene;
+    if (scenePath.empty() || !fs::exists(scenePath))
+        throw FileError(scenePath.empty()
+                            ? (fs::path(a.session) / render::kGroundTruthFile).string()
+                            : scenePath,
+                        "scene not found; pass --scene SCENE.gltf (the scene the session was "
+                        "synthesised from, with its virtual objects)");
+    const Scene scene = loadScene(scenePath);
+    if (!scene.hasVirtual())
+        throw FileError(scenePath, "the scene has no virtual object: nothing to judge");
+
+    // The grid first: bad knobs fail before any frame is decoded.
+    std::vector<render::BenchConfig> grid = render::benchGrid(calib.intrinsics, a.quick, overrides);
+    for (auto& c : grid) c.options.exposure = a.exposure;
+
+    // Frames with a ground-truth pose and ground-truth composite, in session order.
+    int skipped = 0;
+    const std::vector<render::BenchFrame> frames =
+        render::loadBenchFrames(session, *gt, calib.intrinsics, a.start, a.maxFrames, &skipped);
+    if (skipped > 0)
+        spdlog::warn("bench: {} frame(s) without a ground-truth pose or composite skipped",
+                     skipped);
+    if (frames.empty())
+        throw FileError(a.session,
+                        "no frame has both a ground-truth pose (frames.csv) and a "
+                        "ground-truth composite to judge against");
+
+    fs::create_directories(a.output);
+    gl::ContextOptions copt;
+    copt.width = calib.intrinsics.width;
+    copt.height = calib.intrinsics.height;
+    gl::Context ctx = gl::Context::headless(copt);
+
+    const std::string loadBefore = loadAverage();
+    const std::string startedAt = utcNow();
+    spdlog::info("bench: {} configuration(s) over {} frame(s) of {} ({}x{}), load average {}",
+                 grid.size(), frames.size(), a.session, calib.intrinsics.width,
+                 calib.intrinsics.height, loadBefore);
+    std::vector<render::BenchResult> results;
+    std::set<std::pair<int, int>> sizes;
+    for (size_t i = 0; i < grid.size(); ++i) {
+        const auto& c = grid[i];
+        render::BenchResult r =
+            render::runBenchConfig(scene, calib.intrinsics, frames, c, a.repeats);
+        spdlog::info(
+            "bench [{}/{}] {}: {:.1f} GPU ms/frame (median), PSNR {:.2f} dB / "
+            "influenced {:.2f} dB, SSIM {:.4f} / {:.4f}",
+            i + 1, grid.size(), c.label(), r.medianGpuMs, r.error.psnrFrame, r.error.psnrInfluenced,
+            r.error.ssimFrame, r.error.ssimInfluenced);
+        sizes.insert({r.config.width, r.config.height});
+        results.push_back(std::move(r));
+    }
+    // The footage judged as the composite, once per resolution, after the configurations.
+    if (!a.noBaseline)
+        for (auto it = sizes.rbegin(); it != sizes.rend(); ++it)
+            results.push_back(render::footageBaseline(frames, it->first, it->second));
+    const std::string loadAfter = loadAverage();
+
+    const std::string preamble = fmt::format(
+        "# mirage bench\n\n"
+        "- command: `{}`\n"
+        "- session: {} ({} frame(s), {}x{}), scene: {}\n"
+        "- machine: {} ({}), started {}, load average (1/5/15 min) {} before, {} after\n"
+        "- times: medians over frames (x{} repeats) of GPU ms per pass from GL timer queries with "
+        "`syncPasses`; wall ms = render() + composite readback on the CPU\n"
+        "- errors: 8-bit sRGB composite vs the ground-truth composite, pooled over frames; "
+        "\"infl.\" = pixels the virtual objects influence ({} pixel(s) in all at the session's "
+        "size)\n",
+        commandLine(a), a.session, frames.size(), calib.intrinsics.width, calib.intrinsics.height,
+        scenePath, ctx.rendererName(), ctx.versionString(), startedAt, loadBefore, loadAfter,
+        a.repeats, [&] {
+            double n = 0;
+            for (const auto& f : frames) n += cv::countNonZero(f.influence);
+            return n;
+        }());
+    const fs::path out(a.output);
+    render::writeBenchCsv((out / "bench.csv").string(), results);
+    render::writeBenchFramesCsv((out / "bench_frames.csv").string(), results);
+    render::writeBenchMarkdown((out / "bench.md").string(), results, preamble);
+    if (a.images) {
+        // The first frame of every configuration beside its ground truth (sRGB PNG).
+        fs::create_directories(out / "images");
+        for (const auto& r : results) {
+            std::string name = r.baseline ? "footage " + r.config.label() : r.config.label();
+            for (char& ch : name)
+                if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+            writeBgr8(out / "images" / (name + ".png"), r.firstComposite);
+            writeBgr8(
+                out / "images" / fmt::format("truth_{}x{}.png", r.config.width, r.config.height),
+                r.firstTruth);
+        }
+    }
+    spdlog::info("bench: wrote {}, {}, {} (load average {} after)", (out / "bench.csv").string(),
+                 (out / "bench_frames.csv").string(), (out / "bench.md").string(), loadAfter);
+}
+
+const CommandRegistrar reg("bench", [](CLI::App& parent) {
+    auto a = std::make_shared<BenchArgs>();
+    auto* cmd = parent.add_subcommand(
+        "bench",
+        "Speed against error: the real-time renderer over a synthetic session's frames, for a "
+        "grid of knobs, judged against the ground-truth composite");
+    cmd->add_option("session", a->session,
+                    "Synthetic session made with `mirage synth --ground-truth-composite`");
+    cmd->add_option("-o,--output", a->output, "Folder for bench.csv, bench_frames.csv, bench.md");
+    cmd->add_option("--scene", a->scene,
+                    "Scene with the virtual objects (default: the one ground_truth.json names)");
+    cmd->add_flag("--quick", a->quick, "A small grid (one resolution, 64/256 VPLs, gather 1/2)");
+    cmd->add_option("--knob", a->knobs,
+                    "NAME=V1,V2,...: the values of one knob (repeatable; see --list-knobs)")
+        ->allow_extra_args(false);
+    cmd->add_flag("--list-knobs", a->listKnobs, "List the knobs and exit");
+    cmd->add_option("--frames", a->maxFrames, "Use at most N frames");
+    cmd->add_option("--start", a->start, "First frame")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--repeat", a->repeats, "Run the frame sequence R times (timings pooled)")
+        ->capture_default_str();
+    cmd->add_option("--exposure", a->exposure,
+                    "Rendered radiance -> camera linear units (the synth's --exposure)")
+        ->capture_default_str();
+    cmd->add_flag("--no-baseline", a->noBaseline, "Leave out the footage-only rows");
+    cmd->add_flag("--images", a->images,
+                  "Also write each configuration's first composite and the ground truth to "
+                  "OUTDIR/images/ (sRGB PNG)");
+    cmd->callback([a] {
+        if (!a->listKnobs && a->session.empty())
+            throw Error(
+                "mirage bench: SESSION is required (a folder made by `mirage synth "
+                "--ground-truth-composite`)");
+        runBench(*a);
+    });
+});
+
+}  // namespace
+}  // namespace mirage::app

@@ -1,0 +1,114 @@
+#pragma once
+// Speed against error (`mirage bench`, docs/bench.md): the real-time renderer run over the frames
+// of a synthetic session at the ground-truth poses, for a grid of knobs, each configuration judged
+// against the reference renderer's ground-truth composite (GroundTruthComposite.h) by PSNR/SSIM
+// over the whole frame and over the pixels the virtual objects influence, and timed per pass with
+// GL timer queries (RendererOptions::syncPasses, so every pass's query holds only its own work).
+//
+// Knobs are a list (benchKnobs()), not loops: a new knob (impostor resolution, refinement steps,
+// caustic map size, ...) is one entry there, and the grid, CSV and table pick it up.
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera/CameraModel.h"
+#include "core/math/Pose.h"
+#include "core/scene/Scene.h"
+#include "core/session/Session.h"
+#include "render/FrameContext.h"
+#include "render/evaluation/GroundTruthComposite.h"
+#include "render/evaluation/ImageComparison.h"
+
+namespace mirage::render {
+
+// One point of the grid: renderer options plus the render resolution.
+struct BenchConfig {
+    RendererOptions options;
+    int width = 0, height = 0;                               // 0 = the session's size
+    std::vector<std::pair<std::string, std::string>> knobs;  // (name, value) as applied
+    std::string label() const;                               // "vpls=256 indirect_scale=2 ..."
+};
+
+struct BenchKnob {
+    std::string name, help;
+    // Default values of the full and --quick grids for a session camera.
+    std::function<std::vector<std::string>(const CameraIntrinsics& session, bool quick)> defaults;
+    // Sets the value on a configuration; throws mirage::Error naming the knob on a bad value.
+    std::function<void(BenchConfig&, const std::string& value)> apply;
+};
+
+// The knobs, in grid order (the first varies slowest).
+const std::vector<BenchKnob>& benchKnobs();
+
+// The grid: the cartesian product of every knob's values (defaults, or `overrides[name]`).
+// Throws mirage::Error for an unknown knob name or a bad value.
+std::vector<BenchConfig> benchGrid(
+    const CameraIntrinsics& sessionCamera, bool quick,
+    const std::map<std::string, std::vector<std::string>>& overrides);
+
+// A frame of the session with everything the bench needs, at the session's size.
+struct BenchFrame {
+    int index = 0;        // frames.csv frame number
+    Pose T_world_camera;  // ground truth (OpenCV camera axes)
+    cv::Mat footage;      // 8-bit BGR sRGB, as the session stores it
+    cv::Mat truth;        // ground-truth composite, 8-bit BGR sRGB
+    cv::Mat influence;    // CV_8U, nonzero = influenced by the virtual objects
+};
+
+// The main camera's frames of `session` that have a ground-truth pose and a ground-truth
+// composite, from `start` (position in frames.csv), at most `maxFrames` (-1 = all). `skipped`
+// counts frames without either. Throws FileError if a ground-truth image's size differs from the
+// footage or the calibration.
+std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTruthInfo& truth,
+                                        const CameraIntrinsics& mainCamera, int start = 0,
+                                        int maxFrames = -1, int* skipped = nullptr);
+
+struct BenchFrameResult {
+    int index = 0;
+    std::map<std::string, double> passMs;  // GPU ms per pass (0 or absent when skipped)
+    double gpuMs = 0.0;                    // sum of the passes' GPU time
+    double wallMs = 0.0;                   // CPU wall time of render() + composite readback
+    CompositeError error;
+};
+
+struct BenchResult {
+    BenchConfig config;
+    bool baseline = false;            // the footage itself as "composite" (no virtual objects)
+    std::vector<std::string> passes;  // pass names in frame order (those that ran at least once)
+    std::map<std::string, double> medianPassMs;
+    double medianGpuMs = 0.0, medianWallMs = 0.0;
+    CompositeError error;  // pooled over all frames
+    std::vector<BenchFrameResult> frames;
+    cv::Mat firstComposite;  // the first frame's composite (8-bit BGR sRGB), for a look
+    cv::Mat firstTruth;      // and its ground truth at the same size
+};
+
+// Scales a frame set to width x height (same aspect ratio as the session): footage and truth are
+// averaged in linear light (the reference's box-filtered pixels stay box-filtered), a pixel is
+// influenced if any pixel it covers was. Returns the input when the size already matches.
+std::vector<BenchFrame> scaleFrames(const std::vector<BenchFrame>& frames, int width, int height);
+// Intrinsics of the same camera at another resolution (pixel centres kept: OpenCV convention).
+CameraIntrinsics scaleIntrinsics(const CameraIntrinsics& k, int width, int height);
+
+// Runs one configuration over the frames (in order; temporal history reset on the first), each
+// pass `repeats` times over the sequence (timings pooled, error from the last). Needs a current
+// GL 4.5 context. `scene` is the scene with its virtual objects.
+BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCamera,
+                           const std::vector<BenchFrame>& frames, const BenchConfig& config,
+                           int repeats = 1);
+
+// The footage judged as if it were the composite: what a render with the virtual contribution
+// removed scores. Every real configuration must beat it in the influenced pixels.
+BenchResult footageBaseline(const std::vector<BenchFrame>& frames, int width = 0, int height = 0);
+
+// Files: one row per configuration / per configuration and frame; a markdown table.
+void writeBenchCsv(const std::string& path, const std::vector<BenchResult>& results);
+void writeBenchFramesCsv(const std::string& path, const std::vector<BenchResult>& results);
+// `preamble`: markdown put above the table (command, machine load, session).
+void writeBenchMarkdown(const std::string& path, const std::vector<BenchResult>& results,
+                        const std::string& preamble);
+
+}  // namespace mirage::render
