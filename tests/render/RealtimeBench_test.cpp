@@ -83,10 +83,14 @@ raytrace::SyntheticSessionOptions tinySessionOptions() {
     return o;
 }
 
-// One synthetic session shared by the tests of this file (rendered once, ~2 s).
+// One synthetic session shared by the tests of this file (rendered once per process, ~2 s).
+// ctest runs each test in its own process, in parallel: every test gets its own folder, named
+// after it, so one never reads a session another is still writing.
 const fs::path& tinySession() {
     static const fs::path dir = [] {
-        const fs::path d = mirage::test::outputDir("bench_session") / "session";
+        const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+        const fs::path d = mirage::test::outputDir("bench_session") /
+                           (std::string(test->test_suite_name()) + "." + test->name());
         raytrace::writeSyntheticSession(benchScene(true), d, tinySessionOptions());
         return d;
     }();
