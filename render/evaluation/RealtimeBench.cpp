@@ -131,6 +131,29 @@ const std::vector<BenchKnob>& benchKnobs() {
          [](BenchConfig& c, const std::string& v) {
              c.options.indirectScale = parseInt("indirect_scale", v, 1, 2);
          }},
+        // Specular objects (issue 6). One default value each, so the default grid does not grow;
+        // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror
+        // or glass (the impostor and specular passes do not run).
+        {"specular_trace",
+         "what reflected/refracted rays are traced against: impostors (Popescu et al. 2006) or "
+         "cubemap (the plain G-buffer cube-map baseline)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"impostors"}; },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "impostors" && v != "cubemap")
+                 throw Error(fmt::format(
+                     "bench: knob specular_trace: '{}' is not impostors or cubemap", v));
+             c.options.impostorCubeMapBaseline = v == "cubemap";
+         }},
+        {"impostor_resolution", "texels per side of each impostor and cube-map face",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.impostorResolution = parseInt("impostor_resolution", v, 16, 2048);
+         }},
+        {"impostor_steps", "refinement steps of the impostor height-field search",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
+         }},
     };
     return knobs;
 }
