@@ -39,5 +39,14 @@ TEST(ImageCompare, BrokenImageFailsTypicalFloors) {
     EXPECT_GT(percentileAbsDiff(a, b, 0.99), 0.3);
 }
 
+// SSIM's stabilising constants reach every channel: two identical flat black colour images are a
+// perfect match (with the constants on channel 0 only, green and blue would score 0/0 -> 0).
+TEST(ImageCompare, FlatColourImagesScorePerfectInEveryChannel) {
+    const cv::Mat black(40, 40, CV_8UC3, cv::Scalar::all(0));
+    EXPECT_NEAR(ssim(black, black, 255.0), 1.0, 1e-9);
+    const cv::Mat teal(40, 40, CV_8UC3, cv::Scalar(90, 120, 0));
+    EXPECT_NEAR(ssim(teal, teal, 255.0), 1.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace mirage::test

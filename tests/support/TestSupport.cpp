@@ -50,8 +50,10 @@ double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask
     cv::Mat muA2 = muA.mul(muA), muB2 = muB.mul(muB), muAB = muA.mul(muB);
     cv::Mat sA = blur(fa.mul(fa)) - muA2, sB = blur(fb.mul(fb)) - muB2,
             sAB = blur(fa.mul(fb)) - muAB;
-    cv::Mat num = (2 * muAB + c1).mul(2 * sAB + c2);
-    cv::Mat den = (muA2 + muB2 + c1).mul(sA + sB + c2);
+    // Scalar::all: a plain double added to a multi-channel Mat goes to channel 0 only.
+    const cv::Scalar k1 = cv::Scalar::all(c1), k2 = cv::Scalar::all(c2);
+    cv::Mat num = (2 * muAB + k1).mul(2 * sAB + k2);
+    cv::Mat den = (muA2 + muB2 + k1).mul(sA + sB + k2);
     cv::Mat map;
     cv::divide(num, den, map);
     cv::Scalar m = mask.empty() ? cv::mean(map) : cv::mean(map, mask);
