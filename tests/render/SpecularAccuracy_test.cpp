@@ -89,21 +89,18 @@ void save(const std::string& name, const Comparison& c, const Result& r) {
 }
 
 // Fig. 2 combinations (light, specular object, reflected object, refracted object; R = real,
-// V = virtual). All 16 take too long for the test budget (each needs two reference renders), so
-// this covering subset is run: every element is real and virtual at least once, every pair of
-// (object, reflected) and (object, refracted) combinations appears, with both light origins.
-const test::SpecularCase kCases[] = {
-    {true, false, true, true},    // virtual glass among real things (the seed's example)
-    {true, false, false, false},  // virtual glass, virtual surroundings
-    {false, false, true, false},  // virtual light, virtual glass, real reflected, virtual refracted
-    {true, true, false, true},    // real glass reflecting a virtual box
-    {true, true, true, false},    // real glass with a virtual box behind it
-    {false, true, false, false},  // virtual light, real glass, virtual surroundings
-};
+// V = virtual): all 16, each against two reference renders (~1.4 s per case).
+std::vector<test::SpecularCase> allFig2Cases() {
+    std::vector<test::SpecularCase> cases;
+    for (int bits = 0; bits < 16; ++bits)
+        cases.push_back({(bits & 8) != 0, (bits & 4) != 0, (bits & 2) != 0, (bits & 1) != 0});
+    return cases;
+}
 
-// Floors over the sphere's pixels, ~1.5 dB / 0.05 below the lowest measured case (llvmpipe,
-// reference 48 spp seed 3, caustics off); docs/specular.md lists the per-case figures.
-constexpr double kMinPsnr = 24.0, kMinSsim = 0.60;
+// Floors over the sphere's pixels, ~1 dB / 0.04 below the lowest measured case (23.9 dB, SSIM
+// 0.637: virtual light, virtual glass, real surroundings; llvmpipe, reference 48 spp seed 3,
+// caustics off); the broken render (IOR 1.2) scores 20.6 dB. docs/specular.md lists every case.
+constexpr double kMinPsnr = 23.0, kMinSsim = 0.60;
 
 class SpecularFig2 : public ::testing::TestWithParam<test::SpecularCase> {};
 
@@ -122,7 +119,7 @@ TEST_P(SpecularFig2, MatchesReferenceOverTheSpecularObject) {
     EXPECT_GE(r.ssim, kMinSsim);
 }
 
-INSTANTIATE_TEST_SUITE_P(Fig2, SpecularFig2, ::testing::ValuesIn(kCases),
+INSTANTIATE_TEST_SUITE_P(Fig2, SpecularFig2, ::testing::ValuesIn(allFig2Cases()),
                          [](const auto& info) { return info.param.name(); });
 
 // Per effect: reflection only (a mirror sphere), both (glass), refraction only (glass, the
