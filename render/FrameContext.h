@@ -66,7 +66,10 @@ struct RendererOptions {
     bool specularVpls = true;             // light GBuf_refl / GBuf_refr hits with the VPLs too
     int specularVplStride = 4;  // 1, 4 or 16: each hit sums every stride-th VPL (x stride),
                                 // interleaved over 2x2 / 4x4 pixels (cheaper, noisier)
-    bool cullPasses = true;     // run only the passes the scene needs (false: run all; tests)
+    // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
+    // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
+    bool reuseStaticPasses = true;
+    bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
     // glFinish around every pass so each timer query holds only its pass's work. llvmpipe defers
     // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
     // without this a pass's time can show up in the next pass's query. For benchmarks.

@@ -25,6 +25,14 @@ public:
     // (Re)allocates targets for ctx's canvas / plan; called when they change.
     virtual void resize(const FrameContext& ctx) = 0;
     virtual void execute(FrameContext& ctx) = 0;
+
+    // True for passes whose output depends only on the scene and the frame plan (lights, their
+    // matrices, shadow layers, VPL allocation) and never on the camera: shadow maps + RSMs,
+    // VPLs, imperfect shadow maps. Scenes are static, so while the plan is unchanged the renderer
+    // reuses their last output (publishCached) instead of re-running them.
+    virtual bool cameraIndependent() const { return false; }
+    // Publishes what the last execute() wrote, unchanged (cameraIndependent passes only).
+    virtual void publishCached(FrameContext&) {}
 };
 
 }  // namespace mirage::render

@@ -64,11 +64,17 @@ bool FrameReport::ran(const std::string& pass) const {
     return false;
 }
 
+bool FrameReport::reused(const std::string& pass) const {
+    for (const PassReport& p : passes)
+        if (p.name == pass) return p.reused;
+    return false;
+}
+
 std::string FrameReport::summary() const {
     std::ostringstream s;
     for (const PassReport& p : passes)
-        s << fmt::format("{:<10} {:<7} {:7.2f} ms  {}\n", p.name, p.ran ? "ran" : "skipped",
-                         p.gpuMs, p.reason);
+        s << fmt::format("{:<10} {:<7} {:7.2f} ms  {}\n", p.name,
+                         p.ran ? "ran" : (p.reused ? "reused" : "skipped"), p.gpuMs, p.reason);
     s << fmt::format("{:<10} {:<7} {:7.2f} ms\n", "total", "", totalGpuMs);
     return s.str();
 }
@@ -313,6 +319,24 @@ void Renderer::planFrame(const FrameInput& input) {
     prevCameraPos_ = camPos;
 }
 
+namespace {
+
+// The inputs of the camera-independent passes besides the (static) scene and options: the light
+// matrices and parameters, and the frame plan. Equal keys mean equal outputs.
+std::string staticPlanKey(const FrameContext& c) {
+    std::string key(reinterpret_cast<const char*>(&c.lightBlock), sizeof(GpuLightBlock));
+    const FramePlan& p = c.plan;
+    for (const LightPlan& l : p.lights)
+        key += fmt::format("|{}{}{}{} {} {} {} {}", int(l.castsShadow), int(l.needsRealOnlyMap),
+                           int(l.reachesVirtual), int(l.hasRsm), l.firstLayer, l.layers, l.firstVpl,
+                           l.vplCount);
+    key += fmt::format("|{} {}{}{}", p.shadowLayers, int(p.needVpls), int(p.needRealOnlyShadows),
+                       int(p.needRealOnlyIsm));
+    return key;
+}
+
+}  // namespace
+
 const FrameReport& Renderer::render(const FrameInput& input) {
     if (!input.T_world_camera.isFinite())
         throw Error(
@@ -324,6 +348,12 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     c.clearResources();
     c.publish(Resource::CameraImage, &cameraImage_);
     report_ = FrameReport{};
+    // What the camera-independent passes' output depends on: the light matrices and the plan.
+    const std::string planKey = staticPlanKey(c);
+    if (planKey != staticPlanKey_ || staticOutputValid_.size() != passes_.size()) {
+        staticPlanKey_ = planKey;
+        staticOutputValid_.assign(passes_.size(), false);
+    }
     std::vector<bool> ran(passes_.size(), false);
     for (size_t i = 0; i < passes_.size(); ++i) {
         RenderPass& p = *passes_[i];
@@ -331,7 +361,17 @@ const FrameReport& Renderer::render(const FrameInput& input) {
         r.name = p.name();
         PassDecision d = p.decide(c);
         r.reason = d.reason;
-        if (d.run) {
+        const bool reuse =
+            d.run && p.cameraIndependent() && options_.reuseStaticPasses && staticOutputValid_[i];
+        if (!d.run || !p.cameraIndependent()) staticOutputValid_[i] = false;
+        if (reuse) {
+            for (Resource res : p.reads())
+                MR_CHECK(c.has(res), std::string("pass ") + p.name() + " reads " +
+                                         resourceName(res) + ", which no earlier pass wrote");
+            p.publishCached(c);
+            r.reused = true;
+            r.reason = "reused: scene, lights and plan unchanged (" + d.reason + ")";
+        } else if (d.run) {
             for (Resource res : p.reads())
                 MR_CHECK(c.has(res), std::string("pass ") + p.name() + " reads " +
                                          resourceName(res) + ", which no earlier pass wrote");
@@ -342,6 +382,7 @@ const FrameReport& Renderer::render(const FrameInput& input) {
             if (options_.syncPasses) glFinish();
             timers_[i].end();
             r.ran = ran[i] = true;
+            if (p.cameraIndependent()) staticOutputValid_[i] = true;
         }
         report_.passes.push_back(r);
     }

@@ -35,6 +35,7 @@ struct FrameInput {
 struct PassReport {
     std::string name;
     bool ran = false;
+    bool reused = false;  // not run: the output of an earlier frame was reused (still valid)
     std::string reason;
     double gpuMs = 0.0;  // GL_TIME_ELAPSED of the pass (0 when skipped)
 };
@@ -43,6 +44,7 @@ struct FrameReport {
     std::vector<PassReport> passes;
     double totalGpuMs = 0.0;
     bool ran(const std::string& pass) const;
+    bool reused(const std::string& pass) const;  // its output of an earlier frame was reused
     std::string summary() const;  // one line per pass: "name: ran|skipped (reason) x.xx ms"
 };
 
@@ -94,6 +96,10 @@ private:
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
     bool lastRanFilter_ = false;
+    // Camera-independent passes: the plan they were last run for, and whether each pass's last
+    // output is still valid for it.
+    std::string staticPlanKey_;
+    std::vector<bool> staticOutputValid_;
 };
 
 }  // namespace mirage::render

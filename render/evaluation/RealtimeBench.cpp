@@ -131,6 +131,15 @@ const std::vector<BenchKnob>& benchKnobs() {
          [](BenchConfig& c, const std::string& v) {
              c.options.indirectScale = parseInt("indirect_scale", v, 1, 2);
          }},
+        {"static_reuse",
+         "on: reuse the camera-independent passes (shadow, vpl, ism) while the plan is "
+         "unchanged; off: re-run them every frame",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "on" && v != "off")
+                 throw Error(fmt::format("bench: knob static_reuse: '{}' is not on or off", v));
+             c.options.reuseStaticPasses = v == "on";
+         }},
         // Specular objects (issue 6). One default value each, so the default grid does not grow;
         // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror
         // or glass (the impostor and specular passes do not run).

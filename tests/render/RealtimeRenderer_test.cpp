@@ -250,8 +250,9 @@ TEST_F(RealtimeRenderer, VirtualShadowOnlyInLrv) {
     r.render({s.pose, {}, false});
     cv::Mat footage = linearRgbToSrgbBgr8(r.readBuffer(Resource::LR));
     const FrameReport& rep = r.render({s.pose, footage, false});
-    EXPECT_TRUE(rep.ran("shadow"));
-    EXPECT_TRUE(rep.ran("vpl")) << rep.summary();
+    // Second frame, same plan: the shadow maps and VPLs of the first are reused.
+    EXPECT_TRUE(rep.reused("shadow")) << rep.summary();
+    EXPECT_TRUE(rep.reused("vpl")) << rep.summary();
     EXPECT_TRUE(r.plan().lights[0].needsRealOnlyMap);
     cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
     cv::Mat comp = r.compositeLinear(), cover = r.coverage();
@@ -373,6 +374,39 @@ TEST_F(RealtimeRenderer, BrightLightAndNearPlaneStayFinite) {
     double maxVal = 0;
     cv::minMaxLoc(srgb.reshape(1), nullptr, &maxVal);
     EXPECT_EQ(maxVal, 255.0);
+}
+
+// Shadow maps, RSMs, VPLs and ISMs do not depend on the camera: from the second frame on they are
+// reused (reported, 0 ms), and the frame is the one a renderer running every pass produces.
+TEST_F(RealtimeRenderer, CameraIndependentPassesAreReusedAcrossFrames) {
+    SpotScene s;
+    int red = addMaterial(s.scene, {0.8f, 0.1f, 0.1f});
+    addBox(s.scene, "virtual box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f}, red, Origin::Virtual);
+    RendererOptions opt;
+    opt.vplCount = 64;
+    opt.temporalBlend = 0.0f;  // frames comparable one by one
+    cv::Mat footage(s.cam.height, s.cam.width, CV_8UC3, cv::Scalar(90, 100, 110));
+    const Pose second = lookAtPose({0.8, 2.2, 2.6}, {0, 0.2, 0});
+    Renderer reusing(s.scene, s.cam, opt);
+    const FrameReport& first = reusing.render({s.pose, footage, true});
+    for (const char* pass : {"shadow", "vpl", "ism"}) EXPECT_TRUE(first.ran(pass)) << pass;
+    const FrameReport& rep = reusing.render({second, footage, true});
+    for (const char* pass : {"shadow", "vpl", "ism"}) {
+        EXPECT_FALSE(rep.ran(pass)) << pass;
+        EXPECT_TRUE(rep.reused(pass)) << rep.summary();
+    }
+    EXPECT_TRUE(rep.ran("indirect"));
+    EXPECT_NE(rep.summary().find("reused"), std::string::npos);
+
+    opt.reuseStaticPasses = false;
+    Renderer fresh(s.scene, s.cam, opt);
+    fresh.render({s.pose, footage, true});
+    const FrameReport& again = fresh.render({second, footage, true});
+    for (const char* pass : {"shadow", "vpl", "ism"}) EXPECT_TRUE(again.ran(pass)) << pass;
+    EXPECT_GT(test::psnr(reusing.compositeSrgb(), fresh.compositeSrgb(), 255.0), 60.0);
+    // The comparison can fail: the first pose's frame differs from the second's.
+    fresh.render({s.pose, footage, true});
+    EXPECT_LT(test::psnr(reusing.compositeSrgb(), fresh.compositeSrgb(), 255.0), 40.0);
 }
 
 // Passes run only when the scene needs them, and say why.

@@ -54,6 +54,10 @@ void IsmPass::execute(FrameContext& ctx) {
     const long long invocations = (long long)ctx.options.vplCount * ctx.options.ismPointsPerVpl;
     glDispatchCompute(GLuint((invocations + 63) / 64), 1, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    publishCached(ctx);
+}
+
+void IsmPass::publishCached(FrameContext& ctx) {
     ctx.publish(Resource::ImperfectShadowMaps, &all_);
     ctx.publish(Resource::ImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? &real_ : &all_);
 }

@@ -19,6 +19,8 @@ public:
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
     void execute(FrameContext& ctx) override;
+    bool cameraIndependent() const override { return true; }
+    void publishCached(FrameContext& ctx) override;
     static int tilesPerRow(int vplCount);
 
 private:

@@ -97,6 +97,10 @@ void ShadowPass::execute(FrameContext& ctx) {
         }
     }
     glDisable(GL_DEPTH_TEST);
+    publishCached(ctx);
+}
+
+void ShadowPass::publishCached(FrameContext& ctx) {
     ctx.publish(Resource::ShadowMaps, &distance_);
     ctx.publish(Resource::ShadowMapsReal,
                 ctx.plan.needRealOnlyShadows ? &distanceReal_ : &distance_);

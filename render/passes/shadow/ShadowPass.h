@@ -20,6 +20,8 @@ public:
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
     void execute(FrameContext& ctx) override;
+    bool cameraIndependent() const override { return true; }
+    void publishCached(FrameContext& ctx) override;
 
     const gl::Texture& rsmFlux() const { return rsmFlux_; }
     const gl::Texture& rsmNormal() const { return rsmNormal_; }

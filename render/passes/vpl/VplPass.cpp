@@ -36,6 +36,10 @@ void VplPass::execute(FrameContext& ctx) {
     glUniform4iv(program_.uniformLocation("lightVplFirst"), kMaxLights, &ranges[0][0]);
     glDispatchCompute(GLuint((ctx.options.vplCount + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    publishCached(ctx);
+}
+
+void VplPass::publishCached(FrameContext& ctx) {
     ctx.publish(Resource::Vpls, nullptr);
 }
 

@@ -15,6 +15,8 @@ public:
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
     void execute(FrameContext& ctx) override;
+    bool cameraIndependent() const override { return true; }
+    void publishCached(FrameContext& ctx) override;
     const gl::Buffer& vplBuffer() const { return vpls_; }
 
 private:
