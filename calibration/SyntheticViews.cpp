@@ -119,12 +119,12 @@ ChessboardRenderer::ChessboardRenderer(const CameraIntrinsics& camera, int super
                 }
 }
 
-cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardPose& pose) const {
+template <typename ShadeBoardPoint>
+cv::Mat ChessboardRenderer::renderPlane(const BoardPose& pose, ShadeBoardPoint shade) const {
     cv::Matx33d R;
     cv::Rodrigues(pose.rvec, R);
     const cv::Matx33d Rt = R.t();
     const cv::Vec3d origin = -(Rt * pose.tvec);  // camera centre in board coordinates
-    const double sq = board.squareMetres;
     cv::Mat img(camera_.height, camera_.width, CV_8UC1);
     size_t k = 0;
     for (int y = 0; y < camera_.height; ++y) {
@@ -133,21 +133,11 @@ cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardP
             double sum = 0;
             for (int s = 0; s < n_ * n_; ++s) {
                 const cv::Vec3f& r = rays_[k++];
-                double value = 110;
+                double value = kBackground;
                 const cv::Vec3d d = Rt * cv::Vec3d(r[0], r[1], r[2]);
                 if (std::abs(d[2]) > 1e-12) {
                     const double t = -origin[2] / d[2];
-                    if (t > 0) {
-                        // Squares span [-sq, cols*sq] x [-sq, rows*sq]; margin of 1 square.
-                        const double gx = (origin[0] + t * d[0]) / sq + 1;
-                        const double gy = (origin[1] + t * d[1]) / sq + 1;
-                        if (gx >= -1 && gy >= -1 && gx < board.cols + 2 && gy < board.rows + 2) {
-                            value = 230;
-                            if (gx >= 0 && gy >= 0 && gx < board.cols + 1 && gy < board.rows + 1 &&
-                                ((int(std::floor(gx)) + int(std::floor(gy))) & 1) == 0)
-                                value = 25;
-                        }
-                    }
+                    if (t > 0) value = shade(origin[0] + t * d[0], origin[1] + t * d[1]);
                 }
                 sum += value;
             }
@@ -157,41 +147,29 @@ cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardP
     return img;
 }
 
+cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardPose& pose) const {
+    const double sq = board.squareMetres;
+    return renderPlane(pose, [&](double bx, double by) {
+        // Squares span [-sq, cols*sq] x [-sq, rows*sq]; margin of 1 square.
+        const double gx = bx / sq + 1, gy = by / sq + 1;
+        if (gx < -1 || gy < -1 || gx >= board.cols + 2 || gy >= board.rows + 2) return kBackground;
+        if (gx >= 0 && gy >= 0 && gx < board.cols + 1 && gy < board.rows + 1 &&
+            ((int(std::floor(gx)) + int(std::floor(gy))) & 1) == 0)
+            return 25.0;
+        return 230.0;
+    });
+}
+
 cv::Mat ChessboardRenderer::renderTexture(const cv::Mat& texture, double metresPerTexel,
                                           const cv::Point2d& boardOriginTexel,
                                           const BoardPose& pose) const {
     MR_CHECK(texture.type() == CV_8UC1 && metresPerTexel > 0, "texture must be 8-bit grey");
-    cv::Matx33d R;
-    cv::Rodrigues(pose.rvec, R);
-    const cv::Matx33d Rt = R.t();
-    const cv::Vec3d origin = -(Rt * pose.tvec);  // camera centre in board coordinates
-    cv::Mat img(camera_.height, camera_.width, CV_8UC1);
-    size_t k = 0;
-    for (int y = 0; y < camera_.height; ++y) {
-        auto* row = img.ptr<uint8_t>(y);
-        for (int x = 0; x < camera_.width; ++x) {
-            double sum = 0;
-            for (int s = 0; s < n_ * n_; ++s) {
-                const cv::Vec3f& r = rays_[k++];
-                double value = 110;
-                const cv::Vec3d d = Rt * cv::Vec3d(r[0], r[1], r[2]);
-                if (std::abs(d[2]) > 1e-12) {
-                    const double t = -origin[2] / d[2];
-                    if (t > 0) {
-                        const double u = std::floor((origin[0] + t * d[0]) / metresPerTexel +
-                                                    boardOriginTexel.x);
-                        const double v = std::floor((origin[1] + t * d[1]) / metresPerTexel +
-                                                    boardOriginTexel.y);
-                        if (u >= 0 && v >= 0 && u < texture.cols && v < texture.rows)
-                            value = texture.at<uint8_t>(int(v), int(u));
-                    }
-                }
-                sum += value;
-            }
-            row[x] = cv::saturate_cast<uint8_t>(sum / (n_ * n_));
-        }
-    }
-    return img;
+    return renderPlane(pose, [&](double bx, double by) {
+        const double u = std::floor(bx / metresPerTexel + boardOriginTexel.x);
+        const double v = std::floor(by / metresPerTexel + boardOriginTexel.y);
+        if (u < 0 || v < 0 || u >= texture.cols || v >= texture.rows) return kBackground;
+        return double(texture.at<uint8_t>(int(v), int(u)));
+    });
 }
 
 cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,

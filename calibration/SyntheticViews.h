@@ -71,6 +71,11 @@ private:
     CameraIntrinsics camera_;
     int n_;
     std::vector<cv::Vec3f> rays_;  // unit rays, camera frame; zero where unprojection failed
+    static constexpr double kBackground = 110;  // grey value where a ray misses the board
+    // Ray-casts every sub-pixel onto the board plane z = 0 and averages shade(x, y) (board
+    // metres -> grey value) over each pixel's sub-pixels.
+    template <typename ShadeBoardPoint>
+    cv::Mat renderPlane(const BoardPose& pose, ShadeBoardPoint shade) const;
 };
 
 // One-off convenience (builds a renderer).
