@@ -11,17 +11,9 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/image/ImageCompare.h"  // psnr, ssim, ssimMap: the per-image figures
+
 namespace mirage::render {
-
-// Per-pixel SSIM map (Wang et al. 2004: 11x11 Gaussian window, sigma 1.5, C1 = 0.01², C2 = 0.03²)
-// of two images of equal size and type, scaled so `peak` maps to 1; CV_64FC<channels>.
-cv::Mat ssimMap(const cv::Mat& a, const cv::Mat& b, double peak);
-
-// PSNR (dB) over all pixels, or only where mask != 0 (CV_8U). +inf if identical, NaN if the
-// mask is empty.
-double psnr(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
-// Mean SSIM over all channels and pixels (or the masked pixels). NaN if the mask is empty.
-double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
 
 // Sums over frames for pooled figures.
 struct ErrorAccumulator {

@@ -24,17 +24,6 @@
 namespace mirage::render {
 namespace {
 
-double maskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-    cv::Mat d;
-    cv::absdiff(a, b, d);
-    d.convertTo(d, CV_64FC3);
-    cv::multiply(d, d, d);
-    const cv::Scalar sum = cv::sum(d.clone().setTo(0, mask == 0));
-    const double n = 3.0 * cv::countNonZero(mask);
-    const double mse = (sum[0] + sum[1] + sum[2]) / n;
-    return mse <= 0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 / mse);
-}
-
 struct Result {
     double psnr = 0, ssim = 0;
     cv::Mat rt, ref, footage;
@@ -70,7 +59,7 @@ Result realtime(const Comparison& c, const test::SpecularScene& rtScene, Rendere
     out.rt = r.compositeSrgb();
     const cv::Mat lin = r.compositeLinear();
     EXPECT_TRUE(cv::checkRange(lin)) << "NaN/Inf in the composite";
-    out.psnr = maskedPsnr(out.rt, c.refSrgb, c.mask);
+    out.psnr = test::psnr(out.rt, c.refSrgb, 255.0, c.mask);
     out.ssim = test::ssim(out.rt, c.refSrgb, 255.0, c.mask);
     return out;
 }

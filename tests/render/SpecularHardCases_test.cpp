@@ -23,17 +23,6 @@
 namespace mirage::render {
 namespace {
 
-double maskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-    cv::Mat d;
-    cv::absdiff(a, b, d);
-    d.convertTo(d, CV_64FC3);
-    cv::multiply(d, d, d);
-    const cv::Scalar sum = cv::sum(d.clone().setTo(0, mask == 0));
-    const double n = 3.0 * cv::countNonZero(mask);
-    const double mse = (sum[0] + sum[1] + sum[2]) / n;
-    return mse <= 0 ? INFINITY : 10.0 * std::log10(255.0 * 255.0 / mse);
-}
-
 void expectFiniteBuffers(const Renderer& r) {
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "composite";
     for (Resource res : {Resource::SpecularRv, Resource::SpecularR, Resource::Lenv,
@@ -96,7 +85,7 @@ TEST(SpecularHardCases, IorOneVanishesExceptForAbsorption) {
         const cv::Mat out = r.compositeSrgb();
         const cv::Mat mask = test::sphereMask(s, 1.5);
         if (!absorb) {
-            const double p = maskedPsnr(out, footage, mask);
+            const double p = test::psnr(out, footage, 255.0, mask);
             std::cout << "[ specular ] IOR 1, no absorption: PSNR vs footage " << p << " dB\n";
             cv::Mat side;
             cv::hconcat(std::vector<cv::Mat>{footage, out}, side);
@@ -158,7 +147,7 @@ TEST(SpecularHardCases, TotalInternalReflectionAndGrazingViewsStayFinite) {
         cv::absdiff(ref.composite, ref.footage, virt);
         cv::cvtColor(virt, virt, cv::COLOR_BGR2GRAY);
         mask = virt > 6;
-        const double p = maskedPsnr(out, ref.composite, mask);
+        const double p = test::psnr(out, ref.composite, 255.0, mask);
         std::cout << "[ specular ] glass block, camera " << elevation + 0.2
                   << " m high: PSNR vs reference " << p << " dB over " << cv::countNonZero(mask)
                   << " px\n";
@@ -202,7 +191,7 @@ TEST(SpecularHardCases, ThinAndThickGlassMatchReference) {
         cv::Mat cov = r.coverage();
         cv::Mat mask = cov == 2;  // virtual = the slab
         cv::erode(mask, mask, cv::Mat());
-        const double p = maskedPsnr(out, ref.composite, mask);
+        const double p = test::psnr(out, ref.composite, 255.0, mask);
         const double q = test::ssim(out, ref.composite, 255.0, mask);
         std::cout << "[ specular ] glass slab " << thickness * 1000 << " mm: PSNR " << p
                   << " dB, SSIM " << q << " over " << cv::countNonZero(mask) << " px\n";
@@ -250,14 +239,14 @@ TEST(SpecularHardCases, RealObjectOccludedInVideoIsRejectedByDepth) {
     const cv::Mat changed = (d > 20) & mask;
     std::cout << "[ specular ] occluded reflection: " << cv::countNonZero(changed)
               << " sphere px change with validation; PSNR validated "
-              << maskedPsnr(validated, ref.composite, mask) << " dB, unvalidated "
-              << maskedPsnr(unvalidated, ref.composite, mask) << " dB\n";
+              << test::psnr(validated, ref.composite, 255.0, mask) << " dB, unvalidated "
+              << test::psnr(unvalidated, ref.composite, 255.0, mask) << " dB\n";
     ASSERT_GT(cv::countNonZero(changed), 5);
     const cv::Scalar v = cv::mean(validated, changed), u = cv::mean(unvalidated, changed);
     EXPECT_GT(v[2], v[0]);  // BGR: red dominates where the red box is reflected
     EXPECT_GT(u[0], u[2]);  // the wall's blue when the occluded back-projection is accepted
-    EXPECT_GT(maskedPsnr(validated, ref.composite, mask),
-              maskedPsnr(unvalidated, ref.composite, mask) + 1.0);
+    EXPECT_GT(test::psnr(validated, ref.composite, 255.0, mask),
+              test::psnr(unvalidated, ref.composite, 255.0, mask) + 1.0);
 }
 
 // Nothing modelled around a virtual mirror sphere: every reflected ray leaves the scene, so the
@@ -275,7 +264,7 @@ TEST(SpecularHardCases, RaysLeavingTheSceneShowTheEnvironment) {
     const cv::Mat env = r.readBuffer(Resource::Lenv);
     EXPECT_GT(cv::mean(env)[2], 0.0);
     const cv::Mat mask = test::sphereMask(s, 1.5);
-    const double p = maskedPsnr(r.compositeSrgb(), ref.composite, mask);
+    const double p = test::psnr(r.compositeSrgb(), ref.composite, 255.0, mask);
     std::cout << "[ specular ] rays leaving the scene: PSNR " << p << " dB\n";
     EXPECT_GT(p, 35.0);
 }

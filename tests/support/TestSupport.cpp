@@ -8,6 +8,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/image/ImageCompare.h"
+
 namespace mirage::test {
 
 std::filesystem::path dataDir() {
@@ -24,42 +26,12 @@ std::filesystem::path outputDir(const std::string& name) {
     return p;
 }
 
-double psnr(const cv::Mat& a, const cv::Mat& b, double peak) {
-    CV_Assert(a.size() == b.size() && a.type() == b.type());
-    cv::Mat fa, fb;
-    a.convertTo(fa, CV_64F);
-    b.convertTo(fb, CV_64F);
-    cv::Mat d = fa - fb;
-    double mse = d.dot(d) / double(d.total() * d.channels());
-    if (mse <= 0) return std::numeric_limits<double>::infinity();
-    return 10.0 * std::log10(peak * peak / mse);
+double psnr(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask) {
+    return mirage::psnr(a, b, peak, mask);
 }
 
 double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask) {
-    CV_Assert(a.size() == b.size() && a.type() == b.type());
-    const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
-    cv::Mat fa, fb;
-    a.convertTo(fa, CV_64F, 1.0 / peak);
-    b.convertTo(fb, CV_64F, 1.0 / peak);
-    auto blur = [](const cv::Mat& m) {
-        cv::Mat o;
-        cv::GaussianBlur(m, o, cv::Size(11, 11), 1.5);
-        return o;
-    };
-    cv::Mat muA = blur(fa), muB = blur(fb);
-    cv::Mat muA2 = muA.mul(muA), muB2 = muB.mul(muB), muAB = muA.mul(muB);
-    cv::Mat sA = blur(fa.mul(fa)) - muA2, sB = blur(fb.mul(fb)) - muB2,
-            sAB = blur(fa.mul(fb)) - muAB;
-    // Scalar::all: a plain double added to a multi-channel Mat goes to channel 0 only.
-    const cv::Scalar k1 = cv::Scalar::all(c1), k2 = cv::Scalar::all(c2);
-    cv::Mat num = (2 * muAB + k1).mul(2 * sAB + k2);
-    cv::Mat den = (muA2 + muB2 + k1).mul(sA + sB + k2);
-    cv::Mat map;
-    cv::divide(num, den, map);
-    cv::Scalar m = mask.empty() ? cv::mean(map) : cv::mean(map, mask);
-    double sum = 0;
-    for (int c = 0; c < map.channels(); ++c) sum += m[c];
-    return sum / map.channels();
+    return mirage::ssim(a, b, peak, mask);
 }
 
 double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q) {

@@ -13,11 +13,10 @@ std::filesystem::path testDataDir();  // tests/data/
 // A fresh (emptied) folder under the build's test output directory.
 std::filesystem::path outputDir(const std::string& name);
 
-// Peak signal-to-noise ratio in dB between two images of equal size and type (any depth);
-// `peak` is the signal's maximum (1 for linear float, 255 for 8-bit). Infinity if identical.
-double psnr(const cv::Mat& a, const cv::Mat& b, double peak);
-// Mean structural similarity (Wang et al. 2004, 11x11 Gaussian window, sigma 1.5) over all
-// channels, on images scaled so `peak` maps to 1. Optional mask (CV_8U, nonzero = counted).
+// PSNR (dB) and mean SSIM of two images of equal size and type, over all pixels or where
+// mask != 0 (CV_8U): core/image/ImageCompare.h's, the figures the benchmark reports too.
+// `peak` is the signal's maximum (1 for linear float, 255 for 8-bit). PSNR is +inf if identical.
+double psnr(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
 double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
 // The q-quantile (0..1) of the per-pixel absolute difference (max over channels).
 double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q);
