@@ -24,25 +24,6 @@ namespace {
 
 using namespace mirage;
 
-void addSphere(Scene& s, glm::vec3 c, float r, int segments, int material, Origin origin) {
-    Primitive p;
-    const int rings = segments, sectors = 2 * segments;
-    for (int i = 0; i <= rings; ++i)
-        for (int j = 0; j <= sectors; ++j) {
-            const float th = float(M_PI) * i / rings, ph = 2.0f * float(M_PI) * j / sectors;
-            glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
-            p.positions.push_back(c + r * n);
-            p.normals.push_back(n);
-        }
-    for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < sectors; ++j) {
-            uint32_t a = uint32_t(i * (sectors + 1) + j), b = a + uint32_t(sectors + 1);
-            p.indices.insert(p.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
-        }
-    p.material = material;
-    test::addMeshNode(s, "sphere", std::move(p), origin);
-}
-
 // specular: 0 = the sphere is diffuse blue (the diffuse-only frame), 1 = the sphere is glass
 // (IOR 1.5, light absorption), 2 = glass sphere and the virtual box a mirror (issue 6).
 Scene benchScene(int sphereSegments, int specular = 0) {
@@ -71,7 +52,8 @@ Scene benchScene(int sphereSegments, int specular = 0) {
     test::addBox(s, "real box", {-0.6f, 0.0f, -0.5f}, {-0.3f, 0.3f, -0.2f}, white, Origin::Real);
     test::addBox(s, "virtual box", {0.1f, 0.0f, -0.2f}, {0.35f, 0.25f, 0.05f}, red,
                  Origin::Virtual);
-    addSphere(s, {-0.1f, 0.15f, 0.2f}, 0.15f, sphereSegments, blue, Origin::Virtual);
+    test::addUvSphere(s, "sphere", {-0.1f, 0.15f, 0.2f}, 0.15f, blue, Origin::Virtual,
+                      sphereSegments, 2 * sphereSegments);
     test::addLight(s, Light::Type::Spot, {0.6f, 1.4f, 0.6f},
                    glm::normalize(glm::vec3(-0.6f, -1.4f, -0.6f)), 6.0f, Origin::Real, 0.9f, 0.7f);
     return s;

@@ -15,26 +15,6 @@
 
 namespace mirage::test {
 
-inline void addUvSphere(Scene& s, const std::string& name, glm::vec3 c, float r, int segments,
-                        int material, Origin origin) {
-    Primitive p;
-    const int rings = segments, sectors = 2 * segments;
-    for (int i = 0; i <= rings; ++i)
-        for (int j = 0; j <= sectors; ++j) {
-            const float th = float(M_PI) * i / rings, ph = 2.0f * float(M_PI) * j / sectors;
-            glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
-            p.positions.push_back(c + r * n);
-            p.normals.push_back(n);
-        }
-    for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < sectors; ++j) {
-            uint32_t a = uint32_t(i * (sectors + 1) + j), b = a + uint32_t(sectors + 1);
-            p.indices.insert(p.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
-        }
-    p.material = material;
-    addMeshNode(s, name, std::move(p), origin);
-}
-
 // Four inward-facing walls of height h around [-half, half]^2 (one mesh, not planar).
 inline void addRoomWalls(Scene& s, float half, float h, int material, Origin origin) {
     Primitive p;
@@ -74,17 +54,18 @@ inline Scene impostorTestScene(bool withRoom, int sphereSegments = 24, bool near
     const int glassMat = int(s.materials.size()) - 1;
 
     addFloor(s, "floor", 0.0f, 4.0f, grey, Origin::Real);
-    addUvSphere(s, "mirror sphere", {0.0f, 0.25f, 0.0f}, 0.25f, sphereSegments, mirror,
-                Origin::Virtual);
-    addUvSphere(s, "glass sphere", {0.9f, 0.15f, 0.8f}, 0.15f, sphereSegments, glassMat,
-                Origin::Real);
+    addUvSphere(s, "mirror sphere", {0.0f, 0.25f, 0.0f}, 0.25f, mirror, Origin::Virtual,
+                sphereSegments, 2 * sphereSegments);
+    addUvSphere(s, "glass sphere", {0.9f, 0.15f, 0.8f}, 0.15f, glassMat, Origin::Real,
+                sphereSegments, 2 * sphereSegments);
     if (nearSphere)
-        addUvSphere(s, "near red sphere", {0.47f, 0.12f, 0.0f}, 0.12f, 4 * sphereSegments, red,
-                    Origin::Virtual);
+        addUvSphere(s, "near red sphere", {0.47f, 0.12f, 0.0f}, 0.12f, red, Origin::Virtual,
+                    4 * sphereSegments, 2 * (4 * sphereSegments));
     else
         addBox(s, "near red box", {0.35f, 0.0f, -0.1f}, {0.55f, 0.3f, 0.1f}, red, Origin::Virtual);
     addBox(s, "far blue box", {-1.5f, 0.0f, 0.5f}, {-1.1f, 0.6f, 0.9f}, blue, Origin::Real);
-    addUvSphere(s, "green sphere", {0.2f, 0.2f, -1.0f}, 0.2f, sphereSegments, green, Origin::Real);
+    addUvSphere(s, "green sphere", {0.2f, 0.2f, -1.0f}, 0.2f, green, Origin::Real, sphereSegments,
+                2 * sphereSegments);
     if (withRoom) addRoomWalls(s, 2.0f, 1.5f, wall, Origin::Real);
     return s;
 }

@@ -198,7 +198,7 @@ TEST_F(ImpostorTrace, ThickTableUnderTheObjectIsTracedExactly) {
     const int wood = test::addMaterial(s, glm::vec3(0.5f, 0.35f, 0.2f));
     const int mirror = test::addMaterial(s, glm::vec3(0.95f), 0.0f, 1.0f);
     test::addBox(s, "table", {-1.0f, -0.05f, -0.6f}, {1.0f, 0.0f, 0.6f}, wood, Origin::Real);
-    test::addUvSphere(s, "mirror", {0.0f, 0.25f, 0.0f}, 0.25f, 16, mirror, Origin::Virtual);
+    test::addUvSphere(s, "mirror", {0.0f, 0.25f, 0.0f}, 0.25f, mirror, Origin::Virtual, 16, 2 * 16);
     GpuScene gpu(s, 64);
     raytrace::RayTracingScene rt(s, raytrace::SceneSubset::All, *device_);
     ImpostorPass pass;

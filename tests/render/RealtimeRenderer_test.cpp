@@ -376,6 +376,26 @@ TEST_F(RealtimeRenderer, BrightLightAndNearPlaneStayFinite) {
     EXPECT_EQ(maxVal, 255.0);
 }
 
+// The test scenes' UV sphere is wound outward: the reference renderer takes a glass surface's
+// outside from the winding (an inward-wound glass sphere renders as an air bubble in glass).
+TEST(RenderTestScenes, UvSphereIsWoundOutward) {
+    Scene s;
+    const glm::vec3 centre(0.3f, 0.5f, -0.2f);
+    test::addUvSphere(s, "sphere", centre, 0.4f, test::addMaterial(s, glm::vec3(0.5f)),
+                      Origin::Real, 8, 12);
+    const Primitive& p = s.meshes.back().primitives.front();
+    int checked = 0;
+    for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+        const glm::vec3 a = p.positions[p.indices[t]], b = p.positions[p.indices[t + 1]],
+                        c = p.positions[p.indices[t + 2]];
+        const glm::vec3 ng = glm::cross(b - a, c - a);
+        if (glm::length(ng) < 1e-8f) continue;  // degenerate triangles at the poles
+        EXPECT_GT(glm::dot(ng, (a + b + c) / 3.0f - centre), 0.0f) << "triangle " << t / 3;
+        ++checked;
+    }
+    EXPECT_GT(checked, 8 * 12);
+}
+
 // Shadow maps, RSMs, VPLs and ISMs do not depend on the camera: from the second frame on they are
 // reused (reported, 0 ms), and the frame is the one a renderer running every pass produces.
 TEST_F(RealtimeRenderer, CameraIndependentPassesAreReusedAcrossFrames) {

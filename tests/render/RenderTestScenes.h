@@ -37,6 +37,30 @@ inline void addMeshNode(Scene& s, const std::string& name, Primitive prim, Origi
     s.roots.push_back(int(s.nodes.size()) - 1);
 }
 
+// UV sphere (rings x segments quads) with outward normals AND outward winding: the reference
+// renderer takes a transmissive surface's outside from the triangle winding, so an inward-wound
+// glass sphere would be rendered as an air bubble in glass.
+inline void addUvSphere(Scene& s, const std::string& name, glm::vec3 c, float r, int material,
+                        Origin origin, int rings = 32, int segments = 48) {
+    Primitive p;
+    for (int i = 0; i <= rings; ++i) {
+        const float th = float(M_PI) * float(i) / float(rings);
+        for (int j = 0; j <= segments; ++j) {
+            const float ph = 2.0f * float(M_PI) * float(j) / float(segments);
+            glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+            p.positions.push_back(c + r * n);
+            p.normals.push_back(n);
+        }
+    }
+    for (int i = 0; i < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            const uint32_t a = uint32_t(i * (segments + 1) + j), b = a + uint32_t(segments + 1);
+            p.indices.insert(p.indices.end(), {a, a + 1, b, a + 1, b + 1, b});
+        }
+    p.material = material;
+    addMeshNode(s, name, std::move(p), origin);
+}
+
 // Horizontal square at height y, normal +Y, side `size` centred at (cx, y, cz).
 inline void addFloor(Scene& s, const std::string& name, float y, float size, int material,
                      Origin origin, float cx = 0.0f, float cz = 0.0f) {

@@ -75,7 +75,7 @@ TEST(SpecularHardCases, IorOneVanishesExceptForAbsorption) {
             absorb ? test::addGlass(s.scene, 1.0f, att, attDist) : test::addGlass(s.scene, 1.0f);
         // 20 m: every view ray through the sphere meets the table (else it rightly sees L_env).
         test::addFloor(s.scene, "table", 0.0f, 20.0f, table, Origin::Real);
-        test::addSphere(s.scene, "glass", s.sphereCentre, s.sphereRadius, glass, Origin::Virtual);
+        test::addUvSphere(s.scene, "glass", s.sphereCentre, s.sphereRadius, glass, Origin::Virtual);
         test::addSkyEnvironment(s.scene, envDir);
         cv::Mat footage(s.cam.height, s.cam.width, CV_8UC3);
         cv::randu(footage, cv::Scalar::all(40), cv::Scalar::all(220));
@@ -255,7 +255,7 @@ TEST(SpecularHardCases, RaysLeavingTheSceneShowTheEnvironment) {
     gl::Context context = gl::Context::headless();
     test::SpecularScene s;
     const int mirror = test::addMirror(s.scene);
-    test::addSphere(s.scene, "mirror", s.sphereCentre, s.sphereRadius, mirror, Origin::Virtual);
+    test::addUvSphere(s.scene, "mirror", s.sphereCentre, s.sphereRadius, mirror, Origin::Virtual);
     test::addSkyEnvironment(s.scene, test::outputDir("specular_env_only"));
     const Reference ref = reference(s.scene, s.cam, s.pose, 16);
     Renderer r(s.scene, s.cam, singleFrame());
@@ -311,8 +311,8 @@ TEST(SpecularHardCases, PassesRunOnlyWithSpecularObjects) {
         EXPECT_FALSE(rep.ran("specgbuf"));
         EXPECT_FALSE(rep.ran("speclight"));
     }
-    test::addSphere(s.scene, "glass", s.sphereCentre, s.sphereRadius, test::addGlass(s.scene),
-                    Origin::Virtual);
+    test::addUvSphere(s.scene, "glass", s.sphereCentre, s.sphereRadius, test::addGlass(s.scene),
+                      Origin::Virtual);
     Renderer r(s.scene, s.cam, singleFrame());
     const FrameReport& rep = r.render({s.pose, cv::Mat(), true});
     EXPECT_TRUE(rep.ran("backface"));

@@ -16,28 +16,6 @@
 
 namespace mirage::test {
 
-// UV sphere with outward normals.
-inline void addSphere(Scene& s, const std::string& name, glm::vec3 c, float r, int material,
-                      Origin origin, int rings = 32, int segments = 48) {
-    Primitive p;
-    for (int i = 0; i <= rings; ++i) {
-        const float th = float(M_PI) * float(i) / float(rings);
-        for (int j = 0; j <= segments; ++j) {
-            const float ph = 2.0f * float(M_PI) * float(j) / float(segments);
-            glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
-            p.positions.push_back(c + r * n);
-            p.normals.push_back(n);
-        }
-    }
-    for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            const uint32_t a = uint32_t(i * (segments + 1) + j), b = a + uint32_t(segments + 1);
-            p.indices.insert(p.indices.end(), {a, a + 1, b, a + 1, b + 1, b});
-        }
-    p.material = material;
-    addMeshNode(s, name, std::move(p), origin);
-}
-
 inline int addGlass(Scene& s, float ior = 1.5f, glm::vec3 attenuationColor = glm::vec3(1.0f),
                     float attenuationDistance = INFINITY) {
     Material m;
@@ -110,8 +88,8 @@ inline SpecularScene makeSpecularScene(const SpecularCase& c, const std::filesys
     const int green = addMaterial(s.scene, glm::vec3(0.15f, 0.7f, 0.2f));
     const int spec = kind == SpecularKind::Glass ? addGlass(s.scene, ior) : addMirror(s.scene);
     addFloor(s.scene, "table", 0.0f, 3.0f, table, Origin::Real);
-    addSphere(s.scene, "specular sphere", s.sphereCentre, s.sphereRadius, spec,
-              c.objectReal ? Origin::Real : Origin::Virtual);
+    addUvSphere(s.scene, "specular sphere", s.sphereCentre, s.sphereRadius, spec,
+                c.objectReal ? Origin::Real : Origin::Virtual);
     // Reflected: a red box beside the sphere, towards the camera (seen in the sphere's left).
     addBox(s.scene, "reflected box", {-0.55f, 0.0f, 0.05f}, {-0.35f, 0.3f, 0.35f}, red,
            c.reflectedReal ? Origin::Real : Origin::Virtual);
