@@ -22,7 +22,9 @@ public:
     virtual std::vector<Resource> reads() const = 0;
     virtual std::vector<Resource> writes() const = 0;
     virtual PassDecision decide(const FrameContext& ctx) const = 0;
-    // (Re)allocates targets for ctx's canvas / plan; called when they change.
+    // (Re)allocates targets for ctx's canvas / plan. Called before every frame the pass runs:
+    // it must return at once unless a size changed (reallocating costs page faults on every
+    // target, and would drop state such as the temporal history).
     virtual void resize(const FrameContext& ctx) = 0;
     virtual void execute(FrameContext& ctx) = 0;
 

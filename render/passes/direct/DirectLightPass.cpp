@@ -18,6 +18,7 @@ PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
 }
 
 void DirectLightPass::resize(const FrameContext& ctx) {
+    if (rv_.width() == ctx.canvasWidth() && rv_.height() == ctx.canvasHeight()) return;
     rv_ = gl::Texture::create2D("direct L_rv", ctx.canvasWidth(), ctx.canvasHeight(), GL_RGBA16F);
     r_ = gl::Texture::create2D("direct L_r", ctx.canvasWidth(), ctx.canvasHeight(), GL_RGBA16F);
     fbo_ = gl::Framebuffer("direct fbo");
