@@ -13,8 +13,12 @@ CompositePass::CompositePass(const GBufferPass& gbuffer)
       program_("composite",
                {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                 {GL_FRAGMENT_SHADER, "passes/composite/composite.frag",
-                 shaders::source("passes/composite/composite.frag")}}) {
-    locHasSpecular_ = program_.uniformLocation("hasSpecular");
+                 shaders::source("passes/composite/composite.frag")}}),
+      programDiffuse_("composite (diffuse only)",
+                      {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
+                       {GL_FRAGMENT_SHADER, "passes/composite/composite.frag",
+                        shaders::source("passes/composite/composite.frag")}},
+                      "#define MIRAGE_DIFFUSE_ONLY 1") {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
 }
 
@@ -60,7 +64,9 @@ void CompositePass::execute(FrameContext& ctx) {
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    program_.use();
+    const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
+                          ctx.has(Resource::RealSurfaces);
+    (specular ? program_ : programDiffuse_).use();
     ctx.bindFrameBlocks();
     auto tex = [&](Resource a, Resource b) -> GLuint {
         if (ctx.has(a)) return ctx.texture(a).id();
@@ -74,11 +80,8 @@ void CompositePass::execute(FrameContext& ctx) {
     glBindTextureUnit(
         3, ctx.has(Resource::GBuffer) ? gbuffer_.position().id() : ctx.blackTexture().id());
     glBindTextureUnit(4, remap_.id());
-    const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
-                          ctx.has(Resource::RealSurfaces);
-    glUniform1i(locHasSpecular_, specular ? 1 : 0);
-    glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
     if (specular) {
+        glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glBindTextureUnit(5, gbuffer_.emissive().id());
         glBindTextureUnit(6, specHits_->reflection().position.id());
         glBindTextureUnit(7, specHits_->refraction().position.id());

@@ -5,11 +5,13 @@
 
 namespace mirage::render {
 
-DirectLightPass::DirectLightPass(const GBufferPass& gbuffer)
+DirectLightPass::DirectLightPass(const GBufferPass& gbuffer, const GpuScene& scene)
     : gbuffer_(gbuffer),
-      program_("direct", {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                          {GL_FRAGMENT_SHADER, "passes/direct/direct.frag",
-                           shaders::source("passes/direct/direct.frag")}}) {}
+      program_("direct",
+               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
+                {GL_FRAGMENT_SHADER, "passes/direct/direct.frag",
+                 shaders::source("passes/direct/direct.frag")}},
+               scene.lightingDefines()) {}
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
     if (!ctx.has(Resource::GBuffer)) return {false, "no G-buffer"};

@@ -1,16 +1,20 @@
 #include "render/passes/gifilter/GiFilterPass.h"
 
+#include <algorithm>
+#include <string>
+
 #include "render/Shaders.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 
 namespace mirage::render {
 
-GiFilterPass::GiFilterPass(const GBufferPass& gbuffer)
+GiFilterPass::GiFilterPass(const GBufferPass& gbuffer, int interleave)
     : gbuffer_(gbuffer),
       filter_("gi filter",
               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                {GL_FRAGMENT_SHADER, "passes/gifilter/filter.frag",
-                shaders::source("passes/gifilter/filter.frag")}}),
+                shaders::source("passes/gifilter/filter.frag")}},
+              "#define MIRAGE_INTERLEAVE " + std::to_string(std::max(1, interleave))),
       upsample_("gi upsample",
                 {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                  {GL_FRAGMENT_SHADER, "passes/gifilter/upsample.frag",

@@ -11,7 +11,8 @@ class GBufferPass;
 
 class GiFilterPass final : public RenderPass {
 public:
-    explicit GiFilterPass(const GBufferPass& gbuffer);
+    // interleave: RendererOptions::interleave (K), compiled into the filter shader.
+    GiFilterPass(const GBufferPass& gbuffer, int interleave);
     const char* name() const override { return "gifilter"; }
     std::vector<Resource> reads() const override {
         return {Resource::GBuffer, Resource::IndirectRv, Resource::IndirectR, Resource::DirectRv,

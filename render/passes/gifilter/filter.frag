@@ -8,6 +8,11 @@
 // pixels of doing it after upsampling): history reprojected with last frame's camera, rejected
 // where the surface there is at a different distance; off after a cut or tracking loss.
 // Reads the deinterleaved layout of indirect.frag; writes the normal (interleaved) layout.
+#ifndef MIRAGE_INTERLEAVE  // GiFilterPass sets it from RendererOptions::interleave
+#define MIRAGE_INTERLEAVE 4
+#endif
+// K is a compile-time constant so that the K x K loop unrolls: llvmpipe runs a loop with a
+// uniform-buffer bound as a masked SIMD loop, 1.4x slower for this pass.
 in vec2 uv;
 layout(binding = 0) uniform sampler2D gPosition;
 layout(binding = 1) uniform sampler2D gNormal;
@@ -38,7 +43,7 @@ void main() {
     if (int(P.w + 0.5) == ORIGIN_NONE) return;
     vec3 n = texelFetch(gNormal, min(c * scale, size - 1), 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
-    int K = max(counts.z, 1);
+    const int K = MIRAGE_INTERLEAVE;
     ivec2 lowSize = textureSize(indirectRv, 0);
     ivec2 tile = lowSize / K;
     vec3 sumRv = vec3(0.0), sumR = vec3(0.0);

@@ -8,14 +8,15 @@
 namespace mirage::render {
 
 SpecularLightPass::SpecularLightPass(const GBufferPass& gbuffer, const SpecularGBufferPass& hits,
-                                     const VplPass& vpls)
+                                     const VplPass& vpls, const GpuScene& scene)
     : gbuffer_(gbuffer),
       hits_(hits),
       vpls_(vpls),
       program_("specular light",
                {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
                 {GL_FRAGMENT_SHADER, "passes/specular/specular_light.frag",
-                 shaders::source("passes/specular/specular_light.frag")}}) {
+                 shaders::source("passes/specular/specular_light.frag")}},
+               scene.lightingDefines()) {
     locUseVpls_ = program_.uniformLocation("useVpls");
     locVplStride_ = program_.uniformLocation("vplStride");
 }
