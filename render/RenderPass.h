@@ -4,11 +4,17 @@
 // resize(), and records GL work in execute() without allocating. Shaders live beside the pass
 // (render/passes/<pass>/) and are embedded at build time.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "render/FrameContext.h"
 
 namespace mirage::render {
+
+// A program of fullscreen.vert + the fragment shader at `fragmentPath` (relative to render/),
+// with `defines` inserted after #version (shader variants).
+gl::Program fullscreenProgram(std::string_view label, std::string_view fragmentPath,
+                              std::string_view defines = {});
 
 struct PassDecision {
     bool run = true;

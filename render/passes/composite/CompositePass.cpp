@@ -1,6 +1,5 @@
 #include "render/passes/composite/CompositePass.h"
 
-#include "render/Shaders.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
@@ -10,15 +9,10 @@ namespace mirage::render {
 
 CompositePass::CompositePass(const GBufferPass& gbuffer)
     : gbuffer_(gbuffer),
-      program_("composite",
-               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                {GL_FRAGMENT_SHADER, "passes/composite/composite.frag",
-                 shaders::source("passes/composite/composite.frag")}}),
-      programDiffuse_("composite (diffuse only)",
-                      {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                       {GL_FRAGMENT_SHADER, "passes/composite/composite.frag",
-                        shaders::source("passes/composite/composite.frag")}},
-                      "#define MIRAGE_DIFFUSE_ONLY 1") {
+      program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
+      programDiffuse_(fullscreenProgram("composite (diffuse only)",
+                                        "passes/composite/composite.frag",
+                                        "#define MIRAGE_DIFFUSE_ONLY 1")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
 }
 
@@ -60,14 +54,11 @@ void CompositePass::resize(const FrameContext& ctx) {
 
 void CompositePass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glViewport(0, 0, ctx.projection.camera.width, ctx.projection.camera.height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
     glEnable(GL_FRAMEBUFFER_SRGB);
     const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
                           ctx.has(Resource::RealSurfaces);
-    (specular ? program_ : programDiffuse_).use();
-    ctx.bindFrameBlocks();
+    ctx.beginFullscreen(specular ? program_ : programDiffuse_, ctx.projection.camera.width,
+                        ctx.projection.camera.height);
     auto tex = [&](Resource a, Resource b) -> GLuint {
         if (ctx.has(a)) return ctx.texture(a).id();
         if (ctx.has(b)) return ctx.texture(b).id();
@@ -96,8 +87,7 @@ void CompositePass::execute(FrameContext& ctx) {
     } else {
         for (GLuint u = 5; u <= 15; ++u) glBindTextureUnit(u, ctx.blackTexture().id());
     }
-    ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    ctx.drawFullscreenTriangle();
     glDisable(GL_FRAMEBUFFER_SRGB);
     ctx.publish(Resource::Composite, &linear_);
 }

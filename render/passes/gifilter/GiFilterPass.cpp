@@ -3,22 +3,16 @@
 #include <algorithm>
 #include <string>
 
-#include "render/Shaders.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 
 namespace mirage::render {
 
 GiFilterPass::GiFilterPass(const GBufferPass& gbuffer, int interleave)
     : gbuffer_(gbuffer),
-      filter_("gi filter",
-              {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-               {GL_FRAGMENT_SHADER, "passes/gifilter/filter.frag",
-                shaders::source("passes/gifilter/filter.frag")}},
-              "#define MIRAGE_INTERLEAVE " + std::to_string(std::max(1, interleave))),
-      upsample_("gi upsample",
-                {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                 {GL_FRAGMENT_SHADER, "passes/gifilter/upsample.frag",
-                  shaders::source("passes/gifilter/upsample.frag")}}) {}
+      filter_(fullscreenProgram(
+          "gi filter", "passes/gifilter/filter.frag",
+          "#define MIRAGE_INTERLEAVE " + std::to_string(std::max(1, interleave)))),
+      upsample_(fullscreenProgram("gi upsample", "passes/gifilter/upsample.frag")) {}
 
 PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
     if (!ctx.has(Resource::IndirectRv)) return {false, "no indirect light to filter"};
@@ -60,34 +54,26 @@ void GiFilterPass::resize(const FrameContext& ctx) {
 void GiFilterPass::execute(FrameContext& ctx) {
     const int write = current_, read = 1 - current_;
     lowFbo_[write].bind();
-    glViewport(0, 0, lowRv_[write].width(), lowRv_[write].height());
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    filter_.use();
+    ctx.beginFullscreen(filter_, lowRv_[write].width(), lowRv_[write].height());
     glUniform1i(filter_.uniformLocation("scale"), ctx.options.indirectScale);
-    ctx.bindFrameBlocks();
     glBindTextureUnit(0, gbuffer_.position().id());
     glBindTextureUnit(1, gbuffer_.normal().id());
     glBindTextureUnit(2, ctx.texture(Resource::IndirectRv).id());
     glBindTextureUnit(3, ctx.texture(Resource::IndirectR).id());
     glBindTextureUnit(4, lowRv_[read].id());
     glBindTextureUnit(5, lowR_[read].id());
-    ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    ctx.drawFullscreenTriangle();
 
     fbo_.bind();
-    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
-    upsample_.use();
+    ctx.beginFullscreen(upsample_, ctx.canvasWidth(), ctx.canvasHeight());
     glUniform1i(upsample_.uniformLocation("scale"), ctx.options.indirectScale);
-    ctx.bindFrameBlocks();
     glBindTextureUnit(0, gbuffer_.position().id());
     glBindTextureUnit(1, gbuffer_.normal().id());
     glBindTextureUnit(2, lowRv_[write].id());
     glBindTextureUnit(3, lowR_[write].id());
     glBindTextureUnit(4, ctx.texture(Resource::DirectRv).id());
     glBindTextureUnit(5, ctx.texture(Resource::DirectR).id());
-    ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    ctx.drawFullscreenTriangle();
     current_ = read;
     ctx.publish(Resource::LRv, &rv_);
     ctx.publish(Resource::LR, &r_);
