@@ -115,6 +115,10 @@ public:
     GpuLightBlock lightBlock{};
     int frameIndex = 0;
     bool historyValid = false;
+    // Canvas pixels (GL window rect: x, y, width, height) that can show a mirror or glass object
+    // this frame (width 0: none in view). The specular passes shade only these: on llvmpipe a
+    // fragment costs its whole shader even where it exits at once.
+    glm::ivec4 specularScissor{0, 0, 0, 0};
 
     gl::Buffer frameUbo, lightUbo;
     gl::VertexArray emptyVao;  // for full-screen triangles
@@ -135,6 +139,10 @@ public:
     void beginFullscreen(const gl::Program& program, int width, int height) const;
     // The full-screen triangle of fullscreen.vert (no vertex data: emptyVao).
     void drawFullscreenTriangle() const;
+    // Clears colour attachments 0..attachments-1 of the bound framebuffer to 0, then draws the
+    // full-screen triangle only inside `rect` (GL window x, y, width, height; nothing if empty):
+    // for passes whose shader writes 0 outside the pixels that rect holds.
+    void drawFullscreenTriangleIn(const glm::ivec4& rect, int attachments) const;
 
 private:
     std::map<Resource, const gl::Texture*> published_;

@@ -52,6 +52,35 @@ bool inFrustum(const glm::mat4& vp, const BoundingSphere& s) {
     return true;
 }
 
+// The canvas pixels (GL window rectangle x, y, width, height) that can show a specular object
+// this frame: the screen box of the corners of every specular draw's bounding-sphere cube, 2 px
+// margin. The whole canvas when a corner is at or behind the camera plane; width 0 when no
+// specular draw is in the frustum. Conservative: every fragment of a draw lies inside its sphere.
+glm::ivec4 specularScissor(const GpuScene& s, const glm::mat4& viewProj, int width, int height) {
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    bool any = false;
+    for (int i : s.specularDraws()) {
+        const BoundingSphere& b = s.draws()[size_t(i)].bounds;
+        if (!inFrustum(viewProj, b)) continue;
+        any = true;
+        for (int k = 0; k < 8; ++k) {
+            const glm::vec3 corner =
+                b.center + b.radius * glm::vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+            const glm::vec4 c = viewProj * glm::vec4(corner, 1.0f);
+            if (!(c.w > 1e-4f)) return {0, 0, width, height};
+            const glm::vec2 px = (glm::vec2(c) / c.w * 0.5f + 0.5f) * glm::vec2(width, height);
+            lo = glm::min(lo, px);
+            hi = glm::max(hi, px);
+        }
+    }
+    if (!any) return {0, 0, 0, 0};
+    const int x0 = std::clamp(int(std::floor(lo.x)) - 2, 0, width);
+    const int y0 = std::clamp(int(std::floor(lo.y)) - 2, 0, height);
+    const int x1 = std::clamp(int(std::ceil(hi.x)) + 2, 0, width);
+    const int y1 = std::clamp(int(std::ceil(hi.y)) + 2, 0, height);
+    return {x0, y0, x1 - x0, y1 - y0};
+}
+
 glm::vec3 anyPerpendicular(const glm::vec3& d) {
     return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
 }
@@ -294,6 +323,8 @@ void Renderer::planFrame(const FrameInput& input) {
     f.viewMatrix = view;
     f.projMatrix = proj;
     f.viewProj = viewProj;
+    c.specularScissor =
+        specularScissor(s, viewProj, projection_.canvasWidth, projection_.canvasHeight);
     f.prevViewProj = prevViewProj_;
     f.cameraPos = glm::vec4(camPos, 1.0f);
     f.prevCameraPos = glm::vec4(prevCameraPos_, 1.0f);

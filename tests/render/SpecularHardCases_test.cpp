@@ -299,6 +299,50 @@ TEST(SpecularHardCases, UniformEnvironmentGivesTheFresnelWeights) {
     }
 }
 
+// The specular passes shade only the canvas rectangle that can hold a specular object this frame
+// (Renderer's specular scissor, from the objects' bounding spheres). A mirror cut by the image
+// edge, and one so close that its bounds reach behind the camera (whole canvas), must still be
+// shaded at every pixel it covers: in a uniform environment of radiance 1 each of them is its
+// Fresnel weight (>= F0 = 0.95), where an unshaded pixel would be 0.
+TEST(SpecularHardCases, EveryMirrorPixelIsShadedAtTheImageEdgeAndUpClose) {
+    gl::Context context = gl::Context::headless();
+    const auto dir = test::outputDir("specular_scissor");
+    cv::Mat one(8, 16, CV_32FC3, cv::Scalar::all(1.0));
+    writeLinearRgb(dir / "one.pfm", one);
+    test::SpecularScene s;
+    s.scene.environment.kind = Environment::Kind::Equirectangular;
+    s.scene.environment.image = dir / "one.pfm";
+    test::addBox(s.scene, "mirror", {-0.3f, -0.3f, -0.02f}, {0.3f, 0.3f, 0.0f},
+                 test::addMirror(s.scene), Origin::Virtual);
+    const struct {
+        const char* what;
+        Pose pose;
+    } views[] = {{"cut by the image edge", test::lookAtPose({0.5, 0.0, 0.5}, {0.5, 0.0, 0.0})},
+                 {"camera inside the bounds", test::lookAtPose({0.0, 0.0, 0.05}, {0.0, 0.0, 0.0})}};
+    for (const auto& v : views) {
+        Renderer r(s.scene, s.cam, singleFrame());
+        r.render({v.pose, cv::Mat(), true});
+        expectFiniteBuffers(r);
+        const cv::Mat coverage = r.coverage(), composite = r.compositeLinear();
+        int mirrorPixels = 0, unshaded = 0;
+        for (int y = 0; y < coverage.rows; ++y)
+            for (int x = 0; x < coverage.cols; ++x) {
+                if (coverage.at<uchar>(y, x) != 2) continue;
+                ++mirrorPixels;
+                if (composite.at<cv::Vec3f>(y, x)[1] < 0.9f) ++unshaded;
+            }
+        std::cout << "[ specular ] " << v.what << ": " << mirrorPixels << " mirror pixels, "
+                  << unshaded << " unshaded\n";
+        // The first view must really be cut: mirror pixels on the left image column only.
+        if (v.pose.translation.x > 0.1) {
+            EXPECT_EQ(coverage.at<uchar>(coverage.rows / 2, 0), 2) << v.what;
+            EXPECT_NE(coverage.at<uchar>(coverage.rows / 2, coverage.cols - 1), 2) << v.what;
+        }
+        EXPECT_GT(mirrorPixels, int(coverage.total() / 10)) << v.what;
+        EXPECT_EQ(unshaded, 0) << v.what;
+    }
+}
+
 TEST(SpecularHardCases, PassesRunOnlyWithSpecularObjects) {
     gl::Context context = gl::Context::headless();
     test::SpecularScene s;

@@ -31,10 +31,12 @@ SpecularGBufferPass::SpecularGBufferPass(const GBufferPass& gbuffer, const BackF
     : gbuffer_(gbuffer),
       backFaces_(backFaces),
       impostors_(impostors),
-      program_(fullscreenProgram("specular gbuffer", "passes/specular/specular_gbuffer.frag")) {
-    locMode_ = program_.uniformLocation("mode");
-    locSteps_ = program_.uniformLocation("marchSteps");
-}
+      programs_{fullscreenProgram("specular gbuffer (reflection)",
+                                  "passes/specular/specular_gbuffer.frag",
+                                  "#define MIRAGE_SPECULAR_MODE 0"),
+                fullscreenProgram("specular gbuffer (refraction)",
+                                  "passes/specular/specular_gbuffer.frag",
+                                  "#define MIRAGE_SPECULAR_MODE 1")} {}
 
 PassDecision SpecularGBufferPass::decide(const FrameContext& ctx) const {
     if (!ctx.has(Resource::BackFaces)) return {false, "no mirror or glass object in the scene"};
@@ -53,7 +55,6 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
 }
 
 void SpecularGBufferPass::execute(FrameContext& ctx) {
-    ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
                      ctx.scene.specularDrawBuffer().id());
@@ -62,13 +63,14 @@ void SpecularGBufferPass::execute(FrameContext& ctx) {
     glBindTextureUnit(2, gbuffer_.emissive().id());
     glBindTextureUnit(3, backFaces_.position().id());
     glBindTextureUnit(4, backFaces_.normal().id());
-    glUniform1i(locSteps_, ctx.options.refractionMarchSteps);
     impostors_.bindForTracing();  // texture units 16..23, storage bindings 6..7
-    ctx.emptyVao.bind();
     for (int mode = 0; mode < 2; ++mode) {
         (mode == 0 ? refl_ : refr_).fbo.bind();
-        glUniform1i(locMode_, mode);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        const gl::Program& program = programs_[mode];
+        ctx.beginFullscreen(program, ctx.canvasWidth(), ctx.canvasHeight());
+        if (mode == 1)
+            glUniform1i(program.uniformLocation("marchSteps"), ctx.options.refractionMarchSteps);
+        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);  // 0 outside: no specular pixel
     }
     ctx.publish(Resource::ReflectionGBuffer, &refl_.position);
     ctx.publish(Resource::RefractionGBuffer, &refr_.position);

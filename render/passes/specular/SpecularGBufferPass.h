@@ -41,9 +41,8 @@ private:
     const GBufferPass& gbuffer_;
     const BackFacePass& backFaces_;
     const ImpostorPass& impostors_;
-    gl::Program program_;
+    gl::Program programs_[2];  // [0] reflection, [1] refraction (MIRAGE_SPECULAR_MODE)
     SpecularHitBuffer refl_, refr_;
-    GLint locMode_ = -1, locSteps_ = -1;
     int width_ = 0, height_ = 0;
 };
 

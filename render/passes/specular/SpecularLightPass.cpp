@@ -72,7 +72,7 @@ void SpecularLightPass::execute(FrameContext& ctx) {
     glBindTextureUnit(kUnitEnvironmentMap, ctx.scene.environmentMap().id());
     glUniform1i(locUseVpls_, vpls ? 1 : 0);
     glUniform1i(locVplStride_, ctx.options.specularVplStride);
-    ctx.drawFullscreenTriangle();
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);  // 0 outside: not a specular pixel
     ctx.publish(Resource::SpecularRv, &rv_);
     ctx.publish(Resource::SpecularR, &r_);
     ctx.publish(Resource::Lenv, &env_);

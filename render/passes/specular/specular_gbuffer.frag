@@ -33,7 +33,11 @@ layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D gEmissive;  // a = specular slot + 1
 layout(binding = 3) uniform sampler2D backPosition;  // xyz world, w = slot + 1
 layout(binding = 4) uniform sampler2D backNormal;    // outward
-uniform int mode;        // 0 = reflection, 1 = refraction
+#ifndef MIRAGE_SPECULAR_MODE  // SpecularGBufferPass compiles one program per mode
+#define MIRAGE_SPECULAR_MODE 0
+#endif
+// A constant, not a uniform: llvmpipe would run both modes' code for every pixel.
+const int mode = MIRAGE_SPECULAR_MODE;  // 0 = reflection, 1 = refraction
 uniform int marchSteps;  // back-face march steps
 layout(location = 0) out vec4 outPosition;  // hit xyz world (m) | ray direction on a miss;
                                             // w = hit origin (ORIGIN_NONE = miss)
