@@ -45,6 +45,7 @@ void CompositePass::resize(const FrameContext& ctx) {
         canvasToCamera_ = gl::Texture::create2D("canvas to camera", cw, ch, GL_RG32F);
         canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
         canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
+        canvasToCameraTable_ = std::move(table);
     }
     fbo_ = gl::Framebuffer("composite fbo");
     fbo_.attachColor(0, linear_);
@@ -52,13 +53,42 @@ void CompositePass::resize(const FrameContext& ctx) {
     fbo_.finalize(2);
 }
 
+glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const {
+    const int w = ctx.projection.camera.width, h = ctx.projection.camera.height;
+    const int cw = ctx.canvasWidth(), ch = ctx.canvasHeight();
+    if (canvasRect.z <= 0 || canvasRect.w <= 0) return {0, 0, 0, 0};
+    if (canvasToCameraTable_.size() != size_t(cw) * size_t(ch)) return {0, 0, w, h};
+    // The lens map is continuous and one-to-one, so the image of the rectangle lies inside the
+    // bounding box of the image of its border (canvas pixels (x, y) = GL window coordinates).
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    const int x0 = canvasRect.x, y0 = canvasRect.y;
+    const int x1 = std::min(cw, canvasRect.x + canvasRect.z) - 1;
+    const int y1 = std::min(ch, canvasRect.y + canvasRect.w) - 1;
+    auto add = [&](int x, int y) {
+        const glm::vec2 q = canvasToCameraTable_[size_t(y) * size_t(cw) + size_t(x)];
+        lo = glm::min(lo, q);
+        hi = glm::max(hi, q);
+    };
+    for (int x = x0; x <= x1; ++x) add(x, y0), add(x, y1);
+    for (int y = y0; y <= y1; ++y) add(x0, y), add(x1, y);
+    if (lo.x < -1000.0f || lo.y < -1000.0f) return {0, 0, w, h};  // a ray the camera cannot see
+    // + 2 px: the composite reads the canvas at the rounded remap position (0.5 px) and the
+    // table is sampled at pixel centres.
+    const int cx0 = std::clamp(int(std::floor(lo.x)) - 2, 0, w);
+    const int cy0 = std::clamp(int(std::floor(lo.y)) - 2, 0, h);
+    const int cx1 = std::clamp(int(std::ceil(hi.x)) + 3, 0, w);
+    const int cy1 = std::clamp(int(std::ceil(hi.y)) + 3, 0, h);
+    return {cx0, cy0, cx1 - cx0, cy1 - cy0};
+}
+
 void CompositePass::execute(FrameContext& ctx) {
     fbo_.bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
     const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
                           ctx.has(Resource::RealSurfaces);
-    ctx.beginFullscreen(specular ? program_ : programDiffuse_, ctx.projection.camera.width,
-                        ctx.projection.camera.height);
+    // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
+    // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
+    ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
     auto tex = [&](Resource a, Resource b) -> GLuint {
         if (ctx.has(a)) return ctx.texture(a).id();
         if (ctx.has(b)) return ctx.texture(b).id();
@@ -72,7 +102,6 @@ void CompositePass::execute(FrameContext& ctx) {
         3, ctx.has(Resource::GBuffer) ? gbuffer_.position().id() : ctx.blackTexture().id());
     glBindTextureUnit(4, remap_.id());
     if (specular) {
-        glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glBindTextureUnit(5, gbuffer_.emissive().id());
         glBindTextureUnit(6, specHits_->reflection().position.id());
         glBindTextureUnit(7, specHits_->refraction().position.id());
@@ -88,6 +117,15 @@ void CompositePass::execute(FrameContext& ctx) {
         for (GLuint u = 5; u <= 15; ++u) glBindTextureUnit(u, ctx.blackTexture().id());
     }
     ctx.drawFullscreenTriangle();
+    const glm::ivec4 rect = specular ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);
+    if (rect.z > 0 && rect.w > 0) {
+        program_.use();
+        glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(rect.x, rect.y, rect.z, rect.w);
+        ctx.drawFullscreenTriangle();
+        glDisable(GL_SCISSOR_TEST);
+    }
     glDisable(GL_FRAMEBUFFER_SRGB);
     ctx.publish(Resource::Composite, &linear_);
 }

@@ -32,6 +32,10 @@ public:
     const gl::Texture& srgb() const { return srgb_; }
 
 private:
+    // The camera pixels (GL window rect) whose canvas position lies in canvasRect (canvas GL
+    // window rect): where the composite can meet a specular pixel. Empty for an empty rect.
+    glm::ivec4 cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const;
+
     const GBufferPass& gbuffer_;
     // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
     // compositing code would cost every frame even behind a uniform that turns it off.
@@ -44,6 +48,7 @@ private:
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
     gl::Texture canvasToCamera_;
+    std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
     GLint locEpsilon_ = -1;
     gl::Framebuffer fbo_;
 };
