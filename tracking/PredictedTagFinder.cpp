@@ -435,12 +435,18 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
         }
         return o;
     };
-    for (const Candidate& c : candidates)
-        if (attempt(c) != Outcome::Verified) retry.push_back(&c);
-    for (const Candidate* c : retry) {
-        // A second try only helps if something was verified since this tag's first try; the
-        // first failure's reason stands otherwise.
-        const Outcome o = out.empty() ? Outcome::EdgeFailed : attempt(*c);
+    std::vector<Outcome> firstOutcome;
+    for (const Candidate& c : candidates) {
+        const Outcome o = attempt(c);
+        if (o != Outcome::Verified) {
+            retry.push_back(&c);
+            firstOutcome.push_back(o);
+        }
+    }
+    for (size_t i = 0; i < retry.size(); ++i) {
+        // A second try only helps if something was verified (the correction); otherwise the
+        // first failure's reason stands.
+        const Outcome o = out.empty() ? firstOutcome[i] : attempt(*retry[i]);
         if (o == Outcome::EdgeFailed) ++stats.edgeFailed;
         if (o == Outcome::RefineFailed) ++stats.refineFailed;
         if (o == Outcome::DecodeFailed) ++stats.decodeFailed;

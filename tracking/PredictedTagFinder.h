@@ -30,10 +30,11 @@ namespace mirage::tracking {
 
 struct TagPredictionOptions {
     // Only tags whose predicted shortest side is at least this (pixels) are followed: smaller
-    // tags have cells too small for a reliable edge search and bit check.
-    double minSidePx = 20.0;
+    // tags have cells too small for a reliable edge search and bit check. (The pose estimator
+    // uses tags from 10 px; libapriltag with decimate 2 misses most tags under ~25 px.)
+    double minSidePx = 12.0;
     // ... and whose predicted cell size across each border edge (foreshortened) is at least this.
-    double minCellPx = 2.0;
+    double minCellPx = 1.5;
     // Edge search radius across each predicted edge (pixels): searchBasePx + searchMotionFactor x
     // the tag's predicted corner motion since the previous frame (a prediction error grows with
     // the motion), at most searchMaxCells cells: beyond ~1 cell inside the border the payload
