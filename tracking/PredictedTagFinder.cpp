@@ -123,6 +123,7 @@ public:
         m11_ = (vy * sxx - vx * sxy) / det;
         affine_ = true;
     }
+    bool affine() const { return affine_; }
     glm::dvec2 operator()(const glm::dvec2& p) const {
         const glm::dvec2 f = p - centre_;
         if (!affine_) return target_ + f;
@@ -419,11 +420,17 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
     std::vector<glm::dvec2> from, to;
     ImageCorrection correction;
     std::vector<const Candidate*> retry;
-    auto attempt = [&](const Candidate& c) {
+    auto attempt = [&](const Candidate& c, bool firstTry) {
         std::array<glm::dvec2, 4> p = c.pred;
         for (auto& q : p) q = correction(q);
         TagDetection t;
-        const Outcome o = follow(grey, *c.model, p, c.search, t);
+        // Once the affine correction holds (three tags), the corrected prediction is within a
+        // fraction of a pixel: a short search suffices on the first try (the retry searches
+        // the full radius).
+        const double search = firstTry && correction.affine()
+                                  ? std::min(c.search, options_.searchCorrectedPx)
+                                  : c.search;
+        const Outcome o = follow(grey, *c.model, p, search, t);
         if (o == Outcome::Verified) {
             for (int k = 0; k < 4; ++k) {
                 from.push_back(c.pred[size_t(k)]);
@@ -437,7 +444,7 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
     };
     std::vector<Outcome> firstOutcome;
     for (const Candidate& c : candidates) {
-        const Outcome o = attempt(c);
+        const Outcome o = attempt(c, true);
         if (o != Outcome::Verified) {
             retry.push_back(&c);
             firstOutcome.push_back(o);
@@ -446,7 +453,7 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
     for (size_t i = 0; i < retry.size(); ++i) {
         // A second try only helps if something was verified (the correction); otherwise the
         // first failure's reason stands.
-        const Outcome o = out.empty() ? firstOutcome[i] : attempt(*retry[i]);
+        const Outcome o = out.empty() ? firstOutcome[i] : attempt(*retry[i], false);
         if (o == Outcome::EdgeFailed) ++stats.edgeFailed;
         if (o == Outcome::RefineFailed) ++stats.refineFailed;
         if (o == Outcome::DecodeFailed) ++stats.decodeFailed;

@@ -42,6 +42,9 @@ struct TagPredictionOptions {
     double searchBasePx = 2.5;
     double searchMotionFactor = 0.5;
     double searchMaxCells = 1.2;
+    // Search radius once the predictions are corrected by an affine map fitted to three or more
+    // verified tags (PredictedTagFinder::find); a tag that fails is tried again with the full one.
+    double searchCorrectedPx = 2.0;
     // Verification: cells of the border square (border + payload) that may disagree with the
     // expected pattern (36h11 codes differ in >= 11 bits), cells of the quiet-zone ring outside
     // the border that may disagree, and the least brightness difference between the expected

@@ -144,7 +144,7 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         f.detectMs = msSince(t0);
         if (f.prediction.verified >= need) {
             t0 = std::chrono::steady_clock::now();
-            PoseEstimate e = estimator_.estimate(dets, prior);
+            PoseEstimate e = estimator_.estimate(dets, prior, predicted);
             f.poseMs = msSince(t0);
             if (e.state == TrackingState::Ok) {
                 f.tagTracked = true;
