@@ -213,8 +213,9 @@ TEST(TagTracking, VideoTracksAndFallsBackOnJumpsCutsAndNoise) {
         "video (640x480, 180 deg/s): %d/8 frames tracked; worst error over them %.4f deg %.3f mm "
         "(libapriltag's search on the same frames: %.4f deg %.3f mm)\n",
         tracked, worstRot, worstPos * 1e3, worstRotSearch, worstPosSearch * 1e3);
-    EXPECT_LT(worstRot, 0.06);
-    EXPECT_LT(worstPos, 0.6e-3);
+    // Measured 0.047 deg / 0.50 mm (the search: 0.34 deg / 3.0 mm, one-tag frames among them).
+    EXPECT_LT(worstRot, 0.08);
+    EXPECT_LT(worstPos, 0.8e-3);
 
     // Fast motion the prediction cannot follow: the camera jumps 40 mm sideways (one tag pitch)
     // and turns 4 degrees within one frame.
