@@ -88,4 +88,17 @@ void FrameContext::bindFrameBlocks() const {
     glBindBufferBase(GL_UNIFORM_BUFFER, kBindingLights, lightUbo.id());
 }
 
+void FrameContext::beginFullscreen(const gl::Program& program, int width, int height) const {
+    glViewport(0, 0, width, height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    program.use();
+    bindFrameBlocks();
+}
+
+void FrameContext::drawFullscreenTriangle() const {
+    emptyVao.bind();
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
 }  // namespace mirage::render

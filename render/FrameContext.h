@@ -130,6 +130,11 @@ public:
     int canvasWidth() const { return projection.canvasWidth; }
     int canvasHeight() const { return projection.canvasHeight; }
     void bindFrameBlocks() const;
+    // Full-screen pass set-up: viewport width x height, depth test and blending off, `program`
+    // in use and the frame's uniform blocks bound (the pass binds its framebuffer first).
+    void beginFullscreen(const gl::Program& program, int width, int height) const;
+    // The full-screen triangle of fullscreen.vert (no vertex data: emptyVao).
+    void drawFullscreenTriangle() const;
 
 private:
     std::map<Resource, const gl::Texture*> published_;

@@ -15,7 +15,7 @@
 namespace mirage::render {
 namespace {
 
-struct Vertex {  // = GpuSceneVertex (GpuScene.h), layout checked below
+struct Vertex {          // = GpuSceneVertex (GpuScene.h), layout checked below
     glm::vec3 position;  // mesh-local
     glm::vec3 normal;    // mesh-local
     glm::vec2 uv;        // the UV set the base colour texture uses (glTF: (0,0) = top left)
@@ -376,6 +376,12 @@ void GpuScene::bindMaterialTextures(const DrawItem& d, GLuint unit) const {
 void GpuScene::drawItem(const DrawItem& d) const {
     glDrawElementsBaseVertex(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(d.firstIndex) * 4), d.baseVertex);
+}
+
+std::string GpuScene::lightingDefines() const {
+    int faces = 0;
+    for (const SceneLight& l : lights_) faces = std::max(faces, l.type == kLightPoint ? 6 : 1);
+    return "#define MIRAGE_MAX_SHADOW_FACES " + std::to_string(faces);
 }
 
 }  // namespace mirage::render

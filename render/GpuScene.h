@@ -66,6 +66,10 @@ public:
 
     const std::vector<DrawItem>& draws() const { return draws_; }
     const std::vector<SceneLight>& lights() const { return lights_; }
+    // GLSL #defines that specialise the lighting shaders to this scene's lights
+    // (MIRAGE_MAX_SHADOW_FACES: 6 with a point light, 1 with spot / directional only, 0 without
+    // lights; see lighting.glsl for why a constant loop bound matters on llvmpipe).
+    std::string lightingDefines() const;
     // Indices into draws() of the specular (mirror / glass) items, in draw order.
     const std::vector<int>& specularDraws() const { return specularDraws_; }
     const BoundingSphere& bounds() const { return bounds_; }

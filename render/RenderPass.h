@@ -4,11 +4,17 @@
 // resize(), and records GL work in execute() without allocating. Shaders live beside the pass
 // (render/passes/<pass>/) and are embedded at build time.
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "render/FrameContext.h"
 
 namespace mirage::render {
+
+// A program of fullscreen.vert + the fragment shader at `fragmentPath` (relative to render/),
+// with `defines` inserted after #version (shader variants).
+gl::Program fullscreenProgram(std::string_view label, std::string_view fragmentPath,
+                              std::string_view defines = {});
 
 struct PassDecision {
     bool run = true;
@@ -22,7 +28,9 @@ public:
     virtual std::vector<Resource> reads() const = 0;
     virtual std::vector<Resource> writes() const = 0;
     virtual PassDecision decide(const FrameContext& ctx) const = 0;
-    // (Re)allocates targets for ctx's canvas / plan; called when they change.
+    // (Re)allocates targets for ctx's canvas / plan. Called before every frame the pass runs:
+    // it must return at once unless a size changed (reallocating costs page faults on every
+    // target, and would drop state such as the temporal history).
     virtual void resize(const FrameContext& ctx) = 0;
     virtual void execute(FrameContext& ctx) = 0;
 

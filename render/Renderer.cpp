@@ -112,12 +112,12 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     // Reflected-scene impostors of the specular objects' surroundings (issue 6): the specular
     // passes (GBuf_refl / GBuf_refr) take a reference to it and call bindForTracing().
     auto impostor = std::make_unique<ImpostorPass>();
-    auto direct = std::make_unique<DirectLightPass>(*gbuffer);
+    auto direct = std::make_unique<DirectLightPass>(*gbuffer, *scene_);
     auto indirect = std::make_unique<IndirectLightPass>(*gbuffer, *vpl);
-    auto filter = std::make_unique<GiFilterPass>(*gbuffer);
+    auto filter = std::make_unique<GiFilterPass>(*gbuffer, options_.interleave);
     auto backface = std::make_unique<BackFacePass>(*gbuffer);
     auto specGbuf = std::make_unique<SpecularGBufferPass>(*gbuffer, *backface, *impostor);
-    auto specLight = std::make_unique<SpecularLightPass>(*gbuffer, *specGbuf, *vpl);
+    auto specLight = std::make_unique<SpecularLightPass>(*gbuffer, *specGbuf, *vpl, *scene_);
     auto composite = std::make_unique<CompositePass>(*gbuffer);
     composite->setSpecular(specGbuf.get(), specLight.get(), backface.get());
     composite_ = composite.get();

@@ -27,35 +27,44 @@ void incidentLight(int li, vec3 p, out vec3 wi, out vec3 irradiance) {
                  rangeWindow(li, dist) / dist2;
 }
 
-// Fraction of the light reaching p (0..1) from one shadow atlas: the layer whose frustum holds
-// p, 2x2 percentage-closer filtered. Bias grows with the texel footprint and the slope.
-float shadowVisibility(sampler2DArray map, int li, vec3 p, float NdotL) {
+// Fraction of the light reaching p (0..1) in the all-occluder shadow atlas (x) and, when
+// `withReal`, in the real-occluder one (y; else y = x): the layer whose frustum holds p, 2x2
+// percentage-closer filtered. Bias grows with the texel footprint and the slope. The layer search
+// and footprint are shared and each atlas is read with one textureGather: on llvmpipe every
+// texel read is costly and both sides of a branch run, so this is ~2x cheaper than two lookups.
+#ifndef MIRAGE_MAX_SHADOW_FACES  // GpuScene::lightingDefines() sets it for the scene's lights
+#define MIRAGE_MAX_SHADOW_FACES 6  // the most a light has: a point light's cube
+#endif
+vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
+                      bool withReal) {
     ivec4 sh = lights[li].shadow;
-    if (sh.y == 0) return 1.0;
-    for (int f = 0; f < sh.y; ++f) {
+    int layer = -1;
+    vec2 t = vec2(0.0);
+    // A constant bound (faces past sh.y masked off) lets the compiler unroll the loop and read
+    // viewProj[f] at constant offsets; looping to sh.y made llvmpipe's direct pass 1.6x slower.
+    for (int f = 0; f < MIRAGE_MAX_SHADOW_FACES; ++f) {
         vec4 c = lights[li].viewProj[f] * vec4(p, 1.0);
-        if (c.w <= 0.0) continue;
-        vec3 ndc = c.xyz / c.w;
-        if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) continue;
-        float d = lightDistance(li, p);
-        ivec2 size = textureSize(map, 0).xy;
-        float tanOrExtent = lights[li].radiantIntensity.w;
-        float extent = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
-                                                                            : 2.0 * tanOrExtent * d;
-        float texel = extent / float(size.x);
-        float bias = params.y + 1.5 * texel / max(NdotL, 0.2);
-        vec2 t = (ndc.xy * 0.5 + 0.5) * vec2(size) - 0.5;
-        ivec2 i0 = ivec2(floor(t));
-        vec2 fr = t - vec2(i0);
-        float v[4];
-        for (int k = 0; k < 4; ++k) {
-            ivec2 q = clamp(i0 + ivec2(k & 1, k >> 1), ivec2(0), size - 1);
-            float stored = texelFetch(map, ivec3(q, sh.x + f), 0).r;
-            v[k] = d - bias <= stored ? 1.0 : 0.0;
+        vec2 ndc = c.xy / c.w;
+        if (f < sh.y && layer < 0 && c.w > 0.0 && all(lessThanEqual(abs(ndc), vec2(1.0)))) {
+            layer = sh.x + f;
+            t = ndc * 0.5 + 0.5;
         }
-        return mix(mix(v[0], v[1], fr.x), mix(v[2], v[3], fr.x), fr.y);
     }
-    return 1.0;
+    if (layer < 0) return vec2(1.0);
+    float d = lightDistance(li, p);
+    vec2 size = vec2(textureSize(allMap, 0).xy);
+    float tanOrExtent = lights[li].radiantIntensity.w;
+    float extent = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
+                                                                        : 2.0 * tanOrExtent * d;
+    float bias = params.y + 1.5 * extent / size.x / max(NdotL, 0.2);
+    // The gather footprint at t is texels floor(t * size - 0.5) + {0, 1}^2: w = (0,0), z = (1,0),
+    // x = (0,1), y = (1,1); clamp-to-edge at the borders.
+    vec2 fr = fract(t * size - 0.5);
+    vec4 a = step(vec4(d - bias), textureGather(allMap, vec3(t, float(layer)), 0));
+    float visAll = mix(mix(a.w, a.z, fr.x), mix(a.x, a.y, fr.x), fr.y);
+    if (!withReal) return vec2(visAll);
+    vec4 r = step(vec4(d - bias), textureGather(realMap, vec3(t, float(layer)), 0));
+    return vec2(visAll, mix(mix(r.w, r.z, fr.x), mix(r.x, r.y, fr.x), fr.y));
 }
 
 // Lambert diffuse + GGX specular (Smith-Schlick G, Schlick F, F0 = 0.04 for dielectrics), glTF

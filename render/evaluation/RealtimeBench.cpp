@@ -140,6 +140,15 @@ const std::vector<BenchKnob>& benchKnobs() {
                  throw Error(fmt::format("bench: knob static_reuse: '{}' is not on or off", v));
              c.options.reuseStaticPasses = v == "on";
          }},
+        {"sync_passes",
+         "on: glFinish around every pass so each pass's GPU ms is its own (llvmpipe defers work); "
+         "off: as mirage replay runs, passes overlap and only the wall ms is meaningful",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "on" && v != "off")
+                 throw Error(fmt::format("bench: knob sync_passes: '{}' is not on or off", v));
+             c.options.syncPasses = v == "on";
+         }},
         // Specular objects (issue 6). One default value each, so the default grid does not grow;
         // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror
         // or glass (the impostor and specular passes do not run).

@@ -10,6 +10,7 @@
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "render/raytrace/ReferenceRenderer.h"
+#include "tests/render/RenderTestScenes.h"
 
 namespace mirage::raytrace::test {
 
@@ -25,27 +26,9 @@ inline void fixWinding(Primitive& p, const glm::vec3& centre) {
     }
 }
 
-// UV sphere centred at the origin with outward smooth normals.
+// UV sphere centred at the origin (RenderTestScenes.h's generator: outward normals and winding).
 inline Primitive spherePrimitive(float radius, int slices = 96, int stacks = 48) {
-    Primitive p;
-    for (int i = 0; i <= stacks; ++i)
-        for (int j = 0; j <= slices; ++j) {
-            float th = float(M_PI) * float(i) / float(stacks),
-                  ph = 2.0f * float(M_PI) * float(j) / float(slices);
-            glm::vec3 n{std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)};
-            p.positions.push_back(radius * n);
-            p.normals.push_back(n);
-            p.uv0.push_back({float(j) / float(slices), float(i) / float(stacks)});
-        }
-    auto at = [&](int i, int j) { return uint32_t(i * (slices + 1) + j); };
-    for (int i = 0; i < stacks; ++i)
-        for (int j = 0; j < slices; ++j) {
-            if (i > 0) p.indices.insert(p.indices.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
-            if (i < stacks - 1)
-                p.indices.insert(p.indices.end(), {at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
-        }
-    fixWinding(p, glm::vec3(0.0f));
-    return p;
+    return mirage::test::uvSpherePrimitive(glm::vec3(0.0f), radius, stacks, slices);
 }
 
 // Axis-aligned box [lo, hi] with flat outward normals.

@@ -178,7 +178,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     const std::vector<BenchConfig> grid = benchGrid(calib.intrinsics, true, {{"vpls", {"256"}}});
     ASSERT_EQ(grid.size(), 1u);
     EXPECT_EQ(grid[0].label(),
-              "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on "
+              "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=4");
     const BenchResult good = runBenchConfig(benchScene(true), calib.intrinsics, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs

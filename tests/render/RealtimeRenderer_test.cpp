@@ -595,6 +595,34 @@ TEST_F(RealtimeRenderer, TemporalHistoryUsedAndReset) {
     }
 }
 
+// The history really reaches the image: after a small camera move, the smoothed indirect light
+// differs from a fresh render of the same view (the previous frame's light is blended in), yet
+// stays close to it (the scene is static, both estimate the same light). A pass that lost its
+// history between frames (e.g. by reallocating it) would match the fresh render exactly.
+TEST_F(RealtimeRenderer, TemporalHistoryReachesTheImage) {
+    SpotScene s;
+    int m = addMaterial(s.scene, {0.2f, 0.7f, 0.2f});
+    addBox(s.scene, "virtual box", {-0.2f, 0.0f, -0.2f}, {0.2f, 0.4f, 0.2f}, m, Origin::Virtual);
+    const Pose before = lookAtPose({0.0, 2.5, 2.5}, {0, 0, 0});
+    const Pose after = lookAtPose({0.03, 2.5, 2.5}, {0, 0, 0});
+    Renderer smoothed(s.scene, s.cam);
+    smoothed.render({before, {}, false});
+    smoothed.render({after, {}, false});
+    ASSERT_TRUE(smoothed.lastReport().summary().find("history used") != std::string::npos);
+    const cv::Mat withHistory = smoothed.readBuffer(Resource::LRv);
+    Renderer fresh(s.scene, s.cam);
+    fresh.render({after, {}, true});
+    const cv::Mat withoutHistory = fresh.readBuffer(Resource::LRv);
+    double maxDiff = 0.0;
+    const cv::Mat diff = cv::abs(withHistory - withoutHistory);
+    cv::minMaxLoc(diff.reshape(1), nullptr, &maxDiff);
+    EXPECT_GT(maxDiff, 1e-3) << "the history left no trace";
+    std::printf("[ temporal ] max |smoothed - fresh| = %g, PSNR %.1f dB\n", maxDiff,
+                test::psnr(withHistory, withoutHistory, 1.0));
+    EXPECT_GT(test::psnr(withHistory, withoutHistory, 1.0), 35.0);
+    EXPECT_TRUE(allFinite(withHistory));
+}
+
 // Constant environment radiance Le on a Lambertian plane: L = albedo * Le (irradiance pi Le).
 TEST_F(RealtimeRenderer, ConstantEnvironmentGivesAlbedoTimesRadiance) {
     const auto dir = test::outputDir("realtime_env");

@@ -37,11 +37,11 @@ inline void addMeshNode(Scene& s, const std::string& name, Primitive prim, Origi
     s.roots.push_back(int(s.nodes.size()) - 1);
 }
 
-// UV sphere (rings x segments quads) with outward normals AND outward winding: the reference
-// renderer takes a transmissive surface's outside from the triangle winding, so an inward-wound
-// glass sphere would be rendered as an air bubble in glass.
-inline void addUvSphere(Scene& s, const std::string& name, glm::vec3 c, float r, int material,
-                        Origin origin, int rings = 32, int segments = 48) {
+// UV sphere (rings x segments quads; the pole rows are single triangles) with outward normals,
+// uv and outward winding: the reference renderer takes a transmissive surface's outside from the
+// triangle winding, so an inward-wound glass sphere would be rendered as an air bubble in glass.
+// The one sphere generator of the render tests (the reference renderer's tests use it too).
+inline Primitive uvSpherePrimitive(glm::vec3 c, float r, int rings = 32, int segments = 48) {
     Primitive p;
     for (int i = 0; i <= rings; ++i) {
         const float th = float(M_PI) * float(i) / float(rings);
@@ -50,13 +50,21 @@ inline void addUvSphere(Scene& s, const std::string& name, glm::vec3 c, float r,
             glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
             p.positions.push_back(c + r * n);
             p.normals.push_back(n);
+            p.uv0.push_back({float(j) / float(segments), float(i) / float(rings)});
         }
     }
     for (int i = 0; i < rings; ++i)
         for (int j = 0; j < segments; ++j) {
             const uint32_t a = uint32_t(i * (segments + 1) + j), b = a + uint32_t(segments + 1);
-            p.indices.insert(p.indices.end(), {a, a + 1, b, a + 1, b + 1, b});
+            if (i > 0) p.indices.insert(p.indices.end(), {a, a + 1, b});  // not at the north pole
+            if (i < rings - 1) p.indices.insert(p.indices.end(), {a + 1, b + 1, b});  // nor south
         }
+    return p;
+}
+
+inline void addUvSphere(Scene& s, const std::string& name, glm::vec3 c, float r, int material,
+                        Origin origin, int rings = 32, int segments = 48) {
+    Primitive p = uvSpherePrimitive(c, r, rings, segments);
     p.material = material;
     addMeshNode(s, name, std::move(p), origin);
 }

@@ -1,6 +1,5 @@
 #include "render/passes/composite/CompositePass.h"
 
-#include "render/Shaders.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
@@ -10,11 +9,10 @@ namespace mirage::render {
 
 CompositePass::CompositePass(const GBufferPass& gbuffer)
     : gbuffer_(gbuffer),
-      program_("composite",
-               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                {GL_FRAGMENT_SHADER, "passes/composite/composite.frag",
-                 shaders::source("passes/composite/composite.frag")}}) {
-    locHasSpecular_ = program_.uniformLocation("hasSpecular");
+      program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
+      programDiffuse_(fullscreenProgram("composite (diffuse only)",
+                                        "passes/composite/composite.frag",
+                                        "#define MIRAGE_DIFFUSE_ONLY 1")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
 }
 
@@ -25,6 +23,11 @@ PassDecision CompositePass::decide(const FrameContext&) const {
 void CompositePass::resize(const FrameContext& ctx) {
     const CameraProjection& p = ctx.projection;
     const int w = p.camera.width, h = p.camera.height;
+    // Runs before every frame; the camera (and so the remap tables) is fixed for the renderer's
+    // life, so only a size change rebuilds them.
+    if (linear_.width() == w && linear_.height() == h && canvasToCamera_.width() == p.canvasWidth &&
+        canvasToCamera_.height() == p.canvasHeight)
+        return;
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
     srgb_ = gl::Texture::create2D("composite srgb", w, h, GL_SRGB8_ALPHA8);
     remap_ = gl::Texture::create2D("lens remap", w, h, GL_RG32F);
@@ -51,12 +54,11 @@ void CompositePass::resize(const FrameContext& ctx) {
 
 void CompositePass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glViewport(0, 0, ctx.projection.camera.width, ctx.projection.camera.height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    program_.use();
-    ctx.bindFrameBlocks();
+    const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
+                          ctx.has(Resource::RealSurfaces);
+    ctx.beginFullscreen(specular ? program_ : programDiffuse_, ctx.projection.camera.width,
+                        ctx.projection.camera.height);
     auto tex = [&](Resource a, Resource b) -> GLuint {
         if (ctx.has(a)) return ctx.texture(a).id();
         if (ctx.has(b)) return ctx.texture(b).id();
@@ -69,11 +71,8 @@ void CompositePass::execute(FrameContext& ctx) {
     glBindTextureUnit(
         3, ctx.has(Resource::GBuffer) ? gbuffer_.position().id() : ctx.blackTexture().id());
     glBindTextureUnit(4, remap_.id());
-    const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
-                          ctx.has(Resource::RealSurfaces);
-    glUniform1i(locHasSpecular_, specular ? 1 : 0);
-    glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
     if (specular) {
+        glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glBindTextureUnit(5, gbuffer_.emissive().id());
         glBindTextureUnit(6, specHits_->reflection().position.id());
         glBindTextureUnit(7, specHits_->refraction().position.id());
@@ -88,8 +87,7 @@ void CompositePass::execute(FrameContext& ctx) {
     } else {
         for (GLuint u = 5; u <= 15; ++u) glBindTextureUnit(u, ctx.blackTexture().id());
     }
-    ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    ctx.drawFullscreenTriangle();
     glDisable(GL_FRAMEBUFFER_SRGB);
     ctx.publish(Resource::Composite, &linear_);
 }

@@ -33,7 +33,10 @@ public:
 
 private:
     const GBufferPass& gbuffer_;
-    gl::Program program_;
+    // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
+    // compositing code would cost every frame even behind a uniform that turns it off.
+    gl::Program program_;         // with Eqs. 6-11 for mirror / glass pixels
+    gl::Program programDiffuse_;  // MIRAGE_DIFFUSE_ONLY: frames without specular objects
     const SpecularGBufferPass* specHits_ = nullptr;
     const SpecularLightPass* specLight_ = nullptr;
     const BackFacePass* backFaces_ = nullptr;
@@ -41,7 +44,7 @@ private:
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
     gl::Texture canvasToCamera_;
-    GLint locHasSpecular_ = -1, locEpsilon_ = -1;
+    GLint locEpsilon_ = -1;
     gl::Framebuffer fbo_;
 };
 

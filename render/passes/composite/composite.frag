@@ -45,11 +45,11 @@ layout(binding = 12) uniform sampler2D specRRefl;    // the reflection's share o
 layout(binding = 13) uniform sampler2D lEnv;         // L_env
 layout(binding = 14) uniform sampler2D realSurfaces; // nearest real surface, xyz world
 layout(binding = 15) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
-uniform int hasSpecular;
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
 
+#ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 // alpha for L = CI + alpha dL, guarded where the rendered real radiance is near 0.
 vec3 guardedAlpha(vec3 ci, vec3 r) {
     vec3 t = smoothstep(vec3(0.0), vec3(exposure.z), r);
@@ -111,6 +111,7 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
     if (allReal) return ci + guardedAlpha(ci, r + (envReal ? env : vec3(0.0))) * dL;
     return env + ciBp + guardedAlpha(ciBp, r) * dL;
 }
+#endif
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -122,13 +123,16 @@ void main() {
         vec2 cuv = (canvasPx + 0.5) * canvas.zw;
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
-        int slot = hasSpecular == 1 ? int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1 : -1;
         vec3 rv = max(texture(lRv, cuv).rgb, vec3(0.0)) * exposure.x;
         vec3 r = max(texture(lR, cuv).rgb, vec3(0.0)) * exposure.x;
+#ifndef MIRAGE_DIFFUSE_ONLY
+        int slot = int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1;
         if (slot >= 0 && origin != ORIGIN_NONE) {
             result = compositeSpecular(cpi, ci, origin == ORIGIN_REAL);
             coverage = origin == ORIGIN_VIRTUAL ? 1.0 : 0.5;
-        } else if (origin == ORIGIN_VIRTUAL) {
+        } else
+#endif
+        if (origin == ORIGIN_VIRTUAL) {
             result = rv;
             coverage = 1.0;
         } else {

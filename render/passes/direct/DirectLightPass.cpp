@@ -1,15 +1,12 @@
 #include "render/passes/direct/DirectLightPass.h"
 
-#include "render/Shaders.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 
 namespace mirage::render {
 
-DirectLightPass::DirectLightPass(const GBufferPass& gbuffer)
+DirectLightPass::DirectLightPass(const GBufferPass& gbuffer, const GpuScene& scene)
     : gbuffer_(gbuffer),
-      program_("direct", {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                          {GL_FRAGMENT_SHADER, "passes/direct/direct.frag",
-                           shaders::source("passes/direct/direct.frag")}}) {}
+      program_(fullscreenProgram("direct", "passes/direct/direct.frag", scene.lightingDefines())) {}
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
     if (!ctx.has(Resource::GBuffer)) return {false, "no G-buffer"};
@@ -18,6 +15,7 @@ PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
 }
 
 void DirectLightPass::resize(const FrameContext& ctx) {
+    if (rv_.width() == ctx.canvasWidth() && rv_.height() == ctx.canvasHeight()) return;
     rv_ = gl::Texture::create2D("direct L_rv", ctx.canvasWidth(), ctx.canvasHeight(), GL_RGBA16F);
     r_ = gl::Texture::create2D("direct L_r", ctx.canvasWidth(), ctx.canvasHeight(), GL_RGBA16F);
     fbo_ = gl::Framebuffer("direct fbo");
@@ -28,11 +26,7 @@ void DirectLightPass::resize(const FrameContext& ctx) {
 
 void DirectLightPass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    program_.use();
-    ctx.bindFrameBlocks();
+    ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
     glBindTextureUnit(0, gbuffer_.position().id());
     glBindTextureUnit(1, gbuffer_.normal().id());
     glBindTextureUnit(2, gbuffer_.albedo().id());
@@ -42,8 +36,7 @@ void DirectLightPass::execute(FrameContext& ctx) {
     glBindTextureUnit(5, ctx.has(Resource::ShadowMapsReal)
                              ? ctx.texture(Resource::ShadowMapsReal).id()
                              : ctx.farShadowTexture().id());
-    ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    ctx.drawFullscreenTriangle();
     ctx.publish(Resource::DirectRv, &rv_);
     ctx.publish(Resource::DirectR, &r_);
 }

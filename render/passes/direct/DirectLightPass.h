@@ -9,7 +9,7 @@ class ShadowPass;
 
 class DirectLightPass final : public RenderPass {
 public:
-    explicit DirectLightPass(const GBufferPass& gbuffer);
+    DirectLightPass(const GBufferPass& gbuffer, const GpuScene& scene);
     const char* name() const override { return "direct"; }
     std::vector<Resource> reads() const override { return {Resource::GBuffer}; }
     std::vector<Resource> writes() const override {

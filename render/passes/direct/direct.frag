@@ -38,13 +38,10 @@ void main() {
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, A.rgb, A.a, N.w) * E;
-        float visAll = shadowVisibility(shadowAll, li, p, NdotL);
-        rv += c * visAll;
         ivec4 sh = lights[li].shadow;
-        if (sh.w == 1 && pReal) {
-            float visReal = sh.z == 1 ? shadowVisibility(shadowReal, li, p, NdotL) : visAll;
-            r += c * visReal;
-        }
+        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, NdotL, sh.z == 1);
+        rv += c * vis.x;  // all occluders
+        if (sh.w == 1 && pReal) r += c * vis.y;  // real occluders only
     }
     if (flags.x != 0) {
         vec3 env = A.rgb * (1.0 - A.a) / PI * shIrradiance(n);

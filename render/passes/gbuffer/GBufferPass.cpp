@@ -23,6 +23,7 @@ PassDecision GBufferPass::decide(const FrameContext& ctx) const {
 
 void GBufferPass::resize(const FrameContext& ctx) {
     const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    if (position_.width() == w && position_.height() == h) return;  // runs before every frame
     position_ = gl::Texture::create2D("gbuffer position", w, h, GL_RGBA32F);
     normal_ = gl::Texture::create2D("gbuffer normal", w, h, GL_RGBA16F);
     albedo_ = gl::Texture::create2D("gbuffer albedo", w, h, GL_RGBA16F);

@@ -1,7 +1,8 @@
 #pragma once
 // Geometry-aware + temporal filter of the VPL light, summed with direct light into LRv / LR:
-// de-interleave at gather resolution (deinterleave.frag), then joint bilateral upsampling,
-// temporal smoothing and the sum (gifilter.frag). Keeps two history buffers (ping-pong).
+// the K x K filter, de-interleaving and temporal smoothing at gather resolution (filter.frag;
+// its output is the next frame's history, so two gather-size buffers ping-pong), then joint
+// bilateral upsampling and the sum with direct light at full resolution (upsample.frag).
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -10,7 +11,8 @@ class GBufferPass;
 
 class GiFilterPass final : public RenderPass {
 public:
-    explicit GiFilterPass(const GBufferPass& gbuffer);
+    // interleave: RendererOptions::interleave (K), compiled into the filter shader.
+    GiFilterPass(const GBufferPass& gbuffer, int interleave);
     const char* name() const override { return "gifilter"; }
     std::vector<Resource> reads() const override {
         return {Resource::GBuffer, Resource::IndirectRv, Resource::IndirectR, Resource::DirectRv,
@@ -23,13 +25,14 @@ public:
 
 private:
     const GBufferPass& gbuffer_;
-    gl::Program deinterleave_;  // K x K geometry-aware filter at gather resolution
-    gl::Program program_;       // upsampling + temporal + sum with direct light
-    gl::Texture lowRv_, lowR_;
-    gl::Framebuffer lowFbo_;
+    gl::Program filter_;    // K x K geometry-aware filter + temporal, gather resolution
+    gl::Program upsample_;  // joint bilateral upsampling + sum with direct light
+    // Filtered indirect light at gather resolution, rgb + camera distance (m) in a; [current_]
+    // is written this frame and read as history by the next.
+    gl::Texture lowRv_[2], lowR_[2];
+    gl::Framebuffer lowFbo_[2];
     gl::Texture rv_, r_;
-    gl::Texture historyRv_[2], historyR_[2];
-    gl::Framebuffer fbo_[2];
+    gl::Framebuffer fbo_;
     int current_ = 0;
 };
 

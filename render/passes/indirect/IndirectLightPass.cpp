@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "render/Shaders.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/vpl/VplPass.h"
 
@@ -11,10 +10,7 @@ namespace mirage::render {
 IndirectLightPass::IndirectLightPass(const GBufferPass& gbuffer, const VplPass& vpls)
     : gbuffer_(gbuffer),
       vpls_(vpls),
-      program_("indirect",
-               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                {GL_FRAGMENT_SHADER, "passes/indirect/indirect.frag",
-                 shaders::source("passes/indirect/indirect.frag")}}) {}
+      program_(fullscreenProgram("indirect", "passes/indirect/indirect.frag")) {}
 
 PassDecision IndirectLightPass::decide(const FrameContext& ctx) const {
     if (!ctx.plan.needVpls) return {false, "no VPLs this frame"};
@@ -43,11 +39,8 @@ void IndirectLightPass::resize(const FrameContext& ctx) {
 
 void IndirectLightPass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    program_.use();
+    ctx.beginFullscreen(program_, rv_.width(), rv_.height());  // each tile sets its viewport
     glUniform1i(program_.uniformLocation("scale"), ctx.options.indirectScale);
-    ctx.bindFrameBlocks();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.vplBuffer().id());
     glBindTextureUnit(0, gbuffer_.position().id());
     glBindTextureUnit(1, gbuffer_.normal().id());

@@ -1,6 +1,5 @@
 #include "render/passes/specular/SpecularGBufferPass.h"
 
-#include "render/Shaders.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
@@ -32,10 +31,7 @@ SpecularGBufferPass::SpecularGBufferPass(const GBufferPass& gbuffer, const BackF
     : gbuffer_(gbuffer),
       backFaces_(backFaces),
       impostors_(impostors),
-      program_("specular gbuffer",
-               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                {GL_FRAGMENT_SHADER, "passes/specular/specular_gbuffer.frag",
-                 shaders::source("passes/specular/specular_gbuffer.frag")}}) {
+      program_(fullscreenProgram("specular gbuffer", "passes/specular/specular_gbuffer.frag")) {
     locMode_ = program_.uniformLocation("mode");
     locSteps_ = program_.uniformLocation("marchSteps");
 }
@@ -57,11 +53,7 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
 }
 
 void SpecularGBufferPass::execute(FrameContext& ctx) {
-    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    program_.use();
-    ctx.bindFrameBlocks();
+    ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
                      ctx.scene.specularDrawBuffer().id());

@@ -1,6 +1,5 @@
 #include "render/passes/specular/SpecularLightPass.h"
 
-#include "render/Shaders.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
 #include "render/passes/vpl/VplPass.h"
@@ -8,14 +7,12 @@
 namespace mirage::render {
 
 SpecularLightPass::SpecularLightPass(const GBufferPass& gbuffer, const SpecularGBufferPass& hits,
-                                     const VplPass& vpls)
+                                     const VplPass& vpls, const GpuScene& scene)
     : gbuffer_(gbuffer),
       hits_(hits),
       vpls_(vpls),
-      program_("specular light",
-               {{GL_VERTEX_SHADER, "fullscreen.vert", shaders::source("fullscreen.vert")},
-                {GL_FRAGMENT_SHADER, "passes/specular/specular_light.frag",
-                 shaders::source("passes/specular/specular_light.frag")}}) {
+      program_(fullscreenProgram("specular light", "passes/specular/specular_light.frag",
+                                 scene.lightingDefines())) {
     locUseVpls_ = program_.uniformLocation("useVpls");
     locVplStride_ = program_.uniformLocation("vplStride");
 }
@@ -48,11 +45,7 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
 
 void SpecularLightPass::execute(FrameContext& ctx) {
     fbo_.bind();
-    glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    program_.use();
-    ctx.bindFrameBlocks();
+    ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
     const SpecularHitBuffer& a = hits_.reflection();
     const SpecularHitBuffer& b = hits_.refraction();
     const gl::Texture* units[10] = {&a.position, &a.normal, &a.albedo, &a.emissive, &a.weight,
@@ -79,8 +72,7 @@ void SpecularLightPass::execute(FrameContext& ctx) {
     glBindTextureUnit(kUnitEnvironmentMap, ctx.scene.environmentMap().id());
     glUniform1i(locUseVpls_, vpls ? 1 : 0);
     glUniform1i(locVplStride_, ctx.options.specularVplStride);
-    ctx.emptyVao.bind();
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    ctx.drawFullscreenTriangle();
     ctx.publish(Resource::SpecularRv, &rv_);
     ctx.publish(Resource::SpecularR, &r_);
     ctx.publish(Resource::Lenv, &env_);

@@ -14,7 +14,7 @@ class VplPass;
 class SpecularLightPass final : public RenderPass {
 public:
     SpecularLightPass(const GBufferPass& gbuffer, const SpecularGBufferPass& hits,
-                      const VplPass& vpls);
+                      const VplPass& vpls, const GpuScene& scene);
     const char* name() const override { return "speclight"; }
     std::vector<Resource> reads() const override {
         return {Resource::ReflectionGBuffer, Resource::RefractionGBuffer};

@@ -56,13 +56,10 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, albedo, metallic, roughness) * E;
-        float visAll = shadowVisibility(shadowAll, li, x, NdotL);
-        rv += c * visAll;
         ivec4 sh = lights[li].shadow;
-        if (sh.w == 1 && xReal) {
-            float visReal = sh.z == 1 ? shadowVisibility(shadowReal, li, x, NdotL) : visAll;
-            r += c * visReal;
-        }
+        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, x, NdotL, sh.z == 1);
+        rv += c * vis.x;  // all occluders
+        if (sh.w == 1 && xReal) r += c * vis.y;  // real occluders only
     }
     if (flags.x != 0) {
         vec3 env = albedo * (1.0 - metallic) / PI * shIrradiance(n);

@@ -4,15 +4,25 @@
 // around gather pixel c holds one pixel of every VPL group; neighbours count only if their
 // position and normal match c's (weights: cos^16 of the normal difference, distance from c's
 // tangent plane relative to 1 % of the camera distance), so light does not bleed across edges.
+// Then temporal smoothing against VPL flicker, also at gather resolution (a quarter of the
+// pixels of doing it after upsampling): history reprojected with last frame's camera, rejected
+// where the surface there is at a different distance; off after a cut or tracking loss.
 // Reads the deinterleaved layout of indirect.frag; writes the normal (interleaved) layout.
+#ifndef MIRAGE_INTERLEAVE  // GiFilterPass sets it from RendererOptions::interleave
+#define MIRAGE_INTERLEAVE 4
+#endif
+// K is a compile-time constant so that the K x K loop unrolls: llvmpipe runs a loop with a
+// uniform-buffer bound as a masked SIMD loop, 1.4x slower for this pass.
 in vec2 uv;
 layout(binding = 0) uniform sampler2D gPosition;
 layout(binding = 1) uniform sampler2D gNormal;
 layout(binding = 2) uniform sampler2D indirectRv;  // deinterleaved, size a multiple of K
 layout(binding = 3) uniform sampler2D indirectR;
+layout(binding = 4) uniform sampler2D historyRv;  // gather res: rgb filtered, a = camera dist.
+layout(binding = 5) uniform sampler2D historyR;
 uniform int scale;  // gather pixel q was shaded at G-buffer pixel q * scale
-layout(location = 0) out vec4 outRv;
-layout(location = 1) out vec4 outR;
+layout(location = 0) out vec4 outRv;  // rgb filtered + smoothed; a = camera distance (m)
+layout(location = 1) out vec4 outR;   // (the history of the next frame)
 
 float geometryWeight(vec3 p, vec3 n, float camDist, vec3 q, vec3 nq) {
     float planeDist = abs(dot(q - p, n)) / max(0.01 * camDist, 1e-4);
@@ -33,7 +43,7 @@ void main() {
     if (int(P.w + 0.5) == ORIGIN_NONE) return;
     vec3 n = texelFetch(gNormal, min(c * scale, size - 1), 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
-    int K = max(counts.z, 1);
+    const int K = MIRAGE_INTERLEAVE;
     ivec2 lowSize = textureSize(indirectRv, 0);
     ivec2 tile = lowSize / K;
     vec3 sumRv = vec3(0.0), sumR = vec3(0.0);
@@ -50,8 +60,27 @@ void main() {
             sumR += w * texelFetch(indirectR, t, 0).rgb;
             wsum += w;
         }
-    if (wsum > 1e-6) {
-        outRv = vec4(sumRv / wsum, 1.0);
-        outR = vec4(sumR / wsum, 1.0);
+    vec3 iRv = wsum > 1e-6 ? sumRv / wsum : vec3(0.0);
+    vec3 iR = wsum > 1e-6 ? sumR / wsum : vec3(0.0);
+    if (flags.y == 1 && params.z > 0.0) {
+        vec4 prev = prevViewProj * vec4(P.xyz, 1.0);
+        if (prev.w > 1e-6) {
+            vec2 puv = prev.xy / prev.w * 0.5 + 0.5;
+            if (all(greaterThanEqual(puv, vec2(0.0))) && all(lessThanEqual(puv, vec2(1.0)))) {
+                // Canvas position -> gather texel (gather pixel q sits at canvas pixel q*scale).
+                vec2 hp = (puv * vec2(size) - 0.5) / float(scale) + 0.5;
+                vec2 huv = hp / vec2(textureSize(historyRv, 0));
+                vec4 hRv = texture(historyRv, huv);
+                vec4 hR = texture(historyR, huv);
+                float expected = length(P.xyz - prevCameraPos.xyz);
+                if (abs(hRv.a - expected) < 0.02 * expected + 0.005 && allFinite(hRv.rgb) &&
+                    allFinite(hR.rgb)) {
+                    iRv = mix(iRv, hRv.rgb, params.z);
+                    iR = mix(iR, hR.rgb, params.z);
+                }
+            }
+        }
     }
+    outRv = vec4(iRv, camDist);
+    outR = vec4(iR, camDist);
 }
