@@ -166,7 +166,7 @@ bool PredictedTagFinder::verify(const cv::Mat& grey, int id,
                                 const std::array<glm::dvec2, 4>& corners, int* innerErrors,
                                 int* outerErrors, double* contrast) const {
     const TagModel* m = model(id);
-    if (!m) return false;
+    if (!m || grey.type() != CV_8UC1) return false;
     // Unit square over the detection corners: (0,0) top-left = corner 3, (1,0) top-right =
     // corner 2, (1,1) bottom-right = corner 1, (0,1) bottom-left = corner 0 (Board.h).
     const SquareToQuad H({corners[3], corners[2], corners[1], corners[0]});

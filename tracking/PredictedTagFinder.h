@@ -80,7 +80,8 @@ public:
 
     // Verification alone (step 3 above) of corners claimed to be tag `id` of the board: the
     // number of disagreeing cells of the border square and of the quiet-zone ring and the
-    // contrast; true if within the options' limits.
+    // contrast; true if within the options' limits. False for an id not on the board, an image
+    // that is not 8-bit grey, or cells outside the image.
     bool verify(const cv::Mat& grey, int id, const std::array<glm::dvec2, 4>& corners,
                 int* innerErrors = nullptr, int* outerErrors = nullptr,
                 double* contrast = nullptr) const;
