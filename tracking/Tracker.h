@@ -64,8 +64,9 @@ struct TrackedFrame {
     std::vector<TagDetection> detections;
     double sharpness = -1;  // computed only when no tag was found
     double detectMs = 0, poseMs = 0, filterMs = 0;
-    // The region searched first (the full image when no region was used), and whether the
-    // full image had to be searched again because the region's result was not ok.
+    // The region libapriltag searched first (the full image when no region was used; empty when
+    // the tracking mode gave the pose and nothing was searched), and whether the full image had
+    // to be searched again because the region's result was not ok.
     cv::Rect searchRegion;
     bool fullFrameRetry = false;
     // Tracking mode: tried in this frame, its per-tag counts, and whether its tags made the
