@@ -55,14 +55,15 @@ bool intersect(const Line& a, const Line& b, glm::dvec2& out) {
 
 // Sub-pixel edge refinement (see DetectorOptions::refineCorners). Leaves the corners unchanged if
 // any edge cannot be measured or a corner would move by more than 1.5 px.
-void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetection& t) {
+bool Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder,
+                             std::array<glm::dvec2, 4>& corners) {
     glm::dvec2 centroid(0.0);
-    for (const auto& c : t.corners) centroid += 0.25 * c;
+    for (const auto& c : corners) centroid += 0.25 * c;
     std::array<Line, 4> lines;
     for (int k = 0; k < 4; ++k) {
-        const glm::dvec2 a = t.corners[size_t(k)], b = t.corners[size_t((k + 1) % 4)];
+        const glm::dvec2 a = corners[size_t(k)], b = corners[size_t((k + 1) % 4)];
         const double len = glm::length(b - a);
-        if (len < 4.0) return;
+        if (len < 4.0) return false;
         const glm::dvec2 dir = (b - a) / len;
         glm::dvec2 normal(-dir.y, dir.x);
         if (glm::dot(normal, 0.5 * (a + b) - centroid) < 0) normal = -normal;  // points outward
@@ -72,7 +73,7 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
         // over the cells at the border. Under foreshortening it is smaller than along the edge,
         // and a profile longer than one cell would reach the data bits and bias the levels.
         const glm::dvec2 oppositeMid =
-            0.5 * (t.corners[size_t((k + 2) % 4)] + t.corners[size_t((k + 3) % 4)]);
+            0.5 * (corners[size_t((k + 2) % 4)] + corners[size_t((k + 3) % 4)]);
         const double cell = std::abs(glm::dot(normal, 0.5 * (a + b) - oppositeMid)) / cellsAtBorder;
         const double range = std::clamp(0.45 * cell, 0.75, 4.0);
         const double step = 0.25;
@@ -113,7 +114,7 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
         }
         // Most samples must have found the edge (a clean black-to-white step), else the border is
         // occluded, damaged or next to dark surroundings: keep libapriltag's corners.
-        if (pts.size() < 4 || 5 * pts.size() < 3 * size_t(nSamples)) return;
+        if (pts.size() < 4 || 5 * pts.size() < 3 * size_t(nSamples)) return false;
         // Weighted total-least-squares line through the edge points.
         double wsum = 0;
         glm::dvec2 mean(0.0);
@@ -139,15 +140,17 @@ void Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetectio
             const double dist = glm::dot(pts[i] - mean, n);
             res += weights[i] * dist * dist;
         }
-        if (std::sqrt(res / wsum) > 0.3) return;
+        if (std::sqrt(res / wsum) > 0.3) return false;
     }
     std::array<glm::dvec2, 4> refined;
     for (int k = 0; k < 4; ++k) {
         // Corner k joins edge k-1 (corner k-1 -> k) and edge k (corner k -> k+1).
-        if (!intersect(lines[size_t((k + 3) % 4)], lines[size_t(k)], refined[size_t(k)])) return;
-        if (glm::length(refined[size_t(k)] - t.corners[size_t(k)]) > 1.5) return;
+        if (!intersect(lines[size_t((k + 3) % 4)], lines[size_t(k)], refined[size_t(k)]))
+            return false;
+        if (glm::length(refined[size_t(k)] - corners[size_t(k)]) > 1.5) return false;
     }
-    t.corners = refined;
+    corners = refined;
+    return true;
 }
 
 Detector::Detector(const DetectorOptions& options)
@@ -229,7 +232,7 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect&
         t.centre = glm::dvec2(d->c[0], d->c[1]) + shift;
         for (int k = 0; k < 4; ++k)
             t.corners[size_t(k)] = glm::dvec2(d->p[k][0], d->p[k][1]) + shift;
-        if (options_.refineCorners) refineCorners(grey, family_->widthAtBorder(), t);
+        if (options_.refineCorners) refineCorners(grey, family_->widthAtBorder(), t.corners);
         out.push_back(t);
     }
     apriltag_detections_destroy(dets);

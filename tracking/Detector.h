@@ -76,9 +76,15 @@ public:
 
     const DetectorOptions& options() const { return options_; }
 
-private:
-    static void refineCorners(const cv::Mat& grey, int cellsAtBorder, TagDetection& t);
+    // mirage's sub-pixel edge refinement (DetectorOptions::refineCorners) of a tag's detection
+    // corners in an 8-bit grey sRGB-encoded image, from corners within ~0.45 cell of the truth
+    // (cellsAtBorder: TagFamily::widthAtBorder()). Returns false and leaves the corners unchanged
+    // when an edge cannot be measured (occluded, damaged, next to dark surroundings) or a corner
+    // would move by more than 1.5 px. Also used by the tracking mode (PredictedTagFinder).
+    static bool refineCorners(const cv::Mat& grey, int cellsAtBorder,
+                              std::array<glm::dvec2, 4>& corners);
 
+private:
     DetectorOptions options_;
     std::unique_ptr<TagFamily> family_;
     apriltag_detector* detector_ = nullptr;

@@ -240,7 +240,8 @@ PoseEstimator::PoseEstimator(Board board, CameraIntrinsics camera, PoseEstimator
 }
 
 PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections,
-                                     const std::optional<Pose>& prior) const {
+                                     const std::optional<Pose>& prior,
+                                     const std::optional<Pose>& initial) const {
     PoseEstimate out;
     char buf[256];
     // 1. Board tags seen; a tag id seen twice cannot be told apart: both dropped.
@@ -293,9 +294,10 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     for (const auto& o : obs) initTags.push_back(&o);
     std::sort(initTags.begin(), initTags.end(),
               [](const Observation* a, const Observation* b) { return a->sidePx > b->sidePx; });
-    if (initTags.size() > size_t(options_.maxInitTags))
-        initTags.resize(size_t(options_.maxInitTags));
+    const size_t maxInit = initial ? 1 : size_t(std::max(1, options_.maxInitTags));
+    if (initTags.size() > maxInit) initTags.resize(maxInit);
     std::vector<Pose> candidates;
+    if (initial && initial->isFinite()) candidates.push_back(*initial);
     const double maxInitZ = std::cos(glm::radians(options_.maxInitAngleDeg));
     for (const Observation* op : initTags) {
         const Observation& o = *op;

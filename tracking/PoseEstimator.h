@@ -72,8 +72,13 @@ public:
 
     // detections: all tags found in the frame (ids not on the board are ignored).
     // prior: the previous frame's T_world_camera, if tracked.
+    // initial: a pose expected to be close (the tracking mode's prediction, whose tags were
+    // verified where it put them). It becomes the first candidate and only the largest tag's
+    // IPPE solutions are added (for the planar flip of the ambiguity check) instead of those of
+    // maxInitTags tags; outlier rejection and the ambiguity check are unchanged.
     PoseEstimate estimate(const std::vector<TagDetection>& detections,
-                          const std::optional<Pose>& prior = std::nullopt) const;
+                          const std::optional<Pose>& prior = std::nullopt,
+                          const std::optional<Pose>& initial = std::nullopt) const;
 
     const Board& board() const { return board_; }
     const CameraIntrinsics& camera() const { return camera_; }

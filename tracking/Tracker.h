@@ -11,6 +11,7 @@
 #include "tracking/Detector.h"
 #include "tracking/PoseEstimator.h"
 #include "tracking/PoseFilter.h"
+#include "tracking/PredictedTagFinder.h"
 
 namespace mirage::tracking {
 
@@ -42,6 +43,18 @@ struct TrackerOptions {
     double roiMarginPx = 32.0;
     double roiMarginFraction = 0.15;
     int fullFrameEvery = 30;
+    // Tracking mode (docs/tracking.md, "Tracking mode"): after an ok frame (at most priorMaxAgeS
+    // old), the pose of the new frame is predicted by constant velocity from the last two ok
+    // poses and the board's tags are found where it puts them (PredictedTagFinder: edge search,
+    // sub-pixel refinement, verification of every cell against the expected code) instead of by
+    // libapriltag's search. The frame falls back to the search (region of interest, then full
+    // image, as above) when fewer than max(trackMinTags, trackMinFraction x the predicted tags)
+    // are verified, or the pose from them is not ok. Every fullFrameEvery-th frame is searched
+    // in full regardless (recovery, and a check of the whole image).
+    bool tagTracking = true;
+    TagPredictionOptions prediction;
+    int trackMinTags = 2;
+    double trackMinFraction = 0.5;
 };
 
 struct TrackedFrame {
@@ -51,10 +64,17 @@ struct TrackedFrame {
     std::vector<TagDetection> detections;
     double sharpness = -1;  // computed only when no tag was found
     double detectMs = 0, poseMs = 0, filterMs = 0;
-    // The region searched first (the full image when no region was used), and whether the
-    // full image had to be searched again because the region's result was not ok.
+    // The region libapriltag searched first (the full image when no region was used; empty when
+    // the tracking mode gave the pose and nothing was searched), and whether the full image had
+    // to be searched again because the region's result was not ok.
     cv::Rect searchRegion;
     bool fullFrameRetry = false;
+    // Tracking mode: tried in this frame, its per-tag counts, and whether its tags made the
+    // pose (false: the frame fell back to libapriltag's search, or the mode was not tried).
+    bool tagTrackingTried = false;
+    std::optional<Pose> predictedPose;  // T_world_camera the tags were predicted with
+    PredictedTagStats prediction;
+    bool tagTracked = false;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -73,6 +93,7 @@ public:
     void seedPrior(const Pose& T_world_camera, double t) {
         lastOk_ = T_world_camera;
         lastOkT_ = t;
+        previousOk_.reset();
     }
     // A frame that could not be read (corrupt, truncated video): reported lost, filter reset.
     TrackedFrame markLost(double t, const std::string& reason);
@@ -85,13 +106,20 @@ private:
     std::optional<cv::Rect> boardRegion(const Pose& T_world_camera, cv::Size image,
                                         bool withMargins) const;
 
+    // The pose predicted for time t: constant velocity from the last two ok poses when both are
+    // recent, else the last ok pose.
+    Pose predictPose(double t) const;
+
     TrackerOptions options_;
     Detector detector_;
+    PredictedTagFinder tagFinder_;
     PoseEstimator estimator_;
     PoseFilter filter_;
     OneEuroPoseFilter oneEuro_;
     std::optional<Pose> lastOk_;
     double lastOkT_ = 0;
+    std::optional<Pose> previousOk_;  // the ok pose before lastOk_ (for the velocity)
+    double previousOkT_ = 0;
     int framesSinceFullSearch_ = 0;
 };
 

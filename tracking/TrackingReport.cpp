@@ -48,6 +48,8 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
     const PoseEstimate& e = f.estimate;
     ++stateCount_[size_t(e.state)];
     if (!e.tagsUsed.empty() || !e.tagsRejected.empty()) ++withTags_;
+    tagTracked_ += f.tagTracked;
+    trackFallbacks_ += f.tagTrackingTried && !f.tagTracked;
     decodeMs_.push_back(decodeMs);
     detectMs_.push_back(f.detectMs);
     poseMs_.push_back(f.poseMs);
@@ -124,6 +126,12 @@ std::string TrackingReport::summary() const {
         s += b;
     }
     s += "\n";
+    std::snprintf(
+        b, sizeof b,
+        "tracking mode (tags where the predicted pose puts them): %d frames, %d fell back "
+        "to the search\n",
+        tagTracked_, trackFallbacks_);
+    s += b;
     const ErrorStats rms = errorStats(rms_);
     std::snprintf(b, sizeof b, "reprojection RMS (ok frames): median %.3f px, p95 %.3f, max %.3f\n",
                   rms.median, rms.p95, rms.max);

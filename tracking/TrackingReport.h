@@ -49,6 +49,7 @@ private:
     std::filesystem::path path_;
     glm::dvec3 boardCentre_;
     int frames_ = 0, withTags_ = 0, unreadable_ = 0, wrongOk_ = 0;
+    int tagTracked_ = 0, trackFallbacks_ = 0;  // frames from the tracking mode / its fallbacks
     std::array<int, 6> stateCount_{};
     std::vector<double> rms_, decodeMs_, detectMs_, poseMs_, filterMs_;
     std::vector<double> rotErrDeg_, posErrM_, posErrRel_;              // raw estimate vs truth

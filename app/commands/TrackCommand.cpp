@@ -27,6 +27,7 @@ struct TrackArgs {
     int envmapWidth = 512;
     double fps = 30.0;
     bool noFilter = false;
+    bool noTagTracking = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
 };
@@ -70,6 +71,7 @@ void run(const TrackArgs& a) {
     const tracking::Board board = tracking::Board::load(boardPath);
     tracking::TrackerOptions opt = a.options;
     opt.filterEnabled = !a.noFilter;
+    opt.tagTracking = !a.noTagTracking;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -200,6 +202,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
         ->capture_default_str();
     cmd->add_option("--min-tag-px", a->options.pose.minTagSidePx, "Smallest usable tag side")
         ->capture_default_str();
+    cmd->add_flag("--no-tag-tracking", a->noTagTracking,
+                  "Search every frame with libapriltag (region of interest) instead of finding "
+                  "the tags where the predicted pose puts them (docs/tracking.md, Tracking mode)");
     cmd->callback([a] { run(*a); });
 });
 

@@ -86,8 +86,12 @@ TEST(Tracker, RegionOfInterestFollowsTheBoardAndFallsBackToTheFullImage) {
     const cv::Mat a = view({0.1, 0.5, 0.3}, {0, 0, 0});
     const cv::Mat b = view({0.11, 0.5, 0.3}, {0.005, 0, 0});   // small motion
     const cv::Mat c = view({0.1, 0.5, 0.3}, {0.16, 0, 0.06});  // the board jumps aside
-    Tracker withRoi(board, cam);
+    TrackerOptions roiOptions;
+    roiOptions.tagTracking =
+        false;  // libapriltag in the region (the tracking mode: TagTracking_test)
+    Tracker withRoi(board, cam, roiOptions);
     TrackerOptions noRoiOptions;
+    noRoiOptions.tagTracking = false;
     noRoiOptions.roiEnabled = false;
     Tracker noRoi(board, cam, noRoiOptions);
     const cv::Rect full(0, 0, cam.width, cam.height);
