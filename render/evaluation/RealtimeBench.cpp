@@ -27,6 +27,12 @@ int parseInt(const std::string& knob, const std::string& v, int lo, int hi) {
         fmt::format("bench knob '{}': '{}' is not an integer in [{}, {}]", knob, v, lo, hi));
 }
 
+bool parseOnOff(const std::string& knob, const std::string& v) {
+    if (v != "on" && v != "off")
+        throw Error(fmt::format("bench knob '{}': '{}' is not on or off", knob, v));
+    return v == "on";
+}
+
 // "WxH" -> (W, H); "session" -> (0, 0).
 std::pair<int, int> parseResolution(const std::string& v) {
     if (v == "session") return {0, 0};
@@ -136,18 +142,14 @@ const std::vector<BenchKnob>& benchKnobs() {
          "unchanged; off: re-run them every frame",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
          [](BenchConfig& c, const std::string& v) {
-             if (v != "on" && v != "off")
-                 throw Error(fmt::format("bench: knob static_reuse: '{}' is not on or off", v));
-             c.options.reuseStaticPasses = v == "on";
+             c.options.reuseStaticPasses = parseOnOff("static_reuse", v);
          }},
         {"sync_passes",
          "on: glFinish around every pass so each pass's GPU ms is its own (llvmpipe defers work); "
          "off: as mirage replay runs, passes overlap and only the wall ms is meaningful",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
          [](BenchConfig& c, const std::string& v) {
-             if (v != "on" && v != "off")
-                 throw Error(fmt::format("bench: knob sync_passes: '{}' is not on or off", v));
-             c.options.syncPasses = v == "on";
+             c.options.syncPasses = parseOnOff("sync_passes", v);
          }},
         // Specular objects (issue 6). One default value each, so the default grid does not grow;
         // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror

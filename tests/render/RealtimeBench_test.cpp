@@ -280,6 +280,8 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"nonsense", {"1"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"vpls", {"many"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"indirect_scale", {"3"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"sync_passes", {"maybe"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"static_reuse", {"yes"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"2048x1536"}}}), Error);  // upsampling
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"640x640"}}}), Error);    // aspect
 }
