@@ -11,25 +11,6 @@ namespace {
 
 using namespace mirage::raytrace::test;
 
-const EmbreeDevice& device() {
-    static EmbreeDevice d("threads=2");
-    return d;
-}
-
-RenderCamera pinhole(int w, int h, double f, glm::dvec3 eye, glm::dvec3 target,
-                     glm::dvec3 up = {0, 1, 0}) {
-    RenderCamera c;
-    c.intrinsics.width = w;
-    c.intrinsics.height = h;
-    c.intrinsics.fx = c.intrinsics.fy = f;
-    c.intrinsics.cx = 0.5 * w - 0.5;
-    c.intrinsics.cy = 0.5 * h - 0.5;
-    // glm::lookAt builds a glTF-style view (camera looks down -Z): convert to OpenCV axes.
-    c.T_world_camera =
-        Pose::fromMatrix(glm::inverse(glm::lookAt(eye, target, up))) * kCvFromGltfCamera;
-    return c;
-}
-
 RenderSettings quick(int spp, uint64_t seed = 7) {
     RenderSettings s;
     s.samplesPerPixel = spp;
@@ -43,8 +24,8 @@ TEST(RaytraceAnalytic, WhiteFurnaceInsideEmittingSphere) {
     Scene s;
     addObject(s, "sphere", spherePrimitive(1.0f, 48, 24), lambert(glm::vec3(0.5f), glm::vec3(0.5f)),
               glm::dmat4(1.0));
-    RayTracingScene rt(s, SceneSubset::All, device());
-    auto cam = pinhole(16, 16, 8.0, {0, 0, 0}, {0, 0, -1});
+    RayTracingScene rt(s, SceneSubset::All, testDevice());
+    auto cam = lookAtCamera(16, 16, 8.0, {0, 0, 0}, {0, 0, -1});
     auto r = render(rt, cam, quick(64));
     EXPECT_NEAR(meanValue(r.radiance), 1.0, 0.02);
     EXPECT_LT(mirage::test::percentileAbsDiff(r.radiance, constantImage(16, 16, 1.0f), 0.9), 0.25);
@@ -58,8 +39,8 @@ TEST(RaytraceAnalytic, WhiteFurnaceAlbedoOneInUniformEnvironment) {
     setEnvironment(s, dir / "env.exr", constantImage(16, 8, 1.0f));
     addObject(s, "sphere", spherePrimitive(0.5f, 48, 24), lambert(glm::vec3(1.0f)),
               glm::dmat4(1.0));
-    RayTracingScene rt(s, SceneSubset::All, device());
-    auto cam = pinhole(16, 16, 14.0, {0, 0, 2}, {0, 0, 0});
+    RayTracingScene rt(s, SceneSubset::All, testDevice());
+    auto cam = lookAtCamera(16, 16, 14.0, {0, 0, 2}, {0, 0, 0});
     auto r = render(rt, cam, quick(32));
     EXPECT_NEAR(meanValue(r.radiance), 1.0, 0.01);
     double lo, hi;
@@ -69,7 +50,7 @@ TEST(RaytraceAnalytic, WhiteFurnaceAlbedoOneInUniformEnvironment) {
     // The comparison can fail: albedo 0.8 must give a visibly darker sphere.
     Scene dark = s;
     dark.materials[0].baseColor = glm::vec4(0.8f);
-    RayTracingScene rtDark(dark, SceneSubset::All, device());
+    RayTracingScene rtDark(dark, SceneSubset::All, testDevice());
     cv::Mat darkImage = render(rtDark, cam, quick(32)).radiance;
     EXPECT_LT(meanValue(darkImage(cv::Rect(6, 6, 4, 4))), 0.9);
     EXPECT_NEAR(meanValue(r.radiance(cv::Rect(6, 6, 4, 4))), 1.0, 0.03);
@@ -93,8 +74,8 @@ TEST(RaytraceAnalytic, GlassSlabNormalIncidenceTransmitsFresnel) {
         addObject(s, "slab", boxPrimitive({-1, -1, -thickness}, {1, 1, 0}), g, glm::dmat4(1.0));
         addObject(s, "emitter", boxPrimitive({-3, -3, -2.1f}, {3, 3, -2}),
                   lambert(glm::vec3(0.0f), glm::vec3(1.0f)), glm::dmat4(1.0));
-        RayTracingScene rt(s, SceneSubset::All, device());
-        auto cam = pinhole(16, 16, 2000.0, {0, 0, 1}, {0, 0, -1});
+        RayTracingScene rt(s, SceneSubset::All, testDevice());
+        auto cam = lookAtCamera(16, 16, 2000.0, {0, 0, 1}, {0, 0, -1});
         auto r = render(rt, cam, quick(256));
         double single = (1 - F) * (1 - F) * a;
         double all = single / (1 - F * F * a * a);
@@ -115,9 +96,9 @@ TEST(RaytraceAnalytic, MirrorReturnsEnvironmentExactly) {
     setEnvironment(s, dir / "env.exr", env);
     // Mirror plane y = 0 facing up; camera looks down at 45 degrees.
     addObject(s, "mirror", floorPrimitive(20.0f), mirrorMaterial(), glm::dmat4(1.0));
-    RayTracingScene rt(s, SceneSubset::All, device());
+    RayTracingScene rt(s, SceneSubset::All, testDevice());
     EnvironmentLight envLight(env, 1.0f, 0.0);
-    auto cam = pinhole(24, 24, 20.0, {0, 1, 0}, {0.3, 0, -1});
+    auto cam = lookAtCamera(24, 24, 20.0, {0, 1, 0}, {0.3, 0, -1});
     auto r = render(rt, cam, quick(8));
     int checked = 0;
     const glm::mat3 R(cam.T_world_camera.rotationMatrix());
@@ -169,8 +150,8 @@ TEST(RaytraceAnalytic, EnergyNeverGrowsInRandomScenes) {
                 addObject(s, "b" + std::to_string(i),
                           boxPrimitive(glm::vec3(-0.4f), glm::vec3(0.3f)), m, translate(c));
         }
-        RayTracingScene rt(s, SceneSubset::All, device());
-        auto cam = pinhole(24, 24, 16.0, {0, 0.5, 4}, {0, 0, 0});
+        RayTracingScene rt(s, SceneSubset::All, testDevice());
+        auto cam = lookAtCamera(24, 24, 16.0, {0, 0.5, 4}, {0, 0, 0});
         auto r = render(rt, cam, quick(24, uint64_t(trial + 1)));
         EXPECT_TRUE(allFinite(r.radiance));
         EXPECT_EQ(r.nonFiniteSamples, 0);
@@ -194,14 +175,14 @@ TEST(RaytraceAnalytic, IorOneObjectVanishes) {
     Scene with = base;
     addObject(with, "ghost", spherePrimitive(0.4f, 32, 16), glass(1.0f), glm::dmat4(1.0),
               Origin::Virtual);
-    auto cam = pinhole(24, 24, 12.0, {0, 0.3, 2}, {0, 0, 0});
-    auto a = render(RayTracingScene(base, SceneSubset::All, device()), cam, quick(64));
-    auto b = render(RayTracingScene(with, SceneSubset::All, device()), cam, quick(64));
+    auto cam = lookAtCamera(24, 24, 12.0, {0, 0.3, 2}, {0, 0, 0});
+    auto a = render(RayTracingScene(base, SceneSubset::All, testDevice()), cam, quick(64));
+    auto b = render(RayTracingScene(with, SceneSubset::All, testDevice()), cam, quick(64));
     double same = mirage::test::psnr(a.radiance, b.radiance, 2.0);
     EXPECT_GT(same, 30.0);
     // And IOR 1.5 does not vanish (the comparison can fail).
     with.materials.back().ior = 1.5f;
-    auto c = render(RayTracingScene(with, SceneSubset::All, device()), cam, quick(64));
+    auto c = render(RayTracingScene(with, SceneSubset::All, testDevice()), cam, quick(64));
     EXPECT_LT(mirage::test::psnr(a.radiance, c.radiance, 2.0), same - 10.0);
 }
 
@@ -257,9 +238,9 @@ TEST(RaytraceAnalytic, RaysLeavingTheSceneAndGrazingViews) {
     addLight(
         s, "sun", sun,
         glm::inverse(glm::lookAt(glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 0), glm::dvec3(0, 0, -1))));
-    RayTracingScene rt(s, SceneSubset::All, device());
+    RayTracingScene rt(s, SceneSubset::All, testDevice());
     // Camera at floor height looking along it: half the rays leave, the rest graze the floor.
-    auto cam = pinhole(16, 16, 12.0, {0, 1e-3, 1.5}, {0, 1e-3, 0});
+    auto cam = lookAtCamera(16, 16, 12.0, {0, 1e-3, 1.5}, {0, 1e-3, 0});
     auto r = render(rt, cam, quick(8));
     EXPECT_TRUE(allFinite(r.radiance));
     EXPECT_EQ(r.nonFiniteSamples, 0);
@@ -271,7 +252,7 @@ TEST(RaytraceAnalytic, RaysLeavingTheSceneAndGrazingViews) {
     EXPECT_EQ(cv::norm(r.radiance.row(0), cv::NORM_INF), 0.0);
     // An empty scene renders black.
     Scene empty;
-    auto e = render(RayTracingScene(empty, SceneSubset::All, device()), cam, quick(2));
+    auto e = render(RayTracingScene(empty, SceneSubset::All, testDevice()), cam, quick(2));
     EXPECT_EQ(cv::norm(e.radiance, cv::NORM_INF), 0.0);
 }
 

@@ -11,24 +11,6 @@ namespace {
 
 using namespace mirage::raytrace::test;
 
-const EmbreeDevice& device() {
-    static EmbreeDevice d("threads=2");
-    return d;
-}
-
-RenderCamera lookAtCamera(int w, int h, double f, glm::dvec3 eye, glm::dvec3 target,
-                          glm::dvec3 up = {0, 1, 0}) {
-    RenderCamera c;
-    c.intrinsics.width = w;
-    c.intrinsics.height = h;
-    c.intrinsics.fx = c.intrinsics.fy = f;
-    c.intrinsics.cx = 0.5 * w - 0.5;
-    c.intrinsics.cy = 0.5 * h - 0.5;
-    c.T_world_camera =
-        Pose::fromMatrix(glm::inverse(glm::lookAt(eye, target, up))) * kCvFromGltfCamera;
-    return c;
-}
-
 // Flux (per unit incident irradiance) that a smooth glass sphere of radius R, lit by a parallel
 // beam along +X, sends onto the plane x = planeX within radius rMax of the axis: every ray of
 // impact parameter b is split by Fresnel at each interface (any number of internal reflections)
@@ -102,7 +84,7 @@ TEST(RaytraceCaustics, GlassSphereCausticFluxMatchesFresnelAndAbsorption) {
         addLight(
             s, "sun", sun,
             glm::inverse(glm::lookAt(glm::dvec3(0), glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0))));
-        RayTracingScene rt(s, SceneSubset::All, device());
+        RayTracingScene rt(s, SceneSubset::All, testDevice());
         // Looks at the wall from x = 0.25 (never through the sphere at |x| < 0.1).
         const int W = 64, H = 64;
         auto cam = lookAtCamera(W, H, 33.0, {0.25, 0.0, 0.9}, {planeX, 0, 0});
@@ -170,7 +152,7 @@ TEST(RaytraceConvergence, ErrorFallsAsInverseSquareRootOfSamples) {
     addLight(
         s, "spot", spot,
         glm::inverse(glm::lookAt(glm::dvec3(1, 2, 1), glm::dvec3(0, 0, 0), glm::dvec3(0, 1, 0))));
-    RayTracingScene rt(s, SceneSubset::All, device());
+    RayTracingScene rt(s, SceneSubset::All, testDevice());
     auto cam = lookAtCamera(24, 24, 20.0, {0, 1.2, 2.2}, {0, 0.2, 0});
     RenderSettings st;
     st.threads = 2;
@@ -211,7 +193,7 @@ TEST(RaytraceDeterminism, IndependentOfThreadCount) {
     point.type = Light::Type::Point;
     point.intensity = 5.0f;
     addLight(s, "lamp", point, translate({0.2, 1.5, 0.1}));
-    RayTracingScene rt(s, SceneSubset::All, device());
+    RayTracingScene rt(s, SceneSubset::All, testDevice());
     auto cam = lookAtCamera(20, 20, 16.0, {0, 1.5, 2}, {0, 0.2, 0});
     RenderSettings st;
     st.samplesPerPixel = 4;

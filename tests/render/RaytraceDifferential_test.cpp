@@ -12,11 +12,6 @@ namespace {
 
 using namespace mirage::raytrace::test;
 
-const EmbreeDevice& device() {
-    static EmbreeDevice d("threads=2");
-    return d;
-}
-
 // A real floor under a real spot light and a real environment, with virtual objects on it: an
 // opaque box (shadow), a glass ball (caustic) and a virtual point light.
 Scene mixedScene(const std::filesystem::path& dir, bool withVirtual) {
@@ -63,10 +58,10 @@ TEST(RaytraceDifferential, RealOnlyRenderIgnoresVirtualObjectsAndCompositeAddsTh
     st.samplesPerPixel = 24;
     st.threads = 2;
     st.photonsPerPass = 20000;
-    auto images = renderDifferential(mixed, device(), camera(mixed, W, H), st);
+    auto images = renderDifferential(mixed, testDevice(), camera(mixed, W, H), st);
     // L_r is exactly the render of the real scene alone (same seed, same geometry).
-    auto plain =
-        render(RayTracingScene(realOnly, SceneSubset::All, device()), camera(realOnly, W, H), st);
+    auto plain = render(RayTracingScene(realOnly, SceneSubset::All, testDevice()),
+                        camera(realOnly, W, H), st);
     EXPECT_EQ(cv::norm(images.realOnly, plain.radiance, cv::NORM_INF), 0.0);
     EXPECT_EQ(cv::countNonZero(plain.virtualCoverage), 0);
     EXPECT_GT(cv::countNonZero(images.virtualCoverage), 20);

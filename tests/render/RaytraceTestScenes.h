@@ -8,7 +8,9 @@
 #include <opencv2/core.hpp>
 
 #include "core/image/ImageIO.h"
+#include "core/math/Pose.h"
 #include "core/scene/Scene.h"
+#include "render/raytrace/EmbreeDevice.h"
 #include "render/raytrace/ReferenceRenderer.h"
 #include "tests/render/RenderTestScenes.h"
 
@@ -104,18 +106,30 @@ inline int addObject(Scene& s, const std::string& name, Primitive prim, const Ma
                      const glm::dmat4& world, Origin origin = Origin::Real) {
     s.materials.push_back(mat);
     prim.material = int(s.materials.size()) - 1;
-    Mesh mesh;
-    mesh.name = name;
-    mesh.primitives.push_back(std::move(prim));
-    s.meshes.push_back(std::move(mesh));
-    Node n;
-    n.name = name;
-    n.mesh = int(s.meshes.size()) - 1;
-    n.local = n.world = world;
-    n.origin = origin;
-    s.nodes.push_back(n);
-    s.roots.push_back(int(s.nodes.size()) - 1);
+    mirage::test::addMeshNode(s, name, std::move(prim), origin, world);
     return int(s.nodes.size()) - 1;
+}
+
+// The Embree device the reference renderer's tests share (2 threads: the machine's cores).
+inline const EmbreeDevice& testDevice() {
+    static EmbreeDevice d("threads=2");
+    return d;
+}
+
+// A pinhole camera of w x h pixels, focal length f (pixels), principal point at the image centre,
+// at `eye` looking at `target` (OpenCV camera axes in T_world_camera).
+inline RenderCamera lookAtCamera(int w, int h, double f, glm::dvec3 eye, glm::dvec3 target,
+                                 glm::dvec3 up = {0, 1, 0}) {
+    RenderCamera c;
+    c.intrinsics.width = w;
+    c.intrinsics.height = h;
+    c.intrinsics.fx = c.intrinsics.fy = f;
+    c.intrinsics.cx = 0.5 * w - 0.5;
+    c.intrinsics.cy = 0.5 * h - 0.5;
+    // glm::lookAt builds a glTF-style view (camera looks down -Z): convert to OpenCV axes.
+    c.T_world_camera =
+        Pose::fromMatrix(glm::inverse(glm::lookAt(eye, target, up))) * kCvFromGltfCamera;
+    return c;
 }
 
 inline int addLight(Scene& s, const std::string& name, Light light, const glm::dmat4& world,
