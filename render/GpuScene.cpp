@@ -167,8 +167,13 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
                 idx.push_back(i);
             }
             if (r.material < 0 || r.material >= int(mats.size())) r.material = 0;
+            // Bounding sphere about the box centre with the farthest vertex's distance: tight for
+            // a sphere mesh (the box's half-diagonal would be sqrt(3) x its radius), which the
+            // specular scissor, the culling and the refraction exit fallback all use.
             r.center = 0.5f * (lo + hi);
-            r.radius = 0.5f * glm::length(hi - lo);
+            r.radius = 0.0f;
+            for (const glm::vec3& q : p.positions)
+                r.radius = std::max(r.radius, glm::length(q - r.center));
             meshRanges[mi].push_back(r);
         }
     }

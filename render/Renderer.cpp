@@ -52,32 +52,46 @@ bool inFrustum(const glm::mat4& vp, const BoundingSphere& s) {
     return true;
 }
 
-// The canvas pixels (GL window rectangle x, y, width, height) that can show a specular object
-// this frame: the screen box of the corners of every specular draw's bounding-sphere cube, 2 px
-// margin. The whole canvas when a corner is at or behind the camera plane; width 0 when no
-// specular draw is in the frustum. Conservative: every fragment of a draw lies inside its sphere.
-glm::ivec4 specularScissor(const GpuScene& s, const glm::mat4& viewProj, int width, int height) {
-    glm::vec2 lo(1e30f), hi(-1e30f);
+// Slopes a/z of the two planes through the camera centre (containing the other image axis) that
+// touch a sphere whose centre is (ca, cz) in the a-z plane of the camera frame: the sphere's exact
+// extent along image axis a. False when the sphere reaches the camera plane (z <= r): unbounded.
+bool tangentSlopes(double ca, double cz, double r, double& lo, double& hi) {
+    const double a = cz * cz - r * r;
+    if (cz <= r || a <= 1e-9) return false;
+    const double root = r * std::sqrt(ca * ca + a);
+    lo = (ca * cz - root) / a;
+    hi = (ca * cz + root) / a;
+    return true;
+}
+
+// The canvas pixels (GL window rectangle x, y, width, height; GL row 0 = image row 0, see
+// CameraProjection::projectionMatrix) that can show a specular object this frame: the exact
+// projection of every specular draw's bounding sphere, 2 px margin. The whole canvas when a sphere
+// reaches the camera plane; width 0 when no specular draw is in the frustum. Conservative: every
+// fragment of a draw lies inside its bounding sphere.
+glm::ivec4 specularScissor(const GpuScene& s, const glm::mat4& view, const glm::mat4& viewProj,
+                           const CameraProjection& p) {
+    const int width = p.canvasWidth, height = p.canvasHeight;
+    glm::dvec2 lo(1e30), hi(-1e30);
     bool any = false;
     for (int i : s.specularDraws()) {
         const BoundingSphere& b = s.draws()[size_t(i)].bounds;
         if (!inFrustum(viewProj, b)) continue;
         any = true;
-        for (int k = 0; k < 8; ++k) {
-            const glm::vec3 corner =
-                b.center + b.radius * glm::vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
-            const glm::vec4 c = viewProj * glm::vec4(corner, 1.0f);
-            if (!(c.w > 1e-4f)) return {0, 0, width, height};
-            const glm::vec2 px = (glm::vec2(c) / c.w * 0.5f + 0.5f) * glm::vec2(width, height);
-            lo = glm::min(lo, px);
-            hi = glm::max(hi, px);
-        }
+        const glm::dvec3 c(view * glm::vec4(b.center, 1.0f));  // camera frame (OpenCV axes)
+        const double r = double(b.radius) * 1.001 + 1e-5;      // float rounding of the bounds
+        double x0, x1, y0, y1;
+        if (!tangentSlopes(c.x, c.z, r, x0, x1) || !tangentSlopes(c.y, c.z, r, y0, y1))
+            return {0, 0, width, height};
+        // Window position of slope m: fx m + cx + 0.5 (pixel centres at +0.5).
+        lo = glm::min(lo, glm::dvec2(p.camera.fx * x0 + p.canvasCx, p.camera.fy * y0 + p.canvasCy));
+        hi = glm::max(hi, glm::dvec2(p.camera.fx * x1 + p.canvasCx, p.camera.fy * y1 + p.canvasCy));
     }
     if (!any) return {0, 0, 0, 0};
     const int x0 = std::clamp(int(std::floor(lo.x)) - 2, 0, width);
     const int y0 = std::clamp(int(std::floor(lo.y)) - 2, 0, height);
-    const int x1 = std::clamp(int(std::ceil(hi.x)) + 2, 0, width);
-    const int y1 = std::clamp(int(std::ceil(hi.y)) + 2, 0, height);
+    const int x1 = std::clamp(int(std::ceil(hi.x)) + 3, 0, width);
+    const int y1 = std::clamp(int(std::ceil(hi.y)) + 3, 0, height);
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
@@ -323,8 +337,7 @@ void Renderer::planFrame(const FrameInput& input) {
     f.viewMatrix = view;
     f.projMatrix = proj;
     f.viewProj = viewProj;
-    c.specularScissor =
-        specularScissor(s, viewProj, projection_.canvasWidth, projection_.canvasHeight);
+    c.specularScissor = specularScissor(s, view, viewProj, projection_);
     f.prevViewProj = prevViewProj_;
     f.cameraPos = glm::vec4(camPos, 1.0f);
     f.prevCameraPos = glm::vec4(prevCameraPos_, 1.0f);

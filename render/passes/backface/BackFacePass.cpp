@@ -20,8 +20,15 @@ BackFacePass::BackFacePass(const GBufferPass& gbuffer)
 PassDecision BackFacePass::decide(const FrameContext& ctx) const {
     const size_t n = ctx.scene.specularDraws().size();
     if (n == 0) return {false, "no mirror or glass object in the scene"};
+    // The specular passes after this one need BackFaces, so they are skipped with it.
+    const glm::ivec4 r = ctx.specularScissor;
+    if (r.z <= 0 || r.w <= 0) return {false, "no mirror or glass object in view"};
+    const double share = 100.0 * double(r.z) * double(r.w) /
+                         (double(ctx.canvasWidth()) * double(ctx.canvasHeight()));
     return {true,
-            std::to_string(n) + " specular draw(s)" +
+            std::to_string(n) + " specular draw(s) within " + std::to_string(r.z) + "x" +
+                std::to_string(r.w) + " canvas pixels (" + std::to_string(int(share + 0.5)) +
+                " %)" +
                 (ctx.scene.hasVirtual() ? " + real-surface depth (virtual objects present)" : "")};
 }
 
