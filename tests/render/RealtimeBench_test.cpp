@@ -85,12 +85,14 @@ raytrace::SyntheticSessionOptions tinySessionOptions() {
 
 // One synthetic session shared by the tests of this file (rendered once per process, ~2 s).
 // ctest runs each test in its own process, in parallel: every test gets its own folder, named
-// after it, so one never reads a session another is still writing.
+// after it, so one never reads a session another is still writing. (Its own top-level folder:
+// outputDir() empties the folder it is given, so a shared parent would be wiped under the feet
+// of a test that is still reading its session — a flaky failure seen under load.)
 const fs::path& tinySession() {
     static const fs::path dir = [] {
         const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-        const fs::path d = mirage::test::outputDir("bench_session") /
-                           (std::string(test->test_suite_name()) + "." + test->name());
+        const fs::path d = mirage::test::outputDir(
+            "bench_session_" + std::string(test->test_suite_name()) + "." + test->name());
         raytrace::writeSyntheticSession(benchScene(true), d, tinySessionOptions());
         return d;
     }();
