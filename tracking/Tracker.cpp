@@ -234,7 +234,8 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         }
         if (f.searchRegion == full) framesSinceFullSearch_ = 0;
 
-        if (!(options_.coarseToFine && f.searchRegion == full && coarseToFine(grey, prior, f))) {
+        if (!(options_.coarseToFine && grey.cols >= options_.coarseMinWidth &&
+              f.searchRegion == full && coarseToFine(grey, prior, f))) {
             t0 = std::chrono::steady_clock::now();
             f.detections = detector_.detect(grey, f.searchRegion);
             f.detectMs += msSince(t0);

@@ -66,7 +66,10 @@ struct TrackerOptions {
     // frame's. The frame falls back to the ordinary search (DetectorOptions::decimate) when the
     // coarse search finds nothing, its pose is not ok, fewer than max(trackMinTags,
     // trackMinFraction x the predicted tags) are verified, or the final pose is not ok.
+    // Only for frames at least coarseMinWidth pixels wide: at 640x480 the decimated search finds
+    // usable tags in too few frames to pay for itself (docs/tracking.md: equal time, measured).
     bool coarseToFine = true;
+    int coarseMinWidth = 1000;
     float coarseDecimate = 4.0f;
     double coarseSearchPx = 4.0;
     int coarsePoseTags = 4;

@@ -33,6 +33,7 @@ TrackedFrame single(const cv::Mat& img, bool coarseToFine, int coarsePoseTags = 
     o.coarseToFine = coarseToFine;
     o.filterEnabled = false;
     o.coarsePoseTags = coarsePoseTags;
+    o.coarseMinWidth = 0;  // the views are 640x480 (off there by default)
     Tracker tracker(s.board, s.cam, o);
     return tracker.process(img, 0.0);
 }
@@ -128,6 +129,29 @@ TEST(CoarseToFine, OneTagCoarsePoseIsSettledOrFallsBack) {
     }
     std::printf("one-tag coarse poses: %d used, %d fell back\n", used, fellBack);
     EXPECT_GT(used, 0);
+}
+
+// The defaults: off at 640x480 (coarseMinWidth 1000), on at 1280x720 with the same pose as the
+// decimate-2 search.
+TEST(CoarseToFine, DefaultOnlyFrom1000PxWidth) {
+    const Scene& s = scene();
+    const Pose T = testing::lookAt({-0.12, 0.39, 0.17}, {0, 0, 0}, {0, 0, -1}, 0.3);
+    Tracker small(s.board, s.cam);
+    const TrackedFrame a = small.process(s.render(T), 0.0);
+    EXPECT_EQ(a.estimate.state, TrackingState::Ok);
+    EXPECT_FALSE(a.coarseTried);
+    const CameraIntrinsics hd = testing::pinholeCamera(1280, 720, 1000);
+    const cv::Mat img = renderSyntheticBoardView(s.board, s.tex, hd, T);
+    Tracker withDefaults(s.board, hd);
+    TrackerOptions off;
+    off.coarseToFine = false;
+    Tracker without(s.board, hd, off);
+    const TrackedFrame c = withDefaults.process(img, 0.0), o = without.process(img, 0.0);
+    ASSERT_EQ(c.estimate.state, TrackingState::Ok) << c.estimate.reason;
+    ASSERT_EQ(o.estimate.state, TrackingState::Ok) << o.estimate.reason;
+    EXPECT_TRUE(c.coarseUsed);
+    EXPECT_LT(rotationDeg(*c.estimate.pose, *o.estimate.pose), 0.005);
+    EXPECT_LT(glm::length(c.estimate.pose->translation - o.estimate.pose->translation), 3e-5);
 }
 
 // No board: a frame of noise and a blank frame are reported as before (no tag), not ok.

@@ -221,6 +221,10 @@ void BM_MirageTrack(benchmark::State& state) {
     TrackerOptions opt;
     opt.roiEnabled = state.range(1) >= 1;
     opt.tagTracking = state.range(1) >= 2;
+    // Modes 0 and 1 are libapriltag's search at decimate 2 (the coarse-to-fine search of full
+    // frames is measured on single frames, BM_MirageSingle); mode 2 uses it for the periodic full
+    // search, as by default.
+    opt.coarseToFine = state.range(1) >= 2;
     Tracker tracker(f.board, f.cam, opt);
     Accuracy acc;
     const double dt = 1.0 / 30.0;
@@ -269,12 +273,14 @@ BENCHMARK(BM_MirageTrack)
 
 // mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
 // apart). Args: mode 1 = coarse-to-fine (libapriltag at `coarse` decimation, the other board tags
-// found from that pose at full resolution and verified; the default with coarse 4), 0 =
+// found from that pose at full resolution and verified; the default with coarse 4 from 1000 px
+// width), 0 =
 // libapriltag's search at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker).
 void BM_MirageSingle(benchmark::State& state) {
     const Frames& f = frames(int(state.range(0)));
     TrackerOptions opt;
     opt.coarseToFine = state.range(1) == 1;
+    opt.coarseMinWidth = 0;  // measured at 640x480 too (off there by default)
     opt.coarseDecimate = float(state.range(2));
     opt.filterEnabled = false;
     Tracker tracker(f.board, f.cam, opt);
