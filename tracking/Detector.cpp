@@ -232,7 +232,8 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect&
         t.centre = glm::dvec2(d->c[0], d->c[1]) + shift;
         for (int k = 0; k < 4; ++k)
             t.corners[size_t(k)] = glm::dvec2(d->p[k][0], d->p[k][1]) + shift;
-        if (options_.refineCorners) refineCorners(grey, family_->widthAtBorder(), t.corners);
+        if (options_.refineCorners)
+            t.refined = refineCorners(grey, family_->widthAtBorder(), t.corners);
         out.push_back(t);
     }
     apriltag_detections_destroy(dets);

@@ -55,6 +55,9 @@ struct TagDetection {
     glm::dvec2 centre{0.0};
     float decisionMargin = 0;
     int hamming = 0;
+    // The corners went through mirage's sub-pixel refinement (Detector::refineCorners); false:
+    // libapriltag's corners (refinement off or failed), less precise after strong decimation.
+    bool refined = false;
 };
 
 class Detector {

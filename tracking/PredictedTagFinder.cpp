@@ -324,9 +324,7 @@ PredictedTagFinder::Outcome PredictedTagFinder::follow(const cv::Mat& grey, cons
     int inner = 0, outer = 0;
     double contrast = 0;
     if (!verify(grey, m.id, t.corners, &inner, &outer, &contrast)) return Outcome::DecodeFailed;
-    t.hamming = inner + outer;
-    t.decisionMargin = float(contrast);
-    t.centre = SquareToQuad({t.corners[3], t.corners[2], t.corners[1], t.corners[0]})(0.5, 0.5);
+    t.refined = true;
     t.hamming = inner + outer;
     t.decisionMargin = float(contrast);
     t.centre = SquareToQuad({t.corners[3], t.corners[2], t.corners[1], t.corners[0]})(0.5, 0.5);
@@ -337,6 +335,21 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
                                                    const Pose& T_world_camera_predicted,
                                                    const Pose& T_world_camera_previous,
                                                    PredictedTagStats* statsOut) const {
+    return findImpl(grey, T_world_camera_predicted, &T_world_camera_previous, 0.0, nullptr,
+                    statsOut);
+}
+
+std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
+                                                   const Pose& T_world_camera_estimated,
+                                                   double searchPx,
+                                                   const std::vector<TagDetection>& known,
+                                                   PredictedTagStats* statsOut) const {
+    return findImpl(grey, T_world_camera_estimated, nullptr, searchPx, &known, statsOut);
+}
+
+std::vector<TagDetection> PredictedTagFinder::findImpl(
+    const cv::Mat& grey, const Pose& T_world_camera_predicted, const Pose* T_world_camera_previous,
+    double searchPx, const std::vector<TagDetection>* known, PredictedTagStats* statsOut) const {
     std::vector<TagDetection> out;
     PredictedTagStats stats;
     if (grey.empty() || grey.type() != CV_8UC1) {
@@ -344,7 +357,9 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
         return out;
     }
     const Pose T_cw = T_world_camera_predicted.inverse();
-    const Pose T_cw_prev = T_world_camera_previous.inverse();
+    // Without a previous pose the corners "moved" by nothing and the radius is searchPx.
+    const Pose T_cw_prev =
+        (T_world_camera_previous ? *T_world_camera_previous : T_world_camera_predicted).inverse();
     const glm::dvec3 camCentre = T_world_camera_predicted.translation;
     // Centres of the quiet-zone ring's cells lie this many cells outside the corners (+ some for
     // the diagonal and bilinear sampling): they and the edge search must stay inside the image.
@@ -398,7 +413,9 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
         }
         if (minCell < options_.minCellPx) continue;
         // The quiet-zone ring and the search must lie inside the image.
-        const double search = options_.searchBasePx + options_.searchMotionFactor * motion;
+        const double search = T_world_camera_previous
+                                  ? options_.searchBasePx + options_.searchMotionFactor * motion
+                                  : searchPx;
         const double margin = std::max(ringCells * maxSide / widthAtBorder_, search + 0.5) + 2.0;
         bool inside = true;
         for (const auto& p : pred)
@@ -442,8 +459,28 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
         }
         return o;
     };
+    // Tags found already (libapriltag on the decimated image) are taken as they are and only
+    // correct the predictions of the others.
+    std::vector<bool> isKnown(candidates.size(), false);
+    if (known) {
+        for (size_t i = 0; i < candidates.size(); ++i)
+            for (const auto& d : *known)
+                if (d.id == candidates[i].model->id) {
+                    isKnown[i] = true;
+                    for (int k = 0; k < 4; ++k) {
+                        from.push_back(candidates[i].pred[size_t(k)]);
+                        to.push_back(d.corners[size_t(k)]);
+                    }
+                    out.push_back(d);
+                    ++stats.verified;
+                    break;
+                }
+        correction.fit(from, to);
+    }
     std::vector<Outcome> firstOutcome;
-    for (const Candidate& c : candidates) {
+    for (size_t i = 0; i < candidates.size(); ++i) {
+        if (isKnown[i]) continue;
+        const Candidate& c = candidates[i];
         const Outcome o = attempt(c, true);
         if (o != Outcome::Verified) {
             retry.push_back(&c);

@@ -78,6 +78,16 @@ public:
                                    const Pose& T_world_camera_previous,
                                    PredictedTagStats* stats = nullptr) const;
 
+    // The same around where a pose estimated in this very frame puts the tags (the single-frame
+    // coarse-to-fine path of the Tracker: the pose from the few large tags libapriltag found on a
+    // strongly decimated image), every tag searched within searchPx (pixels, still at most
+    // searchMaxCells cells). Tags in `known` (board tags found otherwise in this frame) are
+    // returned as they are, counted as predicted and verified if they are predicted, and their
+    // offsets correct the predictions of the others.
+    std::vector<TagDetection> find(const cv::Mat& grey, const Pose& T_world_camera_estimated,
+                                   double searchPx, const std::vector<TagDetection>& known,
+                                   PredictedTagStats* stats = nullptr) const;
+
     // Verification alone (step 3 above) of corners claimed to be tag `id` of the board: the
     // number of disagreeing cells of the border square and of the quiet-zone ring and the
     // contrast; true if within the options' limits. False for an id not on the board, an image
@@ -96,6 +106,12 @@ private:
         std::vector<uint8_t> pattern;         // totalWidth^2 cells, row-major, 0 black 255 white
     };
     const TagModel* model(int id) const;
+    // Both find()s: per-tag radius from the motion since T_world_camera_previous when given,
+    // else searchPx.
+    std::vector<TagDetection> findImpl(const cv::Mat& grey, const Pose& T_world_camera_predicted,
+                                       const Pose* T_world_camera_previous, double searchPx,
+                                       const std::vector<TagDetection>* known,
+                                       PredictedTagStats* stats) const;
     enum class Outcome { Verified, EdgeFailed, RefineFailed, DecodeFailed };
     // Steps 1-3 for one tag from its predicted corners `pred` (pixels) with edge search radius
     // `search` (pixels, before the cap of searchMaxCells); t = the verified detection.

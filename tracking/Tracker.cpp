@@ -1,11 +1,14 @@
 #include "tracking/Tracker.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 
 #include <opencv2/imgproc.hpp>
+
+#include "tracking/TagFamily.h"
 
 namespace mirage::tracking {
 namespace {
@@ -115,6 +118,74 @@ std::optional<cv::Rect> Tracker::boardRegion(const Pose& T_world_camera, cv::Siz
     return cv::Rect(bx0, by0, bx1 - bx0, by1 - by0);
 }
 
+bool Tracker::coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior, TrackedFrame& f) {
+    f.coarseTried = true;
+    if (!coarseDetector_) {
+        DetectorOptions o = options_.detector;
+        o.decimate = options_.coarseDecimate;
+        // Small tags are the ordinary search's job (the fallback).
+        o.fullResolutionRetry = false;
+        coarseDetector_ = std::make_unique<Detector>(o);
+        coarseCellsAtBorder_ = TagFamily(o.family).widthAtBorder();
+    }
+    auto t0 = std::chrono::steady_clock::now();
+    std::vector<TagDetection> coarse = coarseDetector_->detect(grey);
+    f.coarseTags = int(coarse.size());
+    // Only tags whose corners were refined at full resolution are used (libapriltag's corners
+    // on the decimated image are off by up to half a pixel); the finder tries the others.
+    // A second pass of the refinement from the refined corners: the first one started from
+    // libapriltag's decimated corners, up to ~1 px off, whose sample lines along the edges are
+    // skewed (measured: up to 0.47 px corner error left on a 31 px tag, 0.2 px after this pass).
+    std::erase_if(coarse, [&](TagDetection& d) {
+        return !d.refined || !Detector::refineCorners(grey, coarseCellsAtBorder_, d.corners);
+    });
+    f.detectMs += msSince(t0);
+    if (coarse.empty()) return false;
+    t0 = std::chrono::steady_clock::now();
+    // The coarse pose from the largest tags only: the estimator's cost grows with the tags, and
+    // the finder's image correction takes up what a pose from few tags leaves.
+    std::vector<TagDetection> largest = coarse;
+    auto side = [](const TagDetection& d) {
+        double s = 1e18;
+        for (int k = 0; k < 4; ++k)
+            s = std::min(s, glm::length(d.corners[size_t(k)] - d.corners[size_t((k + 1) % 4)]));
+        return s;
+    };
+    std::sort(largest.begin(), largest.end(),
+              [&](const TagDetection& a, const TagDetection& b) { return side(a) > side(b); });
+    if (options_.coarsePoseTags > 0 && int(largest.size()) > options_.coarsePoseTags)
+        largest.resize(size_t(options_.coarsePoseTags));
+    const PoseEstimate ce = estimator_.estimate(largest, prior);
+    f.poseMs += msSince(t0);
+    // Not ok (one tag with an undecided planar flip, outliers, ...): the ordinary search decides.
+    if (ce.state != TrackingState::Ok) return false;
+
+    t0 = std::chrono::steady_clock::now();
+    PredictedTagStats stats;
+    std::vector<TagDetection> dets =
+        tagFinder_.find(grey, *ce.pose, options_.coarseSearchPx, coarse, &stats);
+    // libapriltag's tags the finder did not predict (too small or too close to the image edge
+    // for it; each was decoded by libapriltag) join the others.
+    for (const auto& c : coarse) {
+        bool have = false;
+        for (const auto& d : dets) have = have || d.id == c.id;
+        if (!have) dets.push_back(c);
+    }
+    f.detectMs += msSince(t0);
+    const int need = std::max(options_.trackMinTags,
+                              int(std::ceil(options_.trackMinFraction * double(stats.predicted))));
+    if (!f.tagTrackingTried) f.prediction = stats;
+    if (stats.verified < need) return false;
+    t0 = std::chrono::steady_clock::now();
+    PoseEstimate e = estimator_.estimate(dets, prior, *ce.pose);
+    f.poseMs += msSince(t0);
+    if (e.state != TrackingState::Ok) return false;
+    f.coarseUsed = true;
+    f.detections = std::move(dets);
+    f.estimate = std::move(e);
+    return true;
+}
+
 TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     TrackedFrame f;
     f.t = t;
@@ -163,12 +234,15 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         }
         if (f.searchRegion == full) framesSinceFullSearch_ = 0;
 
-        t0 = std::chrono::steady_clock::now();
-        f.detections = detector_.detect(grey, f.searchRegion);
-        f.detectMs += msSince(t0);
-        t0 = std::chrono::steady_clock::now();
-        f.estimate = estimator_.estimate(f.detections, prior);
-        f.poseMs += msSince(t0);
+        if (!(options_.coarseToFine && grey.cols >= options_.coarseMinWidth &&
+              f.searchRegion == full && coarseToFine(grey, prior, f))) {
+            t0 = std::chrono::steady_clock::now();
+            f.detections = detector_.detect(grey, f.searchRegion);
+            f.detectMs += msSince(t0);
+            t0 = std::chrono::steady_clock::now();
+            f.estimate = estimator_.estimate(f.detections, prior);
+            f.poseMs += msSince(t0);
+        }
         bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
         if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
             const auto now = boardRegion(*f.estimate.pose, grey.size(), false);

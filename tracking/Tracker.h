@@ -2,6 +2,7 @@
 // Frame-by-frame camera tracking: detection, pose, state with a reason, temporal filtering.
 // One Tracker per video stream (it keeps the previous pose for the planar ambiguity and the
 // filter state). Frames are 8-bit BGR (sRGB-encoded, as cameras deliver them) or grey.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,6 +56,23 @@ struct TrackerOptions {
     TagPredictionOptions prediction;
     int trackMinTags = 2;
     double trackMinFraction = 0.5;
+    // Coarse-to-fine search of a single frame (docs/tracking.md, "Single frames"): when the full
+    // image must be searched (no recent ok pose, or a full search is due), libapriltag first
+    // searches the image decimated by coarseDecimate (no full-resolution retry), which finds the
+    // larger tags cheaply; the pose from the coarsePoseTags largest of them (ok only: outlier
+    // rejection, RMS and ambiguity checks as always) predicts every board tag, and
+    // PredictedTagFinder finds and verifies the others at full resolution within coarseSearchPx
+    // (pixels), corrected by the offsets of libapriltag's tags. The pose from all tags is the
+    // frame's. The frame falls back to the ordinary search (DetectorOptions::decimate) when the
+    // coarse search finds nothing, its pose is not ok, fewer than max(trackMinTags,
+    // trackMinFraction x the predicted tags) are verified, or the final pose is not ok.
+    // Only for frames at least coarseMinWidth pixels wide: at 640x480 the decimated search finds
+    // usable tags in too few frames to pay for itself (docs/tracking.md: equal time, measured).
+    bool coarseToFine = true;
+    int coarseMinWidth = 1000;
+    float coarseDecimate = 4.0f;
+    double coarseSearchPx = 4.0;
+    int coarsePoseTags = 4;
 };
 
 struct TrackedFrame {
@@ -75,6 +93,11 @@ struct TrackedFrame {
     std::optional<Pose> predictedPose;  // T_world_camera the tags were predicted with
     PredictedTagStats prediction;
     bool tagTracked = false;
+    // Coarse-to-fine single-frame search: tried, libapriltag's tags on the decimated image, and
+    // whether it gave the pose (false: the ordinary search did).
+    bool coarseTried = false;
+    int coarseTags = 0;
+    bool coarseUsed = false;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -112,7 +135,13 @@ private:
 
     TrackerOptions options_;
     Detector detector_;
+    // Coarse-to-fine search: the frame's tags from libapriltag on the decimated image, then all
+    // board tags found from their pose; false (f unchanged but the coarse fields) to fall back.
+    bool coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior, TrackedFrame& f);
+
     PredictedTagFinder tagFinder_;
+    std::unique_ptr<Detector> coarseDetector_;  // created at the first full search
+    int coarseCellsAtBorder_ = 8;
     PoseEstimator estimator_;
     PoseFilter filter_;
     OneEuroPoseFilter oneEuro_;

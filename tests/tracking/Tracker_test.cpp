@@ -90,8 +90,12 @@ TEST(Tracker, RegionOfInterestFollowsTheBoardAndFallsBackToTheFullImage) {
     roiOptions.tagTracking =
         false;  // libapriltag in the region (the tracking mode: TagTracking_test)
     Tracker withRoi(board, cam, roiOptions);
+    // Both search the full image with libapriltag at decimate 2 (the coarse-to-fine search of
+    // full frames: CoarseToFine_test).
+    roiOptions.coarseToFine = false;
     TrackerOptions noRoiOptions;
     noRoiOptions.tagTracking = false;
+    noRoiOptions.coarseToFine = false;
     noRoiOptions.roiEnabled = false;
     Tracker noRoi(board, cam, noRoiOptions);
     const cv::Rect full(0, 0, cam.width, cam.height);

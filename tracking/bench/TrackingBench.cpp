@@ -221,6 +221,10 @@ void BM_MirageTrack(benchmark::State& state) {
     TrackerOptions opt;
     opt.roiEnabled = state.range(1) >= 1;
     opt.tagTracking = state.range(1) >= 2;
+    // Modes 0 and 1 are libapriltag's search at decimate 2 (the coarse-to-fine search of full
+    // frames is measured on single frames, BM_MirageSingle); mode 2 uses it for the periodic full
+    // search, as by default.
+    opt.coarseToFine = state.range(1) >= 2;
     Tracker tracker(f.board, f.cam, opt);
     Accuracy acc;
     const double dt = 1.0 / 30.0;
@@ -266,6 +270,40 @@ BENCHMARK(BM_MirageTrack)
     ->Args({1280, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
+// apart). Args: mode 1 = coarse-to-fine (libapriltag at `coarse` decimation, the other board tags
+// found from that pose at full resolution and verified; the default with coarse 4 from 1000 px
+// width), 0 =
+// libapriltag's search at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker).
+void BM_MirageSingle(benchmark::State& state) {
+    const Frames& f = frames(int(state.range(0)));
+    TrackerOptions opt;
+    opt.coarseToFine = state.range(1) == 1;
+    opt.coarseMinWidth = 0;  // measured at 640x480 too (off there by default)
+    opt.coarseDecimate = float(state.range(2));
+    opt.filterEnabled = false;
+    Tracker tracker(f.board, f.cam, opt);
+    Accuracy acc;
+    double t = 0;
+    int coarseUsed = 0;
+    for (size_t v = 0; v < f.images.size(); ++v) {
+        const TrackedFrame r = tracker.process(f.images[v], t += 10.0);
+        acc.visibleTags += visibleTags(f, v);
+        for (const auto& d : r.detections)
+            if (f.board.find(d.id)) {
+                ++acc.foundTags;
+                addCorners(f, v, d.id, d.corners, acc);
+            }
+        if (r.estimate.state == TrackingState::Ok) addPose(f, v, *r.estimate.pose, acc);
+        coarseUsed += r.coarseUsed;
+    }
+    size_t i = 0;
+    for (auto _ : state)
+        benchmark::DoNotOptimize(tracker.process(f.images[i++ % f.images.size()], t += 10.0));
+    report(state, acc, f.images.size());
+    state.counters["coarse_used"] = coarseUsed;
+}
 
 // ---- OpenCV ArUco ----------------------------------------------------------------------------
 
@@ -381,6 +419,16 @@ BENCHMARK(BM_Mirage)
     ->Args({1280, 3})
     ->Args({1280, 4})
     ->Args({1280, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_MirageSingle)
+    ->ArgNames({"width", "mode", "coarse"})
+    ->Args({640, 0, 0})
+    ->Args({640, 1, 3})
+    ->Args({640, 1, 4})
+    ->Args({1280, 0, 0})
+    ->Args({1280, 1, 3})
+    ->Args({1280, 1, 4})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Aruco)
