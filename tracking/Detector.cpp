@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "core/image/ImageIO.h"
+#include "tracking/ImageLine.h"
 #include "tracking/TagFamily.h"
 
 namespace mirage::tracking {
@@ -38,19 +39,6 @@ bool sampleLinear(const cv::Mat& grey, double x, double y, double& v) {
     return true;
 }
 
-struct Line {
-    glm::dvec2 point, dir;  // unit direction
-};
-
-bool intersect(const Line& a, const Line& b, glm::dvec2& out) {
-    const double det = a.dir.x * (-b.dir.y) - a.dir.y * (-b.dir.x);
-    if (std::abs(det) < 1e-6) return false;
-    const glm::dvec2 d = b.point - a.point;
-    const double t = (d.x * (-b.dir.y) - d.y * (-b.dir.x)) / det;
-    out = a.point + t * a.dir;
-    return true;
-}
-
 }  // namespace
 
 // Sub-pixel edge refinement (see DetectorOptions::refineCorners). Leaves the corners unchanged if
@@ -59,7 +47,7 @@ bool Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder,
                              std::array<glm::dvec2, 4>& corners) {
     glm::dvec2 centroid(0.0);
     for (const auto& c : corners) centroid += 0.25 * c;
-    std::array<Line, 4> lines;
+    std::array<ImageLine, 4> lines;
     for (int k = 0; k < 4; ++k) {
         const glm::dvec2 a = corners[size_t(k)], b = corners[size_t((k + 1) % 4)];
         const double len = glm::length(b - a);

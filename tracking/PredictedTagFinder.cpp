@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/Error.h"
+#include "tracking/ImageLine.h"
 #include "tracking/TagFamily.h"
 
 namespace mirage::tracking {
@@ -22,21 +23,8 @@ bool sampleLevel(const cv::Mat& grey, double x, double y, double& v) {
     return true;
 }
 
-struct Line {
-    glm::dvec2 point{0.0}, dir{1.0, 0.0};  // unit direction
-};
-
-bool intersect(const Line& a, const Line& b, glm::dvec2& out) {
-    const double det = a.dir.x * (-b.dir.y) - a.dir.y * (-b.dir.x);
-    if (std::abs(det) < 1e-6) return false;
-    const glm::dvec2 d = b.point - a.point;
-    const double t = (d.x * (-b.dir.y) - d.y * (-b.dir.x)) / det;
-    out = a.point + t * a.dir;
-    return true;
-}
-
 // Total-least-squares line through points (unweighted); RMS distance of the points to it.
-Line fitLine(const std::vector<glm::dvec2>& pts, double& rms) {
+ImageLine fitLine(const std::vector<glm::dvec2>& pts, double& rms) {
     glm::dvec2 mean(0.0);
     for (const auto& p : pts) mean += p;
     mean /= double(pts.size());
@@ -48,7 +36,7 @@ Line fitLine(const std::vector<glm::dvec2>& pts, double& rms) {
         syy += d.y * d.y;
     }
     const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
-    Line l{mean, {std::cos(angle), std::sin(angle)}};
+    ImageLine l{mean, {std::cos(angle), std::sin(angle)}};
     const glm::dvec2 n(-l.dir.y, l.dir.x);
     double s = 0;
     for (const auto& p : pts) {
@@ -233,7 +221,7 @@ PredictedTagFinder::Outcome PredictedTagFinder::follow(const cv::Mat& grey, cons
     thread_local std::vector<glm::dvec2> pts;
     thread_local std::vector<double> profile;
     // 1. Coarse edges.
-    std::array<Line, 4> lines;
+    std::array<ImageLine, 4> lines;
     bool edgesOk = true;
     for (int k = 0; k < 4 && edgesOk; ++k) {
         const glm::dvec2 a = pred[size_t(k)], b = pred[size_t((k + 1) % 4)];
@@ -289,7 +277,7 @@ PredictedTagFinder::Outcome PredictedTagFinder::follow(const cv::Mat& grey, cons
             break;
         }
         double rms = 0;
-        Line l = fitLine(pts, rms);
+        ImageLine l = fitLine(pts, rms);
         if (rms > 0.5) {
             const glm::dvec2 n(-l.dir.y, l.dir.x);
             std::vector<glm::dvec2> kept;
