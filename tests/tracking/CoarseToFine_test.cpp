@@ -13,16 +13,9 @@
 namespace mirage::tracking {
 namespace {
 
-struct Scene {
-    Board board = BoardLayout().makeBoard();
-    BoardRaster tex = renderBoard(board, 8000, false);
-    CameraIntrinsics cam = testing::pinholeCamera();
-    cv::Mat render(const Pose& T) const { return renderSyntheticBoardView(board, tex, cam, T); }
-};
-
+using Scene = testing::BoardViewScene;
 const Scene& scene() {
-    static const Scene s;
-    return s;
+    return testing::boardViewScene();
 }
 
 // One unrelated frame through a fresh Tracker (no previous pose), coarse-to-fine on or off.

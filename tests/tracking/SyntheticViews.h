@@ -5,6 +5,7 @@
 #include "core/camera/CameraModel.h"
 #include "core/image/ImageIO.h"
 #include "core/math/Pose.h"
+#include "tracking/BoardImage.h"
 #include "tracking/BoardLayout.h"
 #include "tracking/SyntheticBoardView.h"
 
@@ -77,6 +78,22 @@ inline cv::Mat renderFisheye(const CameraIntrinsics& cam, const Pose& T_world_ca
             out.at<cv::Vec3b>(y, x) = {enc(c.b), enc(c.g), enc(c.r)};
         }
     return out;
+}
+
+// The default board (BoardLayout) with its raster at 8000 px/m and a pinhole camera: renders
+// synthetic views of the board, shared per test process (the raster takes a moment).
+struct BoardViewScene {
+    Board board = BoardLayout().makeBoard();
+    BoardRaster tex = renderBoard(board, 8000, false);
+    CameraIntrinsics cam = pinholeCamera();
+    cv::Mat render(const Pose& T_world_camera) const {
+        return renderSyntheticBoardView(board, tex, cam, T_world_camera);
+    }
+};
+
+inline const BoardViewScene& boardViewScene() {
+    static const BoardViewScene s;
+    return s;
 }
 
 }  // namespace mirage::tracking::testing

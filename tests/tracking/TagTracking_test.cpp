@@ -14,16 +14,9 @@
 namespace mirage::tracking {
 namespace {
 
-struct Scene {
-    Board board = BoardLayout().makeBoard();
-    BoardRaster tex = renderBoard(board, 8000, false);
-    CameraIntrinsics cam = testing::pinholeCamera();
-    cv::Mat render(const Pose& T) const { return renderSyntheticBoardView(board, tex, cam, T); }
-};
-
+using Scene = testing::BoardViewScene;
 const Scene& scene() {
-    static const Scene s;
-    return s;
+    return testing::boardViewScene();
 }
 
 // The benchmark's orbit (tracking/bench/TrackingBench.cpp): 180 deg/s at 30 fps with n = 60.
