@@ -138,6 +138,31 @@ void report(benchmark::State& state, const Accuracy& a, size_t views) {
     state.counters["wrong_ok"] = a.wrongPoses;
 }
 
+// One frame of a method's accuracy pass: the board tags it found (id, corners in mirage's order)
+// and its pose, if it gave one.
+template <typename Tags>
+void addFrame(const Frames& f, size_t view, const Tags& tags, const std::optional<Pose>& pose,
+              Accuracy& a) {
+    a.visibleTags += visibleTags(f, view);
+    for (const auto& [id, corners] : tags)
+        if (f.board.find(id)) {
+            ++a.foundTags;
+            addCorners(f, view, id, corners, a);
+        }
+    if (pose) addPose(f, view, *pose, a);
+}
+
+// mirage's detections as (id, corners).
+std::vector<std::pair<int, std::array<glm::dvec2, 4>>> tagsOf(const std::vector<TagDetection>& d) {
+    std::vector<std::pair<int, std::array<glm::dvec2, 4>>> out;
+    for (const auto& t : d) out.emplace_back(t.id, t.corners);
+    return out;
+}
+
+std::optional<Pose> okPose(const PoseEstimate& e) {
+    return e.state == TrackingState::Ok ? e.pose : std::nullopt;
+}
+
 // ---- mirage ----------------------------------------------------------------------------------
 
 struct MirageRun {
@@ -153,15 +178,8 @@ void BM_Mirage(benchmark::State& state) {
     PoseEstimator pe(f.board, f.cam);
     Accuracy acc;
     for (size_t v = 0; v < f.images.size(); ++v) {
-        auto d = det.detect(f.images[v]);
-        acc.visibleTags += visibleTags(f, v);
-        for (const auto& t : d)
-            if (f.board.find(t.id)) {
-                ++acc.foundTags;
-                addCorners(f, v, t.id, t.corners, acc);
-            }
-        const PoseEstimate e = pe.estimate(d);
-        if (e.state == TrackingState::Ok) addPose(f, v, *e.pose, acc);
+        const auto d = det.detect(f.images[v]);
+        addFrame(f, v, tagsOf(d), okPose(pe.estimate(d)), acc);
     }
     size_t i = 0;
     for (auto _ : state) {
@@ -234,13 +252,7 @@ void BM_MirageTrack(benchmark::State& state) {
     for (; i < f.images.size(); ++i) tracker.process(f.images[i], double(i) * dt);
     for (size_t v = 0; v < f.images.size(); ++v, ++i) {
         const TrackedFrame t = tracker.process(f.images[v], double(i) * dt);
-        acc.visibleTags += visibleTags(f, v);
-        for (const auto& d : t.detections)
-            if (f.board.find(d.id)) {
-                ++acc.foundTags;
-                addCorners(f, v, d.id, d.corners, acc);
-            }
-        if (t.estimate.state == TrackingState::Ok) addPose(f, v, *t.estimate.pose, acc);
+        addFrame(f, v, tagsOf(t.detections), okPose(t.estimate), acc);
         retries += t.fullFrameRetry;
         tracked += t.tagTracked;
         detectMs += t.detectMs;
@@ -289,13 +301,7 @@ void BM_MirageSingle(benchmark::State& state) {
     int coarseUsed = 0;
     for (size_t v = 0; v < f.images.size(); ++v) {
         const TrackedFrame r = tracker.process(f.images[v], t += 10.0);
-        acc.visibleTags += visibleTags(f, v);
-        for (const auto& d : r.detections)
-            if (f.board.find(d.id)) {
-                ++acc.foundTags;
-                addCorners(f, v, d.id, d.corners, acc);
-            }
-        if (r.estimate.state == TrackingState::Ok) addPose(f, v, *r.estimate.pose, acc);
+        addFrame(f, v, tagsOf(r.detections), okPose(r.estimate), acc);
         coarseUsed += r.coarseUsed;
     }
     size_t i = 0;
@@ -348,8 +354,8 @@ std::optional<Pose> arucoPose(const Frames& f, const std::vector<int>& ids,
     return Pose::fromRotationTranslation(Rg, {tvec[0], tvec[1], tvec[2]}).inverse();
 }
 
-void BM_Aruco(benchmark::State& state) {
-    const Frames& f = frames(int(state.range(0)));
+// ArUco (detectMarkers + solvePnP) per frame over `f`, corner refinement = Arg 1.
+void runAruco(benchmark::State& state, const Frames& f) {
     Aruco a;
     a.params->cornerRefinementMethod = int(state.range(1));
     Accuracy acc;
@@ -357,13 +363,10 @@ void BM_Aruco(benchmark::State& state) {
     std::vector<int> ids;
     for (size_t v = 0; v < f.images.size(); ++v) {
         cv::aruco::detectMarkers(f.images[v], a.dict, corners, ids, a.params);
-        acc.visibleTags += visibleTags(f, v);
+        std::vector<std::pair<int, std::array<glm::dvec2, 4>>> tags;
         for (size_t i = 0; i < ids.size(); ++i)
-            if (f.board.find(ids[i])) {
-                ++acc.foundTags;
-                addCorners(f, v, ids[i], toMirageOrder(corners[i]), acc);
-            }
-        if (auto p = arucoPose(f, ids, corners)) addPose(f, v, *p, acc);
+            tags.emplace_back(ids[i], toMirageOrder(corners[i]));
+        addFrame(f, v, tags, arucoPose(f, ids, corners), acc);
     }
     size_t i = 0;
     for (auto _ : state) {
@@ -373,30 +376,13 @@ void BM_Aruco(benchmark::State& state) {
     report(state, acc, f.images.size());
 }
 
+void BM_Aruco(benchmark::State& state) {
+    runAruco(state, frames(int(state.range(0))));
+}
+
 // ArUco per frame over the same video as BM_MirageTrack.
 void BM_ArucoTrack(benchmark::State& state) {
-    const Frames& f = sequence(int(state.range(0)));
-    Aruco a;
-    a.params->cornerRefinementMethod = int(state.range(1));
-    Accuracy acc;
-    std::vector<std::vector<cv::Point2f>> corners;
-    std::vector<int> ids;
-    for (size_t v = 0; v < f.images.size(); ++v) {
-        cv::aruco::detectMarkers(f.images[v], a.dict, corners, ids, a.params);
-        acc.visibleTags += visibleTags(f, v);
-        for (size_t i = 0; i < ids.size(); ++i)
-            if (f.board.find(ids[i])) {
-                ++acc.foundTags;
-                addCorners(f, v, ids[i], toMirageOrder(corners[i]), acc);
-            }
-        if (auto p = arucoPose(f, ids, corners)) addPose(f, v, *p, acc);
-    }
-    size_t i = 0;
-    for (auto _ : state) {
-        cv::aruco::detectMarkers(f.images[i++ % f.images.size()], a.dict, corners, ids, a.params);
-        benchmark::DoNotOptimize(arucoPose(f, ids, corners));
-    }
-    report(state, acc, f.images.size());
+    runAruco(state, sequence(int(state.range(0))));
 }
 
 BENCHMARK(BM_ArucoTrack)
