@@ -1,5 +1,7 @@
 #include "core/gl/Objects.h"
 
+#include <atomic>
+
 #include "core/Error.h"
 
 namespace mirage::gl {
@@ -51,11 +53,20 @@ void Buffer::upload(const void* data, size_t bytes, size_t offset) {
 }
 
 // ---- Texture ---------------------------------------------------------------------------------
+namespace {
+std::atomic<std::uint64_t> texturesCreated{0};
+}
+
+std::uint64_t Texture::createdCount() {
+    return texturesCreated.load();
+}
+
 Texture Texture::create2D(std::string_view lbl, int w, int h, GLenum fmt, int levels) {
     MR_CHECK(w > 0 && h > 0, "texture size must be positive");
     Texture t;
     GLuint id = 0;
     glCreateTextures(GL_TEXTURE_2D, 1, &id);
+    ++texturesCreated;
     t.h_ = Handle<detail::deleteTexture>(id);
     t.width_ = w;
     t.height_ = h;
@@ -74,6 +85,7 @@ Texture Texture::create2DArray(std::string_view lbl, int w, int h, int layers, G
     Texture t;
     GLuint id = 0;
     glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+    ++texturesCreated;
     t.h_ = Handle<detail::deleteTexture>(id);
     t.width_ = w;
     t.height_ = h;
@@ -91,6 +103,7 @@ Texture Texture::createCube(std::string_view lbl, int size, GLenum fmt, int leve
     Texture t;
     GLuint id = 0;
     glCreateTextures(GL_TEXTURE_CUBE_MAP, 1, &id);
+    ++texturesCreated;
     t.h_ = Handle<detail::deleteTexture>(id);
     t.width_ = t.height_ = size;
     t.layers_ = 6;

@@ -76,6 +76,10 @@ public:
                                  GLenum internalFormat, int levels = 1);
     static Texture createCube(std::string_view label, int size, GLenum internalFormat,
                               int levels = 1);
+    // Textures created so far by this process (all three factories): lets a test check that a
+    // per-frame loop allocates nothing once it runs (a renderer that did cost page faults on
+    // every target and lost its temporal history).
+    static std::uint64_t createdCount();
     GLuint id() const { return h_.id(); }
     int width() const { return width_; }
     int height() const { return height_; }

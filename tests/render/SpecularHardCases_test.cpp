@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <random>
 
@@ -358,6 +359,27 @@ TEST(SpecularHardCases, EveryMirrorPixelIsShadedAtTheImageEdgeAndUpClose) {
         EXPECT_GT(mirrorPixels, int(coverage.total() / 20)) << v.what;
         EXPECT_EQ(unshaded, 0) << v.what;
     }
+}
+
+// After the first frame the renderer allocates no texture: every pass's resize() must return at
+// once while the sizes stay (reallocating cost page faults on every target each frame, and threw
+// the temporal history away). A moving camera over a scene that runs every pass: lights, VPLs,
+// glass (impostors, back faces, specular G-buffers), temporal history.
+TEST(SpecularHardCases, FramesAfterTheFirstAllocateNoTexture) {
+    gl::Context context = gl::Context::headless();
+    const auto s =
+        test::makeSpecularScene(test::SpecularCase{}, test::outputDir("specular_no_alloc"));
+    Renderer r(s.scene, s.cam);
+    r.render({s.pose, cv::Mat(), true});
+    for (const char* pass : {"gbuffer", "direct", "indirect", "gifilter", "specgbuf", "speclight"})
+        EXPECT_TRUE(r.lastReport().ran(pass)) << pass;
+    const std::uint64_t before = gl::Texture::createdCount();
+    for (int i = 1; i <= 4; ++i) {
+        const Pose p = test::lookAtPose({0.05 * i, 0.55, 1.1}, {0.0, 0.15, 0.0});
+        r.render({p, cv::Mat(), false});
+        EXPECT_NE(r.lastReport().summary().find("history used"), std::string::npos);
+    }
+    EXPECT_EQ(gl::Texture::createdCount(), before) << "textures created per frame";
 }
 
 TEST(SpecularHardCases, PassesRunOnlyWithSpecularObjects) {
