@@ -99,6 +99,20 @@ const fs::path& tinySession() {
     return dir;
 }
 
+// A synthetic session's main-camera intrinsics and its bench frames (pose, footage, ground truth).
+struct LoadedBenchSession {
+    CameraIntrinsics camera;
+    std::vector<BenchFrame> frames;
+};
+LoadedBenchSession loadBenchSession(const fs::path& dir) {
+    const Session session = readSession(dir);
+    const auto info = readGroundTruthInfo(dir);
+    EXPECT_TRUE(info.has_value()) << dir;
+    if (!info) return {};
+    const CameraCalibration calib = loadSessionCalibration(session, "main");
+    return {calib.intrinsics, loadBenchFrames(session, *info, calib.intrinsics)};
+}
+
 TEST(GroundTruthComposite, SynthWritesCompositeAndInfluenceThatMatchTheReferenceComposite) {
     const fs::path dir = tinySession();
     SessionReadReport report;
@@ -168,21 +182,16 @@ TEST(GroundTruthComposite, InvalidOrAbsentFilesAreHandled) {
 }
 
 TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
-    const fs::path dir = tinySession();
-    const Session session = readSession(dir);
-    const auto info = readGroundTruthInfo(dir);
-    ASSERT_TRUE(info.has_value());
-    const CameraCalibration calib = loadSessionCalibration(session, "main");
-    const std::vector<BenchFrame> frames = loadBenchFrames(session, *info, calib.intrinsics);
+    const auto [camera, frames] = loadBenchSession(tinySession());
     ASSERT_EQ(frames.size(), 3u);
 
     gl::Context context = gl::Context::headless();
-    const std::vector<BenchConfig> grid = benchGrid(calib.intrinsics, true, {{"vpls", {"256"}}});
+    const std::vector<BenchConfig> grid = benchGrid(camera, true, {{"vpls", {"256"}}});
     ASSERT_EQ(grid.size(), 1u);
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=4");
-    const BenchResult good = runBenchConfig(benchScene(true), calib.intrinsics, frames, grid[0]);
+    const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";
     RecordProperty("psnr_frame_db", std::to_string(good.error.psnrFrame));
@@ -202,8 +211,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     EXPECT_FALSE(passesFloors(footage.error));
     EXPECT_LT(footage.error.psnrInfluenced, kMinPsnrInfluenced);
     // Broken (2): the real-time renderer without the virtual object (its contribution removed).
-    const BenchResult removed =
-        runBenchConfig(benchScene(false), calib.intrinsics, frames, grid[0]);
+    const BenchResult removed = runBenchConfig(benchScene(false), camera, frames, grid[0]);
     std::cout << "[ bench ] virtual object removed: " << removed.error << "\n";
     EXPECT_FALSE(passesFloors(removed.error));
     EXPECT_LT(removed.error.psnrInfluenced, kMinPsnrInfluenced);
@@ -211,8 +219,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     // Downsampled judging (the resolution knob): the ground truth is box-filtered, so the same
     // renderer still scores about as well at half size (23.1 dB measured; footage alone ~13 dB).
     const std::vector<BenchConfig> half =
-        benchGrid(calib.intrinsics, true, {{"vpls", {"256"}}, {"resolution", {"80x60"}}});
-    const BenchResult small = runBenchConfig(benchScene(true), calib.intrinsics, frames, half[0]);
+        benchGrid(camera, true, {{"vpls", {"256"}}, {"resolution", {"80x60"}}});
+    const BenchResult small = runBenchConfig(benchScene(true), camera, frames, half[0]);
     std::cout << "[ bench ] 80x60: " << small.error << "\n";
     EXPECT_EQ(small.config.width, 80);
     EXPECT_GE(small.error.psnrInfluenced, kMinPsnrInfluenced - 1.5);
@@ -242,19 +250,15 @@ TEST(RealtimeBench, HardCasesStayFiniteThroughGroundTruthAndBench) {
     o.seconds = 2.0 / 6.0;  // 2 frames
     o.samplesPerPixel = 4;
     raytrace::writeSyntheticSession(scene, dir, o);
-    const Session session = readSession(dir);
-    const auto info = readGroundTruthInfo(dir);
-    ASSERT_TRUE(info.has_value());
-    const CameraCalibration calib = loadSessionCalibration(session, "main");
-    const std::vector<BenchFrame> frames = loadBenchFrames(session, *info, calib.intrinsics);
+    const auto [camera, frames] = loadBenchSession(dir);
     ASSERT_EQ(frames.size(), 2u);
     const cv::Mat& first = frames[0].influence;
     EXPECT_GT(cv::countNonZero(first == kInfluenceVirtual), first.total() / 2)
         << "the camera should start inside the virtual shell";
 
     gl::Context context = gl::Context::headless();
-    const std::vector<BenchConfig> grid = benchGrid(calib.intrinsics, true, {{"vpls", {"64"}}});
-    const BenchResult r = runBenchConfig(scene, calib.intrinsics, frames, grid[0]);
+    const std::vector<BenchConfig> grid = benchGrid(camera, true, {{"vpls", {"64"}}});
+    const BenchResult r = runBenchConfig(scene, camera, frames, grid[0]);
     std::cout << "[ bench ] hard cases: " << r.error << "\n";
     for (double v : {r.error.psnrFrame, r.error.ssimFrame, r.error.psnrInfluenced,
                      r.error.ssimInfluenced, r.medianGpuMs})
@@ -262,7 +266,7 @@ TEST(RealtimeBench, HardCasesStayFiniteThroughGroundTruthAndBench) {
     EXPECT_GT(r.error.psnrFrame, 10.0);
 
     // The linear buffers of the real-time renderer on the same frames.
-    Renderer renderer(scene, calib.intrinsics);
+    Renderer renderer(scene, camera);
     for (const auto& f : frames) {
         renderer.render({f.T_world_camera, f.footage, true});
         for (const cv::Mat& m : {renderer.compositeLinear(), renderer.readBuffer(Resource::LRv),
