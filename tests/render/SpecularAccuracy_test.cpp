@@ -1,4 +1,4 @@
-// Specular objects (issue 6) against the Embree reference renderer: for combinations of REAL /
+// Specular objects against the Embree reference renderer: for combinations of REAL /
 // VIRTUAL light, specular object, reflected object and refracted object (Knecht 2013 Fig. 2),
 // the real-time composite over the specular object's pixels is compared with the reference
 // differential composite (CI = the reference's real-only render as 8-bit sRGB footage). Also the

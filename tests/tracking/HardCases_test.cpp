@@ -1,4 +1,4 @@
-// The hard cases of issue 4, each a test: each gives a correct pose or an explicit non-ok state,
+// The hard cases of tracking (docs/tracking.md), each a test: each gives a correct pose or an explicit non-ok state,
 // never a confident wrong answer.
 #include <gtest/gtest.h>
 
