@@ -56,9 +56,18 @@ double imageSharpness(const cv::Mat& grey) {
     return weakest / range;
 }
 
+namespace {
+// The detector looks for the board's tag family: a board of tag25h9 tags is searched for
+// tag25h9 codes, whatever the options' default says.
+TrackerOptions forBoard(TrackerOptions o, const Board& board) {
+    o.detector.family = board.family;
+    return o;
+}
+}  // namespace
+
 Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
-    : options_(options),
-      detector_(options.detector),
+    : options_(forBoard(options, board)),
+      detector_(options_.detector),
       tagFinder_(board, camera, options.prediction),
       estimator_(std::move(board), std::move(camera), options.pose),
       filter_(options.filter),

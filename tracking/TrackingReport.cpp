@@ -109,6 +109,26 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
     csv_.flush();
 }
 
+void TrackingReport::addUnreadableFrame(int frameIndex, const TrackedFrame& lost) {
+    add(frameIndex, lost, std::nullopt, 0.0);
+    // The row is written; the counts move from "tracked, lost" to "unreadable".
+    --frames_;
+    --stateCount_[size_t(lost.estimate.state)];
+    ++unreadable_;
+    decodeMs_.pop_back();
+    detectMs_.pop_back();
+    poseMs_.pop_back();
+    filterMs_.pop_back();
+}
+
+void TrackingReport::close() {
+    csv_.flush();
+    const bool ok = csv_.good();
+    csv_.close();
+    if (!ok || csv_.fail())
+        throw FileError(path_.string(), "writing the poses CSV failed (disk full?)");
+}
+
 std::string TrackingReport::summary() const {
     std::string s;
     char b[512];
