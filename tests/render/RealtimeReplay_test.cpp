@@ -10,8 +10,8 @@
 
 #include "core/camera/CalibrationFile.h"
 #include "core/session/Session.h"
-#include "tests/render/RenderTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage {
 namespace {
