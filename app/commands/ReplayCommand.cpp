@@ -34,6 +34,7 @@
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
+#include "core/gl/Objects.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "core/session/MatroskaWriter.h"
@@ -227,14 +228,12 @@ void runReplay(const ReplayArgs& a) {
             result = renderer.compositeSrgb();
             readbackMs = msSince(t2);
             if (a.window) {
-                GLuint fbo = 0;
-                glCreateFramebuffers(1, &fbo);
-                glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0,
-                                          renderer.compositeTexture().id(), 0);
+                // The composite, flipped to the window's bottom-up rows.
+                gl::Framebuffer source("replay window blit");
+                source.attachColor(0, renderer.compositeTexture());
                 const int w = calib.intrinsics.width, h = calib.intrinsics.height;
-                glBlitNamedFramebuffer(fbo, 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
+                glBlitNamedFramebuffer(source.id(), 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
                                        GL_NEAREST);
-                glDeleteFramebuffers(1, &fbo);
             }
         } else {
             result = bgr;  // tracking lost: the footage passes through, history resets

@@ -73,9 +73,9 @@ private:
     size_t rows_, P_;
 };
 
-// Solves A x = b for symmetric positive definite A (n x n, row-major) by Cholesky. False if A is
-// not positive definite (to working precision).
-bool solveCholesky(std::vector<double> A, int n, const std::vector<double>& b,
+// Solves A x = b for symmetric positive definite A (n x n, row-major) by Cholesky, overwriting
+// A with its factor. False if A is not positive definite (to working precision).
+bool solveCholesky(std::vector<double>& A, int n, const std::vector<double>& b,
                    std::vector<double>& x) {
     const size_t N = size_t(n);
     for (size_t j = 0; j < N; ++j) {
@@ -183,13 +183,15 @@ Report solve(const Problem& p, std::vector<double>& x, const Options& o) {
     }
     const size_t P = size_t(p.parameters);
     double lambda = o.initialLambda;
-    std::vector<double> dx, minusG(P), trial, r2;
+    // Buffers reused across iterations (the tracker runs several small solves per frame).
+    std::vector<double> dx, minusG(P), trial, r2, A;
+    NormalEquations ne;
+    ne.parameters = p.parameters;
     rep.stop = Stop::MaxIterations;
     for (int it = 0; it < o.maxIterations; ++it) {
-        NormalEquations ne;
-        ne.parameters = p.parameters;
         ne.JtJ.assign(P * P, 0.0);
         ne.Jtr.assign(P, 0.0);
+        ne.finite = true;
         NormalSink sink(ne, r);
         p.jacobian(x, sink);
         if (!ne.finite) {
@@ -199,10 +201,10 @@ Report solve(const Problem& p, std::vector<double>& x, const Options& o) {
         for (size_t a = 0; a < P; ++a) minusG[a] = -ne.Jtr[a];
         bool accepted = false, converged = false;
         while (lambda <= o.maxLambda) {
-            std::vector<double> A = ne.JtJ;
+            A = ne.JtJ;
             for (size_t a = 0; a < P; ++a)
                 A[a * P + a] += lambda * std::max(ne.JtJ[a * P + a], kDampingFloor);
-            if (!solveCholesky(std::move(A), p.parameters, minusG, dx)) {
+            if (!solveCholesky(A, p.parameters, minusG, dx)) {
                 lambda *= kLambdaUp;
                 continue;
             }

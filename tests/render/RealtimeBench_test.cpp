@@ -23,8 +23,8 @@
 #include "render/evaluation/RealtimeBench.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/SyntheticSession.h"
-#include "tests/render/RenderTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
 namespace {

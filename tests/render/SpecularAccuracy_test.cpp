@@ -18,8 +18,8 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
-#include "tests/render/SpecularTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
 namespace {

@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "tests/support/TestSupport.h"
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/Detector.h"
 #include "tracking/PoseEstimator.h"
 

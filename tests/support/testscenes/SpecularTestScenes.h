@@ -12,7 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/image/ImageIO.h"
-#include "tests/render/RenderTestScenes.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::test {
 
