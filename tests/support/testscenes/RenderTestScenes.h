@@ -9,6 +9,7 @@
 #include "core/camera/CameraModel.h"
 #include "core/math/Pose.h"
 #include "core/scene/Scene.h"
+#include "testscenes/LookAt.h"
 
 namespace mirage::test {
 
@@ -135,10 +136,7 @@ inline void addLight(Scene& s, Light::Type type, glm::vec3 pos, glm::vec3 dir, f
 
 // T_world_camera of an OpenCV camera at `eye` looking at `target` (+Y world up).
 inline Pose lookAtPose(glm::dvec3 eye, glm::dvec3 target) {
-    const glm::dvec3 z = glm::normalize(target - eye);
-    const glm::dvec3 x = glm::normalize(glm::cross(z, glm::dvec3(0, 1, 0)));
-    const glm::dvec3 y = glm::cross(z, x);
-    return Pose::fromRotationTranslation(glm::dmat3(x, y, z), eye);
+    return lookAt(eye, target, glm::dvec3(0, 1, 0));
 }
 
 inline CameraIntrinsics smallCamera(int w = 160, int h = 120, double f = 130.0) {

@@ -5,22 +5,17 @@
 #include "core/camera/CameraModel.h"
 #include "core/image/ImageIO.h"
 #include "core/math/Pose.h"
+#include "testscenes/LookAt.h"
 #include "tracking/BoardImage.h"
 #include "tracking/BoardLayout.h"
 #include "tracking/SyntheticBoardView.h"
 
 namespace mirage::tracking::testing {
 
-// T_world_camera (OpenCV camera axes) at `eye` looking at `target`; `up` is the world direction
-// that appears up in the image; `rollRad` turns the camera about its optical axis.
+// test::lookAt with the board's far edge (-Z) up in the image by default.
 inline Pose lookAt(const glm::dvec3& eye, const glm::dvec3& target,
                    const glm::dvec3& up = glm::dvec3(0, 0, -1), double rollRad = 0.0) {
-    const glm::dvec3 fwd = glm::normalize(target - eye);
-    glm::dvec3 right = glm::normalize(glm::cross(fwd, up));
-    glm::dvec3 down = glm::cross(fwd, right);
-    const glm::dvec3 r2 = std::cos(rollRad) * right + std::sin(rollRad) * down;
-    down = glm::cross(fwd, r2);
-    return Pose::fromRotationTranslation(glm::dmat3(r2, down, fwd), eye);
+    return test::lookAt(eye, target, up, rollRad);
 }
 
 inline CameraIntrinsics pinholeCamera(int w = 640, int h = 480, double f = 600) {
