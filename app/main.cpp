@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
     cli.add_option("--log-level", logLevel, "trace, debug, info, warn, error, off")
         ->capture_default_str();
     cli.require_subcommand(1);
+    // Options of `mirage` itself (--log-level) are accepted after the subcommand as well.
+    cli.fallthrough();
 
     auto& registry = app::commandRegistry();
     std::sort(registry.begin(), registry.end(),
@@ -41,7 +43,9 @@ int main(int argc, char** argv) {
     try {
         cli.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return cli.exit(e);
+        // --help and --version exit 0; every argument error exits 1 (docs/conventions.md), not
+        // CLI11's own codes (104-114).
+        return cli.exit(e) == 0 ? 0 : 1;
     } catch (const Error& e) {
         spdlog::error("{}", e.what());
         return 1;

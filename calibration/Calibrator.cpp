@@ -90,14 +90,22 @@ JointProblem fisheyeInitialGuess(const std::vector<const CalibrationView*>& view
     return p;
 }
 
+// Board and image points of every view in the point types OpenCV's calibrators take
+// (cv::calibrateCamera: float; cv::fisheye::calibrate: double).
+template <class P3, class P2>
+void correspondences(const std::vector<const CalibrationView*>& views,
+                     std::vector<std::vector<P3>>& obj, std::vector<std::vector<P2>>& img) {
+    for (const auto* v : views) {
+        obj.emplace_back(v->boardPoints.begin(), v->boardPoints.end());
+        img.emplace_back(v->imagePoints.begin(), v->imagePoints.end());
+    }
+}
+
 Solution solvePinhole(const std::vector<const CalibrationView*>& views, cv::Size size,
                       const CalibrationOptions& o) {
     std::vector<std::vector<cv::Point3f>> obj;
     std::vector<std::vector<cv::Point2f>> img;
-    for (const auto* v : views) {
-        obj.push_back(v->boardPoints);
-        img.push_back(v->imagePoints);
-    }
+    correspondences(views, obj, img);
     cv::Mat K, D;
     std::vector<cv::Mat> rvecs, tvecs;
     const int flags = o.fixK3 ? cv::CALIB_FIX_K3 : 0;
@@ -134,10 +142,7 @@ Solution solveFisheye(const std::vector<const CalibrationView*>& views, cv::Size
                       const CalibrationOptions& o) {
     std::vector<std::vector<cv::Point3d>> obj;
     std::vector<std::vector<cv::Point2d>> img;
-    for (const auto* v : views) {
-        obj.emplace_back(v->boardPoints.begin(), v->boardPoints.end());
-        img.emplace_back(v->imagePoints.begin(), v->imagePoints.end());
-    }
+    correspondences(views, obj, img);
     std::vector<JointProblem> candidates;
     try {
         cv::Matx33d K;

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calibration/FrameSource.h"
+#include "calibration/JointRefinement.h"
 #include "core/Error.h"
 
 namespace mirage::calib {
@@ -55,129 +56,76 @@ void toCv(const Pose& p, cv::Vec3d& rvec, cv::Vec3d& tvec) {
     tvec = cv::Vec3d(p.translation.x, p.translation.y, p.translation.z);
 }
 
-// Joint refinement of T_camera_main and every pair's board pose T_main_board_i, minimising the
-// reprojection errors (pixels) of both cameras' corners with the intrinsics fixed. Parameters:
-// x = [rvec, tvec of T_camera_main | rvec, tvec of T_main_board_i ...]. Levenberg-Marquardt on
-// central-difference Jacobians (the problem is small: 6 + 6 per pair). Returns the 1-sigma
-// deviations of the first 6 parameters, (J^T J)^-1 sigma^2 as for the intrinsics.
-struct StereoProblem {
-    const CameraIntrinsics* main;
-    const CameraIntrinsics* camera;
-    std::vector<const CalibrationView*> mainViews, cameraViews;
-    std::vector<double> x;
+cv::Vec3d vec3At(const std::vector<double>& x, size_t o) {
+    return {x[o], x[o + 1], x[o + 2]};
+}
 
-    int pairs() const { return int(mainViews.size()); }
-    // Residuals of pair i (main corners, then camera corners), appended to r.
-    void pairResiduals(int i, const std::vector<double>& p, std::vector<double>& r) const {
-        const cv::Vec3d rC(p[0], p[1], p[2]), tC(p[3], p[4], p[5]);
-        const size_t o = 6 + 6 * size_t(i);
-        const cv::Vec3d rB(p[o], p[o + 1], p[o + 2]), tB(p[o + 3], p[o + 4], p[o + 5]);
-        const auto& mv = *mainViews[size_t(i)];
-        const auto pm = projectBoardPoints(mv.boardPoints, *main, rB, tB);
-        for (size_t k = 0; k < pm.size(); ++k) {
-            r.push_back(double(pm[k].x) - mv.imagePoints[k].x);
-            r.push_back(double(pm[k].y) - mv.imagePoints[k].y);
-        }
-        cv::Vec3d r3, t3;  // T_camera_board = T_camera_main * T_main_board
-        cv::composeRT(rB, tB, rC, tC, r3, t3);
-        const auto& cvw = *cameraViews[size_t(i)];
-        const auto pc = projectBoardPoints(cvw.boardPoints, *camera, r3, t3);
-        for (size_t k = 0; k < pc.size(); ++k) {
-            r.push_back(double(pc[k].x) - cvw.imagePoints[k].x);
-            r.push_back(double(pc[k].y) - cvw.imagePoints[k].y);
-        }
-    }
-    double cost(const std::vector<double>& p) const {
-        std::vector<double> r;
-        for (int i = 0; i < pairs(); ++i) pairResiduals(i, p, r);
-        double s = 0;
-        for (double v : r) s += v * v;
-        return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
-    }
-    // Normal equations A = J^T J, g = J^T r at p; also the residual count.
-    void normal(const std::vector<double>& p, cv::Mat& A, cv::Mat& g, int& residuals) const {
-        const int P = int(p.size());
-        A = cv::Mat::zeros(P, P, CV_64F);
-        g = cv::Mat::zeros(P, 1, CV_64F);
-        residuals = 0;
-        const double h = 1e-6;
-        for (int i = 0; i < pairs(); ++i) {
-            std::vector<double> r0;
-            pairResiduals(i, p, r0);
-            const int n = int(r0.size());
-            residuals += n;
-            // Columns that touch this pair: the shared 6 and its own 6.
-            std::vector<int> cols = {0, 1, 2, 3, 4, 5};
-            for (int c = 0; c < 6; ++c) cols.push_back(6 + 6 * i + c);
-            cv::Mat J(n, 12, CV_64F);
-            for (int c = 0; c < 12; ++c) {
-                auto pp = p, pm = p;
-                pp[size_t(cols[size_t(c)])] += h;
-                pm[size_t(cols[size_t(c)])] -= h;
-                std::vector<double> rp, rm;
-                pairResiduals(i, pp, rp);
-                pairResiduals(i, pm, rm);
-                for (int k = 0; k < n; ++k)
-                    J.at<double>(k, c) = (rp[size_t(k)] - rm[size_t(k)]) / (2 * h);
-            }
-            const cv::Mat r(n, 1, CV_64F, r0.data());
-            const cv::Mat JtJ = J.t() * J, Jtr = J.t() * r;
-            for (int a = 0; a < 12; ++a) {
-                g.at<double>(cols[size_t(a)]) += Jtr.at<double>(a);
-                for (int b = 0; b < 12; ++b)
-                    A.at<double>(cols[size_t(a)], cols[size_t(b)]) += JtJ.at<double>(a, b);
-            }
-        }
-    }
-    void refine(int maxIterations) {
-        double c = cost(x), lambda = 1e-3;
-        for (int it = 0; it < maxIterations; ++it) {
-            cv::Mat A, g;
-            int n = 0;
-            normal(x, A, g, n);
-            bool accepted = false;
-            double newCost = c;
-            while (lambda < 1e12) {
-                cv::Mat Ad = A.clone();
-                for (int i = 0; i < Ad.rows; ++i) Ad.at<double>(i, i) *= 1 + lambda;
-                cv::Mat d;
-                if (!cv::solve(Ad, -g, d, cv::DECOMP_CHOLESKY)) {
-                    lambda *= 10;
-                    continue;
-                }
-                auto trial = x;
-                for (size_t k = 0; k < trial.size(); ++k) trial[k] += d.at<double>(int(k));
-                newCost = cost(trial);
-                if (newCost < c) {
-                    x = trial;
-                    accepted = true;
-                    lambda = std::max(lambda / 10, 1e-9);
-                    break;
-                }
-                lambda *= 10;
-            }
-            if (!accepted || (c - newCost) < 1e-12 * c) break;
-            c = newCost;
-        }
-    }
-    // 1-sigma of the shared 6 parameters; +inf if singular.
-    std::array<double, 6> sharedStd() const {
-        std::array<double, 6> sd;
-        sd.fill(std::numeric_limits<double>::infinity());
-        cv::Mat A, g;
-        int n = 0;
-        normal(x, A, g, n);
-        const int dof = n - A.rows;
-        cv::Mat inv;
-        if (dof <= 0 || cv::invert(A, inv, cv::DECOMP_SVD) == 0) return sd;
-        const double sigma2 = cost(x) / dof;
-        for (int i = 0; i < 6; ++i)
-            sd[size_t(i)] = std::sqrt(std::max(0.0, inv.at<double>(i, i) * sigma2));
-        return sd;
-    }
-};
+// The 3x3 block of a composeRT derivative (CV_64F).
+cv::Mat block3(const cv::Mat& d) {
+    return d.reshape(1, 3);
+}
 
 }  // namespace
+
+lm::Problem stereoLeastSquares(const CameraIntrinsics& main, const CameraIntrinsics& camera,
+                               const std::vector<const CalibrationView*>& mainViews,
+                               const std::vector<const CalibrationView*>& cameraViews) {
+    lm::Problem p;
+    p.parameters = int(6 + 6 * mainViews.size());
+    // Residuals of pair i, main view then camera view; optionally the Jacobian block with columns
+    // (T_camera_main's 6, T_main_board_i's 6).
+    auto pair = [&main, &camera, &mainViews, &cameraViews](const std::vector<double>& x, size_t i,
+                                                           std::vector<double>& r, cv::Mat* J) {
+        const cv::Vec3d rC = vec3At(x, 0), tC = vec3At(x, 3);
+        const cv::Vec3d rB = vec3At(x, 6 + 6 * i), tB = vec3At(x, 9 + 6 * i);
+        std::vector<double> rm, rc;
+        cv::Mat Jm, Jc;
+        boardResiduals(*mainViews[i], main, rB, tB, rm, nullptr, J ? &Jm : nullptr);
+        // T_camera_board = T_camera_main * T_main_board.
+        cv::Vec3d r3, t3;
+        cv::Mat dr3dr1, dr3dt1, dr3dr2, dr3dt2, dt3dr1, dt3dt1, dt3dr2, dt3dt2;
+        cv::composeRT(rB, tB, rC, tC, r3, t3, dr3dr1, dr3dt1, dr3dr2, dr3dt2, dt3dr1, dt3dt1,
+                      dt3dr2, dt3dt2);
+        boardResiduals(*cameraViews[i], camera, r3, t3, rc, nullptr, J ? &Jc : nullptr);
+        r = rm;
+        r.insert(r.end(), rc.begin(), rc.end());
+        if (!J) return;
+        const int nm = int(rm.size()), nc = int(rc.size());
+        *J = cv::Mat::zeros(nm + nc, 12, CV_64F);
+        Jm.copyTo(J->rowRange(0, nm).colRange(6, 12));
+        // Chain rule through the composition: d(r3, t3) / d(rC, tC) and / d(rB, tB).
+        const cv::Mat Jr = Jc.colRange(0, 3), Jt = Jc.colRange(3, 6);
+        cv::Mat out = J->rowRange(nm, nm + nc);
+        cv::Mat(Jr * block3(dr3dr2) + Jt * block3(dt3dr2)).copyTo(out.colRange(0, 3));
+        cv::Mat(Jr * block3(dr3dt2) + Jt * block3(dt3dt2)).copyTo(out.colRange(3, 6));
+        cv::Mat(Jr * block3(dr3dr1) + Jt * block3(dt3dr1)).copyTo(out.colRange(6, 9));
+        cv::Mat(Jr * block3(dr3dt1) + Jt * block3(dt3dt1)).copyTo(out.colRange(9, 12));
+    };
+    const size_t pairs = mainViews.size();
+    p.residuals = [pair, pairs](const std::vector<double>& x, std::vector<double>& r) {
+        r.clear();
+        std::vector<double> ri;
+        for (size_t i = 0; i < pairs; ++i) {
+            pair(x, i, ri, nullptr);
+            r.insert(r.end(), ri.begin(), ri.end());
+        }
+        return true;
+    };
+    p.jacobian = [pair, pairs](const std::vector<double>& x, lm::JacobianSink& sink) {
+        std::vector<double> ri;
+        size_t row = 0;
+        for (size_t i = 0; i < pairs; ++i) {
+            cv::Mat J;
+            pair(x, i, ri, &J);
+            std::vector<int> columns = {0, 1, 2, 3, 4, 5};
+            for (int c = 0; c < 6; ++c) columns.push_back(int(6 + 6 * i) + c);
+            const cv::Mat Jc = J.isContinuous() ? J : J.clone();
+            sink.add(row, ri.size(), columns, Jc.ptr<double>());
+            row += ri.size();
+        }
+    };
+    return p;
+}
 
 Pose poseFromCv(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
     cv::Matx33d R;
@@ -239,31 +187,35 @@ StereoExtrinsics estimateStereoExtrinsics(const CameraIntrinsics& main,
             kept.push_back(pairs[k]);
     }
     mean = meanPose(kept);
-    // Joint refinement from the mean and the main camera's per-pair board poses.
-    StereoProblem prob;
-    prob.main = &main;
-    prob.camera = &camera;
+    // Joint refinement of T_camera_main and every pair's board pose T_main_board_i over both
+    // cameras' reprojection errors (pixels), intrinsics fixed, from the mean and the main camera's
+    // per-pair board poses. State: rvec, tvec of T_camera_main, then of each T_main_board_i.
+    std::vector<const CalibrationView*> keptMain, keptCamera;
     cv::Vec3d rC, tC;
     toCv(mean.inverse(), rC, tC);
-    prob.x = {rC[0], rC[1], rC[2], tC[0], tC[1], tC[2]};
+    std::vector<double> x = {rC[0], rC[1], rC[2], tC[0], tC[1], tC[2]};
     for (const auto& p : kept) {
-        prob.mainViews.push_back(&mainViews[p.index]);
-        prob.cameraViews.push_back(&cameraViews[p.index]);
+        keptMain.push_back(&mainViews[p.index]);
+        keptCamera.push_back(&cameraViews[p.index]);
         cv::Vec3d rB, tB;
         toCv(mainBoard[p.index], rB, tB);
-        prob.x.insert(prob.x.end(), {rB[0], rB[1], rB[2], tB[0], tB[1], tB[2]});
+        x.insert(x.end(), {rB[0], rB[1], rB[2], tB[0], tB[1], tB[2]});
     }
-    prob.refine(50);
-    const auto sd = prob.sharedStd();
+    const lm::Problem problem = stereoLeastSquares(main, camera, keptMain, keptCamera);
+    lm::Options o;
+    o.maxIterations = 50;
+    lm::solve(problem, x, o);
+    // 1-sigma of T_camera_main's 6 parameters; +inf if singular.
+    const lm::Covariance cov = lm::covariance(problem, x);
+    std::array<double, 6> sd;
+    for (int i = 0; i < 6; ++i)
+        sd[size_t(i)] = cov.ok ? std::sqrt(std::max(0.0, cov.at(i, i)))
+                               : std::numeric_limits<double>::infinity();
     e.rotationStdDeg = std::sqrt(sd[0] * sd[0] + sd[1] * sd[1] + sd[2] * sd[2]) * kRadToDeg;
     e.translationStdM = std::sqrt(sd[3] * sd[3] + sd[4] * sd[4] + sd[5] * sd[5]);
-    mean = poseFromCv(cv::Vec3d(prob.x[0], prob.x[1], prob.x[2]),
-                      cv::Vec3d(prob.x[3], prob.x[4], prob.x[5]))
-               .inverse();
+    mean = poseFromCv(vec3At(x, 0), vec3At(x, 3)).inverse();
     for (size_t k = 0; k < kept.size(); ++k)
-        mainBoard[kept[k].index] =
-            poseFromCv(cv::Vec3d(prob.x[6 + 6 * k], prob.x[7 + 6 * k], prob.x[8 + 6 * k]),
-                       cv::Vec3d(prob.x[9 + 6 * k], prob.x[10 + 6 * k], prob.x[11 + 6 * k]));
+        mainBoard[kept[k].index] = poseFromCv(vec3At(x, 6 + 6 * k), vec3At(x, 9 + 6 * k));
     e.T_main_camera = mean;
     e.pairCount = int(kept.size());
     double rot2 = 0, tr2 = 0, transfer2 = 0;

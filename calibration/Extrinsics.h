@@ -9,7 +9,7 @@
 // points). Their mean (rotations: normalised sum of sign-aligned quaternions, the chordal L2
 // mean; translations: arithmetic mean) starts a joint Levenberg-Marquardt refinement of
 // T_camera_main and every pair's board pose over both cameras' reprojection errors (intrinsics
-// fixed), whose covariance gives the reported 1-sigma uncertainty.
+// fixed; core/math/LevenbergMarquardt.h), whose covariance gives the reported 1-sigma uncertainty.
 // Pairs whose pose is an outlier (rotation or translation off the first mean by more than 3x the
 // median deviation, and more than 1 degree / 10 mm) are dropped.
 //
@@ -21,6 +21,7 @@
 #include "calibration/CalibrationTarget.h"
 #include "calibration/Calibrator.h"
 #include "core/camera/CameraModel.h"
+#include "core/math/LevenbergMarquardt.h"
 #include "core/math/Pose.h"
 
 namespace mirage::calib {
@@ -58,6 +59,14 @@ struct WorldPose {
     Pose T_world_camera;  // world = the board file's world (a chessboard's own frame)
     double rmsPx = 0;
 };
+
+// The joint refinement above as a least-squares problem (core/math/LevenbergMarquardt.h).
+// State and step: rvec, tvec of T_camera_main, then rvec, tvec of each pair's T_main_board_i.
+// Residuals per pair: the main view's corners, then this camera's (projected - observed, pixels).
+// Analytic Jacobian. The problem refers to the arguments, which must outlive it.
+lm::Problem stereoLeastSquares(const CameraIntrinsics& main, const CameraIntrinsics& camera,
+                               const std::vector<const CalibrationView*>& mainViews,
+                               const std::vector<const CalibrationView*>& cameraViews);
 
 // Pose of a camera in the world from one image with the board at its world placement.
 WorldPose poseFromWorldBoard(const CameraIntrinsics& camera, const std::string& imagePath,

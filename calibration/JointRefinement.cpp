@@ -10,33 +10,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Residuals (projected - observed, 2n x 1) and Jacobians w.r.t. the intrinsics (2n x nI, our
-// order fx fy cx cy dist...) and the pose (2n x 6, rvec then tvec) of one view.
-void viewJacobian(const CalibrationView& view, const CameraIntrinsics& in, const cv::Vec3d& rvec,
-                  const cv::Vec3d& tvec, cv::Mat& residual, cv::Mat& Ji, cv::Mat& Je) {
-    const std::vector<cv::Point3d> obj(view.boardPoints.begin(), view.boardPoints.end());
-    std::vector<cv::Point2d> px;
-    cv::Mat J;
-    const int n = int(obj.size());
-    if (in.model == DistortionModel::KannalaBrandt) {
-        // Columns: fx fy cx cy k1..k4 om(3) T(3) alpha.
-        cv::fisheye::projectPoints(obj, px, rvec, tvec, cameraMatrix(in), distortionVector(in), 0.0,
-                                   J);
-        Ji = J.colRange(0, 8);
-        Je = J.colRange(8, 14);
-    } else {
-        // Columns: rvec(3) tvec(3) fx fy cx cy k1 k2 p1 p2 k3.
-        cv::projectPoints(obj, rvec, tvec, cameraMatrix(in), distortionVector(in), px, J);
-        Ji = J.colRange(6, 15);
-        Je = J.colRange(0, 6);
-    }
-    residual.create(2 * n, 1, CV_64F);
-    for (int i = 0; i < n; ++i) {
-        residual.at<double>(2 * i) = px[size_t(i)].x - view.imagePoints[size_t(i)].x;
-        residual.at<double>(2 * i + 1) = px[size_t(i)].y - view.imagePoints[size_t(i)].y;
-    }
-}
-
 double& intrinsicRef(CameraIntrinsics& in, int i) {
     switch (i) {
         case 0:
@@ -52,142 +25,152 @@ double& intrinsicRef(CameraIntrinsics& in, int i) {
     }
 }
 
-struct Normal {
-    cv::Mat A, g;  // J^T J and J^T r over the free parameters
-    std::vector<int> freeIntrinsics;
-    int residualCount = 0;
-};
-
-Normal buildNormal(const JointProblem& p) {
-    Normal ne;
-    const int nI = p.intrinsicCount();
-    for (int i = 0; i < nI; ++i)
-        if (p.fixedIntrinsics.empty() || !p.fixedIntrinsics[size_t(i)])
-            ne.freeIntrinsics.push_back(i);
-    const int nF = int(ne.freeIntrinsics.size()), nV = int(p.views.size());
-    const int P = nF + 6 * nV;
-    ne.A = cv::Mat::zeros(P, P, CV_64F);
-    ne.g = cv::Mat::zeros(P, 1, CV_64F);
-    for (int v = 0; v < nV; ++v) {
-        cv::Mat r, Ji, Je;
-        viewJacobian(*p.views[size_t(v)], p.intrinsics, p.rvecs[size_t(v)], p.tvecs[size_t(v)], r,
-                     Ji, Je);
-        ne.residualCount += r.rows;
-        cv::Mat Jf(r.rows, nF + 6, CV_64F);
-        for (int k = 0; k < nF; ++k) Ji.col(ne.freeIntrinsics[size_t(k)]).copyTo(Jf.col(k));
-        Je.copyTo(Jf.colRange(nF, nF + 6));
-        const cv::Mat local = Jf.t() * Jf, localG = Jf.t() * r;
-        auto map = [&](int k) { return k < nF ? k : nF + 6 * v + (k - nF); };
-        for (int a = 0; a < nF + 6; ++a) {
-            ne.g.at<double>(map(a)) += localG.at<double>(a);
-            for (int b = 0; b < nF + 6; ++b)
-                ne.A.at<double>(map(a), map(b)) += local.at<double>(a, b);
-        }
-    }
-    return ne;
+std::vector<int> freeIntrinsics(const JointProblem& p) {
+    std::vector<int> free;
+    for (int i = 0; i < p.intrinsicCount(); ++i)
+        if (p.fixedIntrinsics.empty() || !p.fixedIntrinsics[size_t(i)]) free.push_back(i);
+    return free;
 }
 
-bool plausible(const CameraIntrinsics& in) {
-    return in.isValid();
+// The intrinsics of state x (the fixed ones from the problem).
+CameraIntrinsics intrinsicsOf(const JointProblem& p, const std::vector<int>& free,
+                              const std::vector<double>& x) {
+    CameraIntrinsics in = p.intrinsics;
+    in.distortion.resize(p.intrinsics.model == DistortionModel::KannalaBrandt ? 4 : 5, 0.0);
+    for (size_t k = 0; k < free.size(); ++k) intrinsicRef(in, free[k]) = x[k];
+    return in;
+}
+
+cv::Vec3d vec3At(const std::vector<double>& x, size_t o) {
+    return {x[o], x[o + 1], x[o + 2]};
 }
 
 }  // namespace
+
+void boardResiduals(const CalibrationView& view, const CameraIntrinsics& in, const cv::Vec3d& rvec,
+                    const cv::Vec3d& tvec, std::vector<double>& residuals,
+                    cv::Mat* intrinsicsJacobian, cv::Mat* poseJacobian) {
+    const std::vector<cv::Point3d> obj(view.boardPoints.begin(), view.boardPoints.end());
+    std::vector<cv::Point2d> px;
+    const bool withJacobian = intrinsicsJacobian || poseJacobian;
+    cv::Mat J;
+    if (in.model == DistortionModel::KannalaBrandt) {
+        // Columns: fx fy cx cy k1..k4 om(3) T(3) alpha.
+        if (withJacobian)
+            cv::fisheye::projectPoints(obj, px, rvec, tvec, cameraMatrix(in), distortionVector(in),
+                                       0.0, J);
+        else
+            cv::fisheye::projectPoints(obj, px, rvec, tvec, cameraMatrix(in), distortionVector(in));
+        if (intrinsicsJacobian) *intrinsicsJacobian = J.colRange(0, 8);
+        if (poseJacobian) *poseJacobian = J.colRange(8, 14);
+    } else {
+        // Columns: rvec(3) tvec(3) fx fy cx cy k1 k2 p1 p2 k3.
+        if (withJacobian)
+            cv::projectPoints(obj, rvec, tvec, cameraMatrix(in), distortionVector(in), px, J);
+        else
+            cv::projectPoints(obj, rvec, tvec, cameraMatrix(in), distortionVector(in), px);
+        if (intrinsicsJacobian) *intrinsicsJacobian = J.colRange(6, 15);
+        if (poseJacobian) *poseJacobian = J.colRange(0, 6);
+    }
+    residuals.resize(2 * px.size());
+    for (size_t i = 0; i < px.size(); ++i) {
+        residuals[2 * i] = px[i].x - double(view.imagePoints[i].x);
+        residuals[2 * i + 1] = px[i].y - double(view.imagePoints[i].y);
+    }
+}
 
 int JointProblem::intrinsicCount() const {
     return intrinsics.model == DistortionModel::KannalaBrandt ? 8 : 9;
 }
 
 double JointProblem::cost() const {
+    std::vector<double> r;
+    if (!leastSquares(*this).residuals(stateOf(*this), r)) return kInf;
     double sum = 0;
-    for (size_t v = 0; v < views.size(); ++v) {
-        const auto px = projectBoardPoints(views[v]->boardPoints, intrinsics, rvecs[v], tvecs[v]);
-        for (size_t i = 0; i < px.size(); ++i) {
-            const double dx = double(px[i].x) - views[v]->imagePoints[i].x;
-            const double dy = double(px[i].y) - views[v]->imagePoints[i].y;
-            sum += dx * dx + dy * dy;
-        }
-    }
+    for (double v : r) sum += v * v;
     return std::isfinite(sum) ? sum : kInf;
+}
+
+std::vector<double> stateOf(const JointProblem& p) {
+    const std::vector<int> free = freeIntrinsics(p);
+    CameraIntrinsics in = p.intrinsics;
+    in.distortion.resize(p.intrinsics.model == DistortionModel::KannalaBrandt ? 4 : 5, 0.0);
+    std::vector<double> x;
+    for (int i : free) x.push_back(intrinsicRef(in, i));
+    for (size_t v = 0; v < p.views.size(); ++v)
+        for (const cv::Vec3d& w : {p.rvecs[v], p.tvecs[v]}) x.insert(x.end(), {w[0], w[1], w[2]});
+    return x;
+}
+
+void setState(JointProblem& p, const std::vector<double>& x) {
+    const std::vector<int> free = freeIntrinsics(p);
+    p.intrinsics = intrinsicsOf(p, free, x);
+    for (size_t v = 0; v < p.views.size(); ++v) {
+        p.rvecs[v] = vec3At(x, free.size() + 6 * v);
+        p.tvecs[v] = vec3At(x, free.size() + 6 * v + 3);
+    }
+}
+
+lm::Problem leastSquares(const JointProblem& p) {
+    const std::vector<int> free = freeIntrinsics(p);
+    const size_t nF = free.size();
+    lm::Problem ls;
+    ls.parameters = int(nF + 6 * p.views.size());
+    ls.residuals = [&p, free, nF](const std::vector<double>& x, std::vector<double>& r) {
+        const CameraIntrinsics in = intrinsicsOf(p, free, x);
+        r.clear();
+        if (!in.isValid()) return false;
+        std::vector<double> rv;
+        for (size_t v = 0; v < p.views.size(); ++v) {
+            boardResiduals(*p.views[v], in, vec3At(x, nF + 6 * v), vec3At(x, nF + 6 * v + 3), rv);
+            r.insert(r.end(), rv.begin(), rv.end());
+        }
+        return true;
+    };
+    ls.jacobian = [&p, free, nF](const std::vector<double>& x, lm::JacobianSink& sink) {
+        const CameraIntrinsics in = intrinsicsOf(p, free, x);
+        std::vector<double> rv;
+        std::vector<int> columns(free.size() + 6);
+        for (size_t k = 0; k < nF; ++k) columns[k] = int(k);
+        size_t row = 0;
+        for (size_t v = 0; v < p.views.size(); ++v) {
+            cv::Mat Ji, Je;
+            boardResiduals(*p.views[v], in, vec3At(x, nF + 6 * v), vec3At(x, nF + 6 * v + 3), rv,
+                           &Ji, &Je);
+            const int n = int(rv.size());
+            cv::Mat block(n, int(nF) + 6, CV_64F);
+            for (size_t k = 0; k < nF; ++k) Ji.col(free[k]).copyTo(block.col(int(k)));
+            Je.copyTo(block.colRange(int(nF), int(nF) + 6));
+            for (size_t c = 0; c < 6; ++c) columns[nF + c] = int(nF + 6 * v + c);
+            sink.add(row, size_t(n), columns, block.ptr<double>());
+            row += size_t(n);
+        }
+    };
+    return ls;
 }
 
 double refineJointly(JointProblem& p, int maxIterations) {
     size_t pointCount = 0;
     for (const auto* v : p.views) pointCount += v->imagePoints.size();
-    const size_t distCount = p.intrinsics.model == DistortionModel::KannalaBrandt ? 4 : 5;
-    p.intrinsics.distortion.resize(distCount, 0.0);
-    double cost = p.cost();
-    double lambda = 1e-3;
-    for (int it = 0; it < maxIterations && std::isfinite(cost); ++it) {
-        const Normal ne = buildNormal(p);
-        const int P = ne.A.rows, nF = int(ne.freeIntrinsics.size());
-        bool accepted = false;
-        double newCost = cost;
-        while (lambda < 1e12) {
-            cv::Mat A = ne.A.clone();
-            for (int i = 0; i < P; ++i) A.at<double>(i, i) *= 1.0 + lambda;
-            cv::Mat delta;
-            if (!cv::solve(A, -ne.g, delta, cv::DECOMP_CHOLESKY) &&
-                !cv::solve(A, -ne.g, delta, cv::DECOMP_SVD)) {
-                lambda *= 10;
-                continue;
-            }
-            JointProblem trial = p;
-            for (int k = 0; k < nF; ++k)
-                intrinsicRef(trial.intrinsics, ne.freeIntrinsics[size_t(k)]) += delta.at<double>(k);
-            for (size_t v = 0; v < p.views.size(); ++v)
-                for (int c = 0; c < 3; ++c) {
-                    trial.rvecs[v][c] += delta.at<double>(nF + 6 * int(v) + c);
-                    trial.tvecs[v][c] += delta.at<double>(nF + 6 * int(v) + 3 + c);
-                }
-            newCost = plausible(trial.intrinsics) ? trial.cost() : kInf;
-            if (newCost < cost) {
-                p = std::move(trial);
-                accepted = true;
-                lambda = std::max(lambda / 10, 1e-9);
-                break;
-            }
-            lambda *= 10;
-        }
-        if (!accepted) break;
-        const double decrease = (cost - newCost) / std::max(cost, 1e-300);
-        cost = newCost;
-        if (decrease < 1e-12) break;
-    }
-    return std::sqrt(cost / double(std::max<size_t>(pointCount, 1)));
+    p.intrinsics.distortion.resize(p.intrinsics.model == DistortionModel::KannalaBrandt ? 4 : 5,
+                                   0.0);
+    std::vector<double> x = stateOf(p);
+    lm::Options o;
+    o.maxIterations = maxIterations;
+    const lm::Report report = lm::solve(leastSquares(p), x, o);
+    setState(p, x);
+    return std::sqrt(report.finalCost / double(std::max<size_t>(pointCount, 1)));
 }
 
 std::vector<double> intrinsicStdDeviations(const JointProblem& p) {
-    const int nI = p.intrinsicCount();
-    std::vector<double> sd(size_t(nI), kInf);
-    const Normal ne = buildNormal(p);
-    const int P = ne.A.rows, nF = int(ne.freeIntrinsics.size());
-    const int dof = ne.residualCount - P;
-    if (dof <= 0) return sd;
-    const double sigma2 = p.cost() / dof;
-    if (!std::isfinite(sigma2)) return sd;
-    // Jacobi scaling so that focal lengths (hundreds of px) and k's (~0.01) invert together.
-    cv::Mat scale(P, 1, CV_64F);
-    for (int i = 0; i < P; ++i) {
-        const double d = ne.A.at<double>(i, i);
-        if (!(d > 0) || !std::isfinite(d)) return sd;
-        scale.at<double>(i) = 1.0 / std::sqrt(d);
-    }
-    cv::Mat A = ne.A.clone();
-    for (int i = 0; i < P; ++i)
-        for (int j = 0; j < P; ++j) A.at<double>(i, j) *= scale.at<double>(i) * scale.at<double>(j);
-    cv::Mat w, u, vt;
-    cv::SVD::compute(A, w, u, vt, cv::SVD::FULL_UV);
-    if (!(w.at<double>(P - 1) > 1e-12 * w.at<double>(0))) return sd;  // singular: unobservable
-    for (int i = 0; i < nI; ++i) sd[size_t(i)] = 0.0;                 // fixed ones stay 0
-    for (int k = 0; k < nF; ++k) {
-        // (A^-1)_kk = sum_j V_kj^2 / w_j for the symmetric A = V diag(w) V^T.
-        double var = 0;
-        for (int j = 0; j < P; ++j) {
-            const double vkj = vt.at<double>(j, k);
-            var += vkj * vkj / w.at<double>(j);
-        }
-        var *= scale.at<double>(k) * scale.at<double>(k) * sigma2;
-        sd[size_t(ne.freeIntrinsics[size_t(k)])] = var >= 0 ? std::sqrt(var) : kInf;
+    std::vector<double> sd(size_t(p.intrinsicCount()), kInf);
+    const std::vector<int> free = freeIntrinsics(p);
+    const lm::Covariance cov = lm::covariance(leastSquares(p), stateOf(p));
+    if (!cov.ok) return sd;
+    for (double& s : sd) s = 0.0;  // fixed ones stay 0
+    for (size_t k = 0; k < free.size(); ++k) {
+        const double var = cov.at(int(k), int(k));
+        sd[size_t(free[k])] = var >= 0 ? std::sqrt(var) : kInf;
     }
     return sd;
 }

@@ -9,12 +9,14 @@
 //    residuals (pixels) w.r.t. all free parameters (intrinsics + 6 per view), sigma^2 =
 //    sum(r^2) / (2N - P). The same formula as calibrateCameraExtended's, computed here because
 //    cv::fisheye reports none.
-// Jacobians come from cv::projectPoints / cv::fisheye::projectPoints (analytic).
+// The solver and the covariance are core/math/LevenbergMarquardt.h's. Jacobians come from
+// cv::projectPoints / cv::fisheye::projectPoints (analytic).
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "calibration/Calibrator.h"
+#include "core/math/LevenbergMarquardt.h"
 
 namespace mirage::calib {
 
@@ -34,5 +36,20 @@ double refineJointly(JointProblem& problem, int maxIterations);
 // 1-sigma standard deviations of the intrinsics (fx fy cx cy distortion...), 0 for fixed ones,
 // +inf for all when the normal equations are singular (an unobservable parameter).
 std::vector<double> intrinsicStdDeviations(const JointProblem& problem);
+
+// The problem for the solver. State and step: the free intrinsics (in the order fx fy cx cy
+// distortion...), then rvec, tvec of each view. Residuals: projected - observed pixels, x then y
+// per point, view by view. The problem refers to `problem`, which must outlive it.
+lm::Problem leastSquares(const JointProblem& problem);
+std::vector<double> stateOf(const JointProblem& problem);
+void setState(JointProblem& problem, const std::vector<double>& x);
+
+// Residuals (projected - observed, x then y per point) of board points seen in `view` through
+// `intrinsics` at the board pose (rvec, tvec) = T_camera_board, with their Jacobians with respect
+// to the intrinsics (2n x 8 or 9, in the order fx fy cx cy distortion...) and the pose (2n x 6,
+// rvec then tvec). Analytic, from OpenCV's projection functions.
+void boardResiduals(const CalibrationView& view, const CameraIntrinsics& intrinsics,
+                    const cv::Vec3d& rvec, const cv::Vec3d& tvec, std::vector<double>& residuals,
+                    cv::Mat* intrinsicsJacobian = nullptr, cv::Mat* poseJacobian = nullptr);
 
 }  // namespace mirage::calib

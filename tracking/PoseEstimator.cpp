@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 
 #include <opencv2/calib3d.hpp>
 
 #include "core/Error.h"
+#include "core/math/LevenbergMarquardt.h"
 
 namespace mirage::tracking {
 
@@ -64,13 +66,6 @@ void residuals(const CameraIntrinsics& cam, const Pose& T_world_camera,
     }
 }
 
-double rmsOf(const std::vector<double>& r) {
-    if (r.empty()) return 0;
-    double s = 0;
-    for (double v : r) s += v * v;
-    return std::sqrt(s / (double(r.size()) / 2.0));  // per corner (2D error)
-}
-
 // The pose perturbed by x = (rotation vector in world axes, camera-centre offset in metres).
 Pose perturbed(const Pose& p, const double* x) {
     const glm::dvec3 w(x[0], x[1], x[2]);
@@ -93,6 +88,7 @@ struct Fit {
     std::array<double, 36> tagScale{}, tagShift{};
     std::array<double, 6> commonScale{};
     bool ok = false;
+    lm::Report report;
 };
 
 // Jacobian rows (2 per corner) of the pixel residuals w.r.t. x = (world-frame rotation vector of
@@ -175,84 +171,56 @@ void correlatedTerms(const std::vector<double>& J, const std::vector<const Obser
     }
 }
 
-// Levenberg-Marquardt on the pixel reprojection error of all corners of `obs`.
+// The pose as a least-squares problem for core/math/LevenbergMarquardt.h (PoseEstimator.h,
+// poseLeastSquares).
+lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<const Observation*>& obs) {
+    lm::Problem p;
+    p.parameters = 6;
+    p.residuals = [&cam, &obs](const std::vector<double>& x, std::vector<double>& r) {
+        residuals(cam, poseOfState(x), obs, r);
+        return true;
+    };
+    p.jacobian = [&cam, &obs](const std::vector<double>& x, lm::JacobianSink& sink) {
+        std::vector<double> J;
+        jacobian(cam, poseOfState(x), obs, J);
+        static const std::vector<int> kColumns = {0, 1, 2, 3, 4, 5};
+        sink.add(0, J.size() / 6, kColumns, J.data());
+    };
+    p.retract = [](std::vector<double>& x, const std::vector<double>& dx) {
+        x = poseState(perturbed(poseOfState(x), dx.data()));
+    };
+    return p;
+}
+
+// Levenberg-Marquardt on the pixel reprojection error of all corners of `obs`. It stops when the
+// predicted decrease is below 1e-6 of the cost: the remaining step moves the pose by ~1e-3 of its
+// noise.
 Fit refine(const CameraIntrinsics& cam, const Pose& start,
            const std::vector<const Observation*>& obs, bool withCovariance,
            int maxIterations = 30) {
+    const lm::Problem problem = poseProblem(cam, obs);
+    lm::Options o;
+    o.maxIterations = maxIterations;
+    o.relativeTolerance = 1e-6;
+    o.achievedTolerance = 0;
+    o.initialLambda = 1e-4;
+    std::vector<double> x = poseState(start);
     Fit f;
-    f.pose = start;
-    std::vector<double> r, r2, J;
-    residuals(cam, f.pose, obs, r);
-    double cost = 0;
-    for (double v : r) cost += v * v;
-    double lambda = 1e-4;
-    const size_t m = r.size();
-    auto normalEquations = [&](cv::Matx66d& A, cv::Vec6d& g) {
-        jacobian(cam, f.pose, obs, J);
-        A = cv::Matx66d::zeros();
-        g = cv::Vec6d();
-        for (size_t i = 0; i < m; ++i) {
-            const double* Ji = &J[i * 6];
-            for (int a = 0; a < 6; ++a) {
-                g[a] += Ji[a] * r[i];
-                for (int b = a; b < 6; ++b) A(a, b) += Ji[a] * Ji[b];
-            }
-        }
-        for (int a = 0; a < 6; ++a)
-            for (int b = 0; b < a; ++b) A(a, b) = A(b, a);
-    };
-    for (int it = 0; it < maxIterations; ++it) {
-        cv::Matx66d A;
-        cv::Vec6d g;
-        normalEquations(A, g);
-        bool improved = false, converged = false;
-        for (int tries = 0; tries < 8 && !improved; ++tries) {
-            cv::Matx66d Ad = A;
-            for (int a = 0; a < 6; ++a) Ad(a, a) += lambda * std::max(A(a, a), 1e-12);
-            cv::Vec6d dx;
-            if (!cv::solve(Ad, -g, dx, cv::DECOMP_CHOLESKY)) {
-                lambda *= 10;
-                continue;
-            }
-            // Predicted decrease of the Gauss-Newton model; below 1e-6 of the cost we are done (the
-            // remaining step moves the pose by ~1e-3 of its noise).
-            const double predicted = -(2 * g.dot(dx) + dx.dot(A * dx));
-            if (predicted < 1e-6 * cost + 1e-20) {
-                converged = true;
-                break;
-            }
-            const Pose cand = perturbed(f.pose, dx.val);
-            residuals(cam, cand, obs, r2);
-            double c2 = 0;
-            for (double v : r2) c2 += v * v;
-            if (std::isfinite(c2) && c2 < cost) {
-                f.pose = cand;
-                r.swap(r2);
-                cost = c2;
-                lambda = std::max(lambda * 0.2, 1e-9);
-                improved = true;
-            } else {
-                lambda *= 10;
-            }
-        }
-        if (!improved || converged) break;
-    }
-    f.rms = rmsOf(r);
+    f.report = lm::solve(problem, x, o);
+    f.pose = poseOfState(x);
+    const size_t corners = f.report.residualCount / 2;
+    f.rms = corners ? std::sqrt(f.report.finalCost / double(corners)) : 0.0;
     f.ok = f.pose.isFinite() && std::isfinite(f.rms);
-    if (withCovariance && f.ok && m > 6) {
-        cv::Matx66d A;
-        cv::Vec6d g;
-        normalEquations(A, g);
-        // Residual variance per coordinate, m - 6 degrees of freedom.
-        const double sigma2 = cost / double(m - 6);
-        cv::Matx66d inv;
-        if (cv::invert(A, inv, cv::DECOMP_SVD) != 0) {
-            for (int a = 0; a < 6; ++a)
-                for (int b = 0; b < 6; ++b) {
-                    f.covariance[size_t(a * 6 + b)] = inv(a, b) * sigma2;
-                    f.normalInverse[size_t(a * 6 + b)] = inv(a, b);
-                }
-            f.cost = cost;
+    if (withCovariance && f.ok && f.report.residualCount > 6) {
+        const lm::Covariance c = lm::covariance(problem, x);
+        if (c.ok && c.sigma2 > 0) {
+            std::copy(c.matrix.begin(), c.matrix.end(), f.covariance.begin());
+            // (J^T J)^-1 and the sum of squares, for the noise model (modelCovariance).
+            for (size_t i = 0; i < 36; ++i) f.normalInverse[i] = c.matrix[i] / c.sigma2;
+            f.cost = c.sigma2 * double(f.report.residualCount - 6);
+            std::vector<double> r, J;
+            residuals(cam, f.pose, obs, r);
+            jacobian(cam, f.pose, obs, J);
             // Robust noise scale: the median absolute residual (a few tags with damaged
             // corners should not set the noise of all).
             std::vector<double> a(r.size());
@@ -265,7 +233,7 @@ Fit refine(const CameraIntrinsics& cam, const Pose& start,
     return f;
 }
 
-// Corner RMS of one tag (as rmsOf(residuals(...)) for that tag alone, without allocating: it is
+// Corner RMS of one tag (the RMS of residuals(...) for that tag alone, without allocating: it is
 // called for every candidate pose and tag).
 double tagRms(const CameraIntrinsics& cam, const Pose& T_world_camera, const Observation& o) {
     const Pose T_camera_world = T_world_camera.inverse();
@@ -336,27 +304,23 @@ bool samePose(const Pose& a, const Pose& b, double scale, double maxDeg = 1.0,
            glm::length(a.translation - b.translation) < maxRel * scale;
 }
 
-}  // namespace
-
-PoseEstimator::PoseEstimator(Board board, CameraIntrinsics camera, PoseEstimatorOptions options)
-    : board_(std::move(board)), camera_(std::move(camera)), options_(options) {
-    if (!camera_.isValid()) throw Error("pose estimator: invalid camera intrinsics");
-    if (board_.tags.empty()) throw Error("pose estimator: the board has no tags");
+// A tag supports a pose if its corners reproject within this (pixels).
+double inlierThreshold(const PoseEstimatorOptions& o, const Observation& obs) {
+    return std::max(o.candidateInlierPx, 0.15 * obs.sidePx);
 }
 
-PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections,
-                                     const std::optional<Pose>& prior,
-                                     const std::optional<Pose>& initial) const {
-    PoseEstimate out;
-    char buf[256];
-    // 1. Board tags seen; a tag id seen twice cannot be told apart: both dropped.
+// Step 1. The board tags seen; a tag id seen twice cannot be told apart: both dropped; tags
+// under minTagSidePx are dropped. If none is left, `out` gets the state and reason.
+std::vector<Observation> observations(const Board& board, const PoseEstimatorOptions& options,
+                                      const std::vector<TagDetection>& detections,
+                                      PoseEstimate& out) {
     std::map<int, int> seen;
     for (const auto& d : detections)
-        if (board_.find(d.id)) ++seen[d.id];
+        if (board.find(d.id)) ++seen[d.id];
     std::vector<Observation> obs;
     int tooSmall = 0;
     for (const auto& d : detections) {
-        const BoardTag* tag = board_.find(d.id);
+        const BoardTag* tag = board.find(d.id);
         if (!tag) continue;
         if (seen[d.id] > 1) {
             out.tagsRejected.push_back(d.id);
@@ -373,7 +337,7 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         for (int k = 0; k < 4; ++k)
             o.sidePx = std::min(o.sidePx,
                                 glm::length(d.corners[size_t(k)] - d.corners[size_t((k + 1) % 4)]));
-        if (o.sidePx < options_.minTagSidePx) {
+        if (o.sidePx < options.minTagSidePx) {
             ++tooSmall;
             out.tagsRejected.push_back(d.id);
             continue;
@@ -383,33 +347,39 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     if (obs.empty()) {
         if (tooSmall > 0) {
             out.state = TrackingState::TagsTooSmall;
+            char buf[128];
             std::snprintf(buf, sizeof buf, "%d board tag(s) seen, all under %.0f px", tooSmall,
-                          options_.minTagSidePx);
+                          options.minTagSidePx);
             out.reason = buf;
         } else {
             out.state = TrackingState::NoTags;
             out.reason = seen.empty() ? "no board tag detected" : "only duplicated tag ids seen";
         }
-        return out;
     }
+    return obs;
+}
 
-    // 2. Candidates: both IPPE solutions of each of the largest tags (their corners are the most
-    // precise; a few are enough to contain the right pose even with an outlier tag among them),
-    // as T_world_camera.
+// Step 2. Candidates: both IPPE solutions of each of the largest tags (their corners are the most
+// precise; a few are enough to contain the right pose even with an outlier tag among them), as
+// T_world_camera; `initial` first if given (then only the largest tag's solutions are added).
+std::vector<Pose> initialCandidates(const CameraIntrinsics& camera,
+                                    const PoseEstimatorOptions& options,
+                                    const std::vector<Observation>& obs,
+                                    const std::optional<Pose>& initial) {
     std::vector<const Observation*> initTags;
     for (const auto& o : obs) initTags.push_back(&o);
     std::sort(initTags.begin(), initTags.end(),
               [](const Observation* a, const Observation* b) { return a->sidePx > b->sidePx; });
-    const size_t maxInit = initial ? 1 : size_t(std::max(1, options_.maxInitTags));
+    const size_t maxInit = initial ? 1 : size_t(std::max(1, options.maxInitTags));
     if (initTags.size() > maxInit) initTags.resize(maxInit);
     std::vector<Pose> candidates;
     if (initial && initial->isFinite()) candidates.push_back(*initial);
-    const double maxInitZ = std::cos(glm::radians(options_.maxInitAngleDeg));
+    const double maxInitZ = std::cos(glm::radians(options.maxInitAngleDeg));
     for (const Observation* op : initTags) {
         const Observation& o = *op;
         std::vector<cv::Point2d> img;
         for (const auto& p : o.pixels) {
-            const auto ray = camera_.unproject(p);
+            const auto ray = camera.unproject(p);
             if (!ray || ray->z < maxInitZ) break;
             img.emplace_back(ray->x / ray->z, ray->y / ray->z);
         }
@@ -436,24 +406,26 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
             if (cand.isFinite()) candidates.push_back(cand);
         }
     }
-    if (candidates.empty()) {
-        out.state = TrackingState::Lost;
-        out.reason = "no tag gave an initial pose (IPPE failed)";
-        return out;
-    }
+    return candidates;
+}
 
-    // 3. Score candidates by supporting tags, then error; refine the best few.
-    struct Scored {
-        Pose pose;
-        int support = 0;
-        double cost = 0;
-    };
+struct Scored {
+    Pose pose;
+    int support = 0;
+    double cost = 0;
+};
+
+// Step 3. Candidates by supporting tags, then by error (best first).
+std::vector<Scored> scoreCandidates(const CameraIntrinsics& camera,
+                                    const PoseEstimatorOptions& options,
+                                    const std::vector<Pose>& candidates,
+                                    const std::vector<Observation>& obs) {
     std::vector<Scored> scored;
     for (const auto& c : candidates) {
         Scored s{c, 0, 0};
         for (const auto& o : obs) {
-            const double e = tagRms(camera_, c, o);
-            const double thr = std::max(options_.candidateInlierPx, 0.15 * o.sidePx);
+            const double e = tagRms(camera, c, o);
+            const double thr = inlierThreshold(options, o);
             if (e < thr) ++s.support;
             s.cost += std::min(e, thr);
         }
@@ -462,57 +434,57 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) {
         return a.support != b.support ? a.support > b.support : a.cost < b.cost;
     });
+    return scored;
+}
 
-    // Camera-to-board distance: the scale of "the same translation" when comparing poses (the
-    // world origin may be anywhere relative to the board).
-    double sceneScale = 1e-3;
-    for (const auto& c : candidates)
-        sceneScale =
-            std::max(sceneScale, glm::length(c.translation - obs[0].T_world_tag.translation));
+struct Refined {
+    Fit fit;
+    std::vector<const Observation*> inliers;
+};
 
-    struct Refined {
-        Fit fit;
-        std::vector<const Observation*> inliers;
-    };
-    auto refineWithRejection = [&](const Pose& start) {
-        Refined best;
-        std::vector<const Observation*> use;
-        for (const auto& o : obs) {
-            const double thr = std::max(options_.candidateInlierPx, 0.15 * o.sidePx);
-            if (tagRms(camera_, start, o) < 4 * thr) use.push_back(&o);
-        }
-        if (use.empty()) return best;
-        Fit f = refine(camera_, start, use, false);
-        for (int round = 0; round < 3 && f.ok; ++round) {
-            std::vector<double> rmsPerTag;
-            for (const auto& o : obs) rmsPerTag.push_back(tagRms(camera_, f.pose, o));
-            std::vector<double> sorted;
-            for (size_t i = 0; i < obs.size(); ++i)
-                if (std::find(use.begin(), use.end(), &obs[i]) != use.end())
-                    sorted.push_back(rmsPerTag[i]);
-            std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2),
-                             sorted.end());
-            const double thr = std::max(options_.outlierTagRmsPx, 4 * sorted[sorted.size() / 2]);
-            std::vector<const Observation*> next;
-            for (size_t i = 0; i < obs.size(); ++i)
-                if (rmsPerTag[i] < thr) next.push_back(&obs[i]);
-            if (next.empty()) break;
-            if (next == use) break;
-            use = next;
-            f = refine(camera_, f.pose, use, false);
-        }
-        best.fit = f;
-        best.inliers = use;
-        return best;
-    };
+// Refinement from `start` on the tags near it, then up to 3 rounds of dropping tags whose RMS
+// exceeds max(outlierTagRmsPx, 4 x the median) and refining again.
+Refined refineWithRejection(const CameraIntrinsics& camera, const PoseEstimatorOptions& options,
+                            const std::vector<Observation>& obs, const Pose& start) {
+    Refined best;
+    std::vector<const Observation*> use;
+    for (const auto& o : obs)
+        if (tagRms(camera, start, o) < 4 * inlierThreshold(options, o)) use.push_back(&o);
+    if (use.empty()) return best;
+    Fit f = refine(camera, start, use, false);
+    for (int round = 0; round < 3 && f.ok; ++round) {
+        std::vector<double> rmsPerTag;
+        for (const auto& o : obs) rmsPerTag.push_back(tagRms(camera, f.pose, o));
+        std::vector<double> sorted;
+        for (size_t i = 0; i < obs.size(); ++i)
+            if (std::find(use.begin(), use.end(), &obs[i]) != use.end())
+                sorted.push_back(rmsPerTag[i]);
+        std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+        const double thr = std::max(options.outlierTagRmsPx, 4 * sorted[sorted.size() / 2]);
+        std::vector<const Observation*> next;
+        for (size_t i = 0; i < obs.size(); ++i)
+            if (rmsPerTag[i] < thr) next.push_back(&obs[i]);
+        if (next.empty()) break;
+        if (next == use) break;
+        use = next;
+        f = refine(camera, f.pose, use, false);
+    }
+    best.fit = f;
+    best.inliers = use;
+    return best;
+}
 
+// Step 4. Refines the best-supported candidate and distinct others (for the ambiguity test):
+// at most 4 refinements, at most 3 distinct results, best first (most inlier tags, then RMS).
+std::vector<Refined> refineCandidates(const CameraIntrinsics& camera,
+                                      const PoseEstimatorOptions& options,
+                                      const std::vector<Scored>& scored,
+                                      const std::vector<Observation>& obs, double sceneScale) {
     std::vector<Refined> refined;
-    // At most 4 refinements: the best-supported candidate, and distinct others for the ambiguity
-    // test below (most candidates of a multi-tag view converge to the same pose).
     int refinements = 0;
     for (size_t i = 0; i < scored.size() && refined.size() < 3 && refinements < 4; ++i) {
         // A candidate that explains fewer than half as many tags as the best one cannot win and
-        // is no serious alternative (the classic flip of the largest tag is checked below).
+        // is no serious alternative (the classic flip of the largest tag is checked later).
         if (2 * scored[i].support < scored[0].support) break;
         bool dup = false;
         // An unrefined candidate near an already refined pose would converge to it: single-tag
@@ -522,23 +494,136 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
             dup = dup || samePose(r.fit.pose, scored[i].pose, sceneScale, 5.0, 0.05);
         if (dup) continue;
         ++refinements;
-        Refined r = refineWithRejection(scored[i].pose);
+        Refined r = refineWithRejection(camera, options, obs, scored[i].pose);
         if (!r.fit.ok) continue;
         bool dupAfter = false;
         for (const auto& q : refined)
             dupAfter = dupAfter || samePose(q.fit.pose, r.fit.pose, sceneScale);
         if (!dupAfter) refined.push_back(std::move(r));
     }
+    std::sort(refined.begin(), refined.end(), [](const Refined& a, const Refined& b) {
+        return a.inliers.size() != b.inliers.size() ? a.inliers.size() > b.inliers.size()
+                                                    : a.fit.rms < b.fit.rms;
+    });
+    return refined;
+}
+
+struct Alternative {
+    std::optional<Pose> pose;
+    double rmsPx = -1;  // -1: none
+};
+
+// Step 5. The best distinct alternative to `chosen` on the same tags: the other refined poses,
+// and the flipped IPPE solution of the largest used tag (the classic planar ambiguity), which
+// may not have made it into the refined set.
+Alternative bestAlternative(const CameraIntrinsics& camera, const PoseEstimatorOptions& options,
+                            const std::vector<Refined>& refined, const std::vector<Scored>& scored,
+                            const Pose& chosen, double sceneScale) {
+    const std::vector<const Observation*>& inliers = refined[0].inliers;
+    Alternative alt;
+    auto consider = [&](const Pose& start) {
+        const Fit f = refine(camera, start, inliers, false);
+        if (!f.ok || samePose(f.pose, chosen, sceneScale)) return;
+        if (alt.rmsPx < 0 || f.rms < alt.rmsPx) {
+            alt.rmsPx = f.rms;
+            alt.pose = f.pose;
+        }
+    };
+    for (size_t i = 1; i < refined.size(); ++i) consider(refined[i].fit.pose);
+    const Observation* big = inliers[0];
+    for (const auto* o : inliers)
+        if (o->sidePx > big->sidePx) big = o;
+    int attempts = 0;
+    std::vector<Pose> tried;
+    for (const auto& s : scored) {
+        if (attempts >= 2) break;
+        if (samePose(s.pose, chosen, sceneScale)) continue;
+        bool seenBefore = false;
+        for (const auto& t : tried) seenBefore = seenBefore || samePose(t, s.pose, sceneScale);
+        if (seenBefore) continue;
+        if (tagRms(camera, s.pose, *big) > inlierThreshold(options, *big)) continue;
+        tried.push_back(s.pose);
+        ++attempts;
+        consider(s.pose);
+    }
+    return alt;
+}
+
+}  // namespace
+
+std::vector<double> poseState(const Pose& p) {
+    return {p.translation.x, p.translation.y, p.translation.z, p.rotation.w,
+            p.rotation.x,    p.rotation.y,    p.rotation.z};
+}
+
+Pose poseOfState(const std::vector<double>& x) {
+    Pose p;
+    p.translation = {x[0], x[1], x[2]};
+    p.rotation = glm::dquat(x[3], x[4], x[5], x[6]);
+    return p;
+}
+
+lm::Problem poseLeastSquares(const Board& board, const CameraIntrinsics& camera,
+                             const std::vector<TagDetection>& detections) {
+    struct Data {
+        CameraIntrinsics camera;
+        std::vector<Observation> obs;
+        std::vector<const Observation*> use;
+    };
+    auto d = std::make_shared<Data>();
+    d->camera = camera;
+    PoseEstimatorOptions all;
+    all.minTagSidePx = 0;
+    PoseEstimate unused;
+    d->obs = observations(board, all, detections, unused);
+    for (const auto& o : d->obs) d->use.push_back(&o);
+    lm::Problem inner = poseProblem(d->camera, d->use);
+    lm::Problem p = inner;
+    p.residuals = [d, inner](const std::vector<double>& x, std::vector<double>& r) {
+        return inner.residuals(x, r);
+    };
+    p.jacobian = [d, inner](const std::vector<double>& x, lm::JacobianSink& sink) {
+        inner.jacobian(x, sink);
+    };
+    return p;
+}
+
+PoseEstimator::PoseEstimator(Board board, CameraIntrinsics camera, PoseEstimatorOptions options)
+    : board_(std::move(board)), camera_(std::move(camera)), options_(options) {
+    if (!camera_.isValid()) throw Error("pose estimator: invalid camera intrinsics");
+    if (board_.tags.empty()) throw Error("pose estimator: the board has no tags");
+}
+
+PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections,
+                                     const std::optional<Pose>& prior,
+                                     const std::optional<Pose>& initial) const {
+    PoseEstimate out;
+    const std::vector<Observation> obs = observations(board_, options_, detections, out);
+    if (obs.empty()) return out;
+
+    const std::vector<Pose> candidates = initialCandidates(camera_, options_, obs, initial);
+    if (candidates.empty()) {
+        out.state = TrackingState::Lost;
+        out.reason = "no tag gave an initial pose (IPPE failed)";
+        return out;
+    }
+    const std::vector<Scored> scored = scoreCandidates(camera_, options_, candidates, obs);
+
+    // Camera-to-board distance: the scale of "the same translation" when comparing poses (the
+    // world origin may be anywhere relative to the board).
+    double sceneScale = 1e-3;
+    for (const auto& c : candidates)
+        sceneScale =
+            std::max(sceneScale, glm::length(c.translation - obs[0].T_world_tag.translation));
+
+    const std::vector<Refined> refined =
+        refineCandidates(camera_, options_, scored, obs, sceneScale);
     if (refined.empty()) {
         out.state = TrackingState::Lost;
         out.reason = "pose refinement failed";
         return out;
     }
-    std::sort(refined.begin(), refined.end(), [](const Refined& a, const Refined& b) {
-        return a.inliers.size() != b.inliers.size() ? a.inliers.size() > b.inliers.size()
-                                                    : a.fit.rms < b.fit.rms;
-    });
-    Refined& best = refined[0];
+    const Refined& best = refined[0];
     for (const auto* o : best.inliers) out.tagsUsed.push_back(o->tagId);
     for (const auto& o : obs)
         if (std::find(best.inliers.begin(), best.inliers.end(), &o) == best.inliers.end()) {
@@ -556,45 +641,16 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         out.distanceM = glm::length(finalFit.pose.translation - centre);
     }
 
-    // 4. Ambiguity: the best distinct alternative, refined on the same tags.
-    std::optional<Pose> altPose;
-    for (size_t i = 1; i < refined.size(); ++i) {
-        const Fit alt = refine(camera_, refined[i].fit.pose, best.inliers, false);
-        if (!alt.ok || samePose(alt.pose, finalFit.pose, sceneScale)) continue;
-        if (out.alternativeRmsPx < 0 || alt.rms < out.alternativeRmsPx) {
-            out.alternativeRmsPx = alt.rms;
-            altPose = alt.pose;
-        }
-    }
-    // Also the flipped IPPE solution of the largest used tag (the classic planar ambiguity),
-    // which may not have made it into the refined set.
-    {
-        const Observation* big = best.inliers[0];
-        for (const auto* o : best.inliers)
-            if (o->sidePx > big->sidePx) big = o;
-        int attempts = 0;
-        std::vector<Pose> tried;
-        for (const auto& s : scored) {
-            if (attempts >= 2) break;
-            if (samePose(s.pose, finalFit.pose, sceneScale)) continue;
-            bool seenBefore = false;
-            for (const auto& t : tried) seenBefore = seenBefore || samePose(t, s.pose, sceneScale);
-            if (seenBefore) continue;
-            if (tagRms(camera_, s.pose, *big) >
-                std::max(options_.candidateInlierPx, 0.15 * big->sidePx))
-                continue;
-            tried.push_back(s.pose);
-            ++attempts;
-            const Fit alt = refine(camera_, s.pose, best.inliers, false);
-            if (!alt.ok || samePose(alt.pose, finalFit.pose, sceneScale)) continue;
-            if (out.alternativeRmsPx < 0 || alt.rms < out.alternativeRmsPx) {
-                out.alternativeRmsPx = alt.rms;
-                altPose = alt.pose;
-            }
-        }
-    }
+    const Alternative alt =
+        bestAlternative(camera_, options_, refined, scored, finalFit.pose, sceneScale);
+    out.alternativeRmsPx = alt.rmsPx;
 
-    // 5. Consistency: each tag against the others. Tags that the board pose of the others does
+    // Step 6. The state: lost if the tags disagree or the fit is poor; ok if the alternative is
+    // clearly worse or the previous pose decides between them and the uncertainty is within the
+    // bounds (else uncertain); else ambiguous.
+    char buf[256];
+
+    // Consistency: each tag against the others. Tags that the board pose of the others does
     // not explain were dropped above; when they are not outnumbered by the tags used, no subset
     // can be trusted: most likely the board file does not describe the printed board.
     if (!out.tagsDisagreeing.empty() && out.tagsDisagreeing.size() >= out.tagsUsed.size()) {
@@ -618,8 +674,8 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         out.reason = buf;
         return out;
     }
-    // 6. The pose is ok only if its uncertainty is within the bounds (any state decided below
-    // that would be ok becomes uncertain otherwise).
+    // The pose is ok only if its uncertainty is within the bounds (any state decided below that
+    // would be ok becomes uncertain otherwise).
     auto settle = [&](const std::string& what) {
         const double sr = out.sigmaRotDeg(), sp = out.sigmaPosM();
         const double maxPos = options_.okMaxSigmaPosFraction * out.distanceM;
@@ -640,10 +696,10 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         return out;
     };
     const bool clearlyBetter =
-        !altPose || (out.alternativeRmsPx >= options_.ambiguityRatio * finalFit.rms &&
-                     out.alternativeRmsPx - finalFit.rms >= options_.ambiguityMinGapPx);
+        !alt.pose || (alt.rmsPx >= options_.ambiguityRatio * finalFit.rms &&
+                      alt.rmsPx - finalFit.rms >= options_.ambiguityMinGapPx);
     if (clearlyBetter) {
-        if (altPose)
+        if (alt.pose)
             std::snprintf(buf, sizeof buf, "%zu tag(s), RMS %.2f px, alternative %.2f px",
                           best.inliers.size(), finalFit.rms, out.alternativeRmsPx);
         else
@@ -654,14 +710,13 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     // Ambiguous by error alone: let the previous pose decide if it clearly can.
     if (prior) {
         const double dBest = rotationAngleBetween(prior->rotation, finalFit.pose.rotation);
-        const double dAlt = rotationAngleBetween(prior->rotation, altPose->rotation);
+        const double dAlt = rotationAngleBetween(prior->rotation, alt.pose->rotation);
         const double maxRot = glm::radians(options_.priorMaxRotationDeg);
         const Pose* chosen = nullptr;
         if (dBest <= maxRot && dAlt >= 2 * dBest) chosen = &finalFit.pose;
-        if (dAlt <= maxRot && dBest >= 2 * dAlt) chosen = &*altPose;
+        if (dAlt <= maxRot && dBest >= 2 * dAlt) chosen = &*alt.pose;
         if (chosen) {
-            const bool flipped = chosen != &finalFit.pose;
-            if (flipped) {
+            if (chosen != &finalFit.pose) {
                 const Fit f = refine(camera_, *chosen, best.inliers, true);
                 out.pose = f.pose;
                 out.alternativeRmsPx = finalFit.rms;

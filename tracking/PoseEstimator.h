@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/camera/CameraModel.h"
+#include "core/math/LevenbergMarquardt.h"
 #include "core/math/Pose.h"
 #include "tracking/Board.h"
 #include "tracking/Detector.h"
@@ -142,5 +143,15 @@ private:
     CameraIntrinsics camera_;
     PoseEstimatorOptions options_;
 };
+
+// The refinement's least-squares problem (core/math/LevenbergMarquardt.h) over all corners of the
+// board tags in `detections` (a tag id seen twice is left out): residuals = projected - detected
+// pixels, x then y per corner; state = poseState(T_world_camera) = (camera centre in the world,
+// metres; orientation quaternion w x y z); step = (rotation vector of a world-frame perturbation of
+// the orientation, radians; camera-centre offset, metres). The problem keeps copies of its inputs.
+lm::Problem poseLeastSquares(const Board& board, const CameraIntrinsics& camera,
+                             const std::vector<TagDetection>& detections);
+std::vector<double> poseState(const Pose& T_world_camera);
+Pose poseOfState(const std::vector<double>& x);
 
 }  // namespace mirage::tracking

@@ -100,9 +100,18 @@ void Tracker::measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) 
         if (d.edgeWidthPx < 0 && estimator_.board().find(d.id)) d.edgeWidthPx = w;
 }
 
+namespace {
+// The detector looks for the board's tag family: a board of tag25h9 tags is searched for
+// tag25h9 codes, whatever the options' default says.
+TrackerOptions forBoard(TrackerOptions o, const Board& board) {
+    o.detector.family = board.family;
+    return o;
+}
+}  // namespace
+
 Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
-    : options_(options),
-      detector_(options.detector),
+    : options_(forBoard(options, board)),
+      detector_(options_.detector),
       tagFinder_(board, camera, options.prediction),
       estimator_(std::move(board), std::move(camera), options.pose),
       filter_(options.filter),

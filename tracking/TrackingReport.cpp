@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/Csv.h"
 #include "core/Error.h"
 
 namespace mirage::tracking {
@@ -55,14 +56,12 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
     poseMs_.push_back(f.poseMs);
     filterMs_.push_back(f.filterMs);
     const bool ok = e.state == TrackingState::Ok;
-    std::string reason = e.reason;
-    std::replace(reason.begin(), reason.end(), '"', '\'');
     std::string tags;
     for (int id : e.tagsUsed) tags += (tags.empty() ? "" : " ") + std::to_string(id);
     char b[512];
-    std::snprintf(b, sizeof b, "%d,%.6f,%s,\"%s\",", frameIndex, f.t, trackingStateName(e.state),
-                  reason.c_str());
-    csv_ << b << poseCols(ok ? f.filtered : std::nullopt) << "," << tags << ",";
+    std::snprintf(b, sizeof b, "%d,%.6f,%s,", frameIndex, f.t, trackingStateName(e.state));
+    csv_ << b << csvField(e.reason) << "," << poseCols(ok ? f.filtered : std::nullopt) << ","
+         << tags << ",";
     if (ok) {
         rms_.push_back(e.rmsPx);
         std::snprintf(b, sizeof b, "%.4f", e.rmsPx);
@@ -109,6 +108,26 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
     }
     csv_ << "\n";
     csv_.flush();
+}
+
+void TrackingReport::addUnreadableFrame(int frameIndex, const TrackedFrame& lost) {
+    add(frameIndex, lost, std::nullopt, 0.0);
+    // The row is written; the counts move from "tracked, lost" to "unreadable".
+    --frames_;
+    --stateCount_[size_t(lost.estimate.state)];
+    ++unreadable_;
+    decodeMs_.pop_back();
+    detectMs_.pop_back();
+    poseMs_.pop_back();
+    filterMs_.pop_back();
+}
+
+void TrackingReport::close() {
+    csv_.flush();
+    const bool ok = csv_.good();
+    csv_.close();
+    if (!ok || csv_.fail())
+        throw FileError(path_.string(), "writing the poses CSV failed (disk full?)");
 }
 
 std::string TrackingReport::summary() const {

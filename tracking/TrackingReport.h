@@ -35,6 +35,11 @@ public:
     void add(int frameIndex, const TrackedFrame& f, const std::optional<Pose>& groundTruth,
              double decodeMs);
     void addUnreadable(int count) { unreadable_ += count; }
+    // A frame whose image is lost (damaged or missing bytes): its row says lost with `lost`'s
+    // reason (from Tracker::markLost) and it counts as unreadable, not as a tracked frame.
+    void addUnreadableFrame(int frameIndex, const TrackedFrame& lost);
+    // Flushes and closes the CSV; throws FileError if any write failed (e.g. the disk is full).
+    void close();
 
     // Human-readable summary (several lines).
     std::string summary() const;

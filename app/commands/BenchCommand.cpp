@@ -21,8 +21,10 @@
 #include <fmt/format.h>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
@@ -39,7 +41,7 @@ namespace fs = std::filesystem;
 struct BenchArgs {
     std::string session, scene, output;
     std::vector<std::string> knobs;  // NAME=V1,V2,...
-    bool quick = false, listKnobs = false, noBaseline = false, images = false;
+    bool quick = false, listKnobs = false, noBaseline = false, images = false, force = false;
     int maxFrames = -1, start = 0, repeats = 1;
     float exposure = 1.0f;
 };
@@ -122,6 +124,14 @@ void runBench(const BenchArgs& a) {
                             : scenePath,
                         "scene not found; pass --scene SCENE.gltf (the scene the session was "
                         "synthesised from, with its virtual objects)");
+    // The outputs are checked before the benchmark runs (core/OutputFile.h).
+    const fs::path out(a.output);
+    OutputRule rule{sessionInputs(session), a.force, "mirage bench"};
+    rule.inputs.push_back(scenePath);
+    checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/true);
+    OutputFile csvOut(out / "bench.csv", OutputOrigin::Derived, rule);
+    OutputFile framesOut(out / "bench_frames.csv", OutputOrigin::Derived, rule);
+    OutputFile mdOut(out / "bench.md", OutputOrigin::Derived, rule);
     const Scene scene = loadScene(scenePath);
     if (!scene.hasVirtual())
         throw FileError(scenePath, "the scene has no virtual object: nothing to judge");
@@ -142,7 +152,6 @@ void runBench(const BenchArgs& a) {
                         "no frame has both a ground-truth pose (frames.csv) and a "
                         "ground-truth composite to judge against");
 
-    fs::create_directories(a.output);
     gl::ContextOptions copt;
     copt.width = calib.intrinsics.width;
     copt.height = calib.intrinsics.height;
@@ -190,10 +199,12 @@ void runBench(const BenchArgs& a) {
             for (const auto& f : frames) n += cv::countNonZero(f.influence);
             return n;
         }());
-    const fs::path out(a.output);
-    render::writeBenchCsv((out / "bench.csv").string(), results);
-    render::writeBenchFramesCsv((out / "bench_frames.csv").string(), results);
-    render::writeBenchMarkdown((out / "bench.md").string(), results, preamble);
+    render::writeBenchCsv(csvOut.temp().string(), results);
+    render::writeBenchFramesCsv(framesOut.temp().string(), results);
+    render::writeBenchMarkdown(mdOut.temp().string(), results, preamble);
+    csvOut.commit();
+    framesOut.commit();
+    mdOut.commit();
     if (a.images) {
         // The first frame of every configuration beside its ground truth (sRGB PNG).
         fs::create_directories(out / "images");
@@ -227,13 +238,16 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
                     "NAME=V1,V2,...: the values of one knob (repeatable; see --list-knobs)")
         ->allow_extra_args(false);
     cmd->add_flag("--list-knobs", a->listKnobs, "List the knobs and exit");
-    cmd->add_option("--frames", a->maxFrames, "Use at most N frames");
-    cmd->add_option("--start", a->start, "First frame")->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--force", a->force, "Replace bench.csv, bench_frames.csv, bench.md in OUTDIR");
+    cmd->add_option("--frames", a->maxFrames, "Use at most N frames")
+        ->check(wholeIn(-1, 100000000));
+    cmd->add_option("--start", a->start, "First frame")->check(wholeIn(0, 100000000));
     cmd->add_option("--repeat", a->repeats, "Run the frame sequence R times (timings pooled)")
         ->capture_default_str();
     cmd->add_option("--exposure", a->exposure,
                     "Rendered radiance -> camera linear units (the synth's --exposure)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--no-baseline", a->noBaseline, "Leave out the footage-only rows");
     cmd->add_flag("--images", a->images,
                   "Also write each configuration's first composite and the ground truth to "

@@ -4,8 +4,10 @@
 #include <memory>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "tracking/BoardImage.h"
 #include "tracking/BoardLayout.h"
 
@@ -17,6 +19,7 @@ struct BoardArgs {
     std::string output;
     std::string json;
     double dpi = 300;
+    bool force = false;
 };
 
 const CommandRegistrar reg("board", [](CLI::App& parent) {
@@ -37,22 +40,33 @@ const CommandRegistrar reg("board", [](CLI::App& parent) {
     cmd->add_option("--family", a->layout.family, "AprilTag family")->capture_default_str();
     cmd->add_option("-o,--output", a->output, "board.pdf (vector) or board.png")->required();
     cmd->add_option("--json", a->json, "Board file to write (default: output with .json)");
-    cmd->add_option("--dpi", a->dpi, "PNG resolution in dots per inch")->capture_default_str();
+    cmd->add_option("--dpi", a->dpi, "PNG resolution in dots per inch")
+        ->capture_default_str()
+        ->check(finiteIn(1, 4800));
+    cmd->add_flag("--force", a->force, "Replace an existing board file beside the output");
     cmd->callback([a] {
         const std::filesystem::path out(a->output);
         const tracking::Board board = a->layout.makeBoard();
         std::string ext = out.extension().string();
         for (auto& ch : ext) ch = char(std::tolower(ch));
-        if (ext == ".pdf")
-            tracking::writeBoardPdf(out, board);
-        else if (ext == ".png")
-            tracking::writeBoardPng(out, board, a->dpi);
-        else
+        if (ext != ".pdf" && ext != ".png")
             throw Error("mirage board: output '" + a->output + "' must end in .pdf or .png");
         std::filesystem::path json = a->json.empty()
                                          ? std::filesystem::path(out).replace_extension(".json")
                                          : std::filesystem::path(a->json);
-        board.save(json);
+        // Checked before writing anything (core/OutputFile.h); the board file beside the sheet
+        // is not replaced without --force unless named with --json.
+        const OutputRule rule{{}, a->force, "mirage board"};
+        OutputFile sheetOut(out, OutputOrigin::Named, rule);
+        OutputFile jsonOut(json, a->json.empty() ? OutputOrigin::Derived : OutputOrigin::Named,
+                           rule);
+        if (ext == ".pdf")
+            tracking::writeBoardPdf(sheetOut.temp(), board);
+        else
+            tracking::writeBoardPng(sheetOut.temp(), board, a->dpi);
+        board.save(jsonOut.temp());
+        sheetOut.commit();
+        jsonOut.commit();
         spdlog::info("wrote {} ({:.1f} x {:.1f} mm, print at 100 %) and {}", out.string(),
                      board.sheet->width * 1000, board.sheet->height * 1000, json.string());
     });

@@ -5,6 +5,7 @@
 // Exit codes: 0 = reliable calibration written; 2 = written but marked `reliable: false` (the
 // reason is in the file and the report); 1 = error, no file written.
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -18,12 +19,14 @@
 #include "calibration/SyntheticViews.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 
 namespace mirage::app {
 namespace {
 
 struct CalibrateArgs {
+    bool force = false;
     bool batch = false;
     std::vector<std::string> inputs;
     std::string board;
@@ -53,10 +56,10 @@ DistortionModel modelOf(const std::string& name) {
     throw Error("--model '" + name + "': use pinhole or fisheye");
 }
 
-void writeText(const std::string& path, const std::string& text) {
+void writeText(const std::filesystem::path& path, const std::string& text) {
     std::ofstream out(path);
     out << text;
-    if (!out) throw FileError(path, "cannot write the report");
+    closeChecked(out, path);
 }
 
 void runBatch(const CalibrateArgs& a) {
@@ -65,6 +68,19 @@ void runBatch(const CalibrateArgs& a) {
             "--board is required (a board file, chessboard:9x6:0.025 or charuco:5x7:0.04:0.02)");
     if (a.output.empty()) throw Error("-o CAM.yaml is required");
     const auto target = calib::CalibrationTarget::parse(a.board);
+    // Outputs checked before the work (core/OutputFile.h): never an input, parent folders
+    // created, the report beside the calibration never replaced without --force.
+    OutputRule rule{{}, a.force, "mirage calibrate"};
+    for (const auto& in : a.inputs) rule.inputs.push_back(in);
+    for (const auto& in : a.mainInputs) rule.inputs.push_back(in);
+    for (const std::string& in : {a.board, a.mainCalib, a.worldImage})
+        if (!in.empty()) rule.inputs.push_back(in);
+    OutputFile calOut(a.output, OutputOrigin::Named, rule);
+    const std::string reportPath = a.report.empty() ? a.output + ".report.txt" : a.report;
+    OutputFile reportOut(reportPath, a.report.empty() ? OutputOrigin::Derived : OutputOrigin::Named,
+                         rule);
+    std::optional<OutputFile> rosOut;
+    if (!a.ros.empty()) rosOut.emplace(a.ros, OutputOrigin::Named, rule);
     calib::BatchOptions o;
     o.calibration.model = modelOf(a.model);
     o.calibration.fixK3 = a.fixK3;
@@ -97,13 +113,15 @@ void runBatch(const CalibrateArgs& a) {
 
     const std::string report = calib::formatReport(result) + extrinsicReport;
     fmt::print("{}", report);
-    saveCalibration(a.output, cal);
-    const std::string reportPath = a.report.empty() ? a.output + ".report.txt" : a.report;
-    writeText(reportPath, report);
+    saveCalibration(calOut.temp(), cal);
+    writeText(reportOut.temp(), report);
+    calOut.commit();
+    reportOut.commit();
     spdlog::info("wrote {} and {}", a.output, reportPath);
-    if (!a.ros.empty()) {
+    if (rosOut) {
         if (cal.reliable) {
-            saveRosCameraInfo(a.ros, cal, a.rosName);
+            saveRosCameraInfo(rosOut->temp(), cal, a.rosName);
+            rosOut->commit();
             spdlog::info("wrote ROS camera_info {}", a.ros);
         } else {
             spdlog::warn("not writing {}: ROS camera_info cannot carry 'reliable: false'", a.ros);
@@ -204,6 +222,7 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
     cmd->add_option("--ros-name", a->rosName, "camera_name in the ROS export")
         ->capture_default_str();
     cmd->add_option("--report", a->report, "Report file (default: OUTPUT.report.txt)");
+    cmd->add_flag("--force", a->force, "Replace an existing report beside the output");
     cmd->add_flag("--fix-k3", a->fixK3, "Pinhole: keep k3 = 0 (narrow lenses)");
     cmd->add_option("--video-step", a->videoStep,
                     "Videos: use every Nth frame (default: about 120 frames per video)");

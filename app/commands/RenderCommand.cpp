@@ -8,9 +8,11 @@
 #include <fmt/format.h>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "render/raytrace/DifferentialRendering.h"
@@ -25,12 +27,8 @@ struct RenderArgs {
     uint64_t seed = 1;
     float exposure = 1.0f;
     bool saveBuffers = false;
+    bool force = false;
 };
-
-void writeImage(const std::filesystem::path& path, const cv::Mat& linearRgb, float exposure) {
-    writeLinearRgb(path, linearRgb, exposure);
-    spdlog::info("wrote {}", path.string());
-}
 
 void run(const RenderArgs& a) {
     const std::filesystem::path out(a.output);
@@ -46,6 +44,20 @@ void run(const RenderArgs& a) {
     if (a.seconds < 0) throw Error("mirage render: --seconds must be >= 0");
     if (a.width < 1 || a.height < 0)
         throw Error("mirage render: --width/--height must be positive");
+
+    // Inputs and outputs are checked before the render, which can take hours: the output folder
+    // is created and a temporary file reserved in it, the camera image is read now.
+    OutputRule rule{{a.scene}, a.force, "mirage render"};
+    if (!a.cameraImage.empty()) rule.inputs.push_back(a.cameraImage);
+    OutputFile outFile(out, OutputOrigin::Named, rule);
+    std::vector<OutputFile> bufferFiles;
+    if (a.saveBuffers && a.mode == "composite") {
+        const auto stem = out.parent_path() / out.stem();
+        for (const char* suffix : {"_Lr.exr", "_Lrv.exr", "_coverage.exr"})
+            bufferFiles.emplace_back(stem.string() + suffix, OutputOrigin::Derived, rule);
+    }
+    cv::Mat cameraImage;
+    if (!a.cameraImage.empty()) cameraImage = readLinearRgb(a.cameraImage);
 
     Scene scene = loadScene(a.scene);
     int height = a.height;
@@ -87,7 +99,7 @@ void run(const RenderArgs& a) {
             // Synthetic footage: the camera sees exactly the real-only render.
             ci = images.realOnly;
         } else {
-            ci = readLinearRgb(a.cameraImage);
+            ci = cameraImage;
             if (ci.size() != images.realOnly.size())
                 throw FileError(
                     a.cameraImage,
@@ -97,12 +109,14 @@ void run(const RenderArgs& a) {
         }
         result = raytrace::compositeDifferential(ci, images);
         if (a.saveBuffers) {
-            auto stem = out.parent_path() / out.stem();
-            writeImage(stem.string() + "_Lr.exr", images.realOnly, 1.0f);
-            writeImage(stem.string() + "_Lrv.exr", images.realAndVirtual, 1.0f);
             cv::Mat cov;
             cv::merge(std::vector<cv::Mat>(3, images.virtualCoverage), cov);
-            writeImage(stem.string() + "_coverage.exr", cov, 1.0f);
+            const cv::Mat* buffers[] = {&images.realOnly, &images.realAndVirtual, &cov};
+            for (size_t k = 0; k < bufferFiles.size(); ++k) {
+                writeLinearRgb(bufferFiles[k].temp(), *buffers[k], 1.0f);
+                bufferFiles[k].commit();
+                spdlog::info("wrote {}", bufferFiles[k].path().string());
+            }
         }
         spdlog::info("L_r: {} passes in {:.1f} s; L_rv: {} passes in {:.1f} s",
                      images.realStats.passes, images.realStats.seconds, images.mixedStats.passes,
@@ -120,7 +134,9 @@ void run(const RenderArgs& a) {
                          r.nonFiniteSamples);
         result = r.radiance;
     }
-    writeImage(out, result, ext == ".png" ? a.exposure : 1.0f);
+    writeLinearRgb(outFile.temp(), result, ext == ".png" ? a.exposure : 1.0f);
+    outFile.commit();
+    spdlog::info("wrote {}", out.string());
 }
 
 const CommandRegistrar reg("render", [](CLI::App& parent) {
@@ -132,19 +148,27 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
     cmd->add_option("-o,--output", a->output,
                     "Image: .exr/.pfm (linear RGB) or .png (tone-mapped sRGB)")
         ->required();
-    cmd->add_option("--spp", a->spp, "Samples (passes) per pixel")->capture_default_str();
+    cmd->add_option("--spp", a->spp, "Samples (passes) per pixel")
+        ->capture_default_str()
+        ->check(wholeIn(1, 1 << 30));
     cmd->add_option("--seconds", a->seconds,
-                    "Time budget instead of --spp (per image; composite renders two)");
-    cmd->add_option("--width", a->width, "Image width in pixels")->capture_default_str();
+                    "Time budget instead of --spp (per image; composite renders two)")
+        ->check(finiteIn(0, 1e7));
+    cmd->add_option("--width", a->width, "Image width in pixels")
+        ->capture_default_str()
+        ->check(wholeIn(1, 16384));
     cmd->add_option("--height", a->height,
-                    "Image height (default: from the camera's aspect ratio, else 4:3)");
+                    "Image height (default: from the camera's aspect ratio, else 4:3)")
+        ->check(wholeIn(0, 16384));
     cmd->add_option("--seed", a->seed, "Random seed (same seed = same image)")
         ->capture_default_str();
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(0, 4096));
     cmd->add_option("--exposure", a->exposure,
                     "PNG only: multiplies linear radiance before sRGB encoding")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e6, true));
     cmd->add_option("--mode", a->mode,
                     "rv = real + virtual (L_rv), r = real only (L_r), composite = differential "
                     "rendering into "
@@ -152,11 +176,15 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
         ->capture_default_str();
     cmd->add_option("--camera-image", a->cameraImage,
                     "composite: the camera image (linear .exr/.pfm or sRGB .png)");
+    cmd->add_flag("--force", a->force, "Replace existing --save-buffers files beside the output");
     cmd->add_flag("--save-buffers", a->saveBuffers,
                   "composite: also write OUT_Lr.exr, OUT_Lrv.exr, OUT_coverage.exr");
     cmd->add_option("--photons", a->photons, "Caustic photons per pass (0 = automatic)")
-        ->capture_default_str();
-    cmd->add_option("--max-depth", a->maxDepth, "Maximum path vertices")->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(0, 1 << 30));
+    cmd->add_option("--max-depth", a->maxDepth, "Maximum path vertices")
+        ->capture_default_str()
+        ->check(wholeIn(1, 1024));
     cmd->callback([a] { run(*a); });
 });
 

@@ -16,25 +16,30 @@
 // reset on the next tracked frame. An `uncertain` frame is composited with the last ok pose if
 // that is at most 0.25 s old (the reason says so), else treated as lost.
 #include <unistd.h>
-#include <atomic>
+#include <cctype>
 #include <chrono>
-#include <csignal>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
 #include "core/Csv.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
+#include "core/gl/Objects.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "core/session/MatroskaWriter.h"
+#include "core/session/PosesCsv.h"
 #include "core/session/Session.h"
 #include "render/Renderer.h"
 #include "tracking/Tracker.h"
@@ -42,9 +47,9 @@
 namespace mirage::app {
 namespace {
 
-std::atomic<bool> gInterrupted{false};
-extern "C" void onSigint(int) {
-    gInterrupted = true;
+bool gWindowClosed = false;
+bool stopped() {
+    return gWindowClosed || stopRequested();
 }
 
 using Clock = std::chrono::steady_clock;
@@ -52,57 +57,6 @@ using Clock = std::chrono::steady_clock;
 constexpr double kHoldUncertainS = 0.25;
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-struct PoseRow {
-    std::string state, reason;
-    std::optional<Pose> pose;
-};
-
-// Reads a `mirage track` CSV: frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz (header required).
-std::map<int, PoseRow> readPosesCsv(const std::filesystem::path& path) {
-    std::ifstream in(path);
-    if (!in) throw FileError(path.string(), "cannot open the poses file");
-    std::string line;
-    if (!std::getline(in, line)) throw FileError(path.string(), "empty poses file (no header)");
-    const std::vector<std::string> header = splitCsvLine(line);
-    auto col = [&](const std::string& name) {
-        for (size_t i = 0; i < header.size(); ++i)
-            if (header[i] == name) return int(i);
-        throw FileError(path.string(),
-                        "header has no column '" + name +
-                            "' (expected frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz)");
-    };
-    const int cFrame = col("frame"), cState = col("state"), cReason = col("reason");
-    const int cP[7] = {col("tx"), col("ty"), col("tz"), col("qw"), col("qx"), col("qy"), col("qz")};
-    std::map<int, PoseRow> rows;
-    int lineNo = 1;
-    while (std::getline(in, line)) {
-        ++lineNo;
-        if (line.empty()) continue;
-        // The reason column is quoted when it holds commas ("11 tag(s), RMS 0.17 px").
-        std::vector<std::string> f = splitCsvLine(line);
-        f.resize(header.size());
-        PoseRow r;
-        r.state = f[size_t(cState)];
-        r.reason = f[size_t(cReason)];
-        try {
-            const int frame = std::stoi(f[size_t(cFrame)]);
-            if (!f[size_t(cP[0])].empty()) {
-                double v[7];
-                for (int i = 0; i < 7; ++i) v[i] = std::stod(f[size_t(cP[i])]);
-                Pose p;
-                p.translation = {v[0], v[1], v[2]};
-                p.rotation = glm::normalize(glm::dquat(v[3], v[4], v[5], v[6]));
-                if (p.isFinite()) r.pose = p;
-            }
-            rows[frame] = r;
-        } catch (const std::exception&) {
-            throw FileError(path.string(), "line " + std::to_string(lineNo) +
-                                               ": cannot parse frame number or pose numbers");
-        }
-    }
-    return rows;
 }
 
 void progress(int done, int total, double fps) {
@@ -129,7 +83,20 @@ struct ReplayArgs {
     bool window = false;
     bool verbose = false;
     bool groundTruth = false;
+    bool force = false;
 };
+
+// The output's kind from its name: OUT.mkv is a video; a name without extension (or an
+// existing folder) is a folder of PNG frames; anything else would be a surprise, so it is refused.
+bool isVideoOutput(const std::filesystem::path& out) {
+    std::string ext = out.extension().string();
+    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext == ".mkv") return true;
+    if (ext.empty() || std::filesystem::is_directory(out)) return false;
+    throw Error("mirage replay: output '" + out.string() +
+                "' must end in .mkv (MJPEG video) or be a folder (no extension) for PNG frames; " +
+                ext + " is not written");
+}
 
 void runReplay(const ReplayArgs& a) {
     SessionReadReport readReport;
@@ -140,6 +107,24 @@ void runReplay(const ReplayArgs& a) {
         if (c.role == "main") main = &c;
     if (!main && !session.cameras.empty()) main = &session.cameras.front();
     if (!main) throw FileError(a.session, "the session lists no camera");
+
+    // Outputs are checked before any work: never one of the inputs, never an unnamed existing
+    // file without --force; written under temporary names and renamed when finished.
+    const std::filesystem::path out = a.output;
+    const bool mkv = isVideoOutput(out);
+    OutputRule rule{sessionInputs(session), a.force, "mirage replay"};
+    rule.inputs.push_back(a.scene);
+    if (!a.poses.empty()) rule.inputs.push_back(a.poses);
+    std::optional<OutputFile> videoOut;
+    std::filesystem::path csvPath;
+    if (mkv) {
+        videoOut.emplace(out, OutputOrigin::Named, rule);
+        csvPath = std::filesystem::path(out).replace_extension(".csv");
+    } else {
+        checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/true);
+        csvPath = out / "frames.csv";
+    }
+    OutputFile csvOut(csvPath, OutputOrigin::Derived, rule);
     if (main->calibration.empty())
         throw FileError(a.session, "camera '" + main->name +
                                        "' has no calibration file; calibrate it (mirage calibrate) "
@@ -175,18 +160,9 @@ void runReplay(const ReplayArgs& a) {
     render::Renderer renderer(scene, calib.intrinsics, ropt);
 
     // Output.
-    const std::filesystem::path out = a.output;
-    const bool mkv = out.extension() == ".mkv";
-    std::filesystem::path csvPath =
-        mkv ? std::filesystem::path(out).replace_extension(".csv") : out / "frames.csv";
     std::unique_ptr<MatroskaWriter> video;
-    if (mkv) {
-        if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
-        video = std::make_unique<MatroskaWriter>(out, session.fps, a.jpegQuality);
-    } else {
-        std::filesystem::create_directories(out);
-    }
-    std::ofstream csv(csvPath);
+    if (mkv) video = std::make_unique<MatroskaWriter>(videoOut->temp(), session.fps, a.jpegQuality);
+    std::ofstream csv(csvOut.temp());
     if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
     const char* passes[] = {"gbuffer",  "shadow",   "vpl",       "ism",
                             "impostor", "direct",   "indirect",  "gifilter",
@@ -198,7 +174,7 @@ void runReplay(const ReplayArgs& a) {
     auto frames = openCameraFrames(session, main->name);
     const int listed = int(session.frames.size());
     const int total = a.maxFrames >= 0 ? std::min(a.maxFrames, listed - a.start) : listed - a.start;
-    std::signal(SIGINT, onSigint);
+    installStopSignals();
     cv::Mat bgr;
     for (int i = 0; i < a.start && frames->read(bgr); ++i) {
     }
@@ -207,7 +183,7 @@ void runReplay(const ReplayArgs& a) {
     std::optional<Pose> lastGood;  // the last composited tracked or given pose, and its time
     double lastGoodT = 0;
     int done = 0;
-    for (int k = 0; k < total && !gInterrupted; ++k) {
+    for (int k = 0; k < total && !stopped(); ++k) {
         const FrameRecord& rec = session.frames[size_t(a.start + k)];
         const auto t0 = Clock::now();
         if (!frames->read(bgr)) {
@@ -218,7 +194,14 @@ void runReplay(const ReplayArgs& a) {
         const auto t1 = Clock::now();
         PoseRow pr;
         const double tFrame = rec.timestamps.empty() ? k / session.fps : rec.timestamps.front();
-        if (tracker) {
+        const std::string problem = frames->lastProblem();
+        if (bgr.empty()) {
+            // Lost (damaged bytes): no image to composite into and no pose to trust; the row
+            // says why, the output skips the frame.
+            pr = {"lost", problem.empty() ? "frame not decodable" : problem, std::nullopt};
+            if (tracker) tracker->markLost(tFrame, pr.reason);
+            spdlog::warn("replay: {}", pr.reason);
+        } else if (tracker) {
             tracking::TrackedFrame tf = tracker->process(bgr, tFrame);
             pr.state = tracking::trackingStateName(tf.estimate.state);
             pr.reason = tf.estimate.reason;
@@ -264,14 +247,12 @@ void runReplay(const ReplayArgs& a) {
             result = renderer.compositeSrgb();
             readbackMs = msSince(t2);
             if (a.window) {
-                GLuint fbo = 0;
-                glCreateFramebuffers(1, &fbo);
-                glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0,
-                                          renderer.compositeTexture().id(), 0);
+                // The composite, flipped to the window's bottom-up rows.
+                gl::Framebuffer source("replay window blit");
+                source.attachColor(0, renderer.compositeTexture());
                 const int w = calib.intrinsics.width, h = calib.intrinsics.height;
-                glBlitNamedFramebuffer(fbo, 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
+                glBlitNamedFramebuffer(source.id(), 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
                                        GL_NEAREST);
-                glDeleteFramebuffers(1, &fbo);
             }
         } else {
             result = bgr;  // tracking lost: the footage passes through, history resets
@@ -279,15 +260,17 @@ void runReplay(const ReplayArgs& a) {
         lastLost = !pr.pose;
         const auto t3 = Clock::now();
         const double t = tFrame;
-        if (video)
+        if (result.empty()) {
+        } else if (video) {
             video->append(result, t);
-        else
+        } else {
             writeBgr8(out / cv::format("frame_%06d.png", rec.index), result);
+        }
         const double encodeMs = msSince(t3);
         if (a.window) {
             ctx.swapBuffers();
             ctx.pollEvents();
-            if (ctx.shouldClose()) gInterrupted = true;
+            if (ctx.shouldClose()) gWindowClosed = true;
         }
         std::string reason = pr.reason;  // keep the CSV's columns: no commas or newlines inside
         for (char& ch : reason)
@@ -310,10 +293,17 @@ void runReplay(const ReplayArgs& a) {
         progress(done, total, done / std::max(1e-9, msSince(tStart) * 1e-3));
     }
     if (isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
+    // Interrupted or not, the frames done so far become the outputs (a playable video and its
+    // CSV); an interruption still exits non-zero so that scripts do not take it for a full run.
     if (video) video->close();
-    std::signal(SIGINT, SIG_DFL);
-    if (gInterrupted)
+    closeChecked(csv, csvPath);
+    if (videoOut) videoOut->commit();
+    csvOut.commit();
+    restoreStopSignals();
+    if (stopRequested()) {
         spdlog::warn("replay: interrupted after {} frames; {} is playable", done, a.output);
+        commandExitCode() = 128 + stopSignal();
+    }
     spdlog::info("replay: {} frames -> {} (timings: {})", done, a.output, csvPath.string());
 }
 
@@ -332,15 +322,21 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_option("-o,--output", args->output, "OUT.mkv (MJPEG video) or a folder for PNG frames")
         ->required();
     cmd->add_option("--poses", args->poses,
-                    "Camera poses CSV from `mirage track` (default: the session's ground truth)")
+                    "Camera poses CSV from `mirage track` (default: live tracking on the session's "
+                    "board; the ground truth when it has no board file)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
-        ->check(CLI::Range(0, 16384));
-    cmd->add_option("--frames", args->maxFrames, "Replay at most N frames");
-    cmd->add_option("--start", args->start, "First frame")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units");
+
+        ->check(wholeIn(0, 16384));
+    cmd->add_option("--frames", args->maxFrames, "Replay at most N frames")
+        ->check(wholeIn(-1, 100000000));
+    cmd->add_option("--start", args->start, "First frame")->check(wholeIn(0, 100000000));
+    cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
+        ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--ground-truth", args->groundTruth,
                   "Use the session's ground-truth poses (frames.csv) instead of tracking");
+    cmd->add_flag("--force", args->force,
+                  "Replace an existing CSV beside the output (never an input of the replay)");
     cmd->add_flag("--window", args->window, "Show the result in a window (needs a display)");
     cmd->add_flag("-v,--verbose", args->verbose, "Log which passes ran and why");
     cmd->callback([args] { runReplay(*args); });

@@ -2,6 +2,8 @@
 // reference renderer from the scene's REAL parts only (what a real camera would film), along a
 // camera path (orbit, hand-held shake, fast pan), with optional sensor effects, plus the fish-eye
 // environment camera. Writes the session format of docs/session.md (docs/reference-renderer.md).
+#include <unistd.h>
+
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -10,9 +12,11 @@
 #include <fmt/format.h>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/scene/Scene.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tracking/Board.h"
@@ -30,12 +34,25 @@ struct SynthArgs {
 
 void run(SynthArgs a) {
     const fs::path out(a.output);
+    const double frames = a.o.fps * a.o.seconds;
+    if (!(frames >= 1 && frames <= 1e6))
+        throw Error(
+            fmt::format("mirage synth: --fps {} x --seconds {} gives {} frames; the "
+                        "footage must have 1 to 1000000 frames",
+                        a.o.fps, a.o.seconds, frames));
+    OutputRule rule{{a.scene}, a.force, "mirage synth"};
+    if (!a.board.empty()) rule.inputs.push_back(a.board);
+    checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/true);
+    std::error_code ec;
     if (fs::exists(out / "session.json")) {
         if (!a.force)
             throw FileError(
                 out.string(),
                 "already holds a session; choose another folder or pass --force to replace it");
-        fs::remove_all(out);
+    } else if (fs::exists(out) && !fs::is_empty(out, ec) && !a.force) {
+        throw FileError(out.string(),
+                        "exists and is not empty; choose another folder or pass --force to "
+                        "replace it");
     }
     Scene scene = loadScene(a.scene);
     fs::path boardPath =
@@ -50,16 +67,37 @@ void run(SynthArgs a) {
     // The scene's path as given (made absolute): ground_truth.json names it for `mirage bench`.
     a.o.sceneName = fs::absolute(a.scene).lexically_normal().string();
 
+    // The session is written into a temporary folder beside OUT and moved into place when
+    // complete: a failed or interrupted synth leaves no half-written session at OUT.
+    createParentFolders(out);
+    fs::path temp = out;
+    temp.replace_filename(out.filename().string() + ".partial-" + std::to_string(::getpid()));
+    fs::remove_all(temp, ec);
+    struct RemoveOnFailure {
+        fs::path dir;
+        ~RemoveOnFailure() {
+            std::error_code e;
+            if (!dir.empty()) fs::remove_all(dir, e);
+        }
+    } cleanup{temp};
+
     TerminalProgress bar("synth");
     const auto start = std::chrono::steady_clock::now();
     raytrace::writeSyntheticSession(
-        scene, out, a.o, [&](int done, int total, const std::string& segment) {
+        scene, temp, a.o, [&](int done, int total, const std::string& segment) {
             const double elapsed =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             bar.update(done, total,
                        fmt::format("frame {}/{} ({}), {:.0f} s", done, total, segment, elapsed));
         });
     bar.finish();
+    if (fs::exists(out)) fs::remove_all(out);  // --force (checked above), or an empty folder
+    fs::rename(temp, out, ec);
+    if (ec)
+        throw FileError(out.string(),
+                        "cannot move the finished session into place: " + ec.message() +
+                            " (it is complete in " + temp.string() + ")");
+    cleanup.dir.clear();
 }
 
 const CommandRegistrar reg("synth", [](CLI::App& parent) {
@@ -72,46 +110,68 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
     cmd->add_option("-o,--output", a->output, "Session folder to create")->required();
     cmd->add_option("--board", a->board,
                     "Board file the scene shows (default: board.json beside the scene)");
-    cmd->add_option("--width", a->o.width, "Main camera width (pixels)")->capture_default_str();
-    cmd->add_option("--height", a->o.height, "Main camera height (pixels)")->capture_default_str();
+    cmd->add_option("--width", a->o.width, "Main camera width (pixels)")
+        ->capture_default_str()
+        ->check(wholeIn(1, 16384));
+    cmd->add_option("--height", a->o.height, "Main camera height (pixels)")
+        ->capture_default_str()
+        ->check(wholeIn(1, 16384));
     cmd->add_option("--hfov", a->o.hfovDeg, "Main camera horizontal field of view (degrees)")
-        ->capture_default_str();
-    cmd->add_option("--fps", a->o.fps, "Frame rate")->capture_default_str();
-    cmd->add_option("--seconds", a->o.seconds, "Length of the footage")->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 179, true));
+    cmd->add_option("--fps", a->o.fps, "Frame rate")
+        ->capture_default_str()
+        ->check(finiteIn(0, 1000, true));
+    cmd->add_option("--seconds", a->o.seconds, "Length of the footage")
+        ->capture_default_str()
+        ->check(finiteIn(0, 86400, true));
     cmd->add_option("--spp", a->o.samplesPerPixel, "Samples per pixel per frame")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(1, 1 << 20));
     cmd->add_option("--seed", a->o.seed, "Random seed (render noise, sensor noise, shake)")
         ->capture_default_str();
     cmd->add_option("--threads", a->o.threads, "Worker threads (0 = all cores)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(0, 4096));
     cmd->add_option("--orbit-radius", a->o.path.radius, "Orbit radius (metres)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e3, true));
     cmd->add_option("--orbit-height", a->o.path.height, "Camera height above the target (metres)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(-1e3, 1e3));
     cmd->add_option("--pan-deg", a->o.path.panDeg, "Yaw of the final fast pan (degrees)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(-3600, 3600));
     cmd->add_option("--shake-mm", a->o.path.shakeTranslation, "Hand-held shake amplitude (metres)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1));
     cmd->add_option("--exposure", a->o.sensor.exposure, "Exposure (multiplies linear radiance)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--exposure-change", a->o.sensor.exposureChange,
                   "Auto-exposure step (x0.55) at 60 % of the footage");
     cmd->add_option("--vignette", a->o.sensor.vignette, "Corner darkening (0 = none)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1));
     cmd->add_option("--noise", a->o.sensor.noise,
                     "Sensor noise (Poisson-Gaussian, linear units; 0 = none)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1));
     cmd->add_option("--shutter", a->o.shutter,
                     "Motion blur: shutter open time as a fraction of the frame interval")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1));
     cmd->add_option("--blur-subframes", a->o.blurSubframes,
                     "Sub-frame renders averaged for motion blur")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(1, 256));
     cmd->add_option("--env-size", a->o.envSize,
                     "Fish-eye environment camera image size (square, pixels)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(16, 8192));
     cmd->add_option("--env-fov", a->o.envFovDeg, "Fish-eye field of view (degrees)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 360, true));
     cmd->add_flag("--no-env", a->noEnv, "Do not render the environment camera");
     cmd->add_flag("--image-sequence", a->o.imageSequence, "PNG folders instead of MKV videos");
     cmd->add_flag("--ground-truth-composite", a->o.groundTruthComposite,
@@ -119,7 +179,8 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
                   "and the mask of pixels the virtual objects influence (docs/session.md)");
     cmd->add_option("--influence-threshold", a->o.influenceThreshold,
                     "Linear change (camera units) that marks a pixel as influenced")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e6));
     cmd->add_flag("--force", a->force, "Replace an existing session in the output folder");
     cmd->callback([a] { run(*a); });
 });

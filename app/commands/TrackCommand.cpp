@@ -8,8 +8,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
@@ -28,6 +30,7 @@ struct TrackArgs {
     double fps = 30.0;
     bool noFilter = false;
     bool noTagTracking = false;
+    bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
 };
@@ -49,6 +52,7 @@ void run(const TrackArgs& a) {
     std::filesystem::path calibPath, boardPath;
     if (fromSession) {
         session = readSession(a.session, &readReport);
+        for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
         const SessionCamera* cam = session.camera(a.camera);
         if (!cam) throw FileError(a.session, "session has no camera '" + a.camera + "'");
         if (!a.calib.empty())
@@ -67,6 +71,22 @@ void run(const TrackArgs& a) {
         boardPath = a.board;
         frames = openFrames(a.video);
     }
+    // Outputs are checked before any work (never an input; written under a temporary name and
+    // renamed when done), see core/OutputFile.h.
+    OutputRule rule{
+        fromSession ? sessionInputs(session) : std::vector<std::filesystem::path>{a.video}, a.force,
+        "mirage track"};
+    rule.inputs.push_back(calibPath);
+    rule.inputs.push_back(boardPath);
+    OutputFile posesOut(a.output, OutputOrigin::Named, rule);
+    std::optional<OutputFile> envmapOut, validOut;
+    if (!a.envmap.empty()) {
+        auto validPath = std::filesystem::path(a.envmap);
+        validPath.replace_filename(validPath.stem().string() + "_valid.png");
+        envmapOut.emplace(a.envmap, OutputOrigin::Named, rule);
+        validOut.emplace(validPath, OutputOrigin::Derived, rule);
+    }
+
     const CameraCalibration calib = loadCalibration(calibPath);
     const tracking::Board board = tracking::Board::load(boardPath);
     tracking::TrackerOptions opt = a.options;
@@ -78,7 +98,7 @@ void run(const TrackArgs& a) {
         throw Error("mirage track --filter: expected predictive or one-euro, got '" + a.filter +
                     "'");
     tracking::Tracker tracker(board, calib.intrinsics, opt);
-    tracking::TrackingReport report(a.output, boardCentre(board));
+    tracking::TrackingReport report(posesOut.temp(), boardCentre(board));
     if (fromSession) report.addUnreadable(readReport.framesListed - readReport.framesReadable);
 
     // Optional environment map from the session's fish-eye camera, posed by its extrinsic: fixed in
@@ -110,8 +130,10 @@ void run(const TrackArgs& a) {
         envMap.emplace(a.envmapWidth);
     }
 
+    installStopSignals();
+    int repeats = 0;
     int i = 0;
-    for (;; ++i) {
+    for (; !stopRequested(); ++i) {
         cv::Mat bgr;
         const auto t0 = std::chrono::steady_clock::now();
         bool got = false;
@@ -136,6 +158,18 @@ void run(const TrackArgs& a) {
             frameIndex = session.frames[size_t(i)].index;
         }
         tracking::TrackedFrame f;
+        const std::string problem = frames->lastProblem();
+        if (bgr.empty()) {
+            // Lost with its reason (damaged bytes): never tracked from a concealed image.
+            f = tracker.markLost(t, problem.empty() ? "frame not decodable" : problem);
+            report.addUnreadableFrame(frameIndex, f);
+            spdlog::warn("{}", f.estimate.reason);
+            continue;
+        }
+        if (!problem.empty()) {
+            ++repeats;
+            spdlog::warn("{}", problem);
+        }
         if (bgr.cols != calib.intrinsics.width || bgr.rows != calib.intrinsics.height) {
             f = tracker.markLost(t, "frame size " + std::to_string(bgr.cols) + "x" +
                                         std::to_string(bgr.rows) + " differs from the calibration");
@@ -158,18 +192,29 @@ void run(const TrackArgs& a) {
             }
         }
     }
+    restoreStopSignals();
     if (envMap) {
-        writeLinearRgb(a.envmap, envMap->radiance());
-        auto validPath = std::filesystem::path(a.envmap);
-        validPath.replace_filename(validPath.stem().string() + "_valid.png");
+        writeLinearRgb(envmapOut->temp(), envMap->radiance());
         cv::Mat valid;
         cv::cvtColor(envMap->validity(), valid, cv::COLOR_GRAY2BGR);
-        writeBgr8(validPath, valid);
+        writeBgr8(validOut->temp(), valid);
+        envmapOut->commit();
+        validOut->commit();
         spdlog::info("environment map {} ({} frames, {:.1f} % of directions seen; validity {})",
-                     a.envmap, envUpdates, 100 * envMap->validFraction(), validPath.string());
+                     a.envmap, envUpdates, 100 * envMap->validFraction(),
+                     validOut->path().string());
     }
+    report.close();
+    posesOut.commit();
+    if (repeats > 0)
+        spdlog::warn("{} frame(s) repeat the previous frame exactly (frozen or duplicated)",
+                     repeats);
     if (report.frames() == 0 && i == 0) spdlog::warn("no frame could be read");
     spdlog::info("wrote {}\n{}", a.output, report.summary());
+    if (stopRequested()) {
+        spdlog::warn("track: interrupted after {} frames; {} holds them", i, a.output);
+        commandExitCode() = 128 + stopSignal();
+    }
 }
 
 const CommandRegistrar reg("track", [](CLI::App& parent) {
@@ -183,7 +228,10 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_option("--camera", a->camera, "Session camera to track")->capture_default_str();
     cmd->add_option("-o,--output", a->output, "POSES.csv")->required();
     cmd->add_option("--fps", a->fps, "Frame rate for sources without timestamps")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e6, true));
+    cmd->add_flag("--force", a->force,
+                  "Replace an existing file written beside an output (never an input)");
     cmd->add_flag("--no-filter", a->noFilter, "Report the raw per-frame poses");
     cmd->add_option("--filter", a->filter,
                     "Temporal filter: predictive (adaptive constant velocity) or one-euro")
@@ -195,13 +243,17 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
                     "Session camera for --envmap (default: the "
                     "one with role environment)");
     cmd->add_option("--envmap-width", a->envmapWidth, "Equirectangular width (height = width/2)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(8, 16384));
     cmd->add_option("--decimate", a->options.detector.decimate, "Detector quad decimation")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(1, 64));
     cmd->add_option("--threads", a->options.detector.threads, "Detector threads")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(1, 4096));
     cmd->add_option("--min-tag-px", a->options.pose.minTagSidePx, "Smallest usable tag side")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e5));
     cmd->add_flag("--no-tag-tracking", a->noTagTracking,
                   "Search every frame with libapriltag (region of interest) instead of finding "
                   "the tags where the predicted pose puts them (docs/tracking.md, Tracking mode)");

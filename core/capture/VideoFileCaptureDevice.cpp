@@ -15,8 +15,10 @@ VideoFileCaptureDevice::VideoFileCaptureDevice(const std::filesystem::path& p)
 VideoFileCaptureDevice::VideoFileCaptureDevice(const std::filesystem::path& p, Options opts)
     : path_(p), opts_(std::move(opts)), source_(openFrames(p)) {
     if (!(opts_.fps > 0)) throw Error("VideoFileCaptureDevice: fps must be positive");
-    if (!source_->read(first_) || first_.empty())
-        throw FileError(p.string(), "holds no frames to play as a camera");
+    // A lost frame (damaged bytes) is skipped, as a camera drops one.
+    while (source_->read(first_) && first_.empty()) {
+    }
+    if (first_.empty()) throw FileError(p.string(), "holds no frames to play as a camera");
     firstPending_ = true;
 }
 
@@ -53,8 +55,10 @@ bool VideoFileCaptureDevice::dequeue(RawFrame& f, int) {
     if (firstPending_) {
         bgr = first_;
         firstPending_ = false;
-    } else if (!source_->read(bgr)) {
-        return false;
+    } else {
+        do {
+            if (!source_->read(bgr)) return false;
+        } while (bgr.empty());  // lost frames are dropped, as a camera drops them
     }
     if (bgr.size() != first_.size()) throw Error(name() + ": frame size changed mid-stream");
     if (mode_.format == PixelFormat::Mjpeg) {

@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "core/session/FrameInventory.h"
+#include "core/session/MatroskaFrames.h"
 #include "core/session/MatroskaScanner.h"
 #include "core/session/Session.h"
 
@@ -60,9 +61,23 @@ cv::Mat readImageFile(const std::filesystem::path& p) {
     return img;
 }
 
+// mirage's own recordings (Matroska MJPEG) are read by MatroskaFrames: exact frames or a
+// reason why each is lost. Other videos go through FFmpeg.
+std::unique_ptr<MatroskaFrames> openMatroskaMjpeg(const std::filesystem::path& path) {
+    if (!isMatroska(path)) return nullptr;
+    auto m = std::make_unique<MatroskaFrames>(path);
+    if (!m->supported()) return nullptr;
+    return m;
+}
+
 class VideoFileFrames final : public FrameSource {
 public:
-    explicit VideoFileFrames(const std::filesystem::path& path) : cap_(openVideo(path)) {
+    explicit VideoFileFrames(const std::filesystem::path& path) : mkv_(openMatroskaMjpeg(path)) {
+        if (mkv_) {
+            count_ = mkv_->count();
+            return;
+        }
+        cap_ = openVideo(path);
         if (isMatroska(path)) {
             const MatroskaScan scan = scanMatroska(path);
             count_ = scan.completeFrames;
@@ -74,6 +89,14 @@ public:
         }
     }
     bool read(cv::Mat& bgr) override {
+        if (mkv_) {
+            if (position_ >= count_) return false;
+            MatroskaFrames::Frame f = mkv_->frame(position_++);
+            bgr = f.bgr;
+            problem_ = f.problem;
+            last_ = f.seconds;
+            return true;
+        }
         if (limit_ >= 0 && position_ >= limit_) return false;
         if (!cap_.read(bgr) || bgr.empty()) return false;
         if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
@@ -85,11 +108,14 @@ public:
     std::optional<double> lastTimestamp() const override {
         return position_ > 0 ? std::optional<double>(last_) : std::nullopt;
     }
+    std::string lastProblem() const override { return problem_; }
 
 private:
+    std::unique_ptr<MatroskaFrames> mkv_;
     cv::VideoCapture cap_;
     int count_ = -1, limit_ = -1, position_ = 0;
     double last_ = 0;
+    std::string problem_;
 };
 
 class ImageFolderFrames final : public FrameSource {
@@ -126,13 +152,19 @@ public:
         if (std::filesystem::is_directory(path)) {
             images_ = listImageFrames(path, nullptr);
         } else {
-            cap_ = openVideo(path);
+            mkv_ = openMatroskaMjpeg(path);
+            if (!mkv_) cap_ = openVideo(path);
         }
     }
     bool read(cv::Mat& bgr) override {
         if (row_ >= rows_.size()) return false;
         const int want = rows_[row_].index;
-        if (cap_.isOpened()) {
+        problem_.clear();
+        if (mkv_) {
+            MatroskaFrames::Frame f = mkv_->frame(want);
+            bgr = f.bgr;
+            problem_ = f.problem;
+        } else if (cap_.isOpened()) {
             // Skip video frames that have no row (deleted or bad rows) without decoding them.
             while (position_ < want) {
                 if (!cap_.grab()) return false;
@@ -154,10 +186,13 @@ public:
     std::optional<double> lastTimestamp() const override {
         return row_ > 0 ? std::optional<double>(last_) : std::nullopt;
     }
+    std::string lastProblem() const override { return problem_; }
 
 private:
     std::vector<FrameRecord> rows_;
     int cameraIndex_;
+    std::unique_ptr<MatroskaFrames> mkv_;
+    std::string problem_;
     cv::VideoCapture cap_;
     std::map<int, std::filesystem::path> images_;
     size_t row_ = 0;
@@ -220,7 +255,8 @@ FrameInventory inventoryFrames(const std::filesystem::path& path) {
     if (!std::filesystem::exists(path)) throw FileError(path.string(), "video file is missing");
     if (isMatroska(path)) {
         const MatroskaScan scan = scanMatroska(path);
-        inv.videoFrames = scan.completeFrames;
+        // Frames lost inside damaged bytes keep their numbers: the rows after them still match.
+        inv.videoFrames = scan.blocks.empty() ? 0 : scan.blocks.back().position + 1;
         if (scan.truncated || !scan.problem.empty())
             inv.problems.push_back(path.filename().string() + ": " + scan.problem + "; " +
                                    std::to_string(scan.completeFrames) + " complete frames kept");

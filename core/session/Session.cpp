@@ -97,7 +97,9 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     json j;
     try {
         j = json::parse(readFileBytes(jsonPath));
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
+        // parse_error, and out_of_range for a number that overflows a double ("1e999", found
+        // by session_fuzz).
         throw FileError(jsonPath.string(), std::string("not valid JSON: ") + e.what());
     }
     if (!j.is_object()) throw FileError(jsonPath.string(), "expected a JSON object at the top");
@@ -247,6 +249,17 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     else
         for (const auto& w : report.warnings) spdlog::warn("session {}: {}", dir.string(), w);
     return s;
+}
+
+std::vector<std::filesystem::path> sessionInputs(const Session& s) {
+    std::vector<std::filesystem::path> files = {s.dir, s.dir / "session.json",
+                                                s.path(s.framesFile)};
+    if (!s.board.empty()) files.push_back(s.path(s.board));
+    for (const auto& c : s.cameras) {
+        if (!c.video.empty()) files.push_back(s.path(c.video));
+        if (!c.calibration.empty()) files.push_back(s.path(c.calibration));
+    }
+    return files;
 }
 
 }  // namespace mirage

@@ -75,6 +75,10 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* report 
 struct CameraCalibration;
 CameraCalibration loadSessionCalibration(const Session& s, const std::string& camera);
 
+// Every file and folder of a session a command reads (the folder, session.json, frames.csv,
+// board, each camera's video and calibration): what an output must never overwrite.
+std::vector<std::filesystem::path> sessionInputs(const Session& s);
+
 // Writes session.json (atomically). Used by SessionWriter; exposed for tools that edit sessions.
 void writeSessionJson(const Session& s);
 
@@ -82,11 +86,17 @@ void writeSessionJson(const Session& s);
 class FrameSource {
 public:
     virtual ~FrameSource() = default;
-    // Next frame as 8-bit BGR (sRGB-encoded, as cameras deliver it); false at the end.
+    // Next frame as 8-bit BGR (sRGB-encoded, as cameras deliver it); false at the end. True with
+    // an empty image: the frame is lost (lastProblem() says why); callers must check.
     virtual bool read(cv::Mat& bgr) = 0;
     virtual int frameCount() const = 0;  // -1 if unknown
     // Time of the frame last returned by read(), seconds; nullopt if the source has no clock.
     virtual std::optional<double> lastTimestamp() const { return std::nullopt; }
+    // About the frame last read: why it is lost when read() returned true with an EMPTY image
+    // (its bytes are damaged or missing; the frame keeps its place so later frames keep their
+    // numbers), or a remark about a delivered image (it repeats the previous frame exactly).
+    // Empty when nothing is wrong.
+    virtual std::string lastProblem() const { return {}; }
 };
 // The frames of one camera of a session, one per row of Session::frames (in that order; video
 // frames without a row are skipped), with the row's timestamp. Throws FileError if the camera

@@ -18,7 +18,7 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
-#include "tests/render/SpecularTestScenes.h"
+#include "testscenes/SpecularTestScenes.h"
 
 namespace {
 
@@ -125,10 +125,10 @@ void args(benchmark::internal::Benchmark* b) {
 }
 
 // Time against error of the specular pipeline end to end (issue 6): the composite of a virtual
-// glass sphere among real things (tests/render/SpecularTestScenes.h, the seed's Fig. 2 example)
-// at 192x144 against the reference renderer's composite (64 spp, caustics off, computed once),
-// PSNR/SSIM over the sphere's pixels, for impostor resolution x refinement steps and the plain
-// cube-map baseline. Arguments: impostor resolution, refinement steps, baseline (0/1).
+// glass sphere among real things (tests/support/testscenes/SpecularTestScenes.h, the seed's Fig. 2
+// example) at 192x144 against the reference renderer's composite (64 spp, caustics off, computed
+// once), PSNR/SSIM over the sphere's pixels, for impostor resolution x refinement steps and the
+// plain cube-map baseline. Arguments: impostor resolution, refinement steps, baseline (0/1).
 // Reported time = frame GPU time; counters: psnr_db, ssim, specgbuf_ms (the tracing pass).
 struct SpecularReference {
     test::SpecularScene scene;

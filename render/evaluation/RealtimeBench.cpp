@@ -276,6 +276,10 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
         if (maxFrames >= 0 && int(frames.size()) >= maxFrames) break;
         if (!source->read(bgr)) break;
         if (int(i) < start) continue;
+        if (bgr.empty()) {  // lost: its bytes in the video are damaged
+            ++missing;
+            continue;
+        }
         const FrameRecord& rec = session.frames[i];
         auto gt = readGroundTruthFrame(session.dir, truth, rec.index);
         if (!rec.groundTruth || !gt) {

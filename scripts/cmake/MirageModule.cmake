@@ -5,8 +5,8 @@ function(mirage_module name)
   cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   # Benchmarks and tools live beside their module but are not part of the library.
-  # Matched on the path relative to the module, so a checkout under e.g. /work/wt/bench/ keeps its
-  # sources.
+  # Matched on the path relative to the module, so a checkout inside a folder named e.g. bench/
+  # keeps its sources.
   set(kept "")
   foreach(src IN LISTS sources)
     file(RELATIVE_PATH rel ${CMAKE_CURRENT_SOURCE_DIR} ${src})

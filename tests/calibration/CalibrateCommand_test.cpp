@@ -12,6 +12,7 @@
 #include "calibration/Extrinsics.h"
 #include "calibration/SyntheticViews.h"
 #include "tests/support/TestCameras.h"
+#include "testscenes/CalibrationViews.h"
 
 #include <opencv2/calib3d.hpp>
 #include "core/camera/CalibrationFile.h"
@@ -38,13 +39,7 @@ void writeViews(const fs::path& dir, const std::vector<BoardPose>& poses) {
 }
 
 std::vector<BoardPose> tiltedPoses(int n) {
-    std::mt19937 rng(17);
-    PoseSamplerOptions po;
-    po.minDistance = 0.3;
-    po.maxDistance = 0.5;
-    po.marginPx = 12;
-    po.imageSpread = 0.9;
-    return sampleBoardPoses(camera(), kBoard, n, po, rng);
+    return test::closeBoardPoses(camera(), kBoard, n, 17);
 }
 
 TEST(CalibrateCommand, BatchWritesCalibrationReportAndRos) {

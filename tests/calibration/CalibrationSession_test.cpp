@@ -10,6 +10,7 @@
 #include "calibration/CalibrationSession.h"
 #include "calibration/SyntheticViews.h"
 #include "tests/support/TestCameras.h"
+#include "testscenes/CalibrationViews.h"
 
 namespace mirage::calib {
 namespace {
@@ -21,13 +22,7 @@ CameraIntrinsics camera() {
 const ChessboardGeometry kBoard{9, 6, 0.025};
 
 std::vector<BoardPose> poses(int n, unsigned seed) {
-    std::mt19937 rng(seed);
-    PoseSamplerOptions po;
-    po.minDistance = 0.3;
-    po.maxDistance = 0.5;
-    po.marginPx = 12;
-    po.imageSpread = 0.9;
-    return sampleBoardPoses(camera(), kBoard, n, po, rng);
+    return test::closeBoardPoses(camera(), kBoard, n, seed);
 }
 
 TEST(CalibrationSession, AutoCaptureNeedsStillSharpAndNewViews) {

@@ -509,6 +509,50 @@ TEST(SceneLoader, EveryBadFileHasAnExpectation) {
     }
 }
 
+// A relative image URI is resolved against the glTF file's folder only. tinygltf also looks in the
+// current directory, so a texture missing beside the glTF was silently taken from wherever mirage
+// ran. Here the only tex.png lies in the current directory: the load must fail and say where it
+// looked; beside the glTF (or reached from there by "../") the same file loads.
+TEST(SceneLoader, TextureUriResolvesAgainstTheGltfFolderOnly) {
+    const fs::path root = test::outputDir("scene_texture_uri");
+    const fs::path gltfDir = root / "scene", elsewhere = root / "elsewhere";
+    fs::create_directories(gltfDir);
+    fs::create_directories(elsewhere);
+    fs::remove(gltfDir / "tex.png");
+    const cv::Mat red(4, 4, CV_8UC3, cv::Scalar(0, 0, 255));
+    ASSERT_TRUE(cv::imwrite((elsewhere / "tex.png").string(), red));
+    auto writeScene = [&](const std::string& uri) {
+        std::string json = texturedTriangle({{"MARK", {}}});
+        const std::string mark = "data:MARK;base64,";
+        json.replace(json.find(mark), mark.size(), uri);
+        std::ofstream(gltfDir / "tri.gltf") << json;
+    };
+    writeScene("tex.png");
+    const fs::path previous = fs::current_path();
+    fs::current_path(elsewhere);
+    std::string message;
+    try {
+        loadScene(gltfDir / "tri.gltf");
+    } catch (const FileError& e) {
+        message = e.what();
+    }
+    fs::current_path(previous);
+    EXPECT_NE(message.find("'tex.png'"), std::string::npos) << message;
+    EXPECT_NE(message.find(fs::absolute(gltfDir).lexically_normal().string()), std::string::npos)
+        << message;
+
+    writeScene("../elsewhere/tex.png");
+    const Scene up = loadScene(gltfDir / "tri.gltf");
+    ASSERT_EQ(up.textures.size(), 1u);
+    EXPECT_EQ(up.textures[0].width, 4);
+
+    fs::copy_file(elsewhere / "tex.png", gltfDir / "tex.png", fs::copy_options::overwrite_existing);
+    writeScene("tex.png");
+    const Scene beside = loadScene(gltfDir / "tri.gltf");
+    ASSERT_EQ(beside.textures.size(), 1u);
+    EXPECT_EQ(beside.textures[0].pixels[0], 255);  // red, RGBA
+}
+
 TEST(SceneLoader, MissingFile) {
     EXPECT_THROW(loadScene(scenesDir() / "does_not_exist.gltf"), FileError);
 }

@@ -13,7 +13,7 @@
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "render/raytrace/RayTracingScene.h"
-#include "tests/render/ImpostorTestScene.h"
+#include "testscenes/ImpostorTestScene.h"
 
 namespace mirage::render {
 namespace {

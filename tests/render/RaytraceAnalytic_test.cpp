@@ -3,8 +3,8 @@
 
 #include "render/raytrace/Bsdf.h"
 #include "render/raytrace/ReferenceRenderer.h"
-#include "tests/render/RaytraceTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RaytraceTestScenes.h"
 
 namespace mirage::raytrace {
 namespace {

@@ -4,8 +4,8 @@
 
 #include "core/Error.h"
 #include "render/raytrace/DifferentialRendering.h"
-#include "tests/render/RaytraceTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RaytraceTestScenes.h"
 
 namespace mirage::raytrace {
 namespace {

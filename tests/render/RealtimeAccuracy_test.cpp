@@ -1,5 +1,5 @@
-// Accuracy of the real-time renderer against the Embree reference renderer (issue 5,
-// "Accuracy"): the same small scene — a real diffuse table plane under a real spot light and a
+// Accuracy of the real-time renderer against the Embree reference renderer: the
+// same small scene — a real diffuse table plane under a real spot light and a
 // virtual diffuse box casting a shadow on it — is composited by both. The camera image is the
 // reference's real-only render L_r encoded to 8-bit sRGB (what synthetic footage is), so the
 // reference composite CI + alpha (L_rv - L_r) is the ground truth the real-time composite should
@@ -18,8 +18,8 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
-#include "tests/render/RenderTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
 namespace {

@@ -1,4 +1,4 @@
-// `mirage bench` and the ground-truth composite of synthetic sessions (issue 5, "Accuracy"): a
+// `mirage bench` and the ground-truth composite of synthetic sessions: a
 // tiny session with the reference renderer's ground-truth composite is synthesised, the real-time
 // renderer is run over it at the ground-truth poses and judged by PSNR/SSIM over the whole frame
 // and over the pixels the virtual object influences; floors are asserted, and the same comparison
@@ -23,8 +23,8 @@
 #include "render/evaluation/RealtimeBench.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/SyntheticSession.h"
-#include "tests/render/RenderTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
 namespace {
@@ -226,7 +226,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     EXPECT_GE(small.error.psnrInfluenced, kMinPsnrInfluenced - 1.5);
 }
 
-// Hard cases through the whole ground-truth pipeline (issue 5): a black real table (L_r = 0 where
+// Hard cases through the whole ground-truth pipeline: a black real table (L_r = 0 where
 // the light falls), a very bright real light (10^5 W/sr: the footage saturates) and a virtual box
 // the camera sits inside of for the first frame (it crosses the near plane). Nothing may be NaN or
 // Inf: the reference's samples, the real-time buffers, the composites, the error figures.

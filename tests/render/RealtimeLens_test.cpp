@@ -9,7 +9,7 @@
 
 #include "core/gl/Context.h"
 #include "render/Renderer.h"
-#include "tests/render/RenderTestScenes.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
 namespace {

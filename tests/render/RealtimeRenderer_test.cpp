@@ -13,8 +13,8 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
-#include "tests/render/RenderTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
 namespace {

@@ -3,15 +3,17 @@
 // input frame and a timing CSV, and pass footage through where the pose is missing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
 #include <opencv2/core.hpp>
 
+#include "core/Csv.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/session/Session.h"
-#include "tests/render/RenderTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage {
 namespace {
@@ -146,22 +148,14 @@ TEST(RealtimeReplay, WritesPlayableVideoAndTimingCsv) {
     EXPECT_NE(rows[0].find("ground_truth"), std::string::npos);
     // GPU times are plausible on every frame (llvmpipe's first timer query once reported the
     // absolute clock; the renderer primes its queries).
-    const auto gpuCol = [&] {
-        std::stringstream hs(header);
-        std::string c;
-        int i = 0;
-        while (std::getline(hs, c, ',')) {
-            if (c == "gpu_ms") return i;
-            ++i;
-        }
-        return -1;
-    }();
-    ASSERT_GE(gpuCol, 0);
+    // Split with core/Csv.h: the reason column is quoted when it holds commas.
+    const std::vector<std::string> columns = splitCsvLine(header);
+    const auto gpuCol = std::find(columns.begin(), columns.end(), "gpu_ms") - columns.begin();
+    ASSERT_LT(size_t(gpuCol), columns.size());
     for (const std::string& row : rows) {
-        std::stringstream rs(row);
-        std::string c;
-        for (int i = 0; i <= gpuCol; ++i) std::getline(rs, c, ',');
-        EXPECT_LT(std::stod(c), 10000.0) << row;
+        const std::vector<std::string> fields = splitCsvLine(row);
+        ASSERT_EQ(fields.size(), columns.size()) << row;
+        EXPECT_LT(std::stod(fields[size_t(gpuCol)]), 10000.0) << row;
     }
     EXPECT_NE(rows[2].find("lost"), std::string::npos);
 }

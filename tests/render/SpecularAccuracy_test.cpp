@@ -1,4 +1,4 @@
-// Specular objects (issue 6) against the Embree reference renderer: for combinations of REAL /
+// Specular objects against the Embree reference renderer: for combinations of REAL /
 // VIRTUAL light, specular object, reflected object and refracted object (Knecht 2013 Fig. 2),
 // the real-time composite over the specular object's pixels is compared with the reference
 // differential composite (CI = the reference's real-only render as 8-bit sRGB footage). Also the
@@ -18,8 +18,8 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
-#include "tests/render/SpecularTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
 namespace {

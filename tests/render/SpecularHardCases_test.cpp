@@ -1,4 +1,4 @@
-// Hard cases of the specular pipeline (issue 6, "Hard cases"): IOR 1 (the object vanishes except
+// Hard cases of the specular pipeline: IOR 1 (the object vanishes except
 // for absorption), total internal reflection and grazing views (finite, bounded), thin and thick
 // glass against the reference, a real object reflected in a virtual mirror but hidden in the video
 // by a real wall (depth validation must reject the back-projection), rays that leave the modelled
@@ -18,8 +18,8 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
-#include "tests/render/SpecularTestScenes.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
 namespace {

@@ -1,4 +1,4 @@
-# Synthetic-session checks (issue 3): the shipped sample session's ground truth against the tags
+# Synthetic-session checks: the shipped sample session's ground truth against the tags
 # the tracking module detects in its frames. Own executable: it needs mirage_tracking next to
 # mirage_render, which the per-module test executables do not link together.
 file(GLOB synth_tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*_test.cpp)

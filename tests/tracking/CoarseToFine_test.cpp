@@ -7,7 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::tracking {

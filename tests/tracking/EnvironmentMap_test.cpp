@@ -5,7 +5,7 @@
 #include "core/Error.h"
 #include "core/image/ImageIO.h"
 #include "tests/support/TestSupport.h"
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/EnvironmentMap.h"
 
 namespace mirage::tracking {

@@ -1,5 +1,5 @@
-// The hard cases of issue 4, each a test: each gives a correct pose or an explicit non-ok state,
-// never a confident wrong answer.
+// The hard cases of tracking (docs/tracking.md), each a test: each gives a correct pose or an
+// explicit non-ok state, never a confident wrong answer.
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "tests/support/TestSupport.h"
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::tracking {

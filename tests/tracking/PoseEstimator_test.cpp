@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "tests/support/TestSupport.h"
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/Detector.h"
 #include "tracking/PoseEstimator.h"
 
@@ -191,6 +191,60 @@ TEST(PoseEstimator, NoBoardTagsGivesNoTags) {
     foreign.id = 300;  // not on the board
     foreign.corners = {glm::dvec2(10, 60), {60, 60}, {60, 10}, {10, 10}};
     EXPECT_EQ(pe.estimate({foreign}).state, TrackingState::NoTags);
+}
+
+}  // namespace
+}  // namespace mirage::tracking
+
+namespace mirage::tracking {
+namespace {
+
+// The refinement's analytic Jacobian (world-frame rotation vector and camera centre; the lens
+// part by forward differences inside) against central differences of its residuals through the
+// same retraction, for a pinhole with distortion and for a fish-eye, away from the optimum.
+TEST(PoseEstimator, RefinementJacobianMatchesFiniteDifferences) {
+    const Board& board = scene().board;
+    for (const CameraIntrinsics& cam : {testing::pinholeCamera(), testing::fisheyeCamera()}) {
+        const Pose truth = lookAt({0.12, 0.38, 0.2}, {0.01, 0.0, -0.02});
+        std::vector<TagDetection> dets;
+        const Pose T_camera_world = truth.inverse();
+        for (const auto& tag : board.tags) {
+            TagDetection d;
+            d.id = tag.id;
+            const auto corners = tag.cornersInWorld();
+            bool inView = true;
+            for (size_t k = 0; k < 4; ++k) {
+                const auto px = cam.project(T_camera_world * corners[k]);
+                if (!px) inView = false;
+                if (px) d.corners[k] = *px + glm::dvec2(0.3 * std::sin(double(tag.id + k)), 0.2);
+            }
+            if (inView) dets.push_back(d);
+        }
+        ASSERT_GE(dets.size(), 4u);
+        const lm::Problem problem = poseLeastSquares(board, cam, dets);
+        // 1 degree and 5 mm off the truth.
+        Pose at = truth;
+        at.rotation = glm::normalize(
+            glm::angleAxis(glm::radians(1.0), glm::normalize(glm::dvec3(1, 2, 3))) * at.rotation);
+        at.translation += glm::dvec3(0.005, -0.003, 0.002);
+        const auto x = poseState(at);
+        const auto J = lm::denseJacobian(problem, x);
+        const auto Jfd = lm::finiteDifferenceJacobian(problem, x, 1e-6);
+        ASSERT_EQ(J.size(), Jfd.size());
+        ASSERT_EQ(J.size(), dets.size() * 8 * 6);
+        double maxAbs = 0, maxDiff = 0;
+        for (size_t i = 0; i < J.size(); ++i) {
+            maxAbs = std::max(maxAbs, std::abs(Jfd[i]));
+            maxDiff = std::max(maxDiff, std::abs(J[i] - Jfd[i]));
+        }
+        EXPECT_GT(maxAbs, 100.0);  // pixels per radian / metre
+        EXPECT_LT(maxDiff, 1e-4 * maxAbs) << "model " << int(cam.model);
+        // And the solver brings it back to the noise-level optimum, near the truth.
+        auto y = x;
+        const lm::Report rep = lm::solve(problem, y);
+        EXPECT_TRUE(rep.converged()) << rep.summary();
+        EXPECT_LT(glm::degrees(rotationAngleBetween(poseOfState(y).rotation, truth.rotation)), 0.2);
+    }
 }
 
 }  // namespace

@@ -11,7 +11,7 @@
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "tests/support/TestSupport.h"
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/EnvironmentMap.h"
 
 namespace mirage::tracking {

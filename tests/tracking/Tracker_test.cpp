@@ -4,7 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::tracking {
@@ -136,6 +136,33 @@ TEST(Tracker, SharpnessSeparatesSharpAndBlurredImages) {
     EXPECT_GT(sharp, 0.2);
     EXPECT_LT(soft, TrackerOptions().minSharpness);
     EXPECT_EQ(imageSharpness(cv::Mat(100, 100, CV_8U, cv::Scalar(128))), 0.0);
+}
+
+}  // namespace
+}  // namespace mirage::tracking
+
+namespace mirage::tracking {
+namespace {
+
+TEST(Tracker, UsesTheBoardsTagFamily) {
+    // A tag25h9 board must be searched for tag25h9 codes: with the detector's default family
+    // (tag36h11) no tag is found in any frame.
+    BoardLayout layout;
+    layout.family = "tag25h9";
+    layout.gap = 0.01;  // tag25h9 has a wider quiet zone than the default family
+    const Board board = layout.makeBoard();
+    ASSERT_EQ(board.family, "tag25h9");
+    const BoardRaster tex = renderBoard(board, 8000, false);
+    const auto cam = testing::pinholeCamera();
+    Tracker tracker(board, cam);
+    for (int i = 0; i < 3; ++i) {
+        const Pose T = testing::lookAt({0.10 + 0.02 * i, 0.42, 0.25}, {0, 0, 0});
+        const TrackedFrame f =
+            tracker.process(renderSyntheticBoardView(board, tex, cam, T), i / 30.0);
+        ASSERT_EQ(f.estimate.state, TrackingState::Ok)
+            << "frame " << i << ": " << f.estimate.reason;
+        EXPECT_LT(glm::length(f.estimate.pose->translation - T.translation), 0.01);
+    }
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/SyntheticTrials.h"
 #include "tracking/Tracker.h"
 

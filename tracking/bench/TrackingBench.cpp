@@ -12,7 +12,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
 
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/Detector.h"
 #include "tracking/PoseEstimator.h"
 #include "tracking/Tracker.h"

@@ -2,8 +2,9 @@
 // the ok state"): prints the per-condition table (states, wrong-but-ok poses, fraction of errors
 // inside the reported 2-sigma ellipsoids) and the measured corner noise by blur and tag size.
 //   tracking_montecarlo [--views N (2000)] [--seed S (1)] [--supersample K (2)] [--previous-rule]
-// --previous-rule: the covariance from the residuals alone and no bound on it for ok (the rule
-// before the uncertainty bounds; the tag-consistency rule stays), for comparison.
+// --previous-rule: the covariance from the residuals alone (their robust scale) and no bound on
+// it for ok (about the rule before the uncertainty bounds; the tag-consistency rule and the
+// blur measurement stay), for comparison.
 // Single-threaded; about 25 views per second on one core at 640x480.
 #include <algorithm>
 #include <cstdio>
@@ -12,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/tracking/SyntheticViews.h"
+#include "testscenes/TrackingViews.h"
 #include "tracking/SyntheticTrials.h"
 
 int main(int argc, char** argv) {
@@ -24,6 +25,8 @@ int main(int argc, char** argv) {
     for (; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--previous-rule")) {
             options.pose.cornerNoisePriorWeight = 0;
+            options.pose.tagScaleNoise = options.pose.tagShiftNoise = 0;
+            options.pose.commonScaleNoise = 0;
             options.pose.okMaxSigmaRotDeg = 1e9;
             options.pose.okMaxSigmaPosFraction = 1e9;
             continue;

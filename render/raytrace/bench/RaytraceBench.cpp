@@ -8,7 +8,7 @@
 
 #include "render/raytrace/ReferenceRenderer.h"
 #include "render/raytrace/Sampling.h"
-#include "tests/render/RaytraceTestScenes.h"
+#include "testscenes/RaytraceTestScenes.h"
 
 namespace mirage::raytrace {
 namespace {

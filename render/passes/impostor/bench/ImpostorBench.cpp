@@ -1,14 +1,14 @@
 // Time vs error of traceSurroundings(): reflected-scene impostors over impostor resolution and
 // refinement steps, against the plain G-buffer cube-map baseline, on the impostor test scene
-// (tests/render/ImpostorTestScene.h, with the enclosing room). Each configuration traces the same
-// rays from both specular objects' surfaces (uniform over the outer hemisphere) and compares with
-// exact Embree ray casts (computed once).
-// Arguments: impostor resolution, refinement steps, baseline (1 = cube map), near object (0 = the
-// red box, 1 = a finely tessellated red sphere: curved, where refinement matters).
-// Reported time = GPU time of tracing kRays rays in one compute dispatch (GL_TIME_ELAPSED, manual
-// time); counters: hit/miss agreement, origin agreement, median / p90 / mean hit-position error
-// (mm), the one-off build time (ms, wall clock) and texture memory (MiB).
-// Run: build/render/passes/impostor/bench/mirage_impostor_bench --benchmark_repetitions=3
+// (tests/support/testscenes/ImpostorTestScene.h, with the enclosing room). Each configuration
+// traces the same rays from both specular objects' surfaces (uniform over the outer hemisphere) and
+// compares with exact Embree ray casts (computed once). Arguments: impostor resolution, refinement
+// steps, baseline (1 = cube map), near object (0 = the red box, 1 = a finely tessellated red
+// sphere: curved, where refinement matters). Reported time = GPU time of tracing kRays rays in one
+// compute dispatch (GL_TIME_ELAPSED, manual time); counters: hit/miss agreement, origin agreement,
+// median / p90 / mean hit-position error (mm), the one-off build time (ms, wall clock) and texture
+// memory (MiB). Run: build/render/passes/impostor/bench/mirage_impostor_bench
+// --benchmark_repetitions=3
 //      --benchmark_report_aggregates_only=true   (docs/impostors.md)
 #include <benchmark/benchmark.h>
 
@@ -20,7 +20,7 @@
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "render/raytrace/RayTracingScene.h"
-#include "tests/render/ImpostorTestScene.h"
+#include "testscenes/ImpostorTestScene.h"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include "core/scene/Scene.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "render/raytrace/ReferenceRenderer.h"
-#include "tests/render/RenderTestScenes.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::raytrace::test {
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "core/scene/Scene.h"
-#include "tests/render/RenderTestScenes.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::test {
 

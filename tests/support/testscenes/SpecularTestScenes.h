@@ -1,5 +1,5 @@
 #pragma once
-// Scenes for the specular-object tests (issue 6; Knecht 2013 Fig. 2): a real table (checker-free
+// Scenes for the specular-object tests (Knecht 2013 Fig. 2): a real table (checker-free
 // diffuse plane), a glass (or mirror) sphere, a box the sphere REFLECTS (beside it, towards the
 // camera), a box seen THROUGH it (behind it), a spot light, and a smooth sky environment. Each of
 // the light, the specular object, the reflected and the refracted object is REAL or VIRTUAL.
@@ -12,7 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/image/ImageIO.h"
-#include "tests/render/RenderTestScenes.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::test {
 

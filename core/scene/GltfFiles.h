@@ -1,0 +1,23 @@
+#pragma once
+// glTF loading, part 2 of 5: the file access tinygltf gets for external buffers and images
+// (SceneLoader.cpp). Regular files only, size-capped, no '~' expansion, nothing written, and only
+// files resolved against the glTF's own folder: tinygltf also looks a relative URI up in the
+// current directory, which would silently take a same-named file from wherever mirage was started
+// when the file beside the glTF is missing.
+#include <filesystem>
+#include <string>
+
+#include <tiny_gltf.h>
+
+namespace mirage::gltf {
+
+// The callbacks for tinygltf::TinyGLTF::SetFsCallbacks. `baseDir` (the glTF's folder, the same
+// string given to tinygltf as its base directory) must outlive the callbacks. An empty `baseDir`
+// allows no external file at all.
+tinygltf::FsCallbacks fileCallbacks(const std::string* baseDir);
+
+// Whether `path`, as tinygltf joins it, names a file under `baseDir` (textually: tinygltf builds
+// the path as baseDir + '/' + uri; a uri may still use "../").
+bool resolvedAgainst(const std::string& path, const std::string& baseDir);
+
+}  // namespace mirage::gltf

@@ -1,0 +1,47 @@
+#pragma once
+// Frames of a Matroska MJPEG video (what mirage records), read by their byte ranges from the
+// scanner (MatroskaScanner.h) and decoded strictly (core/image/StrictJpeg.h): a frame is either
+// exactly the image that was written or reported lost with the reason, never a concealed or
+// stale image. Damaged container bytes cost only the frames inside them: reading resumes at the
+// next cluster with the frame numbers kept (by the block times).
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/session/MatroskaScanner.h"
+
+namespace mirage {
+
+class MatroskaFrames {
+public:
+    // Scans the file; throws FileError if it is not Matroska (see scanMatroska).
+    explicit MatroskaFrames(const std::filesystem::path& path);
+
+    // True if this reader decodes the video: V_MJPEG, blocks without lacing (else FFmpeg must).
+    bool supported() const;
+    const MatroskaScan& scan() const { return scan_; }
+    // Frame numbers 0 .. count()-1 (lost frames included).
+    int count() const;
+
+    struct Frame {
+        cv::Mat bgr;          // empty if lost
+        double seconds = 0;   // block time
+        std::string problem;  // why it is lost; or, with an image, a remark (exact repeat)
+    };
+    // Frame `position`; positions must be asked for in increasing order.
+    Frame frame(int position);
+
+private:
+    std::filesystem::path path_;
+    MatroskaScan scan_;
+    std::ifstream in_;
+    size_t next_ = 0;  // index into scan_.blocks
+    std::vector<uint8_t> bytes_, previousBytes_;
+    int previousPosition_ = -1;
+};
+
+}  // namespace mirage
