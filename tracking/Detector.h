@@ -58,6 +58,10 @@ struct TagDetection {
     // The corners went through mirage's sub-pixel refinement (Detector::refineCorners); false:
     // libapriltag's corners (refinement off or failed), less precise after strong decimation.
     bool refined = false;
+    // Width of the image's edges around the tag (pixels, about 2 for a sharp image and the
+    // motion-blur length beyond that; tagEdgeWidthPx in Tracker.h), or -1: not measured. The
+    // pose estimator's corner-noise prior grows with it.
+    double edgeWidthPx = -1;
 };
 
 class Detector {

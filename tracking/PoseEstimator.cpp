@@ -27,6 +27,8 @@ const char* trackingStateName(TrackingState s) {
             return "ambiguous";
         case TrackingState::Lost:
             return "lost";
+        case TrackingState::Uncertain:
+            return "uncertain";
     }
     return "?";
 }
@@ -37,7 +39,8 @@ struct Observation {
     int tagId = 0;
     std::array<glm::dvec3, 4> world{};  // corners in the world
     std::array<glm::dvec2, 4> pixels{};
-    double sidePx = 0;  // shortest side in the image
+    double sidePx = 0;        // shortest side in the image
+    double edgeWidthPx = -1;  // TagDetection::edgeWidthPx
     double sizeM = 0;
     Pose T_world_tag;
 };
@@ -77,6 +80,13 @@ struct Fit {
     Pose pose;
     double rms = 1e9;
     std::array<double, 36> covariance{};
+    // (J^T J)^-1 at the solution and the sum of squared residuals (set with the covariance).
+    std::array<double, 36> normalInverse{};
+    double cost = 0;
+    double robustSigma = 0;  // 1.4826 x the median absolute residual (pixels)
+    // Sensitivities to corner errors shared within a tag (correlatedTerms).
+    std::array<double, 36> tagScale{}, tagShift{};
+    std::array<double, 6> commonScale{};
     bool ok = false;
     lm::Report report;
 };
@@ -125,6 +135,42 @@ void jacobian(const CameraIntrinsics& cam, const Pose& T_world_camera,
     }
 }
 
+// The sensitivities of the pose to corner errors that are shared within a tag (docs/tracking.md,
+// "Uncertainty and the ok state"): per tag, J^T u with u the corners' image displacement of a
+// scale change of the tag by 1 px per corner (outwards from its centre), and of a shift by 1 px
+// in x and in y. Accumulated as sum g g^T (per-tag terms) and sum g (the scale term common to
+// all tags of the frame).
+void correlatedTerms(const std::vector<double>& J, const std::vector<const Observation*>& obs,
+                     Fit& f) {
+    f.tagScale = {};
+    f.tagShift = {};
+    f.commonScale = {};
+    size_t row = 0;
+    for (const Observation* o : obs) {
+        glm::dvec2 centre(0.0);
+        for (const auto& p : o->pixels) centre += 0.25 * p;
+        std::array<double, 6> gs{}, gx{}, gy{};
+        for (int k = 0; k < 4; ++k, row += 2) {
+            const glm::dvec2 d = o->pixels[size_t(k)] - centre;
+            const glm::dvec2 u = d / std::max(1e-9, glm::length(d));
+            for (int a = 0; a < 6; ++a) {
+                const double jx = J[row * 6 + size_t(a)], jy = J[(row + 1) * 6 + size_t(a)];
+                gs[size_t(a)] += jx * u.x + jy * u.y;
+                gx[size_t(a)] += jx;
+                gy[size_t(a)] += jy;
+            }
+        }
+        for (int a = 0; a < 6; ++a) {
+            f.commonScale[size_t(a)] += gs[size_t(a)];
+            for (int b = 0; b < 6; ++b) {
+                f.tagScale[size_t(a * 6 + b)] += gs[size_t(a)] * gs[size_t(b)];
+                f.tagShift[size_t(a * 6 + b)] +=
+                    gx[size_t(a)] * gx[size_t(b)] + gy[size_t(a)] * gy[size_t(b)];
+            }
+        }
+    }
+}
+
 // The pose as a least-squares problem for core/math/LevenbergMarquardt.h (PoseEstimator.h,
 // poseLeastSquares).
 lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<const Observation*>& obs) {
@@ -167,7 +213,22 @@ Fit refine(const CameraIntrinsics& cam, const Pose& start,
     f.ok = f.pose.isFinite() && std::isfinite(f.rms);
     if (withCovariance && f.ok && f.report.residualCount > 6) {
         const lm::Covariance c = lm::covariance(problem, x);
-        if (c.ok) std::copy(c.matrix.begin(), c.matrix.end(), f.covariance.begin());
+        if (c.ok && c.sigma2 > 0) {
+            std::copy(c.matrix.begin(), c.matrix.end(), f.covariance.begin());
+            // (J^T J)^-1 and the sum of squares, for the noise model (modelCovariance).
+            for (size_t i = 0; i < 36; ++i) f.normalInverse[i] = c.matrix[i] / c.sigma2;
+            f.cost = c.sigma2 * double(f.report.residualCount - 6);
+            std::vector<double> r, J;
+            residuals(cam, f.pose, obs, r);
+            jacobian(cam, f.pose, obs, J);
+            // Robust noise scale: the median absolute residual (a few tags with damaged
+            // corners should not set the noise of all).
+            std::vector<double> a(r.size());
+            for (size_t i = 0; i < r.size(); ++i) a[i] = std::abs(r[i]);
+            std::nth_element(a.begin(), a.begin() + long(a.size() / 2), a.end());
+            f.robustSigma = 1.4826 * a[a.size() / 2];
+            correlatedTerms(J, obs, f);
+        }
     }
     return f;
 }
@@ -187,6 +248,54 @@ double tagRms(const CameraIntrinsics& cam, const Pose& T_world_camera, const Obs
         }
     }
     return std::sqrt(s / 4.0);
+}
+
+// The pose covariance under the corner noise model of PoseEstimatorOptions:
+//   C = N^-1 (sigma^2 N + s_t^2 S_tag + h^2 H_tag + s_c^2 g g^T) N^-1 k^2,  N = J^T J,
+// sigma^2 the independent corner noise (residuals pooled with the prior sigma0 by tag size and
+// blur), s_t / h the per-tag scale / shift error and s_c the scale error common to all tags
+// (corner errors that move a tag's corners together: blur mixing the payload into the border,
+// clipping, compression), each proportional to sigma0; k the inflation.
+std::array<double, 36> modelCovariance(const Fit& f, const std::vector<const Observation*>& obs,
+                                       const PoseEstimatorOptions& o) {
+    std::array<double, 36> c{};
+    if (obs.empty() || f.normalInverse[0] <= 0) return c;
+    double prior2 = 0;
+    for (const Observation* t : obs) {
+        const double blur = std::max(0.0, t->edgeWidthPx - 2.2);
+        const double s0 = o.cornerNoisePx + o.cornerNoiseSidePx / std::max(1.0, t->sidePx) +
+                          o.cornerNoiseBlur * blur * blur;
+        prior2 += s0 * s0 / double(obs.size());
+    }
+    const double dof = 8.0 * double(obs.size()) - 6.0;
+    // The residuals' robust mean square (median absolute residual, 2N values) stands for the
+    // sum of squares: 2N rho^2 ~ sum r^2, whose expectation is (2N - 6) sigma^2.
+    const double sumSq = 8.0 * double(obs.size()) * f.robustSigma * f.robustSigma;
+    const double sigma2 =
+        (sumSq + o.cornerNoisePriorWeight * prior2) / (dof + o.cornerNoisePriorWeight);
+    const double st2 = o.tagScaleNoise * o.tagScaleNoise * prior2;
+    const double sh2 = o.tagShiftNoise * o.tagShiftNoise * prior2;
+    const double sc2 = o.commonScaleNoise * o.commonScaleNoise * prior2;
+    cv::Matx66d Ninv, M;
+    for (int a = 0; a < 6; ++a)
+        for (int b = 0; b < 6; ++b) {
+            const size_t i = size_t(a * 6 + b);
+            Ninv(a, b) = f.normalInverse[i];
+            M(a, b) = st2 * f.tagScale[i] + sh2 * f.tagShift[i] +
+                      sc2 * f.commonScale[size_t(a)] * f.commonScale[size_t(b)];
+        }
+    const cv::Matx66d C =
+        (Ninv * sigma2 + Ninv * M * Ninv) * (o.covarianceInflation * o.covarianceInflation);
+    for (int a = 0; a < 6; ++a)
+        for (int b = 0; b < 6; ++b) c[size_t(a * 6 + b)] = 0.5 * (C(a, b) + C(b, a));
+    return c;
+}
+
+std::string idList(const std::vector<int>& ids) {
+    std::string s;
+    for (size_t i = 0; i < ids.size(); ++i)
+        s += (i == 0 ? "" : (i + 1 == ids.size() ? " and " : ", ")) + std::to_string(ids[i]);
+    return s;
 }
 
 bool samePose(const Pose& a, const Pose& b, double scale, double maxDeg = 1.0,
@@ -222,6 +331,7 @@ std::vector<Observation> observations(const Board& board, const PoseEstimatorOpt
         o.world = tag->cornersInWorld();
         o.pixels = d.corners;
         o.sizeM = tag->size;
+        o.edgeWidthPx = d.edgeWidthPx;
         o.T_world_tag = tag->T_world_tag;
         o.sidePx = 1e9;
         for (int k = 0; k < 4; ++k)
@@ -516,20 +626,47 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     const Refined& best = refined[0];
     for (const auto* o : best.inliers) out.tagsUsed.push_back(o->tagId);
     for (const auto& o : obs)
-        if (std::find(best.inliers.begin(), best.inliers.end(), &o) == best.inliers.end())
+        if (std::find(best.inliers.begin(), best.inliers.end(), &o) == best.inliers.end()) {
             out.tagsRejected.push_back(o.tagId);
+            out.tagsDisagreeing.push_back(o.tagId);
+        }
     const Fit finalFit = refine(camera_, best.fit.pose, best.inliers, true);
     out.pose = finalFit.pose;
     out.rmsPx = finalFit.rms;
-    out.covariance = finalFit.covariance;
+    out.covariance = modelCovariance(finalFit, best.inliers, options_);
+    {
+        glm::dvec3 centre(0.0);
+        for (const auto* o : best.inliers) centre += o->T_world_tag.translation;
+        centre /= double(best.inliers.size());
+        out.distanceM = glm::length(finalFit.pose.translation - centre);
+    }
 
     const Alternative alt =
         bestAlternative(camera_, options_, refined, scored, finalFit.pose, sceneScale);
     out.alternativeRmsPx = alt.rmsPx;
 
-    // Step 6. The state: lost if the fit is poor; ok if the alternative is clearly worse or the
-    // previous pose decides between them; else ambiguous.
+    // Step 6. The state: lost if the tags disagree or the fit is poor; ok if the alternative is
+    // clearly worse or the previous pose decides between them and the uncertainty is within the
+    // bounds (else uncertain); else ambiguous.
     char buf[256];
+
+    // Consistency: each tag against the others. Tags that the board pose of the others does
+    // not explain were dropped above; when they are not outnumbered by the tags used, no subset
+    // can be trusted: most likely the board file does not describe the printed board.
+    if (!out.tagsDisagreeing.empty() && out.tagsDisagreeing.size() >= out.tagsUsed.size()) {
+        out.state = TrackingState::Lost;
+        out.reason = (out.tagsDisagreeing.size() == 1 ? "tag " : "tags ") +
+                     idList(out.tagsDisagreeing) +
+                     (out.tagsDisagreeing.size() == 1 ? " disagrees" : " disagree") + " with tag" +
+                     (out.tagsUsed.size() == 1 ? " " : "s ") + idList(out.tagsUsed) +
+                     ": is the board file right?";
+        return out;
+    }
+    std::string dropped;
+    if (!out.tagsDisagreeing.empty())
+        dropped = "; dropped tag" + std::string(out.tagsDisagreeing.size() == 1 ? " " : "s ") +
+                  idList(out.tagsDisagreeing) + " (disagree with the others)";
+
     if (!(finalFit.rms <= options_.maxRmsPx)) {
         out.state = TrackingState::Lost;
         std::snprintf(buf, sizeof buf, "reprojection RMS %.2f px over %zu tag(s) exceeds %.2f px",
@@ -537,15 +674,38 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         out.reason = buf;
         return out;
     }
+    // The pose is ok only if its uncertainty is within the bounds (any state decided below that
+    // would be ok becomes uncertain otherwise).
+    auto settle = [&](const std::string& what) {
+        const double sr = out.sigmaRotDeg(), sp = out.sigmaPosM();
+        const double maxPos = options_.okMaxSigmaPosFraction * out.distanceM;
+        char b[400];
+        if (sr > options_.okMaxSigmaRotDeg || sp > maxPos) {
+            out.state = TrackingState::Uncertain;
+            std::snprintf(b, sizeof b,
+                          "%s; 1 sigma %.2f deg / %.1f mm (%.2f %% of %.2f m) exceeds %.2f deg / "
+                          "%.2f %%",
+                          what.c_str(), sr, 1e3 * sp, 100 * sp / out.distanceM, out.distanceM,
+                          options_.okMaxSigmaRotDeg, 100 * options_.okMaxSigmaPosFraction);
+        } else {
+            out.state = TrackingState::Ok;
+            std::snprintf(b, sizeof b, "%s; 1 sigma %.3f deg / %.2f mm", what.c_str(), sr,
+                          1e3 * sp);
+        }
+        out.reason = b + dropped;
+        return out;
+    };
     const bool clearlyBetter =
         !alt.pose || (alt.rmsPx >= options_.ambiguityRatio * finalFit.rms &&
                       alt.rmsPx - finalFit.rms >= options_.ambiguityMinGapPx);
     if (clearlyBetter) {
-        out.state = TrackingState::Ok;
-        std::snprintf(buf, sizeof buf, "%zu tag(s), RMS %.2f px, alternative %.2f px",
-                      best.inliers.size(), finalFit.rms, out.alternativeRmsPx);
-        out.reason = buf;
-        return out;
+        if (alt.pose)
+            std::snprintf(buf, sizeof buf, "%zu tag(s), RMS %.2f px, alternative %.2f px",
+                          best.inliers.size(), finalFit.rms, out.alternativeRmsPx);
+        else
+            std::snprintf(buf, sizeof buf, "%zu tag(s), RMS %.2f px, no alternative pose",
+                          best.inliers.size(), finalFit.rms);
+        return settle(buf);
     }
     // Ambiguous by error alone: let the previous pose decide if it clearly can.
     if (prior) {
@@ -561,23 +721,22 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
                 out.pose = f.pose;
                 out.alternativeRmsPx = finalFit.rms;
                 out.rmsPx = f.rms;
-                out.covariance = f.covariance;
+                out.covariance = modelCovariance(f, best.inliers, options_);
             }
-            out.state = TrackingState::Ok;
             std::snprintf(buf, sizeof buf,
                           "%zu tag(s), RMS %.2f px; planar ambiguity (alternative %.2f px) "
                           "resolved by the previous pose",
                           best.inliers.size(), out.rmsPx, out.alternativeRmsPx);
-            out.reason = buf;
-            return out;
+            return settle(buf);
         }
     }
     out.state = TrackingState::Ambiguous;
     std::snprintf(buf, sizeof buf,
                   "planar ambiguity: two poses fit %zu tag(s) (RMS %.2f vs %.2f px)%s",
                   best.inliers.size(), finalFit.rms, out.alternativeRmsPx,
-                  prior ? " and the previous pose does not decide" : ", no previous pose");
-    out.reason = buf;
+                  prior ? " and the previous pose does not decide"
+                        : ", no well-determined recent pose to decide");
+    out.reason = buf + dropped;
     return out;
 }
 

@@ -8,7 +8,9 @@
 // planar two-fold ambiguity is resolved by the ratio of the reprojection errors of the best pose
 // and the best distinct alternative, or else by closeness to the previous pose. If neither
 // settles it, the state is `ambiguous`, never `ok`.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,8 +23,10 @@
 
 namespace mirage::tracking {
 
-enum class TrackingState { Ok, NoTags, TagsTooSmall, TooBlurred, Ambiguous, Lost };
-// "ok", "no_tags", "tags_too_small", "too_blurred", "ambiguous", "lost" (the CSV spelling).
+enum class TrackingState { Ok, NoTags, TagsTooSmall, TooBlurred, Ambiguous, Lost, Uncertain };
+// "ok", "no_tags", "tags_too_small", "too_blurred", "ambiguous", "lost", "uncertain" (the CSV
+// spelling). Uncertain: a pose was found but its covariance exceeds what ok promises (or it is
+// far from the motion prediction with a weak fit); it is reported, never used as tracking output.
 const char* trackingStateName(TrackingState s);
 
 struct PoseEstimatorOptions {
@@ -41,9 +45,39 @@ struct PoseEstimatorOptions {
     // (RMS ratio) AND by at least ambiguityMinGapPx more, else the frame is ambiguous...
     double ambiguityRatio = 2.0;
     double ambiguityMinGapPx = 0.3;
-    // ...unless a previous pose decides: the chosen pose must be within priorMaxRotationDeg of it
-    // and the alternative at least twice as far from it as the chosen one.
+    // ...unless a previous pose decides (the Tracker passes one only when it was well
+    // determined and recent): the chosen pose must be within priorMaxRotationDeg of it and the
+    // alternative at least twice as far from it as the chosen one.
     double priorMaxRotationDeg = 15.0;
+    // Uncertainty (docs/tracking.md, "Uncertainty and the ok state"). The pose covariance is
+    //   C = k^2 N^-1 (sigma^2 N + sigma0^2 (t^2 S_tag + h^2 H_tag + c^2 g g^T)) N^-1, N = J^T J:
+    // independent corner noise sigma (per image coordinate) plus corner errors shared by the
+    // corners of a tag (a scale change of each tag, t; a shift of each tag, h; a scale change
+    // common to all tags of the frame, c; as multiples of sigma0). sigma^2 pools the residuals'
+    // robust mean square (median absolute residual) with a prior of w degrees of freedom:
+    //   sigma^2 = (2N rho^2 + w sigma0^2) / (2N - 6 + w),
+    // sigma0 = cornerNoisePx + cornerNoiseSidePx / (shortest tag side in pixels)
+    //          + cornerNoiseBlur * max(0, edge width - 2.2 px)^2 (TagDetection::edgeWidthPx, when
+    // measured), averaged in variance over the used tags: small tags have noisier corners
+    // (fewer edge samples; blur and compression move a larger share of them), and a blur wider
+    // than a cell mixes the payload bits into the border edges. With one tag (2 degrees of
+    // freedom left) the residuals alone can claim almost any precision; the prior keeps the
+    // claim honest. All constants measured by Monte Carlo (tracking_montecarlo).
+    double cornerNoisePx = 0.05;
+    double cornerNoiseSidePx = 1.2;
+    double cornerNoiseBlur = 0.12;  // 1 / pixel
+    double cornerNoisePriorWeight = 8.0;
+    double covarianceInflation = 1.0;  // k
+    // t, h, c above (pixels per pixel of sigma0).
+    double tagScaleNoise = 0.15;
+    double tagShiftNoise = 0.1;
+    double commonScaleNoise = 0.5;
+    // A pose is ok only when the square roots of the covariance traces (1 sigma, 3D) are at most
+    // okMaxSigmaRotDeg (degrees) and okMaxSigmaPosFraction of the camera-to-tags distance; a
+    // pose beyond either is `uncertain`. With an honest covariance a pose off by 2 degrees or 2 %
+    // (wrong) is then at least 4 sigma out.
+    double okMaxSigmaRotDeg = 0.5;
+    double okMaxSigmaPosFraction = 0.005;
     // Corners of fish-eye rays more than this far off the optical axis are not used for the IPPE
     // initialisation (normalised coordinates explode near 90 degrees); LM still uses them.
     double maxInitAngleDeg = 75.0;
@@ -59,12 +93,30 @@ struct PoseEstimate {
                                     // lower-error guess, which must not be used as tracking output)
     std::vector<int> tagsUsed;      // board tag ids in the final fit
     std::vector<int> tagsRejected;  // ids detected but rejected as outliers or too small
-    double rmsPx = -1;              // reprojection RMS over the used corners (pixels)
-    double alternativeRmsPx = -1;   // RMS of the best distinct alternative pose (-1: none)
+    // ids that disagree with the pose of the others (a subset of tagsRejected). When they are
+    // not fewer than the tags used, the state is lost and the reason asks about the board file.
+    std::vector<int> tagsDisagreeing;
+    double distanceM = 0;          // camera centre to the centre of the used tags (metres)
+    double rmsPx = -1;             // reprojection RMS over the used corners (pixels)
+    double alternativeRmsPx = -1;  // RMS of the best distinct alternative pose (-1: none)
     // 6x6 covariance (row-major) of (rotation vector of a world-frame perturbation of the
     // camera's orientation, radians; camera centre in the world, metres): J^T J inverse scaled by
     // the residual variance. All zero when not computed.
     std::array<double, 36> covariance{};
+    // Square roots of the covariance traces: rotation (degrees) and camera centre (metres).
+    double sigmaRotDeg() const {
+        return glm::degrees(
+            std::sqrt(std::max(0.0, covariance[0] + covariance[7] + covariance[14])));
+    }
+    double sigmaPosM() const {
+        return std::sqrt(std::max(0.0, covariance[21] + covariance[28] + covariance[35]));
+    }
+    // Many tags, or a small rotation uncertainty: the pose may decide the planar ambiguity of
+    // later frames and stands against a surprising next pose (Tracker).
+    bool wellDetermined(int minTags = 3, double maxSigmaRotDeg = 0.2) const {
+        return state == TrackingState::Ok &&
+               (int(tagsUsed.size()) >= minTags || sigmaRotDeg() <= maxSigmaRotDeg);
+    }
 };
 
 class PoseEstimator {
@@ -72,7 +124,8 @@ public:
     PoseEstimator(Board board, CameraIntrinsics camera, PoseEstimatorOptions options = {});
 
     // detections: all tags found in the frame (ids not on the board are ignored).
-    // prior: the previous frame's T_world_camera, if tracked.
+    // prior: a previous T_world_camera, recent and well determined (it may decide the planar
+    // ambiguity; the Tracker passes none otherwise).
     // initial: a pose expected to be close (the tracking mode's prediction, whose tags were
     // verified where it put them). It becomes the first candidate and only the largest tag's
     // IPPE solutions are added (for the planar flip of the ambiguity check) instead of those of

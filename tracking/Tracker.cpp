@@ -56,6 +56,50 @@ double imageSharpness(const cv::Mat& grey) {
     return weakest / range;
 }
 
+double tagEdgeWidthPx(const cv::Mat& grey, const std::array<glm::dvec2, 4>& corners) {
+    double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+    for (const auto& c : corners) {
+        x0 = std::min(x0, c.x);
+        y0 = std::min(y0, c.y);
+        x1 = std::max(x1, c.x);
+        y1 = std::max(y1, c.y);
+    }
+    const cv::Rect box = cv::Rect(cv::Point(int(std::floor(x0)) - 2, int(std::floor(y0)) - 2),
+                                  cv::Point(int(std::ceil(x1)) + 3, int(std::ceil(y1)) + 3)) &
+                         cv::Rect(0, 0, grey.cols, grey.rows);
+    if (box.width < 4 || box.height < 4) return -1;
+    const double s = imageSharpness(grey(box));
+    return s > 0 ? 1.0 / s : -1;
+}
+
+void Tracker::measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const {
+    int onBoard = 0;
+    TagDetection* largest = nullptr;
+    double largestSide = 0;
+    for (auto& d : dets) {
+        if (!estimator_.board().find(d.id)) continue;
+        ++onBoard;
+        const double side = glm::length(d.corners[0] - d.corners[2]);
+        if (side > largestSide) {
+            largestSide = side;
+            largest = &d;
+        }
+    }
+    if (!largest) return;
+    if (onBoard <= options_.blurMeasureMaxTags) {
+        for (auto& d : dets)
+            if (d.edgeWidthPx < 0 && estimator_.board().find(d.id))
+                d.edgeWidthPx = tagEdgeWidthPx(grey, d.corners);
+        return;
+    }
+    // Many tags: the blur of the frame from the largest one (motion blur is mostly common to
+    // the frame), for the tags not measured yet.
+    const double w =
+        largest->edgeWidthPx >= 0 ? largest->edgeWidthPx : tagEdgeWidthPx(grey, largest->corners);
+    for (auto& d : dets)
+        if (d.edgeWidthPx < 0 && estimator_.board().find(d.id)) d.edgeWidthPx = w;
+}
+
 namespace {
 // The detector looks for the board's tag family: a board of tag25h9 tags is searched for
 // tag25h9 codes, whatever the options' default says.
@@ -164,10 +208,13 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior
               [&](const TagDetection& a, const TagDetection& b) { return side(a) > side(b); });
     if (options_.coarsePoseTags > 0 && int(largest.size()) > options_.coarsePoseTags)
         largest.resize(size_t(options_.coarsePoseTags));
+    measureBlur(grey, largest);
     const PoseEstimate ce = estimator_.estimate(largest, prior);
     f.poseMs += msSince(t0);
     // Not ok (one tag with an undecided planar flip, outliers, ...): the ordinary search decides.
-    if (ce.state != TrackingState::Ok) return false;
+    // An uncertain pose (settled, but too uncertain to report) still predicts where the other
+    // tags are; the pose from all of them is judged again.
+    if (ce.state != TrackingState::Ok && ce.state != TrackingState::Uncertain) return false;
 
     t0 = std::chrono::steady_clock::now();
     PredictedTagStats stats;
@@ -186,6 +233,7 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior
     if (!f.tagTrackingTried) f.prediction = stats;
     if (stats.verified < need) return false;
     t0 = std::chrono::steady_clock::now();
+    measureBlur(grey, dets);
     PoseEstimate e = estimator_.estimate(dets, prior, *ce.pose);
     f.poseMs += msSince(t0);
     if (e.state != TrackingState::Ok) return false;
@@ -205,6 +253,8 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         grey = image;
     std::optional<Pose> prior;
     if (lastOk_ && t - lastOkT_ <= options_.priorMaxAgeS && t >= lastOkT_) prior = lastOk_;
+    // Only a well-determined previous pose may decide the planar ambiguity.
+    const std::optional<Pose> ambiguityPrior = lastOkWellDetermined_ ? prior : std::nullopt;
 
     const cv::Rect full(0, 0, grey.cols, grey.rows);
     f.searchRegion = full;
@@ -224,7 +274,8 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         f.detectMs = msSince(t0);
         if (f.prediction.verified >= need) {
             t0 = std::chrono::steady_clock::now();
-            PoseEstimate e = estimator_.estimate(dets, prior, predicted);
+            measureBlur(grey, dets);
+            PoseEstimate e = estimator_.estimate(dets, ambiguityPrior, predicted);
             f.poseMs = msSince(t0);
             if (e.state == TrackingState::Ok) {
                 f.tagTracked = true;
@@ -244,12 +295,13 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         if (f.searchRegion == full) framesSinceFullSearch_ = 0;
 
         if (!(options_.coarseToFine && grey.cols >= options_.coarseMinWidth &&
-              f.searchRegion == full && coarseToFine(grey, prior, f))) {
+              f.searchRegion == full && coarseToFine(grey, ambiguityPrior, f))) {
             t0 = std::chrono::steady_clock::now();
             f.detections = detector_.detect(grey, f.searchRegion);
             f.detectMs += msSince(t0);
             t0 = std::chrono::steady_clock::now();
-            f.estimate = estimator_.estimate(f.detections, prior);
+            measureBlur(grey, f.detections);
+            f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
             f.poseMs += msSince(t0);
         }
         bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
@@ -266,7 +318,8 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
             f.detections = detector_.detect(grey);
             f.detectMs += msSince(t0);
             t0 = std::chrono::steady_clock::now();
-            f.estimate = estimator_.estimate(f.detections, prior);
+            measureBlur(grey, f.detections);
+            f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
             f.poseMs += msSince(t0);
         }
     }
@@ -285,8 +338,31 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     }
     f.poseMs += msSince(t0);
 
+    const auto wellDetermined = [&](const PoseEstimate& e) {
+        return e.wellDetermined(options_.priorMinTags, options_.priorMaxSigmaRotDeg);
+    };
+    if (f.estimate.state == TrackingState::Ok && prior && !wellDetermined(f.estimate)) {
+        // Prediction guard: a weak fit far from where the recent motion puts the camera.
+        const Pose predicted = f.predictedPose ? *f.predictedPose : predictPose(t);
+        const double rotDeg =
+            glm::degrees(rotationAngleBetween(predicted.rotation, f.estimate.pose->rotation));
+        const double pos = glm::length(predicted.translation - f.estimate.pose->translation);
+        const double dist = std::max(1e-6, f.estimate.distanceM);
+        if (rotDeg > options_.guardMaxRotDeg || pos > options_.guardMaxPosFraction * dist) {
+            f.estimate.state = TrackingState::Uncertain;
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "; %.1f deg / %.1f %% of the distance from the motion prediction with "
+                          "a weak fit (bounds %.1f deg / %.1f %%)",
+                          rotDeg, 100 * pos / dist, options_.guardMaxRotDeg,
+                          100 * options_.guardMaxPosFraction);
+            f.estimate.reason += buf;
+        }
+    }
+
     t0 = std::chrono::steady_clock::now();
     if (f.estimate.state == TrackingState::Ok) {
+        lastOkWellDetermined_ = wellDetermined(f.estimate);
         previousOk_ = lastOk_;
         previousOkT_ = lastOkT_;
         lastOk_ = f.estimate.pose;

@@ -27,8 +27,23 @@ struct TrackerOptions {
     PoseFilterOptions filter;
     OneEuroOptions oneEuro;
     bool filterEnabled = true;
-    // The previous ok pose helps decide the planar ambiguity only if it is this recent (seconds).
+    // The previous ok pose helps decide the planar ambiguity only if it is this recent (seconds)
+    // and was well determined: at least priorMinTags tags or a 1-sigma rotation uncertainty of
+    // at most priorMaxSigmaRotDeg (a weak one-tag pose could pass its own error on).
     double priorMaxAgeS = 0.5;
+    int priorMinTags = 3;
+    double priorMaxSigmaRotDeg = 0.2;
+    // Prediction guard (video): an ok pose that is not well determined (as above) and lies more
+    // than guardMaxRotDeg or guardMaxPosFraction of the distance from the constant-velocity
+    // prediction of the recent ok poses is reported uncertain: a jump that only a weak fit
+    // supports is more likely a wrong pose than a motion.
+    double guardMaxRotDeg = 5.0;
+    double guardMaxPosFraction = 0.05;
+    // The edge width (blur) around the tags feeds the estimator's corner-noise model
+    // (TagDetection::edgeWidthPx): measured for each board tag when at most this many are
+    // detected (few tags leave too few residuals to tell the noise), else once on the largest
+    // tag for all (~0.02 ms a tag).
+    int blurMeasureMaxTags = 4;
     // When no tag is found, an image whose sharpness (strongest gradients over the intensity
     // range, about 1 / edge width in pixels) is below this is reported too_blurred, not no_tags.
     double minSharpness = 0.12;
@@ -106,6 +121,11 @@ struct TrackedFrame {
 // range; about 1 / (edge width in pixels). 0 for an image without contrast.
 double imageSharpness(const cv::Mat& grey);
 
+// Edge width around a tag (pixels): 1 / imageSharpness of the image box of its corners grown by
+// 2 px; about 2 px for a sharp image, the blur length for a motion blur longer than that.
+// -1 when the box has no contrast or lies outside the image.
+double tagEdgeWidthPx(const cv::Mat& grey, const std::array<glm::dvec2, 4>& corners);
+
 class Tracker {
 public:
     Tracker(Board board, CameraIntrinsics camera, TrackerOptions options = {});
@@ -113,9 +133,11 @@ public:
     TrackedFrame process(const cv::Mat& image, double t);
     // A pose known from elsewhere (the last pose of a previous run, another sensor) acts as the
     // previous ok pose at time t: it may decide the planar ambiguity of the next frames.
+    // The caller vouches for it: it counts as well determined.
     void seedPrior(const Pose& T_world_camera, double t) {
         lastOk_ = T_world_camera;
         lastOkT_ = t;
+        lastOkWellDetermined_ = true;
         previousOk_.reset();
     }
     // A frame that could not be read (corrupt, truncated video): reported lost, filter reset.
@@ -139,6 +161,9 @@ private:
     // board tags found from their pose; false (f unchanged but the coarse fields) to fall back.
     bool coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior, TrackedFrame& f);
 
+    // Fills TagDetection::edgeWidthPx of the board tags when there are few (above).
+    void measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const;
+
     PredictedTagFinder tagFinder_;
     std::unique_ptr<Detector> coarseDetector_;  // created at the first full search
     int coarseCellsAtBorder_ = 8;
@@ -147,6 +172,7 @@ private:
     OneEuroPoseFilter oneEuro_;
     std::optional<Pose> lastOk_;
     double lastOkT_ = 0;
+    bool lastOkWellDetermined_ = false;
     std::optional<Pose> previousOk_;  // the ok pose before lastOk_ (for the velocity)
     double previousOkT_ = 0;
     int framesSinceFullSearch_ = 0;

@@ -67,8 +67,10 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
         std::snprintf(b, sizeof b, "%.4f", e.rmsPx);
         csv_ << b;
     }
-    csv_ << "," << poseCols(ok ? e.pose : std::nullopt) << ",";
-    if (ok && e.covariance[0] > 0) {
+    // Uncertain rows keep the raw pose and its uncertainty (for inspection, never as output).
+    const bool withRaw = ok || e.state == TrackingState::Uncertain;
+    csv_ << "," << poseCols(withRaw ? e.pose : std::nullopt) << ",";
+    if (withRaw && e.covariance[0] > 0) {
         const double rotVar = e.covariance[0] + e.covariance[7] + e.covariance[14];
         const double posVar = e.covariance[21] + e.covariance[28] + e.covariance[35];
         std::snprintf(b, sizeof b, "%.5f,%.6f", glm::degrees(std::sqrt(rotVar)), std::sqrt(posVar));
@@ -77,7 +79,7 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
         csv_ << ",";
     }
     csv_ << ",";
-    if (ok && e.alternativeRmsPx >= 0) {
+    if (withRaw && e.alternativeRmsPx >= 0) {
         std::snprintf(b, sizeof b, "%.4f", e.alternativeRmsPx);
         csv_ << b;
     }
@@ -139,7 +141,7 @@ std::string TrackingReport::summary() const {
                   100.0 * withTags_ / denom, 100.0 * stateCount_[0] / denom);
     s += b;
     s += "states:";
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < int(stateCount_.size()); ++i) {
         int n = stateCount_[size_t(i)] + (i == int(TrackingState::Lost) ? unreadable_ : 0);
         std::snprintf(b, sizeof b, " %s %d", trackingStateName(TrackingState(i)), n);
         s += b;

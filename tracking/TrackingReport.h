@@ -7,7 +7,8 @@
 //   raw_tx,raw_ty,raw_tz,raw_qw,raw_qx,raw_qy,raw_qz,std_rot_deg,std_pos_m,alt_rms_px,
 //   detect_ms,pose_ms,gt_rot_err_deg,gt_pos_err_m
 // tx..qz is the filtered pose (the raw one with filtering off), raw_* the single-frame estimate.
-// Non-ok rows leave the pose columns empty. `tags` lists the used tag ids separated by spaces.
+// Non-ok rows leave the pose columns empty; uncertain rows fill raw_*, std_* and alt_rms_px. `tags`
+// lists the used tag ids separated by spaces.
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -55,7 +56,7 @@ private:
     glm::dvec3 boardCentre_;
     int frames_ = 0, withTags_ = 0, unreadable_ = 0, wrongOk_ = 0;
     int tagTracked_ = 0, trackFallbacks_ = 0;  // frames from the tracking mode / its fallbacks
-    std::array<int, 6> stateCount_{};
+    std::array<int, 7> stateCount_{};          // per TrackingState
     std::vector<double> rms_, decodeMs_, detectMs_, poseMs_, filterMs_;
     std::vector<double> rotErrDeg_, posErrM_, posErrRel_;              // raw estimate vs truth
     std::vector<double> rotErrFiltDeg_, posErrFiltM_, posErrFiltRel_;  // filtered vs truth

@@ -13,7 +13,8 @@
 // session's frames.csv poses); otherwise live tracking (tracking::Tracker on the session's board
 // and calibration) when the session has a board file, else the ground truth as a fallback. A frame
 // without a pose is "lost": the camera frame passes through unchanged and temporal history is
-// reset on the next tracked frame.
+// reset on the next tracked frame. An `uncertain` frame is composited with the last ok pose if
+// that is at most 0.25 s old (the reason says so), else treated as lost.
 #include <unistd.h>
 #include <cctype>
 #include <chrono>
@@ -52,6 +53,8 @@ bool stopped() {
 }
 
 using Clock = std::chrono::steady_clock;
+// How long an `uncertain` frame may be composited with the last ok pose (seconds).
+constexpr double kHoldUncertainS = 0.25;
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -177,6 +180,8 @@ void runReplay(const ReplayArgs& a) {
     }
     const auto tStart = Clock::now();
     bool lastLost = true;
+    std::optional<Pose> lastGood;  // the last composited tracked or given pose, and its time
+    double lastGoodT = 0;
     int done = 0;
     for (int k = 0; k < total && !stopped(); ++k) {
         const FrameRecord& rec = session.frames[size_t(a.start + k)];
@@ -213,6 +218,20 @@ void runReplay(const ReplayArgs& a) {
             pr = {"ground_truth", "", rec.groundTruth};
         } else {
             pr = {"lost", "no ground-truth pose in frames.csv", std::nullopt};
+        }
+        // An uncertain pose (tracked, but its uncertainty exceeds what ok promises) is never
+        // composited; for up to kHoldUncertainS after the last ok pose that pose is held (a
+        // short wobble of the tracking does not blink the virtual objects away), later the
+        // footage passes through as for a loss.
+        if (pr.state == "uncertain") {
+            pr.pose.reset();
+            if (lastGood && tFrame >= lastGoodT && tFrame - lastGoodT <= kHoldUncertainS) {
+                pr.pose = lastGood;
+                pr.reason += cv::format("; held the last ok pose (t = %.3f s)", lastGoodT);
+            }
+        } else if (pr.pose) {
+            lastGood = pr.pose;
+            lastGoodT = tFrame;
         }
         const double trackingMs = msSince(t1);
         std::map<std::string, double> passMs;

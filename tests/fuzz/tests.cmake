@@ -21,7 +21,7 @@ function(mirage_scene_fuzz_target target)
   endif()
 endfunction()
 
-add_executable(scene_loader_fuzz ${_fuzz_dir}/SceneLoaderFuzz.cpp ${_fuzz_dir}/SceneLoaderFuzzDriver.cpp)
+add_executable(scene_loader_fuzz ${_fuzz_dir}/SceneLoaderFuzz.cpp ${_fuzz_dir}/FuzzDriver.cpp)
 mirage_scene_fuzz_target(scene_loader_fuzz)
 target_link_libraries(scene_loader_fuzz PRIVATE mirage_warnings)
 file(MAKE_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/output/fuzz)

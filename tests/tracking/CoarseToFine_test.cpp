@@ -76,7 +76,8 @@ void expectSamePose(const TrackedFrame& a, const TrackedFrame& b) {
     ASSERT_EQ(a.estimate.state, b.estimate.state) << a.estimate.reason;
     ASSERT_EQ(a.estimate.pose.has_value(), b.estimate.pose.has_value());
     if (!a.estimate.pose) return;
-    EXPECT_LT(rotationDeg(*a.estimate.pose, *b.estimate.pose), 1e-9);
+    // 1e-5 deg: the resolution of the angle (acos near 1) for equal poses.
+    EXPECT_LT(rotationDeg(*a.estimate.pose, *b.estimate.pose), 1e-5);
     EXPECT_LT(glm::length(a.estimate.pose->translation - b.estimate.pose->translation), 1e-12);
     EXPECT_EQ(a.estimate.tagsUsed, b.estimate.tagsUsed);
 }
@@ -91,7 +92,8 @@ TEST(CoarseToFine, SmallTagsFallBackToTheOrdinarySearch) {
     EXPECT_TRUE(c.coarseTried);
     EXPECT_EQ(c.coarseTags, 0);
     EXPECT_FALSE(c.coarseUsed);
-    ASSERT_EQ(o.estimate.state, TrackingState::Ok) << o.estimate.reason;
+    // 3 small tags: ok or uncertain by their covariance (docs/tracking.md), a pose either way.
+    ASSERT_TRUE(o.estimate.pose.has_value()) << o.estimate.reason;
     expectSamePose(c, o);
 }
 

@@ -86,8 +86,8 @@ TEST(HardCases, TagsUnderTwentyPixels) {
     const Outcome o = run(lookAt(orbit(1.1, 80, 0), {0, 0, 0}), {}, nullptr, std::nullopt, "small");
     expectNoConfidentWrongAnswer(o, "small tags");
     const TrackingState s = o.frame.estimate.state;
-    EXPECT_TRUE(s == TrackingState::Ok || s == TrackingState::TagsTooSmall ||
-                s == TrackingState::NoTags)
+    EXPECT_TRUE(s == TrackingState::Ok || s == TrackingState::Uncertain ||
+                s == TrackingState::TagsTooSmall || s == TrackingState::NoTags)
         << o.frame.estimate.reason;
     // Tiny tags (about 6 px) are never used.
     const Outcome tiny = run(lookAt(orbit(3.0, 85, 0), {0, 0, 0}));
@@ -146,7 +146,8 @@ TEST(HardCases, OneVisibleTagAtAnObliqueView) {
 
 // The planar two-fold ambiguity: one small tag seen nearly frontally has two poses that fit its
 // corners about equally well. Without a previous pose the frame is ambiguous (never ok); with a
-// recent previous pose the right one is chosen.
+// recent previous pose the right one is chosen (the state is then uncertain: one 21 px tag seen
+// head-on leaves a 1-sigma rotation of several degrees).
 TEST(HardCases, PlanarAmbiguityNeedsAPrior) {
     const Board one = singleTagBoard(8);
     const glm::dvec3 c = one.tags[0].T_world_tag.translation;
@@ -157,7 +158,11 @@ TEST(HardCases, PlanarAmbiguityNeedsAPrior) {
     const Outcome withPrior = run(T, {}, &one, lookAt(c + orbit(0.9, 81, 29), c));
     expectNoConfidentWrongAnswer(withPrior, "ambiguous, with prior");
     EXPECT_LT(withPrior.rotErrDeg, 4.0);  // the flipped pose would be ~16 degrees off
-    EXPECT_EQ(withPrior.frame.estimate.state, TrackingState::Ok) << withPrior.frame.estimate.reason;
+    EXPECT_EQ(withPrior.frame.estimate.state, TrackingState::Uncertain)
+        << withPrior.frame.estimate.reason;
+    EXPECT_NE(withPrior.frame.estimate.reason.find("resolved by the previous pose"),
+              std::string::npos)
+        << withPrior.frame.estimate.reason;
 }
 
 TEST(HardCases, NoTagAndNoiseFrames) {
