@@ -73,11 +73,17 @@ std::vector<std::string> knobNames(const std::vector<BenchResult>& results) {
     return names;
 }
 
+// The passes that ran in any result, in the frame graph's order (Renderer::passNames).
 std::vector<std::string> passNames(const std::vector<BenchResult>& results) {
-    std::vector<std::string> names;
+    std::vector<std::string> order, names;
     for (const auto& r : results)
-        for (const auto& p : r.passes)
-            if (std::find(names.begin(), names.end(), p) == names.end()) names.push_back(p);
+        if (!r.passOrder.empty()) order = r.passOrder;
+    for (const std::string& p : order)
+        for (const auto& r : results)
+            if (std::find(r.passes.begin(), r.passes.end(), p) != r.passes.end()) {
+                names.push_back(p);
+                break;
+            }
     return names;
 }
 
@@ -309,6 +315,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
     renderer.render({frames.front().T_world_camera, frames.front().footage, true});
 
     BenchResult result;
+    result.passOrder = renderer.passNames();
     result.config = config;
     result.config.width = w;
     result.config.height = h;
@@ -330,13 +337,8 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
             fr.index = f.index;
             fr.gpuMs = report.totalGpuMs;
             fr.wallMs = wallMs;
-            for (const auto& p : report.passes) {
-                if (!p.ran) continue;
-                fr.passMs[p.name] = p.gpuMs;
-                if (std::find(result.passes.begin(), result.passes.end(), p.name) ==
-                    result.passes.end())
-                    result.passes.push_back(p.name);
-            }
+            for (const auto& p : report.passes)
+                if (p.ran) fr.passMs[p.name] = p.gpuMs;
             CompositeErrorAccumulator one;
             one.add(composite, f.truth, f.influence);
             fr.error = one.result();
@@ -351,6 +353,13 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
         }
         result.error = acc.result();
         result.frames = std::move(frameResults);
+        result.passes.clear();
+        for (const std::string& p : result.passOrder)
+            for (const auto& fr : result.frames)
+                if (fr.passMs.count(p)) {
+                    result.passes.push_back(p);
+                    break;
+                }
         for (const auto& fr : result.frames)
             for (const auto& p : result.passes) {
                 const auto it = fr.passMs.find(p);
