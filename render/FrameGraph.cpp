@@ -457,20 +457,26 @@ bool PassResources::has(Resource r) const {
     return bool(graph_.current_[size_t(r)]);
 }
 
-void PassResources::publish(Resource r, const gl::Texture& texture) {
-    FrameGraph::Slot s;
-    s.texture = &texture;
+const gl::Texture& PassResources::textureOr(Resource r, const gl::Texture& fallback) const {
+    return has(r) ? texture(r) : fallback;
+}
+
+void PassResources::publishSlot(Resource r, const FrameGraph::Slot& s) {
     graph_.checkPublished(graph_.nodes_[node_], r, s, ctx_);
     graph_.current_[size_t(r)] = s;
     graph_.published_[node_].push_back({r, s});
 }
 
+void PassResources::publish(Resource r, const gl::Texture& texture) {
+    FrameGraph::Slot s;
+    s.texture = &texture;
+    publishSlot(r, s);
+}
+
 void PassResources::publish(Resource r, const gl::Buffer& buffer) {
     FrameGraph::Slot s;
     s.buffer = &buffer;
-    graph_.checkPublished(graph_.nodes_[node_], r, s, ctx_);
-    graph_.current_[size_t(r)] = s;
-    graph_.published_[node_].push_back({r, s});
+    publishSlot(r, s);
 }
 
 }  // namespace mirage::render

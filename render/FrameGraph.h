@@ -127,6 +127,8 @@ public:
     const gl::Buffer& buffer(Resource r) const;
     // A declared read (typically optional) is available this frame.
     bool has(Resource r) const;
+    // A declared optional read, or `fallback` when it is not available this frame.
+    const gl::Texture& textureOr(Resource r, const gl::Texture& fallback) const;
     // A declared write: checked against the declared format and size rule (MR_CHECK).
     void publish(Resource r, const gl::Texture& texture);
     void publish(Resource r, const gl::Buffer& buffer);
@@ -136,7 +138,7 @@ private:
     PassResources(FrameGraph& g, size_t node, const FrameContext& ctx)
         : graph_(g), node_(node), ctx_(ctx) {}
     const ResourceRead& declaredRead(Resource r) const;
-    const ResourceWrite& declaredWrite(Resource r) const;
+    void publishSlot(Resource r, const FrameGraph::Slot& s);
     FrameGraph& graph_;
     size_t node_;
     const FrameContext& ctx_;

@@ -197,7 +197,10 @@ void Renderer::planFrame(const FrameInput& input) {
         g.positionRange = glm::vec4(l.position, l.range);
         g.directionType = glm::vec4(l.direction, float(l.type));
         const float scale = 1.0f / std::max(0.001f, l.cosInner - l.cosOuter);
-        g.cone = glm::vec4(l.cosOuter, l.cosInner, scale, -l.cosOuter * scale);
+        g.cosOuter = l.cosOuter;
+        g.cosInner = l.cosInner;
+        g.coneScale = scale;
+        g.coneOffset = -l.cosOuter * scale;
         g.radiantIntensity = glm::vec4(l.radiantIntensity, 1.0f);
         const float farL = glm::length(B.center - l.position) + R + 0.1f;
         const float nearL = std::clamp(farL * 1e-4f, 0.005f, 0.05f);
@@ -229,8 +232,10 @@ void Renderer::planFrame(const FrameInput& input) {
         if (!lp.castsShadow) lp.layers = 0;
         lp.firstLayer = layer;
         layer += lp.layers;
-        g.shadow = glm::ivec4(lp.firstLayer, lp.layers, lp.needsRealOnlyMap ? 1 : 0,
-                              l.origin == Origin::Real ? 1 : 0);
+        g.firstShadowLayer = lp.firstLayer;
+        g.shadowLayers = lp.layers;
+        g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
+        g.isReal = l.origin == Origin::Real ? 1 : 0;
         plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
         plan.lights.push_back(lp);
     }
@@ -280,19 +285,27 @@ void Renderer::planFrame(const FrameInput& input) {
     f.canvas =
         glm::vec4(projection_.canvasWidth, projection_.canvasHeight,
                   1.0f / float(projection_.canvasWidth), 1.0f / float(projection_.canvasHeight));
-    f.counts =
-        glm::ivec4(int(s.lights().size()), options_.vplCount, options_.interleave, c.frameIndex);
+    f.lightCount = int(s.lights().size());
+    f.vplCount = options_.vplCount;
+    f.interleave = options_.interleave;
+    f.frameIndex = c.frameIndex;
     const int envFlag = !s.hasEnvironment()                     ? kOriginNone
                         : s.environmentOrigin() == Origin::Real ? kOriginReal
                                                                 : kOriginVirtual;
     c.historyValid = !input.resetHistory && lastRanFilter_ && c.frameIndex > 0;
-    f.flags = glm::ivec4(envFlag, c.historyValid ? 1 : 0, options_.ismTileSize,
-                         ismTilesPerRow(options_.vplCount));
-    f.params = glm::vec4(options_.vplDistanceClamp, options_.shadowBias * 0.1f,
-                         options_.temporalBlend, float(options_.ismPointsPerVpl));
+    f.envOrigin = envFlag;
+    f.historyValid = c.historyValid ? 1 : 0;
+    f.ismTileSize = options_.ismTileSize;
+    f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
+    f.vplDistanceClamp = options_.vplDistanceClamp;
+    f.shadowBias = options_.shadowBias * 0.1f;
+    f.temporalBlend = options_.temporalBlend;
+    f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
     for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);
-    f.exposure = glm::vec4(options_.exposure, options_.alphaMax, options_.alphaFadeLr,
-                           s.environmentRotation());
+    f.exposure = options_.exposure;
+    f.alphaMax = options_.alphaMax;
+    f.alphaFadeLr = options_.alphaFadeLr;
+    f.envRotation = s.environmentRotation();
     c.frameUbo.upload(&f, sizeof(GpuFrame));
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
     prevViewProj_ = viewProj;

@@ -101,32 +101,32 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
     // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
     ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
-    auto tex = [&](Resource a, Resource b) -> GLuint {
-        if (res.has(a)) return res.texture(a).id();
-        if (res.has(b)) return res.texture(b).id();
-        return ctx.blackTexture().id();
+    auto tex = [&](Resource a, Resource b) {
+        return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
     };
-    glBindTextureUnit(0, res.texture(Resource::CameraImage).id());
-    glBindTextureUnit(1, tex(Resource::LRv, Resource::DirectRv));
-    glBindTextureUnit(2, tex(Resource::LR, Resource::DirectR));
-    glBindTextureUnit(3, res.has(Resource::GBufferPosition)
-                             ? res.texture(Resource::GBufferPosition).id()
-                             : ctx.blackTexture().id());
-    glBindTextureUnit(4, remap_.id());
+    glBindTextureUnit(kUnitCompositeCamera, res.texture(Resource::CameraImage).id());
+    glBindTextureUnit(kUnitCompositeLRv, tex(Resource::LRv, Resource::DirectRv));
+    glBindTextureUnit(kUnitCompositeLR, tex(Resource::LR, Resource::DirectR));
+    glBindTextureUnit(kUnitCompositePosition,
+                      res.textureOr(Resource::GBufferPosition, ctx.blackTexture()).id());
+    glBindTextureUnit(kUnitCompositeRemap, remap_.id());
     if (specular) {
-        glBindTextureUnit(5, res.texture(Resource::GBufferEmissive).id());
-        glBindTextureUnit(6, res.texture(Resource::ReflectionGBuffer).id());
-        glBindTextureUnit(7, res.texture(Resource::RefractionGBuffer).id());
-        glBindTextureUnit(8, res.texture(Resource::ReflectionWeight).id());
-        glBindTextureUnit(9, res.texture(Resource::RefractionWeight).id());
-        glBindTextureUnit(10, res.texture(Resource::SpecularRv).id());
-        glBindTextureUnit(11, res.texture(Resource::SpecularR).id());
-        glBindTextureUnit(12, res.texture(Resource::SpecularRReflection).id());
-        glBindTextureUnit(13, res.texture(Resource::Lenv).id());
-        glBindTextureUnit(14, res.texture(Resource::RealSurfaces).id());
-        glBindTextureUnit(15, canvasToCamera_.id());
+        glBindTextureUnit(kUnitCompositeEmissive, res.texture(Resource::GBufferEmissive).id());
+        glBindTextureUnit(kUnitCompositeReflPosition,
+                          res.texture(Resource::ReflectionGBuffer).id());
+        glBindTextureUnit(kUnitCompositeRefrPosition,
+                          res.texture(Resource::RefractionGBuffer).id());
+        glBindTextureUnit(kUnitCompositeReflWeight, res.texture(Resource::ReflectionWeight).id());
+        glBindTextureUnit(kUnitCompositeRefrWeight, res.texture(Resource::RefractionWeight).id());
+        glBindTextureUnit(kUnitCompositeSpecRv, res.texture(Resource::SpecularRv).id());
+        glBindTextureUnit(kUnitCompositeSpecR, res.texture(Resource::SpecularR).id());
+        glBindTextureUnit(kUnitCompositeSpecRRefl, res.texture(Resource::SpecularRReflection).id());
+        glBindTextureUnit(kUnitCompositeLenv, res.texture(Resource::Lenv).id());
+        glBindTextureUnit(kUnitCompositeRealSurfaces, res.texture(Resource::RealSurfaces).id());
+        glBindTextureUnit(kUnitCompositeCanvasToCamera, canvasToCamera_.id());
     } else {
-        for (GLuint u = 5; u <= 15; ++u) glBindTextureUnit(u, ctx.blackTexture().id());
+        for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
+            glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
     ctx.drawFullscreenTriangle();
     const glm::ivec4 rect = specular ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);

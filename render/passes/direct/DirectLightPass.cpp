@@ -36,15 +36,14 @@ void DirectLightPass::resize(const FrameContext& ctx) {
 void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
-    glBindTextureUnit(0, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(1, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(2, res.texture(Resource::GBufferAlbedo).id());
-    glBindTextureUnit(3, res.texture(Resource::GBufferEmissive).id());
-    glBindTextureUnit(4, res.has(Resource::ShadowMaps) ? res.texture(Resource::ShadowMaps).id()
-                                                       : ctx.farShadowTexture().id());
-    glBindTextureUnit(5, res.has(Resource::ShadowMapsReal)
-                             ? res.texture(Resource::ShadowMapsReal).id()
-                             : ctx.farShadowTexture().id());
+    glBindTextureUnit(kUnitDirectPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitDirectNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitDirectAlbedo, res.texture(Resource::GBufferAlbedo).id());
+    glBindTextureUnit(kUnitDirectEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitDirectShadowAll,
+                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitDirectShadowReal,
+                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
     ctx.drawFullscreenTriangle();
     res.publish(Resource::DirectRv, rv_);
     res.publish(Resource::DirectR, r_);

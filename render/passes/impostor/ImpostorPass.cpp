@@ -16,8 +16,6 @@
 namespace mirage::render {
 namespace {
 
-// Storage bindings of the offline query shader (query.comp); it runs outside frames.
-constexpr unsigned kBindingQueryRays = 4, kBindingQueryHits = 5;
 constexpr int kCoarseSamples = 8;  // linear-search samples per impostor box (trace.glsl)
 constexpr float kEmptyDepth = 1e30f;
 
@@ -93,14 +91,14 @@ ImpostorPass::ImpostorPass()
 }
 
 namespace {
-// The resources trace.glsl reads: texture units kBindingImpostorCubePosition + i, then buffers.
+// The resources trace.glsl reads: texture units kUnitImpostorCubePosition + i, then buffers.
 constexpr Resource kTracingTextures[8] = {
     Resource::ImpostorCubePosition, Resource::ImpostorCubeNormal, Resource::ImpostorCubeAlbedo,
     Resource::ImpostorCubeEmissive, Resource::ImpostorDepth,      Resource::ImpostorNormal,
     Resource::ImpostorAlbedo,       Resource::ImpostorEmissive};
 constexpr GLenum kTracingFormats[8] = {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F,
                                        GL_RG32F,   GL_RGBA16F, GL_RGBA8, GL_RGBA16F};
-static_assert(kBindingImpostorEmissive - kBindingImpostorCubePosition == 7);
+static_assert(kUnitImpostorEmissive - kUnitImpostorCubePosition == 7);
 }  // namespace
 
 void ImpostorPass::setup(PassBuilder& b) const {
@@ -118,7 +116,7 @@ void ImpostorPass::declareTracing(PassBuilder& b) {
 
 void ImpostorPass::bindForTracing(const PassResources& res) {
     for (unsigned i = 0; i < 8; ++i)
-        glBindTextureUnit(kBindingImpostorCubePosition + i, res.texture(kTracingTextures[i]).id());
+        glBindTextureUnit(kUnitImpostorCubePosition + i, res.texture(kTracingTextures[i]).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords,
                      res.buffer(Resource::ImpostorRecords).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects,
@@ -413,7 +411,7 @@ void ImpostorPass::capture(const GpuScene& scene, const Layout& layout, int res)
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
         glUniform1i(locMaterial_, d.material);
         glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        scene.bindMaterialTextures(d, 7);
+        scene.bindMaterialTextures(d, kUnitBaseColorMap);
         scene.drawItem(d);
     };
     auto target = [&](const gl::Texture& a, const gl::Texture& n, const gl::Texture& al,
@@ -487,7 +485,7 @@ void ImpostorPass::bindOwnForTracing() const {
     const gl::Texture* units[8] = {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
                                    &depth_,        &normal_,     &albedo_,     &emissive_};
     for (unsigned i = 0; i < 8; ++i)
-        glBindTextureUnit(kBindingImpostorCubePosition + i, units[i]->id());
+        glBindTextureUnit(kUnitImpostorCubePosition + i, units[i]->id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords, records_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects, objects_.id());
 }

@@ -65,8 +65,8 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
     // For a pass that traces the surroundings with trace.glsl: declares the impostor resources
-    // as its reads, and binds them by name (texture units 16..23 and storage bindings 6..7,
-    // kBindingImpostor* in render/GpuTypes.h).
+    // as its reads, and binds them by name (texture units kUnitImpostor* and storage bindings
+    // kBindingImpostorRecords / kBindingImpostorObjects, render/bindings.glsl).
     static void declareTracing(PassBuilder& b);
     static void bindForTracing(const PassResources& res);
 

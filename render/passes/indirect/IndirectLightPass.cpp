@@ -49,11 +49,11 @@ void IndirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     ctx.beginFullscreen(program_, rv_.width(), rv_.height());  // each tile sets its viewport
     glUniform1i(program_.uniformLocation("scale"), ctx.options.indirectScale);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
-    glBindTextureUnit(0, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(1, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(2, res.texture(Resource::GBufferAlbedo).id());
-    glBindTextureUnit(3, res.texture(Resource::ImperfectShadowMaps).id());
-    glBindTextureUnit(4, res.texture(Resource::ImperfectShadowMapsReal).id());
+    glBindTextureUnit(kUnitIndirectPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitIndirectNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitIndirectAlbedo, res.texture(Resource::GBufferAlbedo).id());
+    glBindTextureUnit(kUnitIndirectIsmAll, res.texture(Resource::ImperfectShadowMaps).id());
+    glBindTextureUnit(kUnitIndirectIsmReal, res.texture(Resource::ImperfectShadowMapsReal).id());
     ctx.emptyVao.bind();
     // One draw per VPL group into its tile: the group is uniform over the draw, so every pixel
     // walks the same VPL list (uniform loads; on llvmpipe divergent SSBO gathers are far slower).

@@ -40,8 +40,8 @@ void IsmPass::execute(FrameContext& ctx, PassResources& res) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingIsmPoints,
                      ctx.scene.surfacePointBuffer().id());
-    glBindImageTexture(0, all_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindImageTexture(1, real_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kImageIsmAll, all_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kImageIsmReal, real_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glUniform1i(program_.uniformLocation("pointCount"), ctx.scene.surfacePointCount());
     glUniform1i(program_.uniformLocation("writeReal"), ctx.plan.needRealOnlyIsm ? 1 : 0);
     const float perVpl = float(std::max(1, ctx.options.ismPointsPerVpl));

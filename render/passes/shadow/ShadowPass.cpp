@@ -77,7 +77,7 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
         glUniform1i(locMaterial_, d.material);
         glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        ctx.scene.bindMaterialTextures(d, 7);
+        ctx.scene.bindMaterialTextures(d, kUnitBaseColorMap);
         ctx.scene.drawItem(d);
     }
 }

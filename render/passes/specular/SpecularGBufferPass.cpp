@@ -78,12 +78,12 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
                      ctx.scene.specularDrawBuffer().id());
-    glBindTextureUnit(0, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(1, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(2, res.texture(Resource::GBufferEmissive).id());
-    glBindTextureUnit(3, res.texture(Resource::BackFacePosition).id());
-    glBindTextureUnit(4, res.texture(Resource::BackFaceNormal).id());
-    ImpostorPass::bindForTracing(res);  // texture units 16..23, storage bindings 6..7
+    glBindTextureUnit(kUnitSpecGbufPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitSpecGbufNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitSpecGbufEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
+    glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
+    ImpostorPass::bindForTracing(res);  // kUnitImpostor*, kBindingImpostorRecords / Objects
     for (int mode = 0; mode < 2; ++mode) {
         (mode == 0 ? refl_ : refr_).fbo.bind();
         const gl::Program& program = programs_[mode];

@@ -5,12 +5,13 @@
 namespace mirage::render {
 
 namespace {
-// GBuf_refl then GBuf_refr, in the texture-unit order of specular_light.frag (0..9).
+// GBuf_refl then GBuf_refr, at kUnitSpecLightReflFirst + 0..4 and kUnitSpecLightRefrFirst + 0..4.
 constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::ReflectionNormal,
                                       Resource::ReflectionAlbedo,   Resource::ReflectionEmissive,
                                       Resource::ReflectionWeight,   Resource::RefractionGBuffer,
                                       Resource::RefractionNormal,   Resource::RefractionAlbedo,
                                       Resource::RefractionEmissive, Resource::RefractionWeight};
+static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
 }  // namespace
 
 SpecularLightPass::SpecularLightPass(const GpuScene& scene)
@@ -60,25 +61,26 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
-    for (GLuint i = 0; i < 10; ++i) glBindTextureUnit(i, res.texture(kHitBuffers[i]).id());
-    glBindTextureUnit(10, res.has(Resource::ShadowMaps) ? res.texture(Resource::ShadowMaps).id()
-                                                        : ctx.farShadowTexture().id());
-    glBindTextureUnit(11, res.has(Resource::ShadowMapsReal)
-                              ? res.texture(Resource::ShadowMapsReal).id()
-                              : ctx.farShadowTexture().id());
+    for (int i = 0; i < 10; ++i)
+        glBindTextureUnit(GLuint(kUnitSpecLightReflFirst + i), res.texture(kHitBuffers[i]).id());
+    glBindTextureUnit(kUnitSpecLightShadowAll,
+                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitSpecLightShadowReal,
+                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
     const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
                       res.has(Resource::ImperfectShadowMaps);
     if (vpls) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
-        glBindTextureUnit(12, res.texture(Resource::ImperfectShadowMaps).id());
-        glBindTextureUnit(13, res.has(Resource::ImperfectShadowMapsReal)
-                                  ? res.texture(Resource::ImperfectShadowMapsReal).id()
-                                  : res.texture(Resource::ImperfectShadowMaps).id());
+        glBindTextureUnit(kUnitSpecLightIsmAll, res.texture(Resource::ImperfectShadowMaps).id());
+        glBindTextureUnit(kUnitSpecLightIsmReal,
+                          res.textureOr(Resource::ImperfectShadowMapsReal,
+                                        res.texture(Resource::ImperfectShadowMaps))
+                              .id());
     } else {
-        glBindTextureUnit(12, 0);
-        glBindTextureUnit(13, 0);
+        glBindTextureUnit(kUnitSpecLightIsmAll, 0);
+        glBindTextureUnit(kUnitSpecLightIsmReal, 0);
     }
-    glBindTextureUnit(14, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitSpecLightPosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitEnvironmentMap, res.texture(Resource::EnvironmentMap).id());
     glUniform1i(locUseVpls_, vpls ? 1 : 0);
     glUniform1i(locVplStride_, ctx.options.specularVplStride);

@@ -27,9 +27,9 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.id());
-    glBindTextureUnit(0, res.texture(Resource::RsmFlux).id());
-    glBindTextureUnit(1, res.texture(Resource::RsmNormal).id());
-    glBindTextureUnit(2, res.texture(Resource::RsmPosition).id());
+    glBindTextureUnit(kUnitVplRsmFlux, res.texture(Resource::RsmFlux).id());
+    glBindTextureUnit(kUnitVplRsmNormal, res.texture(Resource::RsmNormal).id());
+    glBindTextureUnit(kUnitVplRsmPosition, res.texture(Resource::RsmPosition).id());
     glm::ivec4 ranges[kMaxLights] = {};
     for (size_t i = 0; i < ctx.plan.lights.size(); ++i) {
         const LightPlan& lp = ctx.plan.lights[i];
