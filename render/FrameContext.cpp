@@ -1,59 +1,40 @@
 #include "render/FrameContext.h"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 #include "core/Error.h"
 
 namespace mirage::render {
 
-const char* resourceName(Resource r) {
-    switch (r) {
-        case Resource::CameraImage:
-            return "CameraImage";
-        case Resource::GBuffer:
-            return "GBuffer";
-        case Resource::ShadowMaps:
-            return "ShadowMaps";
-        case Resource::ShadowMapsReal:
-            return "ShadowMapsReal";
-        case Resource::ReflectiveShadowMaps:
-            return "ReflectiveShadowMaps";
-        case Resource::Vpls:
-            return "Vpls";
-        case Resource::ImperfectShadowMaps:
-            return "ImperfectShadowMaps";
-        case Resource::ImperfectShadowMapsReal:
-            return "ImperfectShadowMapsReal";
-        case Resource::DirectRv:
-            return "DirectRv";
-        case Resource::DirectR:
-            return "DirectR";
-        case Resource::IndirectRv:
-            return "IndirectRv";
-        case Resource::IndirectR:
-            return "IndirectR";
-        case Resource::LRv:
-            return "LRv";
-        case Resource::LR:
-            return "LR";
-        case Resource::BackFaces:
-            return "BackFaces";
-        case Resource::RealSurfaces:
-            return "RealSurfaces";
-        case Resource::ReflectionGBuffer:
-            return "ReflectionGBuffer";
-        case Resource::RefractionGBuffer:
-            return "RefractionGBuffer";
-        case Resource::SpecularRv:
-            return "SpecularRv";
-        case Resource::SpecularR:
-            return "SpecularR";
-        case Resource::Lenv:
-            return "Lenv";
-        case Resource::Composite:
-            return "Composite";
-        case Resource::Impostors:
-            return "Impostors";
-    }
-    return "?";
+void RendererOptions::validate() const {
+    auto fail = [](const std::string& what) { throw Error("renderer option " + what); };
+    if (vplCount < 0 || vplCount > 16384)
+        fail("vplCount is " + std::to_string(vplCount) + ", out of range (0..16384)");
+    if (interleave < 1 || interleave > 8)
+        fail("interleave must be 1..8, got " + std::to_string(interleave));
+    if (indirectScale != 1 && indirectScale != 2)
+        fail("indirectScale must be 1 or 2, got " + std::to_string(indirectScale));
+    if (shadowMapSize < 16 || shadowMapSize > 4096)
+        fail("shadowMapSize must be 16..4096, got " + std::to_string(shadowMapSize));
+    if (ismTileSize < 8 || ismTileSize > 256)
+        fail("ismTileSize must be 8..256, got " + std::to_string(ismTileSize));
+    if (refractionMarchSteps < 2 || refractionMarchSteps > 128)
+        fail("refractionMarchSteps must be 2..128, got " + std::to_string(refractionMarchSteps));
+    if (specularVplStride != 1 && specularVplStride != 4 && specularVplStride != 16)
+        fail("specularVplStride must be 1, 4 or 16, got " + std::to_string(specularVplStride));
+    if (!(backProjectionEpsilon > 0.0f) || backProjectionEpsilon > 1.0f)
+        fail("backProjectionEpsilon must be in (0, 1] (relative depth tolerance)");
+    if (impostorResolution < 8 || impostorResolution > 2048)
+        fail("impostorResolution must be 8..2048 texels, got " +
+             std::to_string(impostorResolution));
+    if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
+        fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
+}
+
+int ismTilesPerRow(int vplCount) {
+    return std::max(1, int(std::ceil(std::sqrt(double(std::max(vplCount, 1))))));
 }
 
 FrameContext::FrameContext(const GpuScene& s, const CameraProjection& p, const RendererOptions& o)
@@ -70,17 +51,6 @@ FrameContext::FrameContext(const GpuScene& s, const CameraProjection& p, const R
     const float far = 1e30f;
     farShadow_.upload(GL_RED, GL_FLOAT, &far);
     farShadow_.setFilter(GL_NEAREST, GL_NEAREST);
-}
-
-void FrameContext::publish(Resource r, const gl::Texture* tex) {
-    published_[r] = tex;
-}
-
-const gl::Texture& FrameContext::texture(Resource r) const {
-    auto it = published_.find(r);
-    MR_CHECK(it != published_.end() && it->second,
-             std::string("resource ") + resourceName(r) + " read before any pass wrote it");
-    return *it->second;
 }
 
 void FrameContext::bindFrameBlocks() const {

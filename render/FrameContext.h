@@ -1,10 +1,9 @@
 #pragma once
 // Everything one frame's passes share: the scene on the GPU, the camera (intrinsics + pose),
 // the per-frame plan (which lights cast shadows, which need a real-only shadow map, whether
-// VPLs are needed), the uniform buffers, and the frame's resources as published by the passes
-// that wrote them (a pass may only read what an earlier pass published or what was imported).
+// VPLs are needed) and the uniform buffers. The frame's textures are handed from pass to pass by
+// the frame graph (render/FrameGraph.h), not through this context.
 #include <array>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -13,37 +12,9 @@
 #include "render/CameraProjection.h"
 #include "render/GpuScene.h"
 #include "render/GpuTypes.h"
+#include "render/Resource.h"
 
 namespace mirage::render {
-
-// Frame resources. Buffers named L_* are linear HDR radiance (RGBA16F, rgb used).
-enum class Resource {
-    CameraImage,     // imported: the camera frame, sRGB8 texture sampled as linear (image size)
-    GBuffer,         // position/origin, normal/roughness, albedo/metallic, depth (canvas size)
-    ShadowMaps,      // per light layer: distance to the nearest occluder (all geometry)
-    ShadowMapsReal,  // the same with real occluders only (only for lights that need it)
-    ReflectiveShadowMaps,     // per light layer: flux/origin, normal, position (for VPLs)
-    Vpls,                     // SSBO of GpuVpl
-    ImperfectShadowMaps,      // r32ui atlas, one paraboloid tile per VPL (all occluders)
-    ImperfectShadowMapsReal,  // the same with real points only
-    DirectRv,
-    DirectR,  // direct + environment + emission, routed (canvas size)
-    IndirectRv,
-    IndirectR,  // interleaved VPL gather, unfiltered (canvas size)
-    LRv,
-    LR,  // the two GI solutions, filtered and temporally smoothed
-    // Specular objects (issue 6, Knecht 2013 Sec. 4.1 / 5.1; docs/specular.md):
-    BackFaces,          // specular objects' back faces: world position + slot, normal (canvas)
-    RealSurfaces,       // nearest REAL surface per pixel (world position + origin), canvas size
-    ReflectionGBuffer,  // GBuf_refl: reflected-ray hits (position/origin, normal, albedo, ...)
-    RefractionGBuffer,  // GBuf_refr: two-interface refracted-ray hits (Wyman 2005)
-    SpecularRv,         // L'_rv (Eq. 3), Fresnel-weighted, canvas size
-    SpecularR,          // L'_r (Eq. 4)
-    Lenv,               // L_env: environment seen where a ray leaves the modelled scene
-    Composite,          // final image (camera image size): linear RGBA32F + sRGB8
-    Impostors,  // per specular object: reflected-scene impostors + G-buffer cube maps (world)
-};
-const char* resourceName(Resource r);
 
 struct RendererOptions {
     int vplCount = 256;                  // total VPLs per frame, split over the lights with RSMs
@@ -79,7 +50,14 @@ struct RendererOptions {
     int impostorResolution = 256;          // texels per side of each impostor and cube face
     int impostorRefineSteps = 4;           // secant refinement steps of the height-field search
     bool impostorCubeMapBaseline = false;  // true: plain G-buffer cube map, looked up by direction
+
+    // Throws mirage::Error naming the first option out of range and its valid range. The
+    // Renderer calls it once, before anything is allocated.
+    void validate() const;
 };
+
+// Tiles per row of the imperfect shadow map atlas (one square tile per VPL).
+int ismTilesPerRow(int vplCount);
 
 struct LightPlan {
     bool castsShadow = false;        // some caster inside the light's cone
@@ -123,11 +101,6 @@ public:
     gl::Buffer frameUbo, lightUbo;
     gl::VertexArray emptyVao;  // for full-screen triangles
 
-    void publish(Resource r, const gl::Texture* tex);  // tex may be null for buffer resources
-    bool has(Resource r) const { return published_.count(r) != 0; }
-    const gl::Texture& texture(Resource r) const;  // throws (a bug) if not published
-    void clearResources() { published_.clear(); }
-
     const gl::Texture& blackTexture() const { return black_; }          // 1x1 RGBA16F zero
     const gl::Texture& farShadowTexture() const { return farShadow_; }  // 1x1 array, 1e30
 
@@ -145,7 +118,6 @@ public:
     void drawFullscreenTriangleIn(const glm::ivec4& rect, int attachments) const;
 
 private:
-    std::map<Resource, const gl::Texture*> published_;
     gl::Texture black_, farShadow_;
 };
 

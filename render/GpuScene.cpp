@@ -15,12 +15,7 @@
 namespace mirage::render {
 namespace {
 
-struct Vertex {          // = GpuSceneVertex (GpuScene.h), layout checked below
-    glm::vec3 position;  // mesh-local
-    glm::vec3 normal;    // mesh-local
-    glm::vec2 uv;        // the UV set the base colour texture uses (glTF: (0,0) = top left)
-};
-static_assert(sizeof(Vertex) == sizeof(GpuSceneVertex));
+using Vertex = GpuSceneVertex;
 
 GpuMaterial toGpu(const Material& m) {
     GpuMaterial g;
@@ -93,7 +88,22 @@ std::vector<glm::vec3> GpuScene::projectEquirectToSH(const cv::Mat& img, float i
 }
 
 GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
-    // Textures (baseColor ones are sRGB-encoded: GL decodes them to linear when sampled).
+    uploadTextures(scene);
+    const int materialCount = uploadMaterials(scene);
+    // Geometry: one vertex and one index buffer for all primitives.
+    std::vector<Vertex> verts;
+    std::vector<uint32_t> idx;
+    const std::vector<std::vector<Range>> meshRanges =
+        uploadGeometry(scene, materialCount, verts, idx);
+    buildDraws(scene, meshRanges);
+    buildLights(scene);
+    uploadSpecularDraws();
+    buildSurfacePoints(verts, idx, surfacePoints);
+    uploadEnvironment(scene);
+}
+
+// Textures (baseColor ones are sRGB-encoded: GL decodes them to linear when sampled).
+void GpuScene::uploadTextures(const Scene& scene) {
     white_ = gl::Texture::create2D("white 1x1", 1, 1, GL_RGBA8);
     const unsigned char whitePx[4] = {255, 255, 255, 255};
     white_.upload(GL_RGBA, GL_UNSIGNED_BYTE, whitePx);
@@ -112,26 +122,25 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         g.setWrap(GL_REPEAT);
         textures_.push_back(std::move(g));
     }
+}
 
-    // Materials: slot 0 is the glTF default material, slot i+1 is scene.materials[i].
+// Materials: slot 0 is the glTF default material, slot i+1 is scene.materials[i]. Returns the
+// slot count.
+int GpuScene::uploadMaterials(const Scene& scene) {
     std::vector<GpuMaterial> mats;
     mats.push_back(toGpu(Material()));  // glTF default: white, metallic 1, roughness 1
     for (const Material& m : scene.materials) mats.push_back(toGpu(m));
     materials_ = gl::Buffer("scene materials", mats.size() * sizeof(GpuMaterial), mats.data());
 
-    // Geometry: one buffer for all primitives; remember each primitive's range.
-    std::vector<Vertex> verts;
-    std::vector<uint32_t> idx;
-    struct Range {
-        GLint baseVertex;
-        GLuint firstIndex;
-        GLsizei count;
-        int material;
-        int texture;
-        glm::vec3 center;
-        float radius;
-        bool specular;
-    };
+    return int(mats.size());
+}
+
+// Every primitive's vertices and indices appended to verts / idx (uploaded once), and per mesh
+// the range of each of its primitives with its material, texture and local bounding sphere.
+std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& scene,
+                                                                   int materialCount,
+                                                                   std::vector<Vertex>& verts,
+                                                                   std::vector<uint32_t>& idx) {
     std::vector<std::vector<Range>> meshRanges(scene.meshes.size());
     for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
         for (const Primitive& p : scene.meshes[mi].primitives) {
@@ -166,7 +175,7 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
                                 scene.meshes[mi].name + "' has an index out of range");
                 idx.push_back(i);
             }
-            if (r.material < 0 || r.material >= int(mats.size())) r.material = 0;
+            if (r.material < 0 || r.material >= materialCount) r.material = 0;
             // Bounding sphere about the box centre with the farthest vertex's distance: tight for
             // a sphere mesh (the box's half-diagonal would be sqrt(3) x its radius), which the
             // specular scissor, the culling and the refraction exit fallback all use.
@@ -193,8 +202,13 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
         glVertexArrayAttribBinding(vao_.id(), 2, 0);
     }
 
-    // Instances and lights reachable from the scene's roots (Scene::meshInstances /
-    // lightInstances: world-from-node with the REAL/VIRTUAL flag inherited from parents).
+    return meshRanges;
+}
+
+// Draw items of the mesh instances reachable from the scene's roots (Scene::meshInstances:
+// world-from-node with the REAL/VIRTUAL flag inherited from parents), the specular ones among
+// them, and the scene's bounding sphere.
+void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Range>>& meshRanges) {
     glm::vec3 lo(1e30f), hi(-1e30f);
     for (const MeshInstance& inst : scene.meshInstances()) {
         const glm::mat4 world(inst.world);
@@ -226,6 +240,14 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
             draws_.push_back(d);
         }
     }
+    if (!draws_.empty()) {
+        bounds_.center = 0.5f * (lo + hi);
+        bounds_.radius = 0.5f * glm::length(hi - lo);
+    }
+}
+
+// Lights reachable from the scene's roots (Scene::lightInstances), at most kMaxLights.
+void GpuScene::buildLights(const Scene& scene) {
     for (const LightInstance& inst : scene.lightInstances()) {
         if (inst.light < 0 || size_t(inst.light) >= scene.lights.size()) continue;
         const Light& l = scene.lights[size_t(inst.light)];
@@ -250,26 +272,26 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
                         " lights; the real-time renderer supports at most that many");
         lights_.push_back(s);
     }
-    {
-        std::vector<GpuSpecularDraw> spec;
-        for (int di : specularDraws_) {
-            const DrawItem& d = draws_[size_t(di)];
-            spec.push_back(
-                {glm::ivec4(d.material, d.origin == Origin::Real ? kOriginReal : kOriginVirtual, di,
-                            0),
-                 glm::vec4(d.bounds.center, d.bounds.radius)});
-        }
-        if (spec.empty()) spec.push_back({glm::ivec4(0), glm::vec4(0.0f)});
-        specularBuffer_ =
-            gl::Buffer("specular draws", spec.size() * sizeof(GpuSpecularDraw), spec.data());
-    }
-    if (!draws_.empty()) {
-        bounds_.center = 0.5f * (lo + hi);
-        bounds_.radius = 0.5f * glm::length(hi - lo);
-    }
+}
 
-    // Surface point pool for imperfect shadow maps: area-weighted samples over all triangles
-    // (world space), shuffled so that any contiguous or strided subset covers the scene.
+// The specular draw table (GpuSpecularDraw per specular slot).
+void GpuScene::uploadSpecularDraws() {
+    std::vector<GpuSpecularDraw> spec;
+    for (int di : specularDraws_) {
+        const DrawItem& d = draws_[size_t(di)];
+        spec.push_back(
+            {glm::ivec4(d.material, d.origin == Origin::Real ? kOriginReal : kOriginVirtual, di, 0),
+             glm::vec4(d.bounds.center, d.bounds.radius)});
+    }
+    if (spec.empty()) spec.push_back({glm::ivec4(0), glm::vec4(0.0f)});
+    specularBuffer_ =
+        gl::Buffer("specular draws", spec.size() * sizeof(GpuSpecularDraw), spec.data());
+}
+
+// Surface point pool for imperfect shadow maps: area-weighted samples over all triangles
+// (world space), shuffled so that any contiguous or strided subset covers the scene.
+void GpuScene::buildSurfacePoints(const std::vector<Vertex>& verts,
+                                  const std::vector<uint32_t>& idx, int surfacePoints) {
     std::vector<GpuSurfacePoint> pts;
     {
         struct Tri {
@@ -316,8 +338,10 @@ GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
     surfacePointCount_ = int(pts.size());
     if (pts.empty()) pts.push_back({glm::vec4(0.0f)});
     points_ = gl::Buffer("ism surface points", pts.size() * sizeof(GpuSurfacePoint), pts.data());
+}
 
-    // Environment light.
+// Environment light: SH9 for diffuse lighting and the map itself for rays that leave the scene.
+void GpuScene::uploadEnvironment(const Scene& scene) {
     if (scene.environment.kind == Environment::Kind::Equirectangular) {
         cv::Mat env = readLinearRgb(scene.environment.image);
         envSH_ =

@@ -107,6 +107,30 @@ public:
                                                       double rotationYDeg);
 
 private:
+    // One primitive's slice of the shared vertex / index buffers (mesh-local bounding sphere).
+    struct Range {
+        GLint baseVertex;
+        GLuint firstIndex;
+        GLsizei count;
+        int material;
+        int texture;
+        glm::vec3 center;
+        float radius;
+        bool specular;
+    };
+    // The constructor's steps, in order.
+    void uploadTextures(const Scene& scene);
+    int uploadMaterials(const Scene& scene);
+    std::vector<std::vector<Range>> uploadGeometry(const Scene& scene, int materialCount,
+                                                   std::vector<GpuSceneVertex>& verts,
+                                                   std::vector<uint32_t>& idx);
+    void buildDraws(const Scene& scene, const std::vector<std::vector<Range>>& meshRanges);
+    void buildLights(const Scene& scene);
+    void uploadSpecularDraws();
+    void buildSurfacePoints(const std::vector<GpuSceneVertex>& verts,
+                            const std::vector<uint32_t>& idx, int surfacePoints);
+    void uploadEnvironment(const Scene& scene);
+
     std::vector<DrawItem> draws_;
     std::vector<SceneLight> lights_;
     std::vector<int> specularDraws_;

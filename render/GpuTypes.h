@@ -1,87 +1,33 @@
 #pragma once
-// Host mirrors of the GPU structs in render/common.glsl (std140 uniform blocks, std430 storage
-// buffers). Layout is checked with static_asserts; a change on one side must be made on the other.
+// The GPU data layout and binding points as C++: render/gpu_types.glsl and render/bindings.glsl
+// are written once, in the subset of syntax GLSL and C++ share, and included here (vec4 etc. are
+// glm's types). std140 / std430 offsets are checked below; never magic numbers in passes.
+#include <cstddef>
 #include <cstdint>
 
 #include <glm/glm.hpp>
 
 namespace mirage::render {
 
-inline constexpr int kMaxLights = 8;
-inline constexpr int kLightPoint = 0, kLightSpot = 1, kLightDirectional = 2;
-inline constexpr int kOriginNone = 0, kOriginReal = 1, kOriginVirtual = 2;
+using vec4 = glm::vec4;
+using ivec4 = glm::ivec4;
+using mat4 = glm::mat4;
 
-// Uniform/storage binding points shared by every pass (named, never magic numbers in passes).
-inline constexpr unsigned kBindingFrame = 0, kBindingLights = 1, kBindingVpls = 2,
-                          kBindingMaterials = 3, kBindingIsmPoints = 4;
-// Specular passes (issue 6): the specular draw table (SSBO) and the texture units they use for
-// the environment map. Units 16..23 and buffer bindings 6..7 belong to the impostor tracer.
-inline constexpr unsigned kBindingSpecularDraws = 5;
-inline constexpr unsigned kUnitEnvironmentMap = 15;
+#include "render/gpu_types.glsl"  // includes render/bindings.glsl
 
-// Reflected-scene impostors (render/passes/impostor/trace.glsl, issue 6): the ONLY units and
-// binding points traceSurroundings() uses; consumer shaders must leave them alone. trace.glsl
-// spells the same numbers in its layout(binding = N) qualifiers.
-inline constexpr unsigned kBindingImpostorCubePosition = 16,  // sampler2DArray, RGBA32F
-    kBindingImpostorCubeNormal = 17,                          // sampler2DArray, RGBA16F
-    kBindingImpostorCubeAlbedo = 18,                          // sampler2DArray, RGBA8
-    kBindingImpostorCubeEmissive = 19,                        // sampler2DArray, RGBA16F
-    kBindingImpostorDepth = 20,                               // sampler2DArray, RG32F
-    kBindingImpostorNormal = 21,                              // sampler2DArray, RGBA16F
-    kBindingImpostorAlbedo = 22,                              // sampler2DArray, RGBA8
-    kBindingImpostorEmissive = 23,                            // sampler2DArray, RGBA16F
-    kBindingImpostorRecords = 6,                              // SSBO of GpuImpostor
-    kBindingImpostorObjects = 7;                              // SSBO: header + GpuImpostorObject
-
-struct alignas(16) GpuLight {
-    glm::mat4 viewProj[6];
-    glm::vec4 positionRange;
-    glm::vec4 directionType;
-    glm::vec4 radiantIntensity;
-    glm::vec4 cone;
-    glm::ivec4 shadow;
-};
 static_assert(sizeof(GpuLight) == 6 * 64 + 5 * 16);
-
-struct alignas(16) GpuFrame {
-    glm::mat4 viewMatrix, projMatrix, viewProj, prevViewProj;
-    glm::vec4 cameraPos, prevCameraPos, canvas;
-    glm::ivec4 counts, flags;
-    glm::vec4 params;
-    glm::vec4 envSH[9];
-    glm::vec4 exposure;
-};
-static_assert(sizeof(GpuFrame) == 4 * 64 + 3 * 16 + 2 * 16 + 16 + 9 * 16 + 16);
-
-struct GpuLightBlock {
-    GpuLight lights[kMaxLights];
-};
-
-struct GpuVpl {
-    glm::vec4 positionReal, normal, flux, tangent;
-};
+static_assert(offsetof(GpuLight, cosOuter) == 6 * 64 + 3 * 16);
+static_assert(offsetof(GpuLight, firstShadowLayer) == 6 * 64 + 4 * 16);
+static_assert(sizeof(GpuFrame) == 4 * 64 + 3 * 16 + 3 * 16 + 9 * 16 + 16);
+static_assert(offsetof(GpuFrame, lightCount) == 4 * 64 + 3 * 16);
+static_assert(offsetof(GpuFrame, envOrigin) == 4 * 64 + 4 * 16);
+static_assert(offsetof(GpuFrame, vplDistanceClamp) == 4 * 64 + 5 * 16);
+static_assert(offsetof(GpuFrame, envSH) == 4 * 64 + 6 * 16);
+static_assert(offsetof(GpuFrame, exposure) == 4 * 64 + 15 * 16);
+static_assert(sizeof(GpuLightBlock) == kMaxLights * sizeof(GpuLight));
 static_assert(sizeof(GpuVpl) == 64);
-
-struct GpuMaterial {
-    glm::vec4 baseColor, emissive, params;
-    // x = transmission (0..1), y = ior, z = attenuation distance (metres, 0 = no absorption),
-    // w = thickness (mesh units; informational, the real-time refraction measures the distance)
-    glm::vec4 transmission;
-    glm::vec4 attenuation;  // rgb = linear attenuation colour (Beer-Lambert), a = 1 if mirror
-};
 static_assert(sizeof(GpuMaterial) == 80);
-
-// One specular (mirror / glass) draw item, indexed by its slot in GpuScene::specularDraws()
-// (std430, binding kBindingSpecularDraws).
-struct GpuSpecularDraw {
-    glm::ivec4 info;   // x = material index, y = ORIGIN_REAL/VIRTUAL, z = draw index, w unused
-    glm::vec4 bounds;  // world bounding sphere: xyz centre, w radius (metres)
-};
 static_assert(sizeof(GpuSpecularDraw) == 32);
-
-// A surface sample for imperfect shadow maps (std430, binding kBindingIsmPoints).
-struct GpuSurfacePoint {
-    glm::vec4 positionReal;  // xyz world (metres); w = 1 if the geometry is real, 0 if virtual
-};
+static_assert(sizeof(GpuSurfacePoint) == 16);
 
 }  // namespace mirage::render

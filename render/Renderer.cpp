@@ -101,105 +101,41 @@ glm::vec3 anyPerpendicular(const glm::vec3& d) {
 
 }  // namespace
 
-bool FrameReport::ran(const std::string& pass) const {
-    for (const PassReport& p : passes)
-        if (p.name == pass) return p.ran;
-    return false;
-}
-
-bool FrameReport::reused(const std::string& pass) const {
-    for (const PassReport& p : passes)
-        if (p.name == pass) return p.reused;
-    return false;
-}
-
-std::string FrameReport::summary() const {
-    std::ostringstream s;
-    for (const PassReport& p : passes)
-        s << fmt::format("{:<10} {:<7} {:7.2f} ms  {}\n", p.name,
-                         p.ran ? "ran" : (p.reused ? "reused" : "skipped"), p.gpuMs, p.reason);
-    s << fmt::format("{:<10} {:<7} {:7.2f} ms\n", "total", "", totalGpuMs);
-    return s.str();
-}
-
 Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererOptions options)
     : options_(options) {
-    if (options_.vplCount < 0 || options_.vplCount > 16384)
-        throw Error("VPL count " + std::to_string(options_.vplCount) +
-                    " is out of range (0..16384)");
-    if (options_.interleave < 1 || options_.interleave > 8)
-        throw Error("interleave must be 1..8, got " + std::to_string(options_.interleave));
-    if (options_.indirectScale != 1 && options_.indirectScale != 2)
-        throw Error("indirectScale must be 1 or 2, got " + std::to_string(options_.indirectScale));
-    if (options_.shadowMapSize < 16 || options_.shadowMapSize > 4096)
-        throw Error("shadow map size must be 16..4096");
-    if (options_.ismTileSize < 8 || options_.ismTileSize > 256)
-        throw Error("ISM tile size must be 8..256");
-    if (options_.refractionMarchSteps < 2 || options_.refractionMarchSteps > 128)
-        throw Error("refractionMarchSteps must be 2..128, got " +
-                    std::to_string(options_.refractionMarchSteps));
-    if (options_.specularVplStride != 1 && options_.specularVplStride != 4 &&
-        options_.specularVplStride != 16)
-        throw Error("specularVplStride must be 1, 4 or 16, got " +
-                    std::to_string(options_.specularVplStride));
-    if (!(options_.backProjectionEpsilon > 0.0f) || options_.backProjectionEpsilon > 1.0f)
-        throw Error("backProjectionEpsilon must be in (0, 1] (relative depth tolerance)");
+    options_.validate();
     scene_ = std::make_unique<GpuScene>(scene, 16384);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 
-    auto gbuffer = std::make_unique<GBufferPass>();
-    auto shadow = std::make_unique<ShadowPass>();
-    auto vpl = std::make_unique<VplPass>(*shadow);
-    auto ism = std::make_unique<IsmPass>(*vpl);
-    // Reflected-scene impostors of the specular objects' surroundings (issue 6): the specular
-    // passes (GBuf_refl / GBuf_refr) take a reference to it and call bindForTracing().
-    auto impostor = std::make_unique<ImpostorPass>();
-    auto direct = std::make_unique<DirectLightPass>(*gbuffer, *scene_);
-    auto indirect = std::make_unique<IndirectLightPass>(*gbuffer, *vpl);
-    auto filter = std::make_unique<GiFilterPass>(*gbuffer, options_.interleave);
-    auto backface = std::make_unique<BackFacePass>(*gbuffer);
-    auto specGbuf = std::make_unique<SpecularGBufferPass>(*gbuffer, *backface, *impostor);
-    auto specLight = std::make_unique<SpecularLightPass>(*gbuffer, *specGbuf, *vpl, *scene_);
-    auto composite = std::make_unique<CompositePass>(*gbuffer);
-    composite->setSpecular(specGbuf.get(), specLight.get(), backface.get());
-    composite_ = composite.get();
-    passes_.push_back(std::move(gbuffer));
-    passes_.push_back(std::move(shadow));
-    passes_.push_back(std::move(vpl));
-    passes_.push_back(std::move(ism));
-    passes_.push_back(std::move(impostor));
-    passes_.push_back(std::move(direct));
-    passes_.push_back(std::move(indirect));
-    passes_.push_back(std::move(filter));
-    passes_.push_back(std::move(backface));   // specular objects (issue 6): back faces + real
-    passes_.push_back(std::move(specGbuf));   // surfaces, GBuf_refl / GBuf_refr, and their
-    passes_.push_back(std::move(specLight));  // lighting into L'_rv, L'_r, L_env
-    passes_.push_back(std::move(composite));
-    for (auto& p : passes_) timers_.emplace_back(std::string("timer ") + p->name());
-    // Prime every query once: on llvmpipe the very first GL_TIME_ELAPSED result of a process can
-    // be garbage (seen: 3.4e6 ms), which would spoil the first frame's report.
-    {
-        gl::Texture scratch = gl::Texture::create2D("timer priming", 8, 8, GL_RGBA8);
-        gl::Framebuffer fb("timer priming fbo");
-        fb.attachColor(0, scratch);
-        fb.finalize(1);
-        fb.bind();
-        for (gl::TimerQuery& t : timers_) {
-            t.begin();
-            glClear(GL_COLOR_BUFFER_BIT);
-            t.end();
-            (void)t.elapsedMs();
-        }
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    }
+    // The frame, in order. Passes know each other only through the resources they declare.
+    FrameGraph& g = graph_;
+    g.importTexture(Resource::CameraImage, GL_SRGB8_ALPHA8, SizeRule::Camera, "camera frame");
+    g.importTexture(Resource::EnvironmentMap, GL_RGBA16F, SizeRule::Scene, "scene environment");
+    g.addPass(std::make_unique<GBufferPass>());
+    g.addPass(std::make_unique<ShadowPass>());
+    g.addPass(std::make_unique<VplPass>());
+    g.addPass(std::make_unique<IsmPass>());
+    g.addPass(std::make_unique<ImpostorPass>());
+    g.addPass(std::make_unique<DirectLightPass>(*scene_));
+    g.addPass(std::make_unique<IndirectLightPass>());
+    g.addPass(std::make_unique<GiFilterPass>(options_.interleave));
+    g.addPass(std::make_unique<BackFacePass>());
+    g.addPass(std::make_unique<SpecularGBufferPass>());
+    g.addPass(std::make_unique<SpecularLightPass>(*scene_));
+    g.addPass(std::make_unique<CompositePass>());
+    g.markOutput(Resource::Composite);
+    g.markOutput(Resource::CompositeSrgb);
+    g.compile();
 
     cameraImage_ =
         gl::Texture::create2D("camera image", camera.width, camera.height, GL_SRGB8_ALPHA8);
     cameraImage_.setFilter(GL_NEAREST, GL_NEAREST);
     uploadCameraImage(cv::Mat());
+    g.setImport(Resource::CameraImage, cameraImage_);
+    g.setImport(Resource::EnvironmentMap, scene_->environmentMap());
     planFrame(FrameInput{});
-    for (auto& p : passes_) p->resize(*ctx_);
+    for (const FrameGraph::Node& n : g.nodes()) n.pass->resize(*ctx_);
 }
 
 Renderer::~Renderer() = default;
@@ -261,7 +197,10 @@ void Renderer::planFrame(const FrameInput& input) {
         g.positionRange = glm::vec4(l.position, l.range);
         g.directionType = glm::vec4(l.direction, float(l.type));
         const float scale = 1.0f / std::max(0.001f, l.cosInner - l.cosOuter);
-        g.cone = glm::vec4(l.cosOuter, l.cosInner, scale, -l.cosOuter * scale);
+        g.cosOuter = l.cosOuter;
+        g.cosInner = l.cosInner;
+        g.coneScale = scale;
+        g.coneOffset = -l.cosOuter * scale;
         g.radiantIntensity = glm::vec4(l.radiantIntensity, 1.0f);
         const float farL = glm::length(B.center - l.position) + R + 0.1f;
         const float nearL = std::clamp(farL * 1e-4f, 0.005f, 0.05f);
@@ -293,8 +232,10 @@ void Renderer::planFrame(const FrameInput& input) {
         if (!lp.castsShadow) lp.layers = 0;
         lp.firstLayer = layer;
         layer += lp.layers;
-        g.shadow = glm::ivec4(lp.firstLayer, lp.layers, lp.needsRealOnlyMap ? 1 : 0,
-                              l.origin == Origin::Real ? 1 : 0);
+        g.firstShadowLayer = lp.firstLayer;
+        g.shadowLayers = lp.layers;
+        g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
+        g.isReal = l.origin == Origin::Real ? 1 : 0;
         plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
         plan.lights.push_back(lp);
     }
@@ -344,19 +285,27 @@ void Renderer::planFrame(const FrameInput& input) {
     f.canvas =
         glm::vec4(projection_.canvasWidth, projection_.canvasHeight,
                   1.0f / float(projection_.canvasWidth), 1.0f / float(projection_.canvasHeight));
-    f.counts =
-        glm::ivec4(int(s.lights().size()), options_.vplCount, options_.interleave, c.frameIndex);
+    f.lightCount = int(s.lights().size());
+    f.vplCount = options_.vplCount;
+    f.interleave = options_.interleave;
+    f.frameIndex = c.frameIndex;
     const int envFlag = !s.hasEnvironment()                     ? kOriginNone
                         : s.environmentOrigin() == Origin::Real ? kOriginReal
                                                                 : kOriginVirtual;
     c.historyValid = !input.resetHistory && lastRanFilter_ && c.frameIndex > 0;
-    f.flags = glm::ivec4(envFlag, c.historyValid ? 1 : 0, options_.ismTileSize,
-                         IsmPass::tilesPerRow(options_.vplCount));
-    f.params = glm::vec4(options_.vplDistanceClamp, options_.shadowBias * 0.1f,
-                         options_.temporalBlend, float(options_.ismPointsPerVpl));
+    f.envOrigin = envFlag;
+    f.historyValid = c.historyValid ? 1 : 0;
+    f.ismTileSize = options_.ismTileSize;
+    f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
+    f.vplDistanceClamp = options_.vplDistanceClamp;
+    f.shadowBias = options_.shadowBias * 0.1f;
+    f.temporalBlend = options_.temporalBlend;
+    f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
     for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);
-    f.exposure = glm::vec4(options_.exposure, options_.alphaMax, options_.alphaFadeLr,
-                           s.environmentRotation());
+    f.exposure = options_.exposure;
+    f.alphaMax = options_.alphaMax;
+    f.alphaFadeLr = options_.alphaFadeLr;
+    f.envRotation = s.environmentRotation();
     c.frameUbo.upload(&f, sizeof(GpuFrame));
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
     prevViewProj_ = viewProj;
@@ -389,63 +338,23 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     uploadCameraImage(input.cameraImage);
     planFrame(input);
     FrameContext& c = *ctx_;
-    c.clearResources();
-    c.publish(Resource::CameraImage, &cameraImage_);
-    report_ = FrameReport{};
     // What the camera-independent passes' output depends on: the light matrices and the plan.
-    const std::string planKey = staticPlanKey(c);
-    if (planKey != staticPlanKey_ || staticOutputValid_.size() != passes_.size()) {
-        staticPlanKey_ = planKey;
-        staticOutputValid_.assign(passes_.size(), false);
-    }
-    std::vector<bool> ran(passes_.size(), false);
-    for (size_t i = 0; i < passes_.size(); ++i) {
-        RenderPass& p = *passes_[i];
-        PassReport r;
-        r.name = p.name();
-        PassDecision d = p.decide(c);
-        r.reason = d.reason;
-        const bool reuse =
-            d.run && p.cameraIndependent() && options_.reuseStaticPasses && staticOutputValid_[i];
-        if (!d.run || !p.cameraIndependent()) staticOutputValid_[i] = false;
-        if (reuse) {
-            for (Resource res : p.reads())
-                MR_CHECK(c.has(res), std::string("pass ") + p.name() + " reads " +
-                                         resourceName(res) + ", which no earlier pass wrote");
-            p.publishCached(c);
-            r.reused = true;
-            r.reason = "reused: scene, lights and plan unchanged (" + d.reason + ")";
-        } else if (d.run) {
-            for (Resource res : p.reads())
-                MR_CHECK(c.has(res), std::string("pass ") + p.name() + " reads " +
-                                         resourceName(res) + ", which no earlier pass wrote");
-            p.resize(c);  // no-op unless the plan's sizes changed (shadow layers, VPL count)
-            if (options_.syncPasses) glFinish();
-            timers_[i].begin();
-            p.execute(c);
-            if (options_.syncPasses) glFinish();
-            timers_[i].end();
-            r.ran = ran[i] = true;
-            if (p.cameraIndependent()) staticOutputValid_[i] = true;
-        }
-        report_.passes.push_back(r);
-    }
-    for (size_t i = 0; i < passes_.size(); ++i) {
-        if (!ran[i]) continue;
-        report_.passes[i].gpuMs = timers_[i].elapsedMs();
-        report_.totalGpuMs += report_.passes[i].gpuMs;
-    }
-    lastRanFilter_ = report_.ran("gifilter");
+    const FrameReport& report = graph_.execute(c, staticPlanKey(c));
+    lastRanFilter_ = report.ran("gifilter");
     ++c.frameIndex;
-    return report_;
+    return report;
+}
+
+std::vector<std::string> Renderer::passNames() const {
+    return graph_.passNames();
 }
 
 const gl::Texture& Renderer::compositeTexture() const {
-    return composite_->srgb();
+    return graph_.texture(Resource::CompositeSrgb);
 }
 
 cv::Mat Renderer::compositeLinear() const {
-    const gl::Texture& t = composite_->linear();
+    const gl::Texture& t = graph_.texture(Resource::Composite);
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     cv::Mat rgba(t.height(), t.width(), CV_32FC4, px.data()), rgb;
     cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);
@@ -453,7 +362,7 @@ cv::Mat Renderer::compositeLinear() const {
 }
 
 cv::Mat Renderer::compositeSrgb() const {
-    const gl::Texture& t = composite_->srgb();
+    const gl::Texture& t = graph_.texture(Resource::CompositeSrgb);
     auto px = t.read<unsigned char>(GL_RGBA, GL_UNSIGNED_BYTE, 4);
     cv::Mat rgba(t.height(), t.width(), CV_8UC4, px.data()), bgr;
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
@@ -461,7 +370,7 @@ cv::Mat Renderer::compositeSrgb() const {
 }
 
 cv::Mat Renderer::coverage() const {
-    const gl::Texture& t = composite_->linear();
+    const gl::Texture& t = graph_.texture(Resource::Composite);
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     cv::Mat out(t.height(), t.width(), CV_8U);
     for (int y = 0; y < t.height(); ++y)
@@ -474,8 +383,8 @@ cv::Mat Renderer::coverage() const {
 
 cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
     const Resource r = realOnly ? Resource::ImperfectShadowMapsReal : Resource::ImperfectShadowMaps;
-    if (!ctx_->has(r)) throw Error("no imperfect shadow map was rendered this frame");
-    const gl::Texture& t = ctx_->texture(r);
+    if (!graph_.has(r)) throw Error("no imperfect shadow map was rendered this frame");
+    const gl::Texture& t = graph_.texture(r);
     auto bits = t.read<uint32_t>(GL_RED_INTEGER, GL_UNSIGNED_INT, 1);
     cv::Mat out(t.height(), t.width(), CV_32F);
     std::memcpy(out.data, bits.data(), bits.size() * 4);  // float bits were stored
@@ -483,9 +392,7 @@ cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
 }
 
 cv::Mat Renderer::readBuffer(Resource r) const {
-    if (!ctx_->has(r))
-        throw Error(std::string("buffer ") + resourceName(r) + " was not produced this frame");
-    const gl::Texture& t = ctx_->texture(r);
+    const gl::Texture& t = graph_.texture(r);  // throws if the frame did not produce it
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     cv::Mat rgba(t.height(), t.width(), CV_32FC4, px.data()), rgb;
     cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);

@@ -1,14 +1,12 @@
 #pragma once
 // The real-time renderer: differential instant radiosity (Knecht et al. 2010, 2013 Sec. 3.1)
-// compositing a scene's virtual objects into camera footage. A frame is a list of explicit
-// passes (render/passes/<pass>/), each declaring what it reads and writes; the renderer plans
-// the frame from the scene (which lights cast shadows, which need real-only visibility, whether
-// VPLs are needed), runs only the passes the frame needs, times each with a GL timer query and
-// reports which ran and why. Needs a current GL 4.5 context (core/gl/Context.h).
-//
-// Frame, in order: gbuffer -> shadow (+RSM) -> vpl -> ism -> direct -> indirect -> gifilter
-// -> composite. The specular passes (reflection/refraction G-buffers) and caustic maps slot in
-// between ism and composite, publishing into the same LRv / LR resources.
+// compositing a scene's virtual objects into camera footage. The frame is a graph of passes
+// (render/FrameGraph.h; one folder per pass in render/passes/), built once here: the renderer
+// plans each frame from the scene (which lights cast shadows, which need real-only visibility,
+// whether VPLs are needed, whether a specular object is in view), the graph runs only the passes
+// the frame needs, times each with a GL timer query and reports which ran and why
+// (`mirage info --passes SCENE` prints it, docs/realtime-renderer.md draws it). Needs a current
+// GL 4.5 context (core/gl/Context.h).
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,6 +19,7 @@
 #include "core/scene/Scene.h"
 #include "render/CameraProjection.h"
 #include "render/FrameContext.h"
+#include "render/FrameGraph.h"
 #include "render/GpuScene.h"
 #include "render/RenderPass.h"
 
@@ -30,22 +29,6 @@ struct FrameInput {
     Pose T_world_camera;        // camera pose (OpenCV camera axes), world = glTF frame
     cv::Mat cameraImage;        // 8-bit BGR, sRGB-encoded, camera size; empty = black footage
     bool resetHistory = false;  // a cut, a seek or tracking loss: drop temporal history
-};
-
-struct PassReport {
-    std::string name;
-    bool ran = false;
-    bool reused = false;  // not run: the output of an earlier frame was reused (still valid)
-    std::string reason;
-    double gpuMs = 0.0;  // GL_TIME_ELAPSED of the pass (0 when skipped)
-};
-
-struct FrameReport {
-    std::vector<PassReport> passes;
-    double totalGpuMs = 0.0;
-    bool ran(const std::string& pass) const;
-    bool reused(const std::string& pass) const;  // its output of an earlier frame was reused
-    std::string summary() const;  // one line per pass: "name: ran|skipped (reason) x.xx ms"
 };
 
 class Renderer {
@@ -78,7 +61,11 @@ public:
     const FramePlan& plan() const { return ctx_->plan; }
     const GpuScene& gpuScene() const { return *scene_; }
     const RendererOptions& options() const { return options_; }
-    const FrameReport& lastReport() const { return report_; }
+    const FrameReport& lastReport() const { return graph_.lastReport(); }
+    // The passes in frame order (the columns of every per-pass table: replay CSV, bench).
+    std::vector<std::string> passNames() const;
+    // The frame graph: declarations, and what the last frame did (FrameGraph::describe / dot).
+    const FrameGraph& graph() const { return graph_; }
 
 private:
     void planFrame(const FrameInput& input);
@@ -88,18 +75,11 @@ private:
     std::unique_ptr<GpuScene> scene_;
     CameraProjection projection_;
     std::unique_ptr<FrameContext> ctx_;
-    std::vector<std::unique_ptr<RenderPass>> passes_;
-    std::vector<gl::TimerQuery> timers_;
-    class CompositePass* composite_ = nullptr;
+    FrameGraph graph_;
     gl::Texture cameraImage_;
-    FrameReport report_;
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
     bool lastRanFilter_ = false;
-    // Camera-independent passes: the plan they were last run for, and whether each pass's last
-    // output is still valid for it.
-    std::string staticPlanKey_;
-    std::vector<bool> staticOutputValid_;
 };
 
 }  // namespace mirage::render

@@ -37,16 +37,17 @@ void incidentLight(int li, vec3 p, out vec3 wi, out vec3 irradiance) {
 #endif
 vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
                       bool withReal) {
-    ivec4 sh = lights[li].shadow;
+    int firstLayer = lights[li].firstShadowLayer, layers = lights[li].shadowLayers;
     int layer = -1;
     vec2 t = vec2(0.0);
-    // A constant bound (faces past sh.y masked off) lets the compiler unroll the loop and read
-    // viewProj[f] at constant offsets; looping to sh.y made llvmpipe's direct pass 1.6x slower.
+    // A constant bound (faces past `layers` masked off) lets the compiler unroll the loop and
+    // read viewProj[f] at constant offsets; looping to `layers` made llvmpipe's direct pass 1.6x
+    // slower.
     for (int f = 0; f < MIRAGE_MAX_SHADOW_FACES; ++f) {
         vec4 c = lights[li].viewProj[f] * vec4(p, 1.0);
         vec2 ndc = c.xy / c.w;
-        if (f < sh.y && layer < 0 && c.w > 0.0 && all(lessThanEqual(abs(ndc), vec2(1.0)))) {
-            layer = sh.x + f;
+        if (f < layers && layer < 0 && c.w > 0.0 && all(lessThanEqual(abs(ndc), vec2(1.0)))) {
+            layer = firstLayer + f;
             t = ndc * 0.5 + 0.5;
         }
     }
@@ -56,7 +57,7 @@ vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec
     float tanOrExtent = lights[li].radiantIntensity.w;
     float extent = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
                                                                         : 2.0 * tanOrExtent * d;
-    float bias = params.y + 1.5 * extent / size.x / max(NdotL, 0.2);
+    float bias = shadowBias + 1.5 * extent / size.x / max(NdotL, 0.2);
     // The gather footprint at t is texels floor(t * size - 0.5) + {0, 1}^2: w = (0,0), z = (1,0),
     // x = (0,1), y = (1,1); clamp-to-edge at the borders.
     vec2 fr = fract(t * size - 0.5);

@@ -164,11 +164,9 @@ void runReplay(const ReplayArgs& a) {
     if (mkv) video = std::make_unique<MatroskaWriter>(videoOut->temp(), session.fps, a.jpegQuality);
     std::ofstream csv(csvOut.temp());
     if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
-    const char* passes[] = {"gbuffer",  "shadow",   "vpl",       "ism",
-                            "impostor", "direct",   "indirect",  "gifilter",
-                            "backface", "specgbuf", "speclight", "composite"};
+    const std::vector<std::string> passes = renderer.passNames();  // the frame graph's order
     csv << "frame,t,state,reason,decode_ms,tracking_ms";
-    for (const char* p : passes) csv << "," << p << "_ms";
+    for (const std::string& p : passes) csv << "," << p << "_ms";
     csv << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz\n";
 
     auto frames = openCameraFrames(session, main->name);
@@ -277,7 +275,7 @@ void runReplay(const ReplayArgs& a) {
             if (ch == ',' || ch == '\n') ch = ';';
         csv << rec.index << "," << t << "," << pr.state << "," << reason << "," << decodeMs << ","
             << trackingMs;
-        for (const char* p : passes) csv << "," << passMs[p];
+        for (const std::string& p : passes) csv << "," << passMs[p];
         csv << "," << gpuMs << "," << readbackMs << "," << encodeMs << "," << msSince(t0);
         if (pr.pose) {
             const Pose& p = *pr.pose;

@@ -76,8 +76,9 @@ struct BenchFrameResult {
 
 struct BenchResult {
     BenchConfig config;
-    bool baseline = false;            // the footage itself as "composite" (no virtual objects)
-    std::vector<std::string> passes;  // pass names in frame order (those that ran at least once)
+    bool baseline = false;               // the footage itself as "composite" (no virtual objects)
+    std::vector<std::string> passOrder;  // every pass of the frame graph, in frame order
+    std::vector<std::string> passes;     // those that ran at least once, in frame order
     std::map<std::string, double> medianPassMs;
     double medianGpuMs = 0.0, medianWallMs = 0.0;
     CompositeError error;  // pooled over all frames

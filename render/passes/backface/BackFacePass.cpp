@@ -1,26 +1,29 @@
 #include "render/passes/backface/BackFacePass.h"
 
-#include "render/Shaders.h"
-#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/FrameGraph.h"
 
 namespace mirage::render {
 
-BackFacePass::BackFacePass(const GBufferPass& gbuffer)
-    : gbuffer_(gbuffer),
-      program_("backface", {{GL_VERTEX_SHADER, "passes/gbuffer/gbuffer.vert",
-                             shaders::source("passes/gbuffer/gbuffer.vert")},
-                            {GL_FRAGMENT_SHADER, "passes/backface/backface.frag",
-                             shaders::source("passes/backface/backface.frag")}}) {
+BackFacePass::BackFacePass()
+    : program_(rasterProgram("backface", "passes/gbuffer/gbuffer.vert",
+                             "passes/backface/backface.frag")) {
     locModel_ = program_.uniformLocation("model");
     locNormal_ = program_.uniformLocation("normalMatrix");
     locMode_ = program_.uniformLocation("mode");
     locSlot_ = program_.uniformLocation("specularSlot");
 }
 
+void BackFacePass::setup(PassBuilder& b) const {
+    b.read(Resource::GBufferPosition);  // is RealSurfaces when the scene has no virtual geometry
+    b.write(Resource::BackFacePosition, GL_RGBA32F, SizeRule::Canvas);
+    b.write(Resource::BackFaceNormal, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::RealSurfaces, GL_RGBA32F, SizeRule::Canvas);
+}
+
 PassDecision BackFacePass::decide(const FrameContext& ctx) const {
     const size_t n = ctx.scene.specularDraws().size();
     if (n == 0) return {false, "no mirror or glass object in the scene"};
-    // The specular passes after this one need BackFaces, so they are skipped with it.
+    // The specular passes after this one need the back faces, so they are skipped with it.
     const glm::ivec4 r = ctx.specularScissor;
     if (r.z <= 0 || r.w <= 0) return {false, "no mirror or glass object in view"};
     const double share = 100.0 * double(r.z) * double(r.w) /
@@ -55,7 +58,7 @@ void BackFacePass::resize(const FrameContext& ctx) {
     realFbo_.finalize(1);
 }
 
-void BackFacePass::execute(FrameContext& ctx) {
+void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
     glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -79,7 +82,8 @@ void BackFacePass::execute(FrameContext& ctx) {
     glUniform1i(locMode_, 0);
     const std::vector<int>& spec = ctx.scene.specularDraws();
     for (size_t s = 0; s < spec.size(); ++s) draw(ctx.scene.draws()[size_t(spec[s])], int(s));
-    ctx.publish(Resource::BackFaces, &position_);
+    res.publish(Resource::BackFacePosition, position_);
+    res.publish(Resource::BackFaceNormal, normal_);
 
     if (ctx.scene.hasVirtual()) {
         realFbo_.bind();
@@ -88,9 +92,9 @@ void BackFacePass::execute(FrameContext& ctx) {
         glUniform1i(locMode_, 1);
         for (const DrawItem& d : ctx.scene.draws())
             if (d.origin == Origin::Real) draw(d, -1);
-        ctx.publish(Resource::RealSurfaces, &realPosition_);
+        res.publish(Resource::RealSurfaces, realPosition_);
     } else {
-        ctx.publish(Resource::RealSurfaces, &gbuffer_.position());
+        res.publish(Resource::RealSurfaces, res.texture(Resource::GBufferPosition));
     }
     glDisable(GL_DEPTH_TEST);
 }

@@ -11,26 +11,16 @@
 
 namespace mirage::render {
 
-class GBufferPass;
-
 class BackFacePass final : public RenderPass {
 public:
-    explicit BackFacePass(const GBufferPass& gbuffer);
+    BackFacePass();
     const char* name() const override { return "backface"; }
-    std::vector<Resource> reads() const override { return {Resource::GBuffer}; }
-    std::vector<Resource> writes() const override {
-        return {Resource::BackFaces, Resource::RealSurfaces};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
-
-    const gl::Texture& position() const { return position_; }  // xyz world, w = slot + 1
-    const gl::Texture& normal() const { return normal_; }      // xyz outward unit normal
-    const gl::Texture& realPosition() const { return realPosition_; }
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    const GBufferPass& gbuffer_;
     gl::Program program_;
     gl::Texture position_, normal_, depth_, realPosition_, realDepth_;
     gl::Framebuffer fbo_, realFbo_;

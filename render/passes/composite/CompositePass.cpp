@@ -1,19 +1,31 @@
 #include "render/passes/composite/CompositePass.h"
 
-#include "render/passes/backface/BackFacePass.h"
-#include "render/passes/gbuffer/GBufferPass.h"
-#include "render/passes/specular/SpecularGBufferPass.h"
-#include "render/passes/specular/SpecularLightPass.h"
+#include "render/FrameGraph.h"
 
 namespace mirage::render {
 
-CompositePass::CompositePass(const GBufferPass& gbuffer)
-    : gbuffer_(gbuffer),
-      program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
+CompositePass::CompositePass()
+    : program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
       programDiffuse_(fullscreenProgram("composite (diffuse only)",
                                         "passes/composite/composite.frag",
                                         "#define MIRAGE_DIFFUSE_ONLY 1")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
+}
+
+void CompositePass::setup(PassBuilder& b) const {
+    b.read(Resource::CameraImage);
+    // The two GI solutions, or direct light alone when no VPL light was filtered into them.
+    for (Resource r : {Resource::LRv, Resource::LR, Resource::DirectRv, Resource::DirectR,
+                       Resource::GBufferPosition})
+        b.readOptional(r);
+    // Mirror / glass pixels (Eqs. 6-11): only when the specular passes ran.
+    for (Resource r : {Resource::GBufferEmissive, Resource::ReflectionGBuffer,
+                       Resource::RefractionGBuffer, Resource::ReflectionWeight,
+                       Resource::RefractionWeight, Resource::SpecularRv, Resource::SpecularR,
+                       Resource::SpecularRReflection, Resource::Lenv, Resource::RealSurfaces})
+        b.readOptional(r);
+    b.write(Resource::Composite, GL_RGBA32F, SizeRule::Camera);
+    b.write(Resource::CompositeSrgb, GL_SRGB8_ALPHA8, SizeRule::Camera);
 }
 
 PassDecision CompositePass::decide(const FrameContext&) const {
@@ -81,40 +93,40 @@ glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& 
     return {cx0, cy0, cx1 - cx0, cy1 - cy0};
 }
 
-void CompositePass::execute(FrameContext& ctx) {
+void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
-    const bool specular = specHits_ && specLight_ && backFaces_ && ctx.has(Resource::SpecularRv) &&
-                          ctx.has(Resource::RealSurfaces);
+    const bool specular = res.has(Resource::SpecularRv) && res.has(Resource::RealSurfaces) &&
+                          res.has(Resource::ReflectionGBuffer);
     // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
     // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
     ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
-    auto tex = [&](Resource a, Resource b) -> GLuint {
-        if (ctx.has(a)) return ctx.texture(a).id();
-        if (ctx.has(b)) return ctx.texture(b).id();
-        return ctx.blackTexture().id();
+    auto tex = [&](Resource a, Resource b) {
+        return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
     };
-    glBindTextureUnit(0, ctx.has(Resource::CameraImage) ? ctx.texture(Resource::CameraImage).id()
-                                                        : ctx.blackTexture().id());
-    glBindTextureUnit(1, tex(Resource::LRv, Resource::DirectRv));
-    glBindTextureUnit(2, tex(Resource::LR, Resource::DirectR));
-    glBindTextureUnit(
-        3, ctx.has(Resource::GBuffer) ? gbuffer_.position().id() : ctx.blackTexture().id());
-    glBindTextureUnit(4, remap_.id());
+    glBindTextureUnit(kUnitCompositeCamera, res.texture(Resource::CameraImage).id());
+    glBindTextureUnit(kUnitCompositeLRv, tex(Resource::LRv, Resource::DirectRv));
+    glBindTextureUnit(kUnitCompositeLR, tex(Resource::LR, Resource::DirectR));
+    glBindTextureUnit(kUnitCompositePosition,
+                      res.textureOr(Resource::GBufferPosition, ctx.blackTexture()).id());
+    glBindTextureUnit(kUnitCompositeRemap, remap_.id());
     if (specular) {
-        glBindTextureUnit(5, gbuffer_.emissive().id());
-        glBindTextureUnit(6, specHits_->reflection().position.id());
-        glBindTextureUnit(7, specHits_->refraction().position.id());
-        glBindTextureUnit(8, specHits_->reflection().weight.id());
-        glBindTextureUnit(9, specHits_->refraction().weight.id());
-        glBindTextureUnit(10, specLight_->rv().id());
-        glBindTextureUnit(11, specLight_->r().id());
-        glBindTextureUnit(12, specLight_->rReflection().id());
-        glBindTextureUnit(13, specLight_->env().id());
-        glBindTextureUnit(14, ctx.texture(Resource::RealSurfaces).id());
-        glBindTextureUnit(15, canvasToCamera_.id());
+        glBindTextureUnit(kUnitCompositeEmissive, res.texture(Resource::GBufferEmissive).id());
+        glBindTextureUnit(kUnitCompositeReflPosition,
+                          res.texture(Resource::ReflectionGBuffer).id());
+        glBindTextureUnit(kUnitCompositeRefrPosition,
+                          res.texture(Resource::RefractionGBuffer).id());
+        glBindTextureUnit(kUnitCompositeReflWeight, res.texture(Resource::ReflectionWeight).id());
+        glBindTextureUnit(kUnitCompositeRefrWeight, res.texture(Resource::RefractionWeight).id());
+        glBindTextureUnit(kUnitCompositeSpecRv, res.texture(Resource::SpecularRv).id());
+        glBindTextureUnit(kUnitCompositeSpecR, res.texture(Resource::SpecularR).id());
+        glBindTextureUnit(kUnitCompositeSpecRRefl, res.texture(Resource::SpecularRReflection).id());
+        glBindTextureUnit(kUnitCompositeLenv, res.texture(Resource::Lenv).id());
+        glBindTextureUnit(kUnitCompositeRealSurfaces, res.texture(Resource::RealSurfaces).id());
+        glBindTextureUnit(kUnitCompositeCanvasToCamera, canvasToCamera_.id());
     } else {
-        for (GLuint u = 5; u <= 15; ++u) glBindTextureUnit(u, ctx.blackTexture().id());
+        for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
+            glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
     ctx.drawFullscreenTriangle();
     const glm::ivec4 rect = specular ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);
@@ -127,7 +139,8 @@ void CompositePass::execute(FrameContext& ctx) {
         glDisable(GL_SCISSOR_TEST);
     }
     glDisable(GL_FRAMEBUFFER_SRGB);
-    ctx.publish(Resource::Composite, &linear_);
+    res.publish(Resource::Composite, linear_);
+    res.publish(Resource::CompositeSrgb, srgb_);
 }
 
 }  // namespace mirage::render

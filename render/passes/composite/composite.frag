@@ -7,7 +7,7 @@
 // CI is the camera frame, sRGB-encoded 8-bit, linearised by the sRGB texture format (the camera
 // response is taken to be the sRGB curve). L_* are scaled by `exposure` into camera units first.
 // Guard where L_r is near 0 (a black surface, or light only the virtual light reaches): alpha
-// fades to 1 below exposure.z (the model's own radiometry is used) and is capped at exposure.y,
+// fades to 1 below alphaFadeLr (the model's own radiometry is used) and is capped at alphaMax,
 // and the result is clamped to >= 0 and finite. Lens distortion: the L buffers were rendered
 // undistorted on the canvas; `remap` gives each camera pixel's canvas position.
 //
@@ -29,22 +29,22 @@
 // used whatever the reflection does (the seed's exception for virtual refractive objects),
 // without taking an unvalidated colour for the reflection. alpha' is guarded like alpha.
 in vec2 uv;
-layout(binding = 0) uniform sampler2D cameraImage;  // sRGB8 texture: samples are linear
-layout(binding = 1) uniform sampler2D lRv;           // canvas, linear
-layout(binding = 2) uniform sampler2D lR;
-layout(binding = 3) uniform sampler2D gPosition;     // canvas, w = origin
-layout(binding = 4) uniform sampler2D remap;         // camera size: canvas pixel (OpenCV conv.)
-layout(binding = 5) uniform sampler2D gEmissive;     // canvas, a = specular slot + 1
-layout(binding = 6) uniform sampler2D reflPosition;  // GBuf_refl: xyz hit, w = origin
-layout(binding = 7) uniform sampler2D refrPosition;  // GBuf_refr
-layout(binding = 8) uniform sampler2D reflWeight;    // eta1 (rgb)
-layout(binding = 9) uniform sampler2D refrWeight;    // eta2 T (rgb)
-layout(binding = 10) uniform sampler2D specRv;       // L'_rv
-layout(binding = 11) uniform sampler2D specR;        // L'_r
-layout(binding = 12) uniform sampler2D specRRefl;    // the reflection's share of L'_r
-layout(binding = 13) uniform sampler2D lEnv;         // L_env
-layout(binding = 14) uniform sampler2D realSurfaces; // nearest real surface, xyz world
-layout(binding = 15) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
+layout(binding = kUnitCompositeCamera) uniform sampler2D cameraImage;  // sRGB8 texture: samples are linear
+layout(binding = kUnitCompositeLRv) uniform sampler2D lRv;           // canvas, linear
+layout(binding = kUnitCompositeLR) uniform sampler2D lR;
+layout(binding = kUnitCompositePosition) uniform sampler2D gPosition;     // canvas, w = origin
+layout(binding = kUnitCompositeRemap) uniform sampler2D remap;         // camera size: canvas pixel (OpenCV conv.)
+layout(binding = kUnitCompositeEmissive) uniform sampler2D gEmissive;     // canvas, a = specular slot + 1
+layout(binding = kUnitCompositeReflPosition) uniform sampler2D reflPosition;  // GBuf_refl: xyz hit, w = origin
+layout(binding = kUnitCompositeRefrPosition) uniform sampler2D refrPosition;  // GBuf_refr
+layout(binding = kUnitCompositeReflWeight) uniform sampler2D reflWeight;    // eta1 (rgb)
+layout(binding = kUnitCompositeRefrWeight) uniform sampler2D refrWeight;    // eta2 T (rgb)
+layout(binding = kUnitCompositeSpecRv) uniform sampler2D specRv;       // L'_rv
+layout(binding = kUnitCompositeSpecR) uniform sampler2D specR;        // L'_r
+layout(binding = kUnitCompositeSpecRRefl) uniform sampler2D specRRefl;    // the reflection's share of L'_r
+layout(binding = kUnitCompositeLenv) uniform sampler2D lEnv;         // L_env
+layout(binding = kUnitCompositeRealSurfaces) uniform sampler2D realSurfaces; // nearest real surface, xyz world
+layout(binding = kUnitCompositeCanvasToCamera) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
@@ -52,8 +52,8 @@ layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB
 #ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 // alpha for L = CI + alpha dL, guarded where the rendered real radiance is near 0.
 vec3 guardedAlpha(vec3 ci, vec3 r) {
-    vec3 t = smoothstep(vec3(0.0), vec3(exposure.z), r);
-    vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(exposure.y));
+    vec3 t = smoothstep(vec3(0.0), vec3(alphaFadeLr), r);
+    vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(alphaMax));
     return mix(vec3(1.0), ratio, t);
 }
 
@@ -79,12 +79,12 @@ bool backProject(vec3 x, out vec3 colour) {
 
 // Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci.
 vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
-    float ex = exposure.x;
+    float ex = exposure;
     vec3 rv = max(texelFetch(specRv, cpi, 0).rgb, vec3(0.0)) * ex;
     vec3 r = max(texelFetch(specR, cpi, 0).rgb, vec3(0.0)) * ex;
     vec3 rRefl = clamp(texelFetch(specRRefl, cpi, 0).rgb * ex, vec3(0.0), r);
     vec3 env = max(texelFetch(lEnv, cpi, 0).rgb, vec3(0.0)) * ex;
-    bool envReal = flags.x == ORIGIN_REAL;
+    bool envReal = envOrigin == ORIGIN_REAL;
     bool allReal = pReal;
     vec3 ciBp = vec3(0.0);
     for (int k = 0; k < 2; ++k) {
@@ -123,8 +123,8 @@ void main() {
         vec2 cuv = (canvasPx + 0.5) * canvas.zw;
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
-        vec3 rv = max(texture(lRv, cuv).rgb, vec3(0.0)) * exposure.x;
-        vec3 r = max(texture(lR, cuv).rgb, vec3(0.0)) * exposure.x;
+        vec3 rv = max(texture(lRv, cuv).rgb, vec3(0.0)) * exposure;
+        vec3 r = max(texture(lR, cuv).rgb, vec3(0.0)) * exposure;
 #ifndef MIRAGE_DIFFUSE_ONLY
         int slot = int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1;
         if (slot >= 0 && origin != ORIGIN_NONE) {
@@ -136,8 +136,8 @@ void main() {
             result = rv;
             coverage = 1.0;
         } else {
-            vec3 t = smoothstep(vec3(0.0), vec3(exposure.z), r);
-            vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(exposure.y));
+            vec3 t = smoothstep(vec3(0.0), vec3(alphaFadeLr), r);
+            vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(alphaMax));
             vec3 alpha = mix(vec3(1.0), ratio, t);
             result = ci + alpha * (rv - r);
             coverage = origin == ORIGIN_REAL ? 0.5 : 0.0;

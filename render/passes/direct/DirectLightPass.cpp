@@ -1,15 +1,24 @@
 #include "render/passes/direct/DirectLightPass.h"
 
-#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/FrameGraph.h"
 
 namespace mirage::render {
 
-DirectLightPass::DirectLightPass(const GBufferPass& gbuffer, const GpuScene& scene)
-    : gbuffer_(gbuffer),
-      program_(fullscreenProgram("direct", "passes/direct/direct.frag", scene.lightingDefines())) {}
+DirectLightPass::DirectLightPass(const GpuScene& scene)
+    : program_(fullscreenProgram("direct", "passes/direct/direct.frag", scene.lightingDefines())) {}
+
+void DirectLightPass::setup(PassBuilder& b) const {
+    b.read(Resource::GBufferPosition);
+    b.read(Resource::GBufferNormal);
+    b.read(Resource::GBufferAlbedo);
+    b.read(Resource::GBufferEmissive);
+    b.readOptional(Resource::ShadowMaps);  // none: no light has a caster (unshadowed)
+    b.readOptional(Resource::ShadowMapsReal);
+    b.write(Resource::DirectRv, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::DirectR, GL_RGBA16F, SizeRule::Canvas);
+}
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
-    if (!ctx.has(Resource::GBuffer)) return {false, "no G-buffer"};
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
                       (ctx.scene.hasEnvironment() ? " + environment" : "")};
 }
@@ -24,21 +33,20 @@ void DirectLightPass::resize(const FrameContext& ctx) {
     fbo_.finalize(2);
 }
 
-void DirectLightPass::execute(FrameContext& ctx) {
+void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
-    glBindTextureUnit(0, gbuffer_.position().id());
-    glBindTextureUnit(1, gbuffer_.normal().id());
-    glBindTextureUnit(2, gbuffer_.albedo().id());
-    glBindTextureUnit(3, gbuffer_.emissive().id());
-    glBindTextureUnit(4, ctx.has(Resource::ShadowMaps) ? ctx.texture(Resource::ShadowMaps).id()
-                                                       : ctx.farShadowTexture().id());
-    glBindTextureUnit(5, ctx.has(Resource::ShadowMapsReal)
-                             ? ctx.texture(Resource::ShadowMapsReal).id()
-                             : ctx.farShadowTexture().id());
+    glBindTextureUnit(kUnitDirectPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitDirectNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitDirectAlbedo, res.texture(Resource::GBufferAlbedo).id());
+    glBindTextureUnit(kUnitDirectEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitDirectShadowAll,
+                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitDirectShadowReal,
+                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
     ctx.drawFullscreenTriangle();
-    ctx.publish(Resource::DirectRv, &rv_);
-    ctx.publish(Resource::DirectR, &r_);
+    res.publish(Resource::DirectRv, rv_);
+    res.publish(Resource::DirectR, r_);
 }
 
 }  // namespace mirage::render

@@ -4,23 +4,16 @@
 
 namespace mirage::render {
 
-class GBufferPass;
-class ShadowPass;
-
 class DirectLightPass final : public RenderPass {
 public:
-    DirectLightPass(const GBufferPass& gbuffer, const GpuScene& scene);
+    explicit DirectLightPass(const GpuScene& scene);
     const char* name() const override { return "direct"; }
-    std::vector<Resource> reads() const override { return {Resource::GBuffer}; }
-    std::vector<Resource> writes() const override {
-        return {Resource::DirectRv, Resource::DirectR};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    const GBufferPass& gbuffer_;
     gl::Program program_;
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;

@@ -7,12 +7,12 @@
 //   L_r : only if the light and p are real, visibility against real occluders only.
 // The environment map is real (captured) unless the scene says otherwise; it is not shadowed.
 in vec2 uv;
-layout(binding = 0) uniform sampler2D gPosition;  // xyz world, w = origin
-layout(binding = 1) uniform sampler2D gNormal;
-layout(binding = 2) uniform sampler2D gAlbedo;
-layout(binding = 3) uniform sampler2D gEmissive;
-layout(binding = 4) uniform sampler2DArray shadowAll;
-layout(binding = 5) uniform sampler2DArray shadowReal;
+layout(binding = kUnitDirectPosition) uniform sampler2D gPosition;  // xyz world, w = origin
+layout(binding = kUnitDirectNormal) uniform sampler2D gNormal;
+layout(binding = kUnitDirectAlbedo) uniform sampler2D gAlbedo;
+layout(binding = kUnitDirectEmissive) uniform sampler2D gEmissive;
+layout(binding = kUnitDirectShadowAll) uniform sampler2DArray shadowAll;
+layout(binding = kUnitDirectShadowReal) uniform sampler2DArray shadowReal;
 layout(location = 0) out vec4 outRv;  // linear radiance
 layout(location = 1) out vec4 outR;
 
@@ -32,21 +32,21 @@ void main() {
     vec4 A = texelFetch(gAlbedo, px, 0);
     vec3 v = normalize(cameraPos.xyz - p);
     vec3 rv = vec3(0.0), r = vec3(0.0);
-    for (int li = 0; li < counts.x; ++li) {
+    for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, p, wi, E);
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, A.rgb, A.a, N.w) * E;
-        ivec4 sh = lights[li].shadow;
-        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, NdotL, sh.z == 1);
+        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, NdotL,
+                                    lights[li].realOnlyMap == 1);
         rv += c * vis.x;  // all occluders
-        if (sh.w == 1 && pReal) r += c * vis.y;  // real occluders only
+        if (lights[li].isReal == 1 && pReal) r += c * vis.y;  // real occluders only
     }
-    if (flags.x != 0) {
+    if (envOrigin != 0) {
         vec3 env = A.rgb * (1.0 - A.a) / PI * shIrradiance(n);
         rv += env;
-        if (flags.x == ORIGIN_REAL && pReal) r += env;
+        if (envOrigin == ORIGIN_REAL && pReal) r += env;
     }
     vec3 e = texelFetch(gEmissive, px, 0).rgb;
     rv += e;

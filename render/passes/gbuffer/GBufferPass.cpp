@@ -1,19 +1,23 @@
 #include "render/passes/gbuffer/GBufferPass.h"
 
-#include "render/Shaders.h"
-
+#include "render/FrameGraph.h"
 namespace mirage::render {
 
 GBufferPass::GBufferPass()
-    : program_("gbuffer", {{GL_VERTEX_SHADER, "passes/gbuffer/gbuffer.vert",
-                            shaders::source("passes/gbuffer/gbuffer.vert")},
-                           {GL_FRAGMENT_SHADER, "passes/gbuffer/gbuffer.frag",
-                            shaders::source("passes/gbuffer/gbuffer.frag")}}) {
+    : program_(
+          rasterProgram("gbuffer", "passes/gbuffer/gbuffer.vert", "passes/gbuffer/gbuffer.frag")) {
     locModel_ = program_.uniformLocation("model");
     locNormal_ = program_.uniformLocation("normalMatrix");
     locMaterial_ = program_.uniformLocation("materialIndex");
     locOrigin_ = program_.uniformLocation("origin");
     locSpecularSlot_ = program_.uniformLocation("specularSlot");
+}
+
+void GBufferPass::setup(PassBuilder& b) const {
+    b.write(Resource::GBufferPosition, GL_RGBA32F, SizeRule::Canvas);
+    b.write(Resource::GBufferNormal, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::GBufferAlbedo, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::GBufferEmissive, GL_RGBA16F, SizeRule::Canvas);
 }
 
 PassDecision GBufferPass::decide(const FrameContext& ctx) const {
@@ -40,7 +44,7 @@ void GBufferPass::resize(const FrameContext& ctx) {
     fbo_.finalize(4);
 }
 
-void GBufferPass::execute(FrameContext& ctx) {
+void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
     const float zero[4] = {0, 0, 0, 0};
@@ -66,11 +70,14 @@ void GBufferPass::execute(FrameContext& ctx) {
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
         glUniform1i(locMaterial_, d.material);
         glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        ctx.scene.bindMaterialTextures(d, 7);
+        ctx.scene.bindMaterialTextures(d, kUnitBaseColorMap);
         ctx.scene.drawItem(d);
     }
     glDisable(GL_DEPTH_TEST);
-    ctx.publish(Resource::GBuffer, &position_);
+    res.publish(Resource::GBufferPosition, position_);
+    res.publish(Resource::GBufferNormal, normal_);
+    res.publish(Resource::GBufferAlbedo, albedo_);
+    res.publish(Resource::GBufferEmissive, emissive_);
 }
 
 }  // namespace mirage::render

@@ -9,18 +9,10 @@ class GBufferPass final : public RenderPass {
 public:
     GBufferPass();
     const char* name() const override { return "gbuffer"; }
-    std::vector<Resource> reads() const override { return {}; }
-    std::vector<Resource> writes() const override { return {Resource::GBuffer}; }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
-
-    // G-buffer attachments (canvas size), valid after resize().
-    const gl::Texture& position() const { return position_; }
-    const gl::Texture& normal() const { return normal_; }
-    const gl::Texture& albedo() const { return albedo_; }
-    const gl::Texture& emissive() const { return emissive_; }  // a = specular slot + 1
-    const gl::Texture& depth() const { return depth_; }
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
     gl::Program program_;

@@ -2,14 +2,14 @@
 #include "common.glsl"
 // Deferred G-buffer, all linear: world position + origin, world normal + roughness,
 // base colour + metallic, emitted radiance.
-layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 uniform int materialIndex;
 uniform int origin;  // ORIGIN_REAL or ORIGIN_VIRTUAL
 uniform int specularSlot;  // index into GpuScene::specularDraws(), -1 = not specular
 in vec3 worldPos;
 in vec3 worldNormal;
 in vec2 uv;
-layout(binding = 7) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
+layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
 layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic

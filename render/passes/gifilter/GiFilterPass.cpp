@@ -3,19 +3,31 @@
 #include <algorithm>
 #include <string>
 
-#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/FrameGraph.h"
 
 namespace mirage::render {
 
-GiFilterPass::GiFilterPass(const GBufferPass& gbuffer, int interleave)
-    : gbuffer_(gbuffer),
-      filter_(fullscreenProgram(
+GiFilterPass::GiFilterPass(int interleave)
+    : filter_(fullscreenProgram(
           "gi filter", "passes/gifilter/filter.frag",
           "#define MIRAGE_INTERLEAVE " + std::to_string(std::max(1, interleave)))),
       upsample_(fullscreenProgram("gi upsample", "passes/gifilter/upsample.frag")) {}
 
+void GiFilterPass::setup(PassBuilder& b) const {
+    b.read(Resource::GBufferPosition);
+    b.read(Resource::GBufferNormal);
+    b.read(Resource::IndirectRv);
+    b.read(Resource::IndirectR);
+    b.read(Resource::DirectRv);
+    b.read(Resource::DirectR);
+    // This frame's filtered indirect light, read back by the next frame as temporal history.
+    b.write(Resource::GiHistoryRv, GL_RGBA32F, SizeRule::Gather, true);
+    b.write(Resource::GiHistoryR, GL_RGBA32F, SizeRule::Gather, true);
+    b.write(Resource::LRv, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::LR, GL_RGBA16F, SizeRule::Canvas);
+}
+
 PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
-    if (!ctx.has(Resource::IndirectRv)) return {false, "no indirect light to filter"};
     return {true,
             std::string("geometry-aware ") + std::to_string(ctx.options.interleave) + "x" +
                 std::to_string(ctx.options.interleave) +
@@ -51,32 +63,36 @@ void GiFilterPass::resize(const FrameContext& ctx) {
     fbo_.finalize(2);
 }
 
-void GiFilterPass::execute(FrameContext& ctx) {
+void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     const int write = current_, read = 1 - current_;
     lowFbo_[write].bind();
     ctx.beginFullscreen(filter_, lowRv_[write].width(), lowRv_[write].height());
     glUniform1i(filter_.uniformLocation("scale"), ctx.options.indirectScale);
-    glBindTextureUnit(0, gbuffer_.position().id());
-    glBindTextureUnit(1, gbuffer_.normal().id());
-    glBindTextureUnit(2, ctx.texture(Resource::IndirectRv).id());
-    glBindTextureUnit(3, ctx.texture(Resource::IndirectR).id());
-    glBindTextureUnit(4, lowRv_[read].id());
-    glBindTextureUnit(5, lowR_[read].id());
+    const GLuint position = res.texture(Resource::GBufferPosition).id();
+    const GLuint normal = res.texture(Resource::GBufferNormal).id();
+    glBindTextureUnit(kUnitFilterPosition, position);
+    glBindTextureUnit(kUnitFilterNormal, normal);
+    glBindTextureUnit(kUnitFilterIndirectRv, res.texture(Resource::IndirectRv).id());
+    glBindTextureUnit(kUnitFilterIndirectR, res.texture(Resource::IndirectR).id());
+    glBindTextureUnit(kUnitFilterHistoryRv, lowRv_[read].id());
+    glBindTextureUnit(kUnitFilterHistoryR, lowR_[read].id());
     ctx.drawFullscreenTriangle();
 
     fbo_.bind();
     ctx.beginFullscreen(upsample_, ctx.canvasWidth(), ctx.canvasHeight());
     glUniform1i(upsample_.uniformLocation("scale"), ctx.options.indirectScale);
-    glBindTextureUnit(0, gbuffer_.position().id());
-    glBindTextureUnit(1, gbuffer_.normal().id());
-    glBindTextureUnit(2, lowRv_[write].id());
-    glBindTextureUnit(3, lowR_[write].id());
-    glBindTextureUnit(4, ctx.texture(Resource::DirectRv).id());
-    glBindTextureUnit(5, ctx.texture(Resource::DirectR).id());
+    glBindTextureUnit(kUnitUpsamplePosition, position);
+    glBindTextureUnit(kUnitUpsampleNormal, normal);
+    glBindTextureUnit(kUnitUpsampleIndirectRv, lowRv_[write].id());
+    glBindTextureUnit(kUnitUpsampleIndirectR, lowR_[write].id());
+    glBindTextureUnit(kUnitUpsampleDirectRv, res.texture(Resource::DirectRv).id());
+    glBindTextureUnit(kUnitUpsampleDirectR, res.texture(Resource::DirectR).id());
     ctx.drawFullscreenTriangle();
     current_ = read;
-    ctx.publish(Resource::LRv, &rv_);
-    ctx.publish(Resource::LR, &r_);
+    res.publish(Resource::GiHistoryRv, lowRv_[write]);
+    res.publish(Resource::GiHistoryR, lowR_[write]);
+    res.publish(Resource::LRv, rv_);
+    res.publish(Resource::LR, r_);
 }
 
 }  // namespace mirage::render

@@ -7,24 +7,17 @@
 
 namespace mirage::render {
 
-class GBufferPass;
-
 class GiFilterPass final : public RenderPass {
 public:
     // interleave: RendererOptions::interleave (K), compiled into the filter shader.
-    GiFilterPass(const GBufferPass& gbuffer, int interleave);
+    explicit GiFilterPass(int interleave);
     const char* name() const override { return "gifilter"; }
-    std::vector<Resource> reads() const override {
-        return {Resource::GBuffer, Resource::IndirectRv, Resource::IndirectR, Resource::DirectRv,
-                Resource::DirectR};
-    }
-    std::vector<Resource> writes() const override { return {Resource::LRv, Resource::LR}; }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    const GBufferPass& gbuffer_;
     gl::Program filter_;    // K x K geometry-aware filter + temporal, gather resolution
     gl::Program upsample_;  // joint bilateral upsampling + sum with direct light
     // Filtered indirect light at gather resolution, rgb + camera distance (m) in a; [current_]

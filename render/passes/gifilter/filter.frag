@@ -14,12 +14,12 @@
 // K is a compile-time constant so that the K x K loop unrolls: llvmpipe runs a loop with a
 // uniform-buffer bound as a masked SIMD loop, 1.4x slower for this pass.
 in vec2 uv;
-layout(binding = 0) uniform sampler2D gPosition;
-layout(binding = 1) uniform sampler2D gNormal;
-layout(binding = 2) uniform sampler2D indirectRv;  // deinterleaved, size a multiple of K
-layout(binding = 3) uniform sampler2D indirectR;
-layout(binding = 4) uniform sampler2D historyRv;  // gather res: rgb filtered, a = camera dist.
-layout(binding = 5) uniform sampler2D historyR;
+layout(binding = kUnitFilterPosition) uniform sampler2D gPosition;
+layout(binding = kUnitFilterNormal) uniform sampler2D gNormal;
+layout(binding = kUnitFilterIndirectRv) uniform sampler2D indirectRv;  // deinterleaved, size a multiple of K
+layout(binding = kUnitFilterIndirectR) uniform sampler2D indirectR;
+layout(binding = kUnitFilterHistoryRv) uniform sampler2D historyRv;  // gather res: rgb filtered, a = camera dist.
+layout(binding = kUnitFilterHistoryR) uniform sampler2D historyR;
 uniform int scale;  // gather pixel q was shaded at G-buffer pixel q * scale
 layout(location = 0) out vec4 outRv;  // rgb filtered + smoothed; a = camera distance (m)
 layout(location = 1) out vec4 outR;   // (the history of the next frame)
@@ -62,7 +62,7 @@ void main() {
         }
     vec3 iRv = wsum > 1e-6 ? sumRv / wsum : vec3(0.0);
     vec3 iR = wsum > 1e-6 ? sumR / wsum : vec3(0.0);
-    if (flags.y == 1 && params.z > 0.0) {
+    if (historyValid == 1 && temporalBlend > 0.0) {
         vec4 prev = prevViewProj * vec4(P.xyz, 1.0);
         if (prev.w > 1e-6) {
             vec2 puv = prev.xy / prev.w * 0.5 + 0.5;
@@ -75,8 +75,8 @@ void main() {
                 float expected = length(P.xyz - prevCameraPos.xyz);
                 if (abs(hRv.a - expected) < 0.02 * expected + 0.005 && allFinite(hRv.rgb) &&
                     allFinite(hR.rgb)) {
-                    iRv = mix(iRv, hRv.rgb, params.z);
-                    iR = mix(iR, hR.rgb, params.z);
+                    iRv = mix(iRv, hRv.rgb, temporalBlend);
+                    iR = mix(iR, hR.rgb, temporalBlend);
                 }
             }
         }

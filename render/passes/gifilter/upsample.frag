@@ -5,12 +5,12 @@
 // and by geometry (position / normal match with p), and the sum with direct light: the GI
 // solutions L_rv and L_r (linear).
 in vec2 uv;
-layout(binding = 0) uniform sampler2D gPosition;
-layout(binding = 1) uniform sampler2D gNormal;
-layout(binding = 2) uniform sampler2D indirectRv;  // filtered, gather resolution
-layout(binding = 3) uniform sampler2D indirectR;
-layout(binding = 4) uniform sampler2D directRv;
-layout(binding = 5) uniform sampler2D directR;
+layout(binding = kUnitUpsamplePosition) uniform sampler2D gPosition;
+layout(binding = kUnitUpsampleNormal) uniform sampler2D gNormal;
+layout(binding = kUnitUpsampleIndirectRv) uniform sampler2D indirectRv;  // filtered, gather resolution
+layout(binding = kUnitUpsampleIndirectR) uniform sampler2D indirectR;
+layout(binding = kUnitUpsampleDirectRv) uniform sampler2D directRv;
+layout(binding = kUnitUpsampleDirectR) uniform sampler2D directR;
 uniform int scale;  // the indirect buffers are at 1/scale resolution (joint bilateral upsampling)
 layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;

@@ -10,14 +10,12 @@
 
 #include "core/Error.h"
 #include "core/Log.h"
-#include "render/Shaders.h"
+#include "render/FrameGraph.h"
 #include "render/passes/impostor/ImpostorTypes.h"
 
 namespace mirage::render {
 namespace {
 
-// Storage bindings of the offline query shader (query.comp); it runs outside frames.
-constexpr unsigned kBindingQueryRays = 4, kBindingQueryHits = 5;
 constexpr int kCoarseSamples = 8;  // linear-search samples per impostor box (trace.glsl)
 constexpr float kEmptyDepth = 1e30f;
 
@@ -78,12 +76,9 @@ std::string ImpostorBuildStats::summary() const {
 }
 
 ImpostorPass::ImpostorPass()
-    : capture_("impostor capture", {{GL_VERTEX_SHADER, "passes/impostor/capture.vert",
-                                     shaders::source("passes/impostor/capture.vert")},
-                                    {GL_FRAGMENT_SHADER, "passes/impostor/capture.frag",
-                                     shaders::source("passes/impostor/capture.frag")}}),
-      query_("impostor query", {{GL_COMPUTE_SHADER, "passes/impostor/query.comp",
-                                 shaders::source("passes/impostor/query.comp")}}),
+    : capture_(rasterProgram("impostor capture", "passes/impostor/capture.vert",
+                             "passes/impostor/capture.frag")),
+      query_(computeProgram("impostor query", "passes/impostor/query.comp")),
       captureFbo_("impostor capture fbo") {
     locModel_ = capture_.uniformLocation("model");
     locNormal_ = capture_.uniformLocation("normalMatrix");
@@ -93,6 +88,39 @@ ImpostorPass::ImpostorPass()
     locCaptureDepth_ = capture_.uniformLocation("captureDepth");
     locDepthAxis_ = capture_.uniformLocation("depthAxis");
     locRayCount_ = query_.uniformLocation("rayCount");
+}
+
+namespace {
+// The resources trace.glsl reads: texture units kUnitImpostorCubePosition + i, then buffers.
+constexpr Resource kTracingTextures[8] = {
+    Resource::ImpostorCubePosition, Resource::ImpostorCubeNormal, Resource::ImpostorCubeAlbedo,
+    Resource::ImpostorCubeEmissive, Resource::ImpostorDepth,      Resource::ImpostorNormal,
+    Resource::ImpostorAlbedo,       Resource::ImpostorEmissive};
+constexpr GLenum kTracingFormats[8] = {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F,
+                                       GL_RG32F,   GL_RGBA16F, GL_RGBA8, GL_RGBA16F};
+static_assert(kUnitImpostorEmissive - kUnitImpostorCubePosition == 7);
+}  // namespace
+
+void ImpostorPass::setup(PassBuilder& b) const {
+    for (int i = 0; i < 8; ++i)
+        b.write(kTracingTextures[i], kTracingFormats[i], SizeRule::Impostor, true);
+    b.writeBuffer(Resource::ImpostorRecords, SizeRule::Scene, true);
+    b.writeBuffer(Resource::ImpostorObjects, SizeRule::Scene, true);
+}
+
+void ImpostorPass::declareTracing(PassBuilder& b) {
+    for (Resource r : kTracingTextures) b.read(r);
+    b.read(Resource::ImpostorRecords);
+    b.read(Resource::ImpostorObjects);
+}
+
+void ImpostorPass::bindForTracing(const PassResources& res) {
+    for (unsigned i = 0; i < 8; ++i)
+        glBindTextureUnit(kUnitImpostorCubePosition + i, res.texture(kTracingTextures[i]).id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords,
+                     res.buffer(Resource::ImpostorRecords).id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects,
+                     res.buffer(Resource::ImpostorObjects).id());
 }
 
 PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
@@ -106,9 +134,13 @@ PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
                               ctx.options.impostorRefineSteps, stats_.summary())};
 }
 
-void ImpostorPass::execute(FrameContext& ctx) {
-    update(ctx.scene, ctx.options);
-    ctx.publish(Resource::Impostors, &depth_);
+void ImpostorPass::execute(FrameContext& ctx, PassResources& res) {
+    ensureBuilt(ctx.scene, ctx.options);  // options validated with the renderer's
+    const gl::Texture* textures[8] = {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
+                                      &depth_,        &normal_,     &albedo_,     &emissive_};
+    for (int i = 0; i < 8; ++i) res.publish(kTracingTextures[i], *textures[i]);
+    res.publish(Resource::ImpostorRecords, records_);
+    res.publish(Resource::ImpostorObjects, objects_);
 }
 
 bool ImpostorPass::update(const GpuScene& scene, const RendererOptions& o) {
@@ -118,6 +150,10 @@ bool ImpostorPass::update(const GpuScene& scene, const RendererOptions& o) {
     if (o.impostorRefineSteps < 0 || o.impostorRefineSteps > 64)
         throw Error(
             fmt::format("impostorRefineSteps must be 0..64, got {}", o.impostorRefineSteps));
+    return ensureBuilt(scene, o);
+}
+
+bool ImpostorPass::ensureBuilt(const GpuScene& scene, const RendererOptions& o) {
     bool rebuilt = false;
     if (builtScene_ != &scene || builtResolution_ != o.impostorResolution) {
         build(scene, o.impostorResolution);
@@ -136,12 +172,42 @@ void ImpostorPass::uploadMode(const RendererOptions& o) {
     objects_.upload(objectBytes_.data(), sizeof(h));
 }
 
+// Per draw: its world points and, if all are on one plane, that plane.
+struct ImpostorPass::DrawShape {
+    std::vector<glm::vec3> points;
+    bool planar = false;
+    glm::vec3 normal{0.0f};
+    glm::vec3 lo{1e30f}, hi{-1e30f};
+};
+
+// Per specular object: its impostor records (billboards, planes) and enclosing items.
+struct ImpostorPass::Layout {
+    std::vector<GpuImpostor> records;
+    std::vector<GpuImpostorObject> objects;
+    std::vector<std::vector<int>> enclosing;  // [slot]: draw indices in the enclosing cube map
+};
+
 void ImpostorPass::build(const GpuScene& scene, int res) {
     const auto wallStart = std::chrono::steady_clock::now();
-    const std::vector<DrawItem>& draws = scene.draws();
-    const std::vector<int>& specular = scene.specularDraws();
+    const Layout layout = classify(scene, drawShapes(scene), res);
+    allocate(scene, layout, res);
+    // Captures, timed by the wall clock between two glFinish: llvmpipe's GL_TIME_ELAPSED gave
+    // meaningless values for this burst of small render passes, and inside a Renderer frame the
+    // pass timer is running anyway (timer queries cannot nest).
+    glFinish();
+    const auto captureStart = std::chrono::steady_clock::now();
+    capture(scene, layout, res);
+    glFinish();
+    const auto end = std::chrono::steady_clock::now();
+    stats_.captureMs = std::chrono::duration<double, std::milli>(end - captureStart).count();
+    stats_.wallMs = std::chrono::duration<double, std::milli>(end - wallStart).count();
+    spdlog::info("impostors built: {}", stats_.summary());
+}
 
-    // The geometry on the CPU once: planes and tight boxes need the vertices.
+// The geometry on the CPU once (planes and tight boxes need the vertices): every draw's world
+// points, box, and plane if it is planar.
+std::vector<ImpostorPass::DrawShape> ImpostorPass::drawShapes(const GpuScene& scene) {
+    const std::vector<DrawItem>& draws = scene.draws();
     std::vector<GpuSceneVertex> verts;
     std::vector<uint32_t> indices;
     if (scene.vertexBuffer().id() != 0) {
@@ -160,13 +226,6 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
             pts.push_back(glm::vec3(d.model * glm::vec4(verts[vi].position, 1.0f)));
         }
         return pts;
-    };
-    // Per draw: its world points and, if all are on one plane, that plane.
-    struct DrawShape {
-        std::vector<glm::vec3> points;
-        bool planar = false;
-        glm::vec3 normal{0.0f};
-        glm::vec3 lo{1e30f}, hi{-1e30f};
     };
     std::vector<DrawShape> shapes(draws.size());
     for (size_t k = 0; k < draws.size(); ++k) {
@@ -196,10 +255,21 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
         });
     }
 
-    // Impostor records per specular object.
-    std::vector<GpuImpostor> records;
-    std::vector<GpuImpostorObject> objects;
-    std::vector<std::vector<int>> enclosing(specular.size());
+    return shapes;
+}
+
+// Per specular object, how each other draw is represented: a billboard (the item is wholly on
+// the far side of the object), a plane (planar items), or an item of the enclosing cube map.
+// Fills stats_ (counts) and kinds_.
+ImpostorPass::Layout ImpostorPass::classify(const GpuScene& scene,
+                                            const std::vector<DrawShape>& shapes, int res) {
+    const std::vector<DrawItem>& draws = scene.draws();
+    const std::vector<int>& specular = scene.specularDraws();
+    Layout layout;
+    std::vector<GpuImpostor>& records = layout.records;
+    std::vector<GpuImpostorObject>& objects = layout.objects;
+    std::vector<std::vector<int>>& enclosing = layout.enclosing;
+    enclosing.resize(specular.size());
     stats_ = ImpostorBuildStats{};
     kinds_.assign(specular.size(), std::vector<ItemKind>(draws.size(), ItemKind::None));
     stats_.resolution = res;
@@ -269,9 +339,14 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
         objects.push_back(obj);
     }
 
-    // Textures.
-    const int cubeLayers = std::max(1, int(specular.size()) * 12);
-    const int impLayers = std::max(1, int(records.size()));
+    return layout;
+}
+
+// The cube-map and impostor array textures, the capture depth buffer, and the record / object
+// buffers.
+void ImpostorPass::allocate(const GpuScene& scene, const Layout& layout, int res) {
+    const int cubeLayers = std::max(1, int(scene.specularDraws().size()) * 12);
+    const int impLayers = std::max(1, int(layout.records.size()));
     GLint maxLayers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
     if (std::max(cubeLayers, impLayers) > maxLayers)
@@ -303,25 +378,26 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
         stats_.textureBytes +=
             size_t(res) * size_t(res) * size_t(t->layers()) * bytesPerTexel(t->format());
 
-    // Records and objects.
-    if (records.empty()) records.push_back(GpuImpostor{});  // a non-empty buffer to bind
+    // Records and objects (a non-empty records buffer to bind).
+    const std::vector<GpuImpostor> records =
+        layout.records.empty() ? std::vector<GpuImpostor>(1) : layout.records;
     records_ =
         gl::Buffer("impostor records", records.size() * sizeof(GpuImpostor), records.data(), 0);
-    objectBytes_.assign(
-        sizeof(GpuImpostorHeader) + std::max<size_t>(1, objects.size()) * sizeof(GpuImpostorObject),
-        0);
-    if (!objects.empty())
-        std::memcpy(objectBytes_.data() + sizeof(GpuImpostorHeader), objects.data(),
-                    objects.size() * sizeof(GpuImpostorObject));
+    objectBytes_.assign(sizeof(GpuImpostorHeader) +
+                            std::max<size_t>(1, layout.objects.size()) * sizeof(GpuImpostorObject),
+                        0);
+    if (!layout.objects.empty())
+        std::memcpy(objectBytes_.data() + sizeof(GpuImpostorHeader), layout.objects.data(),
+                    layout.objects.size() * sizeof(GpuImpostorObject));
     objects_ = gl::Buffer("impostor objects", objectBytes_.size(), objectBytes_.data());
     builtScene_ = &scene;
     builtResolution_ = res;
+}
 
-    // Captures, timed by the wall clock between two glFinish: llvmpipe's GL_TIME_ELAPSED gave
-    // meaningless values for this burst of small render passes, and inside a Renderer frame the
-    // pass timer is running anyway (timer queries cannot nest).
-    glFinish();
-    const auto captureStart = std::chrono::steady_clock::now();
+// Renders the cube maps (baseline and enclosing items) and every impostor.
+void ImpostorPass::capture(const GpuScene& scene, const Layout& layout, int res) {
+    const std::vector<DrawItem>& draws = scene.draws();
+    const std::vector<int>& specular = scene.specularDraws();
     gl::Framebuffer& fbo = captureFbo_;
     glViewport(0, 0, res, res);
     glEnable(GL_DEPTH_TEST);
@@ -335,7 +411,7 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
         glUniform1i(locMaterial_, d.material);
         glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        scene.bindMaterialTextures(d, 7);
+        scene.bindMaterialTextures(d, kUnitBaseColorMap);
         scene.drawItem(d);
     };
     auto target = [&](const gl::Texture& a, const gl::Texture& n, const gl::Texture& al,
@@ -361,7 +437,7 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
         const float nearM = std::clamp(farM * 1e-5f, 1e-4f, 1e-3f);
         const glm::mat4 proj = glm::perspective(glm::half_pi<float>(), 1.0f, nearM, farM);
         for (int kind = 0; kind < 2; ++kind) {  // 0: baseline (all but self), 1: enclosing
-            if (kind == 1 && enclosing[slot].empty()) continue;
+            if (kind == 1 && layout.enclosing[slot].empty()) continue;
             for (int f = 0; f < 6; ++f) {
                 target(cubePosition_, cubeNormal_, cubeAlbedo_, cubeEmissive_,
                        int(slot) * 12 + kind * 6 + f, glm::vec4(0.0f));
@@ -371,16 +447,16 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
                     for (size_t k = 0; k < draws.size(); ++k)
                         if (int(k) != specular[slot]) drawOne(draws[k]);
                 } else {
-                    for (int k : enclosing[slot]) drawOne(draws[size_t(k)]);
+                    for (int k : layout.enclosing[slot]) drawOne(draws[size_t(k)]);
                 }
             }
         }
     }
     glUniform1i(locCaptureDepth_, 1);
     for (size_t slot = 0; slot < specular.size(); ++slot) {
-        const GpuImpostorObject& obj = objects[slot];
+        const GpuImpostorObject& obj = layout.objects[slot];
         for (int i = 0; i < obj.range.y; ++i) {
-            const GpuImpostor& b = records[size_t(obj.range.x + i)];
+            const GpuImpostor& b = layout.records[size_t(obj.range.x + i)];
             target(depth_, normal_, albedo_, emissive_, b.info.x,
                    glm::vec4(kEmptyDepth, 0.0f, 0.0f, 0.0f));
             // Planar items: a thin slab around the plane (depth is only the coverage there).
@@ -395,14 +471,6 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDisable(GL_DEPTH_TEST);
-    glFinish();
-    stats_.captureMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - captureStart)
-            .count();
-    stats_.wallMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wallStart)
-            .count();
-    spdlog::info("impostors built: {}", stats_.summary());
 }
 
 ImpostorPass::ItemKind ImpostorPass::itemKind(int slot, int draw) const {
@@ -412,13 +480,12 @@ ImpostorPass::ItemKind ImpostorPass::itemKind(int slot, int draw) const {
     return kinds_[size_t(slot)][size_t(draw)];
 }
 
-void ImpostorPass::bindForTracing() const {
-    MR_CHECK(built(), "ImpostorPass::bindForTracing before the impostors were built");
+void ImpostorPass::bindOwnForTracing() const {
+    MR_CHECK(built(), "ImpostorPass::trace before the impostors were built (call update first)");
     const gl::Texture* units[8] = {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
                                    &depth_,        &normal_,     &albedo_,     &emissive_};
-    static_assert(kBindingImpostorEmissive - kBindingImpostorCubePosition == 7);
     for (unsigned i = 0; i < 8; ++i)
-        glBindTextureUnit(kBindingImpostorCubePosition + i, units[i]->id());
+        glBindTextureUnit(kUnitImpostorCubePosition + i, units[i]->id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords, records_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects, objects_.id());
 }
@@ -438,7 +505,7 @@ std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& ray
                  glm::vec4(rays[i].direction, 0.0f)};
     gl::Buffer rayBuf("impostor query rays", in.size() * sizeof(QueryRayGpu), in.data(), 0);
     gl::Buffer hitBuf("impostor query hits", in.size() * sizeof(QueryHitGpu), nullptr, 0);
-    bindForTracing();
+    bindOwnForTracing();
     query_.use();
     glUniform1i(locRayCount_, int(rays.size()));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingQueryRays, rayBuf.id());

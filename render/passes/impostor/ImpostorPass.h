@@ -59,15 +59,16 @@ class ImpostorPass final : public RenderPass {
 public:
     ImpostorPass();
     const char* name() const override { return "impostor"; }
-    std::vector<Resource> reads() const override { return {}; }
-    std::vector<Resource> writes() const override { return {Resource::Impostors}; }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext&) override {}
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
 
-    // Binds everything trace.glsl needs: texture units 16..23 and storage bindings 6..7
-    // (kBindingImpostor* in render/GpuTypes.h). Valid after the pass ran (or update()).
-    void bindForTracing() const;
+    // For a pass that traces the surroundings with trace.glsl: declares the impostor resources
+    // as its reads, and binds them by name (texture units kUnitImpostor* and storage bindings
+    // kBindingImpostorRecords / kBindingImpostorObjects, render/bindings.glsl).
+    static void declareTracing(PassBuilder& b);
+    static void bindForTracing(const PassResources& res);
 
     // Builds the impostors if the scene (by address) or the resolution changed (returns true
     // then), and sets the per-frame mode (refinement steps, baseline). Throws mirage::Error on
@@ -87,8 +88,19 @@ public:
     std::vector<ImpostorHit> trace(const std::vector<ImpostorRay>& rays, double& dispatchMs) const;
 
 private:
+    struct DrawShape;
+    struct Layout;
+    // build(): drawShapes -> classify -> allocate -> capture.
     void build(const GpuScene& scene, int resolution);
+    static std::vector<DrawShape> drawShapes(const GpuScene& scene);
+    Layout classify(const GpuScene& scene, const std::vector<DrawShape>& shapes, int resolution);
+    void allocate(const GpuScene& scene, const Layout& layout, int resolution);
+    void capture(const GpuScene& scene, const Layout& layout, int resolution);
     void uploadMode(const RendererOptions& options);
+    // Builds if the scene or resolution changed (options already validated).
+    bool ensureBuilt(const GpuScene& scene, const RendererOptions& options);
+    // Binds the impostors of this pass for the offline query.
+    void bindOwnForTracing() const;
 
     gl::Program capture_, query_;
     GLint locModel_ = -1, locNormal_ = -1, locViewProj_ = -1, locMaterial_ = -1, locOrigin_ = -1,

@@ -4,7 +4,7 @@
 // cube maps store the world position (m) + origin, impostors the surface's offset along the
 // impostor's W axis (m, the height field) + origin. The normal is stored as modelled (not
 // flipped): the tracer turns it toward the ray origin.
-layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 uniform int materialIndex;
 uniform int origin;         // ORIGIN_REAL or ORIGIN_VIRTUAL
 uniform int captureDepth;   // 0: cube map (position), 1: impostor (offset along depthAxis)
@@ -12,7 +12,7 @@ uniform vec4 depthAxis;     // xyz unit W axis (world), w = -dot(W, impostor cen
 in vec3 worldPos;
 in vec3 worldNormal;
 in vec2 uv;
-layout(binding = 7) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
+layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
 layout(location = 0) out vec4 gPositionOrDepth;
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal, w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic

@@ -14,8 +14,8 @@ struct QueryHit {
     vec4 albedoRough;     // rgb linear base colour, w = roughness
     vec4 emissiveMetal;   // rgb linear emitted radiance, w = metallic
 };
-layout(std430, binding = 4) readonly buffer QueryRays { QueryRay rays[]; };
-layout(std430, binding = 5) writeonly buffer QueryHits { QueryHit hits[]; };
+layout(std430, binding = kBindingQueryRays) readonly buffer QueryRays { QueryRay rays[]; };
+layout(std430, binding = kBindingQueryHits) writeonly buffer QueryHits { QueryHit hits[]; };
 uniform int rayCount;
 void main() {
     int i = int(gl_GlobalInvocationID.x);

@@ -5,8 +5,8 @@
 //
 // specularSlot indexes GpuScene::specularDraws(); the object's own geometry is not in its
 // impostors. rayOrigin / rayDir are world (metres), rayDir unit. Built by ImpostorPass, bound by
-// ImpostorPass::bindForTracing(). Uses ONLY texture units 16..23 and storage-buffer bindings 6..7
-// (mirrored by the kBindingImpostor* constants of render/GpuTypes.h).
+// ImpostorPass::bindForTracing(). Uses ONLY the texture units kUnitImpostor* (16..23) and the
+// storage-buffer bindings kBindingImpostorRecords / kBindingImpostorObjects (render/bindings.glsl).
 //
 // Two methods, chosen by RendererOptions::impostorCubeMapBaseline (header mode.x):
 // - baseline: a G-buffer cube map rendered from the object's bounding-sphere centre c, looked up
@@ -23,16 +23,15 @@
 #ifndef MIRAGE_IMPOSTOR_TRACE_GLSL
 #define MIRAGE_IMPOSTOR_TRACE_GLSL
 
-// Mirrors kBindingImpostor* in render/GpuTypes.h.
-layout(binding = 16) uniform sampler2DArray impCubePosition;  // xyz world (m), w = origin (0 empty)
-layout(binding = 17) uniform sampler2DArray impCubeNormal;    // xyz world normal, w = roughness
-layout(binding = 18) uniform sampler2DArray impCubeAlbedo;    // rgb linear base colour, a = metallic
-layout(binding = 19) uniform sampler2DArray impCubeEmissive;  // rgb linear emitted radiance
-layout(binding = 20) uniform sampler2DArray impDepth;     // r = offset along axisW (m), g = origin;
+layout(binding = kUnitImpostorCubePosition) uniform sampler2DArray impCubePosition;  // xyz world (m), w = origin (0 empty)
+layout(binding = kUnitImpostorCubeNormal) uniform sampler2DArray impCubeNormal;    // xyz world normal, w = roughness
+layout(binding = kUnitImpostorCubeAlbedo) uniform sampler2DArray impCubeAlbedo;    // rgb linear base colour, a = metallic
+layout(binding = kUnitImpostorCubeEmissive) uniform sampler2DArray impCubeEmissive;  // rgb linear emitted radiance
+layout(binding = kUnitImpostorDepth) uniform sampler2DArray impDepth;     // r = offset along axisW (m), g = origin;
                                                           // r = 1e30, g = 0 where empty (linear)
-layout(binding = 21) uniform sampler2DArray impNormal;    // xyz world normal, w = roughness
-layout(binding = 22) uniform sampler2DArray impAlbedo;    // rgb linear base colour, a = metallic
-layout(binding = 23) uniform sampler2DArray impEmissive;  // rgb linear emitted radiance
+layout(binding = kUnitImpostorNormal) uniform sampler2DArray impNormal;    // xyz world normal, w = roughness
+layout(binding = kUnitImpostorAlbedo) uniform sampler2DArray impAlbedo;    // rgb linear base colour, a = metallic
+layout(binding = kUnitImpostorEmissive) uniform sampler2DArray impEmissive;  // rgb linear emitted radiance
 
 struct GpuImpostor {
     vec4 centre;  // xyz world box centre
@@ -47,8 +46,8 @@ struct GpuImpostorObject {
                   // layer (-1 = no enclosing items)
     vec4 params;  // x = enclosing search distance (m)
 };
-layout(std430, binding = 6) readonly buffer ImpostorRecords { GpuImpostor impostors[]; };
-layout(std430, binding = 7) readonly buffer ImpostorObjects {
+layout(std430, binding = kBindingImpostorRecords) readonly buffer ImpostorRecords { GpuImpostor impostors[]; };
+layout(std430, binding = kBindingImpostorObjects) readonly buffer ImpostorObjects {
     ivec4 impMode;   // x = 1 baseline cube map, y = refinement steps, z = objects, w = coarse samples
     vec4 impParams;  // x = cube resolution, y = impostor resolution
     GpuImpostorObject impObjects[];

@@ -2,18 +2,25 @@
 
 #include <algorithm>
 
-#include "render/passes/gbuffer/GBufferPass.h"
-#include "render/passes/vpl/VplPass.h"
+#include "render/FrameGraph.h"
 
 namespace mirage::render {
 
-IndirectLightPass::IndirectLightPass(const GBufferPass& gbuffer, const VplPass& vpls)
-    : gbuffer_(gbuffer),
-      vpls_(vpls),
-      program_(fullscreenProgram("indirect", "passes/indirect/indirect.frag")) {}
+IndirectLightPass::IndirectLightPass()
+    : program_(fullscreenProgram("indirect", "passes/indirect/indirect.frag")) {}
+
+void IndirectLightPass::setup(PassBuilder& b) const {
+    b.read(Resource::GBufferPosition);
+    b.read(Resource::GBufferNormal);
+    b.read(Resource::GBufferAlbedo);
+    b.read(Resource::Vpls);
+    b.read(Resource::ImperfectShadowMaps);
+    b.read(Resource::ImperfectShadowMapsReal);
+    b.write(Resource::IndirectRv, GL_RGBA16F, SizeRule::GatherTiles);
+    b.write(Resource::IndirectR, GL_RGBA16F, SizeRule::GatherTiles);
+}
 
 PassDecision IndirectLightPass::decide(const FrameContext& ctx) const {
-    if (!ctx.plan.needVpls) return {false, "no VPLs this frame"};
     const int k = std::max(1, ctx.options.interleave);
     return {true, "interleaved " + std::to_string(k) + "x" + std::to_string(k) + ": " +
                       std::to_string((ctx.options.vplCount + k * k - 1) / (k * k)) +
@@ -37,16 +44,16 @@ void IndirectLightPass::resize(const FrameContext& ctx) {
     fbo_.finalize(2);
 }
 
-void IndirectLightPass::execute(FrameContext& ctx) {
+void IndirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, rv_.width(), rv_.height());  // each tile sets its viewport
     glUniform1i(program_.uniformLocation("scale"), ctx.options.indirectScale);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.vplBuffer().id());
-    glBindTextureUnit(0, gbuffer_.position().id());
-    glBindTextureUnit(1, gbuffer_.normal().id());
-    glBindTextureUnit(2, gbuffer_.albedo().id());
-    glBindTextureUnit(3, ctx.texture(Resource::ImperfectShadowMaps).id());
-    glBindTextureUnit(4, ctx.texture(Resource::ImperfectShadowMapsReal).id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
+    glBindTextureUnit(kUnitIndirectPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitIndirectNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitIndirectAlbedo, res.texture(Resource::GBufferAlbedo).id());
+    glBindTextureUnit(kUnitIndirectIsmAll, res.texture(Resource::ImperfectShadowMaps).id());
+    glBindTextureUnit(kUnitIndirectIsmReal, res.texture(Resource::ImperfectShadowMapsReal).id());
     ctx.emptyVao.bind();
     // One draw per VPL group into its tile: the group is uniform over the draw, so every pixel
     // walks the same VPL list (uniform loads; on llvmpipe divergent SSBO gathers are far slower).
@@ -61,8 +68,8 @@ void IndirectLightPass::execute(FrameContext& ctx) {
             glUniform2i(locTile, gx * tw, gy * th);
             glDrawArrays(GL_TRIANGLES, 0, 3);
         }
-    ctx.publish(Resource::IndirectRv, &rv_);
-    ctx.publish(Resource::IndirectR, &r_);
+    res.publish(Resource::IndirectRv, rv_);
+    res.publish(Resource::IndirectR, r_);
 }
 
 }  // namespace mirage::render

@@ -4,27 +4,16 @@
 
 namespace mirage::render {
 
-class GBufferPass;
-class VplPass;
-
 class IndirectLightPass final : public RenderPass {
 public:
-    IndirectLightPass(const GBufferPass& gbuffer, const VplPass& vpls);
+    IndirectLightPass();
     const char* name() const override { return "indirect"; }
-    std::vector<Resource> reads() const override {
-        return {Resource::GBuffer, Resource::Vpls, Resource::ImperfectShadowMaps,
-                Resource::ImperfectShadowMapsReal};
-    }
-    std::vector<Resource> writes() const override {
-        return {Resource::IndirectRv, Resource::IndirectR};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    const GBufferPass& gbuffer_;
-    const VplPass& vpls_;
     gl::Program program_;
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;

@@ -8,12 +8,12 @@
 // shadow maps. Routing (DESIGN.md): a VPL at q lights p in L_rv always; in L_r only if the light,
 // q and p are all real, with visibility against real points only. Diffuse receivers.
 in vec2 uv;
-layout(std430, binding = 2) readonly buffer Vpls { GpuVpl vpls[]; };
-layout(binding = 0) uniform sampler2D gPosition;
-layout(binding = 1) uniform sampler2D gNormal;
-layout(binding = 2) uniform sampler2D gAlbedo;
-layout(binding = 3) uniform usampler2D ismAll;
-layout(binding = 4) uniform usampler2D ismReal;
+layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = kUnitIndirectPosition) uniform sampler2D gPosition;
+layout(binding = kUnitIndirectNormal) uniform sampler2D gNormal;
+layout(binding = kUnitIndirectAlbedo) uniform sampler2D gAlbedo;
+layout(binding = kUnitIndirectIsmAll) uniform usampler2D ismAll;
+layout(binding = kUnitIndirectIsmReal) uniform usampler2D ismReal;
 uniform int scale;  // gather pixel q shades G-buffer pixel q * scale
 uniform ivec2 group;       // (x mod K, y mod K) of this draw's pixels
 uniform ivec2 tileOrigin;  // where this group's tile starts in the target
@@ -22,14 +22,14 @@ layout(location = 1) out vec4 outR;
 
 // Distance (m) of the nearest splatted point in direction w from the VPL, +inf if none.
 float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
-    int tile = flags.z, perRow = flags.w;
+    int tile = ismTileSize, perRow = ismTilesPerRow;
     ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
     ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
     return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
 }
 
 void main() {
-    int K = max(counts.z, 1);
+    int K = max(interleave, 1);
     ivec2 q = (ivec2(gl_FragCoord.xy) - tileOrigin) * K + group;  // interleaved gather pixel
     ivec2 g = min(q * scale, textureSize(gPosition, 0) - 1);
     vec4 P = texelFetch(gPosition, g, 0);
@@ -43,9 +43,9 @@ void main() {
     vec4 A = texelFetch(gAlbedo, g, 0);
     vec3 diffuse = A.rgb * (1.0 - A.a) / PI;
     int first = group.x + K * group.y;
-    float clamp2 = params.x * params.x;
+    float clamp2 = vplDistanceClamp * vplDistanceClamp;
     vec3 rv = vec3(0.0), r = vec3(0.0);
-    for (int i = first; i < counts.y; i += K * K) {
+    for (int i = first; i < vplCount; i += K * K) {
         GpuVpl V = vpls[i];
         if (V.normal.w < 0.5) continue;
         vec3 d = p - V.positionReal.xyz;

@@ -2,22 +2,18 @@
 
 #include <cmath>
 
-#include "render/Shaders.h"
-#include "render/passes/vpl/VplPass.h"
-
+#include "render/FrameGraph.h"
 namespace mirage::render {
 
-IsmPass::IsmPass(const VplPass& vpls)
-    : vpls_(vpls),
-      program_("ism", {{GL_COMPUTE_SHADER, "passes/ism/ism.comp",
-                        shaders::source("passes/ism/ism.comp")}}) {}
+IsmPass::IsmPass() : program_(computeProgram("ism", "passes/ism/ism.comp")) {}
 
-int IsmPass::tilesPerRow(int vplCount) {
-    return std::max(1, int(std::ceil(std::sqrt(double(std::max(vplCount, 1))))));
+void IsmPass::setup(PassBuilder& b) const {
+    b.read(Resource::Vpls);
+    b.write(Resource::ImperfectShadowMaps, GL_R32UI, SizeRule::IsmAtlas);
+    b.write(Resource::ImperfectShadowMapsReal, GL_R32UI, SizeRule::IsmAtlas);
 }
 
 PassDecision IsmPass::decide(const FrameContext& ctx) const {
-    if (!ctx.plan.needVpls) return {false, "no VPLs this frame"};
     return {true, std::to_string(ctx.options.vplCount) + " VPLs x " +
                       std::to_string(ctx.options.ismPointsPerVpl) + " points" +
                       (ctx.plan.needRealOnlyIsm ? ", plus a real-only atlas"
@@ -25,7 +21,7 @@ PassDecision IsmPass::decide(const FrameContext& ctx) const {
 }
 
 void IsmPass::resize(const FrameContext& ctx) {
-    const int size = tilesPerRow(ctx.options.vplCount) * ctx.options.ismTileSize;
+    const int size = ismTilesPerRow(ctx.options.vplCount) * ctx.options.ismTileSize;
     if (size == allocatedSize_) return;
     all_ = gl::Texture::create2D("ism atlas", size, size, GL_R32UI);
     real_ = gl::Texture::create2D("ism atlas real-only", size, size, GL_R32UI);
@@ -34,18 +30,18 @@ void IsmPass::resize(const FrameContext& ctx) {
     allocatedSize_ = size;
 }
 
-void IsmPass::execute(FrameContext& ctx) {
+void IsmPass::execute(FrameContext& ctx, PassResources& res) {
     const GLuint far = 0x7F800000u;  // +inf as float bits: nothing splatted
     glClearTexImage(all_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &far);
     if (ctx.plan.needRealOnlyIsm)
         glClearTexImage(real_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &far);
     program_.use();
     ctx.bindFrameBlocks();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.vplBuffer().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingIsmPoints,
                      ctx.scene.surfacePointBuffer().id());
-    glBindImageTexture(0, all_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindImageTexture(1, real_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kImageIsmAll, all_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kImageIsmReal, real_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glUniform1i(program_.uniformLocation("pointCount"), ctx.scene.surfacePointCount());
     glUniform1i(program_.uniformLocation("writeReal"), ctx.plan.needRealOnlyIsm ? 1 : 0);
     const float perVpl = float(std::max(1, ctx.options.ismPointsPerVpl));
@@ -54,12 +50,8 @@ void IsmPass::execute(FrameContext& ctx) {
     const long long invocations = (long long)ctx.options.vplCount * ctx.options.ismPointsPerVpl;
     glDispatchCompute(GLuint((invocations + 63) / 64), 1, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    publishCached(ctx);
-}
-
-void IsmPass::publishCached(FrameContext& ctx) {
-    ctx.publish(Resource::ImperfectShadowMaps, &all_);
-    ctx.publish(Resource::ImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? &real_ : &all_);
+    res.publish(Resource::ImperfectShadowMaps, all_);
+    res.publish(Resource::ImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? real_ : all_);
 }
 
 }  // namespace mirage::render

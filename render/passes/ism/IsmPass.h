@@ -6,25 +6,17 @@
 
 namespace mirage::render {
 
-class VplPass;
-
 class IsmPass final : public RenderPass {
 public:
-    explicit IsmPass(const VplPass& vpls);
+    IsmPass();
     const char* name() const override { return "ism"; }
-    std::vector<Resource> reads() const override { return {Resource::Vpls}; }
-    std::vector<Resource> writes() const override {
-        return {Resource::ImperfectShadowMaps, Resource::ImperfectShadowMapsReal};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
     bool cameraIndependent() const override { return true; }
-    void publishCached(FrameContext& ctx) override;
-    static int tilesPerRow(int vplCount);
 
 private:
-    const VplPass& vpls_;
     gl::Program program_;
     gl::Texture all_, real_;
     int allocatedSize_ = 0;

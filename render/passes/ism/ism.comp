@@ -6,10 +6,10 @@
 // (DESIGN.md timing table). Depth = distance to the VPL in metres, stored as float bits in r32ui
 // (positive floats order like unsigned ints). The real-only atlas gets only the real points.
 layout(local_size_x = 64) in;
-layout(std430, binding = 2) readonly buffer Vpls { GpuVpl vpls[]; };
-layout(std430, binding = 4) readonly buffer Points { vec4 points[]; };  // xyz world, w = real
-layout(r32ui, binding = 0) uniform coherent uimage2D ismAll;
-layout(r32ui, binding = 1) uniform coherent uimage2D ismReal;
+layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(std430, binding = kBindingIsmPoints) readonly buffer Points { vec4 points[]; };  // xyz world, w = real
+layout(r32ui, binding = kImageIsmAll) uniform coherent uimage2D ismAll;
+layout(r32ui, binding = kImageIsmReal) uniform coherent uimage2D ismReal;
 uniform int pointCount;       // size of the pool
 uniform int writeReal;        // 1: also fill the real-only atlas
 uniform float pointRadius;    // metres: radius of the disc one splatted point stands for
@@ -25,7 +25,7 @@ void splat(int vplIndex, vec3 p, bool real) {
     float z = dot(w, n);
     if (z <= 0.0) return;  // behind the VPL's cosine lobe: never lit by it
     vec2 uv = paraboloidUv(v, w);
-    int tile = flags.z, perRow = flags.w;
+    int tile = ismTileSize, perRow = ismTilesPerRow;
     ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
     vec2 texel = (uv * 0.5 + 0.5) * float(tile);
     int r = int(clamp(pointRadius / dist * 0.5 * float(tile) / (1.0 + z), 0.0, 2.0));
@@ -40,10 +40,10 @@ void splat(int vplIndex, vec3 p, bool real) {
 }
 
 void main() {
-    int perVpl = int(params.w);
+    int perVpl = int(ismPointsPerVpl);
     int id = int(gl_GlobalInvocationID.x);
     int vplIndex = id / perVpl;
-    if (vplIndex >= counts.y || pointCount <= 0) return;
+    if (vplIndex >= vplCount || pointCount <= 0) return;
     int j = id % perVpl;
     // Each VPL reads a different contiguous window of the shuffled pool.
     int pi = (vplIndex * 7919 + j) % pointCount;

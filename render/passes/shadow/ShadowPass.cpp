@@ -1,14 +1,10 @@
 #include "render/passes/shadow/ShadowPass.h"
 
-#include "render/Shaders.h"
-
+#include "render/FrameGraph.h"
 namespace mirage::render {
 
 ShadowPass::ShadowPass()
-    : program_("shadow", {{GL_VERTEX_SHADER, "passes/shadow/shadow.vert",
-                           shaders::source("passes/shadow/shadow.vert")},
-                          {GL_FRAGMENT_SHADER, "passes/shadow/shadow.frag",
-                           shaders::source("passes/shadow/shadow.frag")}}),
+    : program_(rasterProgram("shadow", "passes/shadow/shadow.vert", "passes/shadow/shadow.frag")),
       fbo_("shadow fbo") {
     locModel_ = program_.uniformLocation("model");
     locNormal_ = program_.uniformLocation("normalMatrix");
@@ -16,6 +12,14 @@ ShadowPass::ShadowPass()
     locLight_ = program_.uniformLocation("lightIndex");
     locMaterial_ = program_.uniformLocation("materialIndex");
     locOrigin_ = program_.uniformLocation("origin");
+}
+
+void ShadowPass::setup(PassBuilder& b) const {
+    b.write(Resource::ShadowMaps, GL_R32F, SizeRule::ShadowAtlas);
+    b.write(Resource::ShadowMapsReal, GL_R32F, SizeRule::ShadowAtlas);
+    b.write(Resource::RsmFlux, GL_RGBA16F, SizeRule::ShadowAtlas);  // only when VPLs are needed
+    b.write(Resource::RsmNormal, GL_RGBA16F, SizeRule::ShadowAtlas);
+    b.write(Resource::RsmPosition, GL_RGBA32F, SizeRule::ShadowAtlas);
 }
 
 PassDecision ShadowPass::decide(const FrameContext& ctx) const {
@@ -73,12 +77,12 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
         glUniform1i(locMaterial_, d.material);
         glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        ctx.scene.bindMaterialTextures(d, 7);
+        ctx.scene.bindMaterialTextures(d, kUnitBaseColorMap);
         ctx.scene.drawItem(d);
     }
 }
 
-void ShadowPass::execute(FrameContext& ctx) {
+void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     glViewport(0, 0, allocatedSize_, allocatedSize_);
     glEnable(GL_DEPTH_TEST);
@@ -97,14 +101,13 @@ void ShadowPass::execute(FrameContext& ctx) {
         }
     }
     glDisable(GL_DEPTH_TEST);
-    publishCached(ctx);
-}
-
-void ShadowPass::publishCached(FrameContext& ctx) {
-    ctx.publish(Resource::ShadowMaps, &distance_);
-    ctx.publish(Resource::ShadowMapsReal,
-                ctx.plan.needRealOnlyShadows ? &distanceReal_ : &distance_);
-    if (ctx.plan.needVpls) ctx.publish(Resource::ReflectiveShadowMaps, &rsmFlux_);
+    res.publish(Resource::ShadowMaps, distance_);
+    res.publish(Resource::ShadowMapsReal, ctx.plan.needRealOnlyShadows ? distanceReal_ : distance_);
+    if (ctx.plan.needVpls) {
+        res.publish(Resource::RsmFlux, rsmFlux_);
+        res.publish(Resource::RsmNormal, rsmNormal_);
+        res.publish(Resource::RsmPosition, rsmPosition_);
+    }
 }
 
 }  // namespace mirage::render

@@ -13,19 +13,11 @@ class ShadowPass final : public RenderPass {
 public:
     ShadowPass();
     const char* name() const override { return "shadow"; }
-    std::vector<Resource> reads() const override { return {}; }
-    std::vector<Resource> writes() const override {
-        return {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::ReflectiveShadowMaps};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
     bool cameraIndependent() const override { return true; }
-    void publishCached(FrameContext& ctx) override;
-
-    const gl::Texture& rsmFlux() const { return rsmFlux_; }
-    const gl::Texture& rsmNormal() const { return rsmNormal_; }
-    const gl::Texture& rsmPosition() const { return rsmPosition_; }
 
 private:
     void renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);

@@ -5,14 +5,14 @@
 // & Stamminger 2005), what a VPL there needs: the reflected radiant intensity per unit solid
 // angle of the light (flux / steradian, linear RGB), the surface normal facing the light, the
 // world position and whether the surface is real.
-layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 uniform int lightIndex;
 uniform int materialIndex;
 uniform int origin;
 in vec3 worldPos;
 in vec3 worldNormal;
 in vec2 uv;
-layout(binding = 7) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
+layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
 layout(location = 0) out float outDistance;  // metres from the light (see lightDistance)
 layout(location = 1) out vec4 outFlux;       // rgb W/sr * albedo (W/m^2 * albedo for dir.), a = real
 layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light

@@ -1,7 +1,6 @@
 #include "render/passes/specular/SpecularGBufferPass.h"
 
-#include "render/passes/backface/BackFacePass.h"
-#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/FrameGraph.h"
 #include "render/passes/impostor/ImpostorPass.h"
 
 namespace mirage::render {
@@ -24,23 +23,44 @@ void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h) {
     b.fbo.finalize(5);
 }
 
+void publish(PassResources& res, const SpecularHitBuffer& b, Resource position, Resource normal,
+             Resource albedo, Resource emissive, Resource weight) {
+    res.publish(position, b.position);
+    res.publish(normal, b.normal);
+    res.publish(albedo, b.albedo);
+    res.publish(emissive, b.emissive);
+    res.publish(weight, b.weight);
+}
+
+void declare(PassBuilder& b, Resource position, Resource normal, Resource albedo, Resource emissive,
+             Resource weight) {
+    b.write(position, GL_RGBA32F, SizeRule::Canvas);
+    for (Resource r : {normal, albedo, emissive, weight}) b.write(r, GL_RGBA16F, SizeRule::Canvas);
+}
+
 }  // namespace
 
-SpecularGBufferPass::SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces,
-                                         const ImpostorPass& impostors)
-    : gbuffer_(gbuffer),
-      backFaces_(backFaces),
-      impostors_(impostors),
-      programs_{fullscreenProgram("specular gbuffer (reflection)",
+SpecularGBufferPass::SpecularGBufferPass()
+    : programs_{fullscreenProgram("specular gbuffer (reflection)",
                                   "passes/specular/specular_gbuffer.frag",
                                   "#define MIRAGE_SPECULAR_MODE 0"),
                 fullscreenProgram("specular gbuffer (refraction)",
                                   "passes/specular/specular_gbuffer.frag",
                                   "#define MIRAGE_SPECULAR_MODE 1")} {}
 
+void SpecularGBufferPass::setup(PassBuilder& b) const {
+    for (Resource r :
+         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
+          Resource::BackFacePosition, Resource::BackFaceNormal})
+        b.read(r);
+    ImpostorPass::declareTracing(b);
+    declare(b, Resource::ReflectionGBuffer, Resource::ReflectionNormal, Resource::ReflectionAlbedo,
+            Resource::ReflectionEmissive, Resource::ReflectionWeight);
+    declare(b, Resource::RefractionGBuffer, Resource::RefractionNormal, Resource::RefractionAlbedo,
+            Resource::RefractionEmissive, Resource::RefractionWeight);
+}
+
 PassDecision SpecularGBufferPass::decide(const FrameContext& ctx) const {
-    if (!ctx.has(Resource::BackFaces)) return {false, "no mirror or glass object in the scene"};
-    if (!ctx.has(Resource::Impostors)) return {false, "no impostors of the surroundings"};
     return {true, std::to_string(ctx.scene.specularDraws().size()) +
                       " specular draw(s): reflected and refracted rays"};
 }
@@ -54,16 +74,16 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
     allocate(refr_, "GBuf_refr", w, h);
 }
 
-void SpecularGBufferPass::execute(FrameContext& ctx) {
+void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
                      ctx.scene.specularDrawBuffer().id());
-    glBindTextureUnit(0, gbuffer_.position().id());
-    glBindTextureUnit(1, gbuffer_.normal().id());
-    glBindTextureUnit(2, gbuffer_.emissive().id());
-    glBindTextureUnit(3, backFaces_.position().id());
-    glBindTextureUnit(4, backFaces_.normal().id());
-    impostors_.bindForTracing();  // texture units 16..23, storage bindings 6..7
+    glBindTextureUnit(kUnitSpecGbufPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitSpecGbufNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitSpecGbufEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
+    glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
+    ImpostorPass::bindForTracing(res);  // kUnitImpostor*, kBindingImpostorRecords / Objects
     for (int mode = 0; mode < 2; ++mode) {
         (mode == 0 ? refl_ : refr_).fbo.bind();
         const gl::Program& program = programs_[mode];
@@ -72,8 +92,10 @@ void SpecularGBufferPass::execute(FrameContext& ctx) {
             glUniform1i(program.uniformLocation("marchSteps"), ctx.options.refractionMarchSteps);
         ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);  // 0 outside: no specular pixel
     }
-    ctx.publish(Resource::ReflectionGBuffer, &refl_.position);
-    ctx.publish(Resource::RefractionGBuffer, &refr_.position);
+    publish(res, refl_, Resource::ReflectionGBuffer, Resource::ReflectionNormal,
+            Resource::ReflectionAlbedo, Resource::ReflectionEmissive, Resource::ReflectionWeight);
+    publish(res, refr_, Resource::RefractionGBuffer, Resource::RefractionNormal,
+            Resource::RefractionAlbedo, Resource::RefractionEmissive, Resource::RefractionWeight);
 }
 
 }  // namespace mirage::render

@@ -8,10 +8,6 @@
 
 namespace mirage::render {
 
-class GBufferPass;
-class BackFacePass;
-class ImpostorPass;
-
 // One specular G-buffer: hit position + origin (or the ray direction on a miss), normal +
 // roughness, albedo + metallic, emission + specular-pixel flag, weight + distance inside.
 struct SpecularHitBuffer {
@@ -21,26 +17,14 @@ struct SpecularHitBuffer {
 
 class SpecularGBufferPass final : public RenderPass {
 public:
-    SpecularGBufferPass(const GBufferPass& gbuffer, const BackFacePass& backFaces,
-                        const ImpostorPass& impostors);
+    SpecularGBufferPass();
     const char* name() const override { return "specgbuf"; }
-    std::vector<Resource> reads() const override {
-        return {Resource::GBuffer, Resource::BackFaces, Resource::Impostors};
-    }
-    std::vector<Resource> writes() const override {
-        return {Resource::ReflectionGBuffer, Resource::RefractionGBuffer};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
-
-    const SpecularHitBuffer& reflection() const { return refl_; }
-    const SpecularHitBuffer& refraction() const { return refr_; }
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    const GBufferPass& gbuffer_;
-    const BackFacePass& backFaces_;
-    const ImpostorPass& impostors_;
     gl::Program programs_[2];  // [0] reflection, [1] refraction (MIRAGE_SPECULAR_MODE)
     SpecularHitBuffer refl_, refr_;
     int width_ = 0, height_ = 0;

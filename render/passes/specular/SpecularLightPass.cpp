@@ -1,26 +1,41 @@
 #include "render/passes/specular/SpecularLightPass.h"
 
-#include "render/passes/gbuffer/GBufferPass.h"
-#include "render/passes/specular/SpecularGBufferPass.h"
-#include "render/passes/vpl/VplPass.h"
+#include "render/FrameGraph.h"
 
 namespace mirage::render {
 
-SpecularLightPass::SpecularLightPass(const GBufferPass& gbuffer, const SpecularGBufferPass& hits,
-                                     const VplPass& vpls, const GpuScene& scene)
-    : gbuffer_(gbuffer),
-      hits_(hits),
-      vpls_(vpls),
-      program_(fullscreenProgram("specular light", "passes/specular/specular_light.frag",
+namespace {
+// GBuf_refl then GBuf_refr, at kUnitSpecLightReflFirst + 0..4 and kUnitSpecLightRefrFirst + 0..4.
+constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::ReflectionNormal,
+                                      Resource::ReflectionAlbedo,   Resource::ReflectionEmissive,
+                                      Resource::ReflectionWeight,   Resource::RefractionGBuffer,
+                                      Resource::RefractionNormal,   Resource::RefractionAlbedo,
+                                      Resource::RefractionEmissive, Resource::RefractionWeight};
+static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
+}  // namespace
+
+SpecularLightPass::SpecularLightPass(const GpuScene& scene)
+    : program_(fullscreenProgram("specular light", "passes/specular/specular_light.frag",
                                  scene.lightingDefines())) {
     locUseVpls_ = program_.uniformLocation("useVpls");
     locVplStride_ = program_.uniformLocation("vplStride");
 }
 
+void SpecularLightPass::setup(PassBuilder& b) const {
+    for (Resource r : kHitBuffers) b.read(r);
+    b.read(Resource::GBufferPosition);
+    b.read(Resource::EnvironmentMap);
+    for (Resource r : {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::Vpls,
+                       Resource::ImperfectShadowMaps, Resource::ImperfectShadowMapsReal})
+        b.readOptional(r);
+    b.write(Resource::SpecularRv, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::SpecularR, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::SpecularRReflection, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::Lenv, GL_RGBA16F, SizeRule::Canvas);
+}
+
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
-    if (!ctx.has(Resource::ReflectionGBuffer)) return {false, "no specular G-buffers"};
-    const bool vpls = ctx.options.specularVpls && ctx.has(Resource::Vpls) &&
-                      ctx.has(Resource::ImperfectShadowMaps);
+    const bool vpls = ctx.options.specularVpls && ctx.plan.needVpls;
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
                       (ctx.scene.hasEnvironment() ? " + environment" : "") +
                       (vpls ? " + VPLs" : "") + " at the reflected/refracted hits"};
@@ -43,39 +58,37 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     fbo_.finalize(4);
 }
 
-void SpecularLightPass::execute(FrameContext& ctx) {
+void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
-    const SpecularHitBuffer& a = hits_.reflection();
-    const SpecularHitBuffer& b = hits_.refraction();
-    const gl::Texture* units[10] = {&a.position, &a.normal, &a.albedo, &a.emissive, &a.weight,
-                                    &b.position, &b.normal, &b.albedo, &b.emissive, &b.weight};
-    for (GLuint i = 0; i < 10; ++i) glBindTextureUnit(i, units[i]->id());
-    glBindTextureUnit(10, ctx.has(Resource::ShadowMaps) ? ctx.texture(Resource::ShadowMaps).id()
-                                                        : ctx.farShadowTexture().id());
-    glBindTextureUnit(11, ctx.has(Resource::ShadowMapsReal)
-                              ? ctx.texture(Resource::ShadowMapsReal).id()
-                              : ctx.farShadowTexture().id());
-    const bool vpls = ctx.options.specularVpls && ctx.has(Resource::Vpls) &&
-                      ctx.has(Resource::ImperfectShadowMaps);
+    for (int i = 0; i < 10; ++i)
+        glBindTextureUnit(GLuint(kUnitSpecLightReflFirst + i), res.texture(kHitBuffers[i]).id());
+    glBindTextureUnit(kUnitSpecLightShadowAll,
+                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitSpecLightShadowReal,
+                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
+    const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
+                      res.has(Resource::ImperfectShadowMaps);
     if (vpls) {
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.vplBuffer().id());
-        glBindTextureUnit(12, ctx.texture(Resource::ImperfectShadowMaps).id());
-        glBindTextureUnit(13, ctx.has(Resource::ImperfectShadowMapsReal)
-                                  ? ctx.texture(Resource::ImperfectShadowMapsReal).id()
-                                  : ctx.texture(Resource::ImperfectShadowMaps).id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
+        glBindTextureUnit(kUnitSpecLightIsmAll, res.texture(Resource::ImperfectShadowMaps).id());
+        glBindTextureUnit(kUnitSpecLightIsmReal,
+                          res.textureOr(Resource::ImperfectShadowMapsReal,
+                                        res.texture(Resource::ImperfectShadowMaps))
+                              .id());
     } else {
-        glBindTextureUnit(12, 0);
-        glBindTextureUnit(13, 0);
+        glBindTextureUnit(kUnitSpecLightIsmAll, 0);
+        glBindTextureUnit(kUnitSpecLightIsmReal, 0);
     }
-    glBindTextureUnit(14, gbuffer_.position().id());
-    glBindTextureUnit(kUnitEnvironmentMap, ctx.scene.environmentMap().id());
+    glBindTextureUnit(kUnitSpecLightPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitEnvironmentMap, res.texture(Resource::EnvironmentMap).id());
     glUniform1i(locUseVpls_, vpls ? 1 : 0);
     glUniform1i(locVplStride_, ctx.options.specularVplStride);
     ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);  // 0 outside: not a specular pixel
-    ctx.publish(Resource::SpecularRv, &rv_);
-    ctx.publish(Resource::SpecularR, &r_);
-    ctx.publish(Resource::Lenv, &env_);
+    res.publish(Resource::SpecularRv, rv_);
+    res.publish(Resource::SpecularR, r_);
+    res.publish(Resource::SpecularRReflection, rRefl_);
+    res.publish(Resource::Lenv, env_);
 }
 
 }  // namespace mirage::render

@@ -7,34 +7,16 @@
 
 namespace mirage::render {
 
-class GBufferPass;
-class SpecularGBufferPass;
-class VplPass;
-
 class SpecularLightPass final : public RenderPass {
 public:
-    SpecularLightPass(const GBufferPass& gbuffer, const SpecularGBufferPass& hits,
-                      const VplPass& vpls, const GpuScene& scene);
+    explicit SpecularLightPass(const GpuScene& scene);
     const char* name() const override { return "speclight"; }
-    std::vector<Resource> reads() const override {
-        return {Resource::ReflectionGBuffer, Resource::RefractionGBuffer};
-    }
-    std::vector<Resource> writes() const override {
-        return {Resource::SpecularRv, Resource::SpecularR, Resource::Lenv};
-    }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
-
-    const gl::Texture& rv() const { return rv_; }              // L'_rv, linear
-    const gl::Texture& r() const { return r_; }                // L'_r, linear
-    const gl::Texture& rReflection() const { return rRefl_; }  // reflection's share of L'_r
-    const gl::Texture& env() const { return env_; }            // L_env, linear
+    void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    const GBufferPass& gbuffer_;
-    const SpecularGBufferPass& hits_;
-    const VplPass& vpls_;
     gl::Program program_;
     gl::Texture rv_, r_, rRefl_, env_;
     gl::Framebuffer fbo_;

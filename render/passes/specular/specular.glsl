@@ -31,9 +31,9 @@ vec3 schlickColour(vec3 f0, float cosTheta) {
 // equirectangular map: u = 0.5 + (atan2(l.x, -l.z) - rotation) / 2pi, v = acos(l.y) / pi
 // (GpuScene::environmentMap, the reference renderer's convention).
 vec3 environmentRadiance(sampler2D envMap, vec3 l) {
-    if (flags.x == ORIGIN_NONE) return vec3(0.0);
+    if (envOrigin == ORIGIN_NONE) return vec3(0.0);
     l = normalize(l);
-    float phi = atan(l.x, -l.z) - exposure.w;
+    float phi = atan(l.x, -l.z) - envRotation;
     float u = 0.5 + phi / (2.0 * PI);
     float v = acos(clamp(l.y, -1.0, 1.0)) / PI;
     // Explicit LOD 0: the u wrap at +-pi would otherwise pick a tiny mip (there is one level).

@@ -26,13 +26,13 @@
 // with d = |P2 - p| the distance travelled inside (KHR_materials_volume).
 // Weight of the reflected radiance: Fresnel F1 (dielectric) or Schlick(baseColour) (mirror).
 in vec2 uv;
-layout(std430, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
-layout(std430, binding = 5) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
-layout(binding = 0) uniform sampler2D gPosition;
-layout(binding = 1) uniform sampler2D gNormal;
-layout(binding = 2) uniform sampler2D gEmissive;  // a = specular slot + 1
-layout(binding = 3) uniform sampler2D backPosition;  // xyz world, w = slot + 1
-layout(binding = 4) uniform sampler2D backNormal;    // outward
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = kBindingSpecularDraws) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
+layout(binding = kUnitSpecGbufPosition) uniform sampler2D gPosition;
+layout(binding = kUnitSpecGbufNormal) uniform sampler2D gNormal;
+layout(binding = kUnitSpecGbufEmissive) uniform sampler2D gEmissive;  // a = specular slot + 1
+layout(binding = kUnitSpecGbufBackPosition) uniform sampler2D backPosition;  // xyz world, w = slot + 1
+layout(binding = kUnitSpecGbufBackNormal) uniform sampler2D backNormal;    // outward
 #ifndef MIRAGE_SPECULAR_MODE  // SpecularGBufferPass compiles one program per mode
 #define MIRAGE_SPECULAR_MODE 0
 #endif

@@ -13,23 +13,23 @@
 // 5.1). A ray that hit nothing modelled writes the weighted environment radiance into L_env
 // instead (Sec. 4.1.3); L'_rv and L'_r stay untouched there. Linear radiance throughout.
 in vec2 uv;
-layout(std430, binding = 2) readonly buffer Vpls { GpuVpl vpls[]; };
-layout(binding = 0) uniform sampler2D reflPosition;
-layout(binding = 1) uniform sampler2D reflNormal;
-layout(binding = 2) uniform sampler2D reflAlbedo;
-layout(binding = 3) uniform sampler2D reflEmissive;
-layout(binding = 4) uniform sampler2D reflWeight;
-layout(binding = 5) uniform sampler2D refrPosition;
-layout(binding = 6) uniform sampler2D refrNormal;
-layout(binding = 7) uniform sampler2D refrAlbedo;
-layout(binding = 8) uniform sampler2D refrEmissive;
-layout(binding = 9) uniform sampler2D refrWeight;
-layout(binding = 10) uniform sampler2DArray shadowAll;
-layout(binding = 11) uniform sampler2DArray shadowReal;
-layout(binding = 12) uniform usampler2D ismAll;
-layout(binding = 13) uniform usampler2D ismReal;
-layout(binding = 14) uniform sampler2D gPosition;  // primary G-buffer
-layout(binding = 15) uniform sampler2D envMap;
+layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
+layout(binding = kUnitSpecLightReflFirst + 1) uniform sampler2D reflNormal;
+layout(binding = kUnitSpecLightReflFirst + 2) uniform sampler2D reflAlbedo;
+layout(binding = kUnitSpecLightReflFirst + 3) uniform sampler2D reflEmissive;
+layout(binding = kUnitSpecLightReflFirst + 4) uniform sampler2D reflWeight;
+layout(binding = kUnitSpecLightRefrFirst) uniform sampler2D refrPosition;
+layout(binding = kUnitSpecLightRefrFirst + 1) uniform sampler2D refrNormal;
+layout(binding = kUnitSpecLightRefrFirst + 2) uniform sampler2D refrAlbedo;
+layout(binding = kUnitSpecLightRefrFirst + 3) uniform sampler2D refrEmissive;
+layout(binding = kUnitSpecLightRefrFirst + 4) uniform sampler2D refrWeight;
+layout(binding = kUnitSpecLightShadowAll) uniform sampler2DArray shadowAll;
+layout(binding = kUnitSpecLightShadowReal) uniform sampler2DArray shadowReal;
+layout(binding = kUnitSpecLightIsmAll) uniform usampler2D ismAll;
+layout(binding = kUnitSpecLightIsmReal) uniform usampler2D ismReal;
+layout(binding = kUnitSpecLightPosition) uniform sampler2D gPosition;  // primary G-buffer
+layout(binding = kUnitEnvironmentMap) uniform sampler2D envMap;
 uniform int useVpls;    // 1 when VPLs (and their ISMs) exist this frame
 uniform int vplStride;  // interleaving: pixel p sums VPLs g, g + stride, ... (g from p), x stride
 layout(location = 0) out vec4 outRv;     // L'_rv
@@ -39,7 +39,7 @@ layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r (for 
 layout(location = 3) out vec4 outEnv;    // L_env; a = 1 on specular pixels
 
 float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
-    int tile = flags.z, perRow = flags.w;
+    int tile = ismTileSize, perRow = ismTilesPerRow;
     ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
     ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
     return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
@@ -50,28 +50,28 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
               vec3 emissive, int firstVpl, out vec3 rv, out vec3 r) {
     rv = vec3(0.0);
     r = vec3(0.0);
-    for (int li = 0; li < counts.x; ++li) {
+    for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, x, wi, E);
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, albedo, metallic, roughness) * E;
-        ivec4 sh = lights[li].shadow;
-        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, x, NdotL, sh.z == 1);
+        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, x, NdotL,
+                                    lights[li].realOnlyMap == 1);
         rv += c * vis.x;  // all occluders
-        if (sh.w == 1 && xReal) r += c * vis.y;  // real occluders only
+        if (lights[li].isReal == 1 && xReal) r += c * vis.y;  // real occluders only
     }
-    if (flags.x != 0) {
+    if (envOrigin != 0) {
         vec3 env = albedo * (1.0 - metallic) / PI * shIrradiance(n);
         rv += env;
-        if (flags.x == ORIGIN_REAL && xReal) r += env;
+        if (envOrigin == ORIGIN_REAL && xReal) r += env;
     }
     if (useVpls == 1) {
         vec3 diffuse = albedo * (1.0 - metallic) / PI;
-        float clamp2 = params.x * params.x;
+        float clamp2 = vplDistanceClamp * vplDistanceClamp;
         int stride = max(vplStride, 1);
         vec3 vrv = vec3(0.0), vr = vec3(0.0);
-        for (int i = firstVpl; i < counts.y; i += stride) {
+        for (int i = firstVpl; i < vplCount; i += stride) {
             GpuVpl V = vpls[i];
             if (V.normal.w < 0.5) continue;
             vec3 d = x - V.positionReal.xyz;

@@ -1,14 +1,16 @@
 #include "render/passes/vpl/VplPass.h"
 
-#include "render/Shaders.h"
-#include "render/passes/shadow/ShadowPass.h"
-
+#include "render/FrameGraph.h"
 namespace mirage::render {
 
-VplPass::VplPass(const ShadowPass& shadow)
-    : shadow_(shadow),
-      program_("vpl", {{GL_COMPUTE_SHADER, "passes/vpl/vpl.comp",
-                        shaders::source("passes/vpl/vpl.comp")}}) {}
+VplPass::VplPass() : program_(computeProgram("vpl", "passes/vpl/vpl.comp")) {}
+
+void VplPass::setup(PassBuilder& b) const {
+    b.read(Resource::RsmFlux);
+    b.read(Resource::RsmNormal);
+    b.read(Resource::RsmPosition);
+    b.writeBuffer(Resource::Vpls, SizeRule::Vpl);
+}
 
 PassDecision VplPass::decide(const FrameContext& ctx) const {
     return {ctx.plan.needVpls, ctx.plan.vplReason};
@@ -21,13 +23,13 @@ void VplPass::resize(const FrameContext& ctx) {
     allocated_ = n;
 }
 
-void VplPass::execute(FrameContext& ctx) {
+void VplPass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.id());
-    glBindTextureUnit(0, shadow_.rsmFlux().id());
-    glBindTextureUnit(1, shadow_.rsmNormal().id());
-    glBindTextureUnit(2, shadow_.rsmPosition().id());
+    glBindTextureUnit(kUnitVplRsmFlux, res.texture(Resource::RsmFlux).id());
+    glBindTextureUnit(kUnitVplRsmNormal, res.texture(Resource::RsmNormal).id());
+    glBindTextureUnit(kUnitVplRsmPosition, res.texture(Resource::RsmPosition).id());
     glm::ivec4 ranges[kMaxLights] = {};
     for (size_t i = 0; i < ctx.plan.lights.size(); ++i) {
         const LightPlan& lp = ctx.plan.lights[i];
@@ -36,11 +38,7 @@ void VplPass::execute(FrameContext& ctx) {
     glUniform4iv(program_.uniformLocation("lightVplFirst"), kMaxLights, &ranges[0][0]);
     glDispatchCompute(GLuint((ctx.options.vplCount + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    publishCached(ctx);
-}
-
-void VplPass::publishCached(FrameContext& ctx) {
-    ctx.publish(Resource::Vpls, nullptr);
+    res.publish(Resource::Vpls, vpls_);
 }
 
 }  // namespace mirage::render

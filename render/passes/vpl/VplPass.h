@@ -4,23 +4,17 @@
 
 namespace mirage::render {
 
-class ShadowPass;
-
 class VplPass final : public RenderPass {
 public:
-    explicit VplPass(const ShadowPass& shadow);
+    VplPass();
     const char* name() const override { return "vpl"; }
-    std::vector<Resource> reads() const override { return {Resource::ReflectiveShadowMaps}; }
-    std::vector<Resource> writes() const override { return {Resource::Vpls}; }
+    void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
     void resize(const FrameContext& ctx) override;
-    void execute(FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
     bool cameraIndependent() const override { return true; }
-    void publishCached(FrameContext& ctx) override;
-    const gl::Buffer& vplBuffer() const { return vpls_; }
 
 private:
-    const ShadowPass& shadow_;
     gl::Program program_;
     gl::Buffer vpls_;
     int allocated_ = 0;

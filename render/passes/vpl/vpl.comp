@@ -6,10 +6,10 @@
 // scene has no VPL flicker). A VPL's flux is the RSM's reflected intensity times the solid angle
 // its sample stands for.
 layout(local_size_x = 64) in;
-layout(std430, binding = 2) writeonly buffer Vpls { GpuVpl vpls[]; };
-layout(binding = 0) uniform sampler2DArray rsmFlux;      // rgb W/sr * albedo, a = real
-layout(binding = 1) uniform sampler2DArray rsmNormal;
-layout(binding = 2) uniform sampler2DArray rsmPosition;  // xyz world, w = 1 where covered
+layout(std430, binding = kBindingVpls) writeonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = kUnitVplRsmFlux) uniform sampler2DArray rsmFlux;      // rgb W/sr * albedo, a = real
+layout(binding = kUnitVplRsmNormal) uniform sampler2DArray rsmNormal;
+layout(binding = kUnitVplRsmPosition) uniform sampler2DArray rsmPosition;  // xyz world, w = 1 where covered
 uniform ivec4 lightVplFirst[MAX_LIGHTS];  // x = first VPL, y = count, z = 1 if the light has an RSM
 
 float radicalInverse2(uint bits) {
@@ -23,25 +23,24 @@ float radicalInverse2(uint bits) {
 
 void main() {
     int id = int(gl_GlobalInvocationID.x);
-    if (id >= counts.y) return;
+    if (id >= vplCount) return;
     GpuVpl v;
     v.positionReal = vec4(0.0);
     v.normal = vec4(0.0, 1.0, 0.0, 0.0);  // w = 0: unused slot
     v.flux = vec4(0.0);
     v.tangent = vec4(1.0, 0.0, 0.0, 0.0);
-    for (int li = 0; li < counts.x; ++li) {
+    for (int li = 0; li < lightCount; ++li) {
         ivec4 r = lightVplFirst[li];
         if (r.z == 0 || id < r.x || id >= r.x + r.y) continue;
-        ivec4 sh = lights[li].shadow;
         int type = int(lights[li].directionType.w);
         int local = id - r.x;
-        int layers = max(sh.y, 1);
+        int layers = max(lights[li].shadowLayers, 1);
         int layer = local % layers;
         int perLayer = max(r.y / layers, 1);
         int k = local / layers;
         if (k >= perLayer) break;  // remainder of a count not divisible by the layers
         vec2 uv = vec2((float(k) + 0.5) / float(perLayer), radicalInverse2(uint(k)));
-        vec3 tc = vec3(uv, float(sh.x + layer));
+        vec3 tc = vec3(uv, float(lights[li].firstShadowLayer + layer));
         vec4 pos = textureLod(rsmPosition, tc, 0.0);
         if (pos.w < 0.5) break;  // the sample sees no geometry
         vec4 flux = textureLod(rsmFlux, tc, 0.0);
@@ -51,7 +50,7 @@ void main() {
         float weight = type == LIGHT_DIRECTIONAL
                            ? cell
                            : cell / pow(1.0 + t * t * dot(ndc, ndc), 1.5);
-        v.positionReal = vec4(pos.xyz, (sh.w == 1 && flux.a > 0.5) ? 1.0 : 0.0);
+        v.positionReal = vec4(pos.xyz, (lights[li].isReal == 1 && flux.a > 0.5) ? 1.0 : 0.0);
         v.normal = vec4(normalize(textureLod(rsmNormal, tc, 0.0).xyz), 1.0);
         v.flux = vec4(flux.rgb * weight, 0.0);
         vec3 n = v.normal.xyz;

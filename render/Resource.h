@@ -1,0 +1,90 @@
+#pragma once
+// The named resources of a frame (render/FrameGraph.h): every texture and buffer one pass hands
+// to another, each attachment on its own. Buffers named *Rv / *R hold linear HDR radiance
+// (RGBA16F, rgb used) for L_rv (real + virtual) and L_r (real only).
+#include <epoxy/gl.h>
+
+namespace mirage::render {
+
+enum class Resource {
+    // Imported from outside the frame.
+    CameraImage,     // the camera frame, sRGB8 texture sampled as linear (camera image size)
+    EnvironmentMap,  // the scene's equirectangular environment map, linear (1x1 black: none)
+    // Primary G-buffer (canvas size).
+    GBufferPosition,  // xyz world (m), w = origin (ORIGIN_REAL / ORIGIN_VIRTUAL, 0 = empty)
+    GBufferNormal,    // xyz unit world normal, w = roughness
+    GBufferAlbedo,    // rgb linear base colour, a = metallic
+    GBufferEmissive,  // rgb linear emitted radiance, a = specular slot + 1 (0 = not specular)
+    // Per light layer (shadow atlas: shadowMapSize^2 x layers).
+    ShadowMaps,               // distance to the nearest occluder (m), all geometry
+    ShadowMapsReal,           // the same with real occluders only (aliases ShadowMaps where equal)
+    RsmFlux,                  // reflective shadow map: rgb reflected intensity, a = real
+    RsmNormal,                // xyz normal facing the light
+    RsmPosition,              // xyz world (m), w = 1 where covered
+    Vpls,                     // SSBO of GpuVpl (vplCount entries)
+    ImperfectShadowMaps,      // r32ui atlas, one paraboloid tile per VPL (all occluders)
+    ImperfectShadowMapsReal,  // the same with real points only (aliases the first without them)
+    DirectRv,                 // direct + environment + emission (canvas size)
+    DirectR,
+    IndirectRv,  // interleaved VPL gather, deinterleaved and unfiltered (gather size)
+    IndirectR,
+    GiHistoryRv,  // filtered indirect light at gather resolution, a = camera distance (m); kept
+    GiHistoryR,   // by gifilter as the next frame's temporal history (persistent)
+    LRv,          // the two GI solutions: direct + filtered, upsampled indirect (canvas size)
+    LR,
+    // Reflected-scene impostors of the specular objects' surroundings (persistent: built once
+    // per scene; render/passes/impostor/trace.glsl reads them).
+    ImpostorCubePosition,  // G-buffer cube maps, 12 layers per specular object
+    ImpostorCubeNormal,
+    ImpostorCubeAlbedo,
+    ImpostorCubeEmissive,
+    ImpostorDepth,  // depth impostors, one layer each
+    ImpostorNormal,
+    ImpostorAlbedo,
+    ImpostorEmissive,
+    ImpostorRecords,  // SSBO of GpuImpostor
+    ImpostorObjects,  // SSBO: header + GpuImpostorObject per specular object
+    // Specular objects (Knecht 2013 Sec. 4.1 / 5.1; docs/specular.md), canvas size.
+    BackFacePosition,    // specular objects' back faces: xyz world, w = slot + 1
+    BackFaceNormal,      // xyz outward unit normal
+    RealSurfaces,        // nearest REAL surface per pixel: xyz world, w = origin
+    ReflectionGBuffer,   // GBuf_refl: reflected-ray hit position + origin (or the ray on a miss)
+    ReflectionNormal,    // xyz normal, w = roughness
+    ReflectionAlbedo,    // rgb base colour, a = metallic
+    ReflectionEmissive,  // rgb emission, a = specular-pixel flag
+    ReflectionWeight,    // rgb Fresnel weight, a = distance inside
+    RefractionGBuffer,   // GBuf_refr: two-interface refracted-ray hits (Wyman 2005), as above
+    RefractionNormal,
+    RefractionAlbedo,
+    RefractionEmissive,
+    RefractionWeight,
+    SpecularRv,           // L'_rv (Eq. 3), Fresnel-weighted
+    SpecularR,            // L'_r (Eq. 4)
+    SpecularRReflection,  // the reflection's share of L'_r
+    Lenv,                 // L_env: environment seen where a ray leaves the modelled scene
+    Composite,            // the output (camera image size): linear RGBA32F, a = coverage
+    CompositeSrgb,        // the same, sRGB8
+    Count
+};
+inline constexpr int kResourceCount = int(Resource::Count);
+
+const char* resourceName(Resource r);
+
+// How a resource's size follows the frame (checked when a pass publishes a texture).
+enum class SizeRule {
+    Canvas,       // the render canvas (CameraProjection::canvasWidth/Height)
+    Camera,       // the camera image
+    Gather,       // canvas / RendererOptions::indirectScale per axis, rounded up
+    GatherTiles,  // Gather rounded up to a multiple of the interleave K (deinterleaved tiles)
+    ShadowAtlas,  // shadowMapSize^2, one layer per shadow layer of the frame plan
+    IsmAtlas,     // tilesPerRow(vplCount) * ismTileSize, square
+    Impostor,     // impostorResolution^2, layers per specular object / impostor
+    Vpl,          // buffer: vplCount entries
+    Scene,        // sized by the scene (imports, impostor tables)
+};
+const char* sizeRuleName(SizeRule s);
+
+// GL internal format as text ("RGBA16F"; buffers: "SSBO").
+const char* formatName(GLenum format);
+
+}  // namespace mirage::render

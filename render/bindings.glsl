@@ -1,0 +1,108 @@
+// Every texture unit, image unit and buffer binding point of the real-time renderer, named once.
+// Valid GLSL and valid C++: shaders use the names in layout(binding = ...) (GLSL 4.40 constant
+// expressions), passes in glBindTextureUnit / glBindImageTexture / glBindBufferBase
+// (render/GpuTypes.h includes this file in namespace mirage::render). A unit's number only has to
+// be unique among what one program samples; passes therefore reuse the low units.
+#ifndef MIRAGE_BINDINGS_GLSL
+#define MIRAGE_BINDINGS_GLSL
+
+// Uniform / storage buffer binding points.
+const int kBindingFrame = 0;          // FrameBlock (std140)
+const int kBindingLights = 1;         // LightBlock (std140)
+const int kBindingVpls = 2;           // GpuVpl[] (std430)
+const int kBindingMaterials = 3;      // GpuMaterial[]
+const int kBindingIsmPoints = 4;      // GpuSurfacePoint[] (ism.comp)
+const int kBindingSpecularDraws = 5;  // GpuSpecularDraw[]
+const int kBindingImpostorRecords = 6;  // GpuImpostor[] (trace.glsl)
+const int kBindingImpostorObjects = 7;  // header + GpuImpostorObject[] (trace.glsl)
+const int kBindingQueryRays = 4;        // query.comp (offline impostor queries, outside frames)
+const int kBindingQueryHits = 5;
+
+// Material textures of scene draws (gbuffer, shadow, impostor capture).
+const int kUnitBaseColorMap = 7;
+
+// direct.frag
+const int kUnitDirectPosition = 0;
+const int kUnitDirectNormal = 1;
+const int kUnitDirectAlbedo = 2;
+const int kUnitDirectEmissive = 3;
+const int kUnitDirectShadowAll = 4;
+const int kUnitDirectShadowReal = 5;
+
+// vpl.comp
+const int kUnitVplRsmFlux = 0;
+const int kUnitVplRsmNormal = 1;
+const int kUnitVplRsmPosition = 2;
+
+// ism.comp (image units)
+const int kImageIsmAll = 0;
+const int kImageIsmReal = 1;
+
+// indirect.frag
+const int kUnitIndirectPosition = 0;
+const int kUnitIndirectNormal = 1;
+const int kUnitIndirectAlbedo = 2;
+const int kUnitIndirectIsmAll = 3;
+const int kUnitIndirectIsmReal = 4;
+
+// gifilter: filter.frag (gather resolution) and upsample.frag (canvas)
+const int kUnitFilterPosition = 0;
+const int kUnitFilterNormal = 1;
+const int kUnitFilterIndirectRv = 2;
+const int kUnitFilterIndirectR = 3;
+const int kUnitFilterHistoryRv = 4;
+const int kUnitFilterHistoryR = 5;
+const int kUnitUpsamplePosition = 0;
+const int kUnitUpsampleNormal = 1;
+const int kUnitUpsampleIndirectRv = 2;
+const int kUnitUpsampleIndirectR = 3;
+const int kUnitUpsampleDirectRv = 4;
+const int kUnitUpsampleDirectR = 5;
+
+// specular_gbuffer.frag
+const int kUnitSpecGbufPosition = 0;
+const int kUnitSpecGbufNormal = 1;
+const int kUnitSpecGbufEmissive = 2;
+const int kUnitSpecGbufBackPosition = 3;
+const int kUnitSpecGbufBackNormal = 4;
+
+// specular_light.frag: GBuf_refl then GBuf_refr (position, normal, albedo, emissive, weight)
+const int kUnitSpecLightReflFirst = 0;  // .. + 4
+const int kUnitSpecLightRefrFirst = 5;  // .. + 4
+const int kUnitSpecLightShadowAll = 10;
+const int kUnitSpecLightShadowReal = 11;
+const int kUnitSpecLightIsmAll = 12;
+const int kUnitSpecLightIsmReal = 13;
+const int kUnitSpecLightPosition = 14;
+const int kUnitEnvironmentMap = 15;
+
+// composite.frag
+const int kUnitCompositeCamera = 0;
+const int kUnitCompositeLRv = 1;
+const int kUnitCompositeLR = 2;
+const int kUnitCompositePosition = 3;
+const int kUnitCompositeRemap = 4;
+const int kUnitCompositeEmissive = 5;
+const int kUnitCompositeReflPosition = 6;
+const int kUnitCompositeRefrPosition = 7;
+const int kUnitCompositeReflWeight = 8;
+const int kUnitCompositeRefrWeight = 9;
+const int kUnitCompositeSpecRv = 10;
+const int kUnitCompositeSpecR = 11;
+const int kUnitCompositeSpecRRefl = 12;
+const int kUnitCompositeLenv = 13;
+const int kUnitCompositeRealSurfaces = 14;
+const int kUnitCompositeCanvasToCamera = 15;
+
+// Reflected-scene impostors (trace.glsl): the ONLY units traceSurroundings() uses, above every
+// pass's own units so a consumer shader can sample both.
+const int kUnitImpostorCubePosition = 16;  // sampler2DArray, RGBA32F
+const int kUnitImpostorCubeNormal = 17;    // sampler2DArray, RGBA16F
+const int kUnitImpostorCubeAlbedo = 18;    // sampler2DArray, RGBA8
+const int kUnitImpostorCubeEmissive = 19;  // sampler2DArray, RGBA16F
+const int kUnitImpostorDepth = 20;         // sampler2DArray, RG32F
+const int kUnitImpostorNormal = 21;        // sampler2DArray, RGBA16F
+const int kUnitImpostorAlbedo = 22;        // sampler2DArray, RGBA8
+const int kUnitImpostorEmissive = 23;      // sampler2DArray, RGBA16F
+
+#endif

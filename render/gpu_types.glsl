@@ -1,0 +1,106 @@
+// The GPU data layout of the real-time renderer, written once: valid GLSL (included by
+// common.glsl) and valid C++ (render/GpuTypes.h includes it in namespace mirage::render with
+// vec4 = glm::vec4 etc. and checks the sizes). std140 uniform blocks, std430 storage buffers; no
+// bool (flags are ints); every field named (no packed vec4 components). Frames: world = glTF
+// (metres, +Y up); camera = OpenCV (+X right, +Y down, +Z forward). Every radiance value is LINEAR
+// RGB (W / (m^2 sr), with the scene's exposure convention that 1.0 is the camera's white).
+#ifndef MIRAGE_GPU_TYPES_GLSL
+#define MIRAGE_GPU_TYPES_GLSL
+
+#include "bindings.glsl"
+
+// A uniform block: in GLSL its members are globals of the shader; in C++ it is a struct.
+#ifdef __cplusplus
+#define MIRAGE_UNIFORM_BLOCK(blockName, structName, bindingPoint) struct alignas(16) structName
+#else
+#define MIRAGE_UNIFORM_BLOCK(blockName, structName, bindingPoint) \
+    layout(std140, binding = bindingPoint) uniform blockName
+#endif
+
+const int kMaxLights = 8;
+const int kLightPoint = 0;
+const int kLightSpot = 1;
+const int kLightDirectional = 2;
+const int kOriginNone = 0;
+const int kOriginReal = 1;
+const int kOriginVirtual = 2;
+
+struct GpuLight {
+    mat4 viewProj[6];       // world -> light clip space, one per shadow layer (spot/dir use [0])
+    vec4 positionRange;     // xyz world position (metres); w = range (0 = infinite)
+    vec4 directionType;     // xyz unit direction the light shines along; w = kLight* type
+    vec4 radiantIntensity;  // rgb = colour * intensity: W/sr (point, spot) or W/m^2 (dir.);
+                            // w = tan(half fov) (spot), 1 (point), ortho half extent (m, dir.)
+    float cosOuter;         // spot cone: cos(outer angle), cos(inner angle), and the falloff
+    float cosInner;         // clamp(cos * coneScale + coneOffset, 0, 1)^2
+    float coneScale;
+    float coneOffset;
+    int firstShadowLayer;  // first layer in the shadow atlases
+    int shadowLayers;      // layer count (0 = no shadow map)
+    int realOnlyMap;       // 1 if the real-only map differs from the all-occluder map
+    int isReal;            // 1 if the light is real
+};
+
+MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
+    mat4 viewMatrix;    // world -> OpenCV camera
+    mat4 projMatrix;    // OpenCV camera -> GL clip (render canvas, undistorted)
+    mat4 viewProj;
+    mat4 prevViewProj;  // last frame's, for temporal reprojection
+    vec4 cameraPos;     // xyz world (metres)
+    vec4 prevCameraPos;  // xyz world (metres)
+    vec4 canvas;         // render canvas width, height, 1/width, 1/height (pixels)
+    int lightCount;
+    int vplCount;
+    int interleave;  // K: the interleaved-sampling tile size
+    int frameIndex;
+    int envOrigin;       // environment light: kOriginNone (off), kOriginReal, kOriginVirtual
+    int historyValid;    // 1 if the GI filter's temporal history may be used
+    int ismTileSize;     // texels per side of one VPL's imperfect shadow map tile
+    int ismTilesPerRow;  // tiles per row of the ISM atlas
+    float vplDistanceClamp;  // metres: VPL distance below this is clamped
+    float shadowBias;        // metres: RendererOptions::shadowBias x 0.1 (lighting.glsl adds the
+                             // texel footprint)
+    float temporalBlend;     // history weight of the VPL lighting (0 = off)
+    float ismPointsPerVpl;
+    vec4 envSH[9];  // environment irradiance SH (rgb), already scaled by intensity
+    float exposure;     // rendered linear radiance -> camera linear units
+    float alphaMax;     // cap of alpha = CI / L_r
+    float alphaFadeLr;  // L_r below which alpha fades to 1
+    float envRotation;  // environment map rotation about +Y (radians)
+};
+
+MIRAGE_UNIFORM_BLOCK(LightBlock, GpuLightBlock, kBindingLights) {
+    GpuLight lights[kMaxLights];
+};
+
+// One virtual point light (std430, kBindingVpls).
+struct GpuVpl {
+    vec4 positionReal;  // xyz world position; w = 1 if light, surface q are real, else 0
+    vec4 normal;        // xyz unit normal at q (facing the light); w = 1 valid, 0 unused slot
+    vec4 flux;          // rgb = reflected power (W) the VPL emits (cosine lobe); w unused
+    vec4 tangent;       // xyz unit tangent; with cross(normal, tangent): the ISM paraboloid frame
+};
+
+// Materials (std430, kBindingMaterials).
+struct GpuMaterial {
+    vec4 baseColor;     // linear RGBA
+    vec4 emissive;      // rgb linear emitted radiance; w = roughness
+    vec4 params;        // x = metallic
+    vec4 transmission;  // x = transmission (0..1), y = ior, z = attenuation distance (m, 0 =
+                        // none), w = thickness (mesh units, informational)
+    vec4 attenuation;   // rgb = linear attenuation colour (Beer-Lambert), a = 1 for a mirror
+};
+
+// Specular draw table (std430, kBindingSpecularDraws), indexed by specular slot (GpuScene::
+// specularDraws() order). The G-buffer stores slot + 1 in gEmissive.a (0 = not specular).
+struct GpuSpecularDraw {
+    ivec4 info;   // x = material index, y = kOriginReal / kOriginVirtual, z = draw index
+    vec4 bounds;  // world bounding sphere: xyz centre, w radius (metres)
+};
+
+// A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).
+struct GpuSurfacePoint {
+    vec4 positionReal;  // xyz world (metres); w = 1 if the geometry is real, 0 if virtual
+};
+
+#endif
