@@ -15,7 +15,7 @@
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
-#include "tests/render/RenderTestScenes.h"
+#include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
 namespace {
