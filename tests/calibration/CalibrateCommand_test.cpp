@@ -99,9 +99,28 @@ TEST(CalibrateCommand, BatchFromVideo) {
                          "chessboard:9x6:0.025", "-o", out.string(), "--video-step", "2"});
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("board.avi#14"), std::string::npos) << r.output;
+    // Progress while a video is read (there was none).
+    EXPECT_NE(r.output.find("5 frame(s) read"), std::string::npos) << r.output;
     const auto cal = loadCalibration(out);
     EXPECT_EQ(cal.viewCount, 8);
     EXPECT_NEAR(cal.intrinsics.fx, camera().fx, 0.01 * camera().fx);
+}
+
+TEST(CalibrateCommand, TruncatedImageIsRefusedNotTakenAsAView) {
+    // libpng returns the rows of a cut PNG and fills the rest: a view with half a board.
+    const auto dir = test::outputDir("calibrate_truncated");
+    const auto images = dir / "images";
+    fs::create_directories(images);
+    writeViews(images, tiltedPoses(10));
+    const auto cut = images / "view_05.png";
+    fs::resize_file(cut, fs::file_size(cut) * 2 / 3);
+    const auto out = dir / "cam.yaml";
+    const auto r = test::runMirage({"calibrate", "--batch", images.string(), "--board",
+                                    "chessboard:9x6:0.025", "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("view_05.png"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("truncated"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(CalibrateCommand, FrontoParallelViewsGiveAnUnreliableFileNotAConfidentOne) {
