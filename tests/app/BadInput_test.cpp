@@ -181,6 +181,18 @@ TEST(BadInput, RenderChecksInputsAndOutputFolderBeforeRendering) {
     EXPECT_FALSE(has(r, "rendering")) << r.output;
 }
 
+TEST(BadInput, AnImageGivenAsSceneSaysWhatItIs) {
+    const fs::path dir = outputDir("bad_png_scene");
+    const std::string png = (testDataDir() / "scenes/good/mr.png").string();
+    auto r = runMirage({"render", png, "--camera", "MainCamera", "-o", (dir / "x.png").string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_TRUE(has(r, "not a glTF scene (it is a PNG image)")) << r.output;
+    EXPECT_FALSE(has(r, "nesting")) << r.output;
+    r = runMirage({"replay", sample().string(), "--scene", png, "-o", (dir / "r.mkv").string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_TRUE(has(r, "PNG image")) << r.output;
+}
+
 TEST(BadInput, TrackPrintsTheSessionReadersWarnings) {
     const fs::path s = copySample("bad_track_warnings");
     fs::remove(s / "frames.csv");
