@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "core/session/AtomicFile.h"
+#include "core/session/MatroskaScanner.h"
 #include "tests/support/TestSupport.h"
 
 extern char** environ;
@@ -289,6 +290,34 @@ TEST(BadInput, InterruptedTrackLeavesAConsistentCsvAndExitsNonZero) {
         EXPECT_EQ(line.rfind("frame,t,state", 0), 0u);
         EXPECT_FALSE(fs::exists(temp));
     }
+}
+
+TEST(BadInput, InterruptedReplayKeepsAPlayableVideoAndExitsNonZero) {
+    const fs::path dir = outputDir("bad_replay_signal");
+    const fs::path out = dir / "out.mkv";
+    const pid_t pid = spawnMirage({"replay", sample().string(), "--scene", scene(), "-o",
+                                   out.string(), "--ground-truth", "--vpls", "16"},
+                                  dir / "log.txt");
+    fs::path temp;
+    for (int k = 0; k < 3000 && temp.empty(); ++k) {
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().extension() == ".csv" &&
+                e.path().filename().string().find(".partial-") != std::string::npos &&
+                countLines(e.path()) > 2)
+                temp = e.path();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_FALSE(temp.empty()) << "replay never wrote a frame: " << readFileBytes(dir / "log.txt");
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << readFileBytes(dir / "log.txt");
+    const MatroskaScan scan = scanMatroska(out);
+    EXPECT_FALSE(scan.truncated);
+    EXPECT_GE(scan.completeFrames, 2);
+    EXPECT_EQ(countLines(dir / "out.csv"), scan.completeFrames + 1);
+    EXPECT_FALSE(fs::exists(temp));
 }
 
 }  // namespace
