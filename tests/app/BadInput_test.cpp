@@ -320,5 +320,37 @@ TEST(BadInput, InterruptedReplayKeepsAPlayableVideoAndExitsNonZero) {
     EXPECT_FALSE(fs::exists(temp));
 }
 
+TEST(BadInput, StoppedSynthLeavesNoHalfSessionInTheWay) {
+    const fs::path dir = outputDir("bad_synth_stopped");
+    const fs::path out = dir / "session";
+    const std::vector<std::string> args = {"synth",    scene(),    "-o", out.string(), "--width",
+                                           "64",       "--height", "48", "--spp",      "1",
+                                           "--no-env", "--fps",    "4"};
+    auto longRun = args;
+    longRun.insert(longRun.end(), {"--seconds", "30"});
+    const pid_t pid = spawnMirage(longRun, dir / "log.txt");
+    // Wait until frames are being written (into a temporary folder beside OUT), then stop it.
+    bool writing = false;
+    for (int k = 0; k < 3000 && !writing; ++k) {
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().filename().string().find("session.partial-") == 0 &&
+                fs::exists(e.path() / "frames.csv") && countLines(e.path() / "frames.csv") > 2)
+                writing = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_TRUE(writing) << readFileBytes(dir / "log.txt");
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    EXPECT_FALSE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    EXPECT_FALSE(fs::exists(out)) << "a half-written session was left at the output";
+    // The rerun is not blocked.
+    auto shortRun = args;
+    shortRun.insert(shortRun.end(), {"--seconds", "1"});
+    const auto r = runMirage(shortRun);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out / "session.json"));
+}
+
 }  // namespace
 }  // namespace mirage::test
