@@ -29,6 +29,10 @@ BatchResult runBatchCalibration(const std::vector<std::string>& inputs,
                 size.height));
         }
         auto d = target.detect(frame.bgr, frame.name);
+        // Video input can take minutes: say how far it got.
+        if (r.framesRead % 5 == 0)
+            spdlog::info("calibrate: {} frame(s) read, the board found in {} (last: {})",
+                         r.framesRead, views.size() + (d.found ? 1 : 0), frame.name);
         if (d.found) {
             spdlog::debug("{}: {} corners", frame.name, d.view.imagePoints.size());
             views.push_back(std::move(d.view));

@@ -9,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/Error.h"
+#include "core/image/StrictJpeg.h"
 
 namespace mirage::calib {
 namespace fs = std::filesystem;
@@ -38,10 +39,10 @@ public:
             const Item& item = items_[index_];
             if (!item.video) {
                 ++index_;
-                cv::Mat img = cv::imread(item.path.string(), cv::IMREAD_COLOR);
+                std::string why;
+                cv::Mat img = readImageStrict(item.path, &why);
                 if (img.empty())
-                    throw FileError(item.path.string(),
-                                    "cannot be read as an image (corrupt or unsupported format)");
+                    throw FileError(item.path.string(), "cannot be read as an image: " + why);
                 frame.bgr = img;
                 frame.name = item.path.filename().string();
                 frame.timeSeconds = double(imageCount_++) / 30.0;

@@ -21,6 +21,7 @@
 #include <fmt/format.h>
 
 #include "app/Command.h"
+#include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
@@ -132,6 +133,7 @@ void runBench(const BenchArgs& a) {
     OutputFile csvOut(out / "bench.csv", OutputOrigin::Derived, rule);
     OutputFile framesOut(out / "bench_frames.csv", OutputOrigin::Derived, rule);
     OutputFile mdOut(out / "bench.md", OutputOrigin::Derived, rule);
+    checkLooksLikeGltf(scenePath);
     const Scene scene = loadScene(scenePath);
     if (!scene.hasVirtual())
         throw FileError(scenePath, "the scene has no virtual object: nothing to judge");

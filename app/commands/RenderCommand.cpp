@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "app/Command.h"
+#include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
@@ -59,6 +60,7 @@ void run(const RenderArgs& a) {
     cv::Mat cameraImage;
     if (!a.cameraImage.empty()) cameraImage = readLinearRgb(a.cameraImage);
 
+    checkLooksLikeGltf(a.scene);
     Scene scene = loadScene(a.scene);
     int height = a.height;
     if (height == 0) {

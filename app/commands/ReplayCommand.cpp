@@ -28,6 +28,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/Command.h"
+#include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "core/Csv.h"
 #include "core/Error.h"
@@ -130,6 +131,7 @@ void runReplay(const ReplayArgs& a) {
                                        "' has no calibration file; calibrate it (mirage calibrate) "
                                        "and name the YAML in session.json");
     const CameraCalibration calib = loadCalibration(session.path(main->calibration));
+    checkLooksLikeGltf(a.scene);
     Scene scene = loadScene(a.scene);
     if (!scene.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);

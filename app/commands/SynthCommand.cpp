@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "app/Command.h"
+#include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
@@ -54,6 +55,7 @@ void run(SynthArgs a) {
                         "exists and is not empty; choose another folder or pass --force to "
                         "replace it");
     }
+    checkLooksLikeGltf(a.scene);
     Scene scene = loadScene(a.scene);
     fs::path boardPath =
         a.board.empty() ? fs::path(a.scene).parent_path() / "board.json" : fs::path(a.board);

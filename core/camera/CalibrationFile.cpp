@@ -112,6 +112,11 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
                 cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     } catch (const cv::Exception& e) {
         throw FileError(file, std::string("not a valid OpenCV YAML file: ") + e.err);
+    } catch (const std::exception& e) {
+        // OpenCV's YAML parser throws std::length_error on some damaged files (found by
+        // calibration_fuzz); still bad input, not a bug of mirage.
+        throw FileError(file, std::string("not a valid OpenCV YAML file (the parser failed: ") +
+                                  e.what() + ")");
     }
     if (!fs.isOpened()) throw FileError(file, "not a valid OpenCV YAML file");
     Reader r{file, fs.root()};

@@ -2,6 +2,12 @@
 
 #include <csetjmp>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <jpeglib.h>
 
@@ -76,6 +82,34 @@ cv::Mat decodeJpegStrict(const uint8_t* data, size_t size, std::string* problem)
         return {};
     }
     return out;
+}
+
+cv::Mat readImageStrict(const std::filesystem::path& path, std::string* problem) {
+    auto fail = [&](const std::string& why) {
+        if (problem) *problem = why;
+        return cv::Mat();
+    };
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return fail("cannot open the file");
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto data = [&] { return reinterpret_cast<const uint8_t*>(bytes.data()); };
+    if (bytes.size() >= 3 && std::memcmp(bytes.data(), "\xFF\xD8\xFF", 3) == 0)
+        return decodeJpegStrict(data(), bytes.size(), problem);
+    static const char kPngMagic[] = "\x89PNG\r\n\x1a\n";
+    if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngMagic, 8) == 0) {
+        // The IEND chunk: zero length, type, CRC (bytes after it are tolerated).
+        const size_t iend = bytes.rfind(std::string("\0\0\0\0IEND", 8));
+        if (iend == std::string::npos || iend < 8 || iend + 12 > bytes.size())
+            return fail("truncated PNG (no IEND chunk at its end; cut short?)");
+    }
+    cv::Mat img;
+    try {
+        img = cv::imdecode(std::vector<uint8_t>(bytes.begin(), bytes.end()), cv::IMREAD_COLOR);
+    } catch (const cv::Exception& e) {
+        return fail(std::string("cannot decode the image: ") + e.err);
+    }
+    if (img.empty()) return fail("cannot decode the image (corrupt or unsupported format)");
+    return img;
 }
 
 }  // namespace mirage

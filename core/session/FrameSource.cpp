@@ -8,6 +8,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/Error.h"
+#include "core/image/StrictJpeg.h"
 #include "core/session/FrameInventory.h"
 #include "core/session/MatroskaFrames.h"
 #include "core/session/MatroskaScanner.h"
@@ -56,8 +57,9 @@ cv::VideoCapture openVideo(const std::filesystem::path& path) {
 
 // Reads one image file as 8-bit BGR; throws FileError if it is unreadable.
 cv::Mat readImageFile(const std::filesystem::path& p) {
-    cv::Mat img = cv::imread(p.string(), cv::IMREAD_COLOR);
-    if (img.empty()) throw FileError(p.string(), "cannot decode image (corrupt or cut short?)");
+    std::string why;
+    cv::Mat img = readImageStrict(p, &why);
+    if (img.empty()) throw FileError(p.string(), "cannot decode image: " + why);
     return img;
 }
 

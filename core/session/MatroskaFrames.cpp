@@ -23,6 +23,16 @@ int MatroskaFrames::count() const {
     return scan_.blocks.empty() ? 0 : scan_.blocks.back().position + 1;
 }
 
+bool MatroskaFrames::clusterChecksumMatches(const MatroskaBlock& b) {
+    if (b.crcEnd <= b.crcBegin || b.crcEnd - b.crcBegin > (uint64_t(1) << 30)) return false;
+    std::vector<uint8_t> covered(size_t(b.crcEnd - b.crcBegin));
+    in_.clear();
+    in_.seekg(std::streamoff(b.crcBegin));
+    in_.read(reinterpret_cast<char*>(covered.data()), std::streamsize(covered.size()));
+    return uint64_t(in_.gcount()) == covered.size() &&
+           crc32Ieee(covered.data(), covered.size()) == b.crc;
+}
+
 MatroskaFrames::Frame MatroskaFrames::frame(int position) {
     Frame f;
     while (next_ < scan_.blocks.size() && scan_.blocks[next_].position < position) ++next_;
@@ -60,6 +70,11 @@ MatroskaFrames::Frame MatroskaFrames::frame(int position) {
     in_.read(reinterpret_cast<char*>(bytes_.data()), std::streamsize(b.size));
     if (uint64_t(in_.gcount()) != b.size) {
         f.problem = "frame " + std::to_string(position) + " lost: cannot read its bytes";
+        return f;
+    }
+    if (b.hasCrc && !clusterChecksumMatches(b)) {
+        f.problem = "frame " + std::to_string(position) +
+                    " lost: the checksum of its cluster does not match (damaged bytes)";
         return f;
     }
     std::string why;

@@ -2,8 +2,10 @@
 // Frames of a Matroska MJPEG video (what mirage records), read by their byte ranges from the
 // scanner (MatroskaScanner.h) and decoded strictly (core/image/StrictJpeg.h): a frame is either
 // exactly the image that was written or reported lost with the reason, never a concealed or
-// stale image. Damaged container bytes cost only the frames inside them: reading resumes at the
-// next cluster with the frame numbers kept (by the block times).
+// stale image. When the cluster carries a CRC-32 (mirage writes one per cluster), any damaged
+// byte is found, even one that leaves a valid JPEG. Damaged container bytes cost only the frames
+// inside them: reading resumes at the next cluster with the frame numbers kept (by the block
+// times).
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -36,6 +38,8 @@ public:
     Frame frame(int position);
 
 private:
+    bool clusterChecksumMatches(const MatroskaBlock& b);
+
     std::filesystem::path path_;
     MatroskaScan scan_;
     std::ifstream in_;

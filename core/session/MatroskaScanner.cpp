@@ -1,6 +1,7 @@
 #include "core/session/MatroskaScanner.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -127,7 +128,8 @@ private:
     uint64_t fileSize_;
 };
 
-// The first Cluster at or after `from` whose header parses and whose first child is a Timestamp:
+// The first Cluster at or after `from` whose header parses and whose first child is a Timestamp
+// or a CRC-32:
 // where reading resumes after damaged bytes.
 std::optional<uint64_t> nextCluster(Cursor& c, uint64_t from, uint64_t limit) {
     constexpr uint64_t kChunk = 1 << 16;
@@ -143,6 +145,7 @@ std::optional<uint64_t> nextCluster(Cursor& c, uint64_t from, uint64_t limit) {
             const auto first = c.header(e->dataStart);
             if (first && first->id == kClusterTimestamp && first->size >= 1 && first->size <= 8)
                 return pos + i;
+            if (first && first->id == 0xBF /*CRC-32*/ && first->size == 4) return pos + i;
         }
     }
     return std::nullopt;
@@ -183,6 +186,21 @@ void assignPositions(MatroskaScan& r) {
 }
 
 }  // namespace
+
+uint32_t crc32Ieee(const uint8_t* data, size_t size) {
+    static const auto table = [] {
+        std::array<uint32_t, 256> t{};
+        for (uint32_t i = 0; i < 256; ++i) {
+            uint32_t c = i;
+            for (int k = 0; k < 8; ++k) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+            t[i] = c;
+        }
+        return t;
+    }();
+    uint32_t c = 0xFFFFFFFFu;
+    for (size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFF] ^ (c >> 8);
+    return c ^ 0xFFFFFFFFu;
+}
 
 MatroskaScan scanMatroska(const std::filesystem::path& path) {
     std::error_code ec;
@@ -330,6 +348,9 @@ MatroskaScan scanMatroska(std::istream& in, uint64_t fileSize, const std::string
             const uint64_t clusterEnd = e->end(segEnd);
             uint64_t q = e->dataStart;
             bool damaged = false;
+            std::optional<uint32_t> clusterCrc;
+            std::pair<uint64_t, uint64_t> crcRange{0, 0};
+            const size_t firstBlock = r.blocks.size();
             while (q < std::min(clusterEnd, segEnd)) {
                 const auto b = c.header(q);
                 if (!b) {
@@ -359,6 +380,15 @@ MatroskaScan scanMatroska(std::istream& in, uint64_t fileSize, const std::string
                     break;
                 }
                 if (b->id == kClusterTimestamp) clusterTicks = c.readUint(*b);
+                // A CRC-32 first in a cluster of known size covers the rest of the cluster.
+                if (b->id == 0xBF && q == e->dataStart && b->size == 4 && e->size != kUnknown) {
+                    uint8_t v[4];
+                    if (c.read(b->dataStart, v, 4)) {
+                        clusterCrc = uint32_t(v[0]) | uint32_t(v[1]) << 8 | uint32_t(v[2]) << 16 |
+                                     uint32_t(v[3]) << 24;
+                        crcRange = {b->end(segEnd), clusterEnd};
+                    }
+                }
                 const Element* blockElement = nullptr;
                 std::optional<Element> inner;
                 if (b->id == kSimpleBlock) blockElement = &*b;
@@ -386,6 +416,13 @@ MatroskaScan scanMatroska(std::istream& in, uint64_t fileSize, const std::string
                 }
                 q = b->end(segEnd);
             }
+            if (clusterCrc)
+                for (size_t k = firstBlock; k < r.blocks.size(); ++k) {
+                    r.blocks[k].hasCrc = true;
+                    r.blocks[k].crc = *clusterCrc;
+                    r.blocks[k].crcBegin = crcRange.first;
+                    r.blocks[k].crcEnd = crcRange.second;
+                }
             if (damaged) {
                 if (!resync(q, "damaged cluster")) break;
                 continue;

@@ -21,7 +21,12 @@ struct MatroskaBlock {
     int position = 0;               // frame number in the video, counting frames lost to damage
     bool laced = false;             // several frames in one block (not written by mirage)
     bool afterGap = false;          // follows damaged bytes that were skipped
-    std::string damaged;            // set when the block is known to be damaged
+    // The cluster's CRC-32 element (mirage writes one per cluster): the checksum and the bytes
+    // it covers (the rest of the cluster), when present.
+    bool hasCrc = false;
+    uint32_t crc = 0;
+    uint64_t crcBegin = 0, crcEnd = 0;
+    std::string damaged;  // set when the block is known to be damaged
 };
 
 // Bytes the scanner could not parse and skipped, resuming at the next Cluster.
@@ -41,6 +46,9 @@ struct MatroskaScan {
     std::vector<MatroskaBlock> blocks;  // the video track's frames, in file order
     std::vector<MatroskaGap> gaps;      // damaged stretches skipped (resynchronised)
 };
+
+// CRC-32 as Matroska's CRC-32 element uses it (IEEE 802.3, as zlib's crc32).
+uint32_t crc32Ieee(const uint8_t* data, size_t size);
 
 // Throws FileError if the file cannot be opened or is not Matroska at all (no EBML header with
 // DocType matroska/webm). Damage after the header is reported in the result, not thrown.

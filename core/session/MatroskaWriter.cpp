@@ -1,4 +1,5 @@
 #include "core/session/MatroskaWriter.h"
+#include "core/session/MatroskaScanner.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -26,7 +27,7 @@ constexpr uint32_t kTracks = 0x1654AE6B, kTrackEntry = 0xAE, kTrackNumber = 0xD7
                    kTrackUid = 0x73C5, kTrackType = 0x83, kFlagLacing = 0x9C, kCodecId = 0x86,
                    kDefaultDuration = 0x23E383, kVideo = 0xE0, kPixelWidth = 0xB0,
                    kPixelHeight = 0xBA;
-constexpr uint32_t kCluster = 0x1F43B675, kTimestamp = 0xE7, kSimpleBlock = 0xA3;
+constexpr uint32_t kCluster = 0x1F43B675, kTimestamp = 0xE7, kSimpleBlock = 0xA3, kCrc32 = 0xBF;
 
 constexpr uint64_t kTimestampScaleNs = 1000000;  // 1 tick = 1 ms
 
@@ -188,8 +189,15 @@ void MatroskaWriter::appendJpeg(const std::vector<uint8_t>& jpeg, int width, int
     // (0x80 = keyframe: every JPEG is), then the frame bytes.
     std::string block = std::string("\x81\x00\x00\x80", 4);
     block.append(reinterpret_cast<const char*>(jpeg.data()), jpeg.size());
-    const std::string cluster =
-        element(kCluster, uintElement(kTimestamp, uint64_t(ms)) + element(kSimpleBlock, block));
+    // A CRC-32 element first in the cluster covers the rest of it: any damaged byte of the frame
+    // is detected when it is read (JPEG decoding alone cannot see a changed coefficient value).
+    const std::string payload =
+        uintElement(kTimestamp, uint64_t(ms)) + element(kSimpleBlock, block);
+    const uint32_t crc =
+        crc32Ieee(reinterpret_cast<const uint8_t*>(payload.data()), payload.size());
+    std::string crcBytes(4, '\0');
+    for (int i = 0; i < 4; ++i) crcBytes[size_t(i)] = char((crc >> (8 * i)) & 0xFF);
+    const std::string cluster = element(kCluster, element(kCrc32, crcBytes) + payload);
     writeAll(cluster);
     if (fsyncEachFrame && ::fsync(fd_) != 0)
         throw FileError(path_.string(), std::string("fsync failed: ") + std::strerror(errno));

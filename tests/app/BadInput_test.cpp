@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "core/session/AtomicFile.h"
+#include "core/session/MatroskaScanner.h"
 #include "tests/support/TestSupport.h"
 
 extern char** environ;
@@ -181,6 +182,18 @@ TEST(BadInput, RenderChecksInputsAndOutputFolderBeforeRendering) {
     EXPECT_FALSE(has(r, "rendering")) << r.output;
 }
 
+TEST(BadInput, AnImageGivenAsSceneSaysWhatItIs) {
+    const fs::path dir = outputDir("bad_png_scene");
+    const std::string png = (testDataDir() / "scenes/good/mr.png").string();
+    auto r = runMirage({"render", png, "--camera", "MainCamera", "-o", (dir / "x.png").string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_TRUE(has(r, "not a glTF scene (it is a PNG image)")) << r.output;
+    EXPECT_FALSE(has(r, "nesting")) << r.output;
+    r = runMirage({"replay", sample().string(), "--scene", png, "-o", (dir / "r.mkv").string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_TRUE(has(r, "PNG image")) << r.output;
+}
+
 TEST(BadInput, TrackPrintsTheSessionReadersWarnings) {
     const fs::path s = copySample("bad_track_warnings");
     fs::remove(s / "frames.csv");
@@ -277,6 +290,66 @@ TEST(BadInput, InterruptedTrackLeavesAConsistentCsvAndExitsNonZero) {
         EXPECT_EQ(line.rfind("frame,t,state", 0), 0u);
         EXPECT_FALSE(fs::exists(temp));
     }
+}
+
+TEST(BadInput, InterruptedReplayKeepsAPlayableVideoAndExitsNonZero) {
+    const fs::path dir = outputDir("bad_replay_signal");
+    const fs::path out = dir / "out.mkv";
+    const pid_t pid = spawnMirage({"replay", sample().string(), "--scene", scene(), "-o",
+                                   out.string(), "--ground-truth", "--vpls", "16"},
+                                  dir / "log.txt");
+    fs::path temp;
+    for (int k = 0; k < 3000 && temp.empty(); ++k) {
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().extension() == ".csv" &&
+                e.path().filename().string().find(".partial-") != std::string::npos &&
+                countLines(e.path()) > 2)
+                temp = e.path();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_FALSE(temp.empty()) << "replay never wrote a frame: " << readFileBytes(dir / "log.txt");
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << readFileBytes(dir / "log.txt");
+    const MatroskaScan scan = scanMatroska(out);
+    EXPECT_FALSE(scan.truncated);
+    EXPECT_GE(scan.completeFrames, 2);
+    EXPECT_EQ(countLines(dir / "out.csv"), scan.completeFrames + 1);
+    EXPECT_FALSE(fs::exists(temp));
+}
+
+TEST(BadInput, StoppedSynthLeavesNoHalfSessionInTheWay) {
+    const fs::path dir = outputDir("bad_synth_stopped");
+    const fs::path out = dir / "session";
+    const std::vector<std::string> args = {"synth",    scene(),    "-o", out.string(), "--width",
+                                           "64",       "--height", "48", "--spp",      "1",
+                                           "--no-env", "--fps",    "4"};
+    auto longRun = args;
+    longRun.insert(longRun.end(), {"--seconds", "30"});
+    const pid_t pid = spawnMirage(longRun, dir / "log.txt");
+    // Wait until frames are being written (into a temporary folder beside OUT), then stop it.
+    bool writing = false;
+    for (int k = 0; k < 3000 && !writing; ++k) {
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().filename().string().find("session.partial-") == 0 &&
+                fs::exists(e.path() / "frames.csv") && countLines(e.path() / "frames.csv") > 2)
+                writing = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_TRUE(writing) << readFileBytes(dir / "log.txt");
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    EXPECT_FALSE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    EXPECT_FALSE(fs::exists(out)) << "a half-written session was left at the output";
+    // The rerun is not blocked.
+    auto shortRun = args;
+    shortRun.insert(shortRun.end(), {"--seconds", "1"});
+    const auto r = runMirage(shortRun);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out / "session.json"));
 }
 
 }  // namespace

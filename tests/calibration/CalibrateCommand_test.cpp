@@ -94,9 +94,43 @@ TEST(CalibrateCommand, BatchFromVideo) {
                          "chessboard:9x6:0.025", "-o", out.string(), "--video-step", "2"});
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("board.avi#14"), std::string::npos) << r.output;
+    // Progress while a video is read (there was none).
+    EXPECT_NE(r.output.find("5 frame(s) read"), std::string::npos) << r.output;
     const auto cal = loadCalibration(out);
     EXPECT_EQ(cal.viewCount, 8);
     EXPECT_NEAR(cal.intrinsics.fx, camera().fx, 0.01 * camera().fx);
+}
+
+TEST(CalibrateCommand, TruncatedImageIsRefusedNotTakenAsAView) {
+    // libjpeg returns a cut JPEG with its missing rows filled grey ("Premature end of JPEG
+    // file" as a warning only), and the old reader took it as a frame.
+    const auto dir = test::outputDir("calibrate_truncated");
+    const auto images = dir / "images";
+    fs::create_directories(images);
+    writeViews(images, tiltedPoses(10));
+    const cv::Mat view = cv::imread((images / "view_05.png").string());
+    fs::remove(images / "view_05.png");
+    std::vector<uchar> jpeg;
+    cv::imencode(".jpg", view, jpeg);
+    jpeg.resize(jpeg.size() * 2 / 3);
+    std::ofstream(images / "view_05.jpg", std::ios::binary)
+        .write(reinterpret_cast<const char*>(jpeg.data()), std::streamsize(jpeg.size()));
+    const auto out = dir / "cam.yaml";
+    auto r = test::runMirage({"calibrate", "--batch", images.string(), "--board",
+                              "chessboard:9x6:0.025", "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("view_05.jpg"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("Premature end"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+    // A PNG cut short (no IEND chunk) as well.
+    fs::remove(images / "view_05.jpg");
+    cv::imwrite((images / "view_05.png").string(), view);
+    fs::resize_file(images / "view_05.png", fs::file_size(images / "view_05.png") - 12);
+    r = test::runMirage({"calibrate", "--batch", images.string(), "--board", "chessboard:9x6:0.025",
+                         "-o", out.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("view_05.png"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(CalibrateCommand, FrontoParallelViewsGiveAnUnreliableFileNotAConfidentOne) {

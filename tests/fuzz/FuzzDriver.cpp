@@ -1,11 +1,12 @@
-// A small mutation fuzzer for compilers without libFuzzer (gcc). It is not coverage-guided: it
-// mutates the seed corpus (the good and bad test scenes) with byte flips, insertions, deletions,
-// truncations, crossover, GLB header edits and JSON-aware splices (numbers replaced by boundary
-// values, glTF keys and tokens inserted), feeds each result to the target for a fixed time with a
-// fixed seed, and keeps inputs that load successfully as new seeds.
+// A small mutation fuzzer for compilers without libFuzzer (gcc), shared by every fuzz target
+// (tests/fuzz/FuzzTarget.h names the target, its seed files and its format's tokens). It is not
+// coverage-guided: it mutates the seed corpus with byte flips, insertions, deletions,
+// truncations, crossover, GLB header edits and text-aware splices (numbers replaced by boundary
+// values, the format's keys and tokens inserted), feeds each result to the target for a fixed
+// time with a fixed seed, and keeps inputs that load successfully as new seeds.
 //
-//   scene_loader_fuzz --seconds 20 --seed 1 --corpus DIR [--corpus DIR...] [--crash-dir DIR]
-//   scene_loader_fuzz FILE...          # replay inputs (e.g. a saved crash) once each
+//   <target> --seconds 20 --seed 1 --corpus DIR [--corpus DIR...] [--crash-dir DIR]
+//   <target> FILE...          # replay inputs (e.g. a saved crash) once each
 //
 // On a crash (signal, uncaught exception, sanitizer report, or an input running longer than
 // --input-timeout seconds) the offending input is written to --crash-dir as crash-<seed>-<n>.bin
@@ -27,7 +28,7 @@
 #include <vector>
 
 #include "core/Log.h"
-#include "tests/fuzz/SceneLoaderFuzz.h"
+#include "tests/fuzz/FuzzTarget.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define MIRAGE_FUZZ_HAS_SANITIZER 1
@@ -63,7 +64,7 @@ void saveCurrentInput() {
         left -= static_cast<size_t>(n);
     }
     ::close(fd);
-    static const char kMsg[] = "\nscene_loader_fuzz: crashing input saved to ";
+    static const char kMsg[] = "\nfuzz: crashing input saved to ";
     (void)!::write(2, kMsg, sizeof(kMsg) - 1);
     (void)!::write(2, gCrashPath, std::strlen(gCrashPath));
     (void)!::write(2, "\n", 1);
@@ -72,7 +73,7 @@ void saveCurrentInput() {
 
 void onFatalSignal(int sig) {
     if (sig == SIGALRM) {
-        static const char kMsg[] = "\nscene_loader_fuzz: input exceeded the per-input timeout\n";
+        static const char kMsg[] = "\nfuzz: input exceeded the per-input timeout\n";
         (void)!::write(2, kMsg, sizeof(kMsg) - 1);
     }
     saveCurrentInput();
@@ -131,62 +132,6 @@ const std::vector<std::string> kNumbers = {"-1",
                                            "5126",
                                            "34962",
                                            "1.5e10"};
-
-const std::vector<std::string> kTokens = {
-    "\"bufferView\":",
-    "\"byteOffset\":",
-    "\"byteLength\":",
-    "\"byteStride\":",
-    "\"count\":",
-    "\"componentType\":",
-    "\"type\":\"VEC3\"",
-    "\"type\":\"SCALAR\"",
-    "\"normalized\":true",
-    "\"children\":[0]",
-    "\"children\":[1,1]",
-    "\"mesh\":0",
-    "\"camera\":0",
-    "\"mode\":",
-    "\"indices\":",
-    "\"material\":",
-    "\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":0,\"componentType\":5121},\"values\":{"
-    "\"bufferView\":0}}",
-    "\"extensionsRequired\":[\"EXT_unknown\"]",
-    "\"KHR_lights_punctual\":{\"light\":0}",
-    "\"KHR_materials_volume\":{\"attenuationDistance\":0}",
-    "\"extras\":{\"mirage\":{\"real\":true}}",
-    "\"extras\":{\"mirage\":{\"environment\":{\"type\":\"fisheye\",\"image\":\"env.hdr\"}}}",
-    "\"matrix\":[0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0]",
-    "\"rotation\":[0,0,0,0]",
-    "\"scale\":[0,0,0]",
-    "\"uri\":\"data:application/octet-stream;base64,\"",
-    "\"uri\":\"data:image/png;base64,AAAA\"",
-    "\"uri\":\"mr.png\"",
-    "\"uri\":\"env.hdr\"",
-    "\"uri\":\"\"",
-    "\"uri\":\".\"",
-    "\"source\":0",
-    "\"sampler\":0",
-    "\"index\":0",
-    "\"texCoord\":1",
-    "\"scene\":0",
-    "\"nodes\":[0]",
-    "null",
-    "true",
-    "false",
-    "[]",
-    "{}",
-    "\"\"",
-    ",",
-    ":",
-    "[",
-    "]",
-    "{",
-    "}",
-    "\"",
-    "\\u0000",
-    "-",
-    "."};
 
 void mutateNumber(std::string& s, Rng& rng) {
     // Replace a random run of digits (a JSON number, most likely an index or size).
@@ -255,9 +200,11 @@ void mutate(std::string& s, const std::vector<std::string>& pool, Rng& rng, size
             case 7:  // JSON numbers are where indices and sizes live
                 mutateNumber(s, rng);
                 break;
-            case 8: {  // insert a glTF token, with a comma half of the time so it may stay valid
-                       // JSON
-                std::string token = kTokens[pick(rng, kTokens.size())];
+            case 8: {  // insert a token of the format, with a comma half of the time so that
+                       // JSON and CSV may stay valid
+                const std::vector<std::string>& tokens = mirage::fuzz::target().tokens;
+                if (tokens.empty()) break;
+                std::string token = tokens[pick(rng, tokens.size())];
                 if (rng() % 2) token = token + ",";
                 s.insert(pick(rng, s.size() + 1), token);
                 break;
@@ -285,10 +232,11 @@ std::string readFile(const fs::path& p) {
 }
 
 int usage() {
-    std::cerr
-        << "usage: scene_loader_fuzz [--seconds S] [--seed N] [--corpus DIR]... [--crash-dir DIR]\n"
-           "                         [--max-length BYTES] [--input-timeout S]\n"
-           "       scene_loader_fuzz FILE...   (replay inputs once)\n";
+    const std::string name = mirage::fuzz::target().name;
+    std::cerr << "usage: " << name
+              << " [--seconds S] [--seed N] [--corpus DIR]... [--crash-dir DIR]\n"
+                 "       [--max-length BYTES] [--input-timeout S]\n"
+              << "       " << name << " FILE...   (replay inputs once)\n";
     return 2;
 }
 
@@ -334,7 +282,7 @@ int main(int argc, char** argv) {
     if (!replay.empty()) {
         for (const fs::path& p : replay) {
             std::string input = readFile(p);
-            bool loaded = mirage::fuzz::loadSceneOnce(
+            bool loaded = mirage::fuzz::target().runOnce(
                 reinterpret_cast<const uint8_t*>(input.data()), input.size());
             std::cout << p.string() << ": " << (loaded ? "loaded" : "rejected with mirage::Error")
                       << "\n";
@@ -342,18 +290,23 @@ int main(int argc, char** argv) {
         return 0;
     }
 
+    const mirage::fuzz::Target& target = mirage::fuzz::target();
+    auto isSeed = [&](const fs::path& p) {
+        if (target.seedExtensions.empty()) return true;
+        for (const std::string& ext : target.seedExtensions)
+            if (p.extension() == ext) return true;
+        return false;
+    };
     std::vector<std::string> pool;
     for (const fs::path& dir : corpusDirs) {
         std::vector<fs::path> files;
         for (const auto& e : fs::directory_iterator(dir))
-            if (e.is_regular_file() &&
-                (e.path().extension() == ".gltf" || e.path().extension() == ".glb"))
-                files.push_back(e.path());
+            if (e.is_regular_file() && isSeed(e.path())) files.push_back(e.path());
         std::sort(files.begin(), files.end());  // directory order differs between machines
         for (const fs::path& f : files) pool.push_back(readFile(f));
     }
     if (pool.empty()) {
-        std::cerr << "scene_loader_fuzz: no .gltf/.glb seeds found; pass --corpus DIR\n";
+        std::cerr << target.name << ": no seed files found; pass --corpus DIR\n";
         return 2;
     }
     const size_t seeds = pool.size();
@@ -372,8 +325,7 @@ int main(int argc, char** argv) {
                       static_cast<unsigned long long>(runs));
         gCurrentInput = &input;
         ::alarm(inputTimeout);
-        bool ok = mirage::fuzz::loadSceneOnce(reinterpret_cast<const uint8_t*>(input.data()),
-                                              input.size());
+        bool ok = target.runOnce(reinterpret_cast<const uint8_t*>(input.data()), input.size());
         ::alarm(0);
         gCurrentInput = nullptr;
         ++runs;
@@ -388,9 +340,8 @@ int main(int argc, char** argv) {
     }
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "scene_loader_fuzz: " << runs << " inputs in " << elapsed << " s ("
-              << runs / elapsed << "/s), seed " << seed << ", " << seeds << " seed files, "
-              << loaded << " loaded, " << runs - loaded
-              << " rejected with mirage::Error, no crash\n";
+    std::cout << target.name << ": " << runs << " inputs in " << elapsed << " s (" << runs / elapsed
+              << "/s), seed " << seed << ", " << seeds << " seed files, " << loaded << " loaded, "
+              << runs - loaded << " rejected with mirage::Error, no crash\n";
     return 0;
 }

@@ -4,15 +4,17 @@
 // just like a sanitizer finding or a signal.
 //
 // Built two ways (tests/fuzz/tests.cmake):
-//  - with SceneLoaderFuzzDriver.cpp (any compiler): a time-boxed mutation fuzzer run by ctest;
+//  - with FuzzDriver.cpp (any compiler): a time-boxed mutation fuzzer run by ctest;
 //  - with clang's libFuzzer (-DMIRAGE_LIBFUZZER=ON): coverage-guided, for long local runs.
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/scene/Scene.h"
+#include "tests/fuzz/FuzzTarget.h"
 #include "tests/fuzz/SceneLoaderFuzz.h"
 
 namespace mirage::fuzz {
@@ -38,13 +40,69 @@ bool loadSceneOnce(const uint8_t* data, size_t size) {
 
 }  // namespace mirage::fuzz
 
-// libFuzzer calls this once before the first input (the standalone driver does the same itself).
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    spdlog::set_level(spdlog::level::err);  // warnings of rejected inputs would flood the output
-    return 0;
+namespace mirage::fuzz {
+
+namespace {
+const std::vector<std::string> kGltfTokens = {
+    "\"bufferView\":",
+    "\"byteOffset\":",
+    "\"byteLength\":",
+    "\"byteStride\":",
+    "\"count\":",
+    "\"componentType\":",
+    "\"type\":\"VEC3\"",
+    "\"type\":\"SCALAR\"",
+    "\"normalized\":true",
+    "\"children\":[0]",
+    "\"children\":[1,1]",
+    "\"mesh\":0",
+    "\"camera\":0",
+    "\"mode\":",
+    "\"indices\":",
+    "\"material\":",
+    "\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":0,\"componentType\":5121},\"values\":{"
+    "\"bufferView\":0}}",
+    "\"extensionsRequired\":[\"EXT_unknown\"]",
+    "\"KHR_lights_punctual\":{\"light\":0}",
+    "\"KHR_materials_volume\":{\"attenuationDistance\":0}",
+    "\"extras\":{\"mirage\":{\"real\":true}}",
+    "\"extras\":{\"mirage\":{\"environment\":{\"type\":\"fisheye\",\"image\":\"env.hdr\"}}}",
+    "\"matrix\":[0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0]",
+    "\"rotation\":[0,0,0,0]",
+    "\"scale\":[0,0,0]",
+    "\"uri\":\"data:application/octet-stream;base64,\"",
+    "\"uri\":\"data:image/png;base64,AAAA\"",
+    "\"uri\":\"mr.png\"",
+    "\"uri\":\"env.hdr\"",
+    "\"uri\":\"\"",
+    "\"uri\":\".\"",
+    "\"source\":0",
+    "\"sampler\":0",
+    "\"index\":0",
+    "\"texCoord\":1",
+    "\"scene\":0",
+    "\"nodes\":[0]",
+    "null",
+    "true",
+    "false",
+    "[]",
+    "{}",
+    "\"\"",
+    ",",
+    ":",
+    "[",
+    "]",
+    "{",
+    "}",
+    "\"",
+    "\\u0000",
+    "-",
+    "."};
+}  // namespace
+
+const Target& target() {
+    static const Target t{"scene_loader_fuzz", {".gltf", ".glb"}, kGltfTokens, loadSceneOnce};
+    return t;
 }
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    mirage::fuzz::loadSceneOnce(data, size);
-    return 0;
-}
+}  // namespace mirage::fuzz

@@ -2,6 +2,7 @@
 // poses) and a glTF scene written here; the command must write a playable MKV with one frame per
 // input frame and a timing CSV, and pass footage through where the pose is missing.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <fstream>
@@ -182,16 +183,20 @@ TEST(RealtimeReplay, InterruptLeavesPlayableVideo) {
     }
     saveCalibration(dir / "session" / "main.yaml", calib);
     const auto out = dir / "replay.mkv";
-    // Start the replay, wait until the CSV holds a few frames (at most 120 s), then SIGINT it.
+    // Start the replay, wait until its CSV (written as replay.partial-PID.csv until the end,
+    // core/OutputFile.h) holds a few frames (at most 120 s), then SIGINT it.
     const auto csvPath = std::filesystem::path(out).replace_extension(".csv");
     const std::string cmd =
         "'" + std::string(MIRAGE_BINARY) + "' replay '" + (dir / "session").string() +
         "' --scene '" + (dir / "scene.gltf").string() + "' -o '" + out.string() +
         "' --vpls 16 > '" + (dir / "log.txt").string() + "' 2>&1 & pid=$!; " +
-        "for i in $(seq 1200); do [ -f '" + csvPath.string() + "' ] && [ $(wc -l < '" +
-        csvPath.string() + "') -ge 4 ] && break; sleep 0.1; done; kill -INT $pid; wait $pid";
+        "for i in $(seq 1200); do f=$(ls '" + dir.string() +
+        "'/replay.partial-*.csv 2>/dev/null | head -1); [ -n \"$f\" ] && [ $(wc -l < \"$f\") "
+        "-ge 4 ] && break; sleep 0.1; done; kill -INT $pid; wait $pid";
     const int rc = std::system(cmd.c_str());
     ASSERT_NE(rc, -1);
+    // Interrupted: the frames done are kept, and the exit status says it was interrupted.
+    EXPECT_EQ(WEXITSTATUS(rc), 130);
     auto frames = openFrames(out);
     cv::Mat f;
     int n = 0;
