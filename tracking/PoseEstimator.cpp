@@ -212,15 +212,31 @@ Fit refine(const CameraIntrinsics& cam, const Pose& start,
     f.rms = corners ? std::sqrt(f.report.finalCost / double(corners)) : 0.0;
     f.ok = f.pose.isFinite() && std::isfinite(f.rms);
     if (withCovariance && f.ok && f.report.residualCount > 6) {
-        const lm::Covariance c = lm::covariance(problem, x);
-        if (c.ok && c.sigma2 > 0) {
-            std::copy(c.matrix.begin(), c.matrix.end(), f.covariance.begin());
-            // (J^T J)^-1 and the sum of squares, for the noise model (modelCovariance).
-            for (size_t i = 0; i < 36; ++i) f.normalInverse[i] = c.matrix[i] / c.sigma2;
-            f.cost = c.sigma2 * double(f.report.residualCount - 6);
-            std::vector<double> r, J;
-            residuals(cam, f.pose, obs, r);
-            jacobian(cam, f.pose, obs, J);
+        // One evaluation of the residuals and the Jacobian serves the normal equations, the
+        // robust noise scale and the shared-corner-error terms (lm::covariance would evaluate
+        // the Jacobian again: this runs once per frame in the tracking loop).
+        std::vector<double> r, J;
+        residuals(cam, f.pose, obs, r);
+        jacobian(cam, f.pose, obs, J);
+        cv::Matx66d A = cv::Matx66d::zeros();
+        double cost = 0;
+        for (size_t i = 0; i < r.size(); ++i) {
+            const double* Ji = &J[i * 6];
+            cost += r[i] * r[i];
+            for (int u = 0; u < 6; ++u)
+                for (int v = u; v < 6; ++v) A(u, v) += Ji[u] * Ji[v];
+        }
+        for (int u = 0; u < 6; ++u)
+            for (int v = 0; v < u; ++v) A(u, v) = A(v, u);
+        cv::Matx66d inv;
+        if (cv::invert(A, inv, cv::DECOMP_SVD) != 0) {
+            const double sigma2 = cost / double(r.size() - 6);  // residual variance
+            for (int u = 0; u < 6; ++u)
+                for (int v = 0; v < 6; ++v) {
+                    f.normalInverse[size_t(u * 6 + v)] = inv(u, v);
+                    f.covariance[size_t(u * 6 + v)] = inv(u, v) * sigma2;
+                }
+            f.cost = cost;
             // Robust noise scale: the median absolute residual (a few tags with damaged
             // corners should not set the noise of all).
             std::vector<double> a(r.size());

@@ -73,12 +73,12 @@ double tagEdgeWidthPx(const cv::Mat& grey, const std::array<glm::dvec2, 4>& corn
 }
 
 void Tracker::measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const {
-    int onBoard = 0;
+    // Motion blur is mostly common to the frame: measured once, on the largest board tag (the
+    // most edge pixels), and given to every board tag not measured yet.
     TagDetection* largest = nullptr;
     double largestSide = 0;
     for (auto& d : dets) {
         if (!estimator_.board().find(d.id)) continue;
-        ++onBoard;
         const double side = glm::length(d.corners[0] - d.corners[2]);
         if (side > largestSide) {
             largestSide = side;
@@ -86,14 +86,6 @@ void Tracker::measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) 
         }
     }
     if (!largest) return;
-    if (onBoard <= options_.blurMeasureMaxTags) {
-        for (auto& d : dets)
-            if (d.edgeWidthPx < 0 && estimator_.board().find(d.id))
-                d.edgeWidthPx = tagEdgeWidthPx(grey, d.corners);
-        return;
-    }
-    // Many tags: the blur of the frame from the largest one (motion blur is mostly common to
-    // the frame), for the tags not measured yet.
     const double w =
         largest->edgeWidthPx >= 0 ? largest->edgeWidthPx : tagEdgeWidthPx(grey, largest->corners);
     for (auto& d : dets)

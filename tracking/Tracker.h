@@ -39,11 +39,7 @@ struct TrackerOptions {
     // supports is more likely a wrong pose than a motion.
     double guardMaxRotDeg = 5.0;
     double guardMaxPosFraction = 0.05;
-    // The edge width (blur) around the tags feeds the estimator's corner-noise model
-    // (TagDetection::edgeWidthPx): measured for each board tag when at most this many are
-    // detected (few tags leave too few residuals to tell the noise), else once on the largest
-    // tag for all (~0.02 ms a tag).
-    int blurMeasureMaxTags = 4;
+
     // When no tag is found, an image whose sharpness (strongest gradients over the intensity
     // range, about 1 / edge width in pixels) is below this is reported too_blurred, not no_tags.
     double minSharpness = 0.12;
@@ -161,7 +157,8 @@ private:
     // board tags found from their pose; false (f unchanged but the coarse fields) to fall back.
     bool coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior, TrackedFrame& f);
 
-    // Fills TagDetection::edgeWidthPx of the board tags when there are few (above).
+    // Fills TagDetection::edgeWidthPx of the board tags: the edge width (blur) around the
+    // largest one, for the estimator's corner-noise model (~0.02-0.05 ms).
     void measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const;
 
     PredictedTagFinder tagFinder_;
