@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <sstream>
-
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <opencv2/imgproc.hpp>

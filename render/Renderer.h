@@ -54,7 +54,8 @@ public:
     cv::Mat readIsmAtlas(bool realOnly) const;
 
     // The composite as an sRGB8 texture (camera size, memory row 0 = image top row), e.g. to
-    // blit into a window (flip vertically: GL windows put row 0 at the bottom).
+    // blit into a window (flip vertically: GL windows put row 0 at the bottom). Valid after the
+    // first render(); throws mirage::Error before.
     const gl::Texture& compositeTexture() const;
 
     const CameraProjection& projection() const { return projection_; }
