@@ -67,16 +67,22 @@ Solution fromProblem(const JointProblem& p, const std::vector<const CalibrationV
     return s;
 }
 
+// A fish-eye problem over `views` for images of `size`, intrinsics and poses still to be set.
+JointProblem fisheyeProblem(const std::vector<const CalibrationView*>& views, cv::Size size) {
+    JointProblem p;
+    p.views = views;
+    p.intrinsics.width = size.width;
+    p.intrinsics.height = size.height;
+    p.intrinsics.model = DistortionModel::KannalaBrandt;
+    return p;
+}
+
 // Own initialisation of the fish-eye problem: centred principal point, no distortion, a focal
 // length candidate, and each view's pose from the planar PnP on undistorted points.
 JointProblem fisheyeInitialGuess(const std::vector<const CalibrationView*>& views, cv::Size size,
                                  double focal) {
-    JointProblem p;
-    p.views = views;
+    JointProblem p = fisheyeProblem(views, size);
     auto& in = p.intrinsics;
-    in.width = size.width;
-    in.height = size.height;
-    in.model = DistortionModel::KannalaBrandt;
     in.fx = in.fy = focal;
     in.cx = (size.width - 1) / 2.0;
     in.cy = (size.height - 1) / 2.0;
@@ -152,12 +158,8 @@ Solution solveFisheye(const std::vector<const CalibrationView*>& views, cv::Size
         cv::fisheye::calibrate(obj, img, size, K, D, rvecs, tvecs, flags,
                                cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
                                                 o.maxIterations, 1e-10));
-        JointProblem p;
-        p.views = views;
+        JointProblem p = fisheyeProblem(views, size);
         auto& in = p.intrinsics;
-        in.width = size.width;
-        in.height = size.height;
-        in.model = DistortionModel::KannalaBrandt;
         in.fx = K(0, 0);
         in.fy = K(1, 1);
         in.cx = K(0, 2);

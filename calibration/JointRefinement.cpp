@@ -10,7 +10,9 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double& intrinsicRef(CameraIntrinsics& in, int i) {
+// Intrinsic parameter i (fx fy cx cy distortion...) of a mutable or const CameraIntrinsics.
+template <class Intrinsics>
+auto& intrinsicRef(Intrinsics& in, int i) {
     switch (i) {
         case 0:
             return in.fx;
@@ -77,6 +79,10 @@ void boardResiduals(const CalibrationView& view, const CameraIntrinsics& in, con
         residuals[2 * i] = px[i].x - double(view.imagePoints[i].x);
         residuals[2 * i + 1] = px[i].y - double(view.imagePoints[i].y);
     }
+}
+
+double intrinsicParameter(const CameraIntrinsics& in, int i) {
+    return i < 4 ? intrinsicRef(in, i) : in.coeff(size_t(i - 4));
 }
 
 int JointProblem::intrinsicCount() const {

@@ -30,6 +30,10 @@ struct JointProblem {
     double cost() const;  // sum of squared residuals (pixels^2), +inf if not finite
 };
 
+// Intrinsic parameter i in the order of the standard deviations below: fx fy cx cy, then the
+// distortion coefficients (0 where the model has fewer).
+double intrinsicParameter(const CameraIntrinsics& intrinsics, int i);
+
 // Runs LM until converged or maxIterations; returns the final RMS (pixels per point).
 double refineJointly(JointProblem& problem, int maxIterations);
 

@@ -43,10 +43,19 @@ public:
                 if (!std::isfinite(Ji[a])) ne_.finite = false;
                 const size_t ca = size_t(columns[a]);
                 ne_.Jtr[ca] += Ji[a] * ri;
+                // Upper triangle only (completeSymmetric() mirrors it): half the products.
                 double* row = &ne_.JtJ[ca * P];
-                for (size_t b = 0; b < k; ++b) row[size_t(columns[b])] += Ji[a] * Ji[b];
+                for (size_t b = 0; b < k; ++b)
+                    if (size_t(columns[b]) >= ca) row[size_t(columns[b])] += Ji[a] * Ji[b];
             }
         }
+    }
+
+    // Copies the upper triangle of J^T J into the lower one.
+    void completeSymmetric() {
+        const size_t P = size_t(ne_.parameters);
+        for (size_t a = 0; a < P; ++a)
+            for (size_t b = 0; b < a; ++b) ne_.JtJ[a * P + b] = ne_.JtJ[b * P + a];
     }
 
 private:
@@ -162,6 +171,7 @@ NormalEquations normalEquations(const Problem& p, const std::vector<double>& x) 
     if (!ne.finite) return ne;
     NormalSink sink(ne, r);
     p.jacobian(x, sink);
+    sink.completeSymmetric();
     return ne;
 }
 
@@ -194,6 +204,7 @@ Report solve(const Problem& p, std::vector<double>& x, const Options& o) {
         ne.finite = true;
         NormalSink sink(ne, r);
         p.jacobian(x, sink);
+        sink.completeSymmetric();
         if (!ne.finite) {
             rep.stop = Stop::NoDecrease;
             break;

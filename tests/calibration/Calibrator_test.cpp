@@ -10,6 +10,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "calibration/Calibrator.h"
+#include "calibration/JointRefinement.h"
 #include "calibration/SyntheticViews.h"
 #include "core/Error.h"
 #include "tests/support/TestCameras.h"
@@ -35,18 +36,7 @@ std::vector<CalibrationView> makeViews(const CameraIntrinsics& cam, const Chessb
 }
 
 double param(const CameraIntrinsics& c, int i) {
-    switch (i) {
-        case 0:
-            return c.fx;
-        case 1:
-            return c.fy;
-        case 2:
-            return c.cx;
-        case 3:
-            return c.cy;
-        default:
-            return c.coeff(size_t(i - 4));
-    }
+    return intrinsicParameter(c, i);
 }
 
 CalibrationOptions optionsFor(const CameraIntrinsics& c) {
