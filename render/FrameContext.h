@@ -46,7 +46,7 @@ struct RendererOptions {
     // without this a pass's time can show up in the next pass's query. For benchmarks.
     bool syncPasses = false;
 
-    // Reflected-scene impostors for specular objects (render/passes/impostor, issue 6).
+    // Reflected-scene impostors for specular objects (render/passes/impostor).
     int impostorResolution = 256;          // texels per side of each impostor and cube face
     int impostorRefineSteps = 4;           // secant refinement steps of the height-field search
     bool impostorCubeMapBaseline = false;  // true: plain G-buffer cube map, looked up by direction

@@ -25,7 +25,7 @@ namespace {
 using namespace mirage;
 
 // specular: 0 = the sphere is diffuse blue (the diffuse-only frame), 1 = the sphere is glass
-// (IOR 1.5, light absorption), 2 = glass sphere and the virtual box a mirror (issue 6).
+// (IOR 1.5, light absorption), 2 = glass sphere and the virtual box a mirror.
 Scene benchScene(int sphereSegments, int specular = 0) {
     Scene s;
     int white = test::addMaterial(s, glm::vec3(0.75f));
@@ -115,7 +115,7 @@ void args(benchmark::internal::Benchmark* b) {
     b->Args({640, 480, 256, 32, 1, 0, 1});   // VPL gather at full resolution
     b->Args({640, 480, 256, 128, 2, 0, 1});  // ~65k more triangles
     b->Args({320, 240, 256, 32, 2, 0, 1});
-    // Specular objects (issue 6): the same frame with the sphere glass, and glass + mirror box;
+    // Specular objects: the same frame with the sphere glass, and glass + mirror box;
     // compare with {640, 480, 256, 32, 2, 0} for the extra cost.
     b->Args({640, 480, 256, 32, 2, 1, 1});
     b->Args({640, 480, 256, 32, 2, 2, 1});
@@ -124,7 +124,7 @@ void args(benchmark::internal::Benchmark* b) {
     b->Args({640, 480, 256, 32, 2, 1, 16});  // ... 4x4
 }
 
-// Time against error of the specular pipeline end to end (issue 6): the composite of a virtual
+// Time against error of the specular pipeline end to end: the composite of a virtual
 // glass sphere among real things (tests/support/testscenes/SpecularTestScenes.h, the seed's Fig. 2
 // example) at 192x144 against the reference renderer's composite (64 spp, caustics off, computed
 // once), PSNR/SSIM over the sphere's pixels, for impostor resolution x refinement steps and the

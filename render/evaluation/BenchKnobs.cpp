@@ -105,7 +105,7 @@ const std::vector<BenchKnob>& benchKnobs() {
          [](BenchConfig& c, const std::string& v) {
              c.options.syncPasses = parseOnOff("sync_passes", v);
          }},
-        // Specular objects (issue 6). One default value each, so the default grid does not grow;
+        // Specular objects. One default value each, so the default grid does not grow;
         // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror
         // or glass (the impostor and specular passes do not run).
         {"specular_trace",

@@ -303,7 +303,7 @@ def main():
     spot_pos = [0.35, 0.95, 0.45]
     b.node("spot", True, light=b.spot("spot", 1.6, [1.0, 0.95, 0.85], 0.35, 0.55), translation=spot_pos,
            rotation=look_at_rotation(spot_pos, [0, 0, 0]))
-    # Virtual objects (issues 5-6): glass sphere, mirror, diffuse box.
+    # Virtual objects: glass sphere, mirror, diffuse box.
     b.node("glass_sphere", False, b.mesh("glass_sphere", *uv_sphere(0.045), m_glass), translation=[0.02, 0.045, 0.16])
     mirror_rot = look_at_rotation([0, 0, 0], [-1, 0, -1])  # faces +X+Z (towards the camera side)
     b.node("mirror", False, b.mesh("mirror", *box([-0.1, 0, -0.003], [0.1, 0.14, 0.003]), m_mirror),

@@ -1,5 +1,5 @@
 #pragma once
-// Reflected-scene impostors for specular objects (issue 6; Knecht 2013 Sec. 3.2, Popescu et al.
+// Reflected-scene impostors for specular objects (Knecht 2013 Sec. 3.2, Popescu et al.
 // 2006): per specular object (GpuScene::specularDraws()), the data that
 // render/passes/impostor/trace.glsl's traceSurroundings() needs to find where a reflected or
 // refracted ray leaving the object hits its surroundings:

@@ -1,4 +1,4 @@
-// Reflected / refracted ray tracing against a specular object's surroundings (issue 6; Knecht 2013
+// Reflected / refracted ray tracing against a specular object's surroundings (Knecht 2013
 // Sec. 3.2 / 4.1, Popescu et al. 2006 reflected-scene impostors). #include after common.glsl.
 //
 //   SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir);
