@@ -260,11 +260,11 @@ void runReplay(const ReplayArgs& a) {
         lastLost = !pr.pose;
         const auto t3 = Clock::now();
         const double t = tFrame;
-        if (result.empty()) {
-        } else if (video) {
-            video->append(result, t);
-        } else {
-            writeBgr8(out / cv::format("frame_%06d.png", rec.index), result);
+        if (!result.empty()) {  // a lost frame has no image: only its CSV row is written
+            if (video)
+                video->append(result, t);
+            else
+                writeBgr8(out / cv::format("frame_%06d.png", rec.index), result);
         }
         const double encodeMs = msSince(t3);
         if (a.window) {

@@ -230,7 +230,7 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
                 " (first: frame " + std::to_string(firstMissing) + "); those rows are dropped");
         const int held = inventories[ci].count();
         const int lastListed = rows.empty() ? -1 : rows.back().index;
-        if (!inventories[ci].isFolder && held > lastListed + 1 && !rows.empty())
+        if (!inventories[ci].isFolder && held > int64_t(lastListed) + 1 && !rows.empty())
             report.warnings.push_back(
                 "camera '" + s.cameras[ci].name + "': " + s.cameras[ci].video + " holds " +
                 std::to_string(held) + " frames but " + s.framesFile + " ends at frame " +

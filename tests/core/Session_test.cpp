@@ -442,6 +442,21 @@ TEST(SessionCorrupt, DeletedRowsSkipTheirFrames) {
     expectFramesMatch(readAll(*openCameraFrames(s, "env")), {0, 1, 2, 5, 6}, kEnvW, kEnvH, 1, 28.0);
 }
 
+TEST(SessionCorrupt, LargestFrameNumberIsDroppedWithoutOverflow) {
+    // Found by session_fuzz under UBSan: a last row numbered INT_MAX overflowed "last + 1".
+    const fs::path dir = test::outputDir("session_frame_int_max");
+    writeSession(dir, 3, false);
+    rewriteCsv(dir / "frames.csv", [](auto& l) {
+        std::string row = l.back();
+        l.push_back("2147483647" + row.substr(row.find(',')));
+    });
+    SessionReadReport report;
+    const Session s = readSession(dir, &report);
+    EXPECT_EQ(report.framesListed, 4);
+    EXPECT_EQ(report.framesReadable, 3) << allWarnings(report);
+    EXPECT_TRUE(contains(report, "first: frame 2147483647")) << allWarnings(report);
+}
+
 TEST(SessionCorrupt, BadRowsAreReportedAndSkipped) {
     const fs::path dir = test::outputDir("session_bad_rows");
     writeSession(dir, 8, false);
