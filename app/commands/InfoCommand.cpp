@@ -42,8 +42,7 @@ void printPasses(const InfoArgs& a) {
     render::Renderer renderer(scene, cam.intrinsics);
     renderer.render({cam.T_world_camera, cv::Mat(), true});
     std::cout << "frame graph of " << a.passesScene << (a.noLights ? " (lights removed)" : "")
-              << ", camera '" << cameraName << "' at " << a.width
-              << "x" << a.height << ":\n"
+              << ", camera '" << cameraName << "' at " << a.width << "x" << a.height << ":\n"
               << (a.markdown ? renderer.graph().markdown() : renderer.graph().describe());
     if (!a.dot.empty()) {
         std::ofstream out(a.dot);

@@ -1,6 +1,7 @@
 #pragma once
 // Geometry the specular passes need besides the primary G-buffer (canvas size, camera view):
-//  - BackFacePosition / BackFaceNormal: the back faces of the specular (glass) objects, nearest first — world position,
+//  - BackFacePosition / BackFaceNormal: the back faces of the specular (glass) objects, nearest
+//  first — world position,
 //    specular slot and outward normal — Wyman 2005's first pass, from which the refraction pass
 //    finds where a refracted ray leaves the object;
 //  - RealSurfaces: the nearest REAL surface per pixel (world position). The camera image shows
