@@ -1,9 +1,10 @@
 #include "render/Renderer.h"
 
-#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+
+#include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <opencv2/imgproc.hpp>
 

@@ -1,9 +1,8 @@
 #pragma once
 // Geometry the specular passes need besides the primary G-buffer (canvas size, camera view):
 //  - BackFacePosition / BackFaceNormal: the back faces of the specular (glass) objects, nearest
-//  first — world position,
-//    specular slot and outward normal — Wyman 2005's first pass, from which the refraction pass
-//    finds where a refracted ray leaves the object;
+//    first (world position, specular slot and outward normal): Wyman 2005's first pass, from
+//    which the refraction pass finds where a refracted ray leaves the object;
 //  - RealSurfaces: the nearest REAL surface per pixel (world position). The camera image shows
 //    real surfaces only, so a point back-projected into it is valid only if it is that surface
 //    (Knecht 2013 Sec. 4.1.3); virtual objects in front do not hide it in the video. When the
