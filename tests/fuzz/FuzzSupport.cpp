@@ -12,17 +12,24 @@ namespace mirage::fuzz {
 namespace fs = std::filesystem;
 
 const fs::path& scratchDir() {
-    static const fs::path dir = [] {
-        const fs::path d = fs::temp_directory_path() /
-                           ("mirage-fuzz-" + target().name + "-" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        std::atexit([] {
-            std::error_code ec;
-            fs::remove_all(scratchDir(), ec);
-        });
+    // Never destroyed: a handler that std::atexit registers while a function-local static is
+    // still being constructed runs after that static's destructor, so the removal below must
+    // not read a static path object (it did, and left the folder behind).
+    static const fs::path* const dir = [] {
+        auto* d = new fs::path(fs::temp_directory_path() /
+                               ("mirage-fuzz-" + target().name + "-" + std::to_string(::getpid())));
+        fs::create_directories(*d);
         return d;
     }();
-    return dir;
+    static const bool cleanupRegistered = [] {
+        std::atexit([] {
+            std::error_code ec;
+            fs::remove_all(*dir, ec);
+        });
+        return true;
+    }();
+    (void)cleanupRegistered;
+    return *dir;
 }
 
 fs::path writeScratch(const std::string& name, const uint8_t* data, size_t size) {
