@@ -409,6 +409,25 @@ std::string cornerNoiseSplitTable(const std::vector<TrialRecord>& records,
     return s;
 }
 
+// The q-quantile (0..1) of sorted values, interpolated linearly between neighbours (so the
+// median of two values is their mean and never exceeds the 90th percentile).
+static double quantile(const std::vector<double>& sorted, double q) {
+    const double at = q * double(sorted.size() - 1);
+    const size_t lo = size_t(at);
+    const size_t hi = std::min(lo + 1, sorted.size() - 1);
+    return sorted[lo] + (at - double(lo)) * (sorted[hi] - sorted[lo]);
+}
+
+// One table cell: " median / 90th percentile (count) |" of `values`, or " - |" when empty.
+static std::string medianP90Cell(std::vector<double> values) {
+    if (values.empty()) return " - |";
+    std::sort(values.begin(), values.end());
+    char b[64];
+    std::snprintf(b, sizeof b, " %.3f / %.3f (%zu) |", quantile(values, 0.5), quantile(values, 0.9),
+                  values.size());
+    return b;
+}
+
 std::string cornerNoiseTable(const std::vector<TrialRecord>& records) {
     const double blurEdges[] = {0, 1, 2.5, 4, 5.5, 7.01};
     const double sideEdges[] = {0, 20, 25, 30, 40, 1e9};
@@ -428,14 +447,7 @@ std::string cornerNoiseTable(const std::vector<TrialRecord>& records) {
                     if (t.sidePx >= sideEdges[j] && t.sidePx < sideEdges[j + 1])
                         e.push_back(t.rmsErrPx);
             }
-            if (e.empty()) {
-                s += " - |";
-                continue;
-            }
-            std::sort(e.begin(), e.end());
-            std::snprintf(b, sizeof b, " %.3f / %.3f (%zu) |", e[e.size() / 2],
-                          e[size_t(0.9 * double(e.size() - 1))], e.size());
-            s += b;
+            s += medianP90Cell(e);
         }
         s += "\n";
     }
@@ -456,14 +468,7 @@ std::string cornerNoiseTable(const std::vector<TrialRecord>& records) {
                     if (t.sidePx >= sideEdges[j] && t.sidePx < sideEdges[j + 1] &&
                         t.edgeWidthPx >= widthEdges[i] && t.edgeWidthPx < widthEdges[i + 1])
                         e.push_back(t.rmsErrPx);
-            if (e.empty()) {
-                s += " - |";
-                continue;
-            }
-            std::sort(e.begin(), e.end());
-            std::snprintf(b, sizeof b, " %.3f / %.3f (%zu) |", e[e.size() / 2],
-                          e[size_t(0.9 * double(e.size() - 1))], e.size());
-            s += b;
+            s += medianP90Cell(e);
         }
         s += "\n";
     }
@@ -479,8 +484,8 @@ std::string cornerNoiseTable(const std::vector<TrialRecord>& records) {
         if (w.empty()) continue;
         std::sort(w.begin(), w.end());
         std::snprintf(b, sizeof b, "| %.1f-%.1f | %.2f / %.2f / %.2f |\n", blurEdges[i],
-                      std::min(7.0, blurEdges[i + 1]), w[w.size() / 2],
-                      w[size_t(0.1 * double(w.size() - 1))], w[size_t(0.9 * double(w.size() - 1))]);
+                      std::min(7.0, blurEdges[i + 1]), quantile(w, 0.5), quantile(w, 0.1),
+                      quantile(w, 0.9));
         s += b;
     }
     return s;
