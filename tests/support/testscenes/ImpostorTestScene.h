@@ -19,10 +19,7 @@ namespace mirage::test {
 inline void addRoomWalls(Scene& s, float half, float h, int material, Origin origin) {
     Primitive p;
     auto quad = [&](glm::vec3 n, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-        uint32_t base = uint32_t(p.positions.size());
-        p.positions.insert(p.positions.end(), {a, b, c, d});
-        p.normals.insert(p.normals.end(), {n, n, n, n});
-        p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+        appendQuad(p, n, a, b, c, d);
     };
     const float H = half;
     quad({1, 0, 0}, {-H, 0, -H}, {-H, 0, H}, {-H, h, H}, {-H, h, -H});

@@ -139,11 +139,7 @@ inline int addLight(Scene& s, const std::string& name, Light light, const glm::d
     Node n;
     n.name = name;
     n.light = int(s.lights.size()) - 1;
-    n.local = n.world = world;
-    n.origin = origin;
-    s.nodes.push_back(n);
-    s.roots.push_back(int(s.nodes.size()) - 1);
-    return int(s.nodes.size()) - 1;
+    return mirage::test::addRootNode(s, std::move(n), world, origin);
 }
 
 // Camera node at `eye` looking at `target` (glTF camera: looks down its -Z, +Y up).
@@ -156,11 +152,8 @@ inline int addCameraNode(Scene& s, const std::string& name, glm::dvec3 eye, glm:
     Node n;
     n.name = name;
     n.camera = int(s.cameras.size()) - 1;
-    n.local = n.world = glm::inverse(glm::lookAt(eye, target, up));
-    n.origin = Origin::Real;
-    s.nodes.push_back(n);
-    s.roots.push_back(int(s.nodes.size()) - 1);
-    return int(s.nodes.size()) - 1;
+    return mirage::test::addRootNode(s, std::move(n), glm::inverse(glm::lookAt(eye, target, up)),
+                                     Origin::Real);
 }
 
 // Writes an environment image (linear RGB float) to `path` and makes it the scene's environment.

@@ -3,6 +3,7 @@
 // (metres, +Y up); camera poses are T_world_camera with OpenCV axes.
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <glm/glm.hpp>
 
@@ -23,6 +24,25 @@ inline int addMaterial(Scene& s, glm::vec3 albedo, float roughness = 1.0f, float
     return int(s.materials.size()) - 1;
 }
 
+// Appends `n` to the scene as a root node at `world` (local = world) and returns its index.
+inline int addRootNode(Scene& s, Node n, const glm::dmat4& world, Origin origin) {
+    n.local = n.world = world;
+    n.origin = origin;
+    s.nodes.push_back(std::move(n));
+    s.roots.push_back(int(s.nodes.size()) - 1);
+    return int(s.nodes.size()) - 1;
+}
+
+// Appends the quad a-b-c-d (counter-clockwise seen from the side `normal` points to) as two
+// triangles with a flat normal.
+inline void appendQuad(Primitive& p, glm::vec3 normal, glm::vec3 a, glm::vec3 b, glm::vec3 c,
+                       glm::vec3 d) {
+    const uint32_t base = uint32_t(p.positions.size());
+    p.positions.insert(p.positions.end(), {a, b, c, d});
+    p.normals.insert(p.normals.end(), {normal, normal, normal, normal});
+    p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+}
+
 inline void addMeshNode(Scene& s, const std::string& name, Primitive prim, Origin origin,
                         const glm::dmat4& world = glm::dmat4(1.0)) {
     Mesh mesh;
@@ -32,10 +52,7 @@ inline void addMeshNode(Scene& s, const std::string& name, Primitive prim, Origi
     Node n;
     n.name = name;
     n.mesh = int(s.meshes.size()) - 1;
-    n.local = n.world = world;
-    n.origin = origin;
-    s.nodes.push_back(n);
-    s.roots.push_back(int(s.nodes.size()) - 1);
+    addRootNode(s, std::move(n), world, origin);
 }
 
 // UV sphere (rings x segments quads; the pole rows are single triangles) with outward normals,
@@ -88,10 +105,7 @@ inline void addBox(Scene& s, const std::string& name, glm::vec3 lo, glm::vec3 hi
                    Origin origin) {
     Primitive p;
     auto face = [&](glm::vec3 n, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-        uint32_t base = uint32_t(p.positions.size());
-        p.positions.insert(p.positions.end(), {a, b, c, d});
-        p.normals.insert(p.normals.end(), {n, n, n, n});
-        p.indices.insert(p.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+        appendQuad(p, n, a, b, c, d);
     };
     const glm::vec3 L = lo, H = hi;
     face({0, 1, 0}, {L.x, H.y, L.z}, {L.x, H.y, H.z}, {H.x, H.y, H.z}, {H.x, H.y, L.z});
@@ -128,10 +142,7 @@ inline void addLight(Scene& s, Light::Type type, glm::vec3 pos, glm::vec3 dir, f
     Node n;
     n.name = l.name;
     n.light = int(s.lights.size()) - 1;
-    n.local = n.world = m;
-    n.origin = origin;
-    s.nodes.push_back(n);
-    s.roots.push_back(int(s.nodes.size()) - 1);
+    addRootNode(s, std::move(n), m, origin);
 }
 
 // T_world_camera of an OpenCV camera at `eye` looking at `target` (+Y world up).
