@@ -26,4 +26,8 @@ struct CommandRegistrar {
 // Exit code a command sets for main() to return (0 = success).
 int& commandExitCode();
 
+// The process's arguments as given (argv), for records of how an output was made (shard
+// manifests name the command that reruns them).
+std::vector<std::string>& commandLine();
+
 }  // namespace mirage::app

@@ -19,10 +19,15 @@ int& commandExitCode() {
     static int code = 0;
     return code;
 }
+std::vector<std::string>& commandLine() {
+    static std::vector<std::string> args;
+    return args;
+}
 }  // namespace mirage::app
 
 int main(int argc, char** argv) {
     using namespace mirage;
+    app::commandLine().assign(argv, argv + argc);
     CLI::App cli{
         "mirage: virtual glass, mirrors and translucent objects composited into real "
         "camera footage"};

@@ -4,16 +4,19 @@
 #include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/commands/ShardMerge.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
+#include "core/Shards.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "render/raytrace/DifferentialRendering.h"
@@ -22,7 +25,7 @@ namespace mirage::app {
 namespace {
 
 struct RenderArgs {
-    std::string scene, camera, output, mode = "rv", cameraImage;
+    std::string scene, camera, output, mode = "rv", cameraImage, shard, rows;
     int spp = 64, width = 640, height = 0, threads = 0, photons = 0, maxDepth = 64;
     double seconds = 0.0;
     uint64_t seed = 1;
@@ -46,13 +49,30 @@ void run(const RenderArgs& a) {
     if (a.width < 1 || a.height < 0)
         throw Error("mirage render: --width/--height must be positive");
 
+    const ShardSpec shard = a.shard.empty() ? ShardSpec{} : parseShardSpec(a.shard);
+    const ItemRange rowRange = a.rows.empty() ? ItemRange{} : parseItemRange(a.rows);
+    const bool split = !a.shard.empty() || !a.rows.empty();
+    if (split && a.seconds > 0)
+        throw Error(
+            "mirage render: --shard/--rows need a fixed --spp: a time budget (--seconds) gives "
+            "each shard a different number of passes, so the parts would not join");
+
     // Inputs and outputs are checked before the render, which can take hours: the output folder
-    // is created and a temporary file reserved in it, the camera image is read now.
+    // is created and a temporary file reserved in it, the camera image is read now. A shard
+    // writes into OUT.shards/ and leaves OUT to `mirage merge`.
     OutputRule rule{{a.scene}, a.force, "mirage render"};
     if (!a.cameraImage.empty()) rule.inputs.push_back(a.cameraImage);
-    OutputFile outFile(out, OutputOrigin::Named, rule);
+    if (split) {
+        checkOutput(out, OutputOrigin::Named, rule);
+        const auto dir = shardFolder(out, shard);
+        if (std::filesystem::exists(dir / "shard.json") && !a.force)
+            throw FileError(dir.string(),
+                            "this shard is already complete; pass --force to render it again");
+    }
+    std::optional<OutputFile> outFile;
+    if (!split) outFile.emplace(out, OutputOrigin::Named, rule);
     std::vector<OutputFile> bufferFiles;
-    if (a.saveBuffers && a.mode == "composite") {
+    if (a.saveBuffers && a.mode == "composite" && !split) {
         const auto stem = out.parent_path() / out.stem();
         for (const char* suffix : {"_Lr.exr", "_Lrv.exr", "_coverage.exr"})
             bufferFiles.emplace_back(stem.string() + suffix, OutputOrigin::Derived, rule);
@@ -72,6 +92,12 @@ void run(const RenderArgs& a) {
     raytrace::RenderCamera camera = raytrace::cameraFromNode(scene, a.camera, a.width, height);
 
     raytrace::RenderSettings st;
+    if (split) st.rows = selectItems(height, rowRange, shard);
+    if (split && st.rows.empty())
+        throw Error(
+            fmt::format("mirage render: shard {}/{} holds no row of the {} rows; use at "
+                        "most as many shards as rows",
+                        shard.index, shard.count, height));
     st.samplesPerPixel = a.seconds > 0 ? std::max(a.spp, 1 << 20) : a.spp;
     st.maxSeconds = a.seconds;
     st.seed = a.seed;
@@ -92,6 +118,7 @@ void run(const RenderArgs& a) {
                  a.seconds > 0 ? fmt::format("{} s", a.seconds) : fmt::format("{} spp", a.spp));
 
     cv::Mat result;
+    std::vector<cv::Mat> shardBuffers;  // L_r, L_rv, coverage of a split composite (--save-buffers)
     if (a.mode == "composite") {
         raytrace::DifferentialImages images =
             raytrace::renderDifferential(scene, device, camera, st, progress);
@@ -113,6 +140,9 @@ void run(const RenderArgs& a) {
         if (a.saveBuffers) {
             cv::Mat cov;
             cv::merge(std::vector<cv::Mat>(3, images.virtualCoverage), cov);
+            if (split) {
+                shardBuffers = {images.realOnly, images.realAndVirtual, cov};
+            }
             const cv::Mat* buffers[] = {&images.realOnly, &images.realAndVirtual, &cov};
             for (size_t k = 0; k < bufferFiles.size(); ++k) {
                 writeLinearRgb(bufferFiles[k].temp(), *buffers[k], 1.0f);
@@ -136,8 +166,26 @@ void run(const RenderArgs& a) {
                          r.nonFiniteSamples);
         result = r.radiance;
     }
-    writeLinearRgb(outFile.temp(), result, ext == ".png" ? a.exposure : 1.0f);
-    outFile.commit();
+    if (split) {
+        RenderShard rs;
+        rs.shard = shard;
+        rs.range = rowRange;
+        rs.rows = st.rows;
+        rs.exposure = a.exposure;
+        rs.image = result;
+        rs.buffers = shardBuffers;
+        // Everything that changes a pixel, and the scene's bytes; not threads.
+        rs.fingerprint = hex64(fingerprint64(fmt::format(
+            "{} {} {} {}x{} spp {} seed {} photons {} depth {} exposure {:.9g} "
+            "buffers {} scene {} image {}",
+            a.camera, a.mode, ext, a.width, height, a.spp, a.seed, a.photons, a.maxDepth,
+            a.exposure, a.saveBuffers, hex64(fileFingerprint(a.scene)),
+            a.cameraImage.empty() ? std::string("-") : hex64(fileFingerprint(a.cameraImage)))));
+        writeRenderShard(out, rs);
+        return;
+    }
+    writeLinearRgb(outFile->temp(), result, ext == ".png" ? a.exposure : 1.0f);
+    outFile->commit();
     spdlog::info("wrote {}", out.string());
 }
 
@@ -178,7 +226,14 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
         ->capture_default_str();
     cmd->add_option("--camera-image", a->cameraImage,
                     "composite: the camera image (linear .exr/.pfm or sRGB .png)");
-    cmd->add_flag("--force", a->force, "Replace existing --save-buffers files beside the output");
+    cmd->add_flag("--force", a->force,
+                  "Replace existing --save-buffers files beside the output (or an existing shard)");
+    cmd->add_option("--shard", a->shard,
+                    "Render part I of N (I/N, 0-based: every N-th image row from row I) into "
+                    "OUT.shards/; join the parts with `mirage merge OUT` (docs/scale.md)");
+    cmd->add_option("--rows", a->rows,
+                    "Render only image rows A to B-1 (A:B), as a shard; with --shard, the part "
+                    "of those rows");
     cmd->add_flag("--save-buffers", a->saveBuffers,
                   "composite: also write OUT_Lr.exr, OUT_Lrv.exr, OUT_coverage.exr");
     cmd->add_option("--photons", a->photons, "Caustic photons per pass (0 = automatic)")

@@ -18,6 +18,7 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
+#include "core/Shards.h"
 #include "core/scene/Scene.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tracking/Board.h"
@@ -28,10 +29,69 @@ namespace {
 namespace fs = std::filesystem;
 
 struct SynthArgs {
-    std::string scene, output, board;
+    std::string scene, output, board, shard, frames;
     bool force = false, noEnv = false;
     raytrace::SyntheticSessionOptions o;
 };
+
+// A part of the session (core/Shards.h): its frames into OUT.shards/I-of-N, written to a
+// temporary folder and moved into place when complete, like the session itself.
+void writeShard(const SynthArgs& a, const Scene& scene, const ShardSpec& shard,
+                const ItemRange& range, int total, const std::vector<int>& frames) {
+    const fs::path out(a.output);
+    const fs::path dir = shardFolder(out, shard);
+    std::error_code ec;
+    if (fs::exists(dir / "shard.json") && !a.force)
+        throw FileError(dir.string(),
+                        "this shard is already complete; pass --force to render it again");
+    if (frames.empty())
+        throw Error(
+            fmt::format("mirage synth: shard {}/{} of frames {}:{} holds no frame; use at "
+                        "most as many shards as frames",
+                        shard.index, shard.count, range.begin, range.end < 0 ? total : range.end));
+    fs::create_directories(dir.parent_path());
+    fs::path temp = dir;
+    temp += ".partial-" + std::to_string(::getpid());
+    fs::remove_all(temp, ec);
+    struct RemoveOnFailure {
+        fs::path dir;
+        ~RemoveOnFailure() {
+            std::error_code e;
+            if (!dir.empty()) fs::remove_all(dir, e);
+        }
+    } cleanup{temp};
+
+    TerminalProgress bar("synth");
+    const auto start = std::chrono::steady_clock::now();
+    ShardManifest m;
+    m.command = "synth";
+    m.unit = "frames";
+    m.shard = shard;
+    m.total = total;
+    m.range = range;
+    m.items = frames;
+    m.fingerprint = raytrace::syntheticFingerprint(a.o, fileFingerprint(a.scene),
+                                                   fileFingerprint(a.o.boardFile));
+    m.commandLine = commandLine();
+    m.payload = raytrace::writeSyntheticShard(
+        scene, temp, a.o, frames, [&](int done, int count, const std::string& segment) {
+            const double elapsed =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            bar.update(done, count,
+                       fmt::format("shard {}/{}: frame {}/{} ({}), {:.0f} s", shard.index,
+                                   shard.count, done, count, segment, elapsed));
+        });
+    bar.finish();
+    writeShardManifest(temp, m);
+    fs::remove_all(dir, ec);  // --force (checked above), or an incomplete earlier attempt
+    fs::rename(temp, dir, ec);
+    if (ec)
+        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message() +
+                                          " (it is complete in " + temp.string() + ")");
+    cleanup.dir.clear();
+    spdlog::info("wrote shard {}/{} ({} frames) to {}; when every shard is done: mirage merge {}",
+                 shard.index, shard.count, frames.size(), dir.string(), out.string());
+}
 
 void run(SynthArgs a) {
     const fs::path out(a.output);
@@ -68,6 +128,15 @@ void run(SynthArgs a) {
     a.o.environmentCamera = !a.noEnv;
     // The scene's path as given (made absolute): ground_truth.json names it for `mirage bench`.
     a.o.sceneName = fs::absolute(a.scene).lexically_normal().string();
+
+    const ShardSpec shard = a.shard.empty() ? ShardSpec{} : parseShardSpec(a.shard);
+    const ItemRange range = a.frames.empty() ? ItemRange{} : parseItemRange(a.frames);
+    const int total = raytrace::syntheticFrameCount(a.o);
+    const std::vector<int> selected = selectItems(total, range, shard);
+    if (!shard.whole() || int(selected.size()) != total) {
+        writeShard(a, scene, shard, range, total, selected);
+        return;
+    }
 
     // The session is written into a temporary folder beside OUT and moved into place when
     // complete: a failed or interrupted synth leaves no half-written session at OUT.
@@ -183,7 +252,14 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
                     "Linear change (camera units) that marks a pixel as influenced")
         ->capture_default_str()
         ->check(finiteIn(0, 1e6));
-    cmd->add_flag("--force", a->force, "Replace an existing session in the output folder");
+    cmd->add_option("--shard", a->shard,
+                    "Render part I of N (I/N, 0-based: every N-th frame from frame I) into "
+                    "OUT.shards/; join the parts with `mirage merge OUT` (docs/scale.md)");
+    cmd->add_option("--frames", a->frames,
+                    "Render only frames A to B-1 (A:B), as a shard; with --shard, the part of "
+                    "that range");
+    cmd->add_flag("--force", a->force,
+                  "Replace an existing session in the output folder (or an existing shard)");
     cmd->callback([a] { run(*a); });
 });
 

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/Error.h"
+#include "core/Timestamp.h"
 #include "core/session/AtomicFile.h"
 
 namespace mirage {
@@ -261,15 +262,6 @@ cv::Mat column(const std::vector<double>& v) {
     return cv::Mat(v, true);
 }
 
-std::string nowUtc() {
-    const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-    std::tm tm{};
-    gmtime_r(&t, &tm);
-    std::ostringstream ss;
-    ss << std::put_time(&tm, "%Y-%m-%dT%H:%M:%SZ");
-    return ss.str();
-}
-
 }  // namespace
 
 void saveCalibration(const std::filesystem::path& path, const CameraCalibration& c) {
@@ -280,7 +272,7 @@ void saveCalibration(const std::filesystem::path& path, const CameraCalibration&
     cv::FileStorage fs(
         ".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     // Key names and layout of OpenCV's camera calibration sample, so that OpenCV tools read it.
-    fs << "calibration_time" << nowUtc();
+    fs << "calibration_time" << utcTimestamp();
     fs << "nr_of_frames" << c.viewCount;
     fs << "image_width" << in.width;
     fs << "image_height" << in.height;

@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
+#include "core/Timestamp.h"
 #include "core/image/ImageIO.h"
 #include "core/session/AtomicFile.h"
 #include "core/session/FramesCsv.h"
@@ -46,17 +47,6 @@ struct SessionWriter::Impl {
     }
 };
 
-namespace {
-std::string nowUtc() {
-    const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-    std::tm tm{};
-    gmtime_r(&t, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
-}
-}  // namespace
-
 SessionWriter::SessionWriter(const std::filesystem::path& dir, Session meta, Options opts)
     : impl_(std::make_unique<Impl>()) {
     if (!(opts.fps > 0 && std::isfinite(opts.fps)))
@@ -86,7 +76,7 @@ SessionWriter::SessionWriter(const std::filesystem::path& dir, Session meta, Opt
         if (c.video.empty()) c.video = opts.imageSequence ? c.name : c.name + ".mkv";
     }
     if (s.createdBy.empty()) s.createdBy = "mirage";
-    if (s.createdAt.empty()) s.createdAt = nowUtc();
+    if (s.createdAt.empty()) s.createdAt = utcTimestamp();
     impl_->opts = opts;
 
     writeSessionJson(s);  // 1: the folder is a session before any footage exists

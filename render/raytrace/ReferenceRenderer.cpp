@@ -436,6 +436,13 @@ RenderResult render(const RayTracingScene& scene, const RenderCamera& camera,
     std::atomic<long long> nonFinite{0};
     RenderResult result;
     const int tilesX = (width + kTile - 1) / kTile, tilesY = (height + kTile - 1) / kTile;
+    const bool rowSubset = !settings.rows.empty();
+    const int stripsPerRow = (width + kTile * kTile - 1) / (kTile * kTile);
+    for (size_t i = 0; i < settings.rows.size(); ++i)
+        if (settings.rows[i] < 0 || settings.rows[i] >= height ||
+            (i > 0 && settings.rows[i] <= settings.rows[i - 1]))
+            throw Error("render: rows must be ascending and inside the image (0 to " +
+                        std::to_string(height - 1) + ")");
     auto start = std::chrono::steady_clock::now();
     float radius2 = r1 * r1;
 
@@ -449,10 +456,23 @@ RenderResult render(const RayTracingScene& scene, const RenderCamera& camera,
             photonMap = PhotonMap(std::move(photons), std::sqrt(radius2));
         }
         PathContext ctx{scene, usePhotons ? &photonMap : nullptr, settings.maxDepth};
-        parallelFor(tilesX * tilesY, threads, [&](int tile) {
-            int x0 = (tile % tilesX) * kTile, y0 = (tile / tilesX) * kTile;
-            for (int y = y0; y < std::min(height, y0 + kTile); ++y)
-                for (int x = x0; x < std::min(width, x0 + kTile); ++x) {
+        // Work items: square tiles, or for a subset of rows, strips of one row and kTile^2 pixels.
+        const int items = rowSubset ? int(settings.rows.size()) * stripsPerRow : tilesX * tilesY;
+        parallelFor(items, threads, [&](int item) {
+            int x0, y0, x1, y1;
+            if (rowSubset) {
+                y0 = settings.rows[size_t(item / stripsPerRow)];
+                y1 = y0 + 1;
+                x0 = (item % stripsPerRow) * kTile * kTile;
+                x1 = std::min(width, x0 + kTile * kTile);
+            } else {
+                x0 = (item % tilesX) * kTile;
+                y0 = (item / tilesX) * kTile;
+                x1 = std::min(width, x0 + kTile);
+                y1 = std::min(height, y0 + kTile);
+            }
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) {
                     size_t idx = size_t(y) * size_t(width) + size_t(x);
                     Rng rng(settings.seed, (uint64_t(pass) << 40) ^ uint64_t(idx));
                     glm::vec2 jitter = rng.uniform2();

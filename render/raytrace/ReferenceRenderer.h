@@ -11,6 +11,7 @@
 // thread count.
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -46,6 +47,10 @@ struct RenderSettings {
     float initialPhotonRadius = 0.0f;  // metres
     float radiusAlpha = 2.0f / 3.0f;   // Knaus-Zwicker radius reduction (0..1)
     bool caustics = true;              // false: photon map off (the path tracer alone)
+    // Image rows to trace, ascending (empty: all). Other rows stay zero. A pixel's samples depend
+    // on the seed, the pass and the pixel only, so a row comes out the same whichever rows are
+    // traced with it: the rows of a split render (`mirage render --shard`) join bit for bit.
+    std::vector<int> rows;
 };
 
 struct RenderResult {

@@ -2,12 +2,18 @@
 
 #include <chrono>
 #include <ctime>
+#include <memory>
+#include <optional>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include <fmt/format.h>
 
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/Timestamp.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "render/evaluation/GroundTruthComposite.h"
 #include "render/raytrace/ReferenceRenderer.h"
@@ -17,165 +23,357 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string isoNow() {
-    std::time_t t = std::time(nullptr);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-    return buf;
-}
-
 struct LinearFrame {
     cv::Mat radiance;  // CV_32FC3 linear
     cv::Mat coverage;  // CV_32F virtual coverage in [0, 1]
 };
 
-}  // namespace
+// Everything a synthetic run shares between its frames, and the rendering of one frame. Both the
+// whole session and a shard of it are written from this, so a frame comes out the same either
+// way: its seeds depend on the frame number only.
+class SyntheticRun {
+public:
+    SyntheticRun(const Scene& scene, const SyntheticSessionOptions& optionsIn) : a_(optionsIn) {
+        if (!(a_.fps > 0) || !(a_.seconds > 0))
+            throw Error("synthetic session: --fps and --seconds must be positive");
+        if (a_.samplesPerPixel < 1) throw Error("synthetic session: --spp must be >= 1");
+        if (a_.shutter < 0 || a_.shutter > 1)
+            throw Error("synthetic session: --shutter must be in [0, 1] (fraction of a frame)");
+        if (a_.groundTruthComposite && !scene.hasVirtual())
+            throw Error(
+                "synthetic session: the scene has no virtual object, so there is no ground-truth "
+                "composite to write (it would equal the footage); drop --ground-truth-composite "
+                "or use a scene with virtual nodes");
+        device_ = std::make_unique<EmbreeDevice>(
+            a_.threads > 0 ? fmt::format("threads={}", a_.threads) : "");
+        // The footage shows the real world only: L_r's scene (real geometry, real lights,
+        // environment).
+        realScene_ = std::make_unique<RayTracingScene>(scene, SceneSubset::RealOnly, *device_);
+        if (a_.groundTruthComposite)
+            mixedScene_ = std::make_unique<RayTracingScene>(scene, SceneSubset::All, *device_);
 
-void writeSyntheticSession(const Scene& scene, const fs::path& out,
-                           const SyntheticSessionOptions& optionsIn,
-                           const SynthProgress& progress) {
-    SyntheticSessionOptions a = optionsIn;
-    if (!(a.fps > 0) || !(a.seconds > 0))
-        throw Error("synthetic session: --fps and --seconds must be positive");
-    if (a.samplesPerPixel < 1) throw Error("synthetic session: --spp must be >= 1");
-    if (a.shutter < 0 || a.shutter > 1)
-        throw Error("synthetic session: --shutter must be in [0, 1] (fraction of a frame)");
-    if (a.groundTruthComposite && !scene.hasVirtual())
-        throw Error(
-            "synthetic session: the scene has no virtual object, so there is no ground-truth "
-            "composite to write (it would equal the footage); drop --ground-truth-composite or "
-            "use a scene with virtual nodes");
+        mainK_ = pinholeFromHorizontalFov(a_.width, a_.height, a_.hfovDeg);
+        envK_ = equidistantFisheye(a_.envSize, a_.envFovDeg);
+        // The environment camera sits behind the board at table height, looking straight up
+        // (OpenCV axes: +Z = world +Y, +X = world +X, image down = world -Z).
+        T_world_env_ = Pose::fromRotationTranslation(glm::dmat3(1, 0, 0, 0, 0, -1, 0, 1, 0),
+                                                     glm::dvec3(0.0, 0.02, -0.40));
 
-    EmbreeDevice device(a.threads > 0 ? fmt::format("threads={}", a.threads) : "");
-    // The footage shows the real world only: L_r's scene (real geometry, real lights, environment).
-    RayTracingScene realScene(scene, SceneSubset::RealOnly, device);
-    std::unique_ptr<RayTracingScene> mixedScene;
-    if (a.groundTruthComposite)
-        mixedScene = std::make_unique<RayTracingScene>(scene, SceneSubset::All, device);
+        meta_.fps = a_.fps;
+        const std::string ext = a_.imageSequence ? "" : ".mkv";
+        meta_.cameras.push_back({"main", "main" + ext, "main.yaml", "main"});
+        if (a_.environmentCamera)
+            meta_.cameras.push_back({"env", "env" + ext, "env.yaml", "environment"});
+        meta_.board = a_.boardFile.empty() ? "" : "board.json";
+        meta_.createdBy = fmt::format("mirage synth {} ({}x{}, {} spp, seed {})",
+                                      fs::path(a_.sceneName).filename().string(), a_.width,
+                                      a_.height, a_.samplesPerPixel, a_.seed);
+        writerOptions_.fps = a_.fps;
+        writerOptions_.imageSequence = a_.imageSequence;
+        writerOptions_.jpegQuality = 92;
 
-    const CameraIntrinsics mainK = pinholeFromHorizontalFov(a.width, a.height, a.hfovDeg);
-    const CameraIntrinsics envK = equidistantFisheye(a.envSize, a.envFovDeg);
-    // The environment camera sits behind the board at table height, looking straight up
-    // (OpenCV axes: +Z = world +Y, +X = world +X, image down = world -Z).
-    const Pose T_world_env = Pose::fromRotationTranslation(glm::dmat3(1, 0, 0, 0, 0, -1, 0, 1, 0),
-                                                           glm::dvec3(0.0, 0.02, -0.40));
+        st_.samplesPerPixel = a_.samplesPerPixel;
+        st_.threads = a_.threads;
+        frames_ = syntheticFrameCount(a_);
+        duration_ = frames_ / a_.fps;
+        a_.path.duration = duration_;
+        a_.path.seed = a_.seed;
 
-    Session meta;
-    meta.fps = a.fps;
-    const std::string ext = a.imageSequence ? "" : ".mkv";
-    meta.cameras.push_back({"main", "main" + ext, "main.yaml", "main"});
-    if (a.environmentCamera)
-        meta.cameras.push_back({"env", "env" + ext, "env.yaml", "environment"});
-    meta.board = a.boardFile.empty() ? "" : "board.json";
-    meta.createdBy = fmt::format("mirage synth {} ({}x{}, {} spp, seed {})",
-                                 fs::path(a.sceneName).filename().string(), a.width, a.height,
-                                 a.samplesPerPixel, a.seed);
-    meta.createdAt = isoNow();
-    SessionWriter::Options wopts;
-    wopts.fps = a.fps;
-    wopts.imageSequence = a.imageSequence;
-    wopts.jpegQuality = 92;
-    SessionWriter writer(out, meta, wopts);
+        gtInfo_.scene = a_.sceneName;
+        gtInfo_.influenceThreshold = a_.influenceThreshold;
+        gtInfo_.samplesPerPixel = a_.samplesPerPixel;
+        gtInfo_.seed = a_.seed;
 
-    CameraCalibration mainCal;
-    mainCal.intrinsics = mainK;
-    mainCal.avgReprojectionError = 0.0;  // exact by construction
-    saveCalibration(out / "main.yaml", mainCal);
-    if (a.environmentCamera) {
-        CameraCalibration envCal;
-        envCal.intrinsics = envK;
-        envCal.avgReprojectionError = 0.0;
-        envCal.T_parent_camera = T_world_env;
-        envCal.extrinsicParent = "world";
-        saveCalibration(out / "env.yaml", envCal);
-    }
-    if (!a.boardFile.empty())
-        fs::copy_file(a.boardFile, out / "board.json", fs::copy_options::overwrite_existing);
-
-    RenderSettings st;
-    st.samplesPerPixel = a.samplesPerPixel;
-    st.threads = a.threads;
-    const int frames = std::max(1, int(std::lround(a.seconds * a.fps)));
-    const double duration = frames / a.fps;
-    a.path.duration = duration;
-    a.path.seed = a.seed;
-
-    mirage::render::GroundTruthInfo gtInfo;
-    gtInfo.scene = a.sceneName;
-    gtInfo.influenceThreshold = a.influenceThreshold;
-    gtInfo.samplesPerPixel = a.samplesPerPixel;
-    gtInfo.seed = a.seed;
-    if (a.groundTruthComposite) writeGroundTruthInfo(out, gtInfo);
-
-    cv::Mat envLinear;
-    if (a.environmentCamera) {
-        // The scene is static, so one environment render serves every frame (sensor noise differs).
-        RenderSettings es = st;
-        es.seed = a.seed + 7777;
-        envLinear = render(realScene, RenderCamera{envK, T_world_env}, es).radiance;
-    }
-
-    // One frame of a scene subset at time t, exactly as the footage is made: the same seeds for
-    // L_r and L_rv, so where no path touches a virtual object the two renders are identical.
-    auto renderFrame = [&](const RayTracingScene& rt, int f, double t) {
-        LinearFrame lf;
-        if (a.shutter > 0 && a.blurSubframes > 1) {
-            // Motion blur: average renders over the open shutter, centred on t (the ground truth).
-            lf.radiance = cv::Mat::zeros(a.height, a.width, CV_32FC3);
-            lf.coverage = cv::Mat::zeros(a.height, a.width, CV_32F);
-            RenderSettings sub = st;
-            sub.samplesPerPixel = std::max(1, a.samplesPerPixel / a.blurSubframes);
-            for (int s = 0; s < a.blurSubframes; ++s) {
-                const double ts = t + ((s + 0.5) / a.blurSubframes - 0.5) * a.shutter / a.fps;
-                sub.seed = a.seed + uint64_t(f) * 1000 + uint64_t(s);
-                RenderResult r = render(rt, RenderCamera{mainK, cameraPathPose(a.path, ts)}, sub);
-                lf.radiance += r.radiance / double(a.blurSubframes);
-                lf.coverage += r.virtualCoverage / double(a.blurSubframes);
-            }
-        } else {
-            st.seed = a.seed + uint64_t(f) * 1000;
-            RenderResult r = render(rt, RenderCamera{mainK, cameraPathPose(a.path, t)}, st);
-            lf.radiance = std::move(r.radiance);
-            lf.coverage = std::move(r.virtualCoverage);
+        if (a_.environmentCamera) {
+            // The scene is static, so one environment render serves every frame (sensor noise
+            // differs).
+            RenderSettings es = st_;
+            es.seed = a_.seed + 7777;
+            envLinear_ = render(*realScene_, RenderCamera{envK_, T_world_env_}, es).radiance;
         }
-        return lf;
+    }
+
+    int frames() const { return frames_; }
+    const Session& meta() const { return meta_; }
+    const SessionWriter::Options& writerOptions() const { return writerOptions_; }
+    const render::GroundTruthInfo& groundTruthInfo() const { return gtInfo_; }
+    std::string segment(int f) const { return cameraPathSegment(a_.path, f / a_.fps); }
+
+    // Calibration files, the board and ground_truth.json: the same for every frame.
+    void writeStaticFiles(const fs::path& dir) const {
+        CameraCalibration mainCal;
+        mainCal.intrinsics = mainK_;
+        mainCal.avgReprojectionError = 0.0;  // exact by construction
+        saveCalibration(dir / "main.yaml", mainCal);
+        if (a_.environmentCamera) {
+            CameraCalibration envCal;
+            envCal.intrinsics = envK_;
+            envCal.avgReprojectionError = 0.0;
+            envCal.T_parent_camera = T_world_env_;
+            envCal.extrinsicParent = "world";
+            saveCalibration(dir / "env.yaml", envCal);
+        }
+        if (!a_.boardFile.empty())
+            fs::copy_file(a_.boardFile, dir / "board.json", fs::copy_options::overwrite_existing);
+        if (a_.groundTruthComposite) writeGroundTruthInfo(dir, gtInfo_);
+    }
+
+    struct Frame {
+        std::vector<cv::Mat> images;  // one per camera, 8-bit BGR
+        std::vector<double> times;
+        Pose groundTruth;
+        std::optional<render::GroundTruthFrame> composite;
     };
 
-    for (int f = 0; f < frames; ++f) {
-        const double t = f / a.fps;
-        const Pose gt = cameraPathPose(a.path, t);
-        const LinearFrame real = renderFrame(realScene, f, t);
-        const double exposure = exposureAt(a.sensor, t, duration);
-        const uint64_t noiseSeed = a.seed * 31 + uint64_t(f);
-        std::vector<cv::Mat> images{applySensor(real.radiance, a.sensor, exposure, noiseSeed)};
-        std::vector<double> times{t};
-        if (a.environmentCamera) {
-            images.push_back(
-                applySensor(envLinear, a.sensor, a.sensor.exposure, a.seed * 37 + uint64_t(f)));
-            times.push_back(t);
+    Frame renderFrame(int f) {
+        const double t = f / a_.fps;
+        Frame out;
+        out.groundTruth = cameraPathPose(a_.path, t);
+        const LinearFrame real = renderSubset(*realScene_, f, t);
+        const double exposure = exposureAt(a_.sensor, t, duration_);
+        const uint64_t noiseSeed = a_.seed * 31 + uint64_t(f);
+        out.images.push_back(applySensor(real.radiance, a_.sensor, exposure, noiseSeed));
+        out.times.push_back(t);
+        if (a_.environmentCamera) {
+            out.images.push_back(
+                applySensor(envLinear_, a_.sensor, a_.sensor.exposure, a_.seed * 37 + uint64_t(f)));
+            out.times.push_back(t);
         }
-        if (a.groundTruthComposite) {
+        if (a_.groundTruthComposite) {
             // Ground truth: the camera filming the mixed world. The footage is CI = S(L_r) with
             // the sensor S (gain g = exposure x vignette, then noise and 8-bit sRGB encoding), so
             // the reference's differential composite CI + (CI / L_r)(L_rv - L_r) = g L_rv + noise
             // = S(L_rv) wherever the sensor is linear: the same sensor (same noise draws) applied
-            // to L_rv is that composite, and where the sensor clips it is what a camera would show.
-            const LinearFrame mixed = renderFrame(*mixedScene, f, t);
-            mirage::render::GroundTruthFrame g;
-            g.compositeSrgb = applySensor(mixed.radiance, a.sensor, exposure, noiseSeed);
-            g.influence = mirage::render::influenceMask(
-                real.radiance, mixed.radiance, mixed.coverage, exposure, a.influenceThreshold);
-            // Frame f is row f of frames.csv (SessionWriter numbers frames from 0).
-            writeGroundTruthFrame(out, gtInfo, f, g);
+            // to L_rv is that composite, and where the sensor clips it is what a camera would
+            // show.
+            const LinearFrame mixed = renderSubset(*mixedScene_, f, t);
+            render::GroundTruthFrame g;
+            g.compositeSrgb = applySensor(mixed.radiance, a_.sensor, exposure, noiseSeed);
+            g.influence = render::influenceMask(real.radiance, mixed.radiance, mixed.coverage,
+                                                exposure, a_.influenceThreshold);
+            out.composite = std::move(g);
         }
-        writer.append(images, times, gt);
-        if (progress) progress(f + 1, frames, cameraPathSegment(a.path, t));
+        return out;
+    }
+
+private:
+    // One frame of a scene subset at time t, exactly as the footage is made: the same seeds for
+    // L_r and L_rv, so where no path touches a virtual object the two renders are identical.
+    LinearFrame renderSubset(const RayTracingScene& rt, int f, double t) {
+        LinearFrame lf;
+        RenderSettings st = st_;
+        if (a_.shutter > 0 && a_.blurSubframes > 1) {
+            // Motion blur: average renders over the open shutter, centred on t (the ground truth).
+            lf.radiance = cv::Mat::zeros(a_.height, a_.width, CV_32FC3);
+            lf.coverage = cv::Mat::zeros(a_.height, a_.width, CV_32F);
+            st.samplesPerPixel = std::max(1, a_.samplesPerPixel / a_.blurSubframes);
+            for (int s = 0; s < a_.blurSubframes; ++s) {
+                const double ts = t + ((s + 0.5) / a_.blurSubframes - 0.5) * a_.shutter / a_.fps;
+                st.seed = a_.seed + uint64_t(f) * 1000 + uint64_t(s);
+                RenderResult r = render(rt, RenderCamera{mainK_, cameraPathPose(a_.path, ts)}, st);
+                lf.radiance += r.radiance / double(a_.blurSubframes);
+                lf.coverage += r.virtualCoverage / double(a_.blurSubframes);
+            }
+        } else {
+            st.seed = a_.seed + uint64_t(f) * 1000;
+            RenderResult r = render(rt, RenderCamera{mainK_, cameraPathPose(a_.path, t)}, st);
+            lf.radiance = std::move(r.radiance);
+            lf.coverage = std::move(r.virtualCoverage);
+        }
+        return lf;
+    }
+
+    SyntheticSessionOptions a_;
+    std::unique_ptr<EmbreeDevice> device_;
+    std::unique_ptr<RayTracingScene> realScene_, mixedScene_;
+    CameraIntrinsics mainK_, envK_;
+    Pose T_world_env_;
+    Session meta_;
+    SessionWriter::Options writerOptions_;
+    RenderSettings st_;
+    int frames_ = 0;
+    double duration_ = 0;
+    render::GroundTruthInfo gtInfo_;
+    cv::Mat envLinear_;
+};
+
+std::string framePng(const std::string& camera, int frame) {
+    return fmt::format("{}/{:06d}.png", camera, frame);
+}
+
+nlohmann::json poseJson(const Pose& p) {
+    return {p.translation.x, p.translation.y, p.translation.z, p.rotation.w,
+            p.rotation.x,    p.rotation.y,    p.rotation.z};
+}
+
+Pose poseFromJson(const nlohmann::json& j) {
+    Pose p;
+    p.translation = {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+    p.rotation = glm::dquat(j.at(3).get<double>(), j.at(4).get<double>(), j.at(5).get<double>(),
+                            j.at(6).get<double>());
+    return p;
+}
+
+}  // namespace
+
+int syntheticFrameCount(const SyntheticSessionOptions& a) {
+    return std::max(1, int(std::lround(a.seconds * a.fps)));
+}
+
+std::string syntheticFingerprint(const SyntheticSessionOptions& a, uint64_t sceneBytes,
+                                 uint64_t boardBytes) {
+    // Every option that changes a frame; the scene and board by their bytes. Threads and the
+    // output format (MKV or PNG folder) change no pixel but the latter changes the merge, so it
+    // is included; threads are not.
+    const std::string all = fmt::format(
+        "{}x{} hfov {:.17g} fps {:.17g} s {:.17g} spp {} seed {} shutter {:.17g} sub {} env {} "
+        "{} {:.17g} seq {} gt {} thr {:.17g} sensor {:.17g} {} {:.17g} {:.17g} path {:.17g} "
+        "{:.17g} {:.17g} {:.17g} scene {} board {}",
+        a.width, a.height, a.hfovDeg, a.fps, a.seconds, a.samplesPerPixel, a.seed, a.shutter,
+        a.blurSubframes, a.environmentCamera, a.envSize, a.envFovDeg, a.imageSequence,
+        a.groundTruthComposite, a.influenceThreshold, a.sensor.exposure, a.sensor.exposureChange,
+        a.sensor.vignette, a.sensor.noise, a.path.radius, a.path.height, a.path.panDeg,
+        a.path.shakeTranslation, hex64(sceneBytes), hex64(boardBytes));
+    return hex64(fingerprint64(all));
+}
+
+void writeSyntheticSession(const Scene& scene, const fs::path& out,
+                           const SyntheticSessionOptions& a, const SynthProgress& progress) {
+    SyntheticRun run(scene, a);
+    Session meta = run.meta();
+    meta.createdAt = utcTimestamp();
+    SessionWriter writer(out, meta, run.writerOptions());
+    run.writeStaticFiles(out);
+    const int frames = run.frames();
+    for (int f = 0; f < frames; ++f) {
+        SyntheticRun::Frame frame = run.renderFrame(f);
+        // Frame f is row f of frames.csv (SessionWriter numbers frames from 0).
+        if (frame.composite) writeGroundTruthFrame(out, run.groundTruthInfo(), f, *frame.composite);
+        writer.append(frame.images, frame.times, frame.groundTruth);
+        if (progress) progress(f + 1, frames, run.segment(f));
     }
     writer.close();
     spdlog::info("wrote session {} ({} frames at {} fps, {}x{}{}{})", out.string(), frames, a.fps,
                  a.width, a.height,
                  a.environmentCamera ? fmt::format(", fish-eye {}x{}", a.envSize, a.envSize) : "",
                  a.groundTruthComposite ? ", ground-truth composite" : "");
+}
+
+nlohmann::json writeSyntheticShard(const Scene& scene, const fs::path& dir,
+                                   const SyntheticSessionOptions& a, const std::vector<int>& frames,
+                                   const SynthProgress& progress) {
+    SyntheticRun run(scene, a);
+    fs::create_directories(dir);
+    for (const SessionCamera& c : run.meta().cameras) fs::create_directories(dir / c.name);
+    run.writeStaticFiles(dir);
+    nlohmann::json perFrame = nlohmann::json::object();
+    int done = 0;
+    for (int f : frames) {
+        if (f < 0 || f >= run.frames())
+            throw Error(
+                fmt::format("synthetic shard: frame {} is outside 0..{}", f, run.frames() - 1));
+        SyntheticRun::Frame frame = run.renderFrame(f);
+        // PNG keeps the 8-bit images exactly, so the merge encodes the very bytes the whole run
+        // would have encoded.
+        for (size_t c = 0; c < frame.images.size(); ++c)
+            writeBgr8(dir / framePng(run.meta().cameras[c].name, f), frame.images[c]);
+        if (frame.composite) writeGroundTruthFrame(dir, run.groundTruthInfo(), f, *frame.composite);
+        // JSON numbers are written with the shortest exact representation: times and poses
+        // come back bit for bit.
+        perFrame[std::to_string(f)] = {{"times", frame.times},
+                                       {"ground_truth", poseJson(frame.groundTruth)}};
+        if (progress) progress(++done, int(frames.size()), run.segment(f));
+    }
+    nlohmann::json cameras = nlohmann::json::array();
+    for (const SessionCamera& c : run.meta().cameras)
+        cameras.push_back({{"name", c.name},
+                           {"video", c.video},
+                           {"calibration", c.calibration},
+                           {"role", c.role}});
+    return {{"fps", a.fps},
+            {"frames_total", run.frames()},
+            {"cameras", cameras},
+            {"board", run.meta().board},
+            {"created_by", run.meta().createdBy},
+            {"image_sequence", run.writerOptions().imageSequence},
+            {"jpeg_quality", run.writerOptions().jpegQuality},
+            {"ground_truth_composite", a.groundTruthComposite},
+            {"frames", perFrame}};
+}
+
+void mergeSyntheticShards(const ShardSet& set, const fs::path& out, const SynthProgress& progress) {
+    const ShardManifest& first = set.shards.front();
+    const nlohmann::json& p = first.payload;
+    const fs::path firstDir = set.folders.front();
+    try {
+        Session meta;
+        meta.fps = p.at("fps").get<double>();
+        for (const auto& c : p.at("cameras"))
+            meta.cameras.push_back(
+                {c.at("name").get<std::string>(), c.at("video").get<std::string>(),
+                 c.at("calibration").get<std::string>(), c.at("role").get<std::string>()});
+        meta.board = p.at("board").get<std::string>();
+        meta.createdBy = p.at("created_by").get<std::string>();
+        // The run's creation time: its earliest shard's.
+        meta.createdAt = first.createdAt;
+        for (const ShardManifest& m : set.shards)
+            meta.createdAt = std::min(meta.createdAt, m.createdAt);
+        SessionWriter::Options wopts;
+        wopts.fps = meta.fps;
+        wopts.imageSequence = p.at("image_sequence").get<bool>();
+        wopts.jpegQuality = p.at("jpeg_quality").get<int>();
+        const bool groundTruth = p.at("ground_truth_composite").get<bool>();
+
+        SessionWriter writer(out, meta, wopts);
+        // Static files are the same in every shard (same fingerprint): take the first shard's.
+        for (const SessionCamera& c : meta.cameras)
+            if (!c.calibration.empty())
+                fs::copy_file(firstDir / c.calibration, out / c.calibration,
+                              fs::copy_options::overwrite_existing);
+        if (!meta.board.empty())
+            fs::copy_file(firstDir / meta.board, out / meta.board,
+                          fs::copy_options::overwrite_existing);
+        std::optional<render::GroundTruthInfo> gtInfo;
+        if (groundTruth) {
+            gtInfo = render::readGroundTruthInfo(firstDir);
+            if (!gtInfo)
+                throw FileError((firstDir / "ground_truth.json").string(),
+                                "missing: the shard is incomplete (rerun it)");
+            writeGroundTruthInfo(out, *gtInfo);
+        }
+        const int total = first.range.end - first.range.begin;
+        for (int f = first.range.begin; f < first.range.end; ++f) {
+            const size_t s = size_t(set.owner[size_t(f)]);
+            const fs::path dir = set.folders[s];
+            const nlohmann::json& rec = set.shards[s].payload.at("frames").at(std::to_string(f));
+            std::vector<cv::Mat> images;
+            for (const SessionCamera& c : meta.cameras) {
+                const fs::path png = dir / framePng(c.name, f);
+                cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+                if (img.empty())
+                    throw FileError(png.string(), "missing or unreadable: rerun this shard");
+                images.push_back(std::move(img));
+            }
+            if (gtInfo) {
+                std::optional<render::GroundTruthFrame> g =
+                    render::readGroundTruthFrame(dir, *gtInfo, f);
+                if (!g)
+                    throw FileError(dir.string(),
+                                    fmt::format("ground truth of frame {} is missing: "
+                                                "rerun this shard",
+                                                f));
+                // Frames of a --frames range are renumbered from 0, as in the session.
+                writeGroundTruthFrame(out, *gtInfo, f - first.range.begin, *g);
+            }
+            writer.append(images, rec.at("times").get<std::vector<double>>(),
+                          poseFromJson(rec.at("ground_truth")));
+            if (progress) progress(f - first.range.begin + 1, total, "merge");
+        }
+        writer.close();
+    } catch (const nlohmann::json::exception& e) {
+        throw FileError((firstDir / "shard.json").string(),
+                        std::string("payload is malformed: ") + e.what());
+    }
 }
 
 }  // namespace mirage::raytrace

@@ -9,7 +9,11 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "core/Shards.h"
 #include "core/scene/Scene.h"
 #include "render/raytrace/SyntheticFootage.h"
 
@@ -47,5 +51,29 @@ using SynthProgress = std::function<void(int done, int total, const std::string&
 void writeSyntheticSession(const Scene& scene, const std::filesystem::path& out,
                            const SyntheticSessionOptions& options,
                            const SynthProgress& progress = {});
+
+// Frames of the session: round(seconds x fps), at least 1.
+int syntheticFrameCount(const SyntheticSessionOptions& options);
+
+// Fingerprint of everything that changes the frames (options, the scene's and the board's
+// bytes): shards of one run share it, so shards of different runs are never merged.
+std::string syntheticFingerprint(const SyntheticSessionOptions& options, uint64_t sceneBytes,
+                                 uint64_t boardBytes);
+
+// A shard of the session (core/Shards.h): renders only `frames` (frame numbers of the whole
+// session) into `dir`: calibration, board and ground_truth.json as the session has them, each
+// camera's images as lossless PNG (<camera>/<frame>.png), the ground-truth composites under
+// their frame numbers. Returns the manifest payload: the session's metadata and writer settings,
+// and per frame its timestamps and ground-truth pose.
+nlohmann::json writeSyntheticShard(const Scene& scene, const std::filesystem::path& dir,
+                                   const SyntheticSessionOptions& options,
+                                   const std::vector<int>& frames,
+                                   const SynthProgress& progress = {});
+
+// Joins the shards of a synth run (collectShards checked that they are complete) into the
+// session `out` (which must not hold a session), in frame order, encoding each frame as the
+// whole run does: every file but session.json's creation time equals the whole run's.
+void mergeSyntheticShards(const ShardSet& shards, const std::filesystem::path& out,
+                          const SynthProgress& progress = {});
 
 }  // namespace mirage::raytrace

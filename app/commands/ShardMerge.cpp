@@ -1,0 +1,115 @@
+#include "app/commands/ShardMerge.h"
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "app/Command.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/OutputFile.h"
+#include "core/image/ImageIO.h"
+
+namespace mirage::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* const kBufferSuffixes[] = {"_Lr.exr", "_Lrv.exr", "_coverage.exr"};
+const char* const kBufferFiles[] = {"Lr.exr", "Lrv.exr", "coverage.exr"};
+
+// The rows `rows` of `full`, stacked.
+cv::Mat takeRows(const cv::Mat& full, const std::vector<int>& rows) {
+    cv::Mat out(int(rows.size()), full.cols, full.type());
+    for (size_t i = 0; i < rows.size(); ++i) full.row(rows[i]).copyTo(out.row(int(i)));
+    return out;
+}
+
+}  // namespace
+
+void writeRenderShard(const fs::path& out, const RenderShard& rs) {
+    const fs::path dir = shardFolder(out, rs.shard);
+    fs::create_directories(dir.parent_path());
+    fs::path temp = dir;
+    temp += ".partial-" + std::to_string(::getpid());
+    std::error_code ec;
+    fs::remove_all(temp, ec);
+    fs::create_directories(temp);
+    // EXR float keeps every value exactly, whatever the final format.
+    writeLinearRgb(temp / "image.exr", takeRows(rs.image, rs.rows), 1.0f);
+    for (size_t k = 0; k < rs.buffers.size(); ++k)
+        writeLinearRgb(temp / kBufferFiles[k], takeRows(rs.buffers[k], rs.rows), 1.0f);
+    ShardManifest m;
+    m.command = "render";
+    m.unit = "rows";
+    m.shard = rs.shard;
+    m.total = rs.image.rows;
+    m.range = rs.range;
+    m.items = rs.rows;
+    m.fingerprint = rs.fingerprint;
+    m.commandLine = commandLine();
+    m.payload = {{"width", rs.image.cols},
+                 {"height", rs.image.rows},
+                 {"exposure", rs.exposure},
+                 {"buffers", !rs.buffers.empty()}};
+    writeShardManifest(temp, m);
+    fs::remove_all(dir, ec);
+    fs::rename(temp, dir, ec);
+    if (ec)
+        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message());
+    spdlog::info("wrote shard {}/{} ({} rows) to {}; when every shard is done: mirage merge {}",
+                 rs.shard.index, rs.shard.count, rs.rows.size(), dir.string(), out.string());
+}
+
+void mergeRenderShards(const ShardSet& set, const fs::path& out, const fs::path& temp) {
+    const ShardManifest& first = set.shards.front();
+    const fs::path manifest = set.folders.front() / "shard.json";
+    int width = 0, height = 0;
+    float exposure = 1.0f;
+    bool buffers = false;
+    try {
+        width = first.payload.at("width").get<int>();
+        height = first.payload.at("height").get<int>();
+        exposure = first.payload.at("exposure").get<float>();
+        buffers = first.payload.at("buffers").get<bool>();
+    } catch (const nlohmann::json::exception& e) {
+        throw FileError(manifest.string(), std::string("payload is malformed: ") + e.what());
+    }
+    if (width < 1 || height != first.total)
+        throw FileError(manifest.string(), "payload 'width'/'height' do not match 'total'");
+    if (first.range.begin != 0 || first.range.end != height)
+        throw Error(fmt::format(
+            "mirage merge: the shards cover rows {}:{} of {}, not the whole image; an image needs "
+            "every row (render the rest, or crop after merging)",
+            first.range.begin, first.range.end, height));
+    const size_t images = buffers ? 4 : 1;
+    std::vector<cv::Mat> full(images);
+    for (auto& m : full) m = cv::Mat::zeros(height, width, CV_32FC3);
+    for (size_t s = 0; s < set.shards.size(); ++s) {
+        const std::vector<int>& rows = set.shards[s].items;
+        for (size_t k = 0; k < images; ++k) {
+            const fs::path file = set.folders[s] / (k == 0 ? "image.exr" : kBufferFiles[k - 1]);
+            const cv::Mat part = readLinearRgb(file);
+            if (part.rows != int(rows.size()) || part.cols != width)
+                throw FileError(file.string(),
+                                fmt::format("is {}x{}, the manifest says {}x{}: rerun this shard",
+                                            part.cols, part.rows, width, rows.size()));
+            for (size_t i = 0; i < rows.size(); ++i) part.row(int(i)).copyTo(full[k].row(rows[i]));
+        }
+    }
+    std::string ext = out.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    writeLinearRgb(temp, full[0], ext == ".png" ? exposure : 1.0f);
+    if (buffers) {
+        const OutputRule rule{{}, true, "mirage merge"};
+        const fs::path stem = out.parent_path() / out.stem();
+        for (size_t k = 1; k < images; ++k) {
+            OutputFile f(stem.string() + kBufferSuffixes[k - 1], OutputOrigin::Derived, rule);
+            writeLinearRgb(f.temp(), full[k], 1.0f);
+            f.commit();
+        }
+    }
+}
+
+}  // namespace mirage::app

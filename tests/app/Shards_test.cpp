@@ -1,0 +1,151 @@
+// Split runs joined by `mirage merge` equal the unsplit run bit for bit (docs/scale.md):
+// `mirage synth` split by frames, `mirage render` split by rows. Tiny sizes keep it to seconds.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include <fstream>
+#include <iterator>
+
+#include "core/Shards.h"
+#include "tests/support/TestSupport.h"
+
+namespace mirage {
+namespace {
+
+namespace fs = std::filesystem;
+using test::runMirage;
+
+std::string scene() {
+    return (test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
+}
+
+std::string bytesOf(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    EXPECT_TRUE(in) << p;
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Every file of `a` equals the same file of `b`, byte for byte (creation times included: the
+// tests fix them with SOURCE_DATE_EPOCH). Returns the number of files compared.
+int expectSameTree(const fs::path& a, const fs::path& b) {
+    int files = 0;
+    for (const auto& e : fs::recursive_directory_iterator(a)) {
+        if (!e.is_regular_file()) continue;
+        const fs::path rel = fs::relative(e.path(), a);
+        EXPECT_TRUE(fs::exists(b / rel)) << rel << " is missing from " << b;
+        if (!fs::exists(b / rel)) continue;
+        ++files;
+        EXPECT_TRUE(bytesOf(e.path()) == bytesOf(b / rel)) << rel << " differs";
+    }
+    return files;
+}
+
+std::vector<std::string> synthArgs(const fs::path& out) {
+    return {"synth",
+            scene(),
+            "-o",
+            out.string(),
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--fps",
+            "5",
+            "--seconds",
+            "1",
+            "--spp",
+            "2",
+            "--env-size",
+            "32",
+            "--noise",
+            "0.01",
+            "--ground-truth-composite",
+            "--threads",
+            "2"};
+}
+
+TEST(ShardedRuns, SynthShardsMergeToTheWholeSessionBitForBit) {
+    // Creation times from the reproducible-builds clock, so that they are equal too; without it
+    // the files differ by those times only (session.json, calibration YAML).
+    ::setenv("SOURCE_DATE_EPOCH", "1764547200", 1);
+    const fs::path dir = test::outputDir("shards_synth");
+    fs::remove_all(dir);
+    const fs::path whole = dir / "whole", split = dir / "split";
+    auto r = runMirage(synthArgs(whole));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (int i : {2, 0, 1}) {  // any order, as a cluster runs them
+        auto args = synthArgs(split);
+        args.insert(args.end(), {"--shard", std::to_string(i) + "/3"});
+        r = runMirage(args);
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(split)) << "a shard wrote the session itself";
+    r = runMirage({"merge", split.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_FALSE(fs::exists(shardsFolder(split))) << "the shards were kept without --keep-shards";
+    // main.mkv, env.mkv, frames.csv, calibration, board, ground truth: 5 frames x 2 + 6 files.
+    EXPECT_GE(expectSameTree(whole, split), 16);
+    EXPECT_EQ(expectSameTree(split, whole), expectSameTree(whole, split));
+    ::unsetenv("SOURCE_DATE_EPOCH");
+}
+
+TEST(ShardedRuns, MissingOrForeignShardsAreNamedNotMerged) {
+    const fs::path dir = test::outputDir("shards_synth_missing");
+    fs::remove_all(dir);
+    const fs::path split = dir / "split";
+    auto args = synthArgs(split);
+    args.insert(args.end(), {"--shard", "1/2"});
+    ASSERT_EQ(runMirage(args).exitCode, 0);
+    auto r = runMirage({"merge", split.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("3 of 5 frames are missing (0, 2, 4)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--shard 0/2"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(split));
+    // The other half with another seed is another run: refused, nothing written.
+    args = synthArgs(split);
+    args.insert(args.end(), {"--shard", "0/2", "--seed", "9"});
+    ASSERT_EQ(runMirage(args).exitCode, 0);
+    r = runMirage({"merge", split.string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("another run"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(split));
+    // Rendering a finished shard again needs --force.
+    r = runMirage(args);
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("already complete"), std::string::npos) << r.output;
+}
+
+TEST(ShardedRuns, RenderRowShardsMergeToTheWholeImageBitForBit) {
+    const fs::path dir = test::outputDir("shards_render");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    for (const char* ext : {".exr", ".png"}) {
+        const std::vector<std::string> base = {"render",  scene(),     "--camera",  "main",
+                                               "--width", "40",        "--spp",     "3",
+                                               "--mode",  "composite", "--threads", "2"};
+        const fs::path whole = dir / (std::string("whole") + ext);
+        const fs::path split = dir / (std::string("split") + ext);
+        auto args = base;
+        args.insert(args.end(), {"-o", whole.string()});
+        auto r = runMirage(args);
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        for (int i = 0; i < 3; ++i) {
+            args = base;
+            args.insert(args.end(), {"-o", split.string(), "--shard", std::to_string(i) + "/3"});
+            r = runMirage(args);
+            ASSERT_EQ(r.exitCode, 0) << r.output;
+        }
+        r = runMirage({"merge", split.string()});
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        EXPECT_TRUE(bytesOf(whole) == bytesOf(split)) << ext << ": merged image differs";
+    }
+    // A time budget cannot be split.
+    auto r = runMirage({"render", scene(), "--camera", "main", "--seconds", "1", "-o",
+                        (dir / "t.exr").string(), "--shard", "0/2"});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("fixed --spp"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mirage

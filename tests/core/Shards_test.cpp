@@ -1,0 +1,133 @@
+// Splitting work into shards: the specs, the item selection, and the checks that a set of
+// shards is one whole run (core/Shards.h).
+#include "core/Shards.h"
+
+#include <gtest/gtest.h>
+
+#include "core/Error.h"
+#include "tests/support/TestSupport.h"
+
+namespace mirage {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(Shards, SpecsParseAndBadOnesSayTheForm) {
+    const ShardSpec s = parseShardSpec("2/5");
+    EXPECT_EQ(s.index, 2);
+    EXPECT_EQ(s.count, 5);
+    for (const char* bad : {"5/5", "-1/4", "1/0", "1", "a/b", "1/4/2", "", "1/"}) {
+        try {
+            parseShardSpec(bad);
+            ADD_FAILURE() << bad << " was accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("I/N"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_EQ(parseItemRange("3:7").begin, 3);
+    EXPECT_EQ(parseItemRange("3:7").end, 7);
+    EXPECT_EQ(parseItemRange("4:").end, -1);
+    EXPECT_EQ(parseItemRange(":4").begin, 0);
+    for (const char* bad : {"7:3", "3:3", "3", "a:b", "-1:4"})
+        EXPECT_THROW(parseItemRange(bad), Error) << bad;
+}
+
+TEST(Shards, InterleavedSelectionCoversEveryItemOnce) {
+    for (int count : {1, 2, 3, 7, 11}) {
+        std::vector<int> seen(23, 0);
+        for (int i = 0; i < count; ++i)
+            for (int item : selectItems(23, ItemRange{}, ShardSpec{i, count})) ++seen[size_t(item)];
+        for (int n : seen) EXPECT_EQ(n, 1) << count;
+    }
+    EXPECT_EQ(selectItems(10, ItemRange{4, 9}, ShardSpec{1, 2}), (std::vector<int>{5, 7}));
+    EXPECT_THROW(selectItems(10, ItemRange{4, 11}, ShardSpec{}), Error);
+    EXPECT_THROW(selectItems(10, ItemRange{10, -1}, ShardSpec{}), Error);
+}
+
+ShardManifest manifest(int index, int count, int total, const std::string& fingerprint = "f") {
+    ShardManifest m;
+    m.command = "synth";
+    m.unit = "frames";
+    m.shard = {index, count};
+    m.total = total;
+    m.range = {0, total};
+    m.items = selectItems(total, ItemRange{}, m.shard);
+    m.fingerprint = fingerprint;
+    m.commandLine = {"mirage", "synth", "scene.gltf", "-o", "out", "--shard", "0/3"};
+    m.payload = {{"x", 1}};
+    return m;
+}
+
+void writeShard(const fs::path& out, const ShardManifest& m) {
+    const fs::path dir = shardFolder(out, m.shard);
+    fs::create_directories(dir);
+    writeShardManifest(dir, m);
+}
+
+TEST(Shards, CompleteSetIsCollectedInShardOrder) {
+    const fs::path out = test::outputDir("shards_complete") / "out";
+    fs::remove_all(shardsFolder(out));
+    for (int i : {2, 0, 1}) writeShard(out, manifest(i, 3, 8));
+    const ShardSet set = collectShards(out);
+    ASSERT_EQ(set.shards.size(), 3u);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(set.shards[size_t(i)].shard.index, i);
+    for (int item = 0; item < 8; ++item) EXPECT_EQ(set.owner[size_t(item)], item % 3);
+    EXPECT_EQ(set.shards[0].payload["x"], 1);
+}
+
+TEST(Shards, MissingShardIsNamedWithItsRerunCommand) {
+    const fs::path out = test::outputDir("shards_missing") / "out";
+    fs::remove_all(shardsFolder(out));
+    writeShard(out, manifest(0, 3, 8));
+    writeShard(out, manifest(2, 3, 8));
+    fs::create_directories(shardFolder(out, {1, 3}));  // started, never finished
+    try {
+        collectShards(out);
+        FAIL() << "an incomplete set was accepted";
+    } catch (const Error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("3 of 8 frames are missing (1, 4, 7)"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("rerun shard(s) 1 of 3"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("--shard 1/3"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("incomplete folders: 1-of-3"), std::string::npos) << msg;
+    }
+}
+
+TEST(Shards, ShardsOfAnotherRunAreRefused) {
+    const fs::path out = test::outputDir("shards_mixed") / "out";
+    fs::remove_all(shardsFolder(out));
+    writeShard(out, manifest(0, 2, 6, "aaaa"));
+    writeShard(out, manifest(1, 2, 6, "bbbb"));
+    try {
+        collectShards(out);
+        FAIL() << "shards of two runs were merged";
+    } catch (const FileError& e) {
+        EXPECT_NE(std::string(e.what()).find("another run"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(collectShards(test::outputDir("shards_none") / "nothing"), FileError);
+}
+
+TEST(Shards, DamagedManifestNamesTheField) {
+    const fs::path dir = test::outputDir("shards_damaged") / "m";
+    fs::create_directories(dir);
+    ShardManifest m = manifest(0, 1, 4);
+    m.items = {0, 1, 9};
+    writeShardManifest(dir, m);
+    try {
+        readShardManifest(dir);
+        FAIL() << "an item outside the range was accepted";
+    } catch (const FileError& e) {
+        EXPECT_NE(std::string(e.what()).find("'items' holds 9"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Shards, RerunCommandReplacesTheShardOnly) {
+    EXPECT_EQ(rerunCommand({"mirage", "synth", "my scene.gltf", "--shard", "0/4", "-o", "x"},
+                           ShardSpec{3, 4}),
+              "mirage synth 'my scene.gltf' --shard 3/4 -o x");
+    EXPECT_EQ(fingerprint64("a"), fingerprint64("a"));
+    EXPECT_NE(fingerprint64("a"), fingerprint64("b"));
+}
+
+}  // namespace
+}  // namespace mirage
