@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri glslang-tools libopenexr-dev
   ffmpeg xvfb xauth clang-format
+  slurm-wlm munge
 )
 
 missing=()
