@@ -15,6 +15,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -23,9 +24,11 @@
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/commands/ShardMerge.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
+#include "core/Shards.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
@@ -40,7 +43,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct BenchArgs {
-    std::string session, scene, output;
+    std::string session, scene, output, shard;
     std::vector<std::string> knobs;  // NAME=V1,V2,...
     bool quick = false, listKnobs = false, noBaseline = false, images = false, force = false;
     int maxFrames = -1, start = 0, repeats = 1;
@@ -93,6 +96,19 @@ std::string commandLine(const BenchArgs& a) {
     return s;
 }
 
+// The first frame of every configuration beside its ground truth (sRGB PNG).
+void writeBenchImages(const fs::path& folder, const std::vector<render::BenchResult>& results) {
+    fs::create_directories(folder);
+    for (const auto& r : results) {
+        std::string name = r.baseline ? "footage " + r.config.label() : r.config.label();
+        for (char& ch : name)
+            if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+        writeBgr8(folder / (name + ".png"), r.firstComposite);
+        writeBgr8(folder / fmt::format("truth_{}x{}.png", r.config.width, r.config.height),
+                  r.firstTruth);
+    }
+}
+
 void runBench(const BenchArgs& a) {
     if (a.listKnobs) {
         for (const auto& k : render::benchKnobs())
@@ -130,9 +146,19 @@ void runBench(const BenchArgs& a) {
     OutputRule rule{sessionInputs(session), a.force, "mirage bench"};
     rule.inputs.push_back(scenePath);
     checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/true);
-    OutputFile csvOut(out / "bench.csv", OutputOrigin::Derived, rule);
-    OutputFile framesOut(out / "bench_frames.csv", OutputOrigin::Derived, rule);
-    OutputFile mdOut(out / "bench.md", OutputOrigin::Derived, rule);
+    // A shard (--shard I/N) runs every N-th configuration of the grid from I and leaves the
+    // tables to `mirage merge` (core/Shards.h).
+    const bool split = !a.shard.empty();
+    const ShardSpec shard = split ? parseShardSpec(a.shard) : ShardSpec{};
+    if (split && fs::exists(shardFolder(out, shard) / "shard.json") && !a.force)
+        throw FileError(shardFolder(out, shard).string(),
+                        "this shard is already complete; pass --force to run it again");
+    std::optional<OutputFile> csvOut, framesOut, mdOut;
+    if (!split) {
+        csvOut.emplace(out / "bench.csv", OutputOrigin::Derived, rule);
+        framesOut.emplace(out / "bench_frames.csv", OutputOrigin::Derived, rule);
+        mdOut.emplace(out / "bench.md", OutputOrigin::Derived, rule);
+    }
     checkLooksLikeGltf(scenePath);
     const Scene scene = loadScene(scenePath);
     if (!scene.hasVirtual())
@@ -165,21 +191,30 @@ void runBench(const BenchArgs& a) {
                  grid.size(), frames.size(), a.session, calib.intrinsics.width,
                  calib.intrinsics.height, loadBefore);
     std::vector<render::BenchResult> results;
-    std::set<std::pair<int, int>> sizes;
-    for (size_t i = 0; i < grid.size(); ++i) {
-        const auto& c = grid[i];
+    std::set<std::pair<int, int>> sizes;  // of the whole grid, for the footage-only rows
+    for (const auto& c : grid)
+        sizes.insert({c.width > 0 ? c.width : calib.intrinsics.width,
+                      c.height > 0 ? c.height : calib.intrinsics.height});
+    const std::vector<int> chosen = selectItems(int(grid.size()), ItemRange{}, shard);
+    if (chosen.empty())
+        throw Error(
+            fmt::format("mirage bench: shard {}/{} holds none of the {} configurations; "
+                        "use at most as many shards as configurations",
+                        shard.index, shard.count, grid.size()));
+    for (int i : chosen) {
+        const auto& c = grid[size_t(i)];
         render::BenchResult r =
             render::runBenchConfig(scene, calib.intrinsics, frames, c, a.repeats);
         spdlog::info(
             "bench [{}/{}] {}: {:.1f} GPU ms/frame (median), PSNR {:.2f} dB / "
             "influenced {:.2f} dB, SSIM {:.4f} / {:.4f}",
-            i + 1, grid.size(), c.label(), r.medianGpuMs, r.error.psnrFrame, r.error.psnrInfluenced,
-            r.error.ssimFrame, r.error.ssimInfluenced);
-        sizes.insert({r.config.width, r.config.height});
+            results.size() + 1, chosen.size(), c.label(), r.medianGpuMs, r.error.psnrFrame,
+            r.error.psnrInfluenced, r.error.ssimFrame, r.error.ssimInfluenced);
         results.push_back(std::move(r));
     }
-    // The footage judged as the composite, once per resolution, after the configurations.
-    if (!a.noBaseline)
+    // The footage judged as the composite, once per resolution, after the configurations (in a
+    // split bench, by the first shard).
+    if (!a.noBaseline && shard.index == 0)
         for (auto it = sizes.rbegin(); it != sizes.rend(); ++it)
             results.push_back(render::footageBaseline(frames, it->first, it->second));
     const std::string loadAfter = loadAverage();
@@ -201,25 +236,33 @@ void runBench(const BenchArgs& a) {
             for (const auto& f : frames) n += cv::countNonZero(f.influence);
             return n;
         }());
-    render::writeBenchCsv(csvOut.temp().string(), results);
-    render::writeBenchFramesCsv(framesOut.temp().string(), results);
-    render::writeBenchMarkdown(mdOut.temp().string(), results, preamble);
-    csvOut.commit();
-    framesOut.commit();
-    mdOut.commit();
-    if (a.images) {
-        // The first frame of every configuration beside its ground truth (sRGB PNG).
-        fs::create_directories(out / "images");
-        for (const auto& r : results) {
-            std::string name = r.baseline ? "footage " + r.config.label() : r.config.label();
-            for (char& ch : name)
-                if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-            writeBgr8(out / "images" / (name + ".png"), r.firstComposite);
-            writeBgr8(
-                out / "images" / fmt::format("truth_{}x{}.png", r.config.width, r.config.height),
-                r.firstTruth);
-        }
+    if (split) {
+        BenchShard bs;
+        bs.shard = shard;
+        bs.gridSize = int(grid.size());
+        bs.configurations = chosen;
+        bs.results = &results;
+        bs.preamble = preamble;
+        bs.images = a.images;
+        // Everything that decides the grid and the errors; not the timing repeats.
+        std::string knobs;
+        for (const auto& k : a.knobs) knobs += k + ";";
+        bs.fingerprint = hex64(fingerprint64(fmt::format(
+            "{} {} {} {} {} {} {:.9g} {} {} {}",
+            fs::absolute(a.session).lexically_normal().string(), scenePath, a.quick, knobs, a.start,
+            a.maxFrames, a.exposure, a.noBaseline, a.images, hex64(fileFingerprint(scenePath)))));
+        writeBenchShard(out, bs, [&](const fs::path& dir) {
+            if (a.images) writeBenchImages(dir / "images", results);
+        });
+        return;
     }
+    render::writeBenchCsv(csvOut->temp().string(), results);
+    render::writeBenchFramesCsv(framesOut->temp().string(), results);
+    render::writeBenchMarkdown(mdOut->temp().string(), results, preamble);
+    csvOut->commit();
+    framesOut->commit();
+    mdOut->commit();
+    if (a.images) writeBenchImages(out / "images", results);
     spdlog::info("bench: wrote {}, {}, {} (load average {} after)", (out / "bench.csv").string(),
                  (out / "bench_frames.csv").string(), (out / "bench.md").string(), loadAfter);
 }
@@ -251,6 +294,10 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
         ->capture_default_str()
         ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--no-baseline", a->noBaseline, "Leave out the footage-only rows");
+    cmd->add_option("--shard", a->shard,
+                    "Run part I of N of the grid (I/N, 0-based: every N-th configuration from I) "
+                    "into OUTDIR.shards/; join the parts with `mirage merge OUTDIR` "
+                    "(docs/scale.md)");
     cmd->add_flag("--images", a->images,
                   "Also write each configuration's first composite and the ground truth to "
                   "OUTDIR/images/ (sRGB PNG)");

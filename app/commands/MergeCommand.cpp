@@ -69,6 +69,8 @@ void run(const MergeArgs& a) {
         });
     } else if (first.command == "render") {
         mergeRenderShards(set, out, temp);
+    } else if (first.command == "bench") {
+        mergeBenchShards(set, temp);
     } else {
         throw FileError((set.folders.front() / "shard.json").string(),
                         "command '" + first.command +

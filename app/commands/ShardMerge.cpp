@@ -112,4 +112,88 @@ void mergeRenderShards(const ShardSet& set, const fs::path& out, const fs::path&
     }
 }
 
+void writeBenchShard(const fs::path& out, const BenchShard& bs,
+                     const std::function<void(const fs::path& dir)>& extraFiles) {
+    const fs::path dir = shardFolder(out, bs.shard);
+    fs::create_directories(dir.parent_path());
+    fs::path temp = dir;
+    temp += ".partial-" + std::to_string(::getpid());
+    std::error_code ec;
+    fs::remove_all(temp, ec);
+    fs::create_directories(temp);
+    if (extraFiles) extraFiles(temp);
+    nlohmann::json results = nlohmann::json::array();
+    for (const auto& r : *bs.results) results.push_back(render::benchResultToJson(r));
+    ShardManifest m;
+    m.command = "bench";
+    m.unit = "configurations";
+    m.shard = bs.shard;
+    m.total = bs.gridSize;
+    m.items = bs.configurations;
+    m.fingerprint = bs.fingerprint;
+    m.commandLine = commandLine();
+    m.payload = {{"results", results}, {"preamble", bs.preamble}, {"images", bs.images}};
+    writeShardManifest(temp, m);
+    fs::remove_all(dir, ec);
+    fs::rename(temp, dir, ec);
+    if (ec)
+        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message());
+    spdlog::info(
+        "wrote shard {}/{} ({} configurations) to {}; when every shard is done: mirage "
+        "merge {}",
+        bs.shard.index, bs.shard.count, bs.configurations.size(), dir.string(), out.string());
+}
+
+void mergeBenchShards(const ShardSet& set, const fs::path& temp) {
+    std::vector<render::BenchResult> configurations(set.owner.size()), baselines;
+    std::vector<bool> filled(set.owner.size(), false);
+    std::string preamble, machines;
+    for (size_t s = 0; s < set.shards.size(); ++s) {
+        const ShardManifest& m = set.shards[s];
+        const fs::path manifest = set.folders[s] / "shard.json";
+        try {
+            const nlohmann::json& results = m.payload.at("results");
+            // The shard's configurations in its item order, then its footage-only rows.
+            if (results.size() < m.items.size())
+                throw FileError(manifest.string(), "holds fewer results than configurations");
+            for (size_t i = 0; i < results.size(); ++i) {
+                render::BenchResult r = render::benchResultFromJson(results[i]);
+                if (i < m.items.size()) {
+                    configurations[size_t(m.items[i])] = std::move(r);
+                    filled[size_t(m.items[i])] = true;
+                } else {
+                    baselines.push_back(std::move(r));
+                }
+            }
+            const std::string own = m.payload.at("preamble").get<std::string>();
+            if (s == 0) preamble = own;
+            // Each shard's machine line ("- machine: ...") goes into the merged header.
+            const size_t at = own.find("- machine: ");
+            const std::string line =
+                at == std::string::npos ? "" : own.substr(at + 11, own.find('\n', at) - at - 11);
+            machines += fmt::format("  - shard {}/{}: {}\n", m.shard.index, m.shard.count, line);
+        } catch (const nlohmann::json::exception& e) {
+            throw FileError(manifest.string(), std::string("payload is malformed: ") + e.what());
+        }
+        const fs::path images = set.folders[s] / "images";
+        if (fs::is_directory(images)) {
+            fs::create_directories(temp / "images");
+            fs::copy(images, temp / "images", fs::copy_options::overwrite_existing);
+        }
+    }
+    std::vector<render::BenchResult> all;
+    const ShardManifest& first = set.shards.front();
+    for (int i = first.range.begin; i < first.range.end; ++i) {
+        MR_CHECK(filled[size_t(i)], "collectShards left a configuration out");
+        all.push_back(std::move(configurations[size_t(i)]));
+    }
+    for (auto& b : baselines) all.push_back(std::move(b));
+    preamble += fmt::format("- split: {} shards joined by `mirage merge`; each ran on\n{}",
+                            set.shards.size(), machines);
+    fs::create_directories(temp);
+    render::writeBenchCsv((temp / "bench.csv").string(), all);
+    render::writeBenchFramesCsv((temp / "bench_frames.csv").string(), all);
+    render::writeBenchMarkdown((temp / "bench.md").string(), all, preamble);
+}
+
 }  // namespace mirage::app

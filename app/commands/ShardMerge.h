@@ -1,14 +1,17 @@
 #pragma once
 // The parts of split runs (core/Shards.h) that belong to one command each: how a shard of
-// `mirage render` is written, and how `mirage merge` joins those of render (rows of one image).
+// `mirage render` or `mirage bench` is written, and how `mirage merge` joins them: the rows of
+// one image, the configurations of one grid.
 // Synth shards live with the synthetic session (render/raytrace/SyntheticSession.h).
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "core/Shards.h"
+#include "render/evaluation/RealtimeBench.h"
 
 namespace mirage::app {
 
@@ -29,5 +32,25 @@ void writeRenderShard(const std::filesystem::path& out, const RenderShard& shard
 // extension chooses the format), and the --save-buffers images beside `out`.
 void mergeRenderShards(const ShardSet& shards, const std::filesystem::path& out,
                        const std::filesystem::path& temp);
+
+struct BenchShard {
+    ShardSpec shard;
+    int gridSize = 0;
+    std::vector<int> configurations;                  // grid positions run, ascending
+    const std::vector<render::BenchResult>* results;  // those, then footage-only rows (shard 0)
+    std::string preamble;                             // bench.md's header of this shard's run
+    bool images = false;
+    std::string fingerprint;
+};
+
+// Writes the shard's results (JSON, exact) and manifest into OUTDIR.shards/I-of-N; `extraFiles`
+// adds files to the shard's folder before it is marked complete (the --images).
+void writeBenchShard(const std::filesystem::path& out, const BenchShard& shard,
+                     const std::function<void(const std::filesystem::path& dir)>& extraFiles);
+
+// Writes bench.csv, bench_frames.csv and bench.md (and images/) of the whole grid into the
+// folder `temp`: the rows in grid order, as one run writes them; bench.md's header names every
+// shard's machine and load.
+void mergeBenchShards(const ShardSet& shards, const std::filesystem::path& temp);
 
 }  // namespace mirage::app

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -141,6 +142,96 @@ void writeBenchMarkdown(const std::string& path, const std::vector<BenchResult>&
             << num(r.error.psnrInfluenced, 2) << " | " << num(r.error.ssimInfluenced, 4) << " |\n";
     }
     if (!out) throw FileError(path, "write failed");
+}
+
+namespace {
+
+nlohmann::json number(double v) {
+    if (std::isfinite(v)) return v;
+    return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+}
+
+double number(const nlohmann::json& j) {
+    if (j.is_number()) return j.get<double>();
+    const std::string s = j.get<std::string>();
+    if (s == "inf") return std::numeric_limits<double>::infinity();
+    if (s == "-inf") return -std::numeric_limits<double>::infinity();
+    if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
+    throw Error("bench result: '" + s + "' is not a number");
+}
+
+nlohmann::json errorJson(const CompositeError& e) {
+    return {number(e.psnrFrame), number(e.ssimFrame), number(e.psnrInfluenced),
+            number(e.ssimInfluenced), number(e.influencedPixels)};
+}
+
+CompositeError errorFromJson(const nlohmann::json& j) {
+    CompositeError e;
+    e.psnrFrame = number(j.at(0));
+    e.ssimFrame = number(j.at(1));
+    e.psnrInfluenced = number(j.at(2));
+    e.ssimInfluenced = number(j.at(3));
+    e.influencedPixels = number(j.at(4));
+    return e;
+}
+
+nlohmann::json msJson(const std::map<std::string, double>& ms) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [name, v] : ms) j[name] = number(v);
+    return j;
+}
+
+std::map<std::string, double> msFromJson(const nlohmann::json& j) {
+    std::map<std::string, double> ms;
+    for (const auto& [name, v] : j.items()) ms[name] = number(v);
+    return ms;
+}
+
+}  // namespace
+
+nlohmann::json benchResultToJson(const BenchResult& r) {
+    nlohmann::json frames = nlohmann::json::array();
+    for (const auto& f : r.frames)
+        frames.push_back({{"index", f.index},
+                          {"pass_ms", msJson(f.passMs)},
+                          {"gpu_ms", number(f.gpuMs)},
+                          {"wall_ms", number(f.wallMs)},
+                          {"error", errorJson(f.error)}});
+    return {{"knobs", r.config.knobs},
+            {"width", r.config.width},
+            {"height", r.config.height},
+            {"baseline", r.baseline},
+            {"pass_order", r.passOrder},
+            {"passes", r.passes},
+            {"median_pass_ms", msJson(r.medianPassMs)},
+            {"median_gpu_ms", number(r.medianGpuMs)},
+            {"median_wall_ms", number(r.medianWallMs)},
+            {"error", errorJson(r.error)},
+            {"frames", frames}};
+}
+
+BenchResult benchResultFromJson(const nlohmann::json& j) {
+    BenchResult r;
+    r.config.knobs = j.at("knobs").get<std::vector<std::pair<std::string, std::string>>>();
+    r.config.width = j.at("width").get<int>();
+    r.config.height = j.at("height").get<int>();
+    r.baseline = j.at("baseline").get<bool>();
+    r.passOrder = j.at("pass_order").get<std::vector<std::string>>();
+    r.passes = j.at("passes").get<std::vector<std::string>>();
+    r.medianPassMs = msFromJson(j.at("median_pass_ms"));
+    r.medianGpuMs = number(j.at("median_gpu_ms"));
+    r.medianWallMs = number(j.at("median_wall_ms"));
+    r.error = errorFromJson(j.at("error"));
+    for (const auto& f : j.at("frames")) {
+        BenchFrameResult fr;
+        fr.index = f.at("index").get<int>();
+        fr.passMs = msFromJson(f.at("pass_ms"));
+        fr.gpuMs = number(f.at("gpu_ms"));
+        fr.wallMs = number(f.at("wall_ms"));
+        fr.error = errorFromJson(f.at("error"));
+        r.frames.push_back(std::move(fr));
+    }
+    return r;
 }
 
 }  // namespace mirage::render

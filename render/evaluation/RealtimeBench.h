@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "core/camera/CameraModel.h"
@@ -104,6 +105,12 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
 // The footage judged as if it were the composite: what a render with the virtual contribution
 // removed scores. Every real configuration must beat it in the influenced pixels.
 BenchResult footageBaseline(const std::vector<BenchFrame>& frames, int width = 0, int height = 0);
+
+// A result as JSON and back, for the shards of a split bench (core/Shards.h). Everything the
+// tables show survives exactly (non-finite numbers as "inf", "-inf", "nan"); of the configuration
+// only its knobs and size come back (the renderer options are not stored), and no images.
+nlohmann::json benchResultToJson(const BenchResult& result);
+BenchResult benchResultFromJson(const nlohmann::json& json);
 
 // Files: one row per configuration / per configuration and frame; a markdown table.
 void writeBenchCsv(const std::string& path, const std::vector<BenchResult>& results);

@@ -147,5 +147,70 @@ TEST(ShardedRuns, RenderRowShardsMergeToTheWholeImageBitForBit) {
     EXPECT_NE(r.output.find("fixed --spp"), std::string::npos) << r.output;
 }
 
+// The rows of a bench CSV without its timing columns (those ending in "_ms"), which differ
+// from run to run; everything else (configurations, frames, errors) must not.
+std::vector<std::string> untimedRows(const fs::path& csv) {
+    std::ifstream in(csv);
+    std::vector<std::string> rows;
+    std::vector<bool> keep;
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        std::vector<std::string> cells;
+        std::string cell;
+        bool quoted = false;
+        for (char c : line) {
+            if (c == '"') quoted = !quoted;
+            if (c == ',' && !quoted) {
+                cells.push_back(cell);
+                cell.clear();
+            } else {
+                cell += c;
+            }
+        }
+        cells.push_back(cell);
+        if (keep.empty())
+            for (const auto& name : cells)
+                keep.push_back(name.size() < 3 || name.substr(name.size() - 3) != "_ms");
+        std::string row;
+        for (size_t i = 0; i < cells.size() && i < keep.size(); ++i)
+            if (keep[i]) row += cells[i] + ",";
+        rows.push_back(row);
+    }
+    return rows;
+}
+
+TEST(ShardedRuns, BenchShardsMergeToTheWholeGridsRows) {
+    const fs::path dir = test::outputDir("shards_bench");
+    fs::remove_all(dir);
+    const fs::path session = dir / "session";
+    auto r = runMirage({"synth", scene(), "-o", session.string(), "--width", "64", "--height", "48",
+                        "--fps", "2", "--seconds", "1", "--spp", "2", "--no-env",
+                        "--ground-truth-composite", "--threads", "2"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::vector<std::string> base = {"bench", session.string(), "--quick"};
+    auto args = base;
+    args.insert(args.end(), {"-o", (dir / "whole").string()});
+    r = runMirage(args);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (int i : {1, 0}) {
+        args = base;
+        args.insert(args.end(),
+                    {"-o", (dir / "split").string(), "--shard", std::to_string(i) + "/2"});
+        r = runMirage(args);
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+    }
+    r = runMirage({"merge", (dir / "split").string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* file : {"bench.csv", "bench_frames.csv"}) {
+        const auto whole = untimedRows(dir / "whole" / file);
+        const auto split = untimedRows(dir / "split" / file);
+        EXPECT_GE(whole.size(), 4u) << file;  // header, 2+ configurations, the footage row
+        EXPECT_EQ(whole, split) << file;
+    }
+    std::ifstream md(dir / "split" / "bench.md");
+    const std::string text{std::istreambuf_iterator<char>(md), std::istreambuf_iterator<char>()};
+    EXPECT_NE(text.find("shard 1/2"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace mirage
