@@ -78,6 +78,19 @@ std::vector<int> selectItems(int total, const ItemRange& range, const ShardSpec&
     return items;
 }
 
+std::vector<int> selectBlock(int total, const ItemRange& range, const ShardSpec& shard) {
+    const int end = range.end < 0 ? total : range.end;
+    if (range.begin >= total || end > total)
+        throw Error(fmt::format("--frames {}:{} reaches beyond the {} items of this run (0 to {})",
+                                range.begin, end, total, total - 1));
+    const int64_t n = end - range.begin;
+    const int first = range.begin + int(n * shard.index / shard.count);
+    const int last = range.begin + int(n * (shard.index + 1) / shard.count);
+    std::vector<int> items;
+    for (int i = first; i < last; ++i) items.push_back(i);
+    return items;
+}
+
 uint64_t fingerprint64(const std::string& bytes, uint64_t h) {
     for (unsigned char c : bytes) {
         h ^= c;
@@ -118,6 +131,7 @@ void writeShardManifest(const fs::path& dir, const ShardManifest& m) {
     j["total"] = m.total;
     j["range"] = {m.range.begin, m.range.end < 0 ? m.total : m.range.end};
     j["items"] = m.items;
+    j["split"] = m.blocks ? "blocks" : "interleaved";
     j["fingerprint"] = m.fingerprint;
     j["command_line"] = m.commandLine;
     std::string created = m.createdAt;
@@ -158,6 +172,10 @@ ShardManifest readShardManifest(const fs::path& dir) {
         m.range.begin = field("range").at(0).get<int>();
         m.range.end = field("range").at(1).get<int>();
         m.items = field("items").get<std::vector<int>>();
+        const std::string split = field("split").get<std::string>();
+        if (split != "blocks" && split != "interleaved")
+            throw FileError(file.string(), "field 'split' must be \"blocks\" or \"interleaved\"");
+        m.blocks = split == "blocks";
         m.fingerprint = field("fingerprint").get<std::string>();
         m.commandLine = field("command_line").get<std::vector<std::string>>();
         m.createdAt = field("created").get<std::string>();
@@ -233,7 +251,8 @@ ShardSet collectShards(const fs::path& output) {
         const ShardManifest& m = set.shards[i];
         if (m.command != first.command || m.fingerprint != first.fingerprint ||
             m.shard.count != first.shard.count || m.total != first.total ||
-            m.range.begin != first.range.begin || m.range.end != first.range.end)
+            m.range.begin != first.range.begin || m.range.end != first.range.end ||
+            m.blocks != first.blocks)
             throw FileError(
                 set.folders[i].string(),
                 fmt::format("is from another run than {} (command, options, shard count or "
@@ -257,7 +276,14 @@ ShardSet collectShards(const fs::path& output) {
     for (int item = first.range.begin; item < first.range.end; ++item)
         if (set.owner[size_t(item)] < 0) {
             missing.push_back(item);
-            missingShards.insert((item - first.range.begin) % first.shard.count);
+            const int64_t offset = item - first.range.begin,
+                          n = first.range.end - first.range.begin;
+            // Block k holds offsets [n k / N, n (k + 1) / N).
+            int k = int(offset % first.shard.count);
+            if (first.blocks)
+                for (k = 0; k + 1 < first.shard.count && n * (k + 1) / first.shard.count <= offset;)
+                    ++k;
+            missingShards.insert(k);
         }
     if (!missing.empty()) {
         std::string msg =

@@ -36,6 +36,9 @@ ItemRange parseItemRange(const std::string& text);
 // The items of [0, total) that a shard handles: those in `range` whose offset from the range's
 // start is index mod count, ascending. Throws mirage::Error if the range leaves [0, total).
 std::vector<int> selectItems(int total, const ItemRange& range, const ShardSpec& shard);
+// The same for work that runs in order (a replay's temporal history): shard I takes the I-th of N
+// contiguous blocks of the range, [begin + n I / N, begin + n (I + 1) / N) with n items in it.
+std::vector<int> selectBlock(int total, const ItemRange& range, const ShardSpec& shard);
 
 // FNV-1a, 64 bits: the fingerprint of a command's options, so that shards of different runs are
 // never merged. Not cryptographic.
@@ -54,6 +57,7 @@ struct ShardManifest {
     int total = 0;            // items of the whole run
     ItemRange range;          // --frames, as given (end resolved to total)
     std::vector<int> items;   // the items this shard holds, ascending
+    bool blocks = false;      // split into contiguous blocks (selectBlock), else interleaved
     std::string fingerprint;  // options of the run (hex); equal for every shard of one run
     std::vector<std::string> commandLine;  // argv of the run that wrote the shard
     std::string createdAt;                 // UTC, ISO 8601

@@ -71,10 +71,12 @@ void run(const MergeArgs& a) {
         mergeRenderShards(set, out, temp);
     } else if (first.command == "bench") {
         mergeBenchShards(set, temp);
+    } else if (first.command == "replay") {
+        mergeReplayShards(set, out, temp);
     } else {
         throw FileError((set.folders.front() / "shard.json").string(),
                         "command '" + first.command +
-                            "' cannot be merged by this mirage (synth, render, bench)");
+                            "' cannot be merged by this mirage (synth, render, bench, replay)");
     }
     bar.finish();
     moveIntoPlace(temp, out);

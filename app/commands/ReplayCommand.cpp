@@ -30,10 +30,12 @@
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/commands/ShardMerge.h"
 #include "core/Csv.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
+#include "core/Shards.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
 #include "core/gl/Objects.h"
@@ -75,10 +77,14 @@ void progress(int done, int total, double fps) {
 }
 
 struct ReplayArgs {
-    std::string session, scene, output, poses;
+    std::string session, scene, output, poses, shard;
     int vpls = 256;
     int maxFrames = -1;
     int start = 0;
+    // Frames before the first written one that are tracked and rendered but not written, so that
+    // the temporal history (indirect light, the tracker's motion model) is warm at the seam of a
+    // range or shard. 8: the seam measured in docs/scale.md.
+    int warmup = 8;
     float exposure = 1.0f;
     int jpegQuality = 92;
     bool window = false;
@@ -111,18 +117,37 @@ void runReplay(const ReplayArgs& a) {
 
     // Outputs are checked before any work: never one of the inputs, never an unnamed existing
     // file without --force; written under temporary names and renamed when finished.
-    const std::filesystem::path out = a.output;
-    const bool mkv = isVideoOutput(out);
+    const std::filesystem::path userOut = a.output;
+    const bool split = !a.shard.empty();
+    const ShardSpec shard = split ? parseShardSpec(a.shard) : ShardSpec{};
+    const bool userMkv = isVideoOutput(userOut);
     OutputRule rule{sessionInputs(session), a.force, "mirage replay"};
     rule.inputs.push_back(a.scene);
     if (!a.poses.empty()) rule.inputs.push_back(a.poses);
+    // A shard (--shard I/N: the I-th of N contiguous blocks of the frames) writes PNG frames and
+    // its CSV rows into OUT.shards/I-of-N; `mirage merge OUT` makes OUT of them.
+    std::filesystem::path shardTemp;
+    if (split) {
+        checkOutput(userOut, OutputOrigin::Named, rule, /*outIsFolder=*/!userMkv);
+        const auto dir = shardFolder(userOut, shard);
+        if (std::filesystem::exists(dir / "shard.json") && !a.force)
+            throw FileError(dir.string(),
+                            "this shard is already complete; pass --force to replay it again");
+        shardTemp = dir;
+        shardTemp += ".partial-" + std::to_string(::getpid());
+        std::error_code ec;
+        std::filesystem::remove_all(shardTemp, ec);
+        std::filesystem::create_directories(shardTemp);
+    }
+    const std::filesystem::path out = split ? shardTemp : userOut;
+    const bool mkv = split ? false : userMkv;
     std::optional<OutputFile> videoOut;
     std::filesystem::path csvPath;
     if (mkv) {
         videoOut.emplace(out, OutputOrigin::Named, rule);
         csvPath = std::filesystem::path(out).replace_extension(".csv");
     } else {
-        checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/true);
+        if (!split) checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/true);
         csvPath = out / "frames.csv";
     }
     OutputFile csvOut(csvPath, OutputOrigin::Derived, rule);
@@ -173,27 +198,45 @@ void runReplay(const ReplayArgs& a) {
 
     auto frames = openCameraFrames(session, main->name);
     const int listed = int(session.frames.size());
-    const int total = a.maxFrames >= 0 ? std::min(a.maxFrames, listed - a.start) : listed - a.start;
+    if (a.start >= listed)
+        throw Error(fmt::format("mirage replay: --start {} is beyond the session's {} frames",
+                                a.start, listed));
+    const int wanted =
+        a.maxFrames >= 0 ? std::min(a.maxFrames, listed - a.start) : listed - a.start;
+    // The frames written: [begin, begin + total) of the session's list; a shard's block of them.
+    const std::vector<int> block = selectBlock(listed, ItemRange{a.start, a.start + wanted}, shard);
+    if (block.empty())
+        throw Error(
+            fmt::format("mirage replay: shard {}/{} holds none of the {} frames; use at "
+                        "most as many shards as frames",
+                        shard.index, shard.count, wanted));
+    const int begin = block.front();
+    const int total = int(block.size());
+    const int first = std::max(0, begin - a.warmup);  // warm-up frames are not written
     installStopSignals();
     cv::Mat bgr;
-    for (int i = 0; i < a.start && frames->read(bgr); ++i) {
+    for (int i = 0; i < first && frames->read(bgr); ++i) {
     }
     const auto tStart = Clock::now();
     bool lastLost = true;
     std::optional<Pose> lastGood;  // the last composited tracked or given pose, and its time
     double lastGoodT = 0;
     int done = 0;
-    for (int k = 0; k < total && !stopped(); ++k) {
-        const FrameRecord& rec = session.frames[size_t(a.start + k)];
+    int processed = 0;
+    std::vector<std::pair<int, double>> written;  // a shard's frames with an image, and times
+    for (int pos = first; pos < begin + total && !stopped(); ++pos) {
+        const FrameRecord& rec = session.frames[size_t(pos)];
+        const bool emit = pos >= begin;
+        const int k = pos - begin;  // frames written before this one (negative: warm-up)
         const auto t0 = Clock::now();
         if (!frames->read(bgr)) {
-            spdlog::warn("replay: the video ends after {} frames", a.start + k);
+            spdlog::warn("replay: the video ends after {} frames", pos);
             break;
         }
         const double decodeMs = msSince(t0);
         const auto t1 = Clock::now();
         PoseRow pr;
-        const double tFrame = rec.timestamps.empty() ? k / session.fps : rec.timestamps.front();
+        const double tFrame = rec.timestamps.empty() ? pos / session.fps : rec.timestamps.front();
         const std::string problem = frames->lastProblem();
         if (bgr.empty()) {
             // Lost (damaged bytes): no image to composite into and no pose to trust; the row
@@ -242,7 +285,8 @@ void runReplay(const ReplayArgs& a) {
                 renderer.render({*pr.pose, bgr, /*resetHistory=*/lastLost});
             for (const auto& p : rep.passes) passMs[p.name] = p.gpuMs;
             gpuMs = rep.totalGpuMs;
-            if (a.verbose && k == 0) spdlog::info("frame {}:\n{}", rec.index, rep.summary());
+            if (a.verbose && processed == 0)
+                spdlog::info("frame {}:\n{}", rec.index, rep.summary());
             const auto t2 = Clock::now();
             result = renderer.compositeSrgb();
             readbackMs = msSince(t2);
@@ -258,9 +302,12 @@ void runReplay(const ReplayArgs& a) {
             result = bgr;  // tracking lost: the footage passes through, history resets
         }
         lastLost = !pr.pose;
+        ++processed;
+        if (!emit) continue;  // warm-up: history and tracking only
         const auto t3 = Clock::now();
         const double t = tFrame;
         if (!result.empty()) {  // a lost frame has no image: only its CSV row is written
+            if (split) written.push_back({rec.index, t});
             if (video)
                 video->append(result, t);
             else
@@ -290,6 +337,7 @@ void runReplay(const ReplayArgs& a) {
         csv << "\n";
         csv.flush();
         ++done;
+        (void)k;
         progress(done, total, done / std::max(1e-9, msSince(tStart) * 1e-3));
     }
     if (isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
@@ -300,6 +348,25 @@ void runReplay(const ReplayArgs& a) {
     if (videoOut) videoOut->commit();
     csvOut.commit();
     restoreStopSignals();
+    if (split && !stopRequested()) {
+        ReplayShard rs;
+        rs.shard = shard;
+        rs.listed = listed;
+        rs.range = ItemRange{a.start, a.start + wanted};
+        rs.frames = block;
+        rs.folder = shardTemp;
+        rs.video = userMkv;
+        rs.fps = session.fps;
+        rs.jpegQuality = a.jpegQuality;
+        rs.warmup = begin - first;
+        rs.written = written;
+        rs.fingerprint = hex64(fingerprint64(fmt::format(
+            "{} {} {} {} {} {:.9g} {} {}", std::filesystem::absolute(a.session).string(), a.poses,
+            a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
+            userMkv)));
+        finishReplayShard(userOut, rs);
+        return;
+    }
     if (stopRequested()) {
         spdlog::warn("replay: interrupted after {} frames; {} is playable", done, a.output);
         commandExitCode() = 128 + stopSignal();
@@ -331,6 +398,14 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_option("--frames", args->maxFrames, "Replay at most N frames")
         ->check(wholeIn(-1, 100000000));
     cmd->add_option("--start", args->start, "First frame")->check(wholeIn(0, 100000000));
+    cmd->add_option("--warmup", args->warmup,
+                    "Frames before the first written one that are tracked and rendered, not "
+                    "written: temporal history is warm at the seam")
+        ->capture_default_str()
+        ->check(wholeIn(0, 100000));
+    cmd->add_option("--shard", args->shard,
+                    "Replay part I of N (I/N, 0-based: the I-th of N contiguous blocks of the "
+                    "frames, each warmed up) into OUT.shards/; join with `mirage merge OUT`");
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--ground-truth", args->groundTruth,

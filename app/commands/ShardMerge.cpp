@@ -2,6 +2,11 @@
 
 #include <unistd.h>
 
+#include <fstream>
+#include <memory>
+
+#include <opencv2/imgcodecs.hpp>
+
 #include <fmt/format.h>
 
 #include "app/Command.h"
@@ -9,6 +14,7 @@
 #include "core/Log.h"
 #include "core/OutputFile.h"
 #include "core/image/ImageIO.h"
+#include "core/session/MatroskaWriter.h"
 
 namespace mirage::app {
 
@@ -194,6 +200,96 @@ void mergeBenchShards(const ShardSet& set, const fs::path& temp) {
     render::writeBenchCsv((temp / "bench.csv").string(), all);
     render::writeBenchFramesCsv((temp / "bench_frames.csv").string(), all);
     render::writeBenchMarkdown((temp / "bench.md").string(), all, preamble);
+}
+
+void finishReplayShard(const fs::path& out, const ReplayShard& rs) {
+    ShardManifest m;
+    m.command = "replay";
+    m.unit = "frames";
+    m.shard = rs.shard;
+    m.total = rs.listed;
+    m.range = rs.range;
+    m.items = rs.frames;
+    m.blocks = true;
+    m.fingerprint = rs.fingerprint;
+    m.commandLine = commandLine();
+    m.payload = {{"video", rs.video},
+                 {"fps", rs.fps},
+                 {"jpeg_quality", rs.jpegQuality},
+                 {"warmup", rs.warmup},
+                 {"written", rs.written}};
+    writeShardManifest(rs.folder, m);
+    const fs::path dir = shardFolder(out, rs.shard);
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    fs::rename(rs.folder, dir, ec);
+    if (ec)
+        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message());
+    spdlog::info(
+        "wrote shard {}/{} (frames {} to {}, {} warm-up frames before) to {}; when every "
+        "shard is done: mirage merge {}",
+        rs.shard.index, rs.shard.count, rs.frames.front(), rs.frames.back(), rs.warmup,
+        dir.string(), out.string());
+}
+
+void mergeReplayShards(const ShardSet& set, const fs::path& out, const fs::path& temp) {
+    const ShardManifest& first = set.shards.front();
+    bool video = false;
+    double fps = 30.0;
+    int quality = 92;
+    try {
+        video = first.payload.at("video").get<bool>();
+        fps = first.payload.at("fps").get<double>();
+        quality = first.payload.at("jpeg_quality").get<int>();
+    } catch (const nlohmann::json::exception& e) {
+        throw FileError((set.folders.front() / "shard.json").string(),
+                        std::string("payload is malformed: ") + e.what());
+    }
+    // The CSV: the first shard's header, then every shard's rows in order.
+    std::string csv;
+    std::unique_ptr<MatroskaWriter> writer;
+    if (video)
+        writer = std::make_unique<MatroskaWriter>(temp, fps, quality);
+    else
+        fs::create_directories(temp);
+    for (size_t s = 0; s < set.shards.size(); ++s) {
+        const fs::path csvPath = set.folders[s] / "frames.csv";
+        std::ifstream in(csvPath);
+        if (!in) throw FileError(csvPath.string(), "missing: rerun this shard");
+        std::string header;
+        std::getline(in, header);
+        if (s == 0) csv += header + "\n";
+        for (std::string row; std::getline(in, row);)
+            if (!row.empty()) csv += row + "\n";
+        std::vector<std::pair<int, double>> written;
+        try {
+            written =
+                set.shards[s].payload.at("written").get<std::vector<std::pair<int, double>>>();
+        } catch (const nlohmann::json::exception& e) {
+            throw FileError((set.folders[s] / "shard.json").string(),
+                            std::string("payload is malformed: ") + e.what());
+        }
+        for (const auto& [frame, t] : written) {
+            const fs::path png = set.folders[s] / cv::format("frame_%06d.png", frame);
+            if (video) {
+                const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+                if (img.empty())
+                    throw FileError(png.string(), "missing or unreadable: rerun this shard");
+                writer->append(img, t);
+            } else {
+                fs::copy_file(png, temp / png.filename(), fs::copy_options::overwrite_existing);
+            }
+        }
+    }
+    if (writer) writer->close();
+    const fs::path csvOut = video ? fs::path(out).replace_extension(".csv") : temp / "frames.csv";
+    if (video) {
+        OutputFile f(csvOut, OutputOrigin::Derived, OutputRule{{}, true, "mirage merge"});
+        std::ofstream(f.temp()) << csv;
+        f.commit();
+    } else {
+        std::ofstream(csvOut) << csv;
+    }
 }
 
 }  // namespace mirage::app

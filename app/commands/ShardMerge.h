@@ -53,4 +53,26 @@ void writeBenchShard(const std::filesystem::path& out, const BenchShard& shard,
 // shard's machine and load.
 void mergeBenchShards(const ShardSet& shards, const std::filesystem::path& temp);
 
+struct ReplayShard {
+    ShardSpec shard;
+    int listed = 0;                // frames the session lists
+    ItemRange range;               // the frames asked for (--start, --frames)
+    std::vector<int> frames;       // this shard's block of them (positions in the session's list)
+    std::filesystem::path folder;  // where the replay wrote PNG frames and frames.csv
+    bool video = false;            // the merged output is OUT.mkv (else a PNG folder)
+    double fps = 30.0;
+    int jpegQuality = 92;
+    int warmup = 0;  // frames rendered before the block and not written
+    std::vector<std::pair<int, double>> written;  // frames with an image (index, seconds)
+    std::string fingerprint;
+};
+
+// Writes the manifest into the replay's folder and moves it to OUT.shards/I-of-N.
+void finishReplayShard(const std::filesystem::path& out, const ReplayShard& shard);
+
+// Writes OUT (an MJPEG .mkv with its .csv beside it, or a folder of PNG frames with frames.csv)
+// from the shards' frames in order, to `temp` named like `out`.
+void mergeReplayShards(const ShardSet& shards, const std::filesystem::path& out,
+                       const std::filesystem::path& temp);
+
 }  // namespace mirage::app

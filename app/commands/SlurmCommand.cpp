@@ -1,5 +1,5 @@
-// `mirage slurm --shards N [resources] -- synth|render|bench ARGS...`: runs a long command on a
-// Slurm cluster as a job array, one shard per task (`--shard $SLURM_ARRAY_TASK_ID/N`), and a
+// `mirage slurm --shards N [resources] -- synth|render|bench|replay ARGS...`: runs a long command
+// on a Slurm cluster as a job array, one shard per task (`--shard $SLURM_ARRAY_TASK_ID/N`), and a
 // merge job that starts when every task succeeded (`--dependency=afterok`). The scheduler does
 // queuing, retries and placement; mirage only writes the two batch scripts into OUT.slurm/,
 // submits them with sbatch and says how to follow them (docs/scale.md). The output folder must be
@@ -81,7 +81,8 @@ int estimateMemoryMb(const std::vector<std::string>& args) {
         std::error_code ec;
         bytes += 8.0 * double(fs::file_size(args[1], ec));
     }
-    if (cmd == "bench") bytes += double(width) * height * 1000.0;  // G-buffers, images
+    if (cmd == "bench" || cmd == "replay")
+        bytes += double(width) * height * 1000.0;  // G-buffers, images
     const double mb = bytes / 1048576.0 + 512.0;
     return int((mb + 255.0) / 256.0) * 256;
 }
@@ -133,9 +134,9 @@ void run(const SlurmArgs& a) {
             "mirage slurm: give the command after --, e.g. mirage slurm --shards 4 -- synth "
             "scene.gltf -o session --seconds 60");
     const std::string& cmd = a.command.front();
-    if (cmd != "synth" && cmd != "render" && cmd != "bench")
+    if (cmd != "synth" && cmd != "render" && cmd != "bench" && cmd != "replay")
         throw Error("mirage slurm: '" + cmd +
-                    "' cannot be split; synth, render and bench can (docs/scale.md)");
+                    "' cannot be split; synth, render, bench and replay can (docs/scale.md)");
     const std::vector<std::string> args(a.command.begin() + 1, a.command.end());
     if (!optionValue(args, "--shard").empty())
         throw Error("mirage slurm: leave --shard out; each task gets its own");
@@ -158,7 +159,7 @@ void run(const SlurmArgs& a) {
     task += "cd " + quote(workdir.string()) + "\n";
     task += quote(mirage) + " " + cmd;
     for (const auto& arg : args) task += " " + quote(arg);
-    if (cmd != "bench" && optionValue(args, "--threads").empty())
+    if ((cmd == "synth" || cmd == "render") && optionValue(args, "--threads").empty())
         task += " --threads \"${SLURM_CPUS_PER_TASK:-1}\"";
     task += fmt::format(" --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\"\n", a.shards);
 
@@ -207,10 +208,10 @@ void run(const SlurmArgs& a) {
 }
 
 const CommandRegistrar reg("slurm", [](CLI::App& parent) {
-    auto* cmd = parent.add_subcommand(
-        "slurm",
-        "Run synth, render or bench on a Slurm cluster: a job array of --shards tasks and a "
-        "merge job (docs/scale.md)");
+    auto* cmd = parent.add_subcommand("slurm",
+                                      "Run synth, render, bench or replay on a Slurm cluster: a "
+                                      "job array of --shards tasks and a "
+                                      "merge job (docs/scale.md)");
     auto a = std::make_shared<SlurmArgs>();
     cmd->add_option("--shards", a->shards, "Tasks in the job array (one shard each)")
         ->required()
@@ -229,7 +230,7 @@ const CommandRegistrar reg("slurm", [](CLI::App& parent) {
                     "The mirage binary the tasks run (default: this one; must be visible on "
                     "every node)");
     cmd->add_flag("--dry-run", a->dryRun, "Write the batch scripts and print them; submit nothing");
-    cmd->add_option("command", a->command, "-- then synth|render|bench and its arguments")
+    cmd->add_option("command", a->command, "-- then synth|render|bench|replay and its arguments")
         ->expected(-1);
     cmd->callback([a] { run(*a); });
 });

@@ -44,6 +44,46 @@ TEST(Shards, InterleavedSelectionCoversEveryItemOnce) {
     EXPECT_THROW(selectItems(10, ItemRange{10, -1}, ShardSpec{}), Error);
 }
 
+TEST(Shards, BlocksAreContiguousAndCoverEveryItemOnce) {
+    for (int count : {1, 2, 3, 7}) {
+        std::vector<int> seen(17, 0);
+        int next = 3;
+        for (int i = 0; i < count; ++i)
+            for (int item : selectBlock(17, ItemRange{3, 17}, ShardSpec{i, count})) {
+                EXPECT_EQ(item, next++) << count;  // in order, no gap between blocks
+                ++seen[size_t(item)];
+            }
+        for (int item = 3; item < 17; ++item) EXPECT_EQ(seen[size_t(item)], 1) << count;
+    }
+}
+
+TEST(Shards, MissingBlockIsNamed) {
+    const fs::path out = test::outputDir("shards_blocks") / "out";
+    fs::remove_all(shardsFolder(out));
+    for (int i : {0, 2}) {
+        ShardManifest m;
+        m.command = "replay";
+        m.unit = "frames";
+        m.shard = {i, 3};
+        m.total = 10;
+        m.range = {0, 10};
+        m.blocks = true;
+        m.items = selectBlock(10, ItemRange{}, m.shard);
+        m.fingerprint = "f";
+        m.commandLine = {"mirage", "replay", "--shard", "0/3"};
+        const fs::path dir = shardFolder(out, m.shard);
+        fs::create_directories(dir);
+        writeShardManifest(dir, m);
+    }
+    try {
+        collectShards(out);
+        FAIL() << "a missing block was not noticed";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("(3, 4, 5); rerun shard(s) 1 of 3"), std::string::npos)
+            << e.what();
+    }
+}
+
 ShardManifest manifest(int index, int count, int total, const std::string& fingerprint = "f") {
     ShardManifest m;
     m.command = "synth";
