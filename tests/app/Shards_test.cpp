@@ -261,5 +261,34 @@ TEST(ShardedRuns, ReplayBlocksWithWarmupJoinSeamlessly) {
     }
 }
 
+TEST(ShardedRuns, SlurmScriptsRunOneShardPerTaskAndMergeAfterAll) {
+    const fs::path dir = test::outputDir("shards_slurm_dry");
+    fs::remove_all(dir);
+    const fs::path out = dir / "gt";
+    auto r = runMirage({"slurm", "--shards", "4", "--cpus", "3", "--time", "00:30:00", "--dry-run",
+                        "--", "synth", scene(), "-o", out.string(), "--seconds", "2"});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream tasks(dir / "gt.slurm" / "shards.sbatch"),
+        merge(dir / "gt.slurm" / "merge.sbatch");
+    const std::string t{std::istreambuf_iterator<char>(tasks), std::istreambuf_iterator<char>()};
+    const std::string m{std::istreambuf_iterator<char>(merge), std::istreambuf_iterator<char>()};
+    for (const char* want :
+         {"#SBATCH --array=0-3", "#SBATCH --cpus-per-task=3", "#SBATCH --time=00:30:00",
+          "#SBATCH --mem=", "--shard \"${SLURM_ARRAY_TASK_ID}/4\"",
+          "--threads \"${SLURM_CPUS_PER_TASK:-1}\"", " synth "})
+        EXPECT_NE(t.find(want), std::string::npos) << want << " not in:\n" << t;
+    EXPECT_NE(m.find(" merge " + out.string()), std::string::npos) << m;
+    EXPECT_NE(r.output.find("--dependency=afterok:"), std::string::npos) << r.output;
+    // What cannot be split, or is split already, is refused before anything is submitted.
+    r = runMirage({"slurm", "--shards", "2", "--dry-run", "--", "track", "s", "-o", "p.csv"});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    r = runMirage({"slurm", "--shards", "2", "--dry-run", "--", "synth", scene(), "-o",
+                   out.string(), "--shard", "0/2"});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("leave --shard out"), std::string::npos) << r.output;
+    r = runMirage({"slurm", "--shards", "2", "--dry-run", "--", "synth", scene()});
+    EXPECT_NE(r.output.find("needs -o OUT"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace mirage
