@@ -167,4 +167,30 @@ void restoreStopSignals() {
     std::signal(SIGTERM, gPrevTerm == SIG_ERR ? SIG_DFL : gPrevTerm);
 }
 
+StagedPath::StagedPath(std::filesystem::path finalPath) : final_(std::move(finalPath)) {
+    if (!final_.has_filename()) final_ = final_.parent_path();
+    temp_ = final_;
+    temp_.replace_filename(final_.stem().string() + ".partial-" + std::to_string(::getpid()) +
+                           final_.extension().string());
+    std::error_code ec;
+    std::filesystem::remove_all(temp_, ec);
+    if (!final_.parent_path().empty()) std::filesystem::create_directories(final_.parent_path());
+}
+
+StagedPath::~StagedPath() {
+    std::error_code ec;
+    if (!committed_) std::filesystem::remove_all(temp_, ec);
+}
+
+void StagedPath::commit() {
+    std::error_code ec;
+    std::filesystem::remove_all(final_, ec);
+    std::filesystem::rename(temp_, final_, ec);
+    if (ec)
+        throw FileError(final_.string(),
+                        "cannot move the finished result into place: " + ec.message() +
+                            " (it is complete in " + temp_.string() + ")");
+    committed_ = true;
+}
+
 }  // namespace mirage

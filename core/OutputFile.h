@@ -65,6 +65,28 @@ private:
     bool committed_ = false;
 };
 
+// A folder (or file) written under a temporary name beside its final path,
+// "<name>.partial-<pid><ext>", and moved there only when complete: a failed or interrupted
+// writer leaves nothing at the final path and its temporary is removed. Used for sessions,
+// shards and merged outputs, whose checks happen before (checkOutput).
+class StagedPath {
+public:
+    explicit StagedPath(std::filesystem::path finalPath);  // removes a stale temporary first
+    ~StagedPath();                                         // removes the temporary unless moved
+    StagedPath(const StagedPath&) = delete;
+    StagedPath& operator=(const StagedPath&) = delete;
+
+    const std::filesystem::path& temp() const { return temp_; }
+    const std::filesystem::path& finalPath() const { return final_; }
+    // Replaces whatever is at the final path (the caller checked it may) with the temporary.
+    // Throws FileError saying where the complete result was left if the rename fails.
+    void commit();
+
+private:
+    std::filesystem::path final_, temp_;
+    bool committed_ = false;
+};
+
 // Closes a stream that wrote an OutputFile's temp() and throws FileError naming `out` if any
 // write failed (full disk, I/O error): a stream drops failed writes silently otherwise.
 void closeChecked(std::ofstream& stream, const std::filesystem::path& out);

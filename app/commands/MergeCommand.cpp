@@ -3,8 +3,6 @@
 // it (docs/scale.md). Checks first that every item is there exactly once and names what is
 // missing with the command that reruns it; writes OUT under a temporary name and moves it into
 // place; removes the shards afterwards unless --keep-shards.
-#include <unistd.h>
-
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -16,6 +14,7 @@
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/Shards.h"
 #include "render/raytrace/SyntheticSession.h"
 
@@ -29,16 +28,6 @@ struct MergeArgs {
     bool keepShards = false, force = false;
 };
 
-// Moves the finished `temp` to `out` (replacing it only with --force).
-void moveIntoPlace(const fs::path& temp, const fs::path& out) {
-    std::error_code ec;
-    if (fs::exists(out)) fs::remove_all(out, ec);
-    fs::rename(temp, out, ec);
-    if (ec)
-        throw FileError(out.string(), "cannot move the merged result into place: " + ec.message() +
-                                          " (it is complete in " + temp.string() + ")");
-}
-
 void run(const MergeArgs& a) {
     fs::path out(a.output);
     if (!out.has_filename()) out = out.parent_path();
@@ -47,20 +36,8 @@ void run(const MergeArgs& a) {
     if (fs::exists(out) && !a.force)
         throw FileError(out.string(),
                         "exists already; remove it or pass --force to replace it with the merge");
-    if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
-    // The extension stays last: image writers choose the format by it.
-    fs::path temp = out;
-    temp.replace_filename(out.stem().string() + ".partial-" + std::to_string(::getpid()) +
-                          out.extension().string());
-    std::error_code ec;
-    fs::remove_all(temp, ec);
-    struct RemoveOnFailure {
-        fs::path path;
-        ~RemoveOnFailure() {
-            std::error_code e;
-            if (!path.empty()) fs::remove_all(path, e);
-        }
-    } cleanup{temp};
+    StagedPath staged(out);
+    const fs::path& temp = staged.temp();
 
     TerminalProgress bar("merge");
     if (first.command == "synth") {
@@ -79,11 +56,11 @@ void run(const MergeArgs& a) {
                             "' cannot be merged by this mirage (synth, render, bench, replay)");
     }
     bar.finish();
-    moveIntoPlace(temp, out);
-    cleanup.path.clear();
+    staged.commit();
     spdlog::info("merged {} shards ({} {}) of `mirage {}` into {}", set.shards.size(),
                  first.range.end - first.range.begin, first.unit, first.command, out.string());
     if (!a.keepShards) {
+        std::error_code ec;
         fs::remove_all(shardsFolder(out), ec);
         if (ec) spdlog::warn("could not remove {}: {}", shardsFolder(out).string(), ec.message());
     }

@@ -126,20 +126,17 @@ void runReplay(const ReplayArgs& a) {
     if (!a.poses.empty()) rule.inputs.push_back(a.poses);
     // A shard (--shard I/N: the I-th of N contiguous blocks of the frames) writes PNG frames and
     // its CSV rows into OUT.shards/I-of-N; `mirage merge OUT` makes OUT of them.
-    std::filesystem::path shardTemp;
+    std::optional<StagedPath> staged;
     if (split) {
         checkOutput(userOut, OutputOrigin::Named, rule, /*outIsFolder=*/!userMkv);
         const auto dir = shardFolder(userOut, shard);
         if (std::filesystem::exists(dir / "shard.json") && !a.force)
             throw FileError(dir.string(),
                             "this shard is already complete; pass --force to replay it again");
-        shardTemp = dir;
-        shardTemp += ".partial-" + std::to_string(::getpid());
-        std::error_code ec;
-        std::filesystem::remove_all(shardTemp, ec);
-        std::filesystem::create_directories(shardTemp);
+        staged.emplace(dir);
+        std::filesystem::create_directories(staged->temp());
     }
-    const std::filesystem::path out = split ? shardTemp : userOut;
+    const std::filesystem::path out = split ? staged->temp() : userOut;
     const bool mkv = split ? false : userMkv;
     std::optional<OutputFile> videoOut;
     std::filesystem::path csvPath;
@@ -354,7 +351,7 @@ void runReplay(const ReplayArgs& a) {
         rs.listed = listed;
         rs.range = ItemRange{a.start, a.start + wanted};
         rs.frames = block;
-        rs.folder = shardTemp;
+        rs.output = userOut;
         rs.video = userMkv;
         rs.fps = session.fps;
         rs.jpegQuality = a.jpegQuality;
@@ -364,7 +361,7 @@ void runReplay(const ReplayArgs& a) {
             "{} {} {} {} {} {:.9g} {} {}", std::filesystem::absolute(a.session).string(), a.poses,
             a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
             userMkv)));
-        finishReplayShard(userOut, rs);
+        finishReplayShard(*staged, rs);
         return;
     }
     if (stopRequested()) {

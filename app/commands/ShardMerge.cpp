@@ -1,7 +1,5 @@
 #include "app/commands/ShardMerge.h"
 
-#include <unistd.h>
-
 #include <fstream>
 #include <memory>
 
@@ -36,11 +34,8 @@ cv::Mat takeRows(const cv::Mat& full, const std::vector<int>& rows) {
 
 void writeRenderShard(const fs::path& out, const RenderShard& rs) {
     const fs::path dir = shardFolder(out, rs.shard);
-    fs::create_directories(dir.parent_path());
-    fs::path temp = dir;
-    temp += ".partial-" + std::to_string(::getpid());
-    std::error_code ec;
-    fs::remove_all(temp, ec);
+    StagedPath staged(dir);
+    const fs::path& temp = staged.temp();
     fs::create_directories(temp);
     // EXR float keeps every value exactly, whatever the final format.
     writeLinearRgb(temp / "image.exr", takeRows(rs.image, rs.rows), 1.0f);
@@ -60,10 +55,7 @@ void writeRenderShard(const fs::path& out, const RenderShard& rs) {
                  {"exposure", rs.exposure},
                  {"buffers", !rs.buffers.empty()}};
     writeShardManifest(temp, m);
-    fs::remove_all(dir, ec);
-    fs::rename(temp, dir, ec);
-    if (ec)
-        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message());
+    staged.commit();
     spdlog::info("wrote shard {}/{} ({} rows) to {}; when every shard is done: mirage merge {}",
                  rs.shard.index, rs.shard.count, rs.rows.size(), dir.string(), out.string());
 }
@@ -121,11 +113,8 @@ void mergeRenderShards(const ShardSet& set, const fs::path& out, const fs::path&
 void writeBenchShard(const fs::path& out, const BenchShard& bs,
                      const std::function<void(const fs::path& dir)>& extraFiles) {
     const fs::path dir = shardFolder(out, bs.shard);
-    fs::create_directories(dir.parent_path());
-    fs::path temp = dir;
-    temp += ".partial-" + std::to_string(::getpid());
-    std::error_code ec;
-    fs::remove_all(temp, ec);
+    StagedPath staged(dir);
+    const fs::path& temp = staged.temp();
     fs::create_directories(temp);
     if (extraFiles) extraFiles(temp);
     nlohmann::json results = nlohmann::json::array();
@@ -140,10 +129,7 @@ void writeBenchShard(const fs::path& out, const BenchShard& bs,
     m.commandLine = commandLine();
     m.payload = {{"results", results}, {"preamble", bs.preamble}, {"images", bs.images}};
     writeShardManifest(temp, m);
-    fs::remove_all(dir, ec);
-    fs::rename(temp, dir, ec);
-    if (ec)
-        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message());
+    staged.commit();
     spdlog::info(
         "wrote shard {}/{} ({} configurations) to {}; when every shard is done: mirage "
         "merge {}",
@@ -202,7 +188,7 @@ void mergeBenchShards(const ShardSet& set, const fs::path& temp) {
     render::writeBenchMarkdown((temp / "bench.md").string(), all, preamble);
 }
 
-void finishReplayShard(const fs::path& out, const ReplayShard& rs) {
+void finishReplayShard(StagedPath& staged, const ReplayShard& rs) {
     ShardManifest m;
     m.command = "replay";
     m.unit = "frames";
@@ -218,13 +204,10 @@ void finishReplayShard(const fs::path& out, const ReplayShard& rs) {
                  {"jpeg_quality", rs.jpegQuality},
                  {"warmup", rs.warmup},
                  {"written", rs.written}};
-    writeShardManifest(rs.folder, m);
-    const fs::path dir = shardFolder(out, rs.shard);
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-    fs::rename(rs.folder, dir, ec);
-    if (ec)
-        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message());
+    writeShardManifest(staged.temp(), m);
+    staged.commit();
+    const fs::path& dir = staged.finalPath();
+    const fs::path out = rs.output;
     spdlog::info(
         "wrote shard {}/{} (frames {} to {}, {} warm-up frames before) to {}; when every "
         "shard is done: mirage merge {}",

@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/OutputFile.h"
 #include "core/Shards.h"
 #include "render/evaluation/RealtimeBench.h"
 
@@ -58,7 +59,7 @@ struct ReplayShard {
     int listed = 0;                // frames the session lists
     ItemRange range;               // the frames asked for (--start, --frames)
     std::vector<int> frames;       // this shard's block of them (positions in the session's list)
-    std::filesystem::path folder;  // where the replay wrote PNG frames and frames.csv
+    std::filesystem::path output;  // OUT as given
     bool video = false;            // the merged output is OUT.mkv (else a PNG folder)
     double fps = 30.0;
     int jpegQuality = 92;
@@ -67,8 +68,9 @@ struct ReplayShard {
     std::string fingerprint;
 };
 
-// Writes the manifest into the replay's folder and moves it to OUT.shards/I-of-N.
-void finishReplayShard(const std::filesystem::path& out, const ReplayShard& shard);
+// Writes the manifest into the replay's folder (staged.temp(), staged for OUT.shards/I-of-N)
+// and moves it into place.
+void finishReplayShard(StagedPath& staged, const ReplayShard& shard);
 
 // Writes OUT (an MJPEG .mkv with its .csv beside it, or a folder of PNG frames with frames.csv)
 // from the shards' frames in order, to `temp` named like `out`.

@@ -2,8 +2,6 @@
 // reference renderer from the scene's REAL parts only (what a real camera would film), along a
 // camera path (orbit, hand-held shake, fast pan), with optional sensor effects, plus the fish-eye
 // environment camera. Writes the session format of docs/session.md (docs/reference-renderer.md).
-#include <unistd.h>
-
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -40,7 +38,6 @@ void writeShard(const SynthArgs& a, const Scene& scene, const ShardSpec& shard,
                 const ItemRange& range, int total, const std::vector<int>& frames) {
     const fs::path out(a.output);
     const fs::path dir = shardFolder(out, shard);
-    std::error_code ec;
     if (fs::exists(dir / "shard.json") && !a.force)
         throw FileError(dir.string(),
                         "this shard is already complete; pass --force to render it again");
@@ -49,17 +46,8 @@ void writeShard(const SynthArgs& a, const Scene& scene, const ShardSpec& shard,
             fmt::format("mirage synth: shard {}/{} of frames {}:{} holds no frame; use at "
                         "most as many shards as frames",
                         shard.index, shard.count, range.begin, range.end < 0 ? total : range.end));
-    fs::create_directories(dir.parent_path());
-    fs::path temp = dir;
-    temp += ".partial-" + std::to_string(::getpid());
-    fs::remove_all(temp, ec);
-    struct RemoveOnFailure {
-        fs::path dir;
-        ~RemoveOnFailure() {
-            std::error_code e;
-            if (!dir.empty()) fs::remove_all(dir, e);
-        }
-    } cleanup{temp};
+    StagedPath staged(dir);
+    const fs::path& temp = staged.temp();
 
     TerminalProgress bar("synth");
     const auto start = std::chrono::steady_clock::now();
@@ -83,12 +71,7 @@ void writeShard(const SynthArgs& a, const Scene& scene, const ShardSpec& shard,
         });
     bar.finish();
     writeShardManifest(temp, m);
-    fs::remove_all(dir, ec);  // --force (checked above), or an incomplete earlier attempt
-    fs::rename(temp, dir, ec);
-    if (ec)
-        throw FileError(dir.string(), "cannot move the finished shard into place: " + ec.message() +
-                                          " (it is complete in " + temp.string() + ")");
-    cleanup.dir.clear();
+    staged.commit();  // replaces an earlier attempt (--force, checked above)
     spdlog::info("wrote shard {}/{} ({} frames) to {}; when every shard is done: mirage merge {}",
                  shard.index, shard.count, frames.size(), dir.string(), out.string());
 }
@@ -140,17 +123,8 @@ void run(SynthArgs a) {
 
     // The session is written into a temporary folder beside OUT and moved into place when
     // complete: a failed or interrupted synth leaves no half-written session at OUT.
-    createParentFolders(out);
-    fs::path temp = out;
-    temp.replace_filename(out.filename().string() + ".partial-" + std::to_string(::getpid()));
-    fs::remove_all(temp, ec);
-    struct RemoveOnFailure {
-        fs::path dir;
-        ~RemoveOnFailure() {
-            std::error_code e;
-            if (!dir.empty()) fs::remove_all(dir, e);
-        }
-    } cleanup{temp};
+    StagedPath staged(out);
+    const fs::path& temp = staged.temp();
 
     TerminalProgress bar("synth");
     const auto start = std::chrono::steady_clock::now();
@@ -162,13 +136,7 @@ void run(SynthArgs a) {
                        fmt::format("frame {}/{} ({}), {:.0f} s", done, total, segment, elapsed));
         });
     bar.finish();
-    if (fs::exists(out)) fs::remove_all(out);  // --force (checked above), or an empty folder
-    fs::rename(temp, out, ec);
-    if (ec)
-        throw FileError(out.string(),
-                        "cannot move the finished session into place: " + ec.message() +
-                            " (it is complete in " + temp.string() + ")");
-    cleanup.dir.clear();
+    staged.commit();  // replaces a session (--force, checked above) or an empty folder
 }
 
 const CommandRegistrar reg("synth", [](CLI::App& parent) {
