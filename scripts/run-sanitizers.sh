@@ -24,21 +24,6 @@ start=$(date +%s)
 echo "run-sanitizers: tests passed in $(($(date +%s) - start)) s"
 
 if [ "$extra" -gt 0 ]; then
-  crashes="$build/tests/output/fuzz"
-  mkdir -p "$crashes"
-  corpus="$root/tests/fuzz/corpus"
-  run() {  # target corpus-dirs...
-    local target=$1
-    shift
-    local args=()
-    for d in "$@"; do args+=(--corpus "$d"); done
-    "$build/tests/$target" --seconds "$extra" --seed 7 "${args[@]}" --crash-dir "$crashes"
-  }
-  run scene_loader_fuzz "$root/tests/data/scenes/good" "$root/tests/data/scenes/bad"
-  run calibration_fuzz "$root/tests/data/calib" "$root/tests/data/calib/bad"
-  run board_fuzz "$root/data/boards" "$corpus/board"
-  run session_fuzz "$corpus/session"
-  run poses_csv_fuzz "$corpus/poses"
-  run matroska_fuzz "$corpus/matroska"
-  run env_image_fuzz "$corpus/envimage" "$root/tests/data/scenes/good"
+  MIRAGE_FUZZ_SECONDS="$extra" MIRAGE_FUZZ_RUNS="${MIRAGE_FUZZ_RUNS:-0}" \
+    "$root/scripts/run-fuzz.sh" "$build"
 fi

@@ -2,12 +2,15 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
+#include "core/image/LinearImageHeader.h"
 
 namespace mirage {
 
@@ -95,7 +98,14 @@ cv::Mat srgbBgr8ToLinearRgb(const cv::Mat& bgr8) {
 cv::Mat readLinearRgb(const std::filesystem::path& path) {
     enableExr();
     if (!std::filesystem::exists(path)) throw FileError(path.string(), "no such file");
-    const std::string ext = lowerExt(path);
+    {
+        // The decoders trust their headers: screen them first (LinearImageHeader.h).
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw FileError(path.string(), "cannot open for reading");
+        const std::string bytes{std::istreambuf_iterator<char>(in),
+                                std::istreambuf_iterator<char>()};
+        screenLinearImageHeader(path, bytes);
+    }
     cv::Mat img;
     try {
         img = cv::imread(path.string(), cv::IMREAD_UNCHANGED);

@@ -5,7 +5,7 @@
 // values, the format's keys and tokens inserted), feeds each result to the target for a fixed
 // time with a fixed seed, and keeps inputs that load successfully as new seeds.
 //
-//   <target> --seconds 20 --seed 1 --corpus DIR [--corpus DIR...] [--crash-dir DIR]
+//   <target> --seconds 20 [--runs N] --seed 1 --corpus DIR [--corpus DIR...] [--crash-dir DIR]
 //   <target> FILE...          # replay inputs (e.g. a saved crash) once each
 //
 // On a crash (signal, uncaught exception, sanitizer report, or an input running longer than
@@ -234,7 +234,7 @@ std::string readFile(const fs::path& p) {
 int usage() {
     const std::string name = mirage::fuzz::target().name;
     std::cerr << "usage: " << name
-              << " [--seconds S] [--seed N] [--corpus DIR]... [--crash-dir DIR]\n"
+              << " [--seconds S] [--runs N] [--seed N] [--corpus DIR]... [--crash-dir DIR]\n"
                  "       [--max-length BYTES] [--input-timeout S]\n"
               << "       " << name << " FILE...   (replay inputs once)\n";
     return 2;
@@ -244,6 +244,7 @@ int usage() {
 
 int main(int argc, char** argv) {
     double seconds = 20;
+    uint64_t maxRuns = 0;  // 0: no limit; the run ends at --seconds or --runs, whichever is first
     uint64_t seed = 1;
     size_t maxLength = 256 * 1024;
     unsigned inputTimeout = 10;
@@ -260,6 +261,8 @@ int main(int argc, char** argv) {
         };
         if (a == "--seconds")
             seconds = std::stod(next());
+        else if (a == "--runs")
+            maxRuns = std::stoull(next());
         else if (a == "--seed")
             seed = std::stoull(next());
         else if (a == "--corpus")
@@ -316,8 +319,9 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     uint64_t runs = 0, loaded = 0;
     std::string input;
-    while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
-           seconds) {
+    while ((maxRuns == 0 || runs < maxRuns) &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
+               seconds) {
         input = pool[pick(rng, pool.size())];
         mutate(input, pool, rng, maxLength);
         std::snprintf(gCrashPath, sizeof(gCrashPath), "%s/crash-%llu-%llu.bin",
