@@ -104,72 +104,40 @@ CalibrationView projectView(const CameraIntrinsics& camera, const ChessboardGeom
 }
 
 ChessboardRenderer::ChessboardRenderer(const CameraIntrinsics& camera, int supersample)
-    : camera_(camera), n_(std::max(1, supersample)) {
-    rays_.resize(size_t(camera.width) * size_t(camera.height) * size_t(n_ * n_));
-    size_t k = 0;
-    for (int y = 0; y < camera.height; ++y)
-        for (int x = 0; x < camera.width; ++x)
-            for (int sy = 0; sy < n_; ++sy)
-                for (int sx = 0; sx < n_; ++sx) {
-                    // Pixel (x, y) covers [x - 0.5, x + 0.5] (OpenCV: centres at integers).
-                    const glm::dvec2 px{x - 0.5 + (sx + 0.5) / n_, y - 0.5 + (sy + 0.5) / n_};
-                    const auto ray = camera.unproject(px);
-                    rays_[k++] = ray ? cv::Vec3f(float(ray->x), float(ray->y), float(ray->z))
-                                     : cv::Vec3f(0, 0, 0);
-                }
-}
-
-template <typename ShadeBoardPoint>
-cv::Mat ChessboardRenderer::renderPlane(const BoardPose& pose, ShadeBoardPoint shade) const {
-    cv::Matx33d R;
-    cv::Rodrigues(pose.rvec, R);
-    const cv::Matx33d Rt = R.t();
-    const cv::Vec3d origin = -(Rt * pose.tvec);  // camera centre in board coordinates
-    cv::Mat img(camera_.height, camera_.width, CV_8UC1);
-    size_t k = 0;
-    for (int y = 0; y < camera_.height; ++y) {
-        auto* row = img.ptr<uint8_t>(y);
-        for (int x = 0; x < camera_.width; ++x) {
-            double sum = 0;
-            for (int s = 0; s < n_ * n_; ++s) {
-                const cv::Vec3f& r = rays_[k++];
-                double value = kBackground;
-                const cv::Vec3d d = Rt * cv::Vec3d(r[0], r[1], r[2]);
-                if (std::abs(d[2]) > 1e-12) {
-                    const double t = -origin[2] / d[2];
-                    if (t > 0) value = shade(origin[0] + t * d[0], origin[1] + t * d[1]);
-                }
-                sum += value;
-            }
-            row[x] = cv::saturate_cast<uint8_t>(sum / (n_ * n_));
-        }
-    }
-    return img;
-}
+    : renderer_(camera, std::max(1, supersample)) {}
 
 cv::Mat ChessboardRenderer::render(const ChessboardGeometry& board, const BoardPose& pose) const {
+    // One texel per square: the (cols + 1) x (rows + 1) squares of the pattern start at (-sq, -sq)
+    // (inner corner (0, 0) at the origin), with one white square of margin all around.
+    constexpr uint8_t kBlack = 25, kWhite = 230;
     const double sq = board.squareMetres;
-    return renderPlane(pose, [&](double bx, double by) {
-        // Squares span [-sq, cols*sq] x [-sq, rows*sq]; margin of 1 square.
-        const double gx = bx / sq + 1, gy = by / sq + 1;
-        if (gx < -1 || gy < -1 || gx >= board.cols + 2 || gy >= board.rows + 2) return kBackground;
-        if (gx >= 0 && gy >= 0 && gx < board.cols + 1 && gy < board.rows + 1 &&
-            ((int(std::floor(gx)) + int(std::floor(gy))) & 1) == 0)
-            return 25.0;
-        return 230.0;
-    });
+    cv::Mat texture(board.rows + 3, board.cols + 3, CV_8UC1, cv::Scalar(kWhite));
+    for (int v = 1; v <= board.rows + 1; ++v)
+        for (int u = 1; u <= board.cols + 1; ++u)
+            if (((u + v) & 1) == 0) texture.at<uint8_t>(v, u) = kBlack;
+    return renderTexture(texture, sq, {2.0, 2.0}, pose);
 }
 
 cv::Mat ChessboardRenderer::renderTexture(const cv::Mat& texture, double metresPerTexel,
                                           const cv::Point2d& boardOriginTexel,
                                           const BoardPose& pose) const {
     MR_CHECK(texture.type() == CV_8UC1 && metresPerTexel > 0, "texture must be 8-bit grey");
-    return renderPlane(pose, [&](double bx, double by) {
-        const double u = std::floor(bx / metresPerTexel + boardOriginTexel.x);
-        const double v = std::floor(by / metresPerTexel + boardOriginTexel.y);
-        if (u < 0 || v < 0 || u >= texture.cols || v >= texture.rows) return kBackground;
-        return double(texture.at<uint8_t>(int(v), int(u)));
-    });
+    PlaneTexture plane;
+    plane.image = texture;
+    plane.metresPerTexelX = plane.metresPerTexelY = metresPerTexel;
+    plane.originMetres = {-boardOriginTexel.x * metresPerTexel,
+                          -boardOriginTexel.y * metresPerTexel};
+    plane.filter = PlaneTexture::Filter::Nearest;
+    PlaneShading shading;  // texture values are the output levels
+    shading.background = kBackground;
+    cv::Matx33d R;
+    cv::Rodrigues(pose.rvec, R);
+    glm::dmat3 Rg;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) Rg[c][r] = R(r, c);
+    const Pose T_camera_board =
+        Pose::fromRotationTranslation(Rg, glm::dvec3(pose.tvec[0], pose.tvec[1], pose.tvec[2]));
+    return renderer_.render(plane, T_camera_board, shading);
 }
 
 cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,

@@ -1,9 +1,9 @@
 #pragma once
 // Synthetic board views with known intrinsics and poses: for tests (recover known parameters,
 // Monte-Carlo uncertainty checks) and for trying the wizard without a camera
-// (`mirage calibrate --write-synthetic DIR`). The images are rendered by ray casting every
-// sub-pixel through the exact camera model (CameraIntrinsics::unproject) onto the board plane,
-// so they are exact up to the 4x4 supersampling.
+// (`mirage calibrate --write-synthetic DIR`). The images come from core's TexturedPlaneRenderer:
+// every sub-pixel ray-cast through the camera model onto the board plane, averaged in linear
+// light, so they are exact up to the supersampling.
 #include <random>
 #include <vector>
 
@@ -11,6 +11,7 @@
 
 #include "calibration/Calibrator.h"
 #include "core/camera/CameraModel.h"
+#include "core/camera/TexturedPlaneRenderer.h"
 
 namespace mirage::calib {
 
@@ -53,9 +54,9 @@ CalibrationView projectView(const CameraIntrinsics& camera, const ChessboardGeom
 
 // Renders boards as 8-bit grey images (sRGB-encoded values: black squares 25, white 230,
 // background 110), with a white margin of one square around the pattern as printed boards have.
-// Pixels whose ray misses the board show the background. The camera rays of all sub-pixel
-// samples (supersample x supersample per pixel) are computed once per renderer, so rendering a
-// pose costs only the ray-plane intersections.
+// Pixels whose ray misses the board show the background. A thin adapter over
+// TexturedPlaneRenderer (core/camera): the chessboard is a texture of one texel per square with
+// nearest sampling, so its edges are exact; sub-pixels are averaged in linear light.
 class ChessboardRenderer {
 public:
     ChessboardRenderer(const CameraIntrinsics& camera, int supersample = 3);
@@ -68,14 +69,8 @@ public:
                           const cv::Point2d& boardOriginTexel, const BoardPose& pose) const;
 
 private:
-    CameraIntrinsics camera_;
-    int n_;
-    std::vector<cv::Vec3f> rays_;  // unit rays, camera frame; zero where unprojection failed
+    TexturedPlaneRenderer renderer_;
     static constexpr double kBackground = 110;  // grey value where a ray misses the board
-    // Ray-casts every sub-pixel onto the board plane z = 0 and averages shade(x, y) (board
-    // metres -> grey value) over each pixel's sub-pixels.
-    template <typename ShadeBoardPoint>
-    cv::Mat renderPlane(const BoardPose& pose, ShadeBoardPoint shade) const;
 };
 
 // One-off convenience (builds a renderer).
