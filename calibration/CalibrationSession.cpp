@@ -38,11 +38,20 @@ double laplacianVariance(const cv::Mat& grey, const cv::Rect& roi) {
     return stddev[0] * stddev[0];
 }
 
-double meanCornerMotion(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
-    if (a.empty() || a.size() != b.size()) return -1;
+double meanCornerMotion(const CalibrationView& a, const CalibrationView& b) {
     double sum = 0;
-    for (size_t i = 0; i < a.size(); ++i) sum += cv::norm(a[i] - b[i]);
-    return sum / double(a.size());
+    int n = 0;
+    size_t j = 0;
+    for (size_t i = 0; i < a.boardPoints.size(); ++i) {
+        // Both lists keep the target's order, so a forward scan finds the matches.
+        size_t k = j;
+        while (k < b.boardPoints.size() && b.boardPoints[k] != a.boardPoints[i]) ++k;
+        if (k == b.boardPoints.size()) continue;
+        sum += cv::norm(a.imagePoints[i] - b.imagePoints[k]);
+        ++n;
+        j = k + 1;
+    }
+    return n >= 4 ? sum / n : -1;
 }
 
 CalibrationSession::CalibrationSession(CalibrationTarget target, cv::Size imageSize,
@@ -114,7 +123,7 @@ FrameReport CalibrationSession::processFrame(const cv::Mat& image, const std::st
     FrameReport rep;
     auto d = target_.detect(grey, name);
     if (!d.found) {
-        previousCorners_.clear();
+        previousView_ = {};
         stillCount_ = 0;
         heldSinceCapture_ = false;
         return rep;
@@ -122,8 +131,8 @@ FrameReport CalibrationSession::processFrame(const cv::Mat& image, const std::st
     rep.boardFound = true;
     rep.view = d.view;
     const auto& corners = rep.view.imagePoints;
-    rep.motionPx = meanCornerMotion(previousCorners_, corners);
-    previousCorners_ = corners;
+    rep.motionPx = meanCornerMotion(previousView_, rep.view);
+    previousView_ = rep.view;
     if (rep.motionPx >= 0 && rep.motionPx < options_.stillMotionPx) {
         ++stillCount_;
     } else {

@@ -34,6 +34,11 @@ struct CalibrationView {
     std::string name;                      // file name or "frame N": used in reports
     std::vector<cv::Point2f> imagePoints;  // pixels, (0,0) = centre of the top-left pixel
     std::vector<cv::Point3f> boardPoints;  // metres, board frame (z = 0)
+    // Which detector found the board ("classic", "sector-based", "tags", "charuco"; empty when
+    // not from a detector), and how many of its corners were left out because their sub-pixel
+    // refinement did not converge.
+    std::string detector;
+    int unrefinedCorners = 0;
 };
 
 struct CalibrationOptions {

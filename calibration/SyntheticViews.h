@@ -23,10 +23,28 @@ struct ChessboardGeometry {
     std::vector<cv::Point3f> corners() const;
 };
 
+// Ideal fish-eye projections: the image radius of a ray theta off the axis is f * theta
+// (equidistant) or 2 f sin(theta / 2) (equisolid, e.g. most 180-degree photographic fish-eyes).
+enum class FisheyeLens { Equidistant, Equisolid };
+
+// Kannala-Brandt intrinsics of an ideal fish-eye lens with a field of view of fovDeg (full angle),
+// centred in a width x height image, its image circle touching the top and bottom edges. k1..k4
+// are fitted to the lens's theta_d(theta) / f over 0..fov/2 (least squares; exact for
+// equidistant, within 1e-5 px for equisolid up to 190 degrees at 640x480); maxFisheyeTheta is
+// half the field. Throws mirage::Error for a field outside (0, 240] degrees.
+CameraIntrinsics idealFisheye(FisheyeLens lens, double fovDeg, int width, int height);
+
 // Board pose T_camera_board (Rodrigues + metres).
 struct BoardPose {
     cv::Vec3d rvec, tvec;
 };
+
+// The board with its centre at `distance` (metres) along `direction` (camera frame), facing the
+// camera (its normal along the line of sight), then tilted by tiltDeg about the axis at
+// tiltAxisDeg in its plane and rolled by rollDeg about its normal.
+BoardPose boardPoseFacing(const ChessboardGeometry& board, const cv::Vec3d& direction,
+                          double distance, double tiltDeg, double tiltAxisDeg = 0,
+                          double rollDeg = 0);
 
 struct PoseSamplerOptions {
     double minDistance = 0.35, maxDistance = 0.7;  // metres, camera to board centre
@@ -72,6 +90,11 @@ private:
     TexturedPlaneRenderer renderer_;
     static constexpr double kBackground = 110;  // grey value where a ray misses the board
 };
+
+// Blur of an 8-bit sRGB-encoded grey image as a lens or motion makes it: a Gaussian of sigmaPx
+// pixels applied in linear light, then encoded again (blurring the encoded values instead shifts
+// edges toward the dark side by up to ~1 px at sigma 3 when corners are refined in linear light).
+cv::Mat blurInLinearLight(const cv::Mat& srgbGrey, double sigmaPx);
 
 // One-off convenience (builds a renderer).
 cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,

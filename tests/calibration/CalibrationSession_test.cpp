@@ -31,8 +31,8 @@ TEST(CalibrationSession, AutoCaptureNeedsStillSharpAndNewViews) {
     const auto p = poses(2, 1);
     const cv::Mat a = renderer.render(kBoard, p[0]);
     const cv::Mat b = renderer.render(kBoard, p[1]);
-    cv::Mat bBlurred;
-    cv::GaussianBlur(b, bBlurred, cv::Size(), 3.0);
+    // Out of focus as a lens blurs: in linear light.
+    const cv::Mat bBlurred = blurInLinearLight(b, 3.0);
 
     SessionOptions o;
     o.stillFrames = 3;
@@ -142,8 +142,21 @@ TEST(CaptureGate, SharpnessDropsWithBlurAndMotionIsMeasured) {
     cv::GaussianBlur(img, blurred, cv::Size(), 2.0);
     const cv::Rect roi(0, 0, img.cols, img.rows);
     EXPECT_GT(laplacianVariance(img, roi), 3 * laplacianVariance(blurred, roi));
-    EXPECT_NEAR(meanCornerMotion({{0, 0}, {1, 1}}, {{3, 4}, {1, 1}}), 2.5, 1e-9);
-    EXPECT_LT(meanCornerMotion({{0, 0}}, {}), 0);
+    // Matched by board point: b leaves out board point 1 (not refined) and moves point 0 by 5 px.
+    CalibrationView a, b;
+    for (int i = 0; i < 5; ++i) {
+        a.boardPoints.emplace_back(0.01f * i, 0.f, 0.f);
+        a.imagePoints.emplace_back(10.f * i, 0.f);
+        if (i == 1) continue;
+        b.boardPoints.push_back(a.boardPoints.back());
+        b.imagePoints.push_back(a.imagePoints.back() +
+                                (i == 0 ? cv::Point2f(3, 4) : cv::Point2f()));
+    }
+    EXPECT_NEAR(meanCornerMotion(a, b), 5.0 / 4, 1e-6);
+    b.boardPoints.resize(3);
+    b.imagePoints.resize(3);
+    EXPECT_LT(meanCornerMotion(a, b), 0);  // fewer than 4 shared
+    EXPECT_LT(meanCornerMotion(a, {}), 0);
 }
 
 }  // namespace
