@@ -227,9 +227,16 @@ std::vector<std::string> CalibrationSession::unmetTargets() const {
     if (!(pp <= options_.donePrincipalPointStdPx))
         unmet.push_back(fmt::format("principal point std {:.2f} px > {:.2f} px", pp,
                                     options_.donePrincipalPointStdPx));
+    // A fish-eye's distortion is decided toward the rim: say how far off-axis the corners reach.
+    const bool fisheye = c.intrinsics.model == DistortionModel::KannalaBrandt;
     if (coverage_.coveredFraction() < options_.doneCoverage)
-        unmet.push_back(fmt::format("coverage {:.0f}% < {:.0f}%", 100 * coverage_.coveredFraction(),
-                                    100 * options_.doneCoverage));
+        unmet.push_back(
+            fisheye ? fmt::format("coverage {:.0f}% < {:.0f}%: corners reach {:.0f} deg off-axis; "
+                                  "bring the board toward the rim",
+                                  100 * coverage_.coveredFraction(), 100 * options_.doneCoverage,
+                                  c.reachDeg)
+                    : fmt::format("coverage {:.0f}% < {:.0f}%", 100 * coverage_.coveredFraction(),
+                                  100 * options_.doneCoverage));
     return unmet;
 }
 

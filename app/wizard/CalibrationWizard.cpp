@@ -240,8 +240,8 @@ int runCalibrationWizard(const WizardOptions& o) {
             if (rep.decision == calib::CaptureDecision::Captured) lastCaptured = frame.name;
             camTex.show(overlay(current, session, rep));
             if (session.result() && showUndistorted)
-                undistTex.show(
-                    undistorter.apply(current, session.result()->calibration.intrinsics));
+                undistTex.show(undistorter.apply(current, session.result()->calibration.intrinsics,
+                                                 0.5, session.result()->calibration.reachDeg));
             haveFrame = false;
         }
         const bool screenshotDue =

@@ -6,9 +6,12 @@
 #include <cmath>
 #include <random>
 
+#include <opencv2/calib3d.hpp>
+
 #include "calibration/CalibrationTarget.h"
 #include "calibration/Calibrator.h"
 #include "calibration/SyntheticViews.h"
+#include "calibration/Undistorter.h"
 #include "tests/support/TestSupport.h"
 
 namespace mirage::calib {
@@ -99,6 +102,110 @@ TEST(FisheyeRim, TooDistortedBoardGetsItsOwnMessage) {
     ASSERT_FALSE(d.found);
     EXPECT_NE(d.reason.find("too distorted"), std::string::npos) << d.reason;
     EXPECT_EQ(d.reason.find("must be visible"), std::string::npos) << d.reason;
+}
+
+// Projected views (true corners + 0.1 px noise) through a 180-degree equisolid lens, half of them
+// toward the rim.
+std::vector<CalibrationView> rimViews(const CameraIntrinsics& cam, const ChessboardGeometry& board,
+                                      std::vector<BoardPose>& poses, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    std::vector<CalibrationView> views;
+    while (views.size() < 16) {
+        const bool rim = views.size() % 2;
+        const double off = rim ? 60 + 22 * uni(rng) : 55 * uni(rng);
+        const auto pose =
+            boardPoseFacing(board, offAxis(off, 360 * uni(rng)), 0.15 + 0.1 * uni(rng),
+                            rim ? 30 * uni(rng) : 10 + 35 * uni(rng), 360 * uni(rng));
+        auto v = projectView(cam, board, pose, 0.1, rng, "view" + std::to_string(views.size()));
+        if (v.imagePoints.size() != size_t(board.cols * board.rows)) continue;
+        poses.push_back(pose);
+        views.push_back(v);
+    }
+    return views;
+}
+
+// One corner 3 px off in a view far off-axis: dropped, listed with its view, and nothing else
+// of that view dropped; the model recovers the true lens.
+TEST(FisheyeRim, PlantedCornerErrorIsRejected) {
+    const auto cam = idealFisheye(FisheyeLens::Equisolid, 180, 640, 480);
+    const ChessboardGeometry board{9, 6, 0.025};
+    std::vector<BoardPose> poses;
+    auto views = rimViews(cam, board, poses, 5);
+    const size_t bad = 3, corner = 20;  // view 3 lies toward the rim
+    views[bad].imagePoints[corner] += cv::Point2f(3.0f * 0.6f, 3.0f * 0.8f);
+    CalibrationOptions o;
+    o.model = DistortionModel::KannalaBrandt;
+    const auto r = calibrate(views, {cam.width, cam.height}, o);
+    const auto& vr = r.views[bad];
+    ASSERT_EQ(vr.droppedCorners.size(), 1u);
+    EXPECT_LT(cv::norm(vr.droppedCorners[0].boardPoint - views[bad].boardPoints[corner]), 1e-6);
+    EXPECT_GT(vr.droppedCorners[0].residualPx, 2.0);
+    EXPECT_EQ(vr.pointCount, int(views[bad].imagePoints.size()) - 1);
+    EXPECT_LE(r.droppedCornerCount, 2);
+    EXPECT_NEAR(vr.noisePx, 0.1, 0.04);
+    EXPECT_NEAR(r.calibration.intrinsics.fx, cam.fx, 0.003 * cam.fx);
+}
+
+// A board facing the camera 75 degrees off-axis reads as facing it (tilt ~0), not as seen
+// edge-on (75 degrees against the optical axis); the reach covers its corners.
+TEST(FisheyeRim, EdgeBoardFacingTheCameraHasNoTilt) {
+    const auto cam = idealFisheye(FisheyeLens::Equisolid, 180, 640, 480);
+    const ChessboardGeometry board{9, 6, 0.025};
+    std::vector<BoardPose> poses;
+    auto views = rimViews(cam, board, poses, 7);
+    const auto facing = boardPoseFacing(board, offAxis(75, 0), 0.5, 0, 0);
+    std::mt19937 rng(3);
+    views.push_back(projectView(cam, board, facing, 0.1, rng, "facing"));
+    ASSERT_EQ(views.back().imagePoints.size(), 54u);
+    CalibrationOptions o;
+    o.model = DistortionModel::KannalaBrandt;
+    const auto r = calibrate(views, {cam.width, cam.height}, o);
+    const auto& vr = r.views.back();
+    ASSERT_FALSE(vr.rejected) << vr.rejectReason;
+    EXPECT_LT(vr.tiltDeg, 2.0);
+    double tilt = 0, dir = 0;
+    boardTilt(vr.rvec, tilt, dir);
+    EXPECT_GT(tilt, 70.0);  // the optical-axis notion the report used before
+    // Reach: the largest true off-axis angle of a used corner.
+    double truthReach = 0;
+    for (size_t v = 0; v < views.size(); ++v) {
+        const BoardPose& p = v < poses.size() ? poses[v] : facing;
+        cv::Matx33d R;
+        cv::Rodrigues(p.rvec, R);
+        for (const auto& b : views[v].boardPoints) {
+            const cv::Vec3d q = R * cv::Vec3d(b.x, b.y, b.z) + p.tvec;
+            truthReach = std::max(truthReach, std::atan2(std::hypot(q[0], q[1]), q[2]) / kDeg);
+        }
+    }
+    EXPECT_NEAR(r.calibration.reachDeg, truthReach, 0.3);
+    EXPECT_GT(r.calibration.reachRadiusPx, 200.0);
+}
+
+}  // namespace
+}  // namespace mirage::calib
+
+namespace mirage::calib {
+namespace {
+
+// The undistorted preview masks what lies beyond the calibration's reach, and nothing within it.
+TEST(FisheyeRim, UndistorterMasksBeyondTheReach) {
+    const auto cam = idealFisheye(FisheyeLens::Equidistant, 180, 640, 480);
+    const cv::Mat white(cam.height, cam.width, CV_8UC3, cv::Scalar::all(255));
+    Undistorter u;
+    const double zoom = 0.5;
+    const cv::Mat all = u.apply(white, cam, zoom);
+    EXPECT_EQ(u.maskedFraction(), 0.0);
+    const cv::Mat masked = u.apply(white, cam, zoom, 45.0);
+    EXPECT_GT(u.maskedFraction(), 0.05);
+    // The output is a pinhole view with focal fx * zoom: 45 degrees lies at radius fx * zoom.
+    const double r45 = cam.fx * zoom;
+    const auto at = [&](const cv::Mat& m, double radius) {
+        return m.at<cv::Vec3b>(int(std::lround(cam.cy)), int(std::lround(cam.cx + radius)))[0];
+    };
+    EXPECT_EQ(at(all, r45 + 5), 255);
+    EXPECT_EQ(at(masked, r45 + 5), 0);
+    EXPECT_EQ(at(masked, r45 - 5), 255);
 }
 
 }  // namespace
