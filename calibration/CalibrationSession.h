@@ -98,6 +98,8 @@ private:
     ViewSignature signatureOf(const std::vector<cv::Point2f>& corners, double tiltDeg,
                               double directionDeg) const;
     bool isNovel(const ViewSignature& s) const;
+    // The latest calibration's intrinsics, or a nominal guess of the configured model before one.
+    CameraIntrinsics currentIntrinsics() const;
     void estimateTilt(const CalibrationView& view, double& tiltDeg, double& directionDeg) const;
     void recalibrate();
     void rebuildCoverage();

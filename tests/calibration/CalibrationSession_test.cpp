@@ -3,7 +3,11 @@
 // "done" state.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -157,6 +161,80 @@ TEST(CaptureGate, SharpnessDropsWithBlurAndMotionIsMeasured) {
     b.imagePoints.resize(3);
     EXPECT_LT(meanCornerMotion(a, b), 0);  // fewer than 4 shared
     EXPECT_LT(meanCornerMotion(a, {}), 0);
+}
+
+// An equidistant fish-eye with a 180-degree image circle inscribed in 640x480 (radius 240 px).
+CameraIntrinsics equidistantFisheye() {
+    CameraIntrinsics in;
+    in.width = 640;
+    in.height = 480;
+    in.model = DistortionModel::KannalaBrandt;
+    in.fx = in.fy = 240.0 / (CV_PI / 2);
+    in.cx = 319.5;
+    in.cy = 239.5;
+    in.distortion.assign(4, 0.0);
+    return in;
+}
+
+TEST(CoverageMap, FisheyeCountsRingsOffAxisAndNamesTheMissingOnesInDegrees) {
+    const auto lens = equidistantFisheye();
+    CoverageMap m({640, 480});
+    m.setAngularLens(lens);
+    ASSERT_TRUE(m.angular());
+    EXPECT_EQ(m.reachableRings(), CoverageMap::kRingCount);  // the image's corners are past 90 deg
+    // Corners all around, but only within 35 degrees of the axis: the image cells near the
+    // centre hold them, and so do the rings 0-20 and 20-40.
+    std::vector<cv::Point2f> pts;
+    for (double offDeg = 5; offDeg <= 35; offDeg += 10)
+        for (double az = 0; az < 360; az += 15) {
+            const double off = offDeg * CV_PI / 180, a = az * CV_PI / 180;
+            const auto px = lens.project(
+                {std::sin(off) * std::cos(a), std::sin(off) * std::sin(a), std::cos(off)});
+            ASSERT_TRUE(px);
+            pts.emplace_back(float(px->x), float(px->y));
+        }
+    m.add(pts);
+    EXPECT_GT(m.ringCount(0), 0);
+    EXPECT_GT(m.ringCount(1), 0);
+    EXPECT_EQ(m.ringCount(2), 0);
+    EXPECT_EQ(m.ringCount(4), 0);
+    EXPECT_NEAR(m.coveredFraction(), 2.0 / 5.0, 1e-9);  // 2 of 5 rings, every sector
+    const auto missing = m.missingRings();
+    ASSERT_EQ(missing.size(), 1u);
+    EXPECT_EQ(missing[0], "no corners beyond 40 deg off-axis yet");
+    std::string name;
+    const auto c = m.emptiestRegion(name);
+    EXPECT_NE(name.find("80+ deg off-axis"), std::string::npos) << name;
+    EXPECT_GT(std::hypot(c.x - 319.5, c.y - 239.5), 200.0);  // near the rim, not the centre
+    // A gap inside: corners at the rim too leave "between 40 and 80" missing.
+    const double off = 85 * CV_PI / 180;
+    const auto rim = lens.project({std::sin(off), 0, std::cos(off)});
+    ASSERT_TRUE(rim);
+    m.add({cv::Point2f(float(rim->x), float(rim->y))});
+    ASSERT_EQ(m.missingRings().size(), 1u);
+    EXPECT_EQ(m.missingRings()[0], "no corners between 40 and 80 deg off-axis yet");
+}
+
+TEST(CalibrationSession, FisheyeUnmetTargetsNameTheMissingRingsInDegrees) {
+    // Before the first calibration the nominal fish-eye model bins the corners; views near the
+    // centre leave the outer rings listed as not done.
+    const auto lens = equidistantFisheye();
+    SessionOptions o;
+    o.calibration.model = DistortionModel::KannalaBrandt;
+    CalibrationSession s(CalibrationTarget::chessboard(kBoard), {lens.width, lens.height}, o);
+    std::mt19937 rng(3);
+    BoardPose p;
+    p.rvec = cv::Vec3d(0, 0, 0);
+    p.tvec = cv::Vec3d(-0.04, -0.03, 0.6);
+    s.addView(projectView(lens, kBoard, p, 0.1, rng, "centre"));
+    ASSERT_TRUE(s.coverage().angular());
+    const auto unmet = s.unmetTargets();
+    EXPECT_NE(std::find(unmet.begin(), unmet.end(), "no corners beyond 20 deg off-axis yet"),
+              unmet.end())
+        << fmt::format("{}", fmt::join(unmet, " | "));
+    std::string region;
+    s.coverage().emptiestRegion(region);
+    EXPECT_NE(region.find("80+ deg off-axis"), std::string::npos) << region;
 }
 
 }  // namespace
