@@ -78,15 +78,35 @@ std::string formatCalibrationResult(const CalibrationResult& r) {
             s += fmt::format("  {:<3} {:>14.6f} +- {:.6f}{}\n", r.parameterNames[i], value, sd,
                              unit);
     }
-    s += "views (RMS px, tilt deg):\n";
+    const bool fisheye = in.model == DistortionModel::KannalaBrandt;
+    s += fmt::format(
+        "views (RMS px, noise px per coordinate, weight, tilt deg {}, max off-axis deg, "
+        "detector):\n",
+        fisheye ? "to the line of sight" : "to the optical axis");
     for (const auto& v : r.views) {
-        if (v.rejected)
+        if (v.rejected) {
             s += fmt::format("  {:<28} REJECTED: {}\n", v.name, v.rejectReason);
-        else
-            s += fmt::format("  {:<28} {:7.4f}  {:5.1f}  ({} points)\n", v.name, v.rmsPx, v.tiltDeg,
-                             v.pointCount);
+            continue;
+        }
+        s += fmt::format("  {:<28} {:7.4f}  {:6.3f}  {:4.2f}  {:5.1f}  {:5.1f}  {}  ({} points",
+                         v.name, v.rmsPx, v.noisePx, v.weight, v.tiltDeg, v.maxOffAxisDeg,
+                         v.detector.empty() ? "-" : v.detector, v.pointCount);
+        if (v.unrefinedCorners > 0)
+            s += fmt::format(", {} corners not refined (left out)", v.unrefinedCorners);
+        if (!v.droppedCorners.empty()) s += fmt::format(", {} dropped", v.droppedCorners.size());
+        s += ")\n";
+        for (const auto& d : v.droppedCorners)
+            s += fmt::format(
+                "      dropped corner at ({:.1f}, {:.1f}) px, board ({:.4f}, {:.4f}) m: residual "
+                "{:.2f} px\n",
+                d.imagePoint.x, d.imagePoint.y, d.boardPoint.x, d.boardPoint.y, d.residualPx);
     }
+    s += fmt::format("outlier corners dropped: {}\n", r.droppedCornerCount);
     s += fmt::format("largest board tilt: {:.1f} deg\n", r.maxTiltDeg);
+    s += fmt::format(
+        "reach: corners up to {:.1f} deg off the optical axis, {:.1f} px from the principal "
+        "point (beyond: extrapolated)\n",
+        c.reachDeg, c.reachRadiusPx);
     for (const auto& w : r.warnings) s += "warning: " + w + "\n";
     s += c.reliable ? std::string("verdict: reliable\n")
                     : "verdict: UNRELIABLE: " + c.unreliableReason + "\n";

@@ -38,11 +38,20 @@ double laplacianVariance(const cv::Mat& grey, const cv::Rect& roi) {
     return stddev[0] * stddev[0];
 }
 
-double meanCornerMotion(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
-    if (a.empty() || a.size() != b.size()) return -1;
+double meanCornerMotion(const CalibrationView& a, const CalibrationView& b) {
     double sum = 0;
-    for (size_t i = 0; i < a.size(); ++i) sum += cv::norm(a[i] - b[i]);
-    return sum / double(a.size());
+    int n = 0;
+    size_t j = 0;
+    for (size_t i = 0; i < a.boardPoints.size(); ++i) {
+        // Both lists keep the target's order, so a forward scan finds the matches.
+        size_t k = j;
+        while (k < b.boardPoints.size() && b.boardPoints[k] != a.boardPoints[i]) ++k;
+        if (k == b.boardPoints.size()) continue;
+        sum += cv::norm(a.imagePoints[i] - b.imagePoints[k]);
+        ++n;
+        j = k + 1;
+    }
+    return n >= 4 ? sum / n : -1;
 }
 
 CalibrationSession::CalibrationSession(CalibrationTarget target, cv::Size imageSize,
@@ -84,22 +93,25 @@ bool CalibrationSession::isNovel(const ViewSignature& s) const {
     return true;
 }
 
+CameraIntrinsics CalibrationSession::currentIntrinsics() const {
+    if (result_) return result_->calibration.intrinsics;
+    // Before the first calibration: a plausible guess (a fish-eye's image diagonal spanning
+    // 180 degrees); tilts and the coverage by angle are only needed roughly here.
+    CameraIntrinsics in;
+    in.width = size_.width;
+    in.height = size_.height;
+    in.model = options_.calibration.model;
+    const double diag = std::hypot(size_.width, size_.height);
+    in.fx = in.fy = in.model == DistortionModel::KannalaBrandt ? diag / CV_PI : 0.9 * diag;
+    in.cx = (size_.width - 1) / 2.0;
+    in.cy = (size_.height - 1) / 2.0;
+    in.distortion.assign(in.model == DistortionModel::KannalaBrandt ? 4 : 5, 0.0);
+    return in;
+}
+
 void CalibrationSession::estimateTilt(const CalibrationView& view, double& tiltDeg,
                                       double& directionDeg) const {
-    CameraIntrinsics in;
-    if (result_) {
-        in = result_->calibration.intrinsics;
-    } else {
-        // Before the first calibration: a plausible guess; tilts are only needed roughly here.
-        in.width = size_.width;
-        in.height = size_.height;
-        in.model = options_.calibration.model;
-        const double diag = std::hypot(size_.width, size_.height);
-        in.fx = in.fy = in.model == DistortionModel::KannalaBrandt ? diag / CV_PI : 0.9 * diag;
-        in.cx = (size_.width - 1) / 2.0;
-        in.cy = (size_.height - 1) / 2.0;
-        in.distortion.assign(in.model == DistortionModel::KannalaBrandt ? 4 : 5, 0.0);
-    }
+    const CameraIntrinsics in = currentIntrinsics();
     cv::Vec3d rvec, tvec;
     tiltDeg = directionDeg = 0;
     if (estimateBoardPose(view, in, rvec, tvec)) boardTilt(rvec, tiltDeg, directionDeg);
@@ -114,7 +126,7 @@ FrameReport CalibrationSession::processFrame(const cv::Mat& image, const std::st
     FrameReport rep;
     auto d = target_.detect(grey, name);
     if (!d.found) {
-        previousCorners_.clear();
+        previousView_ = {};
         stillCount_ = 0;
         heldSinceCapture_ = false;
         return rep;
@@ -122,8 +134,8 @@ FrameReport CalibrationSession::processFrame(const cv::Mat& image, const std::st
     rep.boardFound = true;
     rep.view = d.view;
     const auto& corners = rep.view.imagePoints;
-    rep.motionPx = meanCornerMotion(previousCorners_, corners);
-    previousCorners_ = corners;
+    rep.motionPx = meanCornerMotion(previousView_, rep.view);
+    previousView_ = rep.view;
     if (rep.motionPx >= 0 && rep.motionPx < options_.stillMotionPx) {
         ++stillCount_;
     } else {
@@ -185,6 +197,9 @@ void CalibrationSession::recalibrate() {
 void CalibrationSession::rebuildCoverage() {
     coverage_.clear();
     tilts_.clear();
+    // A fish-eye's coverage is counted in angles off-axis through the current estimate.
+    if (options_.calibration.model == DistortionModel::KannalaBrandt)
+        coverage_.setAngularLens(currentIntrinsics());
     for (size_t i = 0; i < views_.size(); ++i) {
         const bool rejected = result_ && result_->views[i].rejected;
         if (rejected) continue;
@@ -202,6 +217,9 @@ std::vector<std::string> CalibrationSession::unmetTargets() const {
     const int used = result_ ? result_->usedViewCount() : int(views_.size());
     if (used < options_.doneMinViews)
         unmet.push_back(fmt::format("views {}/{}", used, options_.doneMinViews));
+    // Fish-eye: the rings off-axis with no corner yet (from the nominal lens before the first
+    // calibration, so the wizard says where to go from the first capture on).
+    for (const auto& ring : coverage_.missingRings()) unmet.push_back(ring);
     if (!result_) {
         unmet.push_back(calibrationError_.empty() ? "no calibration yet"
                                                   : "calibration failed: " + calibrationError_);
@@ -218,9 +236,17 @@ std::vector<std::string> CalibrationSession::unmetTargets() const {
     if (!(pp <= options_.donePrincipalPointStdPx))
         unmet.push_back(fmt::format("principal point std {:.2f} px > {:.2f} px", pp,
                                     options_.donePrincipalPointStdPx));
+    // A fish-eye's distortion is decided toward the rim: say how far off-axis the corners reach.
+    const bool fisheye = c.intrinsics.model == DistortionModel::KannalaBrandt;
     if (coverage_.coveredFraction() < options_.doneCoverage)
-        unmet.push_back(fmt::format("coverage {:.0f}% < {:.0f}%", 100 * coverage_.coveredFraction(),
-                                    100 * options_.doneCoverage));
+        unmet.push_back(
+            fisheye
+                ? fmt::format("coverage {:.0f}% of the off-axis rings and sectors < {:.0f}%: "
+                              "corners reach {:.0f} deg off-axis; bring the board toward the rim",
+                              100 * coverage_.coveredFraction(), 100 * options_.doneCoverage,
+                              c.reachDeg)
+                : fmt::format("coverage {:.0f}% < {:.0f}%", 100 * coverage_.coveredFraction(),
+                              100 * options_.doneCoverage));
     return unmet;
 }
 
@@ -243,6 +269,11 @@ std::string CalibrationSession::advice() const {
     if (coverage_.coveredFraction() < options_.doneCoverage) {
         std::string region;
         coverage_.emptiestRegion(region);
+        if (coverage_.angular())
+            return fmt::format(
+                "Move the board to {} of the image: distortion is only known "
+                "where corners have been.",
+                region);
         return fmt::format(
             "Move the board to the {} of the image: distortion is only known "
             "where corners have been.",
@@ -253,6 +284,9 @@ std::string CalibrationSession::advice() const {
                            TiltCoverage::binName(bin));
     std::string region;
     coverage_.emptiestRegion(region);
+    if (coverage_.angular())
+        return fmt::format(
+            "Add tilted views at {}, at different distances, until the uncertainty drops.", region);
     return fmt::format(
         "Add tilted views near the {} of the image, at different distances, "
         "until the uncertainty drops.",

@@ -98,6 +98,8 @@ private:
     ViewSignature signatureOf(const std::vector<cv::Point2f>& corners, double tiltDeg,
                               double directionDeg) const;
     bool isNovel(const ViewSignature& s) const;
+    // The latest calibration's intrinsics, or a nominal guess of the configured model before one.
+    CameraIntrinsics currentIntrinsics() const;
     void estimateTilt(const CalibrationView& view, double& tiltDeg, double& directionDeg) const;
     void recalibrate();
     void rebuildCoverage();
@@ -113,7 +115,7 @@ private:
     CoverageMap coverage_;
     TiltCoverage tilts_;
     // Capture gate state.
-    std::vector<cv::Point2f> previousCorners_;
+    CalibrationView previousView_;  // the last detection, for the motion between frames
     int stillCount_ = 0;
     bool heldSinceCapture_ = false;
     double recentSharpest_ = 0;
@@ -121,7 +123,9 @@ private:
 
 // Variance of the Laplacian of an 8-bit grey image over a rectangle: a focus/blur measure.
 double laplacianVariance(const cv::Mat& grey, const cv::Rect& roi);
-// Mean distance between corresponding corners (pixels); < 0 if the lists differ in size.
-double meanCornerMotion(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b);
+// Mean image distance (pixels) between the corners of the same board points in two detections
+// (matched by board point: the views may hold different subsets, in the target's order); < 0 if
+// they share fewer than 4 board points.
+double meanCornerMotion(const CalibrationView& a, const CalibrationView& b);
 
 }  // namespace mirage::calib

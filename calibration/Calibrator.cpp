@@ -22,6 +22,7 @@ struct Solution {
     std::vector<cv::Vec3d> rvecs, tvecs;  // per active view
     std::vector<double> viewRms;          // per active view, pixels
     std::vector<double> stdDeviations;    // intrinsics, +inf where unobservable
+    cv::Mat covariance;                   // intrinsics, empty if singular
     double rms = 0;                       // over all active points
 };
 
@@ -64,6 +65,7 @@ Solution fromProblem(const JointProblem& p, const std::vector<const CalibrationV
     s.tvecs = p.tvecs;
     computeErrors(views, s);
     s.stdDeviations = intrinsicStdDeviations(p);
+    s.covariance = intrinsicCovariance(p);
     return s;
 }
 
@@ -141,6 +143,7 @@ Solution solvePinhole(const std::vector<const CalibrationView*>& views, cv::Size
     // by the number of points, not the number of residuals (2 per point), minus parameters.
     auto problem = problemOf(views, s, o);
     s.stdDeviations = intrinsicStdDeviations(problem);
+    s.covariance = intrinsicCovariance(problem);
     return s;
 }
 
@@ -201,6 +204,22 @@ bool allFinite(const Solution& s) {
     return true;
 }
 
+// Joint refinement from `s` (the same views with a few corners fewer, or weighted: the optimum
+// is near), each view's residuals scaled by viewScales[v] (empty = 1); the standard deviations
+// then come from the weighted problem. Throws mirage::Error if the result is not finite.
+Solution refit(const std::vector<const CalibrationView*>& views, const Solution& s,
+               const CalibrationOptions& o, const std::vector<double>& viewScales) {
+    JointProblem p = problemOf(views, s, o);
+    p.viewScales = viewScales;
+    refineJointly(p, o.maxIterations);
+    Solution out = fromProblem(p, views);
+    if (!allFinite(out))
+        throw Error(
+            "calibration: the joint refinement after dropping outlier corners or weighting "
+            "views produced no finite result");
+    return out;
+}
+
 Solution solve(const std::vector<const CalibrationView*>& views, cv::Size size,
                const CalibrationOptions& o) {
     try {
@@ -226,6 +245,21 @@ double median(std::vector<double> v) {
     if (v.empty()) return 0;
     std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
     return v[v.size() / 2];
+}
+
+// Length of each corner's reprojection error (pixels).
+std::vector<double> residualLengths(const CalibrationView& v, const CameraIntrinsics& in,
+                                    const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
+    const auto projected = projectBoardPoints(v.boardPoints, in, rvec, tvec);
+    std::vector<double> r(projected.size());
+    for (size_t i = 0; i < projected.size(); ++i) r[i] = cv::norm(projected[i] - v.imagePoints[i]);
+    return r;
+}
+
+// Per-coordinate noise (pixels) from residual lengths: the median length of a 2D Gaussian error
+// is sigma sqrt(2 ln 2) = 1.1774 sigma; the median ignores the outliers being looked for.
+double noiseOf(const std::vector<double>& lengths) {
+    return median(lengths) / 1.1774;
 }
 
 // Why a view cannot be used at all (empty = usable).
@@ -320,6 +354,53 @@ void boardTilt(const cv::Vec3d& rvec, double& tiltDeg, double& directionDeg) {
     directionDeg = std::atan2(sgn * n[1], sgn * n[0]) * kRadToDeg;
 }
 
+void boardTiltToLineOfSight(const cv::Vec3d& rvec, const cv::Vec3d& tvec,
+                            const cv::Point3f& boardCentre, double& tiltDeg, double& directionDeg) {
+    cv::Matx33d R;
+    cv::Rodrigues(rvec, R);
+    const cv::Vec3d n(R(0, 2), R(1, 2), R(2, 2));
+    const cv::Vec3d c = R * cv::Vec3d(boardCentre.x, boardCentre.y, boardCentre.z) + tvec;
+    const cv::Vec3d los = c / cv::norm(c);
+    const double along = n.dot(los);
+    tiltDeg = std::acos(std::min(1.0, std::abs(along))) * kRadToDeg;
+    // The normal's component across the line of sight, pointing back toward the camera.
+    const double sgn = along <= 0 ? 1.0 : -1.0;
+    const cv::Vec3d across = sgn * (n - along * los);
+    directionDeg = std::atan2(across[1], across[0]) * kRadToDeg;
+}
+
+double projectionStdPx(const CameraIntrinsics& in, const cv::Mat& covariance,
+                       const cv::Vec3d& direction) {
+    if (covariance.empty()) return kInf;
+    const int n = covariance.rows;
+    const glm::dvec3 d(direction[0], direction[1], direction[2]);
+    const auto base = in.project(d);
+    if (!base) return kInf;
+    // d(pixel)/d(parameter) by central differences (steps relative to each parameter's scale).
+    cv::Mat G(2, n, CV_64F);
+    for (int i = 0; i < n; ++i) {
+        CameraIntrinsics a = in, b = in;
+        a.distortion.resize(n - 4, 0.0);
+        b.distortion.resize(n - 4, 0.0);
+        auto ref = [](CameraIntrinsics& c, int k) -> double& {
+            return k == 0   ? c.fx
+                   : k == 1 ? c.fy
+                   : k == 2 ? c.cx
+                   : k == 3 ? c.cy
+                            : c.distortion[size_t(k - 4)];
+        };
+        const double h = i < 4 ? 1e-3 : 1e-6;
+        ref(a, i) += h;
+        ref(b, i) -= h;
+        const auto pa = a.project(d), pb = b.project(d);
+        if (!pa || !pb) return kInf;
+        G.at<double>(0, i) = (pa->x - pb->x) / (2 * h);
+        G.at<double>(1, i) = (pa->y - pb->y) / (2 * h);
+    }
+    const cv::Mat S = G * covariance * G.t();
+    return std::sqrt(std::max(0.0, S.at<double>(0, 0) + S.at<double>(1, 1)));
+}
+
 CameraCalibration calibrationForFile(const CalibrationResult& result) {
     CameraCalibration c = result.calibration;
     const bool allFiniteStd = std::all_of(c.stdDeviations.begin(), c.stdDeviations.end(),
@@ -365,6 +446,8 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
         } else {
             active.push_back(i);
         }
+        vr.detector = views[i].detector;
+        vr.unrefinedCorners = views[i].unrefinedCorners;
         result.views.push_back(vr);
     }
     if (active.empty())
@@ -373,13 +456,20 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
             "inside the image); check that the board was detected",
             views.size()));
 
+    // Working copies: outlier corners are dropped from these.
+    std::vector<CalibrationView> work(views.begin(), views.end());
+    std::vector<std::vector<DroppedCorner>> dropped(views.size());
+    auto current = [&] {
+        std::vector<const CalibrationView*> c;
+        for (size_t i : active) c.push_back(&work[i]);
+        return c;
+    };
+
     const size_t usable = active.size();
     const size_t maxRejected = size_t(std::floor(o.maxRejectedFraction * double(usable)));
     Solution s;
     while (true) {
-        std::vector<const CalibrationView*> current;
-        for (size_t i : active) current.push_back(&views[i]);
-        s = solve(current, imageSize, o);
+        s = solve(current(), imageSize, o);
         const double med = median(s.viewRms);
         const auto worst =
             size_t(std::max_element(s.viewRms.begin(), s.viewRms.end()) - s.viewRms.begin());
@@ -396,20 +486,90 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
         active.erase(active.begin() + long(worst));
     }
 
+    // Outlier corners, worst first in each view per round (a gross error inflates its
+    // neighbours' residuals through the fit), re-solved after each round.
+    for (int round = 0; round < 10; ++round) {
+        bool any = false;
+        for (size_t k = 0; k < active.size(); ++k) {
+            CalibrationView& v = work[active[k]];
+            const std::vector<double> r = residualLengths(v, s.intrinsics, s.rvecs[k], s.tvecs[k]);
+            const double noise = noiseOf(r);
+            const double limit = std::max(o.cornerOutlierSigmas * noise, o.cornerOutlierMinPx);
+            const size_t worst = size_t(std::max_element(r.begin(), r.end()) - r.begin());
+            const size_t original = views[active[k]].imagePoints.size();
+            const size_t mayDrop =
+                size_t(std::floor(o.maxRejectedCornerFraction * double(original)));
+            if (!(r[worst] > limit) || dropped[active[k]].size() >= mayDrop ||
+                v.imagePoints.size() <= 6)
+                continue;
+            dropped[active[k]].push_back({v.boardPoints[worst], v.imagePoints[worst], r[worst]});
+            v.boardPoints.erase(v.boardPoints.begin() + long(worst));
+            v.imagePoints.erase(v.imagePoints.begin() + long(worst));
+            any = true;
+        }
+        if (!any) break;
+        s = refit(current(), s, o, {});
+    }
+
+    // Views weighted by their measured noise: one noisier than 1.5x the median view counts
+    // (median / noise)^2 as much per corner.
+    std::vector<double> noise(active.size()), scales(active.size(), 1.0);
+    for (size_t k = 0; k < active.size(); ++k)
+        noise[k] = noiseOf(residualLengths(work[active[k]], s.intrinsics, s.rvecs[k], s.tvecs[k]));
+    const double medianNoise = median(noise);
+    bool weighted = false;
+    if (o.weightViewsByNoise && medianNoise > 0)
+        for (size_t k = 0; k < active.size(); ++k)
+            if (noise[k] > 1.5 * medianNoise) {
+                scales[k] = medianNoise / noise[k];
+                weighted = true;
+            }
+    if (weighted) s = refit(current(), s, o, scales);
+
     auto& c = result.calibration;
     c.intrinsics = s.intrinsics;
     c.avgReprojectionError = s.rms;
     c.stdDeviations = s.stdDeviations;
     c.viewCount = int(active.size());
+    result.intrinsicCovariance = s.covariance;
+    double reachDeg = 0, reachRadius = 0;
     for (size_t k = 0; k < active.size(); ++k) {
+        const CalibrationView& v = work[active[k]];
         auto& vr = result.views[active[k]];
         vr.rmsPx = s.viewRms[k];
         vr.rvec = s.rvecs[k];
         vr.tvec = s.tvecs[k];
-        boardTilt(vr.rvec, vr.tiltDeg, vr.tiltDirectionDeg);
+        vr.pointCount = int(v.imagePoints.size());
+        vr.droppedCorners = dropped[active[k]];
+        vr.noisePx = noiseOf(residualLengths(v, s.intrinsics, s.rvecs[k], s.tvecs[k]));
+        vr.weight = scales[k] * scales[k];
+        result.droppedCornerCount += int(vr.droppedCorners.size());
+        if (o.model == DistortionModel::KannalaBrandt) {
+            cv::Point3f centre(0, 0, 0);
+            for (const auto& b : v.boardPoints) centre += b;
+            centre *= 1.0f / float(v.boardPoints.size());
+            boardTiltToLineOfSight(vr.rvec, vr.tvec, centre, vr.tiltDeg, vr.tiltDirectionDeg);
+        } else {
+            boardTilt(vr.rvec, vr.tiltDeg, vr.tiltDirectionDeg);
+        }
+        // Reach: the corners' angles off the axis (from the fitted pose: exact, no inversion of
+        // the lens polynomial) and their distance from the principal point.
+        cv::Matx33d R;
+        cv::Rodrigues(vr.rvec, R);
+        for (size_t i = 0; i < v.boardPoints.size(); ++i) {
+            const auto& b = v.boardPoints[i];
+            const cv::Vec3d p = R * cv::Vec3d(b.x, b.y, b.z) + vr.tvec;
+            const double angle = std::atan2(std::hypot(p[0], p[1]), p[2]) * kRadToDeg;
+            vr.maxOffAxisDeg = std::max(vr.maxOffAxisDeg, angle);
+            reachRadius = std::max(reachRadius, std::hypot(v.imagePoints[i].x - c.intrinsics.cx,
+                                                           v.imagePoints[i].y - c.intrinsics.cy));
+        }
+        reachDeg = std::max(reachDeg, vr.maxOffAxisDeg);
         result.maxTiltDeg = std::max(result.maxTiltDeg, vr.tiltDeg);
         c.perViewErrors.push_back(s.viewRms[k]);
     }
+    c.reachDeg = reachDeg;
+    c.reachRadiusPx = reachRadius;
 
     // Reliability: every reason is collected, so the user sees all that is wrong at once.
     std::vector<std::string> reasons;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "core/Error.h"
 
 namespace mirage::calib {
@@ -14,24 +16,132 @@ CoverageMap::CoverageMap(cv::Size imageSize, int cols, int rows)
              "coverage grid needs at least 3x3 cells and a valid image size");
 }
 
+namespace {
+
+// Angle off the optical axis (degrees) and azimuth (degrees, 0 = image right, 90 = image down)
+// of a camera-frame ray.
+void rayAngles(const glm::dvec3& ray, double& offAxisDeg, double& azimuthDeg) {
+    offAxisDeg = std::atan2(std::hypot(ray.x, ray.y), ray.z) * 180.0 / CV_PI;
+    azimuthDeg = std::fmod(std::atan2(ray.y, ray.x) * 180.0 / CV_PI + 360.0, 360.0);
+}
+
+std::string ringName(int ring) {
+    const int lo = int(ring * CoverageMap::kRingStepDeg);
+    if (ring + 1 >= CoverageMap::kRingCount) return fmt::format("{}+ deg off-axis", lo);
+    return fmt::format("{}-{} deg off-axis", lo, int(lo + CoverageMap::kRingStepDeg));
+}
+
+const char* sectorName(int sector) {
+    static const char* names[CoverageMap::kSectorCount] = {
+        "right", "bottom right", "bottom", "bottom left", "left", "top left", "top", "top right"};
+    return names[sector];
+}
+
+}  // namespace
+
+void CoverageMap::setAngularLens(const CameraIntrinsics& lens) {
+    MR_CHECK(lens.isValid(), "coverage by angle needs a valid lens");
+    lens_ = lens;
+    // The largest angle off-axis inside the image: walk the image border.
+    double maxDeg = 0;
+    const int steps = 64;
+    for (int i = 0; i <= steps; ++i) {
+        const double t = double(i) / steps;
+        const double w = size_.width - 1.0, h = size_.height - 1.0;
+        for (const glm::dvec2 p : {glm::dvec2(t * w, 0), glm::dvec2(t * w, h), glm::dvec2(0, t * h),
+                                   glm::dvec2(w, t * h)})
+            if (const auto ray = lens.unproject(p)) {
+                double off, az;
+                rayAngles(*ray, off, az);
+                maxDeg = std::max(maxDeg, off);
+            }
+    }
+    maxDeg = std::min(maxDeg, lens.maxFisheyeTheta * 180.0 / CV_PI);
+    reachableRings_ = std::clamp(int(std::ceil(maxDeg / kRingStepDeg)), 1, kRingCount);
+}
+
 void CoverageMap::add(const std::vector<cv::Point2f>& corners) {
     for (const auto& p : corners) {
         const int c = std::clamp(int(p.x / float(size_.width) * float(cols_)), 0, cols_ - 1);
         const int r = std::clamp(int(p.y / float(size_.height) * float(rows_)), 0, rows_ - 1);
         ++counts_[size_t(r * cols_ + c)];
+        if (!lens_) continue;
+        const auto ray = lens_->unproject({p.x, p.y});
+        if (!ray) continue;  // beyond where the lens model inverts: no angle to count
+        double off, az;
+        rayAngles(*ray, off, az);
+        const int ring = std::clamp(int(off / kRingStepDeg), 0, kRingCount - 1);
+        const int sector = std::clamp(int(az / (360.0 / kSectorCount)), 0, kSectorCount - 1);
+        ++bins_[size_t(ring * kSectorCount + sector)];
     }
 }
 
 void CoverageMap::clear() {
     std::fill(counts_.begin(), counts_.end(), 0);
+    std::fill(bins_.begin(), bins_.end(), 0);
+}
+
+int CoverageMap::ringCount(int ring) const {
+    int n = 0;
+    for (int s = 0; s < kSectorCount; ++s) n += binCount(ring, s);
+    return n;
+}
+
+std::vector<std::string> CoverageMap::missingRings() const {
+    std::vector<std::string> out;
+    if (!lens_) return out;
+    for (int r = 0; r < reachableRings_;) {
+        if (ringCount(r) > 0) {
+            ++r;
+            continue;
+        }
+        int end = r;  // one past the run of empty rings
+        while (end < reachableRings_ && ringCount(end) == 0) ++end;
+        const int lo = int(r * kRingStepDeg), hi = int(end * kRingStepDeg);
+        if (end == reachableRings_)
+            out.push_back(fmt::format("no corners beyond {} deg off-axis yet", lo));
+        else if (r == 0)
+            out.push_back(fmt::format("no corners within {} deg of the axis yet", hi));
+        else
+            out.push_back(fmt::format("no corners between {} and {} deg off-axis yet", lo, hi));
+        r = end;
+    }
+    return out;
 }
 
 double CoverageMap::coveredFraction() const {
+    if (lens_) {
+        const auto first = bins_.begin(), last = first + reachableRings_ * kSectorCount;
+        const auto n = std::count_if(first, last, [](int c) { return c > 0; });
+        return double(n) / double(reachableRings_ * kSectorCount);
+    }
     const auto n = std::count_if(counts_.begin(), counts_.end(), [](int c) { return c > 0; });
     return double(n) / double(counts_.size());
 }
 
 cv::Point2f CoverageMap::emptiestRegion(std::string& name) const {
+    if (lens_) {
+        // The emptiest reachable bin; ties go outward (the rim decides a fish-eye's distortion).
+        int bestRing = 0, bestSector = 0, best = std::numeric_limits<int>::max();
+        for (int r = reachableRings_ - 1; r >= 0; --r)
+            for (int s = 0; s < kSectorCount; ++s)
+                if (binCount(r, s) < best) {
+                    best = binCount(r, s);
+                    bestRing = r;
+                    bestSector = s;
+                }
+        name = ringName(bestRing) + ", " + sectorName(bestSector);
+        // Its centre direction, projected; the outermost ring's centre is kept inside the field.
+        const double maxDeg = lens_->maxFisheyeTheta * 180.0 / CV_PI;
+        const double off = std::min((bestRing + 0.5) * kRingStepDeg, maxDeg - 1.0) * CV_PI / 180.0;
+        const double az = (bestSector + 0.5) * (2 * CV_PI / kSectorCount);
+        const glm::dvec3 dir(std::sin(off) * std::cos(az), std::sin(off) * std::sin(az),
+                             std::cos(off));
+        if (const auto px = lens_->project(dir))
+            return {std::clamp(float(px->x), 0.f, float(size_.width - 1)),
+                    std::clamp(float(px->y), 0.f, float(size_.height - 1))};
+        return {float(lens_->cx), float(lens_->cy)};
+    }
     // Slide a 3x3 block over the grid; ties go to the block farthest from the centre, because
     // the image's edges and corners are where distortion needs corners most.
     int bestC = 0, bestR = 0;

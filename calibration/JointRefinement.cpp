@@ -47,6 +47,10 @@ cv::Vec3d vec3At(const std::vector<double>& x, size_t o) {
     return {x[o], x[o + 1], x[o + 2]};
 }
 
+double viewScale(const JointProblem& p, size_t v) {
+    return p.viewScales.empty() ? 1.0 : p.viewScales[v];
+}
+
 }  // namespace
 
 void boardResiduals(const CalibrationView& view, const CameraIntrinsics& in, const cv::Vec3d& rvec,
@@ -129,7 +133,8 @@ lm::Problem leastSquares(const JointProblem& p) {
         std::vector<double> rv;
         for (size_t v = 0; v < p.views.size(); ++v) {
             boardResiduals(*p.views[v], in, vec3At(x, nF + 6 * v), vec3At(x, nF + 6 * v + 3), rv);
-            r.insert(r.end(), rv.begin(), rv.end());
+            const double scale = viewScale(p, v);
+            for (double e : rv) r.push_back(scale * e);
         }
         return true;
     };
@@ -147,6 +152,7 @@ lm::Problem leastSquares(const JointProblem& p) {
             cv::Mat block(n, int(nF) + 6, CV_64F);
             for (size_t k = 0; k < nF; ++k) Ji.col(free[k]).copyTo(block.col(int(k)));
             Je.copyTo(block.colRange(int(nF), int(nF) + 6));
+            block *= viewScale(p, v);
             for (size_t c = 0; c < 6; ++c) columns[nF + c] = int(nF + 6 * v + c);
             sink.add(row, size_t(n), columns, block.ptr<double>());
             row += size_t(n);
@@ -166,6 +172,18 @@ double refineJointly(JointProblem& p, int maxIterations) {
     const lm::Report report = lm::solve(leastSquares(p), x, o);
     setState(p, x);
     return std::sqrt(report.finalCost / double(std::max<size_t>(pointCount, 1)));
+}
+
+cv::Mat intrinsicCovariance(const JointProblem& p) {
+    const std::vector<int> free = freeIntrinsics(p);
+    const lm::Covariance cov = lm::covariance(leastSquares(p), stateOf(p));
+    if (!cov.ok) return {};
+    const int n = p.intrinsicCount();
+    cv::Mat out = cv::Mat::zeros(n, n, CV_64F);
+    for (size_t a = 0; a < free.size(); ++a)
+        for (size_t b = 0; b < free.size(); ++b)
+            out.at<double>(free[a], free[b]) = cov.at(int(a), int(b));
+    return out;
 }
 
 std::vector<double> intrinsicStdDeviations(const JointProblem& p) {

@@ -25,6 +25,9 @@ struct JointProblem {
     CameraIntrinsics intrinsics;          // fx fy cx cy + distortion (5 pinhole, 4 fish-eye)
     std::vector<cv::Vec3d> rvecs, tvecs;  // T_camera_board per view
     std::vector<bool> fixedIntrinsics;    // per intrinsic parameter (8 or 9); empty = all free
+    // Per view: its residuals are multiplied by this (the square root of the view's weight in
+    // the sum of squares; a view with twice the noise gets 0.5). Empty = all 1.
+    std::vector<double> viewScales;
 
     int intrinsicCount() const;
     double cost() const;  // sum of squared residuals (pixels^2), +inf if not finite
@@ -36,6 +39,10 @@ double intrinsicParameter(const CameraIntrinsics& intrinsics, int i);
 
 // Runs LM until converged or maxIterations; returns the final RMS (pixels per point).
 double refineJointly(JointProblem& problem, int maxIterations);
+
+// Covariance of the intrinsics (8x8 or 9x9, CV_64F, order fx fy cx cy distortion..., 0 rows and
+// columns for fixed ones), or an empty matrix when the normal equations are singular.
+cv::Mat intrinsicCovariance(const JointProblem& problem);
 
 // 1-sigma standard deviations of the intrinsics (fx fy cx cy distortion...), 0 for fixed ones,
 // +inf for all when the normal equations are singular (an unobservable parameter).

@@ -1,9 +1,9 @@
 #pragma once
 // Synthetic board views with known intrinsics and poses: for tests (recover known parameters,
 // Monte-Carlo uncertainty checks) and for trying the wizard without a camera
-// (`mirage calibrate --write-synthetic DIR`). The images are rendered by ray casting every
-// sub-pixel through the exact camera model (CameraIntrinsics::unproject) onto the board plane,
-// so they are exact up to the 4x4 supersampling.
+// (`mirage calibrate --write-synthetic DIR`). The images come from core's TexturedPlaneRenderer:
+// every sub-pixel ray-cast through the camera model onto the board plane, averaged in linear
+// light, so they are exact up to the supersampling.
 #include <random>
 #include <vector>
 
@@ -11,6 +11,7 @@
 
 #include "calibration/Calibrator.h"
 #include "core/camera/CameraModel.h"
+#include "core/camera/TexturedPlaneRenderer.h"
 
 namespace mirage::calib {
 
@@ -22,10 +23,28 @@ struct ChessboardGeometry {
     std::vector<cv::Point3f> corners() const;
 };
 
+// Ideal fish-eye projections: the image radius of a ray theta off the axis is f * theta
+// (equidistant) or 2 f sin(theta / 2) (equisolid, e.g. most 180-degree photographic fish-eyes).
+enum class FisheyeLens { Equidistant, Equisolid };
+
+// Kannala-Brandt intrinsics of an ideal fish-eye lens with a field of view of fovDeg (full angle),
+// centred in a width x height image, its image circle touching the top and bottom edges. k1..k4
+// are fitted to the lens's theta_d(theta) / f over 0..fov/2 (least squares; exact for
+// equidistant, within 1e-5 px for equisolid up to 190 degrees at 640x480); maxFisheyeTheta is
+// half the field. Throws mirage::Error for a field outside (0, 240] degrees.
+CameraIntrinsics idealFisheye(FisheyeLens lens, double fovDeg, int width, int height);
+
 // Board pose T_camera_board (Rodrigues + metres).
 struct BoardPose {
     cv::Vec3d rvec, tvec;
 };
+
+// The board with its centre at `distance` (metres) along `direction` (camera frame), facing the
+// camera (its normal along the line of sight), then tilted by tiltDeg about the axis at
+// tiltAxisDeg in its plane and rolled by rollDeg about its normal.
+BoardPose boardPoseFacing(const ChessboardGeometry& board, const cv::Vec3d& direction,
+                          double distance, double tiltDeg, double tiltAxisDeg = 0,
+                          double rollDeg = 0);
 
 struct PoseSamplerOptions {
     double minDistance = 0.35, maxDistance = 0.7;  // metres, camera to board centre
@@ -53,9 +72,9 @@ CalibrationView projectView(const CameraIntrinsics& camera, const ChessboardGeom
 
 // Renders boards as 8-bit grey images (sRGB-encoded values: black squares 25, white 230,
 // background 110), with a white margin of one square around the pattern as printed boards have.
-// Pixels whose ray misses the board show the background. The camera rays of all sub-pixel
-// samples (supersample x supersample per pixel) are computed once per renderer, so rendering a
-// pose costs only the ray-plane intersections.
+// Pixels whose ray misses the board show the background. A thin adapter over
+// TexturedPlaneRenderer (core/camera): the chessboard is a texture of one texel per square with
+// nearest sampling, so its edges are exact; sub-pixels are averaged in linear light.
 class ChessboardRenderer {
 public:
     ChessboardRenderer(const CameraIntrinsics& camera, int supersample = 3);
@@ -68,15 +87,14 @@ public:
                           const cv::Point2d& boardOriginTexel, const BoardPose& pose) const;
 
 private:
-    CameraIntrinsics camera_;
-    int n_;
-    std::vector<cv::Vec3f> rays_;  // unit rays, camera frame; zero where unprojection failed
+    TexturedPlaneRenderer renderer_;
     static constexpr double kBackground = 110;  // grey value where a ray misses the board
-    // Ray-casts every sub-pixel onto the board plane z = 0 and averages shade(x, y) (board
-    // metres -> grey value) over each pixel's sub-pixels.
-    template <typename ShadeBoardPoint>
-    cv::Mat renderPlane(const BoardPose& pose, ShadeBoardPoint shade) const;
 };
+
+// Blur of an 8-bit sRGB-encoded grey image as a lens or motion makes it: a Gaussian of sigmaPx
+// pixels applied in linear light, then encoded again (blurring the encoded values instead shifts
+// edges toward the dark side by up to ~1 px at sigma 3 when corners are refined in linear light).
+cv::Mat blurInLinearLight(const cv::Mat& srgbGrey, double sigmaPx);
 
 // One-off convenience (builds a renderer).
 cv::Mat renderChessboard(const CameraIntrinsics& camera, const ChessboardGeometry& board,

@@ -1,8 +1,8 @@
 #pragma once
-// Renders what a camera sees of a printed board's sheet, for tests and benchmarks: each output
-// pixel is unprojected with the camera model (pinhole Brown-Conrady or Kannala-Brandt fish-eye),
-// intersected with the sheet plane and the board texture sampled there, with supersampling
-// (box filter) against aliasing. Pixel (0,0) is the centre of the top-left pixel (OpenCV).
+// Renders what a camera sees of a printed board's sheet, for tests and benchmarks: the board's
+// raster on the sheet plane through core's TexturedPlaneRenderer (each sub-pixel unprojected with
+// the camera model, the texture sampled bilinearly, sub-pixels averaged in linear light).
+// Pixel (0,0) is the centre of the top-left pixel (OpenCV).
 //
 // Output: 8-bit grey, sRGB-encoded; ink and paper levels mix in linear light.
 #include <opencv2/core.hpp>

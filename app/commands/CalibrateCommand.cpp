@@ -178,7 +178,7 @@ void writeSynthetic(const CalibrateArgs& a) {
     if (!video.isOpened()) throw FileError(videoPath, "cannot open for writing (MJPG/AVI)");
     auto emit = [&](const calib::BoardPose& pose, double blurSigma) {
         cv::Mat img = renderer.render(board, pose);
-        if (blurSigma > 0) cv::GaussianBlur(img, img, cv::Size(), blurSigma);
+        if (blurSigma > 0) img = calib::blurInLinearLight(img, blurSigma);
         cv::Mat n(img.size(), CV_16S);
         cv::randn(n, 0, 1.5);  // sensor noise, 8-bit units
         img.convertTo(img, CV_16S);

@@ -240,8 +240,8 @@ int runCalibrationWizard(const WizardOptions& o) {
             if (rep.decision == calib::CaptureDecision::Captured) lastCaptured = frame.name;
             camTex.show(overlay(current, session, rep));
             if (session.result() && showUndistorted)
-                undistTex.show(
-                    undistorter.apply(current, session.result()->calibration.intrinsics));
+                undistTex.show(undistorter.apply(current, session.result()->calibration.intrinsics,
+                                                 0.5, session.result()->calibration.reachDeg));
             haveFrame = false;
         }
         const bool screenshotDue =
@@ -292,7 +292,24 @@ int runCalibrationWizard(const WizardOptions& o) {
         ImGui::SetNextWindowSize({330, 260});
         ImGui::Begin("Coverage and tilts", nullptr, fixed);
         drawCoverage(session, {300, 130});
-        ImGui::Text("cells covered: %.0f%%", 100 * session.coverage().coveredFraction());
+        if (session.coverage().angular()) {
+            // Fish-eye: corners per ring of angle off-axis (the fraction is over rings x sectors).
+            const auto& cov = session.coverage();
+            ImGui::Text("off-axis bins covered: %.0f%%", 100 * cov.coveredFraction());
+            std::string rings;
+            for (int r = 0; r < cov.reachableRings(); ++r) {
+                const int lo = int(calib::CoverageMap::kRingStepDeg * r);
+                const int hi = int(calib::CoverageMap::kRingStepDeg * (r + 1));
+                rings += fmt::format("{}{}: {}", r ? ", " : "",
+                                     r + 1 < calib::CoverageMap::kRingCount
+                                         ? fmt::format("{}-{}", lo, hi)
+                                         : fmt::format("{}+", lo),
+                                     cov.ringCount(r));
+            }
+            ImGui::TextWrapped("deg off-axis %s", rings.c_str());
+        } else {
+            ImGui::Text("cells covered: %.0f%%", 100 * session.coverage().coveredFraction());
+        }
         const auto& tilts = session.tilts();
         for (int b = 0; b < calib::TiltCoverage::BinCount; ++b) {
             const auto bin = calib::TiltCoverage::Bin(b);

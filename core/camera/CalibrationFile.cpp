@@ -212,6 +212,16 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
     else
         c.viewCount = int(c.perViewErrors.size());
 
+    // The reach (optional: files written before it, or by other tools, have none).
+    if (cv::FileNode e = r.root["reach_off_axis_deg"]; !e.empty()) {
+        c.reachDeg = r.number(e, "reach_off_axis_deg");
+        if (!(c.reachDeg > 0 && c.reachDeg <= 180))
+            r.fail("reach_off_axis_deg", "must be an angle in (0, 180] degrees");
+    }
+    if (cv::FileNode e = r.root["reach_radius_px"]; !e.empty()) {
+        c.reachRadiusPx = r.number(e, "reach_radius_px");
+        if (!(c.reachRadiusPx > 0)) r.fail("reach_radius_px", "must be a positive radius");
+    }
     if (cv::FileNode e = r.root["reliable"]; !e.empty()) c.reliable = r.integer(e, "reliable") != 0;
     if (cv::FileNode e = r.root["unreliable_reason"]; !e.empty()) {
         if (!e.isString()) r.fail("unreliable_reason", "expected a string");
@@ -289,6 +299,8 @@ void saveCalibration(const std::filesystem::path& path, const CameraCalibration&
     // mirage's additions (docs/formats.md).
     fs << "distortion_model" << distortionModelName(in.model);
     if (!c.stdDeviations.empty()) fs << "std_deviations_intrinsics" << column(c.stdDeviations);
+    if (c.reachDeg > 0) fs << "reach_off_axis_deg" << c.reachDeg;
+    if (c.reachRadiusPx > 0) fs << "reach_radius_px" << c.reachRadiusPx;
     fs << "reliable" << int(c.reliable);
     if (!c.unreliableReason.empty()) fs << "unreliable_reason" << c.unreliableReason;
     if (c.T_parent_camera) {

@@ -21,6 +21,11 @@ struct CameraCalibration {
     std::vector<double> stdDeviations;
     std::vector<double> perViewErrors;  // pixels RMS per view
     int viewCount = 0;
+    // Reach: how far the calibration data goes. reachDeg = the largest angle off the optical axis
+    // (degrees) of a corner the calibration used; reachRadiusPx = the largest distance of one
+    // from the principal point (pixels). Beyond them the model is extrapolated (a fish-eye's
+    // error grows fast there). <= 0 = unknown (older files).
+    double reachDeg = -1, reachRadiusPx = -1;
     bool reliable = true;
     std::string unreliableReason;  // set when !reliable: why the numbers should not be trusted
     // Extrinsic pose T_parent_camera, parent is "main" (the main camera, OpenCV axes) or "world".

@@ -3,7 +3,11 @@
 // "done" state.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -31,8 +35,8 @@ TEST(CalibrationSession, AutoCaptureNeedsStillSharpAndNewViews) {
     const auto p = poses(2, 1);
     const cv::Mat a = renderer.render(kBoard, p[0]);
     const cv::Mat b = renderer.render(kBoard, p[1]);
-    cv::Mat bBlurred;
-    cv::GaussianBlur(b, bBlurred, cv::Size(), 3.0);
+    // Out of focus as a lens blurs: in linear light.
+    const cv::Mat bBlurred = blurInLinearLight(b, 3.0);
 
     SessionOptions o;
     o.stillFrames = 3;
@@ -142,8 +146,95 @@ TEST(CaptureGate, SharpnessDropsWithBlurAndMotionIsMeasured) {
     cv::GaussianBlur(img, blurred, cv::Size(), 2.0);
     const cv::Rect roi(0, 0, img.cols, img.rows);
     EXPECT_GT(laplacianVariance(img, roi), 3 * laplacianVariance(blurred, roi));
-    EXPECT_NEAR(meanCornerMotion({{0, 0}, {1, 1}}, {{3, 4}, {1, 1}}), 2.5, 1e-9);
-    EXPECT_LT(meanCornerMotion({{0, 0}}, {}), 0);
+    // Matched by board point: b leaves out board point 1 (not refined) and moves point 0 by 5 px.
+    CalibrationView a, b;
+    for (int i = 0; i < 5; ++i) {
+        a.boardPoints.emplace_back(0.01f * i, 0.f, 0.f);
+        a.imagePoints.emplace_back(10.f * i, 0.f);
+        if (i == 1) continue;
+        b.boardPoints.push_back(a.boardPoints.back());
+        b.imagePoints.push_back(a.imagePoints.back() +
+                                (i == 0 ? cv::Point2f(3, 4) : cv::Point2f()));
+    }
+    EXPECT_NEAR(meanCornerMotion(a, b), 5.0 / 4, 1e-6);
+    b.boardPoints.resize(3);
+    b.imagePoints.resize(3);
+    EXPECT_LT(meanCornerMotion(a, b), 0);  // fewer than 4 shared
+    EXPECT_LT(meanCornerMotion(a, {}), 0);
+}
+
+// An equidistant fish-eye with a 180-degree image circle inscribed in 640x480 (radius 240 px).
+CameraIntrinsics equidistantFisheye() {
+    CameraIntrinsics in;
+    in.width = 640;
+    in.height = 480;
+    in.model = DistortionModel::KannalaBrandt;
+    in.fx = in.fy = 240.0 / (CV_PI / 2);
+    in.cx = 319.5;
+    in.cy = 239.5;
+    in.distortion.assign(4, 0.0);
+    return in;
+}
+
+TEST(CoverageMap, FisheyeCountsRingsOffAxisAndNamesTheMissingOnesInDegrees) {
+    const auto lens = equidistantFisheye();
+    CoverageMap m({640, 480});
+    m.setAngularLens(lens);
+    ASSERT_TRUE(m.angular());
+    EXPECT_EQ(m.reachableRings(), CoverageMap::kRingCount);  // the image's corners are past 90 deg
+    // Corners all around, but only within 35 degrees of the axis: the image cells near the
+    // centre hold them, and so do the rings 0-20 and 20-40.
+    std::vector<cv::Point2f> pts;
+    for (double offDeg = 5; offDeg <= 35; offDeg += 10)
+        for (double az = 0; az < 360; az += 15) {
+            const double off = offDeg * CV_PI / 180, a = az * CV_PI / 180;
+            const auto px = lens.project(
+                {std::sin(off) * std::cos(a), std::sin(off) * std::sin(a), std::cos(off)});
+            ASSERT_TRUE(px);
+            pts.emplace_back(float(px->x), float(px->y));
+        }
+    m.add(pts);
+    EXPECT_GT(m.ringCount(0), 0);
+    EXPECT_GT(m.ringCount(1), 0);
+    EXPECT_EQ(m.ringCount(2), 0);
+    EXPECT_EQ(m.ringCount(4), 0);
+    EXPECT_NEAR(m.coveredFraction(), 2.0 / 5.0, 1e-9);  // 2 of 5 rings, every sector
+    const auto missing = m.missingRings();
+    ASSERT_EQ(missing.size(), 1u);
+    EXPECT_EQ(missing[0], "no corners beyond 40 deg off-axis yet");
+    std::string name;
+    const auto c = m.emptiestRegion(name);
+    EXPECT_NE(name.find("80+ deg off-axis"), std::string::npos) << name;
+    EXPECT_GT(std::hypot(c.x - 319.5, c.y - 239.5), 200.0);  // near the rim, not the centre
+    // A gap inside: corners at the rim too leave "between 40 and 80" missing.
+    const double off = 85 * CV_PI / 180;
+    const auto rim = lens.project({std::sin(off), 0, std::cos(off)});
+    ASSERT_TRUE(rim);
+    m.add({cv::Point2f(float(rim->x), float(rim->y))});
+    ASSERT_EQ(m.missingRings().size(), 1u);
+    EXPECT_EQ(m.missingRings()[0], "no corners between 40 and 80 deg off-axis yet");
+}
+
+TEST(CalibrationSession, FisheyeUnmetTargetsNameTheMissingRingsInDegrees) {
+    // Before the first calibration the nominal fish-eye model bins the corners; views near the
+    // centre leave the outer rings listed as not done.
+    const auto lens = equidistantFisheye();
+    SessionOptions o;
+    o.calibration.model = DistortionModel::KannalaBrandt;
+    CalibrationSession s(CalibrationTarget::chessboard(kBoard), {lens.width, lens.height}, o);
+    std::mt19937 rng(3);
+    BoardPose p;
+    p.rvec = cv::Vec3d(0, 0, 0);
+    p.tvec = cv::Vec3d(-0.04, -0.03, 0.6);
+    s.addView(projectView(lens, kBoard, p, 0.1, rng, "centre"));
+    ASSERT_TRUE(s.coverage().angular());
+    const auto unmet = s.unmetTargets();
+    EXPECT_NE(std::find(unmet.begin(), unmet.end(), "no corners beyond 20 deg off-axis yet"),
+              unmet.end())
+        << fmt::format("{}", fmt::join(unmet, " | "));
+    std::string region;
+    s.coverage().emptiestRegion(region);
+    EXPECT_NE(region.find("80+ deg off-axis"), std::string::npos) << region;
 }
 
 }  // namespace

@@ -196,6 +196,34 @@ TEST(CalibrationFile, FisheyeRoundTrip) {
     EXPECT_FALSE(b.T_parent_camera.has_value());
 }
 
+// The reach (how far off-axis the calibration data went) is saved and read back; files without
+// it load with "unknown" (< 0), and a nonsense value names its key.
+TEST(CalibrationFile, ReachRoundTripsAndIsOptional) {
+    const auto dir = test::outputDir("calibration_reach");
+    CameraCalibration a;
+    a.intrinsics = {640, 480, 170, 170, 319.5, 239.5, DistortionModel::KannalaBrandt, {0, 0, 0, 0}};
+    saveCalibration(dir / "without.yaml", a);
+    const CameraCalibration without = loadCalibration(dir / "without.yaml");
+    EXPECT_LT(without.reachDeg, 0);
+    EXPECT_LT(without.reachRadiusPx, 0);
+    a.reachDeg = 81.25;
+    a.reachRadiusPx = 223.5;
+    saveCalibration(dir / "with.yaml", a);
+    const CameraCalibration b = loadCalibration(dir / "with.yaml");
+    EXPECT_DOUBLE_EQ(b.reachDeg, 81.25);
+    EXPECT_DOUBLE_EQ(b.reachRadiusPx, 223.5);
+    {
+        std::ofstream out(dir / "bad_reach.yaml");
+        out << "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: "
+               "!!opencv-matrix\n"
+               "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 170., 0., 319.5, 0., 170., 239.5, 0., "
+               "0., 1. ]\n"
+               "distortion_coefficients: !!opencv-matrix\n   rows: 4\n   cols: 1\n   dt: d\n"
+               "   data: [ 0., 0., 0., 0. ]\ndistortion_model: fisheye\nreach_off_axis_deg: -3\n";
+    }
+    EXPECT_NE(loadError(dir / "bad_reach.yaml").find("reach_off_axis_deg"), std::string::npos);
+}
+
 TEST(CalibrationFile, RosExportReadsBack) {
     const auto dir = test::outputDir("calibration_ros");
     const CameraCalibration a = exampleCalibration();
