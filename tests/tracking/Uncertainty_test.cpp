@@ -125,6 +125,29 @@ TEST(Uncertainty, CleanViewsAtHalfAMetreStayOk) {
     }
 }
 
+// A single large, sharp tag near the camera (0.2-0.35 m, 26-80 px; the rest of the board
+// covered, no blur, no compression): its covariance is small enough for ok in most views, and
+// no ok pose is wrong. One tag is not always uncertain.
+TEST(Uncertainty, CloseSharpSingleTagCanBeOk) {
+    TrialRanges r;
+    r.oneTagOnly = true;
+    r.minDistanceM = 0.2;
+    r.maxDistanceM = 0.35;
+    r.maxBlurPx = 0;
+    r.minJpegQuality = r.maxJpegQuality = 0;
+    r.minGain = r.maxGain = 1.0;
+    r.maxNoiseLevels = 0.5;
+    r.occluderProbability = 0;
+    const auto records = runTrials(board(), testing::pinholeCamera(), 40001, 60, r);
+    const auto bins = binTrials(records);
+    const std::string table = trialTable(bins);
+    std::printf("%s\n", table.c_str());
+    const TrialBin& one = bins[12];
+    ASSERT_EQ(one.name, "1 tag used");
+    EXPECT_GE(one.ok, 0.5 * one.views) << table;
+    EXPECT_EQ(one.wrongOk, 0) << table;
+}
+
 glm::dvec3 orbit(const glm::dvec3& centre, double dist, double elevDeg, double azDeg) {
     const double el = glm::radians(elevDeg), az = glm::radians(azDeg);
     return centre + dist * glm::dvec3(std::cos(el) * std::sin(az), std::sin(el),
