@@ -93,8 +93,8 @@ struct Fit {
 
 // Jacobian rows (2 per corner) of the pixel residuals w.r.t. x = (world-frame rotation vector of
 // the camera, camera centre): X_c = R^T (X_w - c), so dX_c/dw = R^T [X_w - c]_x and
-// dX_c/dc = -R^T; the 2x3 projection Jacobian dpx/dX_c is taken by forward differences per point
-// (3 projections; the lens models stay in one place, CameraModel.cpp).
+// dX_c/dc = -R^T; the 2x3 projection Jacobian dpx/dX_c comes from the camera model
+// (CameraIntrinsics::projectWithJacobian: closed form for the pinhole model).
 void jacobian(const CameraIntrinsics& cam, const Pose& T_world_camera,
               const std::vector<const Observation*>& obs, std::vector<double>& J) {
     J.assign(obs.size() * 8 * 6, 0.0);
@@ -105,21 +105,9 @@ void jacobian(const CameraIntrinsics& cam, const Pose& T_world_camera,
         for (int k = 0; k < 4; ++k, row += 2) {
             const glm::dvec3 d = o->world[size_t(k)] - c;
             const glm::dvec3 Xc = Rt * d;
-            const auto p0 = cam.project(Xc);
-            if (!p0) continue;  // penalty residual: constant, zero gradient
-            glm::dmat3x2 dp;    // 3 columns of d(px)/dX_c
-            bool ok = true;
-            for (int a = 0; a < 3 && ok; ++a) {
-                glm::dvec3 Xh = Xc;
-                const double h = 1e-6 * std::max(1e-3, std::abs(Xc.z));
-                Xh[a] += h;
-                const auto p1 = cam.project(Xh);
-                if (!p1)
-                    ok = false;
-                else
-                    dp[a] = (*p1 - *p0) / h;
-            }
-            if (!ok) continue;
+            glm::dmat3x2 dp;  // 3 columns of d(px)/dX_c
+            // Out of view: penalty residual, constant, zero gradient.
+            if (!cam.projectWithJacobian(Xc, dp)) continue;
             // dX_c/dw: R^T [d]_x  (columns: R^T (e_i x d) ... = R^T * skew(d) with sign below).
             // X_c(w) = R^T exp(-w) d ~ R^T (d - w x d) = R^T (d + d x w) -> dX_c/dw = R^T [d]_x.
             const glm::dmat3 skew(0, d.z, -d.y, -d.z, 0, d.x, d.y, -d.x, 0);  // columns of [d]_x
@@ -173,16 +161,27 @@ void correlatedTerms(const std::vector<double>& J, const std::vector<const Obser
 
 // The pose as a least-squares problem for core/math/LevenbergMarquardt.h (PoseEstimator.h,
 // poseLeastSquares).
-lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<const Observation*>& obs) {
+// The Jacobian buffer of one refinement and the state it was last evaluated at: the solver's
+// last evaluation is usually at the solution (it stops when the step it predicts from there is
+// negligible), so the covariance reuses it instead of evaluating it again.
+struct JacobianCache {
+    std::vector<double> J;
+    std::vector<double> x;
+};
+
+lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<const Observation*>& obs,
+                        JacobianCache* cache = nullptr) {
     lm::Problem p;
     p.parameters = 6;
     p.residuals = [&cam, &obs](const std::vector<double>& x, std::vector<double>& r) {
         residuals(cam, poseOfState(x), obs, r);
         return true;
     };
-    p.jacobian = [&cam, &obs](const std::vector<double>& x, lm::JacobianSink& sink) {
-        std::vector<double> J;
+    p.jacobian = [&cam, &obs, cache](const std::vector<double>& x, lm::JacobianSink& sink) {
+        std::vector<double> local;
+        std::vector<double>& J = cache ? cache->J : local;
         jacobian(cam, poseOfState(x), obs, J);
+        if (cache) cache->x = x;
         static const std::vector<int> kColumns = {0, 1, 2, 3, 4, 5};
         sink.add(0, J.size() / 6, kColumns, J.data());
     };
@@ -198,7 +197,8 @@ lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<const Obs
 Fit refine(const CameraIntrinsics& cam, const Pose& start,
            const std::vector<const Observation*>& obs, bool withCovariance,
            int maxIterations = 30) {
-    const lm::Problem problem = poseProblem(cam, obs);
+    JacobianCache cache;
+    const lm::Problem problem = poseProblem(cam, obs, &cache);
     lm::Options o;
     o.maxIterations = maxIterations;
     o.relativeTolerance = 1e-6;
@@ -212,12 +212,14 @@ Fit refine(const CameraIntrinsics& cam, const Pose& start,
     f.rms = corners ? std::sqrt(f.report.finalCost / double(corners)) : 0.0;
     f.ok = f.pose.isFinite() && std::isfinite(f.rms);
     if (withCovariance && f.ok && f.report.residualCount > 6) {
-        // One evaluation of the residuals and the Jacobian serves the normal equations, the
-        // robust noise scale and the shared-corner-error terms (lm::covariance would evaluate
-        // the Jacobian again: this runs once per frame in the tracking loop).
-        std::vector<double> r, J;
+        // The residuals and the solver's last Jacobian (at the solution when it converged)
+        // serve the normal equations, the robust noise scale and the shared-corner-error terms
+        // (lm::covariance would evaluate the Jacobian again: this runs once per frame in the
+        // tracking loop).
+        std::vector<double> r;
         residuals(cam, f.pose, obs, r);
-        jacobian(cam, f.pose, obs, J);
+        std::vector<double>& J = cache.J;
+        if (cache.x != x) jacobian(cam, f.pose, obs, J);
         cv::Matx66d A = cv::Matx66d::zeros();
         double cost = 0;
         for (size_t i = 0; i < r.size(); ++i) {
@@ -267,9 +269,12 @@ double tagRms(const CameraIntrinsics& cam, const Pose& T_world_camera, const Obs
 }
 
 // The pose covariance under the corner noise model of PoseEstimatorOptions:
-//   C = N^-1 (sigma^2 N + s_t^2 S_tag + h^2 H_tag + s_c^2 g g^T) N^-1 k^2,  N = J^T J,
+//   C = N^-1 (sigma^2 N + sigma^2 (a^2 - 1) H_tag / 4 + s_t^2 S_tag + h^2 H_tag + s_c^2 g g^T)
+//       N^-1 k^2,  N = J^T J,
 // sigma^2 the independent corner noise (residuals pooled with the prior sigma0 by tag size and
-// blur), s_t / h the per-tag scale / shift error and s_c the scale error common to all tags
+// blur), a the tag centre's share of it (sigma^2 H_tag / 4 is what independent noise puts on the
+// tags' centres; since a <= 1 the sum stays positive semi-definite), s_t / h the per-tag scale /
+// shift error and s_c the scale error common to all tags
 // (corner errors that move a tag's corners together: blur mixing the payload into the border,
 // clipping, compression), each proportional to sigma0; k the inflation.
 std::array<double, 36> modelCovariance(const Fit& f, const std::vector<const Observation*>& obs,
@@ -292,12 +297,16 @@ std::array<double, 36> modelCovariance(const Fit& f, const std::vector<const Obs
     const double st2 = o.tagScaleNoise * o.tagScaleNoise * prior2;
     const double sh2 = o.tagShiftNoise * o.tagShiftNoise * prior2;
     const double sc2 = o.commonScaleNoise * o.commonScaleNoise * prior2;
+    // The centre of a tag errs less than its corners: its variance is tagCentreNoise^2 of what
+    // independent corner noise gives it (the shift mode of each tag's corners, J^T P J = H / 4;
+    // measured: the tag centres' error is 0.4-0.5 of the independent corner noise).
+    const double centre2 = sigma2 * (o.tagCentreNoise * o.tagCentreNoise - 1.0) / 4.0;
     cv::Matx66d Ninv, M;
     for (int a = 0; a < 6; ++a)
         for (int b = 0; b < 6; ++b) {
             const size_t i = size_t(a * 6 + b);
             Ninv(a, b) = f.normalInverse[i];
-            M(a, b) = st2 * f.tagScale[i] + sh2 * f.tagShift[i] +
+            M(a, b) = st2 * f.tagScale[i] + (sh2 + centre2) * f.tagShift[i] +
                       sc2 * f.commonScale[size_t(a)] * f.commonScale[size_t(b)];
         }
     const cv::Matx66d C =

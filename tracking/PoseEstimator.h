@@ -50,11 +50,15 @@ struct PoseEstimatorOptions {
     // alternative at least twice as far from it as the chosen one.
     double priorMaxRotationDeg = 15.0;
     // Uncertainty (docs/tracking.md, "Uncertainty and the ok state"). The pose covariance is
-    //   C = k^2 N^-1 (sigma^2 N + sigma0^2 (t^2 S_tag + h^2 H_tag + c^2 g g^T)) N^-1, N = J^T J:
-    // independent corner noise sigma (per image coordinate) plus corner errors shared by the
-    // corners of a tag (a scale change of each tag, t; a shift of each tag, h; a scale change
-    // common to all tags of the frame, c; as multiples of sigma0). sigma^2 pools the residuals'
-    // robust mean square (median absolute residual) with a prior of w degrees of freedom:
+    //   C = k^2 N^-1 (sigma^2 N + sigma^2 (a^2 - 1) H_tag / 4
+    //                 + sigma0^2 (t^2 S_tag + h^2 H_tag + c^2 g g^T)) N^-1,   N = J^T J:
+    // independent corner noise sigma (per image coordinate), except that the centre of each tag
+    // (the mean of its 4 corners) errs less, a^2 of the variance independent noise gives it
+    // (a = tagCentreNoise; H_tag / 4 is the shift mode of the tags' corners), plus corner errors
+    // shared by the corners of a tag (a scale change of each tag, t; a shift of each tag, h; a
+    // scale change common to all tags of the frame, c; as multiples of sigma0). sigma^2 pools
+    // the residuals' robust mean square (median absolute residual) with a prior of w degrees of
+    // freedom:
     //   sigma^2 = (2N rho^2 + w sigma0^2) / (2N - 6 + w),
     // sigma0 = cornerNoisePx + cornerNoiseSidePx / (shortest tag side in pixels)
     //          + cornerNoiseBlur * max(0, edge width - 2.2 px)^2 (TagDetection::edgeWidthPx, when
@@ -62,16 +66,20 @@ struct PoseEstimatorOptions {
     // (fewer edge samples; blur and compression move a larger share of them), and a blur wider
     // than a cell mixes the payload bits into the border edges. With one tag (2 degrees of
     // freedom left) the residuals alone can claim almost any precision; the prior keeps the
-    // claim honest. All constants measured by Monte Carlo (tracking_montecarlo).
+    // claim honest. With many tags the pose rests on the tags' centres, which the independent
+    // noise alone overstates. All constants measured by Monte Carlo (tracking_montecarlo).
     double cornerNoisePx = 0.05;
     double cornerNoiseSidePx = 1.2;
     double cornerNoiseBlur = 0.12;  // 1 / pixel
     double cornerNoisePriorWeight = 8.0;
     double covarianceInflation = 1.0;  // k
     // t, h, c above (pixels per pixel of sigma0).
-    double tagScaleNoise = 0.15;
+    double tagScaleNoise = 0.4;
     double tagShiftNoise = 0.1;
-    double commonScaleNoise = 0.5;
+    double commonScaleNoise = 0.65;
+    // a above: the tag centre's standard deviation as a fraction of what independent corner
+    // noise gives it (1: independent corners).
+    double tagCentreNoise = 0.75;
     // A pose is ok only when the square roots of the covariance traces (1 sigma, 3D) are at most
     // okMaxSigmaRotDeg (degrees) and okMaxSigmaPosFraction of the camera-to-tags distance; a
     // pose beyond either is `uncertain`. With an honest covariance a pose off by 2 degrees or 2 %

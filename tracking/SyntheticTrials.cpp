@@ -116,8 +116,16 @@ TrialView makeTrialView(const Board& board, const BoardRaster& texture,
     // Aim point off the board centre, within the image footprint at that distance.
     const double halfW = dist * 0.5 * camera.width / camera.fx;
     const double halfH = dist * 0.5 * camera.height / camera.fy;
-    const glm::dvec3 target = centre + rng.uniform(-1.0, 1.0) * r.maxAimOffset * halfW * ax +
-                              rng.uniform(-1.0, 1.0) * r.maxAimOffset * halfH * ay;
+    glm::dvec3 target = centre + rng.uniform(-1.0, 1.0) * r.maxAimOffset * halfW * ax +
+                        rng.uniform(-1.0, 1.0) * r.maxAimOffset * halfH * ay;
+    const BoardTag* onlyTag = nullptr;
+    if (r.oneTagOnly) {
+        onlyTag = &board.tags[size_t(rng.uniform(0, int(board.tags.size())))];
+        const double halfTag = onlyTag->size * 0.5 * (12.0 / 8.0);
+        target = onlyTag->T_world_tag.translation +
+                 rng.uniform(-1.0, 1.0) * r.maxAimOffset * std::min(halfW, 4 * halfTag) * ax +
+                 rng.uniform(-1.0, 1.0) * r.maxAimOffset * std::min(halfH, 4 * halfTag) * ay;
+    }
     const glm::dvec3 eye = target + dist * dir;
     // Up direction: the board's in-plane axis, turned by a random roll.
     const double roll = rng.uniform(-M_PI, M_PI);
@@ -151,7 +159,22 @@ TrialView makeTrialView(const Board& board, const BoardRaster& texture,
     }
     SyntheticViewOptions so;
     so.supersample = supersample;
-    v.image = degradeView(renderSyntheticBoardView(board, texture, camera, v.truth, so), d);
+    cv::Mat view = renderSyntheticBoardView(board, texture, camera, v.truth, so);
+    if (onlyTag) {
+        // Everything but the tag and its quiet zone (one cell beyond the detection corners, 10
+        // of the tag's 8 border-to-border cells) plus a margin of one more cell: grey.
+        v.onlyTagId = onlyTag->id;
+        const Pose T_cw = v.truth.inverse();
+        std::vector<cv::Point> poly;
+        for (const auto& c : BoardTag::cornersInTag(onlyTag->size * 12.0 / 8.0)) {
+            const auto px = camera.project(T_cw * (onlyTag->T_world_tag * c));
+            if (px) poly.emplace_back(int(std::lround(px->x)), int(std::lround(px->y)));
+        }
+        cv::Mat mask(view.size(), CV_8U, cv::Scalar(0));
+        if (poly.size() == 4) cv::fillConvexPoly(mask, poly, cv::Scalar(255));
+        view.setTo(cv::Scalar(d.occluderLevel), mask == 0);
+    }
+    v.image = degradeView(view, d);
     return v;
 }
 
@@ -262,6 +285,8 @@ std::vector<TrialRecord> runTrials(const Board& board, const CameraIntrinsics& c
         r.distanceM = v.distanceM;
         r.degradation = v.degradation;
         r.outcome = scoreEstimate(f.estimate, v.truth, board, camera);
+        r.truth = v.truth;
+        r.detections = f.detections;
         const Pose T_cw = v.truth.inverse();
         for (const auto& d : f.detections) {
             const BoardTag* t = board.find(d.id);
@@ -309,6 +334,22 @@ std::vector<TrialRecord> runTrials(const Board& board, const CameraIntrinsics& c
             r.tags.push_back(tc);
         }
         out.push_back(std::move(r));
+    }
+    return out;
+}
+
+std::vector<TrialRecord> rescoreTrials(const std::vector<TrialRecord>& records, const Board& board,
+                                       const CameraIntrinsics& camera,
+                                       const PoseEstimatorOptions& options) {
+    const PoseEstimator estimator(board, camera, options);
+    std::vector<TrialRecord> out = records;
+    for (auto& r : out) {
+        // A frame without a board tag may have been judged too blurred by the tracker; the
+        // estimator alone cannot tell, and neither state has a pose.
+        const TrackingState before = r.outcome.state;
+        r.outcome = scoreEstimate(estimator.estimate(r.detections), r.truth, board, camera);
+        if (before == TrackingState::TooBlurred && r.outcome.state == TrackingState::NoTags)
+            r.outcome.state = before;
     }
     return out;
 }

@@ -32,6 +32,11 @@ struct TrialRanges {
     double minGain = 0.5, maxGain = 1.6;           // exposure factor in linear light (clips at 1)
     double maxNoiseLevels = 2.0;                   // Gaussian sensor noise, sRGB levels (std)
     double occluderProbability = 0.25;             // a grey blob over part of the view
+    // One-tag views: the camera aims at a random tag (offset by up to maxAimOffset of the tag's
+    // image footprint) and everything but that tag and its quiet zone is painted grey, as when
+    // the rest of the board is covered or out of view. Fills the one-tag condition bin, which
+    // the views of the whole board reach rarely (and then mostly with an undecided planar flip).
+    bool oneTagOnly = false;
 };
 
 // What degrades one view, after rendering (SyntheticBoardView, sRGB 8-bit grey).
@@ -48,6 +53,7 @@ struct Degradation {
 
 struct TrialView {
     Pose truth;            // T_world_camera
+    int onlyTagId = -1;    // the tag left visible (TrialRanges::oneTagOnly), else -1
     double distanceM = 0;  // camera centre to the board centre
     Degradation degradation;
     cv::Mat image;  // 8-bit grey, sRGB-encoded
@@ -113,6 +119,11 @@ struct TrialRecord {
         double independentPx = 0;
     };
     std::vector<TagCorners> tags;
+    // What the pose came from: the true pose and the tracker's detections (with the edge width
+    // it measured), so that the same views can be scored under other pose options
+    // (rescoreTrials) without rendering and detecting again.
+    Pose truth;
+    std::vector<TagDetection> detections;
 };
 
 // Runs `count` views (seeds firstSeed, firstSeed + 1, ...) through one Tracker (frames 10 s
@@ -120,6 +131,12 @@ struct TrialRecord {
 std::vector<TrialRecord> runTrials(const Board& board, const CameraIntrinsics& camera,
                                    uint64_t firstSeed, int count, const TrialRanges& ranges,
                                    const TrackerOptions& options = {}, int supersample = 2);
+
+// The records' detections estimated again with other pose options (each view alone, as in
+// runTrials: no previous pose), scored against the truth; conditions and corner data kept.
+std::vector<TrialRecord> rescoreTrials(const std::vector<TrialRecord>& records, const Board& board,
+                                       const CameraIntrinsics& camera,
+                                       const PoseEstimatorOptions& options);
 
 // The condition bins of docs/tracking.md: all views; by blur, JPEG quality, distance, tags
 // used, smallest used tag, occluder.

@@ -1,5 +1,6 @@
 #include "core/camera/CameraModel.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/Error.h"
@@ -67,6 +68,40 @@ std::optional<glm::dvec2> CameraIntrinsics::project(const glm::dvec3& p) const {
     }
     glm::dvec2 px{fx * d.x + cx, fy * d.y + cy};
     if (!std::isfinite(px.x) || !std::isfinite(px.y)) return std::nullopt;
+    return px;
+}
+
+std::optional<glm::dvec2> CameraIntrinsics::projectWithJacobian(const glm::dvec3& p,
+                                                                glm::dmat3x2& J) const {
+    if (model != DistortionModel::BrownConrady) {
+        const auto p0 = project(p);
+        if (!p0) return std::nullopt;
+        for (int a = 0; a < 3; ++a) {
+            glm::dvec3 q = p;
+            const double h = 1e-6 * std::max(1e-3, std::abs(p.z));
+            q[a] += h;
+            const auto p1 = project(q);
+            if (!p1) return std::nullopt;
+            J[a] = (*p1 - *p0) / h;
+        }
+        return p0;
+    }
+    const auto px = project(p);
+    if (!px) return std::nullopt;
+    const double k1 = coeff(0), k2 = coeff(1), p1 = coeff(2), p2 = coeff(3), k3 = coeff(4);
+    const double iz = 1.0 / p.z, x = p.x * iz, y = p.y * iz;
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dRadial = k1 + r2 * (2 * k2 + 3 * k3 * r2);  // d radial / d r2
+    // Derivatives of the distorted point (u, v) by the normalised point (x, y).
+    const double dudx = radial + 2 * x * x * dRadial + 2 * p1 * y + 6 * p2 * x;
+    const double dudy = 2 * x * y * dRadial + 2 * p1 * x + 2 * p2 * y;
+    const double dvdx = dudy;
+    const double dvdy = radial + 2 * y * y * dRadial + 6 * p1 * y + 2 * p2 * x;
+    // (x, y) = (X / Z, Y / Z).
+    J[0] = {fx * dudx * iz, fy * dvdx * iz};
+    J[1] = {fx * dudy * iz, fy * dvdy * iz};
+    J[2] = {-fx * (dudx * x + dudy * y) * iz, -fy * (dvdx * x + dvdy * y) * iz};
     return px;
 }
 

@@ -32,6 +32,11 @@ struct CameraIntrinsics {
     // Point in the camera frame (metres) to pixel. Points behind the camera (z <= 0 for the
     // pinhole model; theta beyond maxFisheyeTheta for the fish-eye model) give std::nullopt.
     std::optional<glm::dvec2> project(const glm::dvec3& pointCamera) const;
+    // project() and its derivative: column a of dPixelDPoint is d(pixel)/d(pointCamera[a])
+    // (pixels per metre). Closed form for BrownConrady; forward differences for KannalaBrandt.
+    // The pixel is exactly project()'s.
+    std::optional<glm::dvec2> projectWithJacobian(const glm::dvec3& pointCamera,
+                                                  glm::dmat3x2& dPixelDPoint) const;
     // Pixel to unit ray direction in the camera frame. Iterative inversion of the distortion;
     // std::nullopt where it does not converge (far outside the calibrated field of view).
     std::optional<glm::dvec3> unproject(const glm::dvec2& pixel) const;

@@ -36,6 +36,23 @@ public:
         MR_CHECK(firstRow + rows <= r_.size(), "Jacobian block beyond the residuals");
         const size_t k = columns.size();
         const size_t P = size_t(ne_.parameters);
+        bool dense = k == P;
+        for (size_t a = 0; a < k && dense; ++a) dense = size_t(columns[a]) == a;
+        if (dense) {
+            // All parameters in their order (a small problem such as a pose): the same sums
+            // without the column look-ups.
+            for (size_t i = 0; i < rows; ++i) {
+                const double* Ji = values + i * P;
+                const double ri = r_[firstRow + i];
+                for (size_t a = 0; a < P; ++a) {
+                    if (!std::isfinite(Ji[a])) ne_.finite = false;
+                    ne_.Jtr[a] += Ji[a] * ri;
+                    double* row = &ne_.JtJ[a * P];
+                    for (size_t b = a; b < P; ++b) row[b] += Ji[a] * Ji[b];
+                }
+            }
+            return;
+        }
         for (size_t i = 0; i < rows; ++i) {
             const double* Ji = values + i * k;
             const double ri = r_[firstRow + i];

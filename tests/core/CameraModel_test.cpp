@@ -66,6 +66,37 @@ TEST(CameraModel, FisheyeMatchesOpenCVAndInvertsOffAxis) {
     EXPECT_FALSE(cam.project({1, 0, -0.5}));
 }
 
+// projectWithJacobian: the same pixel as project(), and its derivative against central
+// differences (closed form for the pinhole model with all five distortion terms, forward
+// differences for the fish-eye model).
+TEST(CameraModel, ProjectionJacobianMatchesCentralDifferences) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    for (const CameraIntrinsics& cam : {pinhole(), fisheye()}) {
+        for (int i = 0; i < 100; ++i) {
+            const glm::dvec3 p(u(rng), u(rng), 1.0 + u(rng));
+            glm::dmat3x2 J;
+            const auto px = cam.projectWithJacobian(p, J);
+            ASSERT_TRUE(px);
+            EXPECT_EQ(*px, *cam.project(p));
+            for (int a = 0; a < 3; ++a) {
+                const double h = 1e-6;
+                glm::dvec3 lo = p, hi = p;
+                lo[a] -= h;
+                hi[a] += h;
+                const glm::dvec2 fd = (*cam.project(hi) - *cam.project(lo)) / (2 * h);
+                // Pixels per metre: ~500 here; the fish-eye's forward differences are good to
+                // ~1e-3 of that.
+                const double tol = cam.model == DistortionModel::BrownConrady ? 1e-5 : 0.5;
+                EXPECT_NEAR(J[a].x, fd.x, tol) << int(cam.model) << " column " << a;
+                EXPECT_NEAR(J[a].y, fd.y, tol) << int(cam.model) << " column " << a;
+            }
+        }
+        glm::dmat3x2 J;
+        EXPECT_FALSE(cam.projectWithJacobian({0, 0, -1}, J));
+    }
+}
+
 TEST(CameraModel, InvalidIntrinsicsDetected) {
     auto cam = pinhole();
     EXPECT_TRUE(cam.isValid());

@@ -1,7 +1,11 @@
 // Monte-Carlo run of the tracker on degraded synthetic views (docs/tracking.md, "Uncertainty and
 // the ok state"): prints the per-condition table (states, wrong-but-ok poses, fraction of errors
 // inside the reported 2-sigma ellipsoids) and the measured corner noise by blur and tag size.
-//   tracking_montecarlo [--views N (2000)] [--seed S (1)] [--supersample K (2)] [--previous-rule]
+//   tracking_montecarlo [--views N (2000)] [--one-tag-views M (0)] [--seed S (1)]
+//                       [--supersample K (2)] [--previous-rule]
+// --one-tag-views: M more views at 0.4-0.7 m in which only one tag is left visible
+// (TrialRanges::oneTagOnly, seeds S + 500000 ...), so that the one-tag bin holds enough poses
+// to judge.
 // --previous-rule: the covariance from the residuals alone (their robust scale) and no bound on
 // it for ok (about the rule before the uncertainty bounds; the tag-consistency rule and the
 // blur measurement stay), for comparison.
@@ -18,7 +22,7 @@
 
 int main(int argc, char** argv) {
     using namespace mirage::tracking;
-    int views = 2000, supersample = 2;
+    int views = 2000, oneTagViews = 0, supersample = 2;
     unsigned long long seed = 1;
     TrackerOptions options;
     int i = 1;
@@ -27,6 +31,7 @@ int main(int argc, char** argv) {
             options.pose.cornerNoisePriorWeight = 0;
             options.pose.tagScaleNoise = options.pose.tagShiftNoise = 0;
             options.pose.commonScaleNoise = 0;
+            options.pose.tagCentreNoise = 1;
             options.pose.okMaxSigmaRotDeg = 1e9;
             options.pose.okMaxSigmaPosFraction = 1e9;
             continue;
@@ -34,27 +39,44 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) break;
         if (!std::strcmp(argv[i], "--views"))
             views = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--one-tag-views"))
+            oneTagViews = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--seed"))
             seed = std::strtoull(argv[i + 1], nullptr, 10);
         else if (!std::strcmp(argv[i], "--supersample"))
             supersample = std::atoi(argv[i + 1]);
         else {
-            std::fprintf(stderr, "unknown option %s (--views N, --seed S, --supersample K)\n",
+            std::fprintf(stderr,
+                         "unknown option %s (--views N, --one-tag-views M, --seed S, "
+                         "--supersample K, --previous-rule)\n",
                          argv[i]);
             return 2;
         }
         ++i;
     }
-    if (i < argc || views <= 0 || supersample <= 0) {
-        std::fprintf(stderr, "usage: %s [--views N] [--seed S] [--supersample K]\n", argv[0]);
+    if (i < argc || views <= 0 || oneTagViews < 0 || supersample <= 0) {
+        std::fprintf(stderr,
+                     "usage: %s [--views N] [--one-tag-views M] [--seed S] [--supersample K] "
+                     "[--previous-rule]\n",
+                     argv[0]);
         return 2;
     }
     const Board board = BoardLayout().makeBoard();
-    const auto records = runTrials(board, testing::pinholeCamera(), seed, views, TrialRanges{},
-                                   options, supersample);
-    std::printf("%d views, seed %llu, 640x480 f = 600 px, default board (32 mm tags)\n\n%s\n%s",
-                views, seed, trialTable(binTrials(records)).c_str(),
-                cornerNoiseTable(records).c_str());
+    auto records = runTrials(board, testing::pinholeCamera(), seed, views, TrialRanges{}, options,
+                             supersample);
+    if (oneTagViews > 0) {
+        TrialRanges oneTag;
+        oneTag.oneTagOnly = true;
+        oneTag.maxDistanceM = 0.7;  // farther a single tag is mostly ambiguous: no pose to check
+        const auto more = runTrials(board, testing::pinholeCamera(), seed + 500000, oneTagViews,
+                                    oneTag, options, supersample);
+        records.insert(records.end(), more.begin(), more.end());
+    }
+    std::printf(
+        "%d views + %d one-tag views, seed %llu, 640x480 f = 600 px, default board (32 mm "
+        "tags)\n\n%s\n%s",
+        views, oneTagViews, seed, trialTable(binTrials(records)).c_str(),
+        cornerNoiseTable(records).c_str());
     std::printf("\n%s", cornerNoiseSplitTable(records, options.pose).c_str());
     {
         // Median squared Mahalanobis distances (chi-square with 3 degrees of freedom: 2.37).
