@@ -18,19 +18,21 @@ namespace {
 using Vertex = GpuSceneVertex;
 
 GpuMaterial toGpu(const Material& m) {
-    GpuMaterial g;
+    GpuMaterial g{};
     g.baseColor = m.baseColor;
-    g.emissive = glm::vec4(m.emissive, m.roughness);
-    g.params = glm::vec4(m.metallic, 0, 0, 0);
+    g.emissive = m.emissive;
+    g.roughness = m.roughness;
+    g.metallic = m.metallic;
     // KHR_materials_transmission / ior / volume. An infinite (or non-positive) attenuation
     // distance means no absorption: stored as 0.
-    const float attDist = std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f
-                              ? m.attenuationDistance
-                              : 0.0f;
-    g.transmission = glm::vec4(std::clamp(m.transmission, 0.0f, 1.0f),
-                               std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.5f, attDist,
-                               std::max(m.thickness, 0.0f));
-    g.attenuation = glm::vec4(glm::clamp(m.attenuationColor, 0.0f, 1.0f), m.isMirror() ? 1 : 0);
+    g.transmission = std::clamp(m.transmission, 0.0f, 1.0f);
+    g.ior = std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.5f;
+    g.attenuationDistance = std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f
+                                ? m.attenuationDistance
+                                : 0.0f;
+    g.attenuationColor = glm::clamp(m.attenuationColor, 0.0f, 1.0f);
+    g.mirror = m.isMirror() ? 1 : 0;
+    g.thickness = std::max(m.thickness, 0.0f);
     return g;
 }
 
@@ -279,11 +281,15 @@ void GpuScene::uploadSpecularDraws() {
     std::vector<GpuSpecularDraw> spec;
     for (int di : specularDraws_) {
         const DrawItem& d = draws_[size_t(di)];
-        spec.push_back(
-            {glm::ivec4(d.material, d.origin == Origin::Real ? kOriginReal : kOriginVirtual, di, 0),
-             glm::vec4(d.bounds.center, d.bounds.radius)});
+        GpuSpecularDraw g{};
+        g.centre = d.bounds.center;
+        g.radius = d.bounds.radius;
+        g.material = d.material;
+        g.origin = d.origin == Origin::Real ? kOriginReal : kOriginVirtual;
+        g.drawIndex = di;
+        spec.push_back(g);
     }
-    if (spec.empty()) spec.push_back({glm::ivec4(0), glm::vec4(0.0f)});
+    if (spec.empty()) spec.push_back(GpuSpecularDraw{});
     specularBuffer_ =
         gl::Buffer("specular draws", spec.size() * sizeof(GpuSpecularDraw), spec.data());
 }

@@ -9,6 +9,7 @@
 
 namespace mirage::render {
 
+using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using ivec4 = glm::ivec4;
 using mat4 = glm::mat4;
@@ -27,7 +28,12 @@ static_assert(offsetof(GpuFrame, exposure) == 4 * 64 + 15 * 16);
 static_assert(sizeof(GpuLightBlock) == kMaxLights * sizeof(GpuLight));
 static_assert(sizeof(GpuVpl) == 64);
 static_assert(sizeof(GpuMaterial) == 80);
+static_assert(offsetof(GpuMaterial, emissive) == 16 && offsetof(GpuMaterial, roughness) == 28);
+static_assert(offsetof(GpuMaterial, metallic) == 32 && offsetof(GpuMaterial, ior) == 40);
+static_assert(offsetof(GpuMaterial, attenuationColor) == 48 && offsetof(GpuMaterial, mirror) == 60);
+static_assert(offsetof(GpuMaterial, thickness) == 64);
 static_assert(sizeof(GpuSpecularDraw) == 32);
+static_assert(offsetof(GpuSpecularDraw, radius) == 12 && offsetof(GpuSpecularDraw, material) == 16);
 static_assert(sizeof(GpuSurfacePoint) == 16);
 
 }  // namespace mirage::render

@@ -81,21 +81,34 @@ struct GpuVpl {
     vec4 tangent;       // xyz unit tangent; with cross(normal, tangent): the ISM paraboloid frame
 };
 
-// Materials (std430, kBindingMaterials).
+// Materials (std430, kBindingMaterials): glTF metallic-roughness with KHR_materials_transmission,
+// _ior and _volume (docs/scene.md).
 struct GpuMaterial {
-    vec4 baseColor;     // linear RGBA
-    vec4 emissive;      // rgb linear emitted radiance; w = roughness
-    vec4 params;        // x = metallic
-    vec4 transmission;  // x = transmission (0..1), y = ior, z = attenuation distance (m, 0 =
-                        // none), w = thickness (mesh units, informational)
-    vec4 attenuation;   // rgb = linear attenuation colour (Beer-Lambert), a = 1 for a mirror
+    vec4 baseColor;             // linear RGBA
+    vec3 emissive;              // linear emitted radiance
+    float roughness;            // perceptual roughness, 0..1
+    float metallic;             // 0..1
+    float transmission;         // 0..1
+    float ior;                  // index of refraction (> 0)
+    float attenuationDistance;  // metres light travels inside before falling to
+                                // attenuationColor (Beer-Lambert); 0 = no absorption
+    vec3 attenuationColor;      // linear, 0..1
+    int mirror;                 // 1 for a perfect mirror (docs/scene.md), else 0
+    float thickness;            // KHR_materials_volume thickness (mesh units, informational)
+    float pad0;                 // std430: the struct is a multiple of 16 bytes
+    float pad1;
+    float pad2;
 };
 
 // Specular draw table (std430, kBindingSpecularDraws), indexed by specular slot (GpuScene::
 // specularDraws() order). The G-buffer stores slot + 1 in gEmissive.a (0 = not specular).
 struct GpuSpecularDraw {
-    ivec4 info;   // x = material index, y = kOriginReal / kOriginVirtual, z = draw index
-    vec4 bounds;  // world bounding sphere: xyz centre, w radius (metres)
+    vec3 centre;    // world bounding sphere: centre, radius (metres)
+    float radius;
+    int material;   // index into the material table
+    int origin;     // kOriginReal / kOriginVirtual
+    int drawIndex;  // index into GpuScene::draws()
+    int pad0;       // std430: the struct is a multiple of 16 bytes
 };
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).

@@ -30,10 +30,10 @@ void main() {
     if (dot(n, toLight) < 0.0) n = -n;
     float dist = length(lights[li].positionRange.xyz - worldPos);
     float atten = directional ? 1.0 : spotAttenuation(li, -toLight) * rangeWindow(li, dist);
-    vec3 diffuseAlbedo = (m.baseColor.rgb * texture(baseColorMap, uv).rgb) * (1.0 - clamp(m.params.x, 0.0, 1.0));
+    vec3 diffuseAlbedo = (m.baseColor.rgb * texture(baseColorMap, uv).rgb) * (1.0 - clamp(m.metallic, 0.0, 1.0));
     // Glass transmits instead of scattering diffusely (KHR_materials_transmission): only the
     // opaque share bounces into VPLs (reflected/refracted VPLs on caustics are a later issue).
-    diffuseAlbedo *= 1.0 - clamp(m.transmission.x, 0.0, 1.0);
+    diffuseAlbedo *= 1.0 - clamp(m.transmission, 0.0, 1.0);
     outFlux = vec4(lights[li].radiantIntensity.rgb * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
     outNormal = vec4(n, 0.0);
     outPosition = vec4(worldPos, 1.0);
