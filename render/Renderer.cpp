@@ -297,7 +297,7 @@ void Renderer::planFrame(const FrameInput& input) {
     f.ismTileSize = options_.ismTileSize;
     f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
     f.vplDistanceClamp = options_.vplDistanceClamp;
-    f.shadowBias = options_.shadowBias * 0.1f;
+    f.shadowBias = options_.shadowBias;
     f.temporalBlend = options_.temporalBlend;
     f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
     for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);

@@ -58,8 +58,8 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
     int ismTileSize;     // texels per side of one VPL's imperfect shadow map tile
     int ismTilesPerRow;  // tiles per row of the ISM atlas
     float vplDistanceClamp;  // metres: VPL distance below this is clamped
-    float shadowBias;        // metres: RendererOptions::shadowBias x 0.1 (lighting.glsl adds the
-                             // texel footprint)
+    float shadowBias;        // metres: RendererOptions::shadowBias, constant (lighting.glsl adds
+                             // the texel footprint)
     float temporalBlend;     // history weight of the VPL lighting (0 = off)
     float ismPointsPerVpl;
     vec4 envSH[9];  // environment irradiance SH (rgb), already scaled by intensity
