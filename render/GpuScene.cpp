@@ -413,6 +413,21 @@ void GpuScene::drawItem(const DrawItem& d) const {
                              reinterpret_cast<const void*>(size_t(d.firstIndex) * 4), d.baseVertex);
 }
 
+MaterialDraw::MaterialDraw(const gl::Program& program)
+    : model_(program.uniformLocation("model")),
+      normal_(program.uniformLocation("normalMatrix")),
+      material_(program.uniformLocation("materialIndex")),
+      origin_(program.uniformLocation("origin")) {}
+
+void MaterialDraw::draw(const GpuScene& scene, const DrawItem& d) const {
+    glUniformMatrix4fv(model_, 1, GL_FALSE, &d.model[0][0]);
+    glUniformMatrix4fv(normal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
+    glUniform1i(material_, d.material);
+    glUniform1i(origin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
+    scene.bindMaterialTextures(d, kUnitBaseColorMap);
+    scene.drawItem(d);
+}
+
 std::string GpuScene::lightingDefines() const {
     int faces = 0;
     for (const SceneLight& l : lights_) faces = std::max(faces, l.type == kLightPoint ? 6 : 1);

@@ -80,11 +80,7 @@ ImpostorPass::ImpostorPass()
                              "passes/impostor/capture.frag")),
       query_(computeProgram("impostor query", "passes/impostor/query.comp")),
       captureFbo_("impostor capture fbo") {
-    locModel_ = capture_.uniformLocation("model");
-    locNormal_ = capture_.uniformLocation("normalMatrix");
     locViewProj_ = capture_.uniformLocation("captureViewProj");
-    locMaterial_ = capture_.uniformLocation("materialIndex");
-    locOrigin_ = capture_.uniformLocation("origin");
     locCaptureDepth_ = capture_.uniformLocation("captureDepth");
     locDepthAxis_ = capture_.uniformLocation("depthAxis");
     locRayCount_ = query_.uniformLocation("rayCount");
@@ -414,14 +410,7 @@ void ImpostorPass::capture(const GpuScene& scene, const Layout& layout, int res)
     glDisable(GL_BLEND);
     capture_.use();
     scene.bindGeometry();
-    auto drawOne = [&](const DrawItem& d) {
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
-        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
-        glUniform1i(locMaterial_, d.material);
-        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        scene.bindMaterialTextures(d, kUnitBaseColorMap);
-        scene.drawItem(d);
-    };
+    auto drawOne = [&](const DrawItem& d) { captureDraw_.draw(scene, d); };
     auto target = [&](const gl::Texture& a, const gl::Texture& n, const gl::Texture& al,
                       const gl::Texture& e, int layer, const glm::vec4& clear0) {
         fbo.attachColorLayer(0, a, layer);
