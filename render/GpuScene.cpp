@@ -335,14 +335,14 @@ void GpuScene::buildSurfacePoints(const std::vector<Vertex>& verts,
                 if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
                 const Tri& t = tris[k];
                 glm::vec3 p = t.a + u * (t.b - t.a) + v * (t.c - t.a);
-                pts.push_back({glm::vec4(p, t.real)});
+                pts.push_back({p, t.real != 0.0f ? 1 : 0});
                 if (t.real == 0.0f) pointsHaveVirtual_ = true;
             }
             std::shuffle(pts.begin(), pts.end(), rng);
         }
     }
     surfacePointCount_ = int(pts.size());
-    if (pts.empty()) pts.push_back({glm::vec4(0.0f)});
+    if (pts.empty()) pts.push_back(GpuSurfacePoint{});
     points_ = gl::Buffer("ism surface points", pts.size() * sizeof(GpuSurfacePoint), pts.data());
 }
 

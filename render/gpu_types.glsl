@@ -27,10 +27,12 @@ const int kOriginVirtual = 2;
 
 struct GpuLight {
     mat4 viewProj[6];       // world -> light clip space, one per shadow layer (spot/dir use [0])
-    vec4 positionRange;     // xyz world position (metres); w = range (0 = infinite)
-    vec4 directionType;     // xyz unit direction the light shines along; w = kLight* type
-    vec4 radiantIntensity;  // rgb = colour * intensity: W/sr (point, spot) or W/m^2 (dir.);
-                            // w = tan(half fov) (spot), 1 (point), ortho half extent (m, dir.)
+    vec3 position;          // world (metres); directional: the eye of its ortho frustum
+    float range;            // metres (0 = infinite)
+    vec3 direction;         // unit direction the light shines along (world)
+    int type;               // kLightPoint, kLightSpot or kLightDirectional
+    vec3 radiantIntensity;  // colour * intensity: W/sr (point, spot) or W/m^2 (directional)
+    float frustumSize;      // tan(half fov) (spot), 1 (point), ortho half extent (m, dir.)
     float cosOuter;         // spot cone: cos(outer angle), cos(inner angle), and the falloff
     float cosInner;         // clamp(cos * coneScale + coneOffset, 0, 1)^2
     float coneScale;
@@ -75,10 +77,14 @@ MIRAGE_UNIFORM_BLOCK(LightBlock, GpuLightBlock, kBindingLights) {
 
 // One virtual point light (std430, kBindingVpls).
 struct GpuVpl {
-    vec4 positionReal;  // xyz world position; w = 1 if light, surface q are real, else 0
-    vec4 normal;        // xyz unit normal at q (facing the light); w = 1 valid, 0 unused slot
-    vec4 flux;          // rgb = reflected power (W) the VPL emits (cosine lobe); w unused
-    vec4 tangent;       // xyz unit tangent; with cross(normal, tangent): the ISM paraboloid frame
+    vec3 position;  // world position of the surface point q (metres)
+    int isReal;     // 1 if the light and q are real, else 0
+    vec3 normal;    // unit normal at q (facing the light)
+    int valid;      // 1 valid, 0 unused slot
+    vec3 flux;      // reflected power (W) the VPL emits (cosine lobe)
+    float pad0;     // std430: vec3 fields start at 16-byte offsets
+    vec3 tangent;   // unit tangent; with cross(normal, tangent): the ISM paraboloid frame
+    float pad1;
 };
 
 // Materials (std430, kBindingMaterials): glTF metallic-roughness with KHR_materials_transmission,
@@ -113,7 +119,8 @@ struct GpuSpecularDraw {
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).
 struct GpuSurfacePoint {
-    vec4 positionReal;  // xyz world (metres); w = 1 if the geometry is real, 0 if virtual
+    vec3 position;  // world (metres)
+    int isReal;     // 1 if the geometry is real, 0 if virtual
 };
 
 #endif
