@@ -9,36 +9,40 @@ namespace mirage::calib {
 
 BatchResult runBatchCalibration(const std::vector<std::string>& inputs,
                                 const CalibrationTarget& target, const BatchOptions& options) {
-    auto source = openFrameSource(inputs, options.source);
+    auto source = openFrameList(inputs, options.source);
     BatchResult r;
     r.targetDescription = target.description();
     std::vector<CalibrationView> views;
     std::string firstName;
-    InputFrame frame;
-    while (source->next(frame)) {
+    cv::Mat bgr;
+    while (source->read(bgr)) {
         ++r.framesRead;
-        const cv::Size size = frame.bgr.size();
-        if (r.framesRead == 1) {
+        const std::string name = source->lastName();
+        if (bgr.empty()) {
+            r.skipped.push_back({name, "frame lost: " + source->lastProblem()});
+            continue;
+        }
+        const cv::Size size = bgr.size();
+        if (firstName.empty()) {
             r.imageSize = size;
-            firstName = frame.name;
+            firstName = name;
         } else if (size != r.imageSize) {
             throw Error(fmt::format(
                 "mixed image sizes: {} is {}x{} but {} is {}x{}; all inputs must come from the "
                 "same camera at the same resolution",
-                firstName, r.imageSize.width, r.imageSize.height, frame.name, size.width,
-                size.height));
+                firstName, r.imageSize.width, r.imageSize.height, name, size.width, size.height));
         }
-        auto d = target.detect(frame.bgr, frame.name);
+        auto d = target.detect(bgr, name);
         // Video input can take minutes: say how far it got.
         if (r.framesRead % 5 == 0)
             spdlog::info("calibrate: {} frame(s) read, the board found in {} (last: {})",
-                         r.framesRead, views.size() + (d.found ? 1 : 0), frame.name);
+                         r.framesRead, views.size() + (d.found ? 1 : 0), name);
         if (d.found) {
-            spdlog::debug("{}: {} corners", frame.name, d.view.imagePoints.size());
+            spdlog::debug("{}: {} corners", name, d.view.imagePoints.size());
             views.push_back(std::move(d.view));
         } else {
-            spdlog::debug("{}: {}", frame.name, d.reason);
-            r.skipped.push_back({frame.name, d.reason});
+            spdlog::debug("{}: {}", name, d.reason);
+            r.skipped.push_back({name, d.reason});
         }
     }
     if (r.framesRead == 0) throw Error("the inputs hold no frames");

@@ -7,13 +7,13 @@
 
 #include "calibration/CalibrationTarget.h"
 #include "calibration/Calibrator.h"
-#include "calibration/FrameSource.h"
+#include "core/session/FrameSource.h"
 
 namespace mirage::calib {
 
 struct BatchOptions {
     CalibrationOptions calibration;
-    FrameSourceOptions source;
+    FrameListOptions source;
 };
 
 struct SkippedFrame {
@@ -29,8 +29,10 @@ struct BatchResult {
     CalibrationResult calibration;
 };
 
-// Throws mirage::Error / FileError on: no or unreadable inputs, frames of different sizes (both
-// files named), the target found in no frame, or a calibration that produced no finite numbers.
+// Frames come from openFrameList (core/session/FrameSource.h); a lost frame (damaged bytes in
+// a recording) is listed as skipped. Throws mirage::Error / FileError on: no or unreadable inputs,
+// frames of different sizes (both files named), the target found in no frame, or a calibration that
+// produced no finite numbers.
 BatchResult runBatchCalibration(const std::vector<std::string>& inputs,
                                 const CalibrationTarget& target, const BatchOptions& options);
 

@@ -9,9 +9,9 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "calibration/FrameSource.h"
 #include "calibration/JointRefinement.h"
 #include "core/Error.h"
+#include "core/session/FrameSource.h"
 
 namespace mirage::calib {
 namespace {
@@ -245,20 +245,22 @@ StereoExtrinsics extrinsicsFromPairedInputs(const CameraIntrinsics& main,
                                             const CameraIntrinsics& camera,
                                             const std::vector<std::string>& cameraInputs,
                                             const CalibrationTarget& target) {
-    FrameSourceOptions so;
+    FrameListOptions so;
     so.allVideoFrames = true;  // pairing by order needs every frame of both
-    auto mainSource = openFrameSource(mainInputs, so);
-    auto camSource = openFrameSource(cameraInputs, so);
+    auto mainSource = openFrameList(mainInputs, so);
+    auto camSource = openFrameList(cameraInputs, so);
     std::vector<CalibrationView> mv, cv_;
-    InputFrame a, b;
+    cv::Mat a, b;
     while (true) {
-        const bool ga = mainSource->next(a), gb = camSource->next(b);
+        const bool ga = mainSource->read(a), gb = camSource->read(b);
         if (ga != gb)
             throw Error(
                 "extrinsics: --main-input and INPUT hold different numbers of frames; "
                 "they must be taken in pairs");
         if (!ga) break;
-        auto da = target.detect(a.bgr, a.name), db = target.detect(b.bgr, b.name);
+        if (a.empty() || b.empty()) continue;  // a lost frame (damaged recording): no pair
+        auto da = target.detect(a, mainSource->lastName()),
+             db = target.detect(b, camSource->lastName());
         if (da.found && db.found) {
             mv.push_back(std::move(da.view));
             cv_.push_back(std::move(db.view));

@@ -29,6 +29,8 @@ void RendererOptions::validate() const {
     if (impostorResolution < 8 || impostorResolution > 2048)
         fail("impostorResolution must be 8..2048 texels, got " +
              std::to_string(impostorResolution));
+    if (!(shadowBias >= 0.0f && shadowBias <= 1.0f))
+        fail("shadowBias must be in [0, 1] metres, got " + std::to_string(shadowBias));
     if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
         fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
 }

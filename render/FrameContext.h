@@ -25,7 +25,8 @@ struct RendererOptions {
     int indirectScale = 2;               // VPL gather at 1/scale resolution per axis (1 or 2); the
                                          // geometry-aware filter upsamples it to full resolution
     float vplDistanceClamp = 0.1f;       // metres: VPL distance below this is clamped (no spikes)
-    float shadowBias = 0.01f;            // metres, at 1 m distance (scaled with distance)
+    float shadowBias = 0.001f;           // metres: constant depth bias of the shadow-map test
+                                         // (lighting.glsl adds 1.5 texels' footprint / cos)
     float temporalBlend = 0.8f;          // history weight for the VPL lighting (0 = off)
     float exposure = 1.0f;               // rendered linear radiance -> camera linear units
     float alphaMax = 8.0f;               // cap of alpha = CI / L_r

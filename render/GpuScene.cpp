@@ -18,19 +18,21 @@ namespace {
 using Vertex = GpuSceneVertex;
 
 GpuMaterial toGpu(const Material& m) {
-    GpuMaterial g;
+    GpuMaterial g{};
     g.baseColor = m.baseColor;
-    g.emissive = glm::vec4(m.emissive, m.roughness);
-    g.params = glm::vec4(m.metallic, 0, 0, 0);
+    g.emissive = m.emissive;
+    g.roughness = m.roughness;
+    g.metallic = m.metallic;
     // KHR_materials_transmission / ior / volume. An infinite (or non-positive) attenuation
     // distance means no absorption: stored as 0.
-    const float attDist = std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f
-                              ? m.attenuationDistance
-                              : 0.0f;
-    g.transmission = glm::vec4(std::clamp(m.transmission, 0.0f, 1.0f),
-                               std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.5f, attDist,
-                               std::max(m.thickness, 0.0f));
-    g.attenuation = glm::vec4(glm::clamp(m.attenuationColor, 0.0f, 1.0f), m.isMirror() ? 1 : 0);
+    g.transmission = std::clamp(m.transmission, 0.0f, 1.0f);
+    g.ior = std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.5f;
+    g.attenuationDistance = std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f
+                                ? m.attenuationDistance
+                                : 0.0f;
+    g.attenuationColor = glm::clamp(m.attenuationColor, 0.0f, 1.0f);
+    g.mirror = m.isMirror() ? 1 : 0;
+    g.thickness = std::max(m.thickness, 0.0f);
     return g;
 }
 
@@ -279,11 +281,15 @@ void GpuScene::uploadSpecularDraws() {
     std::vector<GpuSpecularDraw> spec;
     for (int di : specularDraws_) {
         const DrawItem& d = draws_[size_t(di)];
-        spec.push_back(
-            {glm::ivec4(d.material, d.origin == Origin::Real ? kOriginReal : kOriginVirtual, di, 0),
-             glm::vec4(d.bounds.center, d.bounds.radius)});
+        GpuSpecularDraw g{};
+        g.centre = d.bounds.center;
+        g.radius = d.bounds.radius;
+        g.material = d.material;
+        g.origin = d.origin == Origin::Real ? kOriginReal : kOriginVirtual;
+        g.drawIndex = di;
+        spec.push_back(g);
     }
-    if (spec.empty()) spec.push_back({glm::ivec4(0), glm::vec4(0.0f)});
+    if (spec.empty()) spec.push_back(GpuSpecularDraw{});
     specularBuffer_ =
         gl::Buffer("specular draws", spec.size() * sizeof(GpuSpecularDraw), spec.data());
 }
@@ -329,14 +335,14 @@ void GpuScene::buildSurfacePoints(const std::vector<Vertex>& verts,
                 if (u + v > 1.0f) u = 1.0f - u, v = 1.0f - v;
                 const Tri& t = tris[k];
                 glm::vec3 p = t.a + u * (t.b - t.a) + v * (t.c - t.a);
-                pts.push_back({glm::vec4(p, t.real)});
+                pts.push_back({p, t.real != 0.0f ? 1 : 0});
                 if (t.real == 0.0f) pointsHaveVirtual_ = true;
             }
             std::shuffle(pts.begin(), pts.end(), rng);
         }
     }
     surfacePointCount_ = int(pts.size());
-    if (pts.empty()) pts.push_back({glm::vec4(0.0f)});
+    if (pts.empty()) pts.push_back(GpuSurfacePoint{});
     points_ = gl::Buffer("ism surface points", pts.size() * sizeof(GpuSurfacePoint), pts.data());
 }
 
@@ -405,6 +411,21 @@ void GpuScene::bindMaterialTextures(const DrawItem& d, GLuint unit) const {
 void GpuScene::drawItem(const DrawItem& d) const {
     glDrawElementsBaseVertex(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(d.firstIndex) * 4), d.baseVertex);
+}
+
+MaterialDraw::MaterialDraw(const gl::Program& program)
+    : model_(program.uniformLocation("model")),
+      normal_(program.uniformLocation("normalMatrix")),
+      material_(program.uniformLocation("materialIndex")),
+      origin_(program.uniformLocation("origin")) {}
+
+void MaterialDraw::draw(const GpuScene& scene, const DrawItem& d) const {
+    glUniformMatrix4fv(model_, 1, GL_FALSE, &d.model[0][0]);
+    glUniformMatrix4fv(normal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
+    glUniform1i(material_, d.material);
+    glUniform1i(origin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
+    scene.bindMaterialTextures(d, kUnitBaseColorMap);
+    scene.drawItem(d);
 }
 
 std::string GpuScene::lightingDefines() const {

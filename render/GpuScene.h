@@ -149,4 +149,19 @@ private:
     float surfaceArea_ = 0.0f;
 };
 
+// Draws scene items with their materials through a raster program that declares the per-draw
+// uniforms `model`, `normalMatrix` (world), `materialIndex`, `origin` (kOriginReal /
+// kOriginVirtual) and samples the base-colour map at kUnitBaseColorMap (the G-buffer, shadow
+// and impostor-capture programs).
+class MaterialDraw {
+public:
+    explicit MaterialDraw(const gl::Program& program);
+    // Sets d's uniforms, binds its base-colour map and draws it. The program is in use and
+    // GpuScene::bindGeometry() was called.
+    void draw(const GpuScene& scene, const DrawItem& d) const;
+
+private:
+    GLint model_ = -1, normal_ = -1, material_ = -1, origin_ = -1;
+};
+
 }  // namespace mirage::render

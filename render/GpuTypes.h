@@ -9,6 +9,7 @@
 
 namespace mirage::render {
 
+using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using ivec4 = glm::ivec4;
 using mat4 = glm::mat4;
@@ -16,6 +17,8 @@ using mat4 = glm::mat4;
 #include "render/gpu_types.glsl"  // includes render/bindings.glsl
 
 static_assert(sizeof(GpuLight) == 6 * 64 + 5 * 16);
+static_assert(offsetof(GpuLight, range) == 6 * 64 + 12 && offsetof(GpuLight, type) == 6 * 64 + 28);
+static_assert(offsetof(GpuLight, frustumSize) == 6 * 64 + 44);
 static_assert(offsetof(GpuLight, cosOuter) == 6 * 64 + 3 * 16);
 static_assert(offsetof(GpuLight, firstShadowLayer) == 6 * 64 + 4 * 16);
 static_assert(sizeof(GpuFrame) == 4 * 64 + 3 * 16 + 3 * 16 + 9 * 16 + 16);
@@ -26,8 +29,15 @@ static_assert(offsetof(GpuFrame, envSH) == 4 * 64 + 6 * 16);
 static_assert(offsetof(GpuFrame, exposure) == 4 * 64 + 15 * 16);
 static_assert(sizeof(GpuLightBlock) == kMaxLights * sizeof(GpuLight));
 static_assert(sizeof(GpuVpl) == 64);
+static_assert(offsetof(GpuVpl, isReal) == 12 && offsetof(GpuVpl, valid) == 28);
+static_assert(offsetof(GpuVpl, tangent) == 48);
 static_assert(sizeof(GpuMaterial) == 80);
+static_assert(offsetof(GpuMaterial, emissive) == 16 && offsetof(GpuMaterial, roughness) == 28);
+static_assert(offsetof(GpuMaterial, metallic) == 32 && offsetof(GpuMaterial, ior) == 40);
+static_assert(offsetof(GpuMaterial, attenuationColor) == 48 && offsetof(GpuMaterial, mirror) == 60);
+static_assert(offsetof(GpuMaterial, thickness) == 64);
 static_assert(sizeof(GpuSpecularDraw) == 32);
-static_assert(sizeof(GpuSurfacePoint) == 16);
+static_assert(offsetof(GpuSpecularDraw, radius) == 12 && offsetof(GpuSpecularDraw, material) == 16);
+static_assert(sizeof(GpuSurfacePoint) == 16 && offsetof(GpuSurfacePoint, isReal) == 12);
 
 }  // namespace mirage::render

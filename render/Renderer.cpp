@@ -193,19 +193,22 @@ void Renderer::planFrame(const FrameInput& input) {
         anyReachesVirtual = anyReachesVirtual || virt;
         anyCaster = anyCaster || lp.castsShadow;
 
-        g.positionRange = glm::vec4(l.position, l.range);
-        g.directionType = glm::vec4(l.direction, float(l.type));
+        g.position = l.position;
+        g.range = l.range;
+        g.direction = l.direction;
+        g.type = l.type;
         const float scale = 1.0f / std::max(0.001f, l.cosInner - l.cosOuter);
         g.cosOuter = l.cosOuter;
         g.cosInner = l.cosInner;
         g.coneScale = scale;
         g.coneOffset = -l.cosOuter * scale;
-        g.radiantIntensity = glm::vec4(l.radiantIntensity, 1.0f);
+        g.radiantIntensity = l.radiantIntensity;
+        g.frustumSize = 1.0f;
         const float farL = glm::length(B.center - l.position) + R + 0.1f;
         const float nearL = std::clamp(farL * 1e-4f, 0.005f, 0.05f);
         if (l.type == kLightSpot) {
             const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
-            g.radiantIntensity.w = std::tan(half);
+            g.frustumSize = std::tan(half);
             g.viewProj[0] =
                 glm::perspective(2.0f * half, 1.0f, nearL, farL) *
                 glm::lookAt(l.position, l.position + l.direction, anyPerpendicular(l.direction));
@@ -215,15 +218,16 @@ void Renderer::planFrame(const FrameInput& input) {
                                        {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
             const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
                                       {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-            g.radiantIntensity.w = 1.0f;
+            g.frustumSize = 1.0f;
             for (int f = 0; f < 6; ++f)
                 g.viewProj[f] = glm::perspective(glm::half_pi<float>(), 1.0f, nearL, farL) *
                                 glm::lookAt(l.position, l.position + dirs[f], ups[f]);
             lp.layers = 6;
         } else {
             const glm::vec3 eye = B.center - l.direction * (2.0f * R + 1.0f);
-            g.positionRange = glm::vec4(eye, 0.0f);
-            g.radiantIntensity.w = R;
+            g.position = eye;
+            g.range = 0.0f;
+            g.frustumSize = R;
             g.viewProj[0] = glm::ortho(-R, R, -R, R, 0.0f, 4.0f * R + 2.0f) *
                             glm::lookAt(eye, B.center, anyPerpendicular(l.direction));
             lp.layers = 1;
@@ -297,7 +301,7 @@ void Renderer::planFrame(const FrameInput& input) {
     f.ismTileSize = options_.ismTileSize;
     f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
     f.vplDistanceClamp = options_.vplDistanceClamp;
-    f.shadowBias = options_.shadowBias * 0.1f;
+    f.shadowBias = options_.shadowBias;
     f.temporalBlend = options_.temporalBlend;
     f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
     for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);

@@ -18,21 +18,21 @@
 
 // Paraboloid coordinates (unit disc) of unit direction w around a VPL's normal (z axis).
 vec2 paraboloidUv(GpuVpl V, vec3 w) {
-    vec3 b = cross(V.normal.xyz, V.tangent.xyz);
-    return vec2(dot(w, V.tangent.xyz), dot(w, b)) / (1.0 + dot(w, V.normal.xyz));
+    vec3 b = cross(V.normal, V.tangent);
+    return vec2(dot(w, V.tangent), dot(w, b)) / (1.0 + dot(w, V.normal));
 }
 
 // glTF KHR_lights_punctual spot cone and range window (the spec's recommended falloff).
 // Lights are passed by index, never copied: a GpuLight is 464 bytes and llvmpipe copies it per
 // pixel if a shader takes it by value.
 float spotAttenuation(int li, vec3 lightToPoint) {
-    if (int(lights[li].directionType.w) != LIGHT_SPOT) return 1.0;
-    float cd = dot(lights[li].directionType.xyz, lightToPoint);
+    if (lights[li].type != LIGHT_SPOT) return 1.0;
+    float cd = dot(lights[li].direction, lightToPoint);
     float a = clamp(cd * lights[li].coneScale + lights[li].coneOffset, 0.0, 1.0);
     return a * a;
 }
 float rangeWindow(int li, float dist) {
-    float range = lights[li].positionRange.w;
+    float range = lights[li].range;
     if (range <= 0.0) return 1.0;
     float r = dist / range;
     return clamp(1.0 - r * r * r * r, 0.0, 1.0);

@@ -27,10 +27,12 @@ const int kOriginVirtual = 2;
 
 struct GpuLight {
     mat4 viewProj[6];       // world -> light clip space, one per shadow layer (spot/dir use [0])
-    vec4 positionRange;     // xyz world position (metres); w = range (0 = infinite)
-    vec4 directionType;     // xyz unit direction the light shines along; w = kLight* type
-    vec4 radiantIntensity;  // rgb = colour * intensity: W/sr (point, spot) or W/m^2 (dir.);
-                            // w = tan(half fov) (spot), 1 (point), ortho half extent (m, dir.)
+    vec3 position;          // world (metres); directional: the eye of its ortho frustum
+    float range;            // metres (0 = infinite)
+    vec3 direction;         // unit direction the light shines along (world)
+    int type;               // kLightPoint, kLightSpot or kLightDirectional
+    vec3 radiantIntensity;  // colour * intensity: W/sr (point, spot) or W/m^2 (directional)
+    float frustumSize;      // tan(half fov) (spot), 1 (point), ortho half extent (m, dir.)
     float cosOuter;         // spot cone: cos(outer angle), cos(inner angle), and the falloff
     float cosInner;         // clamp(cos * coneScale + coneOffset, 0, 1)^2
     float coneScale;
@@ -58,8 +60,8 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
     int ismTileSize;     // texels per side of one VPL's imperfect shadow map tile
     int ismTilesPerRow;  // tiles per row of the ISM atlas
     float vplDistanceClamp;  // metres: VPL distance below this is clamped
-    float shadowBias;        // metres: RendererOptions::shadowBias x 0.1 (lighting.glsl adds the
-                             // texel footprint)
+    float shadowBias;        // metres: RendererOptions::shadowBias, constant (lighting.glsl adds
+                             // the texel footprint)
     float temporalBlend;     // history weight of the VPL lighting (0 = off)
     float ismPointsPerVpl;
     vec4 envSH[9];  // environment irradiance SH (rgb), already scaled by intensity
@@ -75,32 +77,50 @@ MIRAGE_UNIFORM_BLOCK(LightBlock, GpuLightBlock, kBindingLights) {
 
 // One virtual point light (std430, kBindingVpls).
 struct GpuVpl {
-    vec4 positionReal;  // xyz world position; w = 1 if light, surface q are real, else 0
-    vec4 normal;        // xyz unit normal at q (facing the light); w = 1 valid, 0 unused slot
-    vec4 flux;          // rgb = reflected power (W) the VPL emits (cosine lobe); w unused
-    vec4 tangent;       // xyz unit tangent; with cross(normal, tangent): the ISM paraboloid frame
+    vec3 position;  // world position of the surface point q (metres)
+    int isReal;     // 1 if the light and q are real, else 0
+    vec3 normal;    // unit normal at q (facing the light)
+    int valid;      // 1 valid, 0 unused slot
+    vec3 flux;      // reflected power (W) the VPL emits (cosine lobe)
+    float pad0;     // std430: vec3 fields start at 16-byte offsets
+    vec3 tangent;   // unit tangent; with cross(normal, tangent): the ISM paraboloid frame
+    float pad1;
 };
 
-// Materials (std430, kBindingMaterials).
+// Materials (std430, kBindingMaterials): glTF metallic-roughness with KHR_materials_transmission,
+// _ior and _volume (docs/scene.md).
 struct GpuMaterial {
-    vec4 baseColor;     // linear RGBA
-    vec4 emissive;      // rgb linear emitted radiance; w = roughness
-    vec4 params;        // x = metallic
-    vec4 transmission;  // x = transmission (0..1), y = ior, z = attenuation distance (m, 0 =
-                        // none), w = thickness (mesh units, informational)
-    vec4 attenuation;   // rgb = linear attenuation colour (Beer-Lambert), a = 1 for a mirror
+    vec4 baseColor;             // linear RGBA
+    vec3 emissive;              // linear emitted radiance
+    float roughness;            // perceptual roughness, 0..1
+    float metallic;             // 0..1
+    float transmission;         // 0..1
+    float ior;                  // index of refraction (> 0)
+    float attenuationDistance;  // metres light travels inside before falling to
+                                // attenuationColor (Beer-Lambert); 0 = no absorption
+    vec3 attenuationColor;      // linear, 0..1
+    int mirror;                 // 1 for a perfect mirror (docs/scene.md), else 0
+    float thickness;            // KHR_materials_volume thickness (mesh units, informational)
+    float pad0;                 // std430: the struct is a multiple of 16 bytes
+    float pad1;
+    float pad2;
 };
 
 // Specular draw table (std430, kBindingSpecularDraws), indexed by specular slot (GpuScene::
 // specularDraws() order). The G-buffer stores slot + 1 in gEmissive.a (0 = not specular).
 struct GpuSpecularDraw {
-    ivec4 info;   // x = material index, y = kOriginReal / kOriginVirtual, z = draw index
-    vec4 bounds;  // world bounding sphere: xyz centre, w radius (metres)
+    vec3 centre;    // world bounding sphere: centre, radius (metres)
+    float radius;
+    int material;   // index into the material table
+    int origin;     // kOriginReal / kOriginVirtual
+    int drawIndex;  // index into GpuScene::draws()
+    int pad0;       // std430: the struct is a multiple of 16 bytes
 };
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).
 struct GpuSurfacePoint {
-    vec4 positionReal;  // xyz world (metres); w = 1 if the geometry is real, 0 if virtual
+    vec3 position;  // world (metres)
+    int isReal;     // 1 if the geometry is real, 0 if virtual
 };
 
 #endif

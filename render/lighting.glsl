@@ -4,26 +4,26 @@
 #define MIRAGE_LIGHTING_GLSL
 
 // Distance stored in the shadow maps: Euclidean (m) for point/spot lights, along the light
-// direction from the ortho frustum's eye (positionRange.xyz) for directional lights.
+// direction from the ortho frustum's eye (position) for directional lights.
 float lightDistance(int li, vec3 p) {
-    if (int(lights[li].directionType.w) == LIGHT_DIRECTIONAL)
-        return dot(p - lights[li].positionRange.xyz, lights[li].directionType.xyz);
-    return length(p - lights[li].positionRange.xyz);
+    if (lights[li].type == LIGHT_DIRECTIONAL)
+        return dot(p - lights[li].position, lights[li].direction);
+    return length(p - lights[li].position);
 }
 
 // Direction to the light (unit) and the incident irradiance on a surface facing it
 // (W/m^2 before the cosine): I / d^2 with the spot cone and range window for point/spot lights.
 void incidentLight(int li, vec3 p, out vec3 wi, out vec3 irradiance) {
-    if (int(lights[li].directionType.w) == LIGHT_DIRECTIONAL) {
-        wi = -lights[li].directionType.xyz;
-        irradiance = lights[li].radiantIntensity.rgb;
+    if (lights[li].type == LIGHT_DIRECTIONAL) {
+        wi = -lights[li].direction;
+        irradiance = lights[li].radiantIntensity;
         return;
     }
-    vec3 d = lights[li].positionRange.xyz - p;
+    vec3 d = lights[li].position - p;
     float dist2 = max(dot(d, d), 1e-8);
     float dist = sqrt(dist2);
     wi = d / dist;
-    irradiance = lights[li].radiantIntensity.rgb * spotAttenuation(li, -wi) *
+    irradiance = lights[li].radiantIntensity * spotAttenuation(li, -wi) *
                  rangeWindow(li, dist) / dist2;
 }
 
@@ -54,8 +54,8 @@ vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec
     if (layer < 0) return vec2(1.0);
     float d = lightDistance(li, p);
     vec2 size = vec2(textureSize(allMap, 0).xy);
-    float tanOrExtent = lights[li].radiantIntensity.w;
-    float extent = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
+    float tanOrExtent = lights[li].frustumSize;
+    float extent = lights[li].type == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
                                                                         : 2.0 * tanOrExtent * d;
     float bias = shadowBias + 1.5 * extent / size.x / max(NdotL, 0.2);
     // The gather footprint at t is texels floor(t * size - 0.5) + {0, 1}^2: w = (0,0), z = (1,0),

@@ -15,7 +15,6 @@
 
 #include "calibration/BatchCalibration.h"
 #include "calibration/CalibrationSession.h"
-#include "calibration/FrameSource.h"
 #include "calibration/Undistorter.h"
 #include "core/Error.h"
 #include "core/Log.h"
@@ -23,27 +22,23 @@
 #include "core/capture/V4l2Camera.h"
 #include "core/gl/Context.h"
 #include "core/gl/Objects.h"
+#include "core/session/FrameSource.h"
 
 namespace mirage::app {
 namespace {
 
-// A live V4L2 camera (core/capture: mode choice, YUYV/MJPEG decoding, timestamps) as a
-// calibration frame source.
-class LiveCameraSource final : public calib::FrameSource {
-public:
-    explicit LiveCameraSource(const std::string& device) : camera_(device, CaptureRequest{}) {}
-    bool next(calib::InputFrame& f) override {
-        if (!camera_.read(f.bgr)) return false;
-        f.name = fmt::format("frame {}", index_++);
-        f.timeSeconds = camera_.lastTimestamp().value_or(0.0);
-        return true;
+// The next frame of `source` that is not lost, and its name ("frame N" where the source names
+// none: a live camera). A lost frame (damaged bytes in a recording) is logged and skipped.
+bool nextFrame(FrameSource& source, cv::Mat& bgr, std::string& name, int& index) {
+    while (source.read(bgr)) {
+        const int i = index++;
+        name = source.lastName();
+        if (name.empty()) name = fmt::format("frame {}", i);
+        if (!bgr.empty()) return true;
+        spdlog::warn("{}: frame lost ({}), skipped", name, source.lastProblem());
     }
-    bool isLive() const override { return true; }
-
-private:
-    V4l2Camera camera_;
-    int index_ = 0;
-};
+    return false;
+}
 
 // RAII for the ImGui context and its GLFW/OpenGL3 backends.
 struct ImGuiScope {
@@ -190,31 +185,34 @@ void saveScreenshot(const std::string& path, GLFWwindow* window) {
 int runCalibrationWizard(const WizardOptions& o) {
     if (o.board.empty())
         throw Error("--board is required (a board file or chessboard:COLSxROWS:SQUARE_METRES)");
-    std::unique_ptr<calib::FrameSource> source;
+    std::unique_ptr<FrameSource> source;
     bool stillImages = false;
     if (!o.inputs.empty()) {
-        calib::FrameSourceOptions so;
+        FrameListOptions so;
         so.allVideoFrames = true;  // stillness is measured between consecutive video frames
-        source = calib::openFrameSource(o.inputs, so);
+        source = openFrameList(o.inputs, so);
         stillImages = std::none_of(o.inputs.begin(), o.inputs.end(),
-                                   [](const std::string& i) { return calib::isVideoFile(i); });
+                                   [](const std::string& i) { return isVideoFile(i); });
     } else if (!o.cameraDevice.empty()) {
-        source = std::make_unique<LiveCameraSource>(o.cameraDevice);
+        source = std::make_unique<V4l2Camera>(o.cameraDevice, CaptureRequest{});
     } else {
         throw Error(
             "the wizard needs a source: INPUT... (images, a folder or a video) or "
             "--camera /dev/videoN; for headless use, --batch");
     }
     auto target = calib::CalibrationTarget::parse(o.board);
-    calib::InputFrame frame;
-    if (!source->next(frame)) throw Error("the input holds no frames");
+    cv::Mat current;
+    std::string frameName;
+    int frameIndex = 0;
+    if (!nextFrame(*source, current, frameName, frameIndex))
+        throw Error("the input holds no frames");
 
     calib::SessionOptions so;
     so.calibration.model = o.model;
     so.calibration.fixK3 = o.fixK3;
     // Separate photos are each a deliberate, still capture: no stillness over frames needed.
     if (stillImages) so.stillFrames = 0;
-    calib::CalibrationSession session(std::move(target), frame.bgr.size(), so);
+    calib::CalibrationSession session(std::move(target), current.size(), so);
 
     gl::ContextOptions co;
     co.width = 1280;
@@ -226,7 +224,6 @@ int runCalibrationWizard(const WizardOptions& o) {
     calib::Undistorter undistorter;
 
     calib::FrameReport rep;
-    cv::Mat current = frame.bgr;
     bool haveFrame = true, endOfInput = false, paused = false, showUndistorted = true;
     int framesProcessed = 0, exitCode = 0, screenshotCountdown = -1;
     std::string status = "source: " + (o.inputs.empty() ? o.cameraDevice : o.inputs.front());
@@ -235,9 +232,9 @@ int runCalibrationWizard(const WizardOptions& o) {
     while (!ctx.shouldClose()) {
         ctx.pollEvents();
         if (haveFrame) {
-            rep = session.processFrame(current, frame.name);
+            rep = session.processFrame(current, frameName);
             ++framesProcessed;
-            if (rep.decision == calib::CaptureDecision::Captured) lastCaptured = frame.name;
+            if (rep.decision == calib::CaptureDecision::Captured) lastCaptured = frameName;
             camTex.show(overlay(current, session, rep));
             if (session.result() && showUndistorted)
                 undistTex.show(undistorter.apply(current, session.result()->calibration.intrinsics,
@@ -249,8 +246,7 @@ int runCalibrationWizard(const WizardOptions& o) {
             ((o.screenshotAfterFrames > 0 && framesProcessed >= o.screenshotAfterFrames) ||
              endOfInput);
         if (!paused && !endOfInput && !screenshotDue) {
-            if (source->next(frame)) {
-                current = frame.bgr;
+            if (nextFrame(*source, current, frameName, frameIndex)) {
                 haveFrame = true;
             } else {
                 endOfInput = true;
@@ -272,7 +268,7 @@ int runCalibrationWizard(const WizardOptions& o) {
             const float scale = std::min(640.f / float(current.cols), 480.f / float(current.rows));
             ImGui::Image(camTex.id(), {float(current.cols) * scale, float(current.rows) * scale});
         }
-        ImGui::Text("%s | %s | motion %.2f px | sharpness %.0f | tilt %.0f deg", frame.name.c_str(),
+        ImGui::Text("%s | %s | motion %.2f px | sharpness %.0f | tilt %.0f deg", frameName.c_str(),
                     calib::captureDecisionName(rep.decision), rep.motionPx, rep.sharpness,
                     rep.tiltDeg);
         ImGui::End();

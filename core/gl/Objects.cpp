@@ -61,59 +61,41 @@ std::uint64_t Texture::createdCount() {
     return texturesCreated.load();
 }
 
-Texture Texture::create2D(std::string_view lbl, int w, int h, GLenum fmt, int levels) {
-    MR_CHECK(w > 0 && h > 0, "texture size must be positive");
-    Texture t;
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_2D, 1, &id);
-    ++texturesCreated;
-    t.h_ = Handle<detail::deleteTexture>(id);
-    t.width_ = w;
-    t.height_ = h;
-    t.format_ = fmt;
-    t.target_ = GL_TEXTURE_2D;
-    glTextureStorage2D(id, levels, fmt, w, h);
-    label(GL_TEXTURE, id, lbl);
-    t.setFilter(levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR, GL_LINEAR);
-    t.setWrap(GL_CLAMP_TO_EDGE);
-    return t;
-}
-
-Texture Texture::create2DArray(std::string_view lbl, int w, int h, int layers, GLenum fmt,
-                               int levels) {
+Texture Texture::allocate(GLenum target, std::string_view lbl, int w, int h, int layers, GLenum fmt,
+                          int levels, GLenum minFilter) {
     MR_CHECK(w > 0 && h > 0 && layers > 0, "texture size must be positive");
     Texture t;
     GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+    glCreateTextures(target, 1, &id);
     ++texturesCreated;
     t.h_ = Handle<detail::deleteTexture>(id);
     t.width_ = w;
     t.height_ = h;
     t.layers_ = layers;
     t.format_ = fmt;
-    t.target_ = GL_TEXTURE_2D_ARRAY;
-    glTextureStorage3D(id, levels, fmt, w, h, layers);
+    t.target_ = target;
+    if (target == GL_TEXTURE_2D_ARRAY)
+        glTextureStorage3D(id, levels, fmt, w, h, layers);
+    else  // 2D, or a cube map (6 faces from one 2D storage call)
+        glTextureStorage2D(id, levels, fmt, w, h);
     label(GL_TEXTURE, id, lbl);
-    t.setFilter(GL_LINEAR, GL_LINEAR);
+    t.setFilter(minFilter, GL_LINEAR);
     t.setWrap(GL_CLAMP_TO_EDGE);
     return t;
 }
 
+Texture Texture::create2D(std::string_view lbl, int w, int h, GLenum fmt, int levels) {
+    return allocate(GL_TEXTURE_2D, lbl, w, h, 1, fmt, levels,
+                    levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+}
+
+Texture Texture::create2DArray(std::string_view lbl, int w, int h, int layers, GLenum fmt,
+                               int levels) {
+    return allocate(GL_TEXTURE_2D_ARRAY, lbl, w, h, layers, fmt, levels, GL_LINEAR);
+}
+
 Texture Texture::createCube(std::string_view lbl, int size, GLenum fmt, int levels) {
-    Texture t;
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_CUBE_MAP, 1, &id);
-    ++texturesCreated;
-    t.h_ = Handle<detail::deleteTexture>(id);
-    t.width_ = t.height_ = size;
-    t.layers_ = 6;
-    t.format_ = fmt;
-    t.target_ = GL_TEXTURE_CUBE_MAP;
-    glTextureStorage2D(id, levels, fmt, size, size);
-    label(GL_TEXTURE, id, lbl);
-    t.setFilter(GL_LINEAR, GL_LINEAR);
-    t.setWrap(GL_CLAMP_TO_EDGE);
-    return t;
+    return allocate(GL_TEXTURE_CUBE_MAP, lbl, size, size, 6, fmt, levels, GL_LINEAR);
 }
 
 void Texture::setFilter(GLenum minFilter, GLenum magFilter) {

@@ -98,6 +98,9 @@ public:
     }
 
 private:
+    // The three factories: immutable storage, label, min filter `minFilter`, clamp to edge.
+    static Texture allocate(GLenum target, std::string_view label, int width, int height,
+                            int layers, GLenum internalFormat, int levels, GLenum minFilter);
     void readInto(GLenum pixelFormat, GLenum pixelType, void* dst, size_t bytes) const;
     Handle<detail::deleteTexture> h_;
     int width_ = 0, height_ = 0, layers_ = 1;

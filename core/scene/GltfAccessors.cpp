@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <type_traits>
 
 #include "core/Error.h"
 #include "core/scene/GltfScreening.h"
@@ -91,44 +93,35 @@ int componentBytes(int componentType) {
     }
 }
 
+// The value of type T at `p` (unaligned). Normalized 8- and 16-bit integers are divided by their
+// largest value, signed ones clamped at -1 (glTF 3.11: [0,1] or [-1,1]); glTF has no normalized
+// 32-bit components.
+template <class T>
+double loadComponent(const unsigned char* p, bool normalized) {
+    T v;
+    std::memcpy(&v, p, sizeof v);
+    if constexpr (std::is_integral_v<T> && sizeof(T) < 4)
+        if (normalized) return std::max(double(v) / double(std::numeric_limits<T>::max()), -1.0);
+    return double(v);
+}
+
 // One component at `p` as a double; normalized integers map to [0,1] or [-1,1] (glTF 3.11).
 double readComponent(const unsigned char* p, int componentType, bool normalized) {
     switch (componentType) {
-        case TINYGLTF_COMPONENT_TYPE_BYTE: {
-            int8_t v;
-            std::memcpy(&v, p, 1);
-            return normalized ? std::max(v / 127.0, -1.0) : v;
-        }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-            uint8_t v;
-            std::memcpy(&v, p, 1);
-            return normalized ? v / 255.0 : v;
-        }
-        case TINYGLTF_COMPONENT_TYPE_SHORT: {
-            int16_t v;
-            std::memcpy(&v, p, 2);
-            return normalized ? std::max(v / 32767.0, -1.0) : v;
-        }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-            uint16_t v;
-            std::memcpy(&v, p, 2);
-            return normalized ? v / 65535.0 : v;
-        }
-        case TINYGLTF_COMPONENT_TYPE_INT: {
-            int32_t v;
-            std::memcpy(&v, p, 4);
-            return v;
-        }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-            uint32_t v;
-            std::memcpy(&v, p, 4);
-            return v;
-        }
-        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-            float v;
-            std::memcpy(&v, p, 4);
-            return v;
-        }
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+            return loadComponent<int8_t>(p, normalized);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return loadComponent<uint8_t>(p, normalized);
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+            return loadComponent<int16_t>(p, normalized);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return loadComponent<uint16_t>(p, normalized);
+        case TINYGLTF_COMPONENT_TYPE_INT:
+            return loadComponent<int32_t>(p, normalized);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+            return loadComponent<uint32_t>(p, normalized);
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return loadComponent<float>(p, normalized);
         default:
             return 0.0;
     }

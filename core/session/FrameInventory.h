@@ -23,7 +23,7 @@ struct FrameInventory {
 // Throws FileError if `videoOrFolder` does not exist or cannot be opened as video.
 FrameInventory inventoryFrames(const std::filesystem::path& videoOrFolder);
 
-// Image files a folder holds (.png .jpg .jpeg .bmp .tif .tiff .ppm), by frame index: the
+// Image files a folder holds (isImageFile in core/session/FrameSource.h), by frame index: the
 // number at the end of each file name; if any name has none, by sorted name order.
 std::map<int, std::filesystem::path> listImageFrames(const std::filesystem::path& folder,
                                                      std::vector<std::string>* problems);

@@ -1,11 +1,16 @@
-// Frame sources: video files (FFmpeg through OpenCV), image folders, and a session camera's
-// frames in frames.csv order.
+// Frame sources: video files (FFmpeg through OpenCV; mirage's MJPEG Matroska recordings through
+// MatroskaFrames), image folders, a session camera's frames in frames.csv order, and lists of
+// image files, folders and videos (calibration inputs).
+#include "core/session/FrameSource.h"
+
 #include <algorithm>
 #include <cctype>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+
+#include <fmt/format.h>
 
 #include "core/Error.h"
 #include "core/image/StrictJpeg.h"
@@ -22,12 +27,6 @@ std::string lowerExtension(const std::filesystem::path& p) {
     std::string e = p.extension().string();
     for (auto& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
     return e;
-}
-
-bool isImageFile(const std::filesystem::path& p) {
-    static const std::vector<std::string> exts = {".png", ".jpg",  ".jpeg", ".bmp",
-                                                  ".tif", ".tiff", ".ppm"};
-    return std::find(exts.begin(), exts.end(), lowerExtension(p)) != exts.end();
 }
 
 bool isMatroska(const std::filesystem::path& p) {
@@ -55,6 +54,14 @@ cv::VideoCapture openVideo(const std::filesystem::path& path) {
     return cap;
 }
 
+// Video decoders may deliver grey or BGRA frames; sources deliver BGR.
+void toBgr(cv::Mat& img) {
+    if (img.channels() == 1)
+        cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
+    else if (img.channels() == 4)
+        cv::cvtColor(img, img, cv::COLOR_BGRA2BGR);
+}
+
 // Reads one image file as 8-bit BGR; throws FileError if it is unreadable.
 cv::Mat readImageFile(const std::filesystem::path& p) {
     std::string why;
@@ -74,7 +81,8 @@ std::unique_ptr<MatroskaFrames> openMatroskaMjpeg(const std::filesystem::path& p
 
 class VideoFileFrames final : public FrameSource {
 public:
-    explicit VideoFileFrames(const std::filesystem::path& path) : mkv_(openMatroskaMjpeg(path)) {
+    explicit VideoFileFrames(const std::filesystem::path& path)
+        : mkv_(openMatroskaMjpeg(path)), fileName_(path.filename().string()) {
         if (mkv_) {
             count_ = mkv_->count();
             return;
@@ -101,7 +109,7 @@ public:
         }
         if (limit_ >= 0 && position_ >= limit_) return false;
         if (!cap_.read(bgr) || bgr.empty()) return false;
-        if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
+        toBgr(bgr);
         last_ = cap_.get(cv::CAP_PROP_POS_MSEC) / 1000.0;
         ++position_;
         return true;
@@ -111,9 +119,13 @@ public:
         return position_ > 0 ? std::optional<double>(last_) : std::nullopt;
     }
     std::string lastProblem() const override { return problem_; }
+    std::string lastName() const override {
+        return position_ > 0 ? fmt::format("{}#{}", fileName_, position_ - 1) : std::string();
+    }
 
 private:
     std::unique_ptr<MatroskaFrames> mkv_;
+    std::string fileName_;
     cv::VideoCapture cap_;
     int count_ = -1, limit_ = -1, position_ = 0;
     double last_ = 0;
@@ -128,6 +140,7 @@ public:
         if (next_ == images_.end()) return false;
         bgr = readImageFile(next_->second);
         lastIndex_ = next_->first;
+        lastName_ = next_->second.filename().string();
         ++next_;
         return true;
     }
@@ -137,12 +150,14 @@ public:
         if (lastIndex_ < 0 || fps_ <= 0) return std::nullopt;
         return lastIndex_ / fps_;
     }
+    std::string lastName() const override { return lastName_; }
 
 private:
     std::map<int, std::filesystem::path> images_;
     double fps_;
     std::map<int, std::filesystem::path>::const_iterator next_;
     int lastIndex_ = -1;
+    std::string lastName_;
 };
 
 // One camera of a session, row by row of Session::frames.
@@ -151,6 +166,7 @@ public:
     SessionCameraFrames(const Session& s, int cameraIndex)
         : rows_(s.frames), cameraIndex_(cameraIndex) {
         const auto path = s.path(s.cameras[size_t(cameraIndex)].video);
+        fileName_ = path.filename().string();
         if (std::filesystem::is_directory(path)) {
             images_ = listImageFrames(path, nullptr);
         } else {
@@ -174,12 +190,14 @@ public:
             }
             if (!cap_.read(bgr) || bgr.empty()) return false;
             ++position_;
-            if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
+            toBgr(bgr);
         } else {
             const auto it = images_.find(want);
             if (it == images_.end()) return false;
             bgr = readImageFile(it->second);
         }
+        lastName_ = images_.empty() ? fmt::format("{}#{}", fileName_, want)
+                                    : images_.find(want)->second.filename().string();
         last_ = rows_[row_].timestamps.at(size_t(cameraIndex_));
         ++row_;
         return true;
@@ -189,10 +207,12 @@ public:
         return row_ > 0 ? std::optional<double>(last_) : std::nullopt;
     }
     std::string lastProblem() const override { return problem_; }
+    std::string lastName() const override { return lastName_; }
 
 private:
     std::vector<FrameRecord> rows_;
     int cameraIndex_;
+    std::string fileName_, lastName_;
     std::unique_ptr<MatroskaFrames> mkv_;
     std::string problem_;
     cv::VideoCapture cap_;
@@ -202,7 +222,101 @@ private:
     double last_ = 0;
 };
 
+// Image files, folders and videos as one stream (openFrameList).
+class FrameListFrames final : public FrameSource {
+public:
+    struct Item {
+        std::filesystem::path path;
+        enum Kind { Image, Folder, Video } kind;
+    };
+    FrameListFrames(std::vector<Item> items, const FrameListOptions& o)
+        : items_(std::move(items)), options_(o) {
+        for (const Item& i : items_) {
+            if (i.kind == Item::Video) {
+                count_ = -1;
+                break;
+            }
+            count_ += i.kind == Item::Image ? 1 : int(listImageFrames(i.path, nullptr).size());
+        }
+    }
+
+    bool read(cv::Mat& bgr) override {
+        while (index_ < items_.size()) {
+            const Item& item = items_[index_];
+            if (item.kind == Item::Image) {
+                ++index_;
+                bgr = readImageFile(item.path);
+                name_ = item.path.filename().string();
+                problem_.clear();
+                timestamp_.reset();
+                return true;
+            }
+            if (!current_) open(item);
+            if (readSampled(bgr)) return true;
+            if (item.kind == Item::Video && delivered_ == 0)
+                throw FileError(item.path.string(), "video has no readable frames");
+            current_.reset();
+            ++index_;
+        }
+        return false;
+    }
+    int frameCount() const override { return count_; }
+    std::optional<double> lastTimestamp() const override { return timestamp_; }
+    std::string lastProblem() const override { return problem_; }
+    std::string lastName() const override { return name_; }
+
+private:
+    void open(const Item& item) {
+        current_ = openFrames(item.path);
+        step_ = 1;
+        if (item.kind == Item::Video && !options_.allVideoFrames) {
+            step_ = options_.videoStep;
+            const int n = current_->frameCount();
+            if (step_ <= 0)
+                step_ = n > 0 ? std::max(1, (n + options_.maxVideoFrames - 1) /
+                                                std::max(1, options_.maxVideoFrames))
+                              : 1;
+        }
+        read_ = delivered_ = 0;
+    }
+    // The next frame of the current item whose index is a multiple of the step.
+    bool readSampled(cv::Mat& bgr) {
+        while (current_->read(bgr)) {
+            if (read_++ % step_ != 0) continue;
+            ++delivered_;
+            name_ = current_->lastName();
+            problem_ = current_->lastProblem();
+            timestamp_ = current_->lastTimestamp();
+            return true;
+        }
+        return false;
+    }
+
+    std::vector<Item> items_;
+    FrameListOptions options_;
+    int count_ = 0;
+    size_t index_ = 0;
+    std::unique_ptr<FrameSource> current_;
+    int step_ = 1, read_ = 0, delivered_ = 0;
+    std::string name_, problem_;
+    std::optional<double> timestamp_;
+};
+
 }  // namespace
+
+bool isImageFile(const std::filesystem::path& p) {
+    static const char* const exts[] = {".png",  ".jpg", ".jpeg", ".bmp", ".tif",
+                                       ".tiff", ".pgm", ".ppm",  ".webp"};
+    const std::string e = lowerExtension(p);
+    return std::any_of(std::begin(exts), std::end(exts), [&](const char* x) { return e == x; });
+}
+
+bool isVideoFile(const std::filesystem::path& p) {
+    static const char* const exts[] = {".mp4",  ".mkv", ".avi", ".mov",
+                                       ".webm", ".m4v", ".mpg", ".mpeg"};
+    const std::string e = lowerExtension(p);
+    return std::any_of(std::begin(exts), std::end(exts), [&](const char* x) { return e == x; });
+}
 
 bool FrameInventory::has(int index) const {
     if (isFolder) return images.count(index) > 0;
@@ -291,6 +405,32 @@ std::unique_ptr<FrameSource> openCameraFrames(const Session& s, const std::strin
                         "no camera named '" + camera + "' (cameras: " + names + ")");
     }
     return std::make_unique<SessionCameraFrames>(s, i);
+}
+
+std::unique_ptr<FrameSource> openFrameList(const std::vector<std::string>& inputs,
+                                           const FrameListOptions& options) {
+    namespace fs = std::filesystem;
+    if (inputs.empty()) throw Error("no input given: name image files, a folder or a video");
+    std::vector<FrameListFrames::Item> items;
+    for (const std::string& in : inputs) {
+        const fs::path p(in);
+        std::error_code ec;
+        if (fs::is_directory(p, ec)) {
+            if (listImageFrames(p, nullptr).empty())
+                throw FileError(in, "folder has no images (.png, .jpg, .bmp, .tif ...)");
+            items.push_back({p, FrameListFrames::Item::Folder});
+        } else if (fs::is_regular_file(p, ec)) {
+            if (isImageFile(p))
+                items.push_back({p, FrameListFrames::Item::Image});
+            else if (isVideoFile(p))
+                items.push_back({p, FrameListFrames::Item::Video});
+            else
+                throw FileError(in, "neither an image (.png .jpg ...) nor a video (.mp4 .mkv ...)");
+        } else {
+            throw FileError(in, "does not exist");
+        }
+    }
+    return std::make_unique<FrameListFrames>(std::move(items), options);
 }
 
 }  // namespace mirage

@@ -19,6 +19,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/math/Pose.h"
+#include "core/session/FrameSource.h"
 
 namespace mirage {
 
@@ -82,29 +83,10 @@ std::vector<std::filesystem::path> sessionInputs(const Session& s);
 // Writes session.json (atomically). Used by SessionWriter; exposed for tools that edit sessions.
 void writeSessionJson(const Session& s);
 
-// Sequential frame access (video file, image folder, camera).
-class FrameSource {
-public:
-    virtual ~FrameSource() = default;
-    // Next frame as 8-bit BGR (sRGB-encoded, as cameras deliver it); false at the end. True with
-    // an empty image: the frame is lost (lastProblem() says why); callers must check.
-    virtual bool read(cv::Mat& bgr) = 0;
-    virtual int frameCount() const = 0;  // -1 if unknown
-    // Time of the frame last returned by read(), seconds; nullopt if the source has no clock.
-    virtual std::optional<double> lastTimestamp() const { return std::nullopt; }
-    // About the frame last read: why it is lost when read() returned true with an EMPTY image
-    // (its bytes are damaged or missing; the frame keeps its place so later frames keep their
-    // numbers), or a remark about a delivered image (it repeats the previous frame exactly).
-    // Empty when nothing is wrong.
-    virtual std::string lastProblem() const { return {}; }
-};
 // The frames of one camera of a session, one per row of Session::frames (in that order; video
 // frames without a row are skipped), with the row's timestamp. Throws FileError if the camera
 // does not exist or its video cannot be opened.
 std::unique_ptr<FrameSource> openCameraFrames(const Session& s, const std::string& camera);
-// A plain video file (any format FFmpeg reads) or image folder (files sorted by the number in
-// their name, else by name), outside a session. Throws FileError if it cannot be opened.
-std::unique_ptr<FrameSource> openFrames(const std::filesystem::path& videoOrFolder);
 
 // Writes a session frame by frame. Crash-safe: session.json is written first (atomically),
 // each frame's images are flushed before its frames.csv row, and frames.csv is flushed per row,

@@ -6,10 +6,6 @@ namespace mirage::render {
 GBufferPass::GBufferPass()
     : program_(
           rasterProgram("gbuffer", "passes/gbuffer/gbuffer.vert", "passes/gbuffer/gbuffer.frag")) {
-    locModel_ = program_.uniformLocation("model");
-    locNormal_ = program_.uniformLocation("normalMatrix");
-    locMaterial_ = program_.uniformLocation("materialIndex");
-    locOrigin_ = program_.uniformLocation("origin");
     locSpecularSlot_ = program_.uniformLocation("specularSlot");
 }
 
@@ -66,12 +62,7 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
         if (nextSpecular < specular.size() && specular[nextSpecular] == int(di))
             slot = int(nextSpecular++);
         glUniform1i(locSpecularSlot_, slot);
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
-        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
-        glUniform1i(locMaterial_, d.material);
-        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        ctx.scene.bindMaterialTextures(d, kUnitBaseColorMap);
-        ctx.scene.drawItem(d);
+        draw_.draw(ctx.scene, d);
     }
     glDisable(GL_DEPTH_TEST);
     res.publish(Resource::GBufferPosition, position_);

@@ -18,8 +18,8 @@ private:
     gl::Program program_;
     gl::Texture position_, normal_, albedo_, emissive_, depth_;
     gl::Framebuffer fbo_;
-    GLint locModel_ = -1, locNormal_ = -1, locMaterial_ = -1, locOrigin_ = -1,
-          locSpecularSlot_ = -1;
+    MaterialDraw draw_{program_};  // after program_
+    GLint locSpecularSlot_ = -1;
 };
 
 }  // namespace mirage::render

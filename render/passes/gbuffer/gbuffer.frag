@@ -22,7 +22,7 @@ void main() {
     // Shade the side the camera sees (proxies are often single quads seen from either side).
     if (dot(n, cameraPos.xyz - worldPos) < 0.0) n = -n;
     gPosition = vec4(worldPos, float(origin));
-    gNormal = vec4(n, clamp(m.emissive.w, 0.02, 1.0));
-    gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.params.x, 0.0, 1.0));
-    gEmissive = vec4(m.emissive.rgb, float(specularSlot + 1));
+    gNormal = vec4(n, clamp(m.roughness, 0.02, 1.0));
+    gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.metallic, 0.0, 1.0));
+    gEmissive = vec4(m.emissive, float(specularSlot + 1));
 }

@@ -42,9 +42,9 @@ void orthonormalBasis(const glm::vec3& w, glm::vec3& u, glm::vec3& v) {
 // (z = -1 at the face nearest the specular object, so GL_LESS keeps the surface facing it).
 glm::mat4 boxViewProj(const GpuImpostor& b, float renderExtentW) {
     glm::mat4 m(0.0f);
-    const glm::vec3 c(b.centre);
-    const glm::vec3 axes[3] = {glm::vec3(b.axisU), glm::vec3(b.axisV), glm::vec3(b.axisW)};
-    const float ext[3] = {b.axisU.w, b.axisV.w, renderExtentW};
+    const glm::vec3 c = b.centre;
+    const glm::vec3 axes[3] = {b.axisU, b.axisV, b.axisW};
+    const float ext[3] = {b.halfU, b.halfV, renderExtentW};
     for (int r = 0; r < 3; ++r) {
         for (int col = 0; col < 3; ++col) m[col][r] = axes[r][col] / ext[r];
         m[3][r] = -glm::dot(axes[r], c) / ext[r];
@@ -80,11 +80,7 @@ ImpostorPass::ImpostorPass()
                              "passes/impostor/capture.frag")),
       query_(computeProgram("impostor query", "passes/impostor/query.comp")),
       captureFbo_("impostor capture fbo") {
-    locModel_ = capture_.uniformLocation("model");
-    locNormal_ = capture_.uniformLocation("normalMatrix");
     locViewProj_ = capture_.uniformLocation("captureViewProj");
-    locMaterial_ = capture_.uniformLocation("materialIndex");
-    locOrigin_ = capture_.uniformLocation("origin");
     locCaptureDepth_ = capture_.uniformLocation("captureDepth");
     locDepthAxis_ = capture_.uniformLocation("depthAxis");
     locRayCount_ = query_.uniformLocation("rayCount");
@@ -165,9 +161,12 @@ bool ImpostorPass::ensureBuilt(const GpuScene& scene, const RendererOptions& o) 
 
 void ImpostorPass::uploadMode(const RendererOptions& o) {
     GpuImpostorHeader h{};
-    h.mode = glm::ivec4(o.impostorCubeMapBaseline ? 1 : 0, o.impostorRefineSteps, stats_.objects,
-                        kCoarseSamples);
-    h.params = glm::vec4(float(builtResolution_), float(builtResolution_), 0.0f, 0.0f);
+    h.cubeMapBaseline = o.impostorCubeMapBaseline ? 1 : 0;
+    h.refinementSteps = o.impostorRefineSteps;
+    h.objectCount = stats_.objects;
+    h.coarseSamples = kCoarseSamples;
+    h.cubeResolution = float(builtResolution_);
+    h.impostorResolution = float(builtResolution_);
     std::memcpy(objectBytes_.data(), &h, sizeof(h));
     objects_.upload(objectBytes_.data(), sizeof(h));
 }
@@ -280,8 +279,11 @@ ImpostorPass::Layout ImpostorPass::classify(const GpuScene& scene,
         const glm::vec3 c = self.bounds.center;
         const float rS = self.bounds.radius;
         GpuImpostorObject obj{};
-        obj.centre = glm::vec4(c, rS);
-        obj.range = glm::ivec4(int(records.size()), 0, int(slot) * 12, -1);
+        obj.centre = c;
+        obj.radius = rS;
+        obj.firstImpostor = int(records.size());
+        obj.baselineCubeLayer = int(slot) * 12;
+        obj.enclosingCubeLayer = -1;
         float enclosingReach = 0.0f;
         for (size_t k = 0; k < draws.size(); ++k) {
             if (int(k) == specular[slot] || draws[k].indexCount == 0) continue;
@@ -305,20 +307,22 @@ ImpostorPass::Layout ImpostorPass::classify(const GpuScene& scene,
                 hi = glm::max(hi, q);
             }
             const glm::vec3 mid = 0.5f * (lo + hi), ext = 0.5f * (hi - lo) * margin;
-            b.centre = glm::vec4(U * mid.x + V * mid.y + W * mid.z, 0.0f);
-            b.axisU = glm::vec4(U, std::max(ext.x, 1e-5f));
-            b.axisV = glm::vec4(V, std::max(ext.y, 1e-5f));
-            b.axisW = glm::vec4(W, s.planar ? 0.0f : std::max(ext.z, 1e-5f));
-            b.info = glm::ivec4(int(records.size()), s.planar ? 1 : 0, int(k), 0);
+            b.centre = U * mid.x + V * mid.y + W * mid.z;
+            b.axisU = U, b.halfU = std::max(ext.x, 1e-5f);
+            b.axisV = V, b.halfV = std::max(ext.y, 1e-5f);
+            b.axisW = W, b.halfW = s.planar ? 0.0f : std::max(ext.z, 1e-5f);
+            b.layer = int(records.size());
+            b.kind = s.planar ? kImpostorPlane : kImpostorBillboard;
+            b.drawIndex = int(k);
             if (!s.planar) {
                 // A billboard is only valid when the whole item is on the far side of the object:
                 // every point of the specular object must lie in front of the box's near face.
                 float selfReach = -1e30f;
                 for (const glm::vec3& p : shapes[size_t(specular[slot])].points)
-                    selfReach = std::max(selfReach, glm::dot(p - glm::vec3(b.centre), W));
+                    selfReach = std::max(selfReach, glm::dot(p - b.centre, W));
                 if (shapes[size_t(specular[slot])].points.empty())
-                    selfReach = glm::dot(c - glm::vec3(b.centre), W) + rS;
-                if (selfReach > -b.axisW.w) {
+                    selfReach = glm::dot(c - b.centre, W) + rS;
+                if (selfReach > -b.halfW) {
                     enclosing[slot].push_back(int(k));
                     kinds_[slot][k] = ItemKind::Enclosing;
                     for (const glm::vec3& p : s.points)
@@ -328,12 +332,12 @@ ImpostorPass::Layout ImpostorPass::classify(const GpuScene& scene,
             }
             records.push_back(b);
             kinds_[slot][k] = s.planar ? ItemKind::Plane : ItemKind::Billboard;
-            ++obj.range.y;
+            ++obj.impostorCount;
             (s.planar ? stats_.planes : stats_.billboards)++;
         }
         if (!enclosing[slot].empty()) {
-            obj.range.w = int(slot) * 12 + 6;
-            obj.params = glm::vec4(enclosingReach + rS, 0.0f, 0.0f, 0.0f);
+            obj.enclosingCubeLayer = int(slot) * 12 + 6;
+            obj.enclosingReach = enclosingReach + rS;
             stats_.enclosingItems += int(enclosing[slot].size());
         }
         objects.push_back(obj);
@@ -406,14 +410,7 @@ void ImpostorPass::capture(const GpuScene& scene, const Layout& layout, int res)
     glDisable(GL_BLEND);
     capture_.use();
     scene.bindGeometry();
-    auto drawOne = [&](const DrawItem& d) {
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
-        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
-        glUniform1i(locMaterial_, d.material);
-        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        scene.bindMaterialTextures(d, kUnitBaseColorMap);
-        scene.drawItem(d);
-    };
+    auto drawOne = [&](const DrawItem& d) { captureDraw_.draw(scene, d); };
     auto target = [&](const gl::Texture& a, const gl::Texture& n, const gl::Texture& al,
                       const gl::Texture& e, int layer, const glm::vec4& clear0) {
         fbo.attachColorLayer(0, a, layer);
@@ -455,18 +452,19 @@ void ImpostorPass::capture(const GpuScene& scene, const Layout& layout, int res)
     glUniform1i(locCaptureDepth_, 1);
     for (size_t slot = 0; slot < specular.size(); ++slot) {
         const GpuImpostorObject& obj = layout.objects[slot];
-        for (int i = 0; i < obj.range.y; ++i) {
-            const GpuImpostor& b = layout.records[size_t(obj.range.x + i)];
-            target(depth_, normal_, albedo_, emissive_, b.info.x,
+        for (int i = 0; i < obj.impostorCount; ++i) {
+            const GpuImpostor& b = layout.records[size_t(obj.firstImpostor + i)];
+            target(depth_, normal_, albedo_, emissive_, b.layer,
                    glm::vec4(kEmptyDepth, 0.0f, 0.0f, 0.0f));
             // Planar items: a thin slab around the plane (depth is only the coverage there).
-            const float extW =
-                b.info.y == 1 ? std::max(1e-4f, 1e-3f * std::max(b.axisU.w, b.axisV.w)) : b.axisW.w;
+            const float extW = b.kind == kImpostorPlane
+                                   ? std::max(1e-4f, 1e-3f * std::max(b.halfU, b.halfV))
+                                   : b.halfW;
             const glm::mat4 vp = boxViewProj(b, extW);
             glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
-            const glm::vec3 W(b.axisW);
-            glUniform4f(locDepthAxis_, W.x, W.y, W.z, -glm::dot(W, glm::vec3(b.centre)));
-            drawOne(draws[size_t(b.info.z)]);
+            const glm::vec3 W = b.axisW;
+            glUniform4f(locDepthAxis_, W.x, W.y, W.z, -glm::dot(W, b.centre));
+            drawOne(draws[size_t(b.drawIndex)]);
         }
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -103,8 +103,8 @@ private:
     void bindOwnForTracing() const;
 
     gl::Program capture_, query_;
-    GLint locModel_ = -1, locNormal_ = -1, locViewProj_ = -1, locMaterial_ = -1, locOrigin_ = -1,
-          locCaptureDepth_ = -1, locDepthAxis_ = -1, locRayCount_ = -1;
+    MaterialDraw captureDraw_{capture_};  // after capture_
+    GLint locViewProj_ = -1, locCaptureDepth_ = -1, locDepthAxis_ = -1, locRayCount_ = -1;
     // Cube maps: 12 layers per specular object (6 baseline faces, 6 enclosing-items faces).
     gl::Texture cubePosition_, cubeNormal_, cubeAlbedo_, cubeEmissive_;
     // Impostors: one layer each.

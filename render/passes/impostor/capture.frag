@@ -25,7 +25,7 @@ void main() {
         gPositionOrDepth = vec4(dot(depthAxis.xyz, worldPos) + depthAxis.w, float(origin), 0, 0);
     else
         gPositionOrDepth = vec4(worldPos, float(origin));
-    gNormal = vec4(n, clamp(m.emissive.w, 0.02, 1.0));
-    gAlbedo = vec4(m.baseColor.rgb * texture(baseColorMap, uv).rgb, clamp(m.params.x, 0.0, 1.0));
-    gEmissive = vec4(m.emissive.rgb, 0.0);
+    gNormal = vec4(n, clamp(m.roughness, 0.02, 1.0));
+    gAlbedo = vec4(m.baseColor.rgb * texture(baseColorMap, uv).rgb, clamp(m.metallic, 0.0, 1.0));
+    gEmissive = vec4(m.emissive, 0.0);
 }

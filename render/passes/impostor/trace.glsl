@@ -8,7 +8,8 @@
 // ImpostorPass::bindForTracing(). Uses ONLY the texture units kUnitImpostor* (16..23) and the
 // storage-buffer bindings kBindingImpostorRecords / kBindingImpostorObjects (render/bindings.glsl).
 //
-// Two methods, chosen by RendererOptions::impostorCubeMapBaseline (header mode.x):
+// Two methods, chosen by RendererOptions::impostorCubeMapBaseline
+// (GpuImpostorHeader::cubeMapBaseline):
 // - baseline: a G-buffer cube map rendered from the object's bounding-sphere centre c, looked up
 //   by the ray DIRECTION only (classic environment mapping: exact only for a ray starting at c or
 //   for infinitely distant surroundings).
@@ -33,23 +34,11 @@ layout(binding = kUnitImpostorNormal) uniform sampler2DArray impNormal;    // xy
 layout(binding = kUnitImpostorAlbedo) uniform sampler2DArray impAlbedo;    // rgb linear base colour, a = metallic
 layout(binding = kUnitImpostorEmissive) uniform sampler2DArray impEmissive;  // rgb linear emitted radiance
 
-struct GpuImpostor {
-    vec4 centre;  // xyz world box centre
-    vec4 axisU;   // xyz unit, w = half extent (m)
-    vec4 axisV;   // xyz unit, w = half extent (m)
-    vec4 axisW;   // xyz unit away from the specular object / plane normal, w = half extent
-    ivec4 info;   // x = layer, y = kind (0 billboard, 1 plane), z = draw index
-};
-struct GpuImpostorObject {
-    vec4 centre;  // xyz bounding-sphere centre (cube-map centre), w = radius (m)
-    ivec4 range;  // x = first impostor, y = count, z = baseline cube layer, w = enclosing cube
-                  // layer (-1 = no enclosing items)
-    vec4 params;  // x = enclosing search distance (m)
-};
+#include "impostor_types.glsl"
+
 layout(std430, binding = kBindingImpostorRecords) readonly buffer ImpostorRecords { GpuImpostor impostors[]; };
 layout(std430, binding = kBindingImpostorObjects) readonly buffer ImpostorObjects {
-    ivec4 impMode;   // x = 1 baseline cube map, y = refinement steps, z = objects, w = coarse samples
-    vec4 impParams;  // x = cube resolution, y = impostor resolution
+    GpuImpostorHeader impHeader;
     GpuImpostorObject impObjects[];
 };
 
@@ -103,7 +92,7 @@ ivec3 impCubeTexel(vec3 d, int firstLayer) {
     vec3 U = cross(S, F);
     float z = max(dot(d, F), 1e-20);
     vec2 ndc = clamp(vec2(dot(d, S), dot(d, U)) / z, -1.0, 1.0);
-    int res = int(impParams.x);
+    int res = int(impHeader.cubeResolution);
     ivec2 px = clamp(ivec2((ndc * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
     return ivec3(px, firstLayer + f);
 }
@@ -123,7 +112,7 @@ void impFillFromCube(inout SurroundingHit h, ivec3 t, vec3 rayOrigin) {
 // Baseline: the stored surface in direction rayDir from the cube centre (direction only).
 SurroundingHit impTraceCube(GpuImpostorObject obj, vec3 o, vec3 d) {
     SurroundingHit h = impNoHit();
-    ivec3 t = impCubeTexel(d, obj.range.z);
+    ivec3 t = impCubeTexel(d, obj.baselineCubeLayer);
     vec4 p = texelFetch(impCubePosition, t, 0);
     if (p.w < 0.5) return h;
     h.hit = true;
@@ -147,17 +136,17 @@ float impEnclosingH(vec3 c, int layer, vec3 x, out ivec3 texel) {
 bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
                        out ivec3 texel) {
     texel = ivec3(0);
-    if (obj.range.w < 0) return false;
-    vec3 c = obj.centre.xyz;
-    float t1 = min(obj.params.x, tBest);
-    int n = max(impMode.w, 1) * 2;
+    if (obj.enclosingCubeLayer < 0) return false;
+    vec3 c = obj.centre;
+    float t1 = min(obj.enclosingReach, tBest);
+    int n = max(impHeader.coarseSamples, 1) * 2;
     ivec3 ta_tex, tb_tex;
-    float ta = 0.0, ha = impEnclosingH(c, obj.range.w, o, ta_tex);
+    float ta = 0.0, ha = impEnclosingH(c, obj.enclosingCubeLayer, o, ta_tex);
     float tb = 0.0, hb = ha;
     bool found = false;
     for (int i = 1; i <= n && !found; ++i) {
         tb = t1 * float(i) / float(n);
-        hb = impEnclosingH(c, obj.range.w, o + tb * d, tb_tex);
+        hb = impEnclosingH(c, obj.enclosingCubeLayer, o + tb * d, tb_tex);
         if (ha < 0.0 && hb >= 0.0) found = true;
         else {
             ta = tb;
@@ -168,8 +157,8 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
     // Refinement: Newton steps on the tangent plane stored at the current texel (exact for
     // planar walls), kept inside the bracket [ta, tb]; regula falsi when the plane step leaves it.
     float t = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : tb;
-    for (int s = 0; s < impMode.y; ++s) {
-        ivec3 cur_tex = impCubeTexel(o + t * d - c, obj.range.w);
+    for (int s = 0; s < impHeader.refinementSteps; ++s) {
+        ivec3 cur_tex = impCubeTexel(o + t * d - c, obj.enclosingCubeLayer);
         vec4 q = texelFetch(impCubePosition, cur_tex, 0);
         vec3 n = texelFetch(impCubeNormal, cur_tex, 0).xyz;
         float dn = dot(d, n);
@@ -180,7 +169,7 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
         }
         if (abs(tm - t) < 1e-7 * max(tm, 1.0) && s > 0) break;  // converged
         ivec3 tm_tex;
-        float hm = impEnclosingH(c, obj.range.w, o + tm * d, tm_tex);
+        float hm = impEnclosingH(c, obj.enclosingCubeLayer, o + tm * d, tm_tex);
         // Behind / in front of the stored tangent plane, consistent with the plane step (c's
         // side is in front).
         vec4 qm = texelFetch(impCubePosition, tm_tex, 0);
@@ -200,14 +189,14 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
     if (!(t > 0.0) || t >= tBest) return false;
     ivec3 final_tex;
     vec3 x = o + t * d;
-    if (impEnclosingH(c, obj.range.w, x, final_tex) < -IMP_EMPTY) return false;
+    if (impEnclosingH(c, obj.enclosingCubeLayer, x, final_tex) < -IMP_EMPTY) return false;
     // A distance cube stores one surface per direction from c: a ray that passes over an edge
     // (a wall's top) lands "behind" it in a direction where the wall is. Accept only points on
     // the stored surface: within two texel footprints of the texel's point and one footprint of
     // its tangent plane.
     vec4 q = texelFetch(impCubePosition, final_tex, 0);
     vec3 qn = texelFetch(impCubeNormal, final_tex, 0).xyz;
-    float footprint = length(x - c) * 2.0 / impParams.x + 1e-3;
+    float footprint = length(x - c) * 2.0 / impHeader.cubeResolution + 1e-3;
     if (length(x - q.xyz) > 2.0 * footprint) return false;
     if (dot(qn, qn) > 1e-12 && abs(dot(x - q.xyz, normalize(qn))) > footprint) return false;
     tBest = t;
@@ -217,24 +206,24 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
 
 // Height-field offset along axisW at box-local (u, v) metres, bilinear; > IMP_EMPTY if empty.
 float impDepthAt(GpuImpostor I, vec2 q) {
-    vec2 uv = q / vec2(I.axisU.w, I.axisV.w) * 0.5 + 0.5;
+    vec2 uv = q / vec2(I.halfU, I.halfV) * 0.5 + 0.5;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1e30;
-    return textureLod(impDepth, vec3(uv, float(I.info.x)), 0.0).r;
+    return textureLod(impDepth, vec3(uv, float(I.layer)), 0.0).r;
 }
 ivec3 impTexel(GpuImpostor I, vec2 q) {
-    vec2 uv = q / vec2(I.axisU.w, I.axisV.w) * 0.5 + 0.5;
-    int res = int(impParams.y);
-    return ivec3(clamp(ivec2(uv * float(res)), ivec2(0), ivec2(res - 1)), I.info.x);
+    vec2 uv = q / vec2(I.halfU, I.halfV) * 0.5 + 0.5;
+    int res = int(impHeader.impostorResolution);
+    return ivec3(clamp(ivec2(uv * float(res)), ivec2(0), ivec2(res - 1)), I.layer);
 }
 
 // One impostor: nearest hit closer than tBest; on success updates tBest and the texel.
 bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 texel) {
     texel = ivec3(0);
-    vec3 rel = o - I.centre.xyz;
-    vec3 ro = vec3(dot(rel, I.axisU.xyz), dot(rel, I.axisV.xyz), dot(rel, I.axisW.xyz));
-    vec3 rd = vec3(dot(d, I.axisU.xyz), dot(d, I.axisV.xyz), dot(d, I.axisW.xyz));
-    vec3 e = vec3(I.axisU.w, I.axisV.w, I.axisW.w);
-    if (I.info.y == 1) {
+    vec3 rel = o - I.centre;
+    vec3 ro = vec3(dot(rel, I.axisU), dot(rel, I.axisV), dot(rel, I.axisW));
+    vec3 rd = vec3(dot(d, I.axisU), dot(d, I.axisV), dot(d, I.axisW));
+    vec3 e = vec3(I.halfU, I.halfV, I.halfW);
+    if (I.kind == kImpostorPlane) {
         // Planar item: exact ray-plane intersection; parallel rays never hit it.
         if (abs(rd.z) < 1e-7) return false;
         float t = -ro.z / rd.z;
@@ -261,7 +250,7 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
     if (!(t0 < t1)) return false;
     // Coarse linear search for the first step from in front of the stored surface (seen from the
     // specular object) to behind it: h = ray offset along W - stored offset.
-    int n = max(impMode.w, 1);
+    int n = max(impHeader.coarseSamples, 1);
     float dt = (t1 - t0) / float(n);
     float ta = t0;
     float ha = ro.z + ta * rd.z - impDepthAt(I, ro.xy + ta * rd.xy);
@@ -280,17 +269,17 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
     // A depth impostor stores one layer: a ray that enters the silhouette far behind the front
     // surface passes behind the item. Accept only a crossing within one coarse step's travel
     // along W plus two texels.
-    float texelM = 2.0 * max(e.x, e.y) / impParams.y;
+    float texelM = 2.0 * max(e.x, e.y) / impHeader.impostorResolution;
     float thickness = abs(rd.z) * dt + 2.0 * texelM;
     if (ha < -IMP_EMPTY && hb > thickness) return false;
     // Refinement: Newton steps on the tangent plane of the height field at the current estimate
     // (stored normal, bilinear depth), kept inside the bracket [ta, tb]; regula falsi otherwise.
     float t = ha > -IMP_EMPTY && hb - ha > 0.0 ? ta + (tb - ta) * ha / (ha - hb) : tb;
-    for (int s = 0; s < impMode.y; ++s) {
+    for (int s = 0; s < impHeader.refinementSteps; ++s) {
         vec2 qc = ro.xy + t * rd.xy;
         float dq = impDepthAt(I, qc);
         vec3 n = texelFetch(impNormal, impTexel(I, qc), 0).xyz;
-        vec3 nl = vec3(dot(n, I.axisU.xyz), dot(n, I.axisV.xyz), dot(n, I.axisW.xyz));
+        vec3 nl = vec3(dot(n, I.axisU), dot(n, I.axisV), dot(n, I.axisW));
         float dn = dot(rd, nl);
         float tm = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : 0.5 * (ta + tb);
         if (dq < IMP_EMPTY && abs(dn) > 1e-4) {
@@ -318,11 +307,11 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
 
 SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir) {
     SurroundingHit h = impNoHit();
-    if (specularSlot < 0 || specularSlot >= impMode.z) return h;
+    if (specularSlot < 0 || specularSlot >= impHeader.objectCount) return h;
     if (!allFinite(rayOrigin) || !allFinite(rayDir) || dot(rayDir, rayDir) < 1e-12) return h;
     vec3 d = normalize(rayDir);
     GpuImpostorObject obj = impObjects[specularSlot];
-    if (impMode.x == 1) return impTraceCube(obj, rayOrigin, d);
+    if (impHeader.cubeMapBaseline == 1) return impTraceCube(obj, rayOrigin, d);
 
     float tBest = 1e30;
     int best = -1;  // impostor index, or -2 = enclosing cube
@@ -332,8 +321,8 @@ SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir) 
         best = -2;
         bestTexel = tx;
     }
-    for (int k = 0; k < obj.range.y; ++k) {
-        int idx = obj.range.x + k;
+    for (int k = 0; k < obj.impostorCount; ++k) {
+        int idx = obj.firstImpostor + k;
         if (impTraceOne(impostors[idx], rayOrigin, d, tBest, tx)) {
             best = idx;
             bestTexel = tx;

@@ -47,20 +47,20 @@ void main() {
     vec3 rv = vec3(0.0), r = vec3(0.0);
     for (int i = first; i < vplCount; i += K * K) {
         GpuVpl V = vpls[i];
-        if (V.normal.w < 0.5) continue;
-        vec3 d = p - V.positionReal.xyz;
+        if (V.valid == 0) continue;
+        vec3 d = p - V.position;
         float dist2 = dot(d, d);
         if (dist2 < 1e-10) continue;
         float dist = sqrt(dist2);
         vec3 w = d / dist;
-        float cosQ = dot(V.normal.xyz, w), cosP = dot(n, -w);
+        float cosQ = dot(V.normal, w), cosP = dot(n, -w);
         if (cosQ <= 0.0 || cosP <= 0.0) continue;
-        vec3 c = diffuse * V.flux.rgb / PI * cosQ * cosP / max(dist2, clamp2);
+        vec3 c = diffuse * V.flux / PI * cosQ * cosP / max(dist2, clamp2);
         float bias = 0.02 + 0.03 * dist;
         vec2 puv = paraboloidUv(V, w);
         bool visAll = dist - bias <= ismDistance(ismAll, i, puv);
         if (visAll) rv += c;
-        if (V.positionReal.w > 0.5 && pReal) {
+        if (V.isReal != 0 && pReal) {
             bool visReal = dist - bias <= ismDistance(ismReal, i, puv);
             if (visReal) r += c;
         }

@@ -7,7 +7,7 @@
 // (positive floats order like unsigned ints). The real-only atlas gets only the real points.
 layout(local_size_x = 64) in;
 layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
-layout(std430, binding = kBindingIsmPoints) readonly buffer Points { vec4 points[]; };  // xyz world, w = real
+layout(std430, binding = kBindingIsmPoints) readonly buffer Points { GpuSurfacePoint points[]; };
 layout(r32ui, binding = kImageIsmAll) uniform coherent uimage2D ismAll;
 layout(r32ui, binding = kImageIsmReal) uniform coherent uimage2D ismReal;
 uniform int pointCount;       // size of the pool
@@ -16,9 +16,9 @@ uniform float pointRadius;    // metres: radius of the disc one splatted point s
 
 void splat(int vplIndex, vec3 p, bool real) {
     GpuVpl v = vpls[vplIndex];
-    if (v.normal.w < 0.5) return;
-    vec3 n = v.normal.xyz;
-    vec3 d = p - v.positionReal.xyz;
+    if (v.valid == 0) return;
+    vec3 n = v.normal;
+    vec3 d = p - v.position;
     float dist = length(d);
     if (dist < 1e-4) return;
     vec3 w = d / dist;
@@ -47,6 +47,6 @@ void main() {
     int j = id % perVpl;
     // Each VPL reads a different contiguous window of the shuffled pool.
     int pi = (vplIndex * 7919 + j) % pointCount;
-    vec4 pt = points[pi];
-    splat(vplIndex, pt.xyz, pt.w > 0.5);
+    GpuSurfacePoint pt = points[pi];
+    splat(vplIndex, pt.position, pt.isReal != 0);
 }

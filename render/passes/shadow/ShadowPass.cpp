@@ -6,12 +6,8 @@ namespace mirage::render {
 ShadowPass::ShadowPass()
     : program_(rasterProgram("shadow", "passes/shadow/shadow.vert", "passes/shadow/shadow.frag")),
       fbo_("shadow fbo") {
-    locModel_ = program_.uniformLocation("model");
-    locNormal_ = program_.uniformLocation("normalMatrix");
     locViewProj_ = program_.uniformLocation("lightViewProj");
     locLight_ = program_.uniformLocation("lightIndex");
-    locMaterial_ = program_.uniformLocation("materialIndex");
-    locOrigin_ = program_.uniformLocation("origin");
 }
 
 void ShadowPass::setup(PassBuilder& b) const {
@@ -73,12 +69,7 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
     glUniform1i(locLight_, light);
     for (const DrawItem& d : ctx.scene.draws()) {
         if (realOnly && d.origin != Origin::Real) continue;
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
-        glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
-        glUniform1i(locMaterial_, d.material);
-        glUniform1i(locOrigin_, d.origin == Origin::Real ? kOriginReal : kOriginVirtual);
-        ctx.scene.bindMaterialTextures(d, kUnitBaseColorMap);
-        ctx.scene.drawItem(d);
+        draw_.draw(ctx.scene, d);
     }
 }
 

@@ -25,8 +25,8 @@ private:
     gl::Texture distance_, distanceReal_, rsmFlux_, rsmNormal_, rsmPosition_, depth_;
     gl::Framebuffer fbo_;
     int allocatedLayers_ = 0, allocatedSize_ = 0;
-    GLint locModel_ = -1, locNormal_ = -1, locViewProj_ = -1, locLight_ = -1, locMaterial_ = -1,
-          locOrigin_ = -1;
+    MaterialDraw draw_{program_};  // after program_
+    GLint locViewProj_ = -1, locLight_ = -1;
 };
 
 }  // namespace mirage::render

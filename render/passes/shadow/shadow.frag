@@ -22,19 +22,19 @@ void main() {
     const int li = lightIndex;
     outDistance = lightDistance(li, worldPos);
     GpuMaterial m = materials[materialIndex];
-    bool directional = int(lights[li].directionType.w) == LIGHT_DIRECTIONAL;
-    vec3 toLight = directional ? -lights[li].directionType.xyz
-                               : normalize(lights[li].positionRange.xyz - worldPos);
+    bool directional = lights[li].type == LIGHT_DIRECTIONAL;
+    vec3 toLight = directional ? -lights[li].direction
+                               : normalize(lights[li].position - worldPos);
     vec3 n = normalize(worldNormal);
     if (!allFinite(n)) n = toLight;
     if (dot(n, toLight) < 0.0) n = -n;
-    float dist = length(lights[li].positionRange.xyz - worldPos);
+    float dist = length(lights[li].position - worldPos);
     float atten = directional ? 1.0 : spotAttenuation(li, -toLight) * rangeWindow(li, dist);
-    vec3 diffuseAlbedo = (m.baseColor.rgb * texture(baseColorMap, uv).rgb) * (1.0 - clamp(m.params.x, 0.0, 1.0));
+    vec3 diffuseAlbedo = (m.baseColor.rgb * texture(baseColorMap, uv).rgb) * (1.0 - clamp(m.metallic, 0.0, 1.0));
     // Glass transmits instead of scattering diffusely (KHR_materials_transmission): only the
     // opaque share bounces into VPLs (reflected/refracted VPLs on caustics are a later issue).
-    diffuseAlbedo *= 1.0 - clamp(m.transmission.x, 0.0, 1.0);
-    outFlux = vec4(lights[li].radiantIntensity.rgb * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
+    diffuseAlbedo *= 1.0 - clamp(m.transmission, 0.0, 1.0);
+    outFlux = vec4(lights[li].radiantIntensity * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
     outNormal = vec4(n, 0.0);
     outPosition = vec4(worldPos, 1.0);
 }

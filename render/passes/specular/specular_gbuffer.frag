@@ -50,19 +50,19 @@ layout(location = 4) out vec4 outWeight;    // rgb Fresnel x transmittance weigh
 // Reflection weight of a smooth surface with this material at cos(theta) = cosV.
 vec3 reflectionWeight(GpuMaterial m, float cosV, float transWeight) {
     vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
-    if (m.attenuation.a > 0.5) return schlickColour(base, cosV);  // perfect mirror
-    float F = fresnelDielectric(cosV, max(m.transmission.y, 1e-3));
+    if (m.mirror != 0) return schlickColour(base, cosV);  // perfect mirror
+    float F = fresnelDielectric(cosV, max(m.ior, 1e-3));
     float opaque = 1.0 - transWeight;
-    float metal = opaque > 0.0 ? min(1.0, clamp(m.params.x, 0.0, 1.0) / opaque) : 0.0;
+    float metal = opaque > 0.0 ? min(1.0, clamp(m.metallic, 0.0, 1.0) / opaque) : 0.0;
     vec3 opaqueF = (1.0 - metal) * vec3(F) + metal * schlickColour(base, cosV);
     return transWeight * vec3(F) + opaque * opaqueF;
 }
 
 // Exit of a ray inside the object with bounding sphere (c, r): the far intersection.
-vec3 sphereExit(vec3 o, vec3 d, vec4 sphere) {
-    vec3 oc = o - sphere.xyz;
+vec3 sphereExit(vec3 o, vec3 d, vec3 centre, float radius) {
+    vec3 oc = o - centre;
     float b = dot(oc, d);
-    float cc = dot(oc, oc) - sphere.w * sphere.w;
+    float cc = dot(oc, oc) - radius * radius;
     float disc = max(b * b - cc, 0.0);
     return o + max(-b + sqrt(disc), 0.0) * d;
 }
@@ -101,12 +101,12 @@ void main() {
     v /= vl;
     vec3 d = -v;
     GpuSpecularDraw sd = specularDraws[slot];
-    GpuMaterial m = materials[sd.info.x];
+    GpuMaterial m = materials[sd.material];
     float cosV = clamp(dot(n, v), 1e-4, 1.0);  // grazing: clamped, never 0
-    bool mirror = m.attenuation.a > 0.5;
-    float transWeight = mirror ? 0.0 : clamp(m.transmission.x, 0.0, 1.0) *
-                                           (1.0 - clamp(m.params.x, 0.0, 1.0));
-    float eta = max(m.transmission.y, 1e-3);
+    bool mirror = m.mirror != 0;
+    float transWeight = mirror ? 0.0 : clamp(m.transmission, 0.0, 1.0) *
+                                           (1.0 - clamp(m.metallic, 0.0, 1.0));
+    float eta = max(m.ior, 1e-3);
     float eps = 1e-4 + 1e-4 * vl;  // ray offset against self-intersection (metres)
 
     if (mode == 0) {
@@ -128,7 +128,7 @@ void main() {
     T1 = normalize(T1);
     // March T1 through the back-face buffer: the exit is where the ray's camera distance passes
     // the stored back face's (same object).
-    float maxLen = 2.0 * sd.bounds.w + 1e-3;
+    float maxLen = 2.0 * sd.radius + 1e-3;
     int steps = clamp(marchSteps, 2, 128);
     float prevT = 0.0, hitT = -1.0;
     for (int i = 1; i <= steps; ++i) {
@@ -166,10 +166,10 @@ void main() {
         ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
         N2 = texelFetch(backNormal, qi, 0).xyz;
         if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 != slot || dot(N2, N2) < 0.25)
-            N2 = normalize(P2 - sd.bounds.xyz);
+            N2 = normalize(P2 - sd.centre);
     } else {
-        P2 = sphereExit(p, T1, sd.bounds);
-        N2 = normalize(P2 - sd.bounds.xyz);
+        P2 = sphereExit(p, T1, sd.centre, sd.radius);
+        N2 = normalize(P2 - sd.centre);
     }
     N2 = normalize(N2);
     if (!allFinite(N2)) N2 = T1;
@@ -185,8 +185,8 @@ void main() {
     T2 = normalize(T2);
     vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
     vec3 absorb = vec3(1.0);
-    if (m.transmission.z > 0.0)
-        absorb = pow(max(m.attenuation.rgb, vec3(1e-6)), vec3(inside / m.transmission.z));
+    if (m.attenuationDistance > 0.0)
+        absorb = pow(max(m.attenuationColor, vec3(1e-6)), vec3(inside / m.attenuationDistance));
     vec3 weight = transWeight * (1.0 - F1) * (1.0 - F2) * base * base * absorb;
     SurroundingHit h = traceSurroundings(slot, P2 + T2 * eps, T2);
     writeHit(h, T2, weight, inside);

@@ -73,19 +73,19 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
         vec3 vrv = vec3(0.0), vr = vec3(0.0);
         for (int i = firstVpl; i < vplCount; i += stride) {
             GpuVpl V = vpls[i];
-            if (V.normal.w < 0.5) continue;
-            vec3 d = x - V.positionReal.xyz;
+            if (V.valid == 0) continue;
+            vec3 d = x - V.position;
             float dist2 = dot(d, d);
             if (dist2 < 1e-10) continue;
             float dist = sqrt(dist2);
             vec3 w = d / dist;
-            float cosQ = dot(V.normal.xyz, w), cosP = dot(n, -w);
+            float cosQ = dot(V.normal, w), cosP = dot(n, -w);
             if (cosQ <= 0.0 || cosP <= 0.0) continue;
-            vec3 c = diffuse * V.flux.rgb / PI * cosQ * cosP / max(dist2, clamp2);
+            vec3 c = diffuse * V.flux / PI * cosQ * cosP / max(dist2, clamp2);
             float bias = 0.02 + 0.03 * dist;
             vec2 puv = paraboloidUv(V, w);
             if (dist - bias <= ismDistance(ismAll, i, puv)) vrv += c;
-            if (V.positionReal.w > 0.5 && xReal && dist - bias <= ismDistance(ismReal, i, puv))
+            if (V.isReal != 0 && xReal && dist - bias <= ismDistance(ismReal, i, puv))
                 vr += c;
         }
         rv += vrv * float(stride);

@@ -25,14 +25,18 @@ void main() {
     int id = int(gl_GlobalInvocationID.x);
     if (id >= vplCount) return;
     GpuVpl v;
-    v.positionReal = vec4(0.0);
-    v.normal = vec4(0.0, 1.0, 0.0, 0.0);  // w = 0: unused slot
-    v.flux = vec4(0.0);
-    v.tangent = vec4(1.0, 0.0, 0.0, 0.0);
+    v.position = vec3(0.0);
+    v.isReal = 0;
+    v.normal = vec3(0.0, 1.0, 0.0);
+    v.valid = 0;  // unused slot
+    v.flux = vec3(0.0);
+    v.pad0 = 0.0;
+    v.tangent = vec3(1.0, 0.0, 0.0);
+    v.pad1 = 0.0;
     for (int li = 0; li < lightCount; ++li) {
         ivec4 r = lightVplFirst[li];
         if (r.z == 0 || id < r.x || id >= r.x + r.y) continue;
-        int type = int(lights[li].directionType.w);
+        int type = lights[li].type;
         int local = id - r.x;
         int layers = max(lights[li].shadowLayers, 1);
         int layer = local % layers;
@@ -45,17 +49,19 @@ void main() {
         if (pos.w < 0.5) break;  // the sample sees no geometry
         vec4 flux = textureLod(rsmFlux, tc, 0.0);
         vec2 ndc = uv * 2.0 - 1.0;
-        float t = lights[li].radiantIntensity.w;  // tan(half fov), or ortho half extent (m) for dir.
+        float t = lights[li].frustumSize;  // tan(half fov), or ortho half extent (m) for dir.
         float cell = (2.0 * t) * (2.0 * t) / float(perLayer);
         float weight = type == LIGHT_DIRECTIONAL
                            ? cell
                            : cell / pow(1.0 + t * t * dot(ndc, ndc), 1.5);
-        v.positionReal = vec4(pos.xyz, (lights[li].isReal == 1 && flux.a > 0.5) ? 1.0 : 0.0);
-        v.normal = vec4(normalize(textureLod(rsmNormal, tc, 0.0).xyz), 1.0);
-        v.flux = vec4(flux.rgb * weight, 0.0);
-        vec3 n = v.normal.xyz;
-        v.tangent = vec4(normalize(abs(n.y) < 0.99 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0))), 0.0);
-        if (!allFinite(v.flux.rgb) || !allFinite(v.normal.xyz)) v.normal.w = 0.0;
+        v.position = pos.xyz;
+        v.isReal = (lights[li].isReal == 1 && flux.a > 0.5) ? 1 : 0;
+        v.normal = normalize(textureLod(rsmNormal, tc, 0.0).xyz);
+        v.valid = 1;
+        v.flux = flux.rgb * weight;
+        vec3 n = v.normal;
+        v.tangent = normalize(abs(n.y) < 0.99 ? cross(n, vec3(0, 1, 0)) : cross(n, vec3(1, 0, 0)));
+        if (!allFinite(v.flux) || !allFinite(v.normal)) v.valid = 0;
         break;
     }
     vpls[id] = v;

@@ -1,0 +1,53 @@
+// RendererOptions::validate: every option out of its range is refused with its name, before the
+// renderer allocates anything.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/Error.h"
+#include "render/FrameContext.h"
+
+namespace mirage::render {
+namespace {
+
+std::string refusal(const RendererOptions& o) {
+    try {
+        o.validate();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "accepted";
+}
+
+TEST(RendererOptions, DefaultsAreValid) {
+    EXPECT_EQ(refusal(RendererOptions{}), "accepted");
+}
+
+TEST(RendererOptions, ShadowBiasIsMetresInZeroToOne) {
+    RendererOptions o;
+    EXPECT_FLOAT_EQ(o.shadowBias, 0.001f);  // 1 mm: what the shaders used before it was metres
+    for (float bad : {-0.001f, 1.5f, std::numeric_limits<float>::quiet_NaN(),
+                      std::numeric_limits<float>::infinity()}) {
+        o.shadowBias = bad;
+        EXPECT_NE(refusal(o).find("shadowBias must be in [0, 1] metres"), std::string::npos) << bad;
+    }
+    o.shadowBias = 0.0f;
+    EXPECT_EQ(refusal(o), "accepted");
+}
+
+TEST(RendererOptions, OtherRangesNameTheOption) {
+    RendererOptions o;
+    o.vplCount = -1;
+    EXPECT_NE(refusal(o).find("vplCount"), std::string::npos);
+    o = {};
+    o.indirectScale = 3;
+    EXPECT_NE(refusal(o).find("indirectScale"), std::string::npos);
+    o = {};
+    o.backProjectionEpsilon = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_NE(refusal(o).find("backProjectionEpsilon"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mirage::render
