@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
 
+#include "calibration/CoverageMap.h"
 #include "calibration/JointRefinement.h"
 #include "core/Error.h"
 
@@ -615,6 +616,16 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
             fmt::format("the corners span only {:.0f}% of the image: distortion near the edges is "
                         "extrapolated; move the board into the corners",
                         100 * covered));
+    // A fish-eye's distortion is decided toward the rim: name the rings off-axis (through the
+    // fitted lens) that the image can hold but no used corner reached.
+    if (c.intrinsics.model == DistortionModel::KannalaBrandt) {
+        CoverageMap rings(imageSize);
+        rings.setAngularLens(c.intrinsics);
+        for (size_t i : active) rings.add(views[i].imagePoints);
+        for (const auto& missing : rings.missingRings())
+            result.warnings.push_back(
+                missing + ": the model is extrapolated there; add views toward the rim");
+    }
     return result;
 }
 

@@ -42,22 +42,35 @@ const char* sectorName(int sector) {
 void CoverageMap::setAngularLens(const CameraIntrinsics& lens) {
     MR_CHECK(lens.isValid(), "coverage by angle needs a valid lens");
     lens_ = lens;
-    // The largest angle off-axis inside the image: walk the image border.
-    double maxDeg = 0;
-    const int steps = 64;
-    for (int i = 0; i <= steps; ++i) {
-        const double t = double(i) / steps;
-        const double w = size_.width - 1.0, h = size_.height - 1.0;
-        for (const glm::dvec2 p : {glm::dvec2(t * w, 0), glm::dvec2(t * w, h), glm::dvec2(0, t * h),
-                                   glm::dvec2(w, t * h)})
-            if (const auto ray = lens.unproject(p)) {
+    // A bin can be filled when the image reaches at least half a ring past its inner edge along
+    // the sector's centre azimuth (from the principal point to the image border). So a ring that
+    // only the image's corners touch (a fish-eye's 80+ ring in a 4:3 frame whose circle overfills
+    // the width) is not demanded, while a circular fish-eye's rim ring is.
+    const double maxDeg = lens.maxFisheyeTheta * 180.0 / CV_PI;
+    const double w = size_.width - 1.0, h = size_.height - 1.0;
+    reachableRings_ = 0;
+    std::fill(reachableBins_.begin(), reachableBins_.end(), char(0));
+    for (int sector = 0; sector < kSectorCount; ++sector) {
+        const double a = (sector + 0.5) * (2 * CV_PI / kSectorCount);
+        const double dx = std::cos(a), dy = std::sin(a);
+        double t = std::numeric_limits<double>::infinity();
+        if (dx > 1e-9) t = std::min(t, (w - lens.cx) / dx);
+        if (dx < -1e-9) t = std::min(t, -lens.cx / dx);
+        if (dy > 1e-9) t = std::min(t, (h - lens.cy) / dy);
+        if (dy < -1e-9) t = std::min(t, -lens.cy / dy);
+        double borderDeg = maxDeg;  // where the model does not invert, its trusted limit
+        if (std::isfinite(t) && t > 0)
+            if (const auto ray = lens.unproject({lens.cx + t * dx, lens.cy + t * dy})) {
                 double off, az;
                 rayAngles(*ray, off, az);
-                maxDeg = std::max(maxDeg, off);
+                borderDeg = std::min(off, maxDeg);
+            }
+        for (int ring = 0; ring < kRingCount; ++ring)
+            if (borderDeg >= (ring + 0.5) * kRingStepDeg - 1e-6) {
+                reachableBins_[size_t(ring * kSectorCount + sector)] = 1;
+                reachableRings_ = std::max(reachableRings_, ring + 1);
             }
     }
-    maxDeg = std::min(maxDeg, lens.maxFisheyeTheta * 180.0 / CV_PI);
-    reachableRings_ = std::clamp(int(std::ceil(maxDeg / kRingStepDeg)), 1, kRingCount);
 }
 
 void CoverageMap::add(const std::vector<cv::Point2f>& corners) {
@@ -111,9 +124,13 @@ std::vector<std::string> CoverageMap::missingRings() const {
 
 double CoverageMap::coveredFraction() const {
     if (lens_) {
-        const auto first = bins_.begin(), last = first + reachableRings_ * kSectorCount;
-        const auto n = std::count_if(first, last, [](int c) { return c > 0; });
-        return double(n) / double(reachableRings_ * kSectorCount);
+        int n = 0, reachable = 0;
+        for (size_t i = 0; i < bins_.size(); ++i)
+            if (reachableBins_[i]) {
+                ++reachable;
+                n += bins_[i] > 0;
+            }
+        return reachable ? double(n) / double(reachable) : 0.0;
     }
     const auto n = std::count_if(counts_.begin(), counts_.end(), [](int c) { return c > 0; });
     return double(n) / double(counts_.size());
@@ -125,7 +142,7 @@ cv::Point2f CoverageMap::emptiestRegion(std::string& name) const {
         int bestRing = 0, bestSector = 0, best = std::numeric_limits<int>::max();
         for (int r = reachableRings_ - 1; r >= 0; --r)
             for (int s = 0; s < kSectorCount; ++s)
-                if (binCount(r, s) < best) {
+                if (reachableBins_[size_t(r * kSectorCount + s)] && binCount(r, s) < best) {
                     best = binCount(r, s);
                     bestRing = r;
                     bestSector = s;

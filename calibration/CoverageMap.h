@@ -26,8 +26,9 @@ public:
     void clear();
 
     // Counts corners by angle off-axis through this lens from now on (the cells still count).
-    // Rings the lens cannot see inside the image (inner edge beyond the largest angle of the
-    // image's border) are left out of the fraction. Call before add().
+    // A (ring, sector) bin is reachable when the image border along the sector's centre azimuth
+    // lies at least half a ring (10 degrees) past the ring's inner edge; only reachable bins
+    // count in the fraction, and only rings with one are demanded. Call before add().
     void setAngularLens(const CameraIntrinsics& lens);
     bool angular() const { return lens_.has_value(); }
     static constexpr int kRingCount = 5;  // 0-20, 20-40, 40-60, 60-80, 80+ degrees
@@ -35,8 +36,12 @@ public:
     static constexpr int kSectorCount = 8;  // azimuth sectors of 45 degrees, 0 = image right
     int ringCount(int ring) const;          // corners in a ring, all sectors
     int binCount(int ring, int sector) const { return bins_[size_t(ring * kSectorCount + sector)]; }
-    // Rings the lens reaches inside the image (angular mode only).
+    // Rings with at least one reachable bin (angular mode only); the reachable rings are the
+    // innermost ones.
     int reachableRings() const { return reachableRings_; }
+    bool reachable(int ring, int sector) const {
+        return reachableBins_[size_t(ring * kSectorCount + sector)] != 0;
+    }
     // "no corners beyond 60 deg off-axis yet", "no corners between 20 and 40 deg off-axis yet":
     // one sentence per run of empty reachable rings; empty when every ring has a corner or the
     // map is not angular.
@@ -61,6 +66,7 @@ private:
     std::optional<CameraIntrinsics> lens_;
     int reachableRings_ = 0;
     std::vector<int> bins_ = std::vector<int>(size_t(kRingCount * kSectorCount), 0);
+    std::vector<char> reachableBins_ = std::vector<char>(size_t(kRingCount * kSectorCount), 0);
 };
 
 // Board tilt bins. A view's tilt is the angle between the board normal and the optical axis;

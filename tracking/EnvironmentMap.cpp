@@ -52,13 +52,17 @@ void EnvironmentMap::update(const cv::Mat& frame, const CameraIntrinsics& cam,
     // with R^T; project() refuses rays beyond the calibrated field of view.
     cv::Mat mapX(H, W, CV_32F), mapY(H, W, CV_32F);
     const glm::dmat3 Rt = glm::transpose(T_world_camera.rotationMatrix());
+    // Beyond the calibration's reach: cos(angle off the +Z optical axis) below this.
+    const double minCosOffAxis =
+        reachDeg_ > 0 ? std::cos(std::min(reachDeg_, 180.0) * M_PI / 180.0) : -2.0;
     cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
         for (int y = rows.start; y < rows.end; ++y) {
             float* mx = mapX.ptr<float>(y);
             float* my = mapY.ptr<float>(y);
             for (int x = 0; x < W; ++x) {
                 const glm::dvec3 dCam = Rt * direction(x + 0.5, y + 0.5, W, H);
-                const auto px = cam.project(dCam);
+                const auto px =
+                    dCam.z < minCosOffAxis * glm::length(dCam) ? std::nullopt : cam.project(dCam);
                 // Inside the image with a half-pixel margin so bilinear sampling stays in it.
                 if (px && px->x >= 0 && px->y >= 0 && px->x <= cam.width - 1 &&
                     px->y <= cam.height - 1) {

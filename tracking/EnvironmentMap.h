@@ -14,6 +14,11 @@
 // (CameraIntrinsics::project succeeds and lands inside the image). Directions never seen stay
 // invalid (radiance 0): nothing is invented. Seen directions keep their last value when later
 // frames do not see them. Clipped (saturated) camera pixels are marked in clipped().
+//
+// Reach: a calibration states the largest angle off its optical axis its data covered; beyond
+// it the fish-eye model is extrapolated (pixels of error within a few degrees). With a reach set,
+// directions farther off the camera's axis are not sampled: they stay as the unseen part of the
+// sphere does (invalid, radiance 0) unless another frame sees them within the reach.
 #include <opencv2/core.hpp>
 
 #include "core/camera/CameraModel.h"
@@ -33,6 +38,10 @@ public:
     void update(const cv::Mat& frameBgr8, const CameraIntrinsics& fisheye,
                 const Pose& T_world_camera, double blend = 1.0);
     void clear();
+    // Largest angle off the fish-eye's optical axis (degrees) sampled from now on; <= 0 = no
+    // limit (the calibration does not state its reach: the whole projectable field is used).
+    void setReachDeg(double reachDeg) { reachDeg_ = reachDeg; }
+    double reachDeg() const { return reachDeg_; }
 
     const cv::Mat& radiance() const { return radiance_; }  // CV_32FC3 linear RGB
     const cv::Mat& validity() const { return valid_; }     // CV_8U, 255 = seen, 0 = never seen
@@ -47,6 +56,7 @@ public:
 
 private:
     cv::Mat radiance_, valid_, clipped_;
+    double reachDeg_ = -1;
 };
 
 }  // namespace mirage::tracking

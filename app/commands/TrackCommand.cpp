@@ -128,6 +128,15 @@ void run(const TrackArgs& a) {
                 "T_parent_camera missing: the fish-eye's pose (parent main or world) is needed");
         envFrames = openCameraFrames(session, name);
         envMap.emplace(a.envmapWidth);
+        // Beyond the calibration data's reach the fish-eye model is extrapolated: not sampled.
+        if (envCalib->reachDeg > 0) {
+            envMap->setReachDeg(envCalib->reachDeg);
+            spdlog::warn(
+                "{}: the calibration reaches {:.1f} deg off-axis; environment-map directions "
+                "beyond it are not sampled (left unseen in the validity map). Calibrate with "
+                "boards nearer the rim to widen it.",
+                session.path(ec->calibration).string(), envCalib->reachDeg);
+        }
     }
 
     installStopSignals();

@@ -4,6 +4,8 @@
 // confident numbers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <random>
 
@@ -82,6 +84,23 @@ TEST(Calibrator, FisheyeRecoversKnownIntrinsics) {
             << r.parameterNames[i];
     EXPECT_NEAR(got.fx, cam.fx, 0.005 * cam.fx);
     EXPECT_NEAR(r.calibration.avgReprojectionError, 0.2 * std::sqrt(2.0), 0.05);
+}
+
+TEST(Calibrator, FisheyeWithCornersOnlyNearTheCentreNamesTheMissingRings) {
+    const auto cam = fisheyeCamera();
+    ChessboardGeometry board{8, 6, 0.04};
+    std::mt19937 rng(11);
+    PoseSamplerOptions po;
+    po.minDistance = 0.45;
+    po.maxDistance = 0.6;
+    po.imageSpread = 0.15;  // boards around the image centre only
+    const auto views = makeViews(cam, board, sampleBoardPoses(cam, board, 12, po, rng), 0.2, rng);
+    const auto r = calibrate(views, {cam.width, cam.height}, optionsFor(cam));
+    const auto found = std::find_if(r.warnings.begin(), r.warnings.end(), [](const auto& w) {
+        return w.find("no corners beyond") != std::string::npos &&
+               w.find("deg off-axis yet") != std::string::npos;
+    });
+    EXPECT_NE(found, r.warnings.end()) << "reach " << r.calibration.reachDeg << " deg";
 }
 
 // The reported 1-sigma deviations must match the spread of the estimates over independent noisy

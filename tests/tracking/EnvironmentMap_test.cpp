@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/Error.h"
@@ -106,6 +109,45 @@ TEST(EnvironmentMap, NeverSeenStaysInvalidAndUpdatesAccumulate) {
     env.update(renderFisheye(cam, downPose), cam, downPose);
     EXPECT_GT(env.validFraction(), 0.95);
     EXPECT_THROW(env.update(cv::Mat(10, 10, CV_8UC3), cam, up), Error);
+}
+
+TEST(EnvironmentMap, DirectionsBeyondTheCalibrationsReachAreNotSampled) {
+    const auto cam = hemisphereFisheye(300);
+    const Pose up = testing::lookAt({0, 0, 0}, {0, 1, 0}, glm::dvec3(0, 0, -1));
+    const cv::Mat frame = renderFisheye(cam, up);
+    EnvironmentMap full(128), reached(128);
+    full.update(frame, cam, up);
+    reached.setReachDeg(50.0);
+    reached.update(frame, cam, up);
+    // Directions by their angle off the camera's axis (world +Y here): within 48 degrees both
+    // maps sampled them alike; beyond 52 only the map without a reach did, the other left them
+    // as unseen (invalid, radiance 0).
+    int inside = 0, beyondFull = 0, beyondReached = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 128; ++x) {
+            const glm::dvec3 d = EnvironmentMap::direction(x + 0.5, y + 0.5, 128, 64);
+            const double offAxisDeg = glm::degrees(std::acos(std::clamp(d.y, -1.0, 1.0)));
+            const bool vf = full.validity().at<uint8_t>(y, x) != 0;
+            const bool vr = reached.validity().at<uint8_t>(y, x) != 0;
+            if (offAxisDeg < 48) {
+                EXPECT_TRUE(vr) << x << "," << y;
+                inside += vr;
+            } else if (offAxisDeg > 52) {
+                beyondFull += vf && offAxisDeg < 85;
+                beyondReached += vr;
+                if (!vr) {
+                    EXPECT_EQ(reached.radiance().at<cv::Vec3f>(y, x), cv::Vec3f(0, 0, 0));
+                }
+            }
+        }
+    EXPECT_GT(inside, 100);
+    EXPECT_GT(beyondFull, 300);  // the frame does see there
+    EXPECT_EQ(beyondReached, 0);
+    EXPECT_LT(reached.validFraction(), 0.6 * full.validFraction());
+    // No reach (a calibration without the field): the whole field, as before.
+    reached.setReachDeg(-1);
+    reached.update(frame, cam, up);
+    EXPECT_NEAR(reached.validFraction(), full.validFraction(), 1e-12);
 }
 
 }  // namespace

@@ -181,6 +181,28 @@ TEST(TrackCommand, EnvironmentMapFromTheSessionsFisheye) {
     EXPECT_LT(err / n, 0.02);
     // Straight down was never seen.
     EXPECT_EQ(valid.at<uint8_t>(63, 64), 0);
+    // The fish-eye (axis tilted about 60 degrees from straight up) sees the zenith (top row)
+    // without a stated reach...
+    EXPECT_GT(cv::countNonZero(valid.row(0)), 0);
+    EXPECT_EQ(r.output.find("not sampled"), std::string::npos) << r.output;
+
+    // ...but not with a calibration whose data reaches only 45 degrees off-axis: directions
+    // beyond it are left unseen, and a warning says so once.
+    envCal.reachDeg = 45.0;
+    saveCalibration(dir / "env.yaml", envCal);
+    const auto r45 =
+        test::runMirage({"track", dir.string(), "-o", (out / "p45.csv").string(), "--envmap",
+                         (out / "env45.exr").string(), "--envmap-width", "128"});
+    ASSERT_EQ(r45.exitCode, 0) << r45.output;
+    const cv::Mat valid45 = cv::imread((out / "env45_valid.png").string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_EQ(valid45.size(), env.size());
+    EXPECT_EQ(cv::countNonZero(valid45.row(0)), 0);
+    EXPECT_GT(cv::countNonZero(valid45), 0);
+    EXPECT_LT(cv::countNonZero(valid45), 0.7 * cv::countNonZero(valid));
+    const auto first = r45.output.find("reaches 45.0 deg off-axis");
+    ASSERT_NE(first, std::string::npos) << r45.output;
+    EXPECT_EQ(r45.output.find("reaches 45.0 deg off-axis", first + 1), std::string::npos)
+        << r45.output;
 }
 
 TEST(TrackCommand, BadInputNamesTheFile) {
