@@ -45,11 +45,11 @@ void run(const MergeArgs& a) {
             bar.update(done, total, fmt::format("frame {}/{}", done, total));
         });
     } else if (first.command == "render") {
-        mergeRenderShards(set, out, temp);
+        mergeRenderShards(set, out, temp, a.force);
     } else if (first.command == "bench") {
         mergeBenchShards(set, temp);
     } else if (first.command == "replay") {
-        mergeReplayShards(set, out, temp);
+        mergeReplayShards(set, out, temp, a.force);
     } else {
         throw FileError((set.folders.front() / "shard.json").string(),
                         "command '" + first.command +

@@ -60,7 +60,7 @@ void writeRenderShard(const fs::path& out, const RenderShard& rs) {
                  rs.shard.index, rs.shard.count, rs.rows.size(), dir.string(), out.string());
 }
 
-void mergeRenderShards(const ShardSet& set, const fs::path& out, const fs::path& temp) {
+void mergeRenderShards(const ShardSet& set, const fs::path& out, const fs::path& temp, bool force) {
     const ShardManifest& first = set.shards.front();
     const fs::path manifest = set.folders.front() / "shard.json";
     int width = 0, height = 0;
@@ -100,7 +100,7 @@ void mergeRenderShards(const ShardSet& set, const fs::path& out, const fs::path&
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
     writeLinearRgb(temp, full[0], ext == ".png" ? exposure : 1.0f);
     if (buffers) {
-        const OutputRule rule{{}, true, "mirage merge"};
+        const OutputRule rule{{}, force, "mirage merge"};
         const fs::path stem = out.parent_path() / out.stem();
         for (size_t k = 1; k < images; ++k) {
             OutputFile f(stem.string() + kBufferSuffixes[k - 1], OutputOrigin::Derived, rule);
@@ -215,7 +215,7 @@ void finishReplayShard(StagedPath& staged, const ReplayShard& rs) {
         dir.string(), out.string());
 }
 
-void mergeReplayShards(const ShardSet& set, const fs::path& out, const fs::path& temp) {
+void mergeReplayShards(const ShardSet& set, const fs::path& out, const fs::path& temp, bool force) {
     const ShardManifest& first = set.shards.front();
     bool video = false;
     double fps = 30.0;
@@ -267,7 +267,7 @@ void mergeReplayShards(const ShardSet& set, const fs::path& out, const fs::path&
     if (writer) writer->close();
     const fs::path csvOut = video ? fs::path(out).replace_extension(".csv") : temp / "frames.csv";
     if (video) {
-        OutputFile f(csvOut, OutputOrigin::Derived, OutputRule{{}, true, "mirage merge"});
+        OutputFile f(csvOut, OutputOrigin::Derived, OutputRule{{}, force, "mirage merge"});
         std::ofstream(f.temp()) << csv;
         f.commit();
     } else {

@@ -31,8 +31,9 @@ void writeRenderShard(const std::filesystem::path& out, const RenderShard& shard
 
 // Joins the rows of every shard into one image written to `temp` (named like `out`, whose
 // extension chooses the format), and the --save-buffers images beside `out`.
+// Files beside `out` (--save-buffers, a video's CSV) are replaced only with `force`.
 void mergeRenderShards(const ShardSet& shards, const std::filesystem::path& out,
-                       const std::filesystem::path& temp);
+                       const std::filesystem::path& temp, bool force);
 
 struct BenchShard {
     ShardSpec shard;
@@ -75,6 +76,6 @@ void finishReplayShard(StagedPath& staged, const ReplayShard& shard);
 // Writes OUT (an MJPEG .mkv with its .csv beside it, or a folder of PNG frames with frames.csv)
 // from the shards' frames in order, to `temp` named like `out`.
 void mergeReplayShards(const ShardSet& shards, const std::filesystem::path& out,
-                       const std::filesystem::path& temp);
+                       const std::filesystem::path& temp, bool force);
 
 }  // namespace mirage::app
