@@ -216,10 +216,11 @@ namespace mirage::calib {
 namespace {
 
 // Two draws of the fish-eye Monte-Carlo (the `fisheye_montecarlo` benchmark runs 20; these two
-// take ~4 s CPU each, seed 1 would take ~70 s): an equidistant and an equisolid lens, views out to the rim, blur and noise, detected and
-// calibrated. mirage's model lies within 0.25 px of the true lens up to 80 degrees, never worse
-// than cv::fisheye::calibrate on the same corners by more than 10 % + 0.1 px, and its stated
-// uncertainty is not wildly off (the 2-sigma share over many draws is the benchmark's).
+// take ~4 s CPU each, seed 1 would take ~70 s): an equidistant and an equisolid lens, views out to
+// the rim, blur and noise, detected and calibrated. mirage's model lies within 0.25 px of the true
+// lens up to 80 degrees, never worse than cv::fisheye::calibrate on the same corners by more than
+// 10 % + 0.1 px, and its stated uncertainty is not wildly off (the 2-sigma share over many draws is
+// the benchmark's).
 TEST(FisheyeRim, MonteCarloDrawsMatchTheTrueLens) {
     for (const unsigned seed : {2u, 3u}) {
         const FisheyeDraw d = runFisheyeDraw(seed);
