@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -77,13 +78,14 @@ int estimateMemoryMb(const std::vector<std::string>& args) {
     const int width = intOption(args, "--width", 640);
     const int height = intOption(args, "--height", cmd == "render" ? width * 3 / 4 : 480);
     double bytes = double(width) * height * 400.0;
-    if (args.size() > 1 && fs::exists(args[1])) {
-        std::error_code ec;
-        bytes += 8.0 * double(fs::file_size(args[1], ec));
+    std::error_code ec;
+    if (args.size() > 1 && fs::is_regular_file(args[1], ec)) {  // a scene; not a session folder
+        const auto size = fs::file_size(args[1], ec);
+        if (!ec) bytes += 8.0 * double(size);
     }
     if (cmd == "bench" || cmd == "replay")
-        bytes += double(width) * height * 1000.0;  // G-buffers, images
-    const double mb = bytes / 1048576.0 + 512.0;
+        bytes += double(width) * height * 1000.0;                            // G-buffers, images
+    const double mb = std::min(bytes / 1048576.0 + 512.0, double(1 << 24));  // --mem's limit
     return int((mb + 255.0) / 256.0) * 256;
 }
 

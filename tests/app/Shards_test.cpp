@@ -286,6 +286,11 @@ TEST(ShardedRuns, SlurmScriptsRunOneShardPerTaskAndMergeAfterAll) {
                    out.string(), "--shard", "0/2"});
     EXPECT_EQ(r.exitCode, 1) << r.output;
     EXPECT_NE(r.output.find("leave --shard out"), std::string::npos) << r.output;
+    // A session folder as the first argument (bench, replay): the estimate stays sane.
+    r = runMirage({"slurm", "--shards", "2", "--dry-run", "--", "bench",
+                   (test::dataDir() / "sessions" / "sample").string(), "-o", (dir / "b").string()});
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("1024 MB each"), std::string::npos) << r.output;
     r = runMirage({"slurm", "--shards", "2", "--dry-run", "--", "synth", scene()});
     EXPECT_NE(r.output.find("needs -o OUT"), std::string::npos) << r.output;
 }
