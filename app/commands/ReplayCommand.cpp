@@ -224,7 +224,6 @@ void runReplay(const ReplayArgs& a) {
     for (int pos = first; pos < begin + total && !stopped(); ++pos) {
         const FrameRecord& rec = session.frames[size_t(pos)];
         const bool emit = pos >= begin;
-        const int k = pos - begin;  // frames written before this one (negative: warm-up)
         const auto t0 = Clock::now();
         if (!frames->read(bgr)) {
             spdlog::warn("replay: the video ends after {} frames", pos);
@@ -334,7 +333,6 @@ void runReplay(const ReplayArgs& a) {
         csv << "\n";
         csv.flush();
         ++done;
-        (void)k;
         progress(done, total, done / std::max(1e-9, msSince(tStart) * 1e-3));
     }
     if (isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
