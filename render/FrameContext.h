@@ -46,6 +46,9 @@ struct RendererOptions {
     // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
     // without this a pass's time can show up in the next pass's query. For benchmarks.
     bool syncPasses = false;
+    // false: the composite is the footage unchanged, as if no virtual object existed (the live
+    // view's "hide" key; the bench's `virtual=off` sanity point, which must score as the footage).
+    bool showVirtual = true;
 
     // Reflected-scene impostors for specular objects (render/passes/impostor).
     int impostorResolution = 256;          // texels per side of each impostor and cube face

@@ -24,6 +24,7 @@
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/commands/BenchSuite.h"
 #include "app/commands/ShardMerge.h"
 #include "core/Error.h"
 #include "core/Log.h"
@@ -43,7 +44,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct BenchArgs {
-    std::string session, scene, output, shard;
+    std::string session, scene, output, shard, suite, suiteFile;
     std::vector<std::string> knobs;  // NAME=V1,V2,...
     bool quick = false, listKnobs = false, noBaseline = false, images = false, force = false;
     int maxFrames = -1, start = 0, repeats = 1;
@@ -298,10 +299,30 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
                     "Run part I of N of the grid (I/N, 0-based: every N-th configuration from I) "
                     "into OUTDIR.shards/; join the parts with `mirage merge OUTDIR` "
                     "(docs/scale.md)");
+    cmd->add_option("--suite", a->suite,
+                    "Write the results page to OUTDIR/results.md: every effect's session "
+                    "synthesised (or reused from OUTDIR/sessions), its knob sweeps, plots, crops "
+                    "and scaling curves (docs/results.md; hours on 2 cores)");
+    cmd->add_option("--suite-file", a->suiteFile,
+                    "With --suite: the effects, sizes and sweeps from this JSON file instead of "
+                    "the standard suite (docs/bench.md)");
     cmd->add_flag("--images", a->images,
                   "Also write each configuration's first composite and the ground truth to "
                   "OUTDIR/images/ (sRGB PNG)");
     cmd->callback([a] {
+        if (!a->suiteFile.empty() && a->suite.empty())
+            throw Error("mirage bench: --suite-file needs --suite OUTDIR");
+        if (!a->suite.empty()) {
+            if (!a->session.empty() || !a->output.empty())
+                throw Error(
+                    "mirage bench: --suite OUTDIR makes its own sessions; give no SESSION or "
+                    "-o with it");
+            const SuiteSpec spec = a->suiteFile.empty() ? defaultSuite() : loadSuite(a->suiteFile);
+            std::string cmdLine = "mirage bench --suite " + a->suite;
+            if (!a->suiteFile.empty()) cmdLine += " --suite-file " + a->suiteFile;
+            runSuite(spec, a->suite, cmdLine);
+            return;
+        }
         if (!a->listKnobs && a->session.empty())
             throw Error(
                 "mirage bench: SESSION is required (a folder made by `mirage synth "

@@ -223,7 +223,7 @@ std::string svgScatter(const ScatterPlot& p) {
             "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#888\" "
             "stroke-dasharray=\"6 4\"/>\n",
             f.x0(), y, f.x1(), y);
-        s += text(f.x1() - 4, y - 5, p.baselineLabel, "end", 11, " fill=\"#666\"");
+        s += text(f.x0() + 6, y - 5, p.baselineLabel, "start", 11, " fill=\"#666\"");
     }
     if (p.drawFront) {
         const std::vector<size_t> front = paretoFront(p.points);
@@ -280,7 +280,7 @@ std::string svgStackedBars(const StackedBarPlot& p) {
     f.left = 150;
     f.right = 70;
     f.width = p.width;
-    f.bottom = 44 + legendRows * legendRow;
+    f.bottom = 66 + legendRows * legendRow;
     f.height = f.top + double(p.bars.size()) * (barH + gap) + gap + f.bottom;
     double hi = 0;
     for (const Bar& b : p.bars) {
@@ -318,7 +318,7 @@ std::string svgStackedBars(const StackedBarPlot& p) {
         y += barH + gap;
     }
     s += text((f.x0() + f.x1()) / 2, f.height - f.bottom + 34, p.xLabel, "middle");
-    const double legendTop = f.height - f.bottom + 44;
+    const double legendTop = f.height - f.bottom + 62;
     const double colW = (f.width - 40) / legendCols;
     for (size_t i = 0; i < names.size(); ++i) {
         const double lx = 20 + double(i % legendCols) * colW;

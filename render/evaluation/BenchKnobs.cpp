@@ -43,6 +43,10 @@ std::pair<int, int> parseResolution(const std::string& v) {
     return {w, h};
 }
 
+std::string onOff(bool b) {
+    return b ? "on" : "off";
+}
+
 bool sameAspect(int w, int h, int W, int H) {
     return std::abs(double(w) * H - double(h) * W) <= 0.01 * double(W) * H;
 }
@@ -75,6 +79,9 @@ const std::vector<BenchKnob>& benchKnobs() {
          },
          [](BenchConfig& c, const std::string& v) {
              std::tie(c.width, c.height) = parseResolution(v);
+         },
+         [](const BenchConfig& c) {
+             return c.width > 0 ? fmt::format("{}x{}", c.width, c.height) : std::string("session");
          }},
         {"vpls", "virtual point lights per frame (RendererOptions::vplCount)",
          [](const CameraIntrinsics&, bool quick) {
@@ -83,28 +90,32 @@ const std::vector<BenchKnob>& benchKnobs() {
          },
          [](BenchConfig& c, const std::string& v) {
              c.options.vplCount = parseInt("vpls", v, 0, 16384);
-         }},
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.vplCount); }},
         {"indirect_scale", "VPL gather at 1/N resolution per axis (1 or 2)",
          [](const CameraIntrinsics&, bool quick) {
              return quick ? std::vector<std::string>{"2"} : std::vector<std::string>{"2", "1"};
          },
          [](BenchConfig& c, const std::string& v) {
              c.options.indirectScale = parseInt("indirect_scale", v, 1, 2);
-         }},
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.indirectScale); }},
         {"static_reuse",
          "on: reuse the camera-independent passes (shadow, vpl, ism) while the plan is "
          "unchanged; off: re-run them every frame",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.reuseStaticPasses = parseOnOff("static_reuse", v);
-         }},
+         },
+         [](const BenchConfig& c) { return onOff(c.options.reuseStaticPasses); }},
         {"sync_passes",
          "on: glFinish around every pass so each pass's GPU ms is its own (llvmpipe defers work); "
          "off: as mirage replay runs, passes overlap and only the wall ms is meaningful",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.syncPasses = parseOnOff("sync_passes", v);
-         }},
+         },
+         [](const BenchConfig& c) { return onOff(c.options.syncPasses); }},
         // Specular objects. One default value each, so the default grid does not grow;
         // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror
         // or glass (the impostor and specular passes do not run).
@@ -117,19 +128,46 @@ const std::vector<BenchKnob>& benchKnobs() {
                  throw Error(fmt::format(
                      "bench: knob specular_trace: '{}' is not impostors or cubemap", v));
              c.options.impostorCubeMapBaseline = v == "cubemap";
+         },
+         [](const BenchConfig& c) {
+             return std::string(c.options.impostorCubeMapBaseline ? "cubemap" : "impostors");
          }},
         {"impostor_resolution", "texels per side of each impostor and cube-map face",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.impostorResolution = parseInt("impostor_resolution", v, 16, 2048);
-         }},
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.impostorResolution); }},
         {"impostor_steps", "refinement steps of the impostor height-field search",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
-         }},
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.impostorRefineSteps); }},
+        {"virtual",
+         "on: composite the virtual objects; off: the composite is the footage unchanged (a "
+         "sanity point: it must score as the footage-only row, and any configuration that does "
+         "not beat that row is broken)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.showVirtual = parseOnOff("virtual", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.showVirtual); }},
     };
     return knobs;
+}
+
+BenchConfig benchDefaultConfig() {
+    BenchConfig c;
+    c.options.syncPasses = true;  // per-pass attribution of GPU time (see RendererOptions)
+    return c;
+}
+
+std::map<std::string, std::string> benchDefaultKnobs() {
+    const BenchConfig c = benchDefaultConfig();
+    std::map<std::string, std::string> values;
+    for (const auto& k : benchKnobs()) values[k.name] = k.value(c);
+    return values;
 }
 
 std::vector<BenchConfig> benchGrid(
@@ -145,9 +183,7 @@ std::vector<BenchConfig> benchGrid(
         }
         if (values.empty()) throw Error(fmt::format("bench: knob '{}' has no values", name));
     }
-    BenchConfig base;
-    base.options.syncPasses = true;  // per-pass attribution of GPU time (see RendererOptions)
-    std::vector<BenchConfig> grid{base};
+    std::vector<BenchConfig> grid{benchDefaultConfig()};
     for (const auto& knob : benchKnobs()) {
         const auto it = overrides.find(knob.name);
         const std::vector<std::string> values =

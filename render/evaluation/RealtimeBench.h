@@ -39,10 +39,18 @@ struct BenchKnob {
     std::function<std::vector<std::string>(const CameraIntrinsics& session, bool quick)> defaults;
     // Sets the value on a configuration; throws mirage::Error naming the knob on a bad value.
     std::function<void(BenchConfig&, const std::string& value)> apply;
+    // The knob's value in a configuration (what `apply` would have set).
+    std::function<std::string(const BenchConfig&)> value;
 };
 
 // The knobs, in grid order (the first varies slowest).
 const std::vector<BenchKnob>& benchKnobs();
+
+// The configuration every grid starts from: RendererOptions' defaults at the session's size,
+// with syncPasses on (per-pass GPU time); and each knob's value in it ("the default" of the
+// results page: one point per knob setting varies one knob from here).
+BenchConfig benchDefaultConfig();
+std::map<std::string, std::string> benchDefaultKnobs();
 
 // The grid: the cartesian product of every knob's values (defaults, or `overrides[name]`).
 // Throws mirage::Error for an unknown knob name or a bad value.

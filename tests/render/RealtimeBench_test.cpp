@@ -190,7 +190,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     ASSERT_EQ(grid.size(), 1u);
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
-              "specular_trace=impostors impostor_resolution=256 impostor_steps=4");
+              "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";
@@ -215,6 +215,14 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     std::cout << "[ bench ] virtual object removed: " << removed.error << "\n";
     EXPECT_FALSE(passesFloors(removed.error));
     EXPECT_LT(removed.error.psnrInfluenced, kMinPsnrInfluenced);
+    // Broken (3): the renderer told to hide the virtual objects (knob virtual=off) scores as the
+    // footage: the sanity point the results page flags.
+    const BenchResult hidden =
+        runBenchConfig(benchScene(true), camera, frames,
+                       benchGrid(camera, true, {{"vpls", {"256"}}, {"virtual", {"off"}}})[0]);
+    std::cout << "[ bench ] virtual=off: " << hidden.error << "\n";
+    EXPECT_NEAR(hidden.error.psnrInfluenced, footage.error.psnrInfluenced, 0.05);
+    EXPECT_NEAR(hidden.error.psnrFrame, footage.error.psnrFrame, 0.05);
 
     // Downsampled judging (the resolution knob): the ground truth is box-filtered, so the same
     // renderer still scores about as well at half size (23.1 dB measured; footage alone ~13 dB).
@@ -290,6 +298,22 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"static_reuse", {"yes"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"2048x1536"}}}), Error);  // upsampling
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"640x640"}}}), Error);    // aspect
+    EXPECT_THROW(benchGrid(cam, true, {{"virtual", {"hidden"}}}), Error);
+
+    // Every knob reads back the value it applied (the results page's "default" is read this way),
+    // and the default configuration is RendererOptions' defaults.
+    for (const auto& knob : benchKnobs()) {
+        ASSERT_TRUE(knob.value) << knob.name << " has no value reader";
+        for (const std::string& v : knob.defaults(cam, false)) {
+            BenchConfig c = benchDefaultConfig();
+            knob.apply(c, v);
+            EXPECT_EQ(knob.value(c), v) << knob.name;
+        }
+    }
+    const auto defaults = benchDefaultKnobs();
+    EXPECT_EQ(defaults.at("vpls"), std::to_string(RendererOptions{}.vplCount));
+    EXPECT_EQ(defaults.at("resolution"), "session");
+    EXPECT_EQ(defaults.at("virtual"), "on");
 }
 
 TEST(RealtimeBench, CommandRunsOnASynthesisedSessionAndRejectsBadInput) {

@@ -10,6 +10,7 @@ CompositePass::CompositePass()
                                         "passes/composite/composite.frag",
                                         "#define MIRAGE_DIFFUSE_ONLY 1")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
+    locShowVirtual_ = programDiffuse_.uniformLocation("showVirtual");
 }
 
 void CompositePass::setup(PassBuilder& b) const {
@@ -101,6 +102,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
     // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
     ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
+    glUniform1i(locShowVirtual_, ctx.options.showVirtual ? 1 : 0);
     auto tex = [&](Resource a, Resource b) {
         return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
     };
@@ -129,7 +131,8 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
             glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
     ctx.drawFullscreenTriangle();
-    const glm::ivec4 rect = specular ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);
+    const glm::ivec4 rect =
+        specular && ctx.options.showVirtual ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);
     if (rect.z > 0 && rect.w > 0) {
         program_.use();
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);

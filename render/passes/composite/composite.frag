@@ -46,6 +46,7 @@ layout(binding = kUnitCompositeLenv) uniform sampler2D lEnv;         // L_env
 layout(binding = kUnitCompositeRealSurfaces) uniform sampler2D realSurfaces; // nearest real surface, xyz world
 layout(binding = kUnitCompositeCanvasToCamera) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
+uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
 
@@ -119,7 +120,7 @@ void main() {
     vec2 canvasPx = texelFetch(remap, px, 0).xy;
     vec3 result = ci;
     float coverage = 0.0;
-    if (canvasPx.x > -1000.0) {
+    if (canvasPx.x > -1000.0 && showVirtual != 0) {
         vec2 cuv = (canvasPx + 0.5) * canvas.zw;
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);

@@ -1,0 +1,122 @@
+// `mirage bench --suite` on a tiny suite (2 effects, 2 values per knob, 80x60, 2 frames): every
+// plot, table and crop of the results page is written and non-empty, a renderer with the virtual
+// contribution removed (the `virtual=off` knob) is flagged as not beating the footage while the
+// default is not, the sessions are reused on a second run, and a bad suite file is refused with
+// its field named.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "tests/support/TestSupport.h"
+
+namespace mirage {
+namespace {
+
+namespace fs = std::filesystem;
+using test::runMirage;
+
+std::string readAll(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+fs::path writeSuite(const fs::path& dir, const std::string& body) {
+    fs::create_directories(dir);
+    const fs::path file = dir / "suite.json";
+    std::ofstream(file) << body;
+    return file;
+}
+
+std::string tinySuite() {
+    const std::string scene = (test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
+    return R"({
+  "scene": ")" +
+           scene + R"(",
+  "width": 80, "height": 60, "fps": 2, "seconds": 1, "spp": 4, "repeats": 1,
+  "effects": [
+    {"name": "diffuse", "hide": ["glass_sphere", "mirror"],
+     "sweeps": {"vpls": ["16", "64"], "virtual": ["on", "off"]}},
+    {"name": "mirror", "hide": ["glass_sphere"], "sweeps": {"impostor_resolution": ["32", "64"]}}
+  ],
+  "scaling": {"resolutions": ["40x30", "80x60"], "vpls": ["16", "32"], "triangles": [200, 2000]}
+})";
+}
+
+TEST(BenchSuite, TinySuiteWritesEveryPlotTableAndCropAndFlagsABrokenRenderer) {
+    const fs::path dir = test::outputDir("bench_suite");
+    fs::remove_all(dir);
+    const fs::path suite = writeSuite(dir, tinySuite());
+    const fs::path out = dir / "results";
+    const auto r = runMirage({"bench", "--suite", out.string(), "--suite-file", suite.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+
+    const std::string md = readAll(out / "results.md");
+    ASSERT_FALSE(md.empty());
+    for (const char* needle :
+         {"## diffuse", "## mirror", "## Scaling", "machine:", "GL renderer:", "load average",
+          "footage only", "passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg"})
+        EXPECT_NE(md.find(needle), std::string::npos) << needle;
+    for (const char* svg : {"passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg",
+                            "scaling_pixels.svg", "scaling_vpls.svg", "scaling_triangles.svg"}) {
+        const std::string s = readAll(out / svg);
+        EXPECT_GT(s.size(), 500u) << svg;
+        EXPECT_NE(s.find("</svg>"), std::string::npos) << svg;
+        EXPECT_EQ(s.find("nan"), std::string::npos) << svg;
+    }
+    for (const char* png : {"images/diffuse_default.png", "images/diffuse_cheapest.png",
+                            "images/mirror_default.png", "images/mirror_cheapest.png"})
+        EXPECT_GT(fs::file_size(out / png), 100u) << png;
+
+    // The hidden-virtual point is flagged (red, and named in the tables); the default is not.
+    EXPECT_NE(md.find("virtual=off (not above footage)"), std::string::npos) << md;
+    EXPECT_EQ(md.find("| default (not above footage)"), std::string::npos) << md;
+    const std::string diffuse = readAll(out / "diffuse_time_error.svg");
+    EXPECT_NE(diffuse.find("#D00000"), std::string::npos);
+    const std::string mirror = readAll(out / "mirror_time_error.svg");
+    EXPECT_EQ(mirror.find("#D00000"), std::string::npos) << "no mirror setting should be broken";
+    // One point per setting: diffuse has default, vpls=16, vpls=64, virtual=off (vpls=256 and
+    // virtual=on are the default).
+    size_t points = 0;
+    for (size_t p = diffuse.find("class=\"point\""); p != std::string::npos;
+         p = diffuse.find("class=\"point\"", p + 1))
+        ++points;
+    EXPECT_EQ(points, 4u);
+
+    // A second run reuses the sessions.
+    const auto again =
+        runMirage({"bench", "--suite", out.string(), "--suite-file", suite.string()});
+    ASSERT_EQ(again.exitCode, 0) << again.output;
+    EXPECT_NE(again.output.find("reusing the session"), std::string::npos) << again.output;
+}
+
+TEST(BenchSuite, BadSuiteFilesAreRefusedWithTheirField) {
+    const fs::path dir = test::outputDir("bench_suite_bad");
+    fs::remove_all(dir);
+    const struct {
+        std::string body, expect;
+    } cases[] = {
+        {"{\"effects\": []}", "effects"},
+        {"{\"width\": 4, \"effects\": [{\"name\": \"a\"}]}", "width"},
+        {"{\"effects\": [{\"name\": \"a\", \"sweeps\": {\"vpls\": \"64\"}}]}", "wrong type"},
+        {"{\"effects\": [{\"name\": \"a\", \"sweeps\": {\"warp\": [\"1\"]}}]}", "unknown knob"},
+        {"{\"effects\": [{\"name\": \"a\", \"hide\": [\"no_such_node\"]}]}", "no_such_node"},
+        {"not json", "not valid JSON"},
+    };
+    for (const auto& c : cases) {
+        const fs::path suite = writeSuite(dir, c.body);
+        const auto r =
+            runMirage({"bench", "--suite", (dir / "out").string(), "--suite-file", suite.string()});
+        EXPECT_NE(r.exitCode, 0) << c.body;
+        EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.body << "\n" << r.output;
+        EXPECT_FALSE(fs::exists(dir / "out" / "results.md"));
+    }
+    const auto both = runMirage({"bench", "S", "--suite", (dir / "out").string()});
+    EXPECT_NE(both.exitCode, 0);
+    EXPECT_NE(both.output.find("no SESSION"), std::string::npos) << both.output;
+}
+
+}  // namespace
+}  // namespace mirage
