@@ -377,7 +377,7 @@ SuiteSpec defaultSuite() {
           {"impostor_resolution", {"128", "256"}},
           {"specular_trace", {"impostors", "cubemap"}}}},
     };
-    s.scalingResolutions = {"320x240", "480x360", "640x480"};
+    s.scalingResolutions = {"320x240", "640x480", "1024x768", "1600x1200", "1920x1440"};
     s.scalingVpls = {"64", "128", "256", "512", "1024"};
     s.scalingTriangles = {1000, 10000, 100000, 1000000};
     return s;
@@ -463,7 +463,7 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
     std::vector<Scene> scenes;
     for (const auto& e : spec.effects)
         scenes.push_back(sceneVariant(full, e.hideNodes, spec.scene));
-    fs::create_directories(out / "images");
+    fs::create_directories(out / "results" / "images");
 
     std::vector<EffectRun> runs(spec.effects.size());
     for (size_t i = 0; i < spec.effects.size(); ++i) {
@@ -541,8 +541,8 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
         }
         bars.bars.push_back(std::move(b));
     }
-    writeText(out / "passes.svg", plot::svgStackedBars(bars));
-    md += "\n![time per pass](passes.svg)\n";
+    writeText(out / "results" / "passes.svg", plot::svgStackedBars(bars));
+    md += "\n![time per pass](results/passes.svg)\n";
 
     for (const EffectRun& r : runs) {
         const std::string name = safeName(r.effect->name);
@@ -556,10 +556,10 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
         p.hasBaseline = std::isfinite(r.baseline.error.psnrInfluenced);
         p.baselineY = r.baseline.error.psnrInfluenced;
         p.baselineLabel = "footage only";
-        writeText(out / (name + "_time_error.svg"), plot::svgScatter(p));
+        writeText(out / "results" / (name + "_time_error.svg"), plot::svgScatter(p));
         md += fmt::format("\n## {}\n\n{}. Session `{}`.\n\n![{} speed against error]({})\n\n",
                           r.effect->name, r.effect->title, fs::relative(r.session, out).string(),
-                          r.effect->name, name + "_time_error.svg");
+                          r.effect->name, "results/" + name + "_time_error.svg");
         md +=
             "| setting | ms per frame | PSNR infl. (dB) | SSIM infl. | PSNR frame (dB) | "
             "Pareto |\n|---|---|---|---|---|---|\n";
@@ -580,7 +580,7 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
                  {"default", 0}, {"cheapest", r.cheapest}}) {
             const cv::Mat crop = sideBySide(r.results[idx], r.frames.front().influence);
             if (crop.empty()) continue;
-            const std::string file = fmt::format("images/{}_{}.png", name, which);
+            const std::string file = fmt::format("results/images/{}_{}.png", name, which);
             writeBgr8(out / file, crop);
             md += fmt::format("- {} ({}): ![{} {}]({})\n", which, r.pointLabels[idx],
                               r.effect->name, which, file);
@@ -603,8 +603,8 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
             lp.yLabel = "ms per frame";
             lp.logX = logX;
             lp.series = {std::move(s)};
-            writeText(out / file, plot::svgLines(lp));
-            md += fmt::format("![{}]({})\n", title, file);
+            writeText(out / "results" / file, plot::svgLines(lp));
+            md += fmt::format("![{}](results/{})\n", title, file);
         };
         line("scaling_pixels.svg", "Frame time against pixels", "megapixels", scaling.pixels,
              false);

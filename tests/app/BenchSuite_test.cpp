@@ -61,21 +61,21 @@ TEST(BenchSuite, TinySuiteWritesEveryPlotTableAndCropAndFlagsABrokenRenderer) {
         EXPECT_NE(md.find(needle), std::string::npos) << needle;
     for (const char* svg : {"passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg",
                             "scaling_pixels.svg", "scaling_vpls.svg", "scaling_triangles.svg"}) {
-        const std::string s = readAll(out / svg);
+        const std::string s = readAll(out / "results" / svg);
         EXPECT_GT(s.size(), 500u) << svg;
         EXPECT_NE(s.find("</svg>"), std::string::npos) << svg;
         EXPECT_EQ(s.find("nan"), std::string::npos) << svg;
     }
     for (const char* png : {"images/diffuse_default.png", "images/diffuse_cheapest.png",
                             "images/mirror_default.png", "images/mirror_cheapest.png"})
-        EXPECT_GT(fs::file_size(out / png), 100u) << png;
+        EXPECT_GT(fs::file_size(out / "results" / png), 100u) << png;
 
     // The hidden-virtual point is flagged (red, and named in the tables); the default is not.
     EXPECT_NE(md.find("virtual=off (not above footage)"), std::string::npos) << md;
     EXPECT_EQ(md.find("| default (not above footage)"), std::string::npos) << md;
-    const std::string diffuse = readAll(out / "diffuse_time_error.svg");
+    const std::string diffuse = readAll(out / "results" / "diffuse_time_error.svg");
     EXPECT_NE(diffuse.find("#D00000"), std::string::npos);
-    const std::string mirror = readAll(out / "mirror_time_error.svg");
+    const std::string mirror = readAll(out / "results" / "mirror_time_error.svg");
     EXPECT_EQ(mirror.find("#D00000"), std::string::npos) << "no mirror setting should be broken";
     // One point per setting: diffuse has default, vpls=16, vpls=64, virtual=off (vpls=256 and
     // virtual=on are the default).
