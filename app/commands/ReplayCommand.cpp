@@ -28,6 +28,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/Command.h"
+#include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "app/commands/ShardMerge.h"
@@ -56,8 +57,6 @@ bool stopped() {
 }
 
 using Clock = std::chrono::steady_clock;
-// How long an `uncertain` frame may be composited with the last ok pose (seconds).
-constexpr double kHoldUncertainS = 0.25;
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -215,9 +214,7 @@ void runReplay(const ReplayArgs& a) {
     for (int i = 0; i < first && frames->read(bgr); ++i) {
     }
     const auto tStart = Clock::now();
-    bool lastLost = true;
-    std::optional<Pose> lastGood;  // the last composited tracked or given pose, and its time
-    double lastGoodT = 0;
+    FrameCompositor compositor(renderer, tracker.get());
     int done = 0;
     int processed = 0;
     std::vector<std::pair<int, double>> written;  // a shard's frames with an image, and times
@@ -230,74 +227,32 @@ void runReplay(const ReplayArgs& a) {
             break;
         }
         const double decodeMs = msSince(t0);
-        const auto t1 = Clock::now();
-        PoseRow pr;
         const double tFrame = rec.timestamps.empty() ? pos / session.fps : rec.timestamps.front();
         const std::string problem = frames->lastProblem();
-        if (bgr.empty()) {
-            // Lost (damaged bytes): no image to composite into and no pose to trust; the row
-            // says why, the output skips the frame.
-            pr = {"lost", problem.empty() ? "frame not decodable" : problem, std::nullopt};
-            if (tracker) tracker->markLost(tFrame, pr.reason);
-            spdlog::warn("replay: {}", pr.reason);
-        } else if (tracker) {
-            tracking::TrackedFrame tf = tracker->process(bgr, tFrame);
-            pr.state = tracking::trackingStateName(tf.estimate.state);
-            pr.reason = tf.estimate.reason;
-            if (tf.estimate.state == tracking::TrackingState::Ok)
-                pr.pose = tf.filtered ? tf.filtered : tf.estimate.pose;
+        std::optional<PoseRow> given;  // nullopt: tracked (or lost) by the compositor
+        if (bgr.empty() || tracker) {
         } else if (useTracked) {
             auto it = poses.find(rec.index);
-            if (it != poses.end())
-                pr = it->second;
-            else
-                pr = {"lost", "no row in the poses file", std::nullopt};
-            if (pr.state != "ok" && pr.state != "tracking") pr.pose.reset();
+            PoseRow row =
+                it != poses.end() ? it->second : PoseRow{"lost", "no row in the poses file", {}};
+            if (row.state != "ok" && row.state != "tracking") row.pose.reset();
+            given = row;
         } else if (rec.groundTruth) {
-            pr = {"ground_truth", "", rec.groundTruth};
+            given = PoseRow{"ground_truth", "", rec.groundTruth};
         } else {
-            pr = {"lost", "no ground-truth pose in frames.csv", std::nullopt};
+            given = PoseRow{"lost", "no ground-truth pose in frames.csv", std::nullopt};
         }
-        // An uncertain pose (tracked, but its uncertainty exceeds what ok promises) is never
-        // composited; for up to kHoldUncertainS after the last ok pose that pose is held (a
-        // short wobble of the tracking does not blink the virtual objects away), later the
-        // footage passes through as for a loss.
-        if (pr.state == "uncertain") {
-            pr.pose.reset();
-            if (lastGood && tFrame >= lastGoodT && tFrame - lastGoodT <= kHoldUncertainS) {
-                pr.pose = lastGood;
-                pr.reason += cv::format("; held the last ok pose (t = %.3f s)", lastGoodT);
-            }
-        } else if (pr.pose) {
-            lastGood = pr.pose;
-            lastGoodT = tFrame;
-        }
-        const double trackingMs = msSince(t1);
-        std::map<std::string, double> passMs;
-        double gpuMs = 0, readbackMs = 0;
-        cv::Mat result;
-        if (pr.pose) {
-            const render::FrameReport& rep =
-                renderer.render({*pr.pose, bgr, /*resetHistory=*/lastLost});
-            for (const auto& p : rep.passes) passMs[p.name] = p.gpuMs;
-            gpuMs = rep.totalGpuMs;
-            if (a.verbose && processed == 0)
-                spdlog::info("frame {}:\n{}", rec.index, rep.summary());
-            const auto t2 = Clock::now();
-            result = renderer.compositeSrgb();
-            readbackMs = msSince(t2);
-            if (a.window) {
-                // The composite, flipped to the window's bottom-up rows.
-                gl::Framebuffer source("replay window blit");
-                source.attachColor(0, renderer.compositeTexture());
-                const int w = calib.intrinsics.width, h = calib.intrinsics.height;
-                glBlitNamedFramebuffer(source.id(), 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
-                                       GL_NEAREST);
-            }
-        } else {
-            result = bgr;  // tracking lost: the footage passes through, history resets
-        }
-        lastLost = !pr.pose;
+        CompositedFrame cf = compositor.process(bgr, tFrame, problem, given);
+        const PoseRow& pr = cf.pose;
+        if (bgr.empty()) spdlog::warn("replay: {}", pr.reason);
+        const double trackingMs = cf.trackingMs;
+        std::map<std::string, double>& passMs = cf.passMs;
+        const double gpuMs = cf.gpuMs, readbackMs = cf.readbackMs;
+        const cv::Mat& result = cf.image;
+        if (cf.report && a.verbose && processed == 0)
+            spdlog::info("frame {}:\n{}", rec.index, cf.report->summary());
+        if (cf.report && a.window)
+            compositor.blitToWindow(calib.intrinsics.width, calib.intrinsics.height);
         ++processed;
         if (!emit) continue;  // warm-up: history and tracking only
         const auto t3 = Clock::now();
