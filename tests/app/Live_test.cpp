@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -184,6 +186,161 @@ TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
         caught += d.psnrDb <= kSameImageDb;
     }
     EXPECT_EQ(caught, int(rows.size()));
+}
+
+// The footage as recorded (main.mkv, JPEG) against the frames the stand-in delivered.
+std::vector<cv::Mat> recordedFrames(const fs::path& session) {
+    const Session s = readSession(session);
+    auto src = openCameraFrames(s, "main");
+    std::vector<cv::Mat> out;
+    cv::Mat bgr;
+    while (src->read(bgr)) out.push_back(bgr.clone());
+    return out;
+}
+
+// PSNR (dB) of the part of the composites' difference that the footage's difference does not
+// explain: r = (replay - live) - (recorded - original), per pixel and channel. Where the virtual
+// objects change nothing the composite is the footage, so r = 0 there by construction; what is
+// left is the rendering's response to the JPEG error (through alpha = CI / L_r and the video
+// seen in the glass) and any difference in the rendering itself.
+double unexplainedDb(const cv::Mat& live, const cv::Mat& replay, const cv::Mat& original,
+                     const cv::Mat& recorded) {
+    cv::Mat a, b, c, d;
+    live.convertTo(a, CV_32F);
+    replay.convertTo(b, CV_32F);
+    original.convertTo(c, CV_32F);
+    recorded.convertTo(d, CV_32F);
+    const cv::Mat r = (b - a) - (d - c);
+    const cv::Scalar m = cv::mean(r.mul(r));
+    const double mse = (m[0] + m[1] + m[2]) / 3;
+    return mse <= 0 ? 1e9 : 10 * std::log10(255.0 * 255.0 / mse);
+}
+
+TEST(LiveRecording, ReplayOfTheRecordingReproducesTheLiveComposite) {
+    const fs::path dir = outputDir("live_record");
+    const std::string scene = (dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
+    const fs::path rec = dir / "rec";
+    auto live = runMirage({"live", "--camera", sampleSession().string(), "--scene", scene,
+                           "--headless", "--camera-fps", "6", "--frames", "3", "-o",
+                           (dir / "live").string(), "--record", rec.string()});
+    ASSERT_EQ(live.exitCode, 0) << live.output;
+    const std::vector<LiveRow> rows = readLiveCsv(dir / "live" / "frames.csv");
+    ASSERT_EQ(rows.size(), 3u);
+
+    // The recording: a session with the calibration, the board, every processed frame (with
+    // live's capture time) and the live poses.
+    SessionReadReport report;
+    const Session s = readSession(rec, &report);
+    EXPECT_TRUE(report.ok());
+    ASSERT_EQ(s.frames.size(), rows.size());
+    for (size_t k = 0; k < rows.size(); ++k) EXPECT_EQ(s.frames[k].timestamps.at(0), rows[k].t);
+    EXPECT_TRUE(fs::exists(rec / "board.json"));
+    EXPECT_EQ(s.cameras.at(0).calibration, "main.yaml");
+    const std::map<int, PoseRow> poses = readPosesCsv(rec / "poses.csv");
+    ASSERT_EQ(poses.size(), rows.size());
+    for (const auto& [frame, row] : poses) EXPECT_EQ(row.state, rows[size_t(frame)].state);
+
+    auto replay = runMirage({"replay", rec.string(), "--scene", scene, "--poses",
+                             (rec / "poses.csv").string(), "-o", (dir / "replay").string()});
+    ASSERT_EQ(replay.exitCode, 0) << replay.output;
+    const std::vector<cv::Mat> original = sampleFrames(rows), recorded = recordedFrames(rec);
+    ASSERT_EQ(recorded.size(), rows.size());
+    // The recording stores the footage as JPEG (quality 92), so the replay composites slightly
+    // different footage; everything else is the same (frames, order, times, poses). Tolerance:
+    // what the footage's difference does not explain stays above 55 dB (measured 72-76 dB; the
+    // sample's footage is itself MJPEG, so re-encoding changes it little: 60-64 dB), and the
+    // composites differ no more than the footage does, to 1 dB. Every pose 3 mm off: 30-33 dB.
+    auto check = [&](const fs::path& replayDir, double& worstUnexplained) {
+        worstUnexplained = 1e9;
+        bool ok = true;
+        for (size_t k = 0; k < rows.size(); ++k) {
+            const cv::Mat l = cv::imread(frameFile(dir / "live", int(k)).string());
+            const cv::Mat r = cv::imread(frameFile(replayDir, int(k)).string());
+            if (l.empty() || r.empty()) return false;
+            const double footageDb = psnr(original[k], recorded[k], 255);
+            const double compositeDb = psnr(l, r, 255);
+            const double unexplained = unexplainedDb(l, r, original[k], recorded[k]);
+            std::printf(
+                "frame %zu: footage JPEG %.1f dB, composites %.1f dB, unexplained %.1f dB\n", k,
+                footageDb, compositeDb, unexplained);
+            worstUnexplained = std::min(worstUnexplained, unexplained);
+            ok = ok && unexplained > 55.0 && compositeDb > footageDb - 1.0;
+        }
+        return ok;
+    };
+    double worst = 0;
+    EXPECT_TRUE(check(dir / "replay", worst)) << "worst unexplained " << worst << " dB";
+    // The tolerance catches a small error: the replay with every pose 3 mm off.
+    const fs::path off = shiftedPoses(rec / "poses.csv", 0.003, dir / "poses_3mm.csv");
+    auto wrong = runMirage({"replay", rec.string(), "--scene", scene, "--poses", off.string(), "-o",
+                            (dir / "replay_3mm").string()});
+    ASSERT_EQ(wrong.exitCode, 0) << wrong.output;
+    EXPECT_FALSE(check(dir / "replay_3mm", worst)) << "worst unexplained " << worst << " dB";
+}
+
+// kill -9 while recording: every frame with a frames.csv row is readable, every one but at most
+// the last has its live pose, and the session replays.
+TEST(LiveRecording, KilledLeavesEveryEarlierFrameReadable) {
+    const fs::path dir = outputDir("live_record_kill");
+    const fs::path rec = dir / "rec";
+    const std::string log = (dir / "live.log").string();
+    const std::vector<std::string> args = {
+        MIRAGE_BINARY, "live",         "--camera",   sampleSession().string(),
+        "--scene",     diffuseScene(), "--headless", "--camera-fps",
+        "6",           "--record",     rec.string()};
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        std::vector<char*> argv;
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        FILE* f = std::freopen(log.c_str(), "w", stderr);
+        (void)f;
+        ::execv(argv[0], argv.data());
+        _exit(127);
+    }
+    ASSERT_GT(pid, 0);
+    // Wait for three recorded frames (rows after the header), then kill without warning.
+    auto rowsOnDisk = [&] {
+        std::ifstream in(rec / "frames.csv");
+        std::string line;
+        int n = -1;
+        while (std::getline(in, line)) ++n;
+        return n;
+    };
+    const auto t0 = std::chrono::steady_clock::now();
+    while (rowsOnDisk() < 3 && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(90))
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ::kill(pid, SIGKILL);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the recording ended before it was killed";
+    const int rows = rowsOnDisk();
+    ASSERT_GE(rows, 3);
+
+    SessionReadReport report;
+    const Session s = readSession(rec, &report);
+    EXPECT_EQ(report.framesListed, rows);
+    EXPECT_EQ(report.framesReadable, rows);
+    auto src = openCameraFrames(s, "main");
+    cv::Mat bgr;
+    int decoded = 0;
+    while (src->read(bgr)) {
+        EXPECT_FALSE(bgr.empty()) << src->lastProblem();
+        EXPECT_EQ(bgr.size(), cv::Size(640, 480));
+        ++decoded;
+    }
+    EXPECT_EQ(decoded, rows);
+    const std::map<int, PoseRow> poses = readPosesCsv(rec / "poses.csv");
+    EXPECT_GE(int(poses.size()), rows - 1);
+    EXPECT_LE(int(poses.size()), rows);
+    for (const auto& [frame, row] : poses) {
+        EXPECT_LT(frame, rows);
+        EXPECT_EQ(row.state, "ok") << "frame " << frame;
+    }
+    auto replay =
+        runMirage({"replay", rec.string(), "--scene", diffuseScene(), "--poses",
+                   (rec / "poses.csv").string(), "--frames", "2", "-o", (dir / "replay").string()});
+    EXPECT_EQ(replay.exitCode, 0) << replay.output;
 }
 
 }  // namespace
