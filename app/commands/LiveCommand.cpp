@@ -6,11 +6,13 @@
 //
 // Outputs (all optional): -o OUT.mkv or a folder of PNG frames, with a per-frame CSV beside it
 // (OUT.csv or OUT/frames.csv):
-//   frame,t,state,reason,camera_frame,dropped,tracking_ms,<pass>_ms...,gpu_ms,readback_ms,
+//   frame,t,state,reason,camera_frame,dropped,driver_dropped,tracking_ms,<pass>_ms...,gpu_ms,
+//   readback_ms,
 //   frame_ms,latency_ms,tx,ty,tz,qw,qx,qy,qz
 // frame = processed frame number (from 0), t = capture time (seconds, CLOCK_MONOTONIC),
 // camera_frame = the camera's frame counter, dropped = camera frames dropped before this one was
-// taken (newer ones replaced them while processing was busy), latency_ms = output written (or
+// taken (newer ones replaced them while processing was busy), driver_dropped = those the V4L2
+// driver dropped (sequence-number gaps), latency_ms = output written (or
 // shown) minus capture time. The pose is T_world_camera, numbers in their shortest exact form (the
 // file is a poses file for `mirage replay --poses`).
 // --record SESSION: the processed frames with their live poses (core/capture/LiveRecording.h).
@@ -31,6 +33,7 @@
 #include "core/Log.h"
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/capture/CameraControls.h"
 #include "core/capture/CaptureFormat.h"
 #include "core/capture/LatestFrameCapture.h"
 #include "core/capture/LiveRecording.h"
@@ -63,6 +66,7 @@ struct LiveArgs {
     int jpegQuality = 92;
     bool headless = false;
     bool force = false;
+    ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
 };
 
 // The camera: what it is, where its frames come from, how they are paced, and the calibration
@@ -93,12 +97,22 @@ CameraInput openCamera(const LiveArgs& a) {
         req.width = a.width;
         req.height = a.height;
         req.fps = a.cameraFps > 0 ? a.cameraFps : 30;
-        auto cam = std::make_unique<V4l2Camera>(a.camera, req);
+        // Opens the camera and locks its exposure: at the start and after every reconnection
+        // (a camera plugged in again starts with automatic exposure).
+        auto open = [req, device = a.camera, lock = a.exposureLock]() {
+            auto cam = std::make_unique<V4l2Camera>(device, req);
+            cam->lockExposure(lock);
+            return cam;
+        };
+        auto cam = open();
         in.fps = cam->mode().fps;
         in.description = "camera " + v4l2DevicePath(a.camera);
+        if (!cam->modeNote().empty()) in.description += " (" + cam->modeNote() + ")";
         in.source = std::move(cam);
-        // A camera paces itself and stamps frames with the driver's monotonic clock.
+        // A camera paces itself and stamps frames with the driver's monotonic clock; unplugged,
+        // it is reopened until it is back ("camera lost" meanwhile).
         in.pacing.sourceClockIsMonotonic = true;
+        in.pacing.reopen = [open]() -> std::unique_ptr<FrameSource> { return open(); };
         return in;
     }
     const fs::path p = a.camera;
@@ -212,7 +226,7 @@ void runLive(const LiveArgs& a) {
     if (csvOut) {
         csv.open(csvOut->temp());
         if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
-        csv << "frame,t,state,reason,camera_frame,dropped,tracking_ms";
+        csv << "frame,t,state,reason,camera_frame,dropped,driver_dropped,tracking_ms";
         for (const std::string& p : passes) csv << "," << p << "_ms";
         csv << ",gpu_ms,readback_ms,frame_ms,latency_ms,tx,ty,tz,qw,qx,qy,qz\n";
     }
@@ -233,6 +247,7 @@ void runLive(const LiveArgs& a) {
     int processed = 0;
     const auto tStart = Clock::now();
     bool windowClosed = false;
+    bool reportedLost = false;
     while (!stopRequested() && !windowClosed && (a.maxFrames < 0 || processed < a.maxFrames)) {
         CapturedFrame f;
         if (!capture.next(f, 0.1)) {
@@ -241,8 +256,18 @@ void runLive(const LiveArgs& a) {
                 windowClosed = ctx.shouldClose();
             }
             if (capture.ended()) break;
+            // Unplugged: the window stays, the recording keeps every frame so far, and the
+            // session goes on when the camera is back.
+            const bool lost = capture.state() == LatestFrameCapture::State::Lost;
+            if (lost && !reportedLost)
+                spdlog::warn("live: camera lost: {}; waiting for it to come back",
+                             capture.lostReason());
+            if (!lost && reportedLost) spdlog::info("live: camera back");
+            reportedLost = lost;
             continue;
         }
+        if (reportedLost) spdlog::info("live: camera back");
+        reportedLost = false;
         if (!f.bgr.empty() && (f.bgr.cols != width || f.bgr.rows != height))
             throw Error(fmt::format(
                 "mirage live: {} delivers {}x{} frames but the calibration {} is for {}x{}; use "
@@ -270,7 +295,7 @@ void runLive(const LiveArgs& a) {
         if (csv.is_open()) {
             csv << processed << "," << exactDecimal(f.captureSeconds) << ","
                 << csvField(cf.pose.state) << "," << csvField(cf.pose.reason) << "," << f.sequence
-                << "," << f.droppedBefore << "," << cf.trackingMs;
+                << "," << f.droppedBefore << "," << f.deviceDroppedBefore << "," << cf.trackingMs;
             for (const std::string& p : passes) {
                 auto it = cf.passMs.find(p);
                 csv << "," << (it == cf.passMs.end() ? 0.0 : it->second);
@@ -307,9 +332,10 @@ void runLive(const LiveArgs& a) {
     restoreStopSignals();
     spdlog::info(
         "live: {} frames in {:.1f} s ({:.1f} frames/s); camera delivered {}, dropped {} while "
-        "processing was busy; median capture-to-display latency {:.0f} ms",
+        "processing was busy (the driver dropped {}); median capture-to-display latency {:.0f} "
+        "ms; camera reconnected {} times",
         processed, seconds, processed / std::max(seconds, 1e-9), capture.delivered(),
-        capture.dropped(), median(latencies));
+        capture.dropped(), capture.deviceDropped(), median(latencies), capture.reconnections());
     if (!captureError.empty()) throw Error("mirage live: " + captureError);
     if (stopRequested()) commandExitCode() = 128 + stopSignal();
 }
@@ -356,6 +382,18 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--force", args->force, "Replace an existing CSV beside the output");
+    auto setOpt = [](std::optional<int64_t>& o) { return [&o](int64_t v) { o = v; }; };
+    cmd->add_option_function<int64_t>("--camera-exposure", setOpt(args->exposureLock.exposure),
+                                      "Webcam exposure time (V4L2 units of 100 us; default: "
+                                      "where automatic exposure settled, then locked)")
+        ->check(wholeIn(1, 1000000));
+    cmd->add_option_function<int64_t>("--camera-gain", setOpt(args->exposureLock.gain),
+                                      "Webcam gain (device units; default: locked where it was)")
+        ->check(wholeIn(0, 1000000));
+    cmd->add_option_function<int64_t>(
+           "--white-balance", setOpt(args->exposureLock.whiteBalanceK),
+           "Webcam white balance, kelvin (default: locked where automatic white balance was)")
+        ->check(wholeIn(1000, 20000));
     cmd->callback([args] { runLive(*args); });
 });
 

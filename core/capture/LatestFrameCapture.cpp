@@ -38,9 +38,14 @@ void LatestFrameCapture::run() {
         try {
             if (!source_->read(f.bgr)) break;
         } catch (const std::exception& e) {
-            std::lock_guard<std::mutex> lock(mutex_);
-            error_ = e.what();
-            break;
+            if (!options_.reopen) {
+                std::lock_guard<std::mutex> lock(mutex_);
+                error_ = e.what();
+                break;
+            }
+            if (!reconnect(e.what())) break;
+            --i;  // no frame this round
+            continue;
         }
         f.problem = source_->lastProblem();
         f.sequence = i;
@@ -61,6 +66,7 @@ void LatestFrameCapture::run() {
         if (stop_) break;
         f.captureSeconds =
             options_.sourceClockIsMonotonic && sourceTime ? *sourceTime : steadySeconds();
+        deviceDropped_ = deviceDroppedBase_ + source_->deviceDroppedFrames();
         if (slot_) ++dropped_;  // never taken: the newer frame replaces it
         slot_ = std::move(f);
         ++delivered_;
@@ -72,6 +78,55 @@ void LatestFrameCapture::run() {
     ready_.notify_all();
 }
 
+bool LatestFrameCapture::reconnect(const std::string& reason) {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        lost_ = true;
+        lostReason_ = reason;
+        deviceDroppedBase_ = deviceDropped_;
+    }
+    ready_.notify_all();
+    source_.reset();  // close the failed device before opening it again
+    for (;;) {
+        {
+            std::unique_lock<std::mutex> lock(mutex_);
+            if (wake_.wait_for(lock, std::chrono::duration<double>(options_.retrySeconds),
+                               [this] { return stop_; }))
+                return false;
+        }
+        try {
+            source_ = options_.reopen();
+        } catch (const std::exception& e) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            lostReason_ = reason + " (reconnecting: " + e.what() + ")";
+            continue;
+        }
+        if (!source_) continue;
+        std::lock_guard<std::mutex> lock(mutex_);
+        lost_ = false;
+        ++reconnections_;
+        return true;
+    }
+}
+
+LatestFrameCapture::State LatestFrameCapture::state() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (ended_ && !slot_) return State::Ended;
+    return lost_ ? State::Lost : State::Streaming;
+}
+std::string LatestFrameCapture::lostReason() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return lostReason_;
+}
+int LatestFrameCapture::reconnections() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return reconnections_;
+}
+int64_t LatestFrameCapture::deviceDropped() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return deviceDropped_;
+}
+
 bool LatestFrameCapture::next(CapturedFrame& frame, double timeoutSeconds) {
     std::unique_lock<std::mutex> lock(mutex_);
     const bool got = ready_.wait_for(lock, std::chrono::duration<double>(timeoutSeconds),
@@ -79,6 +134,7 @@ bool LatestFrameCapture::next(CapturedFrame& frame, double timeoutSeconds) {
     if (!got || !slot_) return false;
     frame = std::move(*slot_);
     frame.droppedBefore = dropped_;
+    frame.deviceDroppedBefore = deviceDropped_;
     slot_.reset();
     return true;
 }

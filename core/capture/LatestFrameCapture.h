@@ -12,6 +12,7 @@
 // would when processing is slower.
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -34,6 +35,7 @@ struct CapturedFrame {
     double captureSeconds = 0;
     // Frames the hand-off dropped before this one was taken (replaced in the slot unseen).
     int64_t droppedBefore = 0;
+    int64_t deviceDroppedBefore = 0;  // and those the device dropped (driver sequence gaps)
 };
 
 class LatestFrameCapture {
@@ -47,7 +49,13 @@ public:
         // Capture time from the source's lastTimestamp() (a V4L2 camera's driver clock, which
         // is CLOCK_MONOTONIC) instead of the steady clock when the frame is released.
         bool sourceClockIsMonotonic = false;
+        // A camera that fails (unplugged: ENODEV, a stalled stream) is reopened with this,
+        // every `retrySeconds`, until it is back or stop(); meanwhile state() is Lost with the
+        // reason. Unset: a failure ends the stream (error()).
+        std::function<std::unique_ptr<FrameSource>()> reopen;
+        double retrySeconds = 0.5;
     };
+    enum class State { Streaming, Lost, Ended };
     // Starts the capture thread. The source is read only by that thread from now on.
     LatestFrameCapture(std::unique_ptr<FrameSource> source, Options options);
     ~LatestFrameCapture();  // stops and joins the thread
@@ -62,10 +70,16 @@ public:
     std::string error() const;  // the source's exception text, if it failed
     int64_t delivered() const;  // frames the source delivered (taken + dropped + waiting)
     int64_t dropped() const;    // frames replaced in the slot before they were taken
-    void stop();                // ends the thread (also done by the destructor)
+    // Frames the device dropped (driver sequence gaps), over every reconnection.
+    int64_t deviceDropped() const;
+    State state() const;
+    std::string lostReason() const;  // why the camera is (or last was) lost
+    int reconnections() const;
+    void stop();  // ends the thread (also done by the destructor)
 
 private:
     void run();
+    bool reconnect(const std::string& reason);  // false when stopped meanwhile
 
     std::unique_ptr<FrameSource> source_;
     Options options_;
@@ -74,7 +88,10 @@ private:
     std::optional<CapturedFrame> slot_;
     bool stop_ = false, ended_ = false;
     std::string error_;
-    int64_t delivered_ = 0, dropped_ = 0;
+    int64_t delivered_ = 0, dropped_ = 0, deviceDroppedBase_ = 0, deviceDropped_ = 0;
+    bool lost_ = false;
+    std::string lostReason_;
+    int reconnections_ = 0;
     std::thread thread_;
 };
 

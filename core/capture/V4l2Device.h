@@ -23,6 +23,8 @@ public:
     void start() override;
     bool dequeue(RawFrame& frame, int timeoutMs) override;
     void stop() override;
+    std::vector<CameraControl> controls() override;
+    std::optional<int64_t> setControl(CameraControlId id, int64_t value) override;
 
     struct Impl;
 
