@@ -20,9 +20,19 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <optional>
+
+#include <epoxy/gl.h>
+
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <opencv2/imgproc.hpp>
 
 #include "app/Command.h"
 #include "app/FrameCompositor.h"
@@ -67,7 +77,95 @@ struct LiveArgs {
     bool headless = false;
     bool force = false;
     ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
+    std::string screenshot;         // window: save a PNG after --screenshot-after frames, exit
+    int screenshotAfter = 10;
 };
+
+constexpr int kHudWidth = 330;  // pixels, right of the view
+
+// Quality presets of the HUD: VPLs, gather scale (1 = full resolution), impostor resolution.
+struct QualityPreset {
+    const char* name;
+    int vpls, indirectScale, impostorResolution;
+};
+constexpr QualityPreset kPresets[] = {
+    {"low", 64, 2, 128}, {"medium", 256, 2, 256}, {"high", 1024, 1, 512}};
+
+// What the HUD can show instead of the composite (canvas-size linear buffers, tone-mapped by
+// clamping to [0, 1] and sRGB encoding).
+struct BufferView {
+    const char* name;
+    std::optional<render::Resource> resource;  // nullopt: the composite
+};
+const BufferView kViews[] = {{"composite", std::nullopt},
+                             {"L_rv (real + virtual)", render::Resource::LRv},
+                             {"L_r (real only)", render::Resource::LR},
+                             {"direct L_rv", render::Resource::DirectRv},
+                             {"direct L_r", render::Resource::DirectR},
+                             {"G-buffer albedo", render::Resource::GBufferAlbedo},
+                             {"G-buffer normal", render::Resource::GBufferNormal}};
+constexpr int kViewCount = int(sizeof kViews / sizeof kViews[0]);
+
+// RAII for the ImGui context and its GLFW/OpenGL3 backends (as the calibration wizard's).
+struct ImGuiScope {
+    explicit ImGuiScope(GLFWwindow* window) {
+        IMGUI_CHECKVERSION();
+        ImGui::CreateContext();
+        ImGui::GetIO().IniFilename = nullptr;
+        ImGui::StyleColorsDark();
+        ImGui_ImplGlfw_InitForOpenGL(window, true);
+        ImGui_ImplOpenGL3_Init("#version 450");
+    }
+    ~ImGuiScope() {
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+    }
+    ImGuiScope(const ImGuiScope&) = delete;
+    ImGuiScope& operator=(const ImGuiScope&) = delete;
+};
+
+// The window's pixels (back buffer) as a PNG.
+void saveWindowPng(const fs::path& path, GLFWwindow* window) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    cv::Mat rgba(h, w, CV_8UC4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_BACK);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+    cv::Mat bgr;
+    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+    cv::flip(bgr, bgr, 0);  // GL rows start at the bottom
+    createParentFolders(path);
+    writeBgr8(path, bgr);
+    spdlog::info("live: screenshot {}", path.string());
+}
+
+// A linear RGB float buffer (top row first) shown as sRGB 8-bit BGR.
+cv::Mat toneMapForView(const cv::Mat& linearRgb) {
+    cv::Mat c;
+    cv::min(cv::max(linearRgb, 0.0), 1.0, c);
+    cv::Mat out(c.size(), CV_8UC3);
+    for (int y = 0; y < c.rows; ++y)
+        for (int x = 0; x < c.cols; ++x) {
+            const cv::Vec3f v = c.at<cv::Vec3f>(y, x);
+            cv::Vec3b& o = out.at<cv::Vec3b>(y, x);
+            for (int k = 0; k < 3; ++k) {
+                const float l = v[2 - k];  // RGB -> BGR
+                const float e =
+                    l <= 0.0031308f ? 12.92f * l : 1.055f * std::pow(l, 1 / 2.4f) - 0.055f;
+                o[k] = uint8_t(std::lround(std::clamp(e, 0.0f, 1.0f) * 255));
+            }
+        }
+    return out;
+}
+
+std::string timestampName(const char* prefix, const char* ext) {
+    const std::time_t now = std::time(nullptr);
+    char buf[64];
+    std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", std::localtime(&now));
+    return std::string(prefix) + buf + ext;
+}
 
 // The camera: what it is, where its frames come from, how they are paced, and the calibration
 // and board found beside a recorded stand-in.
@@ -77,6 +175,8 @@ struct CameraInput {
     std::string description;
     fs::path calibration, board;  // defaults from a session stand-in
     double fps = 30;              // nominal rate (recorded into session.json)
+    std::string exposureText = "as recorded (a stand-in)";  // for the HUD
+    std::vector<std::string> exposureWarnings;
     std::vector<fs::path> inputs;
 };
 
@@ -104,7 +204,11 @@ CameraInput openCamera(const LiveArgs& a) {
             cam->lockExposure(lock);
             return cam;
         };
-        auto cam = open();
+        auto cam = std::make_unique<V4l2Camera>(a.camera, req);
+        const ExposureLockReport lock = cam->lockExposure(a.exposureLock);
+        in.exposureText = lock.exposureLocked ? "locked" : "AUTOMATIC (not locked)";
+        for (const auto& n : lock.notes) in.exposureText += "; " + n;
+        in.exposureWarnings = lock.warnings;
         in.fps = cam->mode().fps;
         in.description = "camera " + v4l2DevicePath(a.camera);
         if (!cam->modeNote().empty()) in.description += " (" + cam->modeNote() + ")";
@@ -209,20 +313,27 @@ void runLive(const LiveArgs& a) {
     if (!a.record.empty()) checkOutput(a.record, OutputOrigin::Named, rule, true);
 
     gl::ContextOptions copt;
-    copt.width = width;
-    copt.height = height;
+    copt.width = width + kHudWidth;  // the view, and the HUD beside it
+    copt.height = std::max(height, 560);
     copt.title = "mirage live";
     gl::Context ctx = a.headless ? gl::Context::headless(copt) : gl::Context::window(copt);
-    render::RendererOptions ropt;
-    ropt.vplCount = a.vpls;
-    ropt.exposure = a.exposure;
-    render::Renderer renderer(scene, calib.intrinsics, ropt);
-    FrameCompositor compositor(renderer, &tracker);
+    int preset = 1;  // medium: the defaults
+    auto makeRenderer = [&](int vpls, int indirectScale, int impostorResolution) {
+        render::RendererOptions ropt;
+        ropt.vplCount = vpls;
+        ropt.indirectScale = indirectScale;
+        ropt.impostorResolution = impostorResolution;
+        ropt.exposure = a.exposure;
+        return std::make_unique<render::Renderer>(scene, calib.intrinsics, ropt);
+    };
+    std::unique_ptr<render::Renderer> renderer =
+        makeRenderer(a.vpls, kPresets[preset].indirectScale, kPresets[preset].impostorResolution);
+    auto compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
 
     std::unique_ptr<MatroskaWriter> video;
     if (mkv) video = std::make_unique<MatroskaWriter>(videoOut->temp(), cam.fps, a.jpegQuality);
     std::ofstream csv;
-    const std::vector<std::string> passes = renderer.passNames();
+    const std::vector<std::string> passes = renderer->passNames();
     if (csvOut) {
         csv.open(csvOut->temp());
         if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
@@ -231,89 +342,245 @@ void runLive(const LiveArgs& a) {
         csv << ",gpu_ms,readback_ms,frame_ms,latency_ms,tx,ty,tz,qw,qx,qy,qz\n";
     }
     std::unique_ptr<LiveRecording> recording;
-    if (!a.record.empty()) {
+    bool recordNameUsed = false;
+    auto startRecording = [&] {
+        fs::path dir = !a.record.empty() && !recordNameUsed ? fs::path(a.record)
+                                                            : fs::path(timestampName("live-", ""));
+        recordNameUsed = true;
         LiveRecording::Options ro;
         ro.fps = cam.fps;
         ro.jpegQuality = a.jpegQuality;
-        recording = std::make_unique<LiveRecording>(a.record, calibPath, boardPath, ro);
-        spdlog::info("live: recording into {}", a.record);
-    }
+        recording = std::make_unique<LiveRecording>(dir, calibPath, boardPath, ro);
+        spdlog::info("live: recording into {}", dir.string());
+    };
+    auto stopRecording = [&] {
+        if (!recording) return;
+        recording->close();
+        spdlog::info(
+            "live: recorded {} frames into {} (replay: mirage replay {} --scene {} --poses "
+            "{}/poses.csv -o OUT)",
+            recording->frames(), recording->dir().string(), recording->dir().string(), a.scene,
+            recording->dir().string());
+        recording.reset();
+    };
+    if (!a.record.empty()) startRecording();
 
     spdlog::info("live: {} -> {} ({}x{}); tracking on {}", cam.description,
                  a.headless ? "headless" : "window", width, height, boardPath.string());
+    std::optional<ImGuiScope> imgui;
+    if (!a.headless) imgui.emplace(ctx.glfwWindow());
+    gl::Texture shown;  // what the window shows: the composite or a buffer, RGBA8
+    cv::Mat shownRgba;
+    auto show = [&](const cv::Mat& bgr) {
+        if (bgr.empty()) return;
+        if (shown.id() == 0) {
+            shown = gl::Texture::create2D("live view", bgr.cols, bgr.rows, GL_RGBA8);
+            shown.setFilter(GL_LINEAR, GL_LINEAR);
+        }
+        cv::cvtColor(bgr, shownRgba, cv::COLOR_BGR2RGBA);
+        shown.upload(GL_RGBA, GL_UNSIGNED_BYTE, shownRgba.data);
+    };
+
     installStopSignals();
     LatestFrameCapture capture(std::move(cam.source), cam.pacing);
     std::vector<double> latencies;
     int processed = 0;
     const auto tStart = Clock::now();
-    bool windowClosed = false;
-    bool reportedLost = false;
+    bool windowClosed = false, reportedLost = false;
+    bool paused = false, hideVirtual = false;
+    int view = 0;
+    double fpsEma = 0, lastLatencyMs = 0;
+    auto lastFrameAt = Clock::now();
+    CompositedFrame last;  // the last processed frame, for the HUD
+    std::string viewProblem;
     while (!stopRequested() && !windowClosed && (a.maxFrames < 0 || processed < a.maxFrames)) {
         CapturedFrame f;
-        if (!capture.next(f, 0.1)) {
-            if (!a.headless) {
-                ctx.pollEvents();
-                windowClosed = ctx.shouldClose();
-            }
-            if (capture.ended()) break;
-            // Unplugged: the window stays, the recording keeps every frame so far, and the
-            // session goes on when the camera is back.
-            const bool lost = capture.state() == LatestFrameCapture::State::Lost;
-            if (lost && !reportedLost)
-                spdlog::warn("live: camera lost: {}; waiting for it to come back",
-                             capture.lostReason());
-            if (!lost && reportedLost) spdlog::info("live: camera back");
-            reportedLost = lost;
-            continue;
+        bool got = false;
+        if (!paused) {
+            got = capture.next(f, a.headless ? 0.1 : 0.005);
+            if (!got && capture.ended()) break;
         }
-        if (reportedLost) spdlog::info("live: camera back");
-        reportedLost = false;
-        if (!f.bgr.empty() && (f.bgr.cols != width || f.bgr.rows != height))
+        const bool lost = capture.state() == LatestFrameCapture::State::Lost;
+        if (lost && !reportedLost)
+            spdlog::warn("live: camera lost: {}; waiting for it to come back",
+                         capture.lostReason());
+        if (!lost && reportedLost) spdlog::info("live: camera back");
+        reportedLost = lost;
+        if (got && !f.bgr.empty() && (f.bgr.cols != width || f.bgr.rows != height))
             throw Error(fmt::format(
                 "mirage live: {} delivers {}x{} frames but the calibration {} is for {}x{}; use "
                 "the calibration of this camera at this size (or ask the camera for {}x{})",
                 cam.description, f.bgr.cols, f.bgr.rows, calibPath.string(), width, height, width,
                 height));
-        const auto t0 = Clock::now();
-        CompositedFrame cf = compositor.process(f.bgr, f.captureSeconds, f.problem, std::nullopt);
-        if (f.bgr.empty()) spdlog::warn("live: {}", cf.pose.reason);
-        if (!cf.image.empty()) {
-            if (video) video->append(cf.image, f.captureSeconds);
-            if (!out.empty() && !mkv)
-                writeBgr8(out / cv::format("frame_%06d.png", processed), cf.image);
-        }
-        if (!a.headless) {
-            if (cf.report) compositor.blitToWindow(width, height);
-            ctx.swapBuffers();
-            ctx.pollEvents();
-            windowClosed = ctx.shouldClose();
-        }
-        // Shown (or written): the end of the capture-to-display latency.
-        const double latencyMs = (steadySeconds() - f.captureSeconds) * 1e3;
-        latencies.push_back(latencyMs);
-        if (recording && !f.bgr.empty()) recording->append(f.bgr, f.captureSeconds, cf.pose);
-        if (csv.is_open()) {
-            csv << processed << "," << exactDecimal(f.captureSeconds) << ","
-                << csvField(cf.pose.state) << "," << csvField(cf.pose.reason) << "," << f.sequence
-                << "," << f.droppedBefore << "," << f.deviceDroppedBefore << "," << cf.trackingMs;
-            for (const std::string& p : passes) {
-                auto it = cf.passMs.find(p);
-                csv << "," << (it == cf.passMs.end() ? 0.0 : it->second);
+        if (got) {
+            const auto t0 = Clock::now();
+            CompositedFrame cf =
+                compositor->process(f.bgr, f.captureSeconds, f.problem, std::nullopt, !hideVirtual);
+            if (f.bgr.empty()) spdlog::warn("live: {}", cf.pose.reason);
+            if (!cf.image.empty()) {
+                if (video) video->append(cf.image, f.captureSeconds);
+                if (!out.empty() && !mkv)
+                    writeBgr8(out / cv::format("frame_%06d.png", processed), cf.image);
+                if (!a.headless) {
+                    viewProblem.clear();
+                    cv::Mat img = cf.image;
+                    if (kViews[view].resource && cf.report) {
+                        try {
+                            img = toneMapForView(renderer->readBuffer(*kViews[view].resource));
+                        } catch (const Error& e) {
+                            viewProblem = e.what();
+                        }
+                    }
+                    show(img);
+                }
             }
-            csv << "," << cf.gpuMs << "," << cf.readbackMs << "," << msSince(t0) << ","
-                << latencyMs;
-            if (cf.pose.pose) {
-                const Pose& p = *cf.pose.pose;
-                for (double v : {p.translation.x, p.translation.y, p.translation.z, p.rotation.w,
-                                 p.rotation.x, p.rotation.y, p.rotation.z})
-                    csv << "," << exactDecimal(v);
-            } else {
-                csv << ",,,,,,,";
+            // Written (headless) or uploaded for display: the end of the capture-to-display
+            // latency (the window's swap follows below).
+            const double latencyMs = (steadySeconds() - f.captureSeconds) * 1e3;
+            latencies.push_back(latencyMs);
+            lastLatencyMs = latencyMs;
+            if (recording && !f.bgr.empty()) recording->append(f.bgr, f.captureSeconds, cf.pose);
+            if (csv.is_open()) {
+                csv << processed << "," << exactDecimal(f.captureSeconds) << ","
+                    << csvField(cf.pose.state) << "," << csvField(cf.pose.reason) << ","
+                    << f.sequence << "," << f.droppedBefore << "," << f.deviceDroppedBefore << ","
+                    << cf.trackingMs;
+                for (const std::string& p : passes) {
+                    auto it = cf.passMs.find(p);
+                    csv << "," << (it == cf.passMs.end() ? 0.0 : it->second);
+                }
+                csv << "," << cf.gpuMs << "," << cf.readbackMs << "," << msSince(t0) << ","
+                    << latencyMs;
+                if (cf.pose.pose) {
+                    const Pose& p = *cf.pose.pose;
+                    for (double v : {p.translation.x, p.translation.y, p.translation.z,
+                                     p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z})
+                        csv << "," << exactDecimal(v);
+                } else {
+                    csv << ",,,,,,,";
+                }
+                csv << "\n";
+                csv.flush();
             }
-            csv << "\n";
-            csv.flush();
+            const double dt = msSince(lastFrameAt) * 1e-3;
+            lastFrameAt = Clock::now();
+            if (processed > 0 && dt > 0) fpsEma = fpsEma == 0 ? 1 / dt : 0.8 * fpsEma + 0.2 / dt;
+            last = std::move(cf);
+            last.image.release();
+            ++processed;
         }
-        ++processed;
+        if (a.headless) continue;
+
+        // Window: the view, the HUD, the keys.
+        ctx.pollEvents();
+        windowClosed = ctx.shouldClose();
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        int fbw = 0, fbh = 0;
+        glfwGetFramebufferSize(ctx.glfwWindow(), &fbw, &fbh);
+        // The view fills the space left of the HUD, keeping the camera's aspect ratio.
+        const float scale = std::min(float(std::max(fbw - kHudWidth, 1)) / float(width),
+                                     float(fbh) / float(height));
+        if (shown.id() != 0)
+            ImGui::GetBackgroundDrawList()->AddImage(
+                reinterpret_cast<ImTextureID>(static_cast<uintptr_t>(shown.id())), {0, 0},
+                {float(width) * scale, float(height) * scale});
+        bool screenshot = false, toggleRecord = false;
+        const ImGuiIO& io = ImGui::GetIO();
+        if (!io.WantCaptureKeyboard) {
+            if (ImGui::IsKeyPressed(GLFW_KEY_P, false)) paused = !paused;
+            if (ImGui::IsKeyPressed(GLFW_KEY_R, false)) toggleRecord = true;
+            if (ImGui::IsKeyPressed(GLFW_KEY_S, false)) screenshot = true;
+            if (ImGui::IsKeyPressed(GLFW_KEY_H, false)) hideVirtual = !hideVirtual;
+            if (ImGui::IsKeyPressed(GLFW_KEY_B, false)) view = (view + 1) % kViewCount;
+            if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) windowClosed = true;
+        }
+        ImGui::SetNextWindowPos({float(fbw - kHudWidth), 0});
+        ImGui::SetNextWindowSize({float(kHudWidth), float(fbh)});
+        ImGui::Begin(
+            "mirage live", nullptr,
+            ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+        const ImVec4 red(1, 0.4f, 0.4f, 1), green(0.4f, 1, 0.4f, 1), amber(1, 0.85f, 0.3f, 1);
+        if (lost) ImGui::TextColored(red, "CAMERA LOST: %s", capture.lostReason().c_str());
+        ImGui::Text("%.1f frames/s | latency %.0f ms", fpsEma, lastLatencyMs);
+        ImGui::Text("dropped %lld (driver %lld)", static_cast<long long>(capture.dropped()),
+                    static_cast<long long>(capture.deviceDropped()));
+        const std::string& st = last.pose.state;
+        ImGui::TextColored(st == "ok"   ? green
+                           : st.empty() ? amber
+                                        : red,
+                           "tracking: %s", st.empty() ? "waiting for a frame" : st.c_str());
+        ImGui::PushTextWrapPos(0);
+        if (!last.pose.reason.empty()) ImGui::TextWrapped("%s", last.pose.reason.c_str());
+        ImGui::TextWrapped("exposure: %s", cam.exposureText.c_str());
+        for (const auto& w : cam.exposureWarnings) ImGui::TextColored(amber, "%s", w.c_str());
+        ImGui::PopTextWrapPos();
+        ImGui::Separator();
+        if (last.report && ImGui::BeginTable("passes", 2, ImGuiTableFlags_SizingFixedFit)) {
+            for (const auto& pr : last.report->passes) {
+                ImGui::TableNextRow();
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(pr.name.c_str());
+                ImGui::TableNextColumn();
+                if (pr.ran)
+                    ImGui::Text("%6.2f ms", pr.gpuMs);
+                else
+                    ImGui::TextDisabled("%s", pr.reused ? "reused" : "off");
+            }
+            ImGui::EndTable();
+            ImGui::Text("GPU %.1f ms", last.gpuMs);
+        }
+        ImGui::Separator();
+        int newPreset = preset;
+        if (ImGui::BeginCombo("quality", kPresets[preset].name)) {
+            for (int i = 0; i < 3; ++i)
+                if (ImGui::Selectable(kPresets[i].name, i == preset)) newPreset = i;
+            ImGui::EndCombo();
+        }
+        if (ImGui::BeginCombo("view (B)", kViews[view].name)) {
+            for (int i = 0; i < kViewCount; ++i)
+                if (ImGui::Selectable(kViews[i].name, i == view)) view = i;
+            ImGui::EndCombo();
+        }
+        if (!viewProblem.empty()) ImGui::TextColored(amber, "%s", viewProblem.c_str());
+        ImGui::Checkbox("pause (P)", &paused);
+        ImGui::SameLine();
+        ImGui::Checkbox("hide virtual (H)", &hideVirtual);
+        if (ImGui::Button(recording ? "stop recording (R)" : "record (R)")) toggleRecord = true;
+        ImGui::SameLine();
+        if (ImGui::Button("screenshot (S)")) screenshot = true;
+        if (recording)
+            ImGui::TextColored(red, "REC %s: %d frames", recording->dir().string().c_str(),
+                               recording->frames());
+        ImGui::End();
+        ImGui::Render();
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, fbw, fbh);
+        glClearColor(0, 0, 0, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (!a.screenshot.empty() && processed >= a.screenshotAfter) {
+            saveWindowPng(a.screenshot, ctx.glfwWindow());
+            windowClosed = true;
+        }
+        if (screenshot) saveWindowPng(timestampName("mirage-live-", ".png"), ctx.glfwWindow());
+        ctx.swapBuffers();
+        if (toggleRecord) {
+            if (recording)
+                stopRecording();
+            else
+                startRecording();
+        }
+        if (newPreset != preset) {
+            // A new renderer with the preset's options; the temporal history starts again.
+            preset = newPreset;
+            renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
+                                    kPresets[preset].impostorResolution);
+            compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
+            last.report = nullptr;
+            spdlog::info("live: quality {}", kPresets[preset].name);
+        }
     }
     const std::string captureError = capture.error();
     capture.stop();
@@ -322,13 +589,7 @@ void runLive(const LiveArgs& a) {
     if (csv.is_open()) closeChecked(csv, csvPath);
     if (videoOut) videoOut->commit();
     if (csvOut) csvOut->commit();
-    if (recording) {
-        recording->close();
-        spdlog::info(
-            "live: recorded {} frames into {} (replay: mirage replay {} --scene {} "
-            "--poses {}/poses.csv -o OUT)",
-            recording->frames(), a.record, a.record, a.scene, a.record);
-    }
+    stopRecording();
     restoreStopSignals();
     spdlog::info(
         "live: {} frames in {:.1f} s ({:.1f} frames/s); camera delivered {}, dropped {} while "
@@ -382,6 +643,12 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--force", args->force, "Replace an existing CSV beside the output");
+    cmd->add_option("--screenshot", args->screenshot,
+                    "Window: save a PNG of the window after --screenshot-after frames, then exit");
+    cmd->add_option("--screenshot-after", args->screenshotAfter,
+                    "Window: frames to process before --screenshot")
+        ->capture_default_str()
+        ->check(wholeIn(1, 100000000));
     auto setOpt = [](std::optional<int64_t>& o) { return [&o](int64_t v) { o = v; }; };
     cmd->add_option_function<int64_t>("--camera-exposure", setOpt(args->exposureLock.exposure),
                                       "Webcam exposure time (V4L2 units of 100 us; default: "

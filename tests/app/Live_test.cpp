@@ -9,12 +9,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/Csv.h"
 #include "core/session/PosesCsv.h"
@@ -341,6 +343,35 @@ TEST(LiveRecording, KilledLeavesEveryEarlierFrameReadable) {
         runMirage({"replay", rec.string(), "--scene", diffuseScene(), "--poses",
                    (rec / "poses.csv").string(), "--frames", "2", "-o", (dir / "replay").string()});
     EXPECT_EQ(replay.exitCode, 0) << replay.output;
+}
+
+// The window with its HUD under a virtual X server (xvfb-run, from scripts/install-deps.sh):
+// the view shows the footage with the virtual objects, the HUD beside it.
+TEST(LiveWindow, ShowsTheCompositeAndTheHudUnderXvfb) {
+    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0)
+        GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+    const fs::path dir = outputDir("live_window");
+    const fs::path shot = dir / "window.png";
+    const std::string cmd = "xvfb-run -a -s '-screen 0 1280x1024x24' '" +
+                            std::string(MIRAGE_BINARY) + "' live --camera '" +
+                            sampleSession().string() + "' --scene '" + diffuseScene() +
+                            "' --camera-fps 6 --screenshot '" + shot.string() +
+                            "' --screenshot-after 3 > '" + (dir / "log.txt").string() + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    const cv::Mat png = cv::imread(shot.string());
+    ASSERT_FALSE(png.empty());
+    // 640x480 view + 330 px HUD, at least 560 rows.
+    EXPECT_EQ(png.cols, 640 + 330);
+    EXPECT_EQ(png.rows, 560);
+    // The view is the sample's footage (a lit table), not an empty window.
+    const cv::Mat view = png(cv::Rect(0, 0, 640, 480));
+    EXPECT_GT(cv::mean(view)[1], 40.0);
+    // The HUD: a dark panel with text (bright pixels of the glyphs).
+    const cv::Mat hud = png(cv::Rect(640, 0, 330, 560));
+    cv::Mat grey;
+    cv::cvtColor(hud, grey, cv::COLOR_BGR2GRAY);
+    EXPECT_LT(cv::mean(grey)[0], 60.0);
+    EXPECT_GT(cv::countNonZero(grey > 180), 500);
 }
 
 }  // namespace
