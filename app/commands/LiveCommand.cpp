@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <optional>
 
 #include <epoxy/gl.h>
@@ -76,6 +77,7 @@ struct LiveArgs {
     int jpegQuality = 92;
     bool headless = false;
     bool force = false;
+    bool loop = false;              // a stand-in starts again at its end
     ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
     std::string screenshot;         // window: save a PNG after --screenshot-after frames, exit
     int screenshotAfter = 10;
@@ -180,6 +182,26 @@ struct CameraInput {
     std::vector<fs::path> inputs;
 };
 
+// A recorded stand-in played again from the start whenever it ends (for benchmarks longer than
+// the recording).
+class LoopingSource final : public FrameSource {
+public:
+    LoopingSource(std::unique_ptr<FrameSource> first,
+                  std::function<std::unique_ptr<FrameSource>()> reopen)
+        : current_(std::move(first)), reopen_(std::move(reopen)) {}
+    bool read(cv::Mat& bgr) override {
+        if (current_->read(bgr)) return true;
+        current_ = reopen_();
+        return current_->read(bgr);
+    }
+    int frameCount() const override { return -1; }
+    std::string lastProblem() const override { return current_->lastProblem(); }
+
+private:
+    std::unique_ptr<FrameSource> current_;
+    std::function<std::unique_ptr<FrameSource>()> reopen_;
+};
+
 bool isDeviceName(const std::string& s) {
     if (s.rfind("/dev/video", 0) == 0) return true;
     return !s.empty() &&
@@ -244,12 +266,26 @@ CameraInput openCamera(const LiveArgs& a) {
         in.description = "video " + a.camera;
         in.pacing.paceBySourceTime = true;  // the video's own clock when it has one
     }
+    if (!(in.fps > 0)) in.fps = 30;
     if (a.cameraFps > 0) {
         in.fps = a.cameraFps;
-        in.pacing.paceFps = a.cameraFps;
         in.pacing.paceBySourceTime = false;
-    } else if (!in.source->lastTimestamp() && in.fps <= 0) {
-        in.fps = 30;
+    }
+    in.pacing.paceFps = in.fps;  // frames without a time of their own (a video without a clock)
+    if (a.loop) {
+        // Played again from the start at its end, paced at its rate (the recorded times would
+        // start over).
+        in.pacing.paceBySourceTime = false;
+        auto reopen = [path = p, isSession = fs::exists(p / "session.json")]() {
+            if (!isSession) return openFrames(path);
+            Session s = readSession(path);
+            const SessionCamera* main = &s.cameras.front();
+            for (const auto& c : s.cameras)
+                if (c.role == "main") main = &c;
+            return openCameraFrames(s, main->name);
+        };
+        in.source = std::make_unique<LoopingSource>(std::move(in.source), reopen);
+        in.description += ", looped";
     }
     return in;
 }
@@ -621,7 +657,7 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
         ->check(CLI::ExistingFile);
     cmd->add_option("--camera-fps", args->cameraFps,
                     "Frame rate asked of a webcam, or at which a stand-in delivers frames "
-                    "(default: 30 / the stand-in's own)")
+                    "(default: 30; a session's own times; a video's own clock, else 30)")
         ->check(finiteIn(0, 1000, true));
     cmd->add_option("--width", args->width, "Frame width asked of a webcam")
         ->capture_default_str()
@@ -629,6 +665,8 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_option("--height", args->height, "Frame height asked of a webcam")
         ->capture_default_str()
         ->check(wholeIn(16, 16384));
+    cmd->add_flag("--camera-loop", args->loop,
+                  "Play a stand-in session or video again from the start when it ends");
     cmd->add_flag("--headless", args->headless, "No window (EGL): for tests and benchmarks");
     cmd->add_option("--frames", args->maxFrames, "Stop after N processed frames")
         ->check(wholeIn(-1, 100000000));

@@ -53,13 +53,13 @@ void LatestFrameCapture::run() {
         // Pacing: a stand-in waits until the moment a camera would have delivered this frame.
         // The wait is interruptible by stop().
         std::optional<Clock::time_point> due;
-        if (options_.paceFps > 0) {
-            due = start + std::chrono::duration_cast<Clock::duration>(
-                              std::chrono::duration<double>(double(i) / options_.paceFps));
-        } else if (options_.paceBySourceTime && sourceTime) {
+        if (options_.paceBySourceTime && sourceTime) {
             if (!firstSourceTime) firstSourceTime = sourceTime;
             due = start + std::chrono::duration_cast<Clock::duration>(
                               std::chrono::duration<double>(*sourceTime - *firstSourceTime));
+        } else if (options_.paceFps > 0) {
+            due = start + std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(double(i) / options_.paceFps));
         }
         std::unique_lock<std::mutex> lock(mutex_);
         if (due && wake_.wait_until(lock, *due, [this] { return stop_; })) break;

@@ -41,9 +41,10 @@ struct CapturedFrame {
 class LatestFrameCapture {
 public:
     struct Options {
-        // > 0: release frame i at start + i / paceFps (a stand-in for a camera at that rate).
-        // 0 and `paceBySourceTime`: release at the source's own timestamps (relative to its
-        // first); 0 without it: no pacing (the source blocks by itself, as a camera does).
+        // `paceBySourceTime`: release each frame at the source's own timestamp (relative to its
+        // first), as it was recorded; frames without one (and every frame without that flag)
+        // at start + i / paceFps when paceFps > 0 (a stand-in for a camera at that rate); else
+        // no pacing (the source blocks by itself, as a camera does).
         double paceFps = 0;
         bool paceBySourceTime = false;
         // Capture time from the source's lastTimestamp() (a V4L2 camera's driver clock, which
