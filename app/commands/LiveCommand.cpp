@@ -44,6 +44,7 @@
 #include "core/Log.h"
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/capture/CameraCatalog.h"
 #include "core/capture/CameraControls.h"
 #include "core/capture/CaptureFormat.h"
 #include "core/capture/LatestFrameCapture.h"
@@ -77,7 +78,8 @@ struct LiveArgs {
     int jpegQuality = 92;
     bool headless = false;
     bool force = false;
-    bool loop = false;              // a stand-in starts again at its end
+    bool loop = false;  // a stand-in starts again at its end
+    bool listCameras = false;
     ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
     std::string screenshot;         // window: save a PNG after --screenshot-after frames, exit
     int screenshotAfter = 10;
@@ -179,6 +181,7 @@ struct CameraInput {
     double fps = 30;              // nominal rate (recorded into session.json)
     std::string exposureText = "as recorded (a stand-in)";  // for the HUD
     std::vector<std::string> exposureWarnings;
+    std::string calibrationHint, boardHint;  // where a webcam's defaults were looked for
     std::vector<fs::path> inputs;
 };
 
@@ -202,37 +205,90 @@ private:
     std::function<std::unique_ptr<FrameSource>()> reopen_;
 };
 
+// The first V4L2 node that opens as a capture device; throws saying where it looked.
+std::string firstCamera() {
+    const std::vector<std::string> nodes = v4l2DeviceNodes();
+    std::string tried;
+    for (const std::string& n : nodes) {
+        try {
+            V4l2Device d(n);
+            if (!d.modes().empty()) return n;
+            tried += "\n  " + n + ": no MJPEG or YUYV mode";
+        } catch (const Error& e) {
+            tried += "\n  " + n + ": " + e.what();
+        }
+    }
+    throw Error("mirage live: no camera found (looked at /dev/video*: " +
+                (nodes.empty() ? std::string("there is none") : "none streams video" + tried) +
+                "); plug in a webcam, or let a recorded session or video stand in for one: "
+                "--camera SESSION_OR_VIDEO");
+}
+
+// The calibration (and board) kept for a camera in cameraConfigDir(), by its model's name.
+struct CameraDefaults {
+    std::string card;
+    fs::path calibration, board;  // where they are looked for
+    bool haveCalibration = false, haveBoard = false;
+};
+CameraDefaults cameraDefaults(const std::string& node) {
+    CameraDefaults d;
+    V4l2Device dev(node);
+    d.card = dev.card();
+    const fs::path dir = cameraConfigDir();
+    const std::string stem = cameraFileStem(d.card);
+    d.calibration = dir / (stem + ".yaml");
+    d.haveCalibration = fs::exists(d.calibration);
+    d.board = dir / (stem + ".board.json");
+    if (!fs::exists(d.board)) d.board = dir / "board.json";
+    d.haveBoard = fs::exists(d.board);
+    return d;
+}
+
 bool isDeviceName(const std::string& s) {
     if (s.rfind("/dev/video", 0) == 0) return true;
     return !s.empty() &&
            std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit((unsigned char)c); });
 }
 
+// A webcam's calibration and board from cameraConfigDir(), or what to do when there is none.
+void defaultsFor(const std::string& node, CameraInput& in) {
+    const CameraDefaults d = cameraDefaults(node);
+    if (d.haveCalibration) in.calibration = d.calibration;
+    if (d.haveBoard) in.board = d.board;
+    in.calibrationHint = d.haveCalibration
+                             ? ""
+                             : "looked for " + d.calibration.string() + " (camera '" + d.card +
+                                   "'); calibrate it there: mirage calibrate --camera " + node +
+                                   " --board BOARD.json -o " + d.calibration.string();
+    in.boardHint = d.haveBoard ? ""
+                               : "looked for " + d.board.string() + "; copy the board file of " +
+                                     "your printed board there";
+}
+
 CameraInput openCamera(const LiveArgs& a) {
     CameraInput in;
-    if (a.camera.empty())
-        throw Error(
-            "mirage live: name the camera with --camera: /dev/videoN (or N) for a webcam, or a "
-            "recorded session folder or video to stand in for one");
-    if (isDeviceName(a.camera)) {
+    std::string device = a.camera;
+    if (device.empty()) device = firstCamera();
+    if (isDeviceName(device)) {
         CaptureRequest req;
         req.width = a.width;
         req.height = a.height;
         req.fps = a.cameraFps > 0 ? a.cameraFps : 30;
         // Opens the camera and locks its exposure: at the start and after every reconnection
         // (a camera plugged in again starts with automatic exposure).
-        auto open = [req, device = a.camera, lock = a.exposureLock]() {
+        auto open = [req, device, lock = a.exposureLock]() {
             auto cam = std::make_unique<V4l2Camera>(device, req);
             cam->lockExposure(lock);
             return cam;
         };
-        auto cam = std::make_unique<V4l2Camera>(a.camera, req);
+        auto cam = std::make_unique<V4l2Camera>(device, req);
         const ExposureLockReport lock = cam->lockExposure(a.exposureLock);
         in.exposureText = lock.exposureLocked ? "locked" : "AUTOMATIC (not locked)";
         for (const auto& n : lock.notes) in.exposureText += "; " + n;
         in.exposureWarnings = lock.warnings;
         in.fps = cam->mode().fps;
-        in.description = "camera " + v4l2DevicePath(a.camera);
+        in.description = "camera " + v4l2DevicePath(device);
+        defaultsFor(v4l2DevicePath(device), in);
         if (!cam->modeNote().empty()) in.description += " (" + cam->modeNote() + ")";
         in.source = std::move(cam);
         // A camera paces itself and stamps frames with the driver's monotonic clock; unplugged,
@@ -305,18 +361,52 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+// --list-cameras: every V4L2 node, its modes and controls, and which calibration matches.
+void listCameras() {
+    const std::vector<std::string> nodes = v4l2DeviceNodes();
+    std::printf("calibrations are looked for in %s\n", cameraConfigDir().string().c_str());
+    if (nodes.empty()) std::printf("no cameras: /dev/video* holds none\n");
+    for (const std::string& n : nodes) {
+        try {
+            V4l2Device d(n);
+            const std::vector<CaptureMode> modes = d.modes();
+            std::printf("%s: %s\n", n.c_str(), d.card().c_str());
+            for (const CaptureMode& m : modes)
+                std::printf("  %s %dx%d at %.2f frames/s\n", pixelFormatName(m.format), m.width,
+                            m.height, m.fps);
+            if (modes.empty()) std::printf("  no MJPEG or YUYV mode (not usable)\n");
+            std::string controls;
+            for (const CameraControl& c : d.controls())
+                controls += std::string(controls.empty() ? "" : ", ") + cameraControlName(c.id);
+            std::printf("  controls: %s\n", controls.empty() ? "none" : controls.c_str());
+            const CameraDefaults def = cameraDefaults(n);
+            std::printf("  calibration: %s%s\n", def.calibration.string().c_str(),
+                        def.haveCalibration ? "" : " (none yet: mirage calibrate ... -o there)");
+            std::printf("  board: %s%s\n", def.board.string().c_str(),
+                        def.haveBoard ? "" : " (none)");
+        } catch (const Error& e) {
+            std::printf("%s: not usable: %s\n", n.c_str(), e.what());
+        }
+    }
+}
+
 void runLive(const LiveArgs& a) {
+    if (a.listCameras) return listCameras();
+    if (a.scene.empty()) throw Error("mirage live: --scene SCENE is required");
     CameraInput cam = openCamera(a);
     const fs::path calibPath = !a.calibration.empty() ? fs::path(a.calibration) : cam.calibration;
     if (calibPath.empty())
         throw Error("mirage live: no calibration for " + cam.description +
-                    "; pass --calibration CAM.yaml (the file `mirage calibrate` saved for this "
-                    "camera; calibrate it first if there is none)");
+                    (cam.calibrationHint.empty() ? "" : ": " + cam.calibrationHint) +
+                    "; or pass --calibration CAM.yaml (the file `mirage calibrate` saved for "
+                    "this camera)");
     const fs::path boardPath = !a.board.empty() ? fs::path(a.board) : cam.board;
     if (boardPath.empty())
         throw Error("mirage live: no tag board for " + cam.description +
-                    "; pass --board BOARD.json (the board file of the printed board, e.g. from "
-                    "`mirage board`)");
+                    (cam.boardHint.empty() ? "" : ": " + cam.boardHint) +
+                    "; or pass --board BOARD.json (the board file of the printed board, e.g. "
+                    "from `mirage board`)");
+    spdlog::info("live: calibration {}, board {}", calibPath.string(), boardPath.string());
     const CameraCalibration calib = loadCalibration(calibPath);
     const int width = calib.intrinsics.width, height = calib.intrinsics.height;
     checkLooksLikeGltf(a.scene);
@@ -346,7 +436,10 @@ void runLive(const LiveArgs& a) {
         }
         csvOut.emplace(csvPath, OutputOrigin::Derived, rule);
     }
-    if (!a.record.empty()) checkOutput(a.record, OutputOrigin::Named, rule, true);
+    if (!a.record.empty()) {
+        checkOutput(a.record, OutputOrigin::Named, rule, true);
+        LiveRecording::checkFolder(a.record);
+    }
 
     gl::ContextOptions copt;
     copt.width = width + kHudWidth;  // the view, and the HUD beside it
@@ -642,18 +735,20 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     auto* cmd = parent.add_subcommand(
         "live", "Live AR session: track a camera, composite the scene's virtual objects, show it");
     cmd->add_option("--camera", args->camera,
-                    "/dev/videoN (or N) for a webcam; a session folder or a video stands in for "
-                    "a camera, paced at its frame rate");
+                    "/dev/videoN (or N) for a webcam (default: the first camera); a session "
+                    "folder or a video stands in for a camera, paced at its frame rate");
     cmd->add_option("--scene", args->scene,
-                    "Scene (.gltf/.glb) with real proxies and virtual objects")
-        ->required()
+                    "Scene (.gltf/.glb) with real proxies and virtual objects (required)")
         ->check(CLI::ExistingFile);
+    cmd->add_flag("--list-cameras", args->listCameras,
+                  "List the cameras, their modes and controls, and which calibration matches");
     cmd->add_option("--calibration", args->calibration,
                     "The camera's calibration (OpenCV YAML from `mirage calibrate`; default: the "
-                    "stand-in session's)")
+                    "stand-in session's, or a webcam's in the camera folder: --list-cameras)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--board", args->board,
-                    "Tag board file (default: the stand-in session's board)")
+                    "Tag board file (default: the stand-in session's, or beside a webcam's "
+                    "calibration)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--camera-fps", args->cameraFps,
                     "Frame rate asked of a webcam, or at which a stand-in delivers frames "

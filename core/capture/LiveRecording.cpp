@@ -30,10 +30,7 @@ LiveRecording::LiveRecording(const std::filesystem::path& dir,
     : dir_(dir) {
     namespace fs = std::filesystem;
     std::error_code ec;
-    if (fs::exists(dir) && !(fs::is_directory(dir) && fs::is_empty(dir)))
-        throw FileError(dir.string(),
-                        "exists and is not an empty folder; record into a new folder so that "
-                        "recorded footage is never mixed with or written over other files");
+    checkFolder(dir);
     fs::create_directories(dir, ec);
     if (ec) throw FileError(dir.string(), "cannot create the recording folder: " + ec.message());
     // The copies first: session.json names them, and the session must be complete from its
@@ -62,6 +59,14 @@ LiveRecording::LiveRecording(const std::filesystem::path& dir,
     if (posesFd_ < 0)
         throw FileError(poses.string(), std::string("cannot create: ") + std::strerror(errno));
     writeAll(posesFd_, posesCsvHeader(), poses);
+}
+
+void LiveRecording::checkFolder(const std::filesystem::path& dir) {
+    namespace fs = std::filesystem;
+    if (fs::exists(dir) && !(fs::is_directory(dir) && fs::is_empty(dir)))
+        throw FileError(dir.string(),
+                        "exists and is not an empty folder; record into a new folder so that "
+                        "recorded footage is never mixed with or written over other files");
 }
 
 LiveRecording::~LiveRecording() {

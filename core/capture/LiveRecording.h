@@ -36,6 +36,8 @@ public:
     LiveRecording(const std::filesystem::path& dir, const std::filesystem::path& calibration,
                   const std::filesystem::path& board, Options options);
     ~LiveRecording();
+    // The constructor's check of `dir` alone, for callers that check their outputs before work.
+    static void checkFolder(const std::filesystem::path& dir);
     LiveRecording(const LiveRecording&) = delete;
     LiveRecording& operator=(const LiveRecording&) = delete;
 

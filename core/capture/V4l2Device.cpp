@@ -136,6 +136,10 @@ std::string V4l2Device::name() const {
     return impl_->path + " (" + impl_->card + ")";
 }
 
+std::string V4l2Device::card() const {
+    return impl_->card;
+}
+
 std::vector<CaptureMode> V4l2Device::modes() {
     Impl& m = *impl_;
     std::vector<CaptureMode> out;

@@ -18,6 +18,7 @@ public:
     V4l2Device& operator=(const V4l2Device&) = delete;
 
     std::string name() const override;
+    std::string card() const;  // the driver's name of the camera model ("HD Webcam C270")
     std::vector<CaptureMode> modes() override;
     CaptureMode configure(const CaptureMode& mode) override;
     void start() override;

@@ -374,5 +374,72 @@ TEST(LiveWindow, ShowsTheCompositeAndTheHudUnderXvfb) {
     EXPECT_GT(cv::countNonZero(grey > 180), 500);
 }
 
+// Bad input and missing defaults: a clear message and a non-zero exit, before any work.
+TEST(LiveBadInput, SaysWhatIsMissingAndWhatToDo) {
+    const fs::path dir = outputDir("live_bad_input");
+    const std::string video = (sampleSession() / "main.mkv").string();
+    const std::string calib = (sampleSession() / "main.yaml").string();
+    const std::string board = (sampleSession() / "board.json").string();
+    auto expectError = [](const CommandResult& r, const std::string& text) {
+        EXPECT_NE(r.exitCode, 0) << r.output;
+        EXPECT_NE(r.output.find(text), std::string::npos) << "expected '" << text << "' in\n"
+                                                          << r.output;
+    };
+    expectError(runMirage({"live", "--headless", "--camera", sampleSession().string()}),
+                "--scene SCENE is required");
+    expectError(runMirage({"live", "--scene", diffuseScene(), "--headless", "--camera",
+                           (dir / "no-such-video.mkv").string()}),
+                "no such camera, session or video");
+    // A video brings no calibration or board.
+    expectError(runMirage({"live", "--scene", diffuseScene(), "--headless", "--camera", video}),
+                "pass --calibration CAM.yaml");
+    expectError(runMirage({"live", "--scene", diffuseScene(), "--headless", "--camera", video,
+                           "--calibration", calib}),
+                "pass --board BOARD.json");
+    // A calibration for another frame size.
+    {
+        std::ifstream in(calib);
+        std::stringstream text;
+        text << in.rdbuf();
+        std::string yaml = text.str();
+        yaml.replace(yaml.find("image_width: 640"), 16, "image_width: 800");
+        yaml.replace(yaml.find("image_height: 480"), 17, "image_height: 600");
+        std::ofstream(dir / "other_size.yaml") << yaml;
+    }
+    expectError(runMirage({"live", "--scene", diffuseScene(), "--headless", "--camera", video,
+                           "--calibration", (dir / "other_size.yaml").string(), "--board", board,
+                           "--frames", "1"}),
+                "delivers 640x480 frames but the calibration");
+    // Recording never mixes with other files.
+    fs::create_directories(dir / "busy");
+    std::ofstream(dir / "busy" / "notes.txt") << "mine\n";
+    expectError(runMirage({"live", "--scene", diffuseScene(), "--headless", "--camera",
+                           sampleSession().string(), "--record", (dir / "busy").string()}),
+                "is not an empty folder");
+    EXPECT_TRUE(fs::exists(dir / "busy" / "notes.txt"));
+    // The defaults: where calibrations are looked for, and what to do without a camera.
+    auto list = runMirage({"live", "--list-cameras"});
+    EXPECT_EQ(list.exitCode, 0) << list.output;
+    EXPECT_NE(list.output.find("calibrations are looked for in"), std::string::npos) << list.output;
+    if (!fs::exists("/dev/video0")) {
+        expectError(runMirage({"live", "--scene", diffuseScene(), "--headless"}),
+                    "no camera found (looked at /dev/video*");
+    }
+}
+
+// A stand-in played in a loop delivers more frames than it holds.
+TEST(LiveHeadless, LoopedStandInGoesOnPastItsEnd) {
+    const fs::path dir = outputDir("live_loop");
+    auto r = runMirage({"live", "--camera", sampleSession().string(), "--camera-loop",
+                        "--camera-fps", "200", "--scene", diffuseScene(), "--headless", "--vpls",
+                        "16", "--frames", "3", "-o", (dir / "out").string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::vector<LiveRow> rows = readLiveCsv(dir / "out" / "frames.csv");
+    ASSERT_EQ(rows.size(), 3u);
+    // 36 frames at 200 frames/s last 0.18 s; three renders on llvmpipe take longer, so the
+    // camera counter passes the session's end.
+    EXPECT_GT(rows.back().cameraFrame, 36) << r.output;
+}
+
 }  // namespace
 }  // namespace mirage::test
