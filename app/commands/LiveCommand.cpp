@@ -26,6 +26,7 @@
 #include <fstream>
 #include <functional>
 #include <optional>
+#include <thread>
 
 #include <epoxy/gl.h>
 
@@ -35,6 +36,7 @@
 #include <imgui.h>
 #include <opencv2/imgproc.hpp>
 
+#include "app/BoardPlane.h"
 #include "app/Command.h"
 #include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
@@ -54,6 +56,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
+#include "core/scene/ScenePlacement.h"
 #include "core/session/MatroskaWriter.h"
 #include "core/session/Session.h"
 #include "render/Renderer.h"
@@ -80,6 +83,7 @@ struct LiveArgs {
     bool force = false;
     bool loop = false;  // a stand-in starts again at its end
     bool listCameras = false;
+    std::string placement;          // default: <scene>.placement.json
     ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
     std::string screenshot;         // window: save a PNG after --screenshot-after frames, exit
     int screenshotAfter = 10;
@@ -413,7 +417,23 @@ void runLive(const LiveArgs& a) {
     Scene scene = loadScene(a.scene);
     if (!scene.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
-    tracking::Tracker tracker(tracking::Board::load(boardPath), calib.intrinsics);
+    const tracking::Board board = tracking::Board::load(boardPath);
+    tracking::Tracker tracker(board, calib.intrinsics);
+    // Where the virtual objects stand: the saved placement (moves within the board's plane).
+    const fs::path placementFile =
+        a.placement.empty() ? placementPath(a.scene) : fs::path(a.placement);
+    ScenePlacement placement = loadPlacement(placementFile).value_or(ScenePlacement{});
+    const PlacementPlane plane = boardPlane(board);
+    if (!placement.isIdentity())
+        spdlog::info(
+            "live: placement from {}: moved {:.3f}, {:.3f} m, turned {:.1f} deg, scale {:.3f}",
+            placementFile.string(), placement.moveU, placement.moveV, placement.turnDeg,
+            placement.scale);
+    auto placedScene = [&](const ScenePlacement& p) {
+        Scene placed = scene;
+        applyPlacement(placed, p, plane);
+        return placed;
+    };
 
     // Outputs, checked before any work (as replay's).
     OutputRule rule{cam.inputs, a.force, "mirage live"};
@@ -447,13 +467,16 @@ void runLive(const LiveArgs& a) {
     copt.title = "mirage live";
     gl::Context ctx = a.headless ? gl::Context::headless(copt) : gl::Context::window(copt);
     int preset = 1;  // medium: the defaults
+    // A renderer for the scene as placed. Built anew when the quality or the placement changes:
+    // every pass (shadows, VPLs, imperfect shadow maps, impostors) then runs for the new scene in
+    // the next frame; while nothing changes the camera-independent passes are reused.
     auto makeRenderer = [&](int vpls, int indirectScale, int impostorResolution) {
         render::RendererOptions ropt;
         ropt.vplCount = vpls;
         ropt.indirectScale = indirectScale;
         ropt.impostorResolution = impostorResolution;
         ropt.exposure = a.exposure;
-        return std::make_unique<render::Renderer>(scene, calib.intrinsics, ropt);
+        return std::make_unique<render::Renderer>(placedScene(placement), calib.intrinsics, ropt);
     };
     std::unique_ptr<render::Renderer> renderer =
         makeRenderer(a.vpls, kPresets[preset].indirectScale, kPresets[preset].impostorResolution);
@@ -518,6 +541,8 @@ void runLive(const LiveArgs& a) {
     bool windowClosed = false, reportedLost = false;
     bool paused = false, hideVirtual = false;
     int view = 0;
+    bool placementPending = false;
+    auto placementChangedAt = Clock::now();
     double fpsEma = 0, lastLatencyMs = 0;
     auto lastFrameAt = Clock::now();
     CompositedFrame last;  // the last processed frame, for the HUD
@@ -526,8 +551,12 @@ void runLive(const LiveArgs& a) {
         CapturedFrame f;
         bool got = false;
         if (!paused) {
-            got = capture.next(f, a.headless ? 0.1 : 0.005);
+            // The window redraws at most about every 15 ms while it waits for a frame (a frame
+            // that arrives ends the wait at once), so the HUD stays responsive without spinning.
+            got = capture.next(f, a.headless ? 0.1 : 0.015);
             if (!got && capture.ended()) break;
+        } else {
+            std::this_thread::sleep_for(std::chrono::milliseconds(15));
         }
         const bool lost = capture.state() == LatestFrameCapture::State::Lost;
         if (lost && !reportedLost)
@@ -624,6 +653,24 @@ void runLive(const LiveArgs& a) {
             if (ImGui::IsKeyPressed(GLFW_KEY_H, false)) hideVirtual = !hideVirtual;
             if (ImGui::IsKeyPressed(GLFW_KEY_B, false)) view = (view + 1) % kViewCount;
             if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) windowClosed = true;
+            // Placement, snapped to the board plane: 1 cm steps, 5 degree turns, 5 % scale.
+            ScenePlacement p = placement;
+            if (ImGui::IsKeyPressed(GLFW_KEY_LEFT)) p.moveU -= 0.01;
+            if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT)) p.moveU += 0.01;
+            if (ImGui::IsKeyPressed(GLFW_KEY_UP)) p.moveV -= 0.01;
+            if (ImGui::IsKeyPressed(GLFW_KEY_DOWN)) p.moveV += 0.01;
+            if (ImGui::IsKeyPressed(GLFW_KEY_Q)) p.turnDeg += 5;
+            if (ImGui::IsKeyPressed(GLFW_KEY_E)) p.turnDeg -= 5;
+            if (ImGui::IsKeyPressed(GLFW_KEY_EQUAL) || ImGui::IsKeyPressed(GLFW_KEY_KP_ADD))
+                p.scale *= 1.05;
+            if (ImGui::IsKeyPressed(GLFW_KEY_MINUS) || ImGui::IsKeyPressed(GLFW_KEY_KP_SUBTRACT))
+                p.scale /= 1.05;
+            if (ImGui::IsKeyPressed(GLFW_KEY_0, false)) p = ScenePlacement{};
+            if (!(p == placement)) {
+                placement = p;
+                placementChangedAt = Clock::now();
+                placementPending = true;
+            }
         }
         ImGui::SetNextWindowPos({float(fbw - kHudWidth), 0});
         ImGui::SetNextWindowSize({float(kHudWidth), float(fbh)});
@@ -673,6 +720,9 @@ void runLive(const LiveArgs& a) {
             ImGui::EndCombo();
         }
         if (!viewProblem.empty()) ImGui::TextColored(amber, "%s", viewProblem.c_str());
+        ImGui::Text("placement %+.2f %+.2f m, %+.0f deg, x%.2f%s", placement.moveU, placement.moveV,
+                    placement.turnDeg, placement.scale, placementPending ? " (moving)" : "");
+        ImGui::TextDisabled("arrows move, Q/E turn, +/- scale, 0 reset");
         ImGui::Checkbox("pause (P)", &paused);
         ImGui::SameLine();
         ImGui::Checkbox("hide virtual (H)", &hideVirtual);
@@ -700,6 +750,21 @@ void runLive(const LiveArgs& a) {
                 stopRecording();
             else
                 startRecording();
+        }
+        // A placement change is applied once the keys rest for 0.3 s (a rebuild takes about a
+        // second on llvmpipe), and saved beside the scene.
+        if (placementPending && msSince(placementChangedAt) > 300) {
+            placementPending = false;
+            renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
+                                    kPresets[preset].impostorResolution);
+            compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
+            last.report = nullptr;
+            try {
+                savePlacement(placementFile, placement);
+                spdlog::info("live: placement saved to {}", placementFile.string());
+            } catch (const Error& e) {
+                spdlog::warn("live: placement not saved: {}", e.what());
+            }
         }
         if (newPreset != preset) {
             // A new renderer with the preset's options; the temporal history starts again.
@@ -740,6 +805,9 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_option("--scene", args->scene,
                     "Scene (.gltf/.glb) with real proxies and virtual objects (required)")
         ->check(CLI::ExistingFile);
+    cmd->add_option("--placement", args->placement,
+                    "Where the virtual objects stand (default: SCENE.placement.json if it exists; "
+                    "the window's keys move them and save it there)");
     cmd->add_flag("--list-cameras", args->listCameras,
                   "List the cameras, their modes and controls, and which calibration matches");
     cmd->add_option("--calibration", args->calibration,

@@ -27,6 +27,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "app/BoardPlane.h"
 #include "app/Command.h"
 #include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
@@ -42,6 +43,7 @@
 #include "core/gl/Objects.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
+#include "core/scene/ScenePlacement.h"
 #include "core/session/MatroskaWriter.h"
 #include "core/session/PosesCsv.h"
 #include "core/session/Session.h"
@@ -76,7 +78,7 @@ void progress(int done, int total, double fps) {
 }
 
 struct ReplayArgs {
-    std::string session, scene, output, poses, shard;
+    std::string session, scene, output, poses, shard, placement;
     int vpls = 256;
     int maxFrames = -1;
     int start = 0;
@@ -154,6 +156,20 @@ void runReplay(const ReplayArgs& a) {
     const CameraCalibration calib = loadCalibration(session.path(main->calibration));
     checkLooksLikeGltf(a.scene);
     Scene scene = loadScene(a.scene);
+    // The virtual objects where a live session placed them (SCENE.placement.json), on the plane
+    // of the session's board.
+    const std::filesystem::path placementFile =
+        a.placement.empty() ? placementPath(a.scene) : std::filesystem::path(a.placement);
+    if (const auto placement = loadPlacement(placementFile);
+        placement && !placement->isIdentity()) {
+        if (session.board.empty() || !std::filesystem::exists(session.path(session.board)))
+            throw FileError(placementFile.string(),
+                            "places the virtual objects on the tag board, but the session has "
+                            "no board file");
+        applyPlacement(scene, *placement,
+                       boardPlane(tracking::Board::load(session.path(session.board))));
+        spdlog::info("replay: virtual objects placed as {} says", placementFile.string());
+    }
     if (!scene.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
 
@@ -311,9 +327,11 @@ void runReplay(const ReplayArgs& a) {
         rs.warmup = begin - first;
         rs.written = written;
         rs.fingerprint = hex64(fingerprint64(fmt::format(
-            "{} {} {} {} {} {:.9g} {} {}", std::filesystem::absolute(a.session).string(), a.poses,
-            a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
-            userMkv)));
+            "{} {} {} {} {} {:.9g} {} {} {}", std::filesystem::absolute(a.session).string(),
+            a.poses, a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
+            userMkv,
+            std::filesystem::exists(placementFile) ? hex64(fileFingerprint(placementFile))
+                                                   : std::string())));
         finishReplayShard(*staged, rs);
         return;
     }
@@ -341,6 +359,10 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_option("--poses", args->poses,
                     "Camera poses CSV from `mirage track` (default: live tracking on the session's "
                     "board; the ground truth when it has no board file)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--placement", args->placement,
+                    "Where the virtual objects stand on the session's board (default: "
+                    "SCENE.placement.json if it exists, as `mirage live` saves it)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
 

@@ -441,5 +441,45 @@ TEST(LiveHeadless, LoopedStandInGoesOnPastItsEnd) {
     EXPECT_GT(rows.back().cameraFrame, 36) << r.output;
 }
 
+// Virtual objects placed elsewhere on the board: live composites them there, and a replay of the
+// recording with the same placement file reproduces that; without it, it does not.
+TEST(LivePlacement, ReplayAppliesTheSamePlacement) {
+    const fs::path dir = outputDir("live_placement");
+    const fs::path placement = dir / "moved.placement.json";
+    std::ofstream(placement) << R"({"format": "mirage-placement", "version": 1, "move_u_m": 0.06,
+                                    "move_v_m": 0.02, "turn_deg": 30, "scale": 1.2})";
+    const fs::path none = dir / "none.placement.json";
+    std::ofstream(none) << R"({"format": "mirage-placement", "version": 1})";
+    const fs::path rec = dir / "rec";
+    auto live =
+        runMirage({"live", "--camera", sampleSession().string(), "--scene", diffuseScene(),
+                   "--headless", "--camera-fps", "6", "--frames", "2", "--placement",
+                   placement.string(), "-o", (dir / "live").string(), "--record", rec.string()});
+    ASSERT_EQ(live.exitCode, 0) << live.output;
+    EXPECT_NE(live.output.find("placement from"), std::string::npos) << live.output;
+    const std::vector<LiveRow> rows = readLiveCsv(dir / "live" / "frames.csv");
+    ASSERT_EQ(rows.size(), 2u);
+    const std::vector<cv::Mat> original = sampleFrames(rows), recorded = recordedFrames(rec);
+    auto worstUnexplained = [&](const std::string& placementFile, const std::string& name) {
+        auto r = runMirage({"replay", rec.string(), "--scene", diffuseScene(), "--poses",
+                            (rec / "poses.csv").string(), "--placement", placementFile, "-o",
+                            (dir / name).string()});
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+        double worst = 1e9;
+        for (size_t k = 0; k < rows.size(); ++k) {
+            const cv::Mat l = cv::imread(frameFile(dir / "live", int(k)).string());
+            const cv::Mat p = cv::imread(frameFile(dir / name, int(k)).string());
+            if (l.empty() || p.empty()) return 0.0;
+            worst = std::min(worst, unexplainedDb(l, p, original[k], recorded[k]));
+        }
+        std::printf("replay with %s: worst unexplained difference %.1f dB\n", placementFile.c_str(),
+                    worst);
+        return worst;
+    };
+    // The tolerance of LiveRecording (55 dB): the same placement passes, none fails.
+    EXPECT_GT(worstUnexplained(placement.string(), "replay_placed"), 55.0);
+    EXPECT_LT(worstUnexplained(none.string(), "replay_unplaced"), 55.0);
+}
+
 }  // namespace
 }  // namespace mirage::test
