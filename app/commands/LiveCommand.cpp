@@ -746,10 +746,17 @@ void runLive(const LiveArgs& a) {
         if (screenshot) saveWindowPng(timestampName("mirage-live-", ".png"), ctx.glfwWindow());
         ctx.swapBuffers();
         if (toggleRecord) {
-            if (recording)
-                stopRecording();
-            else
-                startRecording();
+            try {
+                if (recording)
+                    stopRecording();
+                else
+                    startRecording();
+            } catch (const Error& e) {
+                // A recording that cannot start (a folder in the way, a full disk) must not end
+                // the session: say why and go on.
+                spdlog::warn("live: {}", e.what());
+                recording.reset();
+            }
         }
         // A placement change is applied once the keys rest for 0.3 s (a rebuild takes about a
         // second on llvmpipe), and saved beside the scene.
