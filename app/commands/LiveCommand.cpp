@@ -41,6 +41,8 @@
 #include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/OutputKind.h"
+#include "app/WindowSupport.h"
 #include "core/Csv.h"
 #include "core/Error.h"
 #include "core/Log.h"
@@ -113,41 +115,6 @@ const BufferView kViews[] = {{"composite", std::nullopt},
                              {"G-buffer albedo", render::Resource::GBufferAlbedo},
                              {"G-buffer normal", render::Resource::GBufferNormal}};
 constexpr int kViewCount = int(sizeof kViews / sizeof kViews[0]);
-
-// RAII for the ImGui context and its GLFW/OpenGL3 backends (as the calibration wizard's).
-struct ImGuiScope {
-    explicit ImGuiScope(GLFWwindow* window) {
-        IMGUI_CHECKVERSION();
-        ImGui::CreateContext();
-        ImGui::GetIO().IniFilename = nullptr;
-        ImGui::StyleColorsDark();
-        ImGui_ImplGlfw_InitForOpenGL(window, true);
-        ImGui_ImplOpenGL3_Init("#version 450");
-    }
-    ~ImGuiScope() {
-        ImGui_ImplOpenGL3_Shutdown();
-        ImGui_ImplGlfw_Shutdown();
-        ImGui::DestroyContext();
-    }
-    ImGuiScope(const ImGuiScope&) = delete;
-    ImGuiScope& operator=(const ImGuiScope&) = delete;
-};
-
-// The window's pixels (back buffer) as a PNG.
-void saveWindowPng(const fs::path& path, GLFWwindow* window) {
-    int w = 0, h = 0;
-    glfwGetFramebufferSize(window, &w, &h);
-    cv::Mat rgba(h, w, CV_8UC4);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_BACK);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-    cv::Mat bgr;
-    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
-    cv::flip(bgr, bgr, 0);  // GL rows start at the bottom
-    createParentFolders(path);
-    writeBgr8(path, bgr);
-    spdlog::info("live: screenshot {}", path.string());
-}
 
 // A linear RGB float buffer (top row first) shown as sRGB 8-bit BGR.
 cv::Mat toneMapForView(const cv::Mat& linearRgb) {
@@ -350,15 +317,6 @@ CameraInput openCamera(const LiveArgs& a) {
     return in;
 }
 
-bool isVideoOutput(const fs::path& out) {
-    std::string ext = out.extension().string();
-    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (ext == ".mkv") return true;
-    if (ext.empty() || fs::is_directory(out)) return false;
-    throw Error("mirage live: output '" + out.string() +
-                "' must end in .mkv (MJPEG video) or be a folder (no extension) for PNG frames");
-}
-
 double median(std::vector<double> v) {
     if (v.empty()) return 0;
     std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
@@ -445,7 +403,7 @@ void runLive(const LiveArgs& a) {
     bool mkv = false;
     if (!a.output.empty()) {
         out = a.output;
-        mkv = isVideoOutput(out);
+        mkv = isVideoOutput(out, "mirage live");
         if (mkv) {
             videoOut.emplace(out, OutputOrigin::Named, rule);
             csvPath = fs::path(out).replace_extension(".csv");

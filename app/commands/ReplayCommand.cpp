@@ -32,6 +32,7 @@
 #include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/OutputKind.h"
 #include "app/commands/ShardMerge.h"
 #include "core/Csv.h"
 #include "core/Error.h"
@@ -94,18 +95,6 @@ struct ReplayArgs {
     bool force = false;
 };
 
-// The output's kind from its name: OUT.mkv is a video; a name without extension (or an
-// existing folder) is a folder of PNG frames; anything else would be a surprise, so it is refused.
-bool isVideoOutput(const std::filesystem::path& out) {
-    std::string ext = out.extension().string();
-    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (ext == ".mkv") return true;
-    if (ext.empty() || std::filesystem::is_directory(out)) return false;
-    throw Error("mirage replay: output '" + out.string() +
-                "' must end in .mkv (MJPEG video) or be a folder (no extension) for PNG frames; " +
-                ext + " is not written");
-}
-
 void runReplay(const ReplayArgs& a) {
     SessionReadReport readReport;
     Session session = readSession(a.session, &readReport);
@@ -121,7 +110,7 @@ void runReplay(const ReplayArgs& a) {
     const std::filesystem::path userOut = a.output;
     const bool split = !a.shard.empty();
     const ShardSpec shard = split ? parseShardSpec(a.shard) : ShardSpec{};
-    const bool userMkv = isVideoOutput(userOut);
+    const bool userMkv = isVideoOutput(userOut, "mirage replay");
     OutputRule rule{sessionInputs(session), a.force, "mirage replay"};
     rule.inputs.push_back(a.scene);
     if (!a.poses.empty()) rule.inputs.push_back(a.poses);
