@@ -500,6 +500,8 @@ void runLive(const LiveArgs& a) {
     bool paused = false, hideVirtual = false;
     int view = 0;
     bool placementPending = false;
+    std::optional<glm::dvec3> dragStart;  // where a left-drag started on the board plane
+    ScenePlacement dragFrom;
     auto placementChangedAt = Clock::now();
     double fpsEma = 0, lastLatencyMs = 0;
     auto lastFrameAt = Clock::now();
@@ -624,6 +626,24 @@ void runLive(const LiveArgs& a) {
             if (ImGui::IsKeyPressed(GLFW_KEY_MINUS) || ImGui::IsKeyPressed(GLFW_KEY_KP_SUBTRACT))
                 p.scale /= 1.05;
             if (ImGui::IsKeyPressed(GLFW_KEY_0, false)) p = ScenePlacement{};
+            // Left-drag on the view moves the objects with the point under the mouse (on the
+            // board plane, seen with the last tracked pose).
+            const ImVec2 mouse = io.MousePos;
+            const glm::dvec2 px(mouse.x / scale, mouse.y / scale);
+            if (ImGui::IsMouseClicked(0) && !io.WantCaptureMouse && last.pose.pose &&
+                mouse.x < float(width) * scale) {
+                dragStart = pixelOnPlane(calib.intrinsics, *last.pose.pose, px, plane);
+                dragFrom = placement;
+            }
+            if (!ImGui::IsMouseDown(0)) dragStart.reset();
+            if (dragStart && last.pose.pose && ImGui::IsMouseDragging(0)) {
+                if (const auto hit = pixelOnPlane(calib.intrinsics, *last.pose.pose, px, plane)) {
+                    const glm::dvec2 m = inPlaneMove(*dragStart, *hit, plane);
+                    // Snapped to whole millimetres on the board.
+                    p.moveU = dragFrom.moveU + std::round(m.x * 1000) / 1000;
+                    p.moveV = dragFrom.moveV + std::round(m.y * 1000) / 1000;
+                }
+            }
             if (!(p == placement)) {
                 placement = p;
                 placementChangedAt = Clock::now();
@@ -680,7 +700,7 @@ void runLive(const LiveArgs& a) {
         if (!viewProblem.empty()) ImGui::TextColored(amber, "%s", viewProblem.c_str());
         ImGui::Text("placement %+.2f %+.2f m, %+.0f deg, x%.2f%s", placement.moveU, placement.moveV,
                     placement.turnDeg, placement.scale, placementPending ? " (moving)" : "");
-        ImGui::TextDisabled("arrows move, Q/E turn, +/- scale, 0 reset");
+        ImGui::TextDisabled("drag or arrows move, Q/E turn, +/- scale, 0 reset");
         ImGui::Checkbox("pause (P)", &paused);
         ImGui::SameLine();
         ImGui::Checkbox("hide virtual (H)", &hideVirtual);
@@ -718,7 +738,7 @@ void runLive(const LiveArgs& a) {
         }
         // A placement change is applied once the keys rest for 0.3 s (a rebuild takes about a
         // second on llvmpipe), and saved beside the scene.
-        if (placementPending && msSince(placementChangedAt) > 300) {
+        if (placementPending && msSince(placementChangedAt) > 300 && !dragStart) {
             placementPending = false;
             renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
                                     kPresets[preset].impostorResolution);

@@ -25,6 +25,27 @@ glm::dmat4 placementMatrix(const ScenePlacement& p, const PlacementPlane& plane,
     return m;
 }
 
+std::optional<glm::dvec3> pixelOnPlane(const CameraIntrinsics& camera, const Pose& T_world_camera,
+                                       const glm::dvec2& pixel, const PlacementPlane& plane) {
+    const std::optional<glm::dvec3> ray = camera.unproject(pixel);
+    if (!ray) return std::nullopt;
+    const glm::dvec3 o = T_world_camera.translation;
+    const glm::dvec3 d = T_world_camera.rotation * *ray;
+    const glm::dvec3 n = glm::normalize(plane.normal);
+    const double denom = glm::dot(d, n);
+    if (std::abs(denom) < 1e-9) return std::nullopt;
+    const double t = glm::dot(plane.point - o, n) / denom;
+    if (!(t > 0)) return std::nullopt;
+    return o + t * d;
+}
+
+glm::dvec2 inPlaneMove(const glm::dvec3& a, const glm::dvec3& b, const PlacementPlane& plane) {
+    const glm::dvec3 n = glm::normalize(plane.normal);
+    const glm::dvec3 u = glm::normalize(plane.axisU - glm::dot(plane.axisU, n) * n);
+    const glm::dvec3 v = glm::cross(n, u);
+    return {glm::dot(b - a, u), glm::dot(b - a, v)};
+}
+
 glm::dvec3 virtualCentre(const Scene& scene) {
     glm::dvec3 sum(0.0);
     int n = 0;

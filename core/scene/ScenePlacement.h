@@ -11,6 +11,8 @@
 
 #include <glm/glm.hpp>
 
+#include "core/camera/CameraModel.h"
+#include "core/math/Pose.h"
 #include "core/scene/Scene.h"
 
 namespace mirage {
@@ -40,6 +42,15 @@ glm::dvec3 virtualCentre(const Scene& scene);
 // Applies the placement to every virtual node (the top virtual node of each virtual subtree is
 // moved; its descendants follow). Returns the number of subtrees moved.
 int applyPlacement(Scene& scene, const ScenePlacement& p, const PlacementPlane& plane);
+
+// Where the camera ray through `pixel` (camera image pixels, centre of the top-left pixel at
+// (0, 0)) meets the plane, in the world; nullopt when the ray misses it (parallel, or the plane
+// is behind the camera). `T_world_camera` in OpenCV camera axes. For dragging objects with the
+// mouse.
+std::optional<glm::dvec3> pixelOnPlane(const CameraIntrinsics& camera, const Pose& T_world_camera,
+                                       const glm::dvec2& pixel, const PlacementPlane& plane);
+// The in-plane move (along axisU, and along normal x axisU) from world point a to world point b.
+glm::dvec2 inPlaneMove(const glm::dvec3& a, const glm::dvec3& b, const PlacementPlane& plane);
 
 // <scene file>.placement.json
 std::filesystem::path placementPath(const std::filesystem::path& scene);

@@ -87,6 +87,42 @@ TEST(ScenePlacement, TurnAndScaleKeepTheCentreOnThePlane) {
     }
 }
 
+// Dragging with the mouse: the pixel where a plane point is seen maps back to that point, and a
+// drag between two pixels moves by the in-plane offset of their points.
+TEST(ScenePlacement, PixelOnPlaneInvertsTheProjection) {
+    CameraIntrinsics cam;
+    cam.width = 640;
+    cam.height = 480;
+    cam.fx = cam.fy = 554.256;
+    cam.cx = 319.5;
+    cam.cy = 239.5;
+    cam.distortion = {-0.1, 0.02, 0.001, -0.002, 0.0};
+    // A camera 0.4 m above the table looking down at 45 degrees (OpenCV axes: +Z forward).
+    const glm::dvec3 eye(0.1, 0.4, 0.5);
+    const glm::dvec3 fwd = glm::normalize(glm::dvec3(0.0, -0.4, -0.4));
+    const glm::dvec3 right = glm::normalize(glm::cross(fwd, glm::dvec3(0, 1, 0)));
+    const glm::dvec3 down = glm::cross(fwd, right);
+    const Pose T = Pose::fromRotationTranslation(glm::dmat3(right, down, fwd), eye);
+    const PlacementPlane plane = tablePlane();
+    for (const glm::dvec3 w :
+         {glm::dvec3(0.1, 0, 0.1), glm::dvec3(-0.05, 0, 0.0), glm::dvec3(0.2, 0, 0.05)}) {
+        const glm::dvec3 pc = glm::transpose(T.rotationMatrix()) * (w - T.translation);
+        const std::optional<glm::dvec2> px = cam.project(pc);
+        ASSERT_TRUE(px.has_value());
+        const std::optional<glm::dvec3> back = pixelOnPlane(cam, T, *px, plane);
+        ASSERT_TRUE(back.has_value());
+        EXPECT_NEAR(glm::length(*back - w), 0.0, 1e-6);
+    }
+    const glm::dvec2 m = inPlaneMove({0, 0, 0}, {0.03, 0, -0.02}, plane);
+    EXPECT_NEAR(m.x, 0.03, 1e-12);
+    EXPECT_NEAR(m.y, 0.02, 1e-12);  // v = +Y x +X = -Z
+    // A pixel whose ray points above the horizon never meets the table.
+    EXPECT_FALSE(pixelOnPlane(cam,
+                              Pose::fromRotationTranslation(glm::dmat3(right, -down, -fwd), eye),
+                              {320, 240}, plane)
+                     .has_value());
+}
+
 TEST(ScenePlacement, FileRoundTripsAndBadContentIsRefused) {
     const auto dir = test::outputDir("scene_placement");
     const auto file = dir / "scene.gltf.placement.json";
