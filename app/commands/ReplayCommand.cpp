@@ -27,9 +27,12 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "app/BoardPlane.h"
 #include "app/Command.h"
+#include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/OutputKind.h"
 #include "app/commands/ShardMerge.h"
 #include "core/Csv.h"
 #include "core/Error.h"
@@ -41,6 +44,7 @@
 #include "core/gl/Objects.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
+#include "core/scene/ScenePlacement.h"
 #include "core/session/MatroskaWriter.h"
 #include "core/session/PosesCsv.h"
 #include "core/session/Session.h"
@@ -56,8 +60,6 @@ bool stopped() {
 }
 
 using Clock = std::chrono::steady_clock;
-// How long an `uncertain` frame may be composited with the last ok pose (seconds).
-constexpr double kHoldUncertainS = 0.25;
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -77,7 +79,7 @@ void progress(int done, int total, double fps) {
 }
 
 struct ReplayArgs {
-    std::string session, scene, output, poses, shard;
+    std::string session, scene, output, poses, shard, placement;
     int vpls = 256;
     int maxFrames = -1;
     int start = 0;
@@ -92,18 +94,6 @@ struct ReplayArgs {
     bool groundTruth = false;
     bool force = false;
 };
-
-// The output's kind from its name: OUT.mkv is a video; a name without extension (or an
-// existing folder) is a folder of PNG frames; anything else would be a surprise, so it is refused.
-bool isVideoOutput(const std::filesystem::path& out) {
-    std::string ext = out.extension().string();
-    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (ext == ".mkv") return true;
-    if (ext.empty() || std::filesystem::is_directory(out)) return false;
-    throw Error("mirage replay: output '" + out.string() +
-                "' must end in .mkv (MJPEG video) or be a folder (no extension) for PNG frames; " +
-                ext + " is not written");
-}
 
 void runReplay(const ReplayArgs& a) {
     SessionReadReport readReport;
@@ -120,7 +110,7 @@ void runReplay(const ReplayArgs& a) {
     const std::filesystem::path userOut = a.output;
     const bool split = !a.shard.empty();
     const ShardSpec shard = split ? parseShardSpec(a.shard) : ShardSpec{};
-    const bool userMkv = isVideoOutput(userOut);
+    const bool userMkv = isVideoOutput(userOut, "mirage replay");
     OutputRule rule{sessionInputs(session), a.force, "mirage replay"};
     rule.inputs.push_back(a.scene);
     if (!a.poses.empty()) rule.inputs.push_back(a.poses);
@@ -155,6 +145,20 @@ void runReplay(const ReplayArgs& a) {
     const CameraCalibration calib = loadCalibration(session.path(main->calibration));
     checkLooksLikeGltf(a.scene);
     Scene scene = loadScene(a.scene);
+    // The virtual objects where a live session placed them (SCENE.placement.json), on the plane
+    // of the session's board.
+    const std::filesystem::path placementFile =
+        a.placement.empty() ? placementPath(a.scene) : std::filesystem::path(a.placement);
+    if (const auto placement = loadPlacement(placementFile);
+        placement && !placement->isIdentity()) {
+        if (session.board.empty() || !std::filesystem::exists(session.path(session.board)))
+            throw FileError(placementFile.string(),
+                            "places the virtual objects on the tag board, but the session has "
+                            "no board file");
+        applyPlacement(scene, *placement,
+                       boardPlane(tracking::Board::load(session.path(session.board))));
+        spdlog::info("replay: virtual objects placed as {} says", placementFile.string());
+    }
     if (!scene.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
 
@@ -215,9 +219,7 @@ void runReplay(const ReplayArgs& a) {
     for (int i = 0; i < first && frames->read(bgr); ++i) {
     }
     const auto tStart = Clock::now();
-    bool lastLost = true;
-    std::optional<Pose> lastGood;  // the last composited tracked or given pose, and its time
-    double lastGoodT = 0;
+    FrameCompositor compositor(renderer, tracker.get());
     int done = 0;
     int processed = 0;
     std::vector<std::pair<int, double>> written;  // a shard's frames with an image, and times
@@ -230,74 +232,32 @@ void runReplay(const ReplayArgs& a) {
             break;
         }
         const double decodeMs = msSince(t0);
-        const auto t1 = Clock::now();
-        PoseRow pr;
         const double tFrame = rec.timestamps.empty() ? pos / session.fps : rec.timestamps.front();
         const std::string problem = frames->lastProblem();
-        if (bgr.empty()) {
-            // Lost (damaged bytes): no image to composite into and no pose to trust; the row
-            // says why, the output skips the frame.
-            pr = {"lost", problem.empty() ? "frame not decodable" : problem, std::nullopt};
-            if (tracker) tracker->markLost(tFrame, pr.reason);
-            spdlog::warn("replay: {}", pr.reason);
-        } else if (tracker) {
-            tracking::TrackedFrame tf = tracker->process(bgr, tFrame);
-            pr.state = tracking::trackingStateName(tf.estimate.state);
-            pr.reason = tf.estimate.reason;
-            if (tf.estimate.state == tracking::TrackingState::Ok)
-                pr.pose = tf.filtered ? tf.filtered : tf.estimate.pose;
+        std::optional<PoseRow> given;  // nullopt: tracked (or lost) by the compositor
+        if (bgr.empty() || tracker) {
         } else if (useTracked) {
             auto it = poses.find(rec.index);
-            if (it != poses.end())
-                pr = it->second;
-            else
-                pr = {"lost", "no row in the poses file", std::nullopt};
-            if (pr.state != "ok" && pr.state != "tracking") pr.pose.reset();
+            PoseRow row =
+                it != poses.end() ? it->second : PoseRow{"lost", "no row in the poses file", {}};
+            if (row.state != "ok" && row.state != "tracking") row.pose.reset();
+            given = row;
         } else if (rec.groundTruth) {
-            pr = {"ground_truth", "", rec.groundTruth};
+            given = PoseRow{"ground_truth", "", rec.groundTruth};
         } else {
-            pr = {"lost", "no ground-truth pose in frames.csv", std::nullopt};
+            given = PoseRow{"lost", "no ground-truth pose in frames.csv", std::nullopt};
         }
-        // An uncertain pose (tracked, but its uncertainty exceeds what ok promises) is never
-        // composited; for up to kHoldUncertainS after the last ok pose that pose is held (a
-        // short wobble of the tracking does not blink the virtual objects away), later the
-        // footage passes through as for a loss.
-        if (pr.state == "uncertain") {
-            pr.pose.reset();
-            if (lastGood && tFrame >= lastGoodT && tFrame - lastGoodT <= kHoldUncertainS) {
-                pr.pose = lastGood;
-                pr.reason += cv::format("; held the last ok pose (t = %.3f s)", lastGoodT);
-            }
-        } else if (pr.pose) {
-            lastGood = pr.pose;
-            lastGoodT = tFrame;
-        }
-        const double trackingMs = msSince(t1);
-        std::map<std::string, double> passMs;
-        double gpuMs = 0, readbackMs = 0;
-        cv::Mat result;
-        if (pr.pose) {
-            const render::FrameReport& rep =
-                renderer.render({*pr.pose, bgr, /*resetHistory=*/lastLost});
-            for (const auto& p : rep.passes) passMs[p.name] = p.gpuMs;
-            gpuMs = rep.totalGpuMs;
-            if (a.verbose && processed == 0)
-                spdlog::info("frame {}:\n{}", rec.index, rep.summary());
-            const auto t2 = Clock::now();
-            result = renderer.compositeSrgb();
-            readbackMs = msSince(t2);
-            if (a.window) {
-                // The composite, flipped to the window's bottom-up rows.
-                gl::Framebuffer source("replay window blit");
-                source.attachColor(0, renderer.compositeTexture());
-                const int w = calib.intrinsics.width, h = calib.intrinsics.height;
-                glBlitNamedFramebuffer(source.id(), 0, 0, 0, w, h, 0, h, w, 0, GL_COLOR_BUFFER_BIT,
-                                       GL_NEAREST);
-            }
-        } else {
-            result = bgr;  // tracking lost: the footage passes through, history resets
-        }
-        lastLost = !pr.pose;
+        CompositedFrame cf = compositor.process(bgr, tFrame, problem, given);
+        const PoseRow& pr = cf.pose;
+        if (bgr.empty()) spdlog::warn("replay: {}", pr.reason);
+        const double trackingMs = cf.trackingMs;
+        std::map<std::string, double>& passMs = cf.passMs;
+        const double gpuMs = cf.gpuMs, readbackMs = cf.readbackMs;
+        const cv::Mat& result = cf.image;
+        if (cf.report && a.verbose && processed == 0)
+            spdlog::info("frame {}:\n{}", rec.index, cf.report->summary());
+        if (cf.report && a.window)
+            compositor.blitToWindow(calib.intrinsics.width, calib.intrinsics.height);
         ++processed;
         if (!emit) continue;  // warm-up: history and tracking only
         const auto t3 = Clock::now();
@@ -356,9 +316,11 @@ void runReplay(const ReplayArgs& a) {
         rs.warmup = begin - first;
         rs.written = written;
         rs.fingerprint = hex64(fingerprint64(fmt::format(
-            "{} {} {} {} {} {:.9g} {} {}", std::filesystem::absolute(a.session).string(), a.poses,
-            a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
-            userMkv)));
+            "{} {} {} {} {} {:.9g} {} {} {}", std::filesystem::absolute(a.session).string(),
+            a.poses, a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
+            userMkv,
+            std::filesystem::exists(placementFile) ? hex64(fileFingerprint(placementFile))
+                                                   : std::string())));
         finishReplayShard(*staged, rs);
         return;
     }
@@ -386,6 +348,10 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_option("--poses", args->poses,
                     "Camera poses CSV from `mirage track` (default: live tracking on the session's "
                     "board; the ground truth when it has no board file)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--placement", args->placement,
+                    "Where the virtual objects stand on the session's board (default: "
+                    "SCENE.placement.json if it exists, as `mirage live` saves it)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
 

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "app/WindowSupport.h"
 #include "calibration/BatchCalibration.h"
 #include "calibration/CalibrationSession.h"
 #include "calibration/Undistorter.h"
@@ -39,25 +40,6 @@ bool nextFrame(FrameSource& source, cv::Mat& bgr, std::string& name, int& index)
     }
     return false;
 }
-
-// RAII for the ImGui context and its GLFW/OpenGL3 backends.
-struct ImGuiScope {
-    explicit ImGuiScope(GLFWwindow* window) {
-        IMGUI_CHECKVERSION();
-        ImGui::CreateContext();
-        ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini next to the user's files
-        ImGui::StyleColorsDark();
-        ImGui_ImplGlfw_InitForOpenGL(window, true);
-        ImGui_ImplOpenGL3_Init("#version 450");
-    }
-    ~ImGuiScope() {
-        ImGui_ImplOpenGL3_Shutdown();
-        ImGui_ImplGlfw_Shutdown();
-        ImGui::DestroyContext();
-    }
-    ImGuiScope(const ImGuiScope&) = delete;
-    ImGuiScope& operator=(const ImGuiScope&) = delete;
-};
 
 // An RGBA8 texture showing an 8-bit BGR image (sRGB-encoded values shown as they are).
 class ImageTexture {
@@ -163,21 +145,6 @@ void saveCalibrationFile(const WizardOptions& o, const calib::CalibrationSession
                           : "saved " + o.output + " marked UNRELIABLE: " + cal.unreliableReason;
     exitCode = cal.reliable ? 0 : 2;
     spdlog::info("{}", status);
-}
-
-void saveScreenshot(const std::string& path, GLFWwindow* window) {
-    int w = 0, h = 0;
-    glfwGetFramebufferSize(window, &w, &h);
-    cv::Mat rgba(h, w, CV_8UC4);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadBuffer(GL_BACK);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-    cv::Mat bgr;
-    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
-    cv::flip(bgr, bgr, 0);  // GL rows start at the bottom
-    std::filesystem::create_directories(std::filesystem::absolute(path).parent_path());
-    if (!cv::imwrite(path, bgr)) throw FileError(path, "cannot write the screenshot");
-    spdlog::info("wrote screenshot {}", path);
 }
 
 }  // namespace
@@ -422,7 +389,7 @@ int runCalibrationWizard(const WizardOptions& o) {
         glClear(GL_COLOR_BUFFER_BIT);
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         if (screenshotCountdown >= 0 && screenshotCountdown-- == 0) {
-            saveScreenshot(o.screenshot, ctx.glfwWindow());
+            saveWindowPng(o.screenshot, ctx.glfwWindow());
             break;
         }
         ctx.swapBuffers();

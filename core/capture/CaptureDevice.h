@@ -4,6 +4,7 @@
 // (V4l2Device) and with a recorded video posing as a camera (VideoFileCaptureDevice), which is
 // how it is tested on machines without a webcam.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,23 @@ struct RawFrame {
     int64_t sequence = -1;      // driver frame counter (gaps = dropped frames); < 0 = none
 };
 
+// Image controls mirage sets (V4L2: V4L2_CID_EXPOSURE_AUTO, _EXPOSURE_ABSOLUTE, _AUTOGAIN,
+// _GAIN, _AUTO_WHITE_BALANCE, _WHITE_BALANCE_TEMPERATURE).
+enum class CameraControlId {
+    AutoExposure,      // 1 = automatic, 0 = manual
+    Exposure,          // exposure time, device units (V4L2: 100 us)
+    AutoGain,          // 1 = automatic, 0 = manual
+    Gain,              // device units
+    AutoWhiteBalance,  // 1 = automatic, 0 = manual
+    WhiteBalance,      // colour temperature, kelvin
+};
+const char* cameraControlName(CameraControlId id);
+
+struct CameraControl {
+    CameraControlId id = CameraControlId::Exposure;
+    int64_t min = 0, max = 0, value = 0;  // range and current value, device units
+};
+
 class CaptureDevice {
 public:
     virtual ~CaptureDevice() = default;
@@ -47,6 +65,11 @@ public:
     // throws mirage::Error on a device error or timeout (camera unplugged).
     virtual bool dequeue(RawFrame& frame, int timeoutMs) = 0;
     virtual void stop() = 0;
+    // The controls of CameraControlId the device offers, with their current values.
+    virtual std::vector<CameraControl> controls() { return {}; }
+    // Sets a control; returns the value the device holds afterwards (drivers clamp or refuse),
+    // nullopt when the device has no such control or refuses it outright.
+    virtual std::optional<int64_t> setControl(CameraControlId, int64_t) { return std::nullopt; }
 };
 
 }  // namespace mirage

@@ -1,5 +1,7 @@
 #include "core/capture/V4l2Camera.h"
 
+#include <cmath>
+
 #include <spdlog/spdlog.h>
 
 #include "core/Error.h"
@@ -27,6 +29,14 @@ V4l2Camera::V4l2Camera(std::unique_ptr<CaptureDevice> device, const CaptureReque
                     (offered.empty() ? "nothing" : offered) + ")");
     }
     mode_ = device_->configure(*chosen);
+    if (mode_.format != chosen->format || mode_.width != chosen->width ||
+        mode_.height != chosen->height || std::abs(mode_.fps - chosen->fps) > 0.01) {
+        modeNote_ =
+            fmt::format("asked {} {}x{} at {:.2f} fps, the driver gives {} {}x{} at {:.2f} fps",
+                        pixelFormatName(chosen->format), chosen->width, chosen->height, chosen->fps,
+                        pixelFormatName(mode_.format), mode_.width, mode_.height, mode_.fps);
+        spdlog::warn("camera {}: {}; using what it gives", device_->name(), modeNote_);
+    }
     spdlog::info("camera {}: {} {}x{} at {:.2f} fps", device_->name(),
                  pixelFormatName(mode_.format), mode_.width, mode_.height, mode_.fps);
     device_->start();
@@ -37,6 +47,13 @@ V4l2Camera::~V4l2Camera() {
         device_->stop();
     } catch (...) {
     }
+}
+
+ExposureLockReport V4l2Camera::lockExposure(const ExposureSettings& settings) {
+    ExposureLockReport r = mirage::lockExposure(*device_, settings);
+    for (const auto& n : r.notes) spdlog::info("camera {}: {}", device_->name(), n);
+    for (const auto& w : r.warnings) spdlog::warn("camera {}: {}", device_->name(), w);
+    return r;
 }
 
 bool V4l2Camera::read(cv::Mat& bgr) {
@@ -50,6 +67,7 @@ bool V4l2Camera::read(cv::Mat& bgr) {
             continue;
         }
         last_ = clock_.stamp(raw, host);
+        dropped_ = clock_.droppedFrames();
         return true;
     }
     throw Error(device_->name() +

@@ -81,8 +81,8 @@ V4l2Device::V4l2Device(const std::string& deviceOrIndex) : impl_(std::make_uniqu
     struct stat st {};
     if (::stat(m.path.c_str(), &st) != 0)
         throw Error("camera " + m.path +
-                    " not found: is a camera plugged in? (`ls /dev/video*`; replay a recorded "
-                    "session instead with `mirage replay`)");
+                    " not found: is a camera plugged in? (`ls /dev/video*`; a recorded session "
+                    "or video can stand in for a camera: `mirage live --camera SESSION`)");
     if (!S_ISCHR(st.st_mode))
         throw Error("camera " + m.path + " is not a device file (expected /dev/videoN)");
     // Plain open + QUERYCAP first, so that a non-V4L2 file gets a clear error (and libv4l2
@@ -134,6 +134,10 @@ V4l2Device::~V4l2Device() {
 
 std::string V4l2Device::name() const {
     return impl_->path + " (" + impl_->card + ")";
+}
+
+std::string V4l2Device::card() const {
+    return impl_->card;
 }
 
 std::vector<CaptureMode> V4l2Device::modes() {
@@ -316,6 +320,71 @@ void V4l2Device::stop() {
     m.streaming = false;
     m.queuedIndex = -1;
     m.releaseBuffers();
+}
+
+namespace {
+
+uint32_t v4l2ControlId(CameraControlId id) {
+    switch (id) {
+        case CameraControlId::AutoExposure:
+            return V4L2_CID_EXPOSURE_AUTO;
+        case CameraControlId::Exposure:
+            return V4L2_CID_EXPOSURE_ABSOLUTE;
+        case CameraControlId::AutoGain:
+            return V4L2_CID_AUTOGAIN;
+        case CameraControlId::Gain:
+            return V4L2_CID_GAIN;
+        case CameraControlId::AutoWhiteBalance:
+            return V4L2_CID_AUTO_WHITE_BALANCE;
+        case CameraControlId::WhiteBalance:
+            return V4L2_CID_WHITE_BALANCE_TEMPERATURE;
+    }
+    return 0;
+}
+
+// V4L2_CID_EXPOSURE_AUTO is a menu (auto, manual, shutter priority, aperture priority; UVC
+// webcams usually offer manual and aperture priority); mirage's control is on/off.
+int64_t fromV4l2(CameraControlId id, int64_t v) {
+    if (id == CameraControlId::AutoExposure) return v == V4L2_EXPOSURE_MANUAL ? 0 : 1;
+    return v;
+}
+
+}  // namespace
+
+std::vector<CameraControl> V4l2Device::controls() {
+    Impl& m = *impl_;
+    std::vector<CameraControl> out;
+    for (CameraControlId id : {CameraControlId::AutoExposure, CameraControlId::Exposure,
+                               CameraControlId::AutoGain, CameraControlId::Gain,
+                               CameraControlId::AutoWhiteBalance, CameraControlId::WhiteBalance}) {
+        v4l2_queryctrl q{};
+        q.id = v4l2ControlId(id);
+        if (xioctl(m.fd, VIDIOC_QUERYCTRL, &q) != 0 || (q.flags & V4L2_CTRL_FLAG_DISABLED))
+            continue;
+        v4l2_control c{};
+        c.id = q.id;
+        if (xioctl(m.fd, VIDIOC_G_CTRL, &c) != 0) continue;
+        out.push_back({id, q.minimum, q.maximum, fromV4l2(id, c.value)});
+    }
+    return out;
+}
+
+std::optional<int64_t> V4l2Device::setControl(CameraControlId id, int64_t value) {
+    Impl& m = *impl_;
+    std::vector<int64_t> tries = {value};
+    if (id == CameraControlId::AutoExposure)
+        tries = value == 0
+                    ? std::vector<int64_t>{V4L2_EXPOSURE_MANUAL}
+                    : std::vector<int64_t>{V4L2_EXPOSURE_APERTURE_PRIORITY, V4L2_EXPOSURE_AUTO};
+    for (int64_t v : tries) {
+        v4l2_control c{};
+        c.id = v4l2ControlId(id);
+        c.value = int32_t(v);
+        if (xioctl(m.fd, VIDIOC_S_CTRL, &c) != 0) continue;
+        if (xioctl(m.fd, VIDIOC_G_CTRL, &c) != 0) return std::nullopt;
+        return fromV4l2(id, c.value);
+    }
+    return std::nullopt;
 }
 
 }  // namespace mirage

@@ -18,11 +18,14 @@ public:
     V4l2Device& operator=(const V4l2Device&) = delete;
 
     std::string name() const override;
+    std::string card() const;  // the driver's name of the camera model ("HD Webcam C270")
     std::vector<CaptureMode> modes() override;
     CaptureMode configure(const CaptureMode& mode) override;
     void start() override;
     bool dequeue(RawFrame& frame, int timeoutMs) override;
     void stop() override;
+    std::vector<CameraControl> controls() override;
+    std::optional<int64_t> setControl(CameraControlId id, int64_t value) override;
 
     struct Impl;
 

@@ -30,6 +30,9 @@ public:
     // What the frame last read is called in messages: its image file's name, or "VIDEO#N" for
     // frame N (from 0) of a video file. Empty for sources without names (a live camera).
     virtual std::string lastName() const { return {}; }
+    // Frames the device itself dropped so far (a V4L2 driver's sequence-number gaps); 0 for
+    // recorded sources.
+    virtual int64_t deviceDroppedFrames() const { return 0; }
 };
 
 // By extension: .png .jpg .jpeg .bmp .tif .tiff .pgm .ppm .webp.

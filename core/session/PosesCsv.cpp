@@ -1,5 +1,6 @@
 #include "core/session/PosesCsv.h"
 
+#include <charconv>
 #include <cmath>
 #include <sstream>
 #include <vector>
@@ -72,6 +73,31 @@ std::map<int, PoseRow> parsePosesCsv(const std::string& text, const std::string&
         }
     }
     return rows;
+}
+
+std::string exactDecimal(double v) {
+    char buf[64];
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    MR_CHECK(ec == std::errc(), "exactDecimal: buffer too small");
+    return std::string(buf, end);
+}
+
+std::string posesCsvHeader() {
+    return "frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz\n";
+}
+
+std::string posesCsvRow(int frame, double t, const PoseRow& row) {
+    std::string s = std::to_string(frame) + "," + exactDecimal(t) + "," + csvField(row.state) +
+                    "," + csvField(row.reason);
+    if (row.pose) {
+        const Pose& p = *row.pose;
+        for (double v : {p.translation.x, p.translation.y, p.translation.z, p.rotation.w,
+                         p.rotation.x, p.rotation.y, p.rotation.z})
+            s += "," + exactDecimal(v);
+    } else {
+        s += ",,,,,,,";
+    }
+    return s + "\n";
 }
 
 std::map<int, PoseRow> readPosesCsv(const std::filesystem::path& path) {

@@ -24,4 +24,13 @@ std::map<int, PoseRow> readPosesCsv(const std::filesystem::path& path);
 // The same on the file's text; `source` names it in messages.
 std::map<int, PoseRow> parsePosesCsv(const std::string& text, const std::string& source);
 
+// Writing the same format: the header line and one row (each with '\n'). Numbers in their
+// shortest exact form, so a pose read back is the pose written, bit for bit (a replay of the
+// poses renders what the writer rendered); the reason quoted when it needs it; a row without
+// a pose leaves the seven pose fields empty.
+std::string posesCsvHeader();
+std::string posesCsvRow(int frame, double t, const PoseRow& row);
+// A double in its shortest exact decimal form ("0.1", "1e-07").
+std::string exactDecimal(double v);
+
 }  // namespace mirage
