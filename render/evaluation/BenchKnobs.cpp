@@ -2,6 +2,7 @@
 // configurations (render/evaluation/RealtimeBench.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 #include <fmt/format.h>
@@ -127,6 +128,29 @@ const std::vector<BenchKnob>& benchKnobs() {
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
+         }},
+        // Caustics (docs/caustics.md): one default value each, as the specular knobs.
+        {"caustics", "on: photon G-buffers and the caustic splat for spot lights on mirror/glass",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.caustics = parseOnOff("caustics", v);
+         }},
+        {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.causticMapSize = parseInt("caustic_map", v, 16, 2048);
+             if (c.options.causticMapSize % 8 != 0)
+                 throw Error(fmt::format("bench: knob caustic_map: {} is not a multiple of 8", v));
+         }},
+        {"caustic_quad", "photon quad radius in photon spacings on the receiver (0.25..8)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1.5"}; },
+         [](BenchConfig& c, const std::string& v) {
+             char* end = nullptr;
+             const float q = std::strtof(v.c_str(), &end);
+             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.25f && q <= 8.0f))
+                 throw Error(
+                     fmt::format("bench: knob caustic_quad: '{}' is not a number in [0.25, 8]", v));
+             c.options.causticQuadScale = q;
          }},
     };
     return knobs;
