@@ -290,6 +290,14 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"static_reuse", {"yes"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"2048x1536"}}}), Error);  // upsampling
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"640x640"}}}), Error);    // aspect
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_map", {"100"}}}), Error);  // not a multiple of 8
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_quad", {"wide"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_quad", {"9"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"caustics", {"sometimes"}}}), Error);
+    const auto caustic = benchGrid(cam, true, {{"caustic_map", {"128", "512"}}});
+    ASSERT_EQ(caustic.size(), 4u);  // x the quick grid's 64 / 256 VPLs
+    EXPECT_EQ(caustic[0].options.causticMapSize, 128);
+    EXPECT_EQ(caustic[1].options.causticMapSize, 512);
 }
 
 TEST(RealtimeBench, CommandRunsOnASynthesisedSessionAndRejectsBadInput) {
