@@ -31,6 +31,12 @@ void RendererOptions::validate() const {
              std::to_string(impostorResolution));
     if (!(shadowBias >= 0.0f && shadowBias <= 1.0f))
         fail("shadowBias must be in [0, 1] metres, got " + std::to_string(shadowBias));
+    if (causticMapSize < 16 || causticMapSize > 2048 || causticMapSize % 8 != 0)
+        fail("causticMapSize must be a multiple of 8 in 16..2048 texels, got " +
+             std::to_string(causticMapSize));
+    if (!(causticQuadScale >= 0.25f && causticQuadScale <= 8.0f))
+        fail("causticQuadScale must be in [0.25, 8] (photon spacings), got " +
+             std::to_string(causticQuadScale));
     if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
         fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
 }
@@ -53,6 +59,10 @@ FrameContext::FrameContext(const GpuScene& s, const CameraProjection& p, const R
     const float far = 1e30f;
     farShadow_.upload(GL_RED, GL_FLOAT, &far);
     farShadow_.setFilter(GL_NEAREST, GL_NEAREST);
+    noGlass_ = gl::Texture::create2DArray("no glass 1x1", 1, 1, 1, GL_RGBA32F);
+    const float noGlass[4] = {0.0f, 0.0f, 0.0f, 1e30f};
+    noGlass_.upload(GL_RGBA, GL_FLOAT, noGlass);
+    noGlass_.setFilter(GL_NEAREST, GL_NEAREST);
 }
 
 void FrameContext::bindFrameBlocks() const {

@@ -36,6 +36,16 @@ struct RendererOptions {
     int refractionMarchSteps = 16;        // back-face depth march steps of the refracted ray
     float backProjectionEpsilon = 0.02f;  // depth validation: |d - d_gbuf| < eps * d + 0.005 m
     bool specularVpls = true;             // light GBuf_refl / GBuf_refr hits with the VPLs too
+    // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
+    // false: glass is an opaque occluder, as mirrors are.
+    bool glassShadows = true;
+    // Caustics from spot lights (Knecht 2013 Sec. 4.2, 5.2; docs/caustics.md): photon G-buffers
+    // of causticMapSize^2 texels per spot light whose cone holds a mirror or glass object (the
+    // frustum fitted to the objects' bounding sphere), splatted as quads whose world radius is
+    // causticQuadScale x the spacing of neighbouring photons on the receiver (Wyman 2008).
+    bool caustics = true;
+    int causticMapSize = 256;
+    float causticQuadScale = 1.5f;
     int specularVplStride = 4;  // 1, 4 or 16: each hit sums every stride-th VPL (x stride),
                                 // interleaved over 2x2 / 4x4 pixels (cheaper, noisier)
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
@@ -64,10 +74,22 @@ struct RendererOptions {
 int ismTilesPerRow(int vplCount);
 
 struct LightPlan {
-    bool castsShadow = false;        // some caster inside the light's cone
-    bool needsRealOnlyMap = false;   // a virtual caster in the cone of a REAL light
-    bool reachesVirtual = false;     // a virtual object inside the light's cone
-    bool hasRsm = false;             // VPLs are placed from this light
+    bool castsShadow = false;       // some caster inside the light's cone
+    bool needsRealOnlyMap = false;  // a virtual caster in the cone of a REAL light
+    bool reachesVirtual = false;    // a virtual object inside the light's cone
+    bool hasRsm = false;            // VPLs are placed from this light
+    // Glass in the cone transmits this light in the shadow maps (ShadowGlass atlases); a light
+    // with a real-only shadow map also gets a real-only glass layer (real glass only).
+    bool glassTransmits = false;
+    bool needsRealOnlyGlass = false;
+    // Caustics: a spot light with a specular object in its cone gets photon G-buffers (layer
+    // causticLayer) rendered through causticViewProj (world -> clip, fitted to the specular
+    // objects' bounding sphere; tan of its half angle causticTanHalf). Glass is then opaque in
+    // this light's shadow maps: the photons carry the light through it (as in the reference).
+    bool caustics = false;
+    int causticLayer = -1;
+    glm::mat4 causticViewProj{1.0f};
+    float causticTanHalf = 1.0f;
     int firstLayer = 0, layers = 0;  // in the shadow / RSM atlases
     int firstVpl = 0, vplCount = 0;
     std::string reason;
@@ -78,6 +100,11 @@ struct FramePlan {
     int shadowLayers = 0;
     bool needVpls = false;
     bool needRealOnlyShadows = false;
+    bool glassShadows = false;  // some light's shadow maps have glass (ShadowGlass written)
+    bool needRealOnlyGlass = false;
+    int causticLayers = 0;           // spot lights with photon G-buffers this frame
+    float causticIrradiance = 0.0f;  // W/m^2: the largest I / d^2 of a caustic light at its objects
+    std::string causticReason;
     bool needRealOnlyIsm = false;
     std::string vplReason;
 };
@@ -107,6 +134,8 @@ public:
 
     const gl::Texture& blackTexture() const { return black_; }          // 1x1 RGBA16F zero
     const gl::Texture& farShadowTexture() const { return farShadow_; }  // 1x1 array, 1e30
+    // 1x1 RGBA32F array (0, 0, 0, 1e30): no glass between any light and any point.
+    const gl::Texture& noGlassTexture() const { return noGlass_; }
 
     int canvasWidth() const { return projection.canvasWidth; }
     int canvasHeight() const { return projection.canvasHeight; }
@@ -122,7 +151,7 @@ public:
     void drawFullscreenTriangleIn(const glm::ivec4& rect, int attachments) const;
 
 private:
-    gl::Texture black_, farShadow_;
+    gl::Texture black_, farShadow_, noGlass_;
 };
 
 }  // namespace mirage::render

@@ -37,6 +37,10 @@ bool expectedSize(SizeRule s, const FrameContext& c, int& w, int& h, int& layers
         case SizeRule::IsmAtlas:
             w = h = ismTilesPerRow(o.vplCount) * o.ismTileSize;
             return true;
+        case SizeRule::CausticMap:
+            w = h = o.causticMapSize;
+            layers = std::max(1, c.plan.causticLayers);
+            return true;
         case SizeRule::Impostor:
         case SizeRule::Vpl:
         case SizeRule::Scene:

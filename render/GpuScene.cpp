@@ -154,10 +154,12 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                     -1,
                     glm::vec3(0.0f),
                     0.0f,
+                    false,
                     false};
             const Material& mat = scene.material(p.material);
             // Mirror: metallic ~1 with low roughness; glass: any transmission (rough glass too).
             r.specular = mat.isMirror() || mat.isTransmissive();
+            r.transmissive = mat.isTransmissive() && !mat.isMirror();
             const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
             if (mat.baseColorTexture.valid() &&
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
@@ -231,6 +233,7 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             d.baseColorTexture = r.texture;
             d.origin = inst.origin;
             d.specular = r.specular;
+            d.transmissive = r.transmissive;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
             d.indexCount = r.count;
@@ -431,7 +434,15 @@ void MaterialDraw::draw(const GpuScene& scene, const DrawItem& d) const {
 std::string GpuScene::lightingDefines() const {
     int faces = 0;
     for (const SceneLight& l : lights_) faces = std::max(faces, l.type == kLightPoint ? 6 : 1);
-    return "#define MIRAGE_MAX_SHADOW_FACES " + std::to_string(faces);
+    std::string defines = "#define MIRAGE_MAX_SHADOW_FACES " + std::to_string(faces) + "\n";
+    if (hasTransmissive()) defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
+    return defines;
+}
+
+bool GpuScene::hasTransmissive() const {
+    for (const DrawItem& d : draws_)
+        if (d.transmissive) return true;
+    return false;
 }
 
 }  // namespace mirage::render

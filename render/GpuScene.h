@@ -39,6 +39,9 @@ struct DrawItem {
     // A specular object (mirror or glass): its pixels are shaded from the reflected / refracted
     // ray hits (GBuf_refl / GBuf_refr, Knecht 2013 Sec. 4.1), not from its own surface.
     bool specular = false;
+    // Glass (transmission > 0, not a mirror): it transmits light in the shadow maps (coloured,
+    // Fresnel- and absorption-weighted) instead of blocking it.
+    bool transmissive = false;
     GLint baseVertex = 0;
     GLuint firstIndex = 0;
     GLsizei indexCount = 0;
@@ -68,8 +71,10 @@ public:
     const std::vector<SceneLight>& lights() const { return lights_; }
     // GLSL #defines that specialise the lighting shaders to this scene's lights
     // (MIRAGE_MAX_SHADOW_FACES: 6 with a point light, 1 with spot / directional only, 0 without
-    // lights; see lighting.glsl for why a constant loop bound matters on llvmpipe).
+    // lights; see lighting.glsl for why a constant loop bound matters on llvmpipe;
+    // MIRAGE_GLASS_SHADOWS when some draw is glass: the shadow lookups read the glass atlases).
     std::string lightingDefines() const;
+    bool hasTransmissive() const;
     // Indices into draws() of the specular (mirror / glass) items, in draw order.
     const std::vector<int>& specularDraws() const { return specularDraws_; }
     const BoundingSphere& bounds() const { return bounds_; }
@@ -117,6 +122,7 @@ private:
         glm::vec3 center;
         float radius;
         bool specular;
+        bool transmissive;
     };
     // The constructor's steps, in order.
     void uploadTextures(const Scene& scene);

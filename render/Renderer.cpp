@@ -10,6 +10,8 @@
 
 #include "core/Error.h"
 #include "render/passes/backface/BackFacePass.h"
+#include "render/passes/caustic/CausticPass.h"
+#include "render/passes/caustic/PhotonGBufferPass.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
@@ -94,6 +96,22 @@ glm::ivec4 specularScissor(const GpuScene& s, const glm::mat4& view, const glm::
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
+// The smallest sphere holding both.
+BoundingSphere mergeSpheres(const BoundingSphere& a, const BoundingSphere& b) {
+    const glm::vec3 d = b.center - a.center;
+    const float dist = glm::length(d);
+    if (dist + b.radius <= a.radius) return a;
+    if (dist + a.radius <= b.radius) return b;
+    BoundingSphere m;
+    m.radius = 0.5f * (dist + a.radius + b.radius);
+    m.center = a.center + d * ((m.radius - a.radius) / std::max(dist, 1e-12f));
+    return m;
+}
+
+float luminance(const glm::vec3& c) {
+    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
+
 glm::vec3 anyPerpendicular(const glm::vec3& d) {
     return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
 }
@@ -116,9 +134,11 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<VplPass>());
     g.addPass(std::make_unique<IsmPass>());
     g.addPass(std::make_unique<ImpostorPass>());
+    g.addPass(std::make_unique<PhotonGBufferPass>(*scene_));
     g.addPass(std::make_unique<DirectLightPass>(*scene_));
     g.addPass(std::make_unique<IndirectLightPass>());
     g.addPass(std::make_unique<GiFilterPass>(options_.interleave));
+    g.addPass(std::make_unique<CausticPass>());
     g.addPass(std::make_unique<BackFacePass>());
     g.addPass(std::make_unique<SpecularGBufferPass>());
     g.addPass(std::make_unique<SpecularLightPass>(*scene_));
@@ -182,14 +202,55 @@ void Renderer::planFrame(const FrameInput& input) {
         const SceneLight& l = s.lights()[i];
         GpuLight& g = c.lightBlock.lights[i];
         LightPlan lp;
-        bool real = false, virt = false;
+        bool real = false, virt = false, glassReal = false, glassVirtual = false;
         for (const DrawItem& d : s.draws()) {
             if (!inLightCone(l, d.bounds)) continue;
             (d.origin == Origin::Real ? real : virt) = true;
+            if (d.transmissive) (d.origin == Origin::Real ? glassReal : glassVirtual) = true;
         }
         lp.castsShadow = real || virt;
         lp.reachesVirtual = virt;
         lp.needsRealOnlyMap = lp.castsShadow && virt && real && l.origin == Origin::Real;
+        // Caustics: a spot light whose cone holds a mirror or glass object.
+        BoundingSphere specBounds;
+        bool specularInCone = false;
+        for (int di : s.specularDraws()) {
+            const BoundingSphere& b = s.draws()[size_t(di)].bounds;
+            if (!inLightCone(l, b)) continue;
+            specBounds = specularInCone ? mergeSpheres(specBounds, b) : b;
+            specularInCone = true;
+        }
+        if (l.type == kLightSpot && specularInCone && options_.caustics) {
+            lp.caustics = true;
+            lp.causticLayer = plan.causticLayers++;
+            const float d = glm::length(specBounds.center - l.position);
+            const float radius = std::max(specBounds.radius * 1.02f, 1e-4f);
+            const float peak = luminance(l.radiantIntensity);
+            if (d > radius) {
+                // Fitted to the objects: every texel falls on (or near) them.
+                const float half = std::asin(std::min(radius / d, 0.999f));
+                const glm::vec3 axis = (specBounds.center - l.position) / d;
+                lp.causticTanHalf = std::tan(half);
+                lp.causticViewProj =
+                    glm::perspective(2.0f * half, 1.0f, std::max((d - radius) * 0.5f, 1e-3f),
+                                     d + radius * 1.5f) *
+                    glm::lookAt(l.position, specBounds.center, anyPerpendicular(axis));
+                plan.causticIrradiance =
+                    std::max(plan.causticIrradiance, peak / std::max(d * d, 1e-4f));
+            } else {
+                // The light inside the objects' bounds: the spot's own frustum.
+                const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
+                lp.causticTanHalf = std::tan(half);
+                lp.causticViewProj =
+                    glm::perspective(2.0f * half, 1.0f, 1e-3f, 2.0f * radius + 1e-2f) *
+                    glm::lookAt(l.position, l.position + l.direction,
+                                anyPerpendicular(l.direction));
+                plan.causticIrradiance = std::max(plan.causticIrradiance,
+                                                  peak / std::max(radius * radius * 0.01f, 1e-4f));
+            }
+        }
+        lp.glassTransmits = options_.glassShadows && (glassReal || glassVirtual) && !lp.caustics;
+        lp.needsRealOnlyGlass = lp.needsRealOnlyMap && lp.glassTransmits;
         anyReachesVirtual = anyReachesVirtual || virt;
         anyCaster = anyCaster || lp.castsShadow;
 
@@ -240,9 +301,19 @@ void Renderer::planFrame(const FrameInput& input) {
         g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
         g.isReal = l.origin == Origin::Real ? 1 : 0;
         plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
+        plan.glassShadows = plan.glassShadows || lp.glassTransmits;
+        plan.needRealOnlyGlass = plan.needRealOnlyGlass || lp.needsRealOnlyGlass;
         plan.lights.push_back(lp);
     }
     plan.shadowLayers = layer;
+    if (plan.causticLayers > 0) {
+        plan.causticReason = std::to_string(plan.causticLayers) +
+                             " spot light(s) with a mirror or glass object in the cone";
+    } else if (!options_.caustics) {
+        plan.causticReason = "caustics off";
+    } else {
+        plan.causticReason = "no spot light's cone holds a mirror or glass object";
+    }
 
     // VPLs: needed when the virtual objects change the indirect light that can be seen.
     if (options_.vplCount <= 0) {
@@ -323,11 +394,16 @@ std::string staticPlanKey(const FrameContext& c) {
     std::string key(reinterpret_cast<const char*>(&c.lightBlock), sizeof(GpuLightBlock));
     const FramePlan& p = c.plan;
     for (const LightPlan& l : p.lights)
-        key += fmt::format("|{}{}{}{} {} {} {} {}", int(l.castsShadow), int(l.needsRealOnlyMap),
-                           int(l.reachesVirtual), int(l.hasRsm), l.firstLayer, l.layers, l.firstVpl,
-                           l.vplCount);
-    key += fmt::format("|{} {}{}{}", p.shadowLayers, int(p.needVpls), int(p.needRealOnlyShadows),
-                       int(p.needRealOnlyIsm));
+        key +=
+            fmt::format("|{}{}{}{}{}{} {} {} {} {}", int(l.castsShadow), int(l.needsRealOnlyMap),
+                        int(l.reachesVirtual), int(l.hasRsm), int(l.glassTransmits),
+                        int(l.needsRealOnlyGlass), l.firstLayer, l.layers, l.firstVpl, l.vplCount);
+    for (const LightPlan& l : p.lights)
+        key += fmt::format("|c{} {}", int(l.caustics), l.causticLayer) +
+               std::string(reinterpret_cast<const char*>(&l.causticViewProj), sizeof(glm::mat4));
+    key +=
+        fmt::format("|{} {}{}{}{}{}", p.shadowLayers, int(p.needVpls), int(p.needRealOnlyShadows),
+                    int(p.needRealOnlyIsm), int(p.glassShadows), int(p.needRealOnlyGlass));
     return key;
 }
 

@@ -12,6 +12,8 @@ const char* resourceName(Resource r) {
         "GBufferEmissive",
         "ShadowMaps",
         "ShadowMapsReal",
+        "ShadowGlass",
+        "ShadowGlassReal",
         "RsmFlux",
         "RsmNormal",
         "RsmPosition",
@@ -53,6 +55,12 @@ const char* resourceName(Resource r) {
         "SpecularR",
         "SpecularRReflection",
         "Lenv",
+        "PhotonHitRefl",
+        "PhotonPowerRefl",
+        "PhotonHitRefr",
+        "PhotonPowerRefr",
+        "CausticRv",
+        "CausticR",
         "Composite",
         "CompositeSrgb",
     };
@@ -76,6 +84,8 @@ const char* sizeRuleName(SizeRule s) {
             return "ISM atlas";
         case SizeRule::Impostor:
             return "impostor layers";
+        case SizeRule::CausticMap:
+            return "caustic map";
         case SizeRule::Vpl:
             return "VPL count";
         case SizeRule::Scene:

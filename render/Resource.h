@@ -18,6 +18,9 @@ enum class Resource {
     // Per light layer (shadow atlas: shadowMapSize^2 x layers).
     ShadowMaps,               // distance to the nearest occluder (m), all geometry
     ShadowMapsReal,           // the same with real occluders only (aliases ShadowMaps where equal)
+    ShadowGlass,              // glass between light and texel: rgb = sum of ln(transmittance)
+                              // terms (Fresnel, colour, Beer-Lambert), a = nearest glass (m)
+    ShadowGlassReal,          // the same with real glass only (aliases ShadowGlass where equal)
     RsmFlux,                  // reflective shadow map: rgb reflected intensity, a = real
     RsmNormal,                // xyz normal facing the light
     RsmPosition,              // xyz world (m), w = 1 where covered
@@ -62,8 +65,19 @@ enum class Resource {
     SpecularR,            // L'_r (Eq. 4)
     SpecularRReflection,  // the reflection's share of L'_r
     Lenv,                 // L_env: environment seen where a ray leaves the modelled scene
-    Composite,            // the output (camera image size): linear RGBA32F, a = coverage
-    CompositeSrgb,        // the same, sRGB8
+    // Caustics (Knecht 2013 Sec. 5.2; docs/caustics.md). Photon G-buffers, one layer per caustic
+    // spot light (causticMapSize^2): per texel of the specular objects seen from the light, the
+    // receiver hit of the reflected / refracted photon (xyz world; w = 4 x hit origin + the
+    // photon's real-path visibility, 0 = no photon) and its power (rgb W, a = visibility from
+    // the light through all occluders).
+    PhotonHitRefl,
+    PhotonPowerRefl,
+    PhotonHitRefr,
+    PhotonPowerRefr,
+    CausticRv,      // caustic radiance reflected by the receiver towards the camera (Eq. 12)
+    CausticR,       // the same for L_r: light, specular object and receiver real (Eqs. 13-14)
+    Composite,      // the output (camera image size): linear RGBA32F, a = coverage
+    CompositeSrgb,  // the same, sRGB8
     Count
 };
 inline constexpr int kResourceCount = int(Resource::Count);
@@ -79,6 +93,7 @@ enum class SizeRule {
     ShadowAtlas,  // shadowMapSize^2, one layer per shadow layer of the frame plan
     IsmAtlas,     // tilesPerRow(vplCount) * ismTileSize, square
     Impostor,     // impostorResolution^2, layers per specular object / impostor
+    CausticMap,   // causticMapSize^2, one layer per caustic spot light of the frame plan
     Vpl,          // buffer: vplCount entries
     Scene,        // sized by the scene (imports, impostor tables)
 };

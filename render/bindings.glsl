@@ -20,6 +20,8 @@ const int kBindingQueryHits = 5;
 
 // Material textures of scene draws (gbuffer, shadow, impostor capture).
 const int kUnitBaseColorMap = 7;
+// shadow.frag: the glass layer of the light layer being rendered (RSM flux behind glass).
+const int kUnitShadowGlassLayer = 8;
 
 // direct.frag
 const int kUnitDirectPosition = 0;
@@ -28,6 +30,8 @@ const int kUnitDirectAlbedo = 2;
 const int kUnitDirectEmissive = 3;
 const int kUnitDirectShadowAll = 4;
 const int kUnitDirectShadowReal = 5;
+const int kUnitDirectGlassAll = 6;  // ShadowGlass / ShadowGlassReal (glass in the shadow maps)
+const int kUnitDirectGlassReal = 7;
 
 // vpl.comp
 const int kUnitVplRsmFlux = 0;
@@ -75,6 +79,31 @@ const int kUnitSpecLightIsmAll = 12;
 const int kUnitSpecLightIsmReal = 13;
 const int kUnitSpecLightPosition = 14;
 const int kUnitEnvironmentMap = 15;
+const int kUnitSpecLightGlassAll = 24;  // above the impostor units
+const int kUnitSpecLightGlassReal = 25;
+
+// photon_gbuffer.frag (passes/caustic): the light's back faces of the specular objects and the
+// shadow maps (light visibility of the photon's first surface); trace.glsl's units above.
+const int kUnitPhotonBackPosition = 0;
+const int kUnitPhotonBackNormal = 1;
+const int kUnitPhotonShadowAll = 2;
+const int kUnitPhotonShadowReal = 3;
+
+// caustic_splat.comp: the photon G-buffers and the primary G-buffer; the fixed-point
+// accumulation image (6 layers: L_rv rgb, L_r rgb irradiance).
+const int kUnitSplatReflHit = 0;
+const int kUnitSplatReflPower = 1;
+const int kUnitSplatRefrHit = 2;
+const int kUnitSplatRefrPower = 3;
+const int kUnitSplatPosition = 4;
+const int kUnitSplatNormal = 5;
+const int kUnitSplatEmissive = 6;
+const int kImageCausticAccum = 0;
+// caustic_resolve.frag
+const int kUnitResolveAccum = 0;
+const int kUnitResolvePosition = 1;
+const int kUnitResolveAlbedo = 2;
+const int kUnitResolveEmissive = 3;
 
 // composite.frag
 const int kUnitCompositeCamera = 0;
@@ -93,6 +122,8 @@ const int kUnitCompositeSpecRRefl = 12;
 const int kUnitCompositeLenv = 13;
 const int kUnitCompositeRealSurfaces = 14;
 const int kUnitCompositeCanvasToCamera = 15;
+const int kUnitCompositeCausticRv = 16;  // CausticRv / CausticR (black without caustics)
+const int kUnitCompositeCausticR = 17;
 
 // Reflected-scene impostors (trace.glsl): the ONLY units traceSurroundings() uses, above every
 // pass's own units so a consumer shader can sample both.

@@ -27,19 +27,16 @@ void incidentLight(int li, vec3 p, out vec3 wi, out vec3 irradiance) {
                  rangeWindow(li, dist) / dist2;
 }
 
-// Fraction of the light reaching p (0..1) in the all-occluder shadow atlas (x) and, when
-// `withReal`, in the real-occluder one (y; else y = x): the layer whose frustum holds p, 2x2
-// percentage-closer filtered. Bias grows with the texel footprint and the slope. The layer search
-// and footprint are shared and each atlas is read with one textureGather: on llvmpipe every
-// texel read is costly and both sides of a branch run, so this is ~2x cheaper than two lookups.
 #ifndef MIRAGE_MAX_SHADOW_FACES  // GpuScene::lightingDefines() sets it for the scene's lights
 #define MIRAGE_MAX_SHADOW_FACES 6  // the most a light has: a point light's cube
 #endif
-vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
-                      bool withReal) {
+// The shadow layer whose frustum holds p: atlas layer, texture coordinate, light distance d,
+// depth bias, and the bilinear weights of the 2x2 gather footprint. False outside every layer.
+bool shadowFootprint(int li, vec3 p, float NdotL, float mapSize, out int layer, out vec2 t,
+                     out float d, out float bias, out vec2 fr) {
     int firstLayer = lights[li].firstShadowLayer, layers = lights[li].shadowLayers;
-    int layer = -1;
-    vec2 t = vec2(0.0);
+    layer = -1;
+    t = vec2(0.0);
     // A constant bound (faces past `layers` masked off) lets the compiler unroll the loop and
     // read viewProj[f] at constant offsets; looping to `layers` made llvmpipe's direct pass 1.6x
     // slower.
@@ -51,22 +48,63 @@ vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec
             t = ndc * 0.5 + 0.5;
         }
     }
-    if (layer < 0) return vec2(1.0);
-    float d = lightDistance(li, p);
-    vec2 size = vec2(textureSize(allMap, 0).xy);
+    d = lightDistance(li, p);
     float tanOrExtent = lights[li].frustumSize;
     float extent = lights[li].type == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
-                                                                        : 2.0 * tanOrExtent * d;
-    float bias = shadowBias + 1.5 * extent / size.x / max(NdotL, 0.2);
+                                                        : 2.0 * tanOrExtent * d;
+    bias = shadowBias + 1.5 * extent / mapSize / max(NdotL, 0.2);
     // The gather footprint at t is texels floor(t * size - 0.5) + {0, 1}^2: w = (0,0), z = (1,0),
     // x = (0,1), y = (1,1); clamp-to-edge at the borders.
-    vec2 fr = fract(t * size - 0.5);
+    fr = fract(t * mapSize - 0.5);
+    return layer >= 0;
+}
+
+float bilinearGather(vec4 g, vec2 fr) { return mix(mix(g.w, g.z, fr.x), mix(g.x, g.y, fr.x), fr.y); }
+
+// Fraction of the light reaching p (0..1) in the all-occluder shadow atlas (x) and, when
+// `withReal`, in the real-occluder one (y; else y = x): the layer whose frustum holds p, 2x2
+// percentage-closer filtered. Bias grows with the texel footprint and the slope. The layer search
+// and footprint are shared and each atlas is read with one textureGather: on llvmpipe every
+// texel read is costly and both sides of a branch run, so this is ~2x cheaper than two lookups.
+vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
+                      bool withReal) {
+    int layer;
+    vec2 t, fr;
+    float d, bias;
+    if (!shadowFootprint(li, p, NdotL, float(textureSize(allMap, 0).x), layer, t, d, bias, fr))
+        return vec2(1.0);
     vec4 a = step(vec4(d - bias), textureGather(allMap, vec3(t, float(layer)), 0));
-    float visAll = mix(mix(a.w, a.z, fr.x), mix(a.x, a.y, fr.x), fr.y);
+    float visAll = bilinearGather(a, fr);
     if (!withReal) return vec2(visAll);
     vec4 r = step(vec4(d - bias), textureGather(realMap, vec3(t, float(layer)), 0));
-    return vec2(visAll, mix(mix(r.w, r.z, fr.x), mix(r.x, r.y, fr.x), fr.y));
+    return vec2(visAll, bilinearGather(r, fr));
 }
+
+#ifdef MIRAGE_GLASS_SHADOWS
+// Coloured transmittance of the glass between light li and p (shadow_glass.frag): the layer's
+// summed ln(transmittance), applied in the fraction of the 2x2 footprint where the nearest glass
+// is closer to the light than p. Multiplies tAll (all glass) and, when `withReal`, tReal (real
+// glass only; else tReal = tAll's factor too). Every glass surface along the light's ray counts
+// once p is behind the nearest: a receiver between two glass objects on one ray is tinted by both.
+void glassTransmittance(sampler2DArray glassAll, sampler2DArray glassReal, int li, vec3 p,
+                        float NdotL, bool withReal, inout vec3 tAll, inout vec3 tReal) {
+    int layer;
+    vec2 t, fr;
+    float d, bias;
+    if (!shadowFootprint(li, p, NdotL, float(textureSize(glassAll, 0).x), layer, t, d, bias, fr))
+        return;
+    vec3 tc = vec3(t, float(layer));
+    float behind = bilinearGather(step(textureGather(glassAll, tc, 3), vec4(d - bias)), fr);
+    vec3 ga = mix(vec3(1.0), exp(min(texture(glassAll, tc).rgb, vec3(0.0))), behind);
+    tAll *= ga;
+    if (!withReal) {
+        tReal *= ga;
+        return;
+    }
+    float behindR = bilinearGather(step(textureGather(glassReal, tc, 3), vec4(d - bias)), fr);
+    tReal *= mix(vec3(1.0), exp(min(texture(glassReal, tc).rgb, vec3(0.0))), behindR);
+}
+#endif
 
 // Lambert diffuse + GGX specular (Smith-Schlick G, Schlick F, F0 = 0.04 for dielectrics), glTF
 // metallic-roughness. Returns BRDF * cos (the factor multiplying incident irradiance).

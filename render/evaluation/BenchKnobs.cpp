@@ -2,6 +2,7 @@
 // configurations (render/evaluation/RealtimeBench.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 #include <fmt/format.h>
@@ -153,6 +154,32 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.showVirtual = parseOnOff("virtual", v);
          },
          [](const BenchConfig& c) { return onOff(c.options.showVirtual); }},
+        // Caustics (docs/caustics.md): one default value each, as the specular knobs.
+        {"caustics", "on: photon G-buffers and the caustic splat for spot lights on mirror/glass",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.caustics = parseOnOff("caustics", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.caustics); }},
+        {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.causticMapSize = parseInt("caustic_map", v, 16, 2048);
+             if (c.options.causticMapSize % 8 != 0)
+                 throw Error(fmt::format("bench: knob caustic_map: {} is not a multiple of 8", v));
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.causticMapSize); }},
+        {"caustic_quad", "photon quad radius in photon spacings on the receiver (0.25..8)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1.5"}; },
+         [](BenchConfig& c, const std::string& v) {
+             char* end = nullptr;
+             const float q = std::strtof(v.c_str(), &end);
+             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.25f && q <= 8.0f))
+                 throw Error(
+                     fmt::format("bench: knob caustic_quad: '{}' is not a number in [0.25, 8]", v));
+             c.options.causticQuadScale = q;
+         },
+         [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
     };
     return knobs;
 }

@@ -190,7 +190,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     ASSERT_EQ(grid.size(), 1u);
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
-              "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on");
+              "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on "
+              "caustics=on caustic_map=256 caustic_quad=1.5");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";
@@ -298,6 +299,14 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"static_reuse", {"yes"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"2048x1536"}}}), Error);  // upsampling
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"640x640"}}}), Error);    // aspect
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_map", {"100"}}}), Error);  // not a multiple of 8
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_quad", {"wide"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_quad", {"9"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"caustics", {"sometimes"}}}), Error);
+    const auto caustic = benchGrid(cam, true, {{"caustic_map", {"128", "512"}}});
+    ASSERT_EQ(caustic.size(), 4u);  // x the quick grid's 64 / 256 VPLs
+    EXPECT_EQ(caustic[0].options.causticMapSize, 128);
+    EXPECT_EQ(caustic[1].options.causticMapSize, 512);
     EXPECT_THROW(benchGrid(cam, true, {{"virtual", {"hidden"}}}), Error);
 
     // Every knob reads back the value it applied (the results page's "default" is read this way),

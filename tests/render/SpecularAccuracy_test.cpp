@@ -41,7 +41,7 @@ Comparison reference(const test::SpecularScene& s, int spp = 48) {
     st.samplesPerPixel = spp;
     st.threads = 2;
     st.seed = 3;
-    st.caustics = false;  // the real-time renderer has no caustics yet (later issue)
+    st.caustics = true;  // photon map on: light through glass as it is (docs/caustics.md)
     const raytrace::DifferentialImages ref =
         raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
     EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
@@ -86,10 +86,10 @@ std::vector<test::SpecularCase> allFig2Cases() {
     return cases;
 }
 
-// Floors over the sphere's pixels, ~1 dB / 0.04 below the lowest measured case (23.9 dB, SSIM
-// 0.637: virtual light, virtual glass, real surroundings; llvmpipe, reference 48 spp seed 3,
-// caustics off); the broken render (IOR 1.2) scores 20.6 dB. docs/specular.md lists every case.
-constexpr double kMinPsnr = 23.0, kMinSsim = 0.60;
+// Floors over the sphere's pixels, ~0.7 dB / 0.03 below the lowest measured case (23.2 dB, SSIM
+// 0.600: virtual light, virtual glass, real surroundings; llvmpipe, reference 48 spp seed 3,
+// caustics on); the broken render (IOR 1.2) scores 20.3 dB. docs/specular.md lists every case.
+constexpr double kMinPsnr = 22.5, kMinSsim = 0.57;
 
 class SpecularFig2 : public ::testing::TestWithParam<test::SpecularCase> {};
 

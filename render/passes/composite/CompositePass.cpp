@@ -16,8 +16,8 @@ CompositePass::CompositePass()
 void CompositePass::setup(PassBuilder& b) const {
     b.read(Resource::CameraImage);
     // The two GI solutions, or direct light alone when no VPL light was filtered into them.
-    for (Resource r : {Resource::LRv, Resource::LR, Resource::DirectRv, Resource::DirectR,
-                       Resource::GBufferPosition})
+    for (Resource r : {Resource::LRv, Resource::LR, Resource::CausticRv, Resource::CausticR,
+                       Resource::DirectRv, Resource::DirectR, Resource::GBufferPosition})
         b.readOptional(r);
     // Mirror / glass pixels (Eqs. 6-11): only when the specular passes ran.
     for (Resource r : {Resource::GBufferEmissive, Resource::ReflectionGBuffer,
@@ -109,6 +109,10 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitCompositeCamera, res.texture(Resource::CameraImage).id());
     glBindTextureUnit(kUnitCompositeLRv, tex(Resource::LRv, Resource::DirectRv));
     glBindTextureUnit(kUnitCompositeLR, tex(Resource::LR, Resource::DirectR));
+    glBindTextureUnit(kUnitCompositeCausticRv,
+                      res.textureOr(Resource::CausticRv, ctx.blackTexture()).id());
+    glBindTextureUnit(kUnitCompositeCausticR,
+                      res.textureOr(Resource::CausticR, ctx.blackTexture()).id());
     glBindTextureUnit(kUnitCompositePosition,
                       res.textureOr(Resource::GBufferPosition, ctx.blackTexture()).id());
     glBindTextureUnit(kUnitCompositeRemap, remap_.id());

@@ -32,6 +32,8 @@ in vec2 uv;
 layout(binding = kUnitCompositeCamera) uniform sampler2D cameraImage;  // sRGB8 texture: samples are linear
 layout(binding = kUnitCompositeLRv) uniform sampler2D lRv;           // canvas, linear
 layout(binding = kUnitCompositeLR) uniform sampler2D lR;
+layout(binding = kUnitCompositeCausticRv) uniform sampler2D causticRv;  // caustic light (Eqs. 12-14)
+layout(binding = kUnitCompositeCausticR) uniform sampler2D causticR;
 layout(binding = kUnitCompositePosition) uniform sampler2D gPosition;     // canvas, w = origin
 layout(binding = kUnitCompositeRemap) uniform sampler2D remap;         // camera size: canvas pixel (OpenCV conv.)
 layout(binding = kUnitCompositeEmissive) uniform sampler2D gEmissive;     // canvas, a = specular slot + 1
@@ -124,8 +126,8 @@ void main() {
         vec2 cuv = (canvasPx + 0.5) * canvas.zw;
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
-        vec3 rv = max(texture(lRv, cuv).rgb, vec3(0.0)) * exposure;
-        vec3 r = max(texture(lR, cuv).rgb, vec3(0.0)) * exposure;
+        vec3 rv = max(texture(lRv, cuv).rgb + texture(causticRv, cuv).rgb, vec3(0.0)) * exposure;
+        vec3 r = max(texture(lR, cuv).rgb + texture(causticR, cuv).rgb, vec3(0.0)) * exposure;
 #ifndef MIRAGE_DIFFUSE_ONLY
         int slot = int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1;
         if (slot >= 0 && origin != ORIGIN_NONE) {

@@ -14,6 +14,8 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.read(Resource::GBufferEmissive);
     b.readOptional(Resource::ShadowMaps);  // none: no light has a caster (unshadowed)
     b.readOptional(Resource::ShadowMapsReal);
+    b.readOptional(Resource::ShadowGlass);  // none: no glass in a light's cone
+    b.readOptional(Resource::ShadowGlassReal);
     b.write(Resource::DirectRv, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::DirectR, GL_RGBA16F, SizeRule::Canvas);
 }
@@ -44,6 +46,10 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
                       res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitDirectShadowReal,
                       res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitDirectGlassAll,
+                      res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
+    glBindTextureUnit(kUnitDirectGlassReal,
+                      res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
     ctx.drawFullscreenTriangle();
     res.publish(Resource::DirectRv, rv_);
     res.publish(Resource::DirectR, r_);

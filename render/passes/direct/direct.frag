@@ -13,6 +13,10 @@ layout(binding = kUnitDirectAlbedo) uniform sampler2D gAlbedo;
 layout(binding = kUnitDirectEmissive) uniform sampler2D gEmissive;
 layout(binding = kUnitDirectShadowAll) uniform sampler2DArray shadowAll;
 layout(binding = kUnitDirectShadowReal) uniform sampler2DArray shadowReal;
+#ifdef MIRAGE_GLASS_SHADOWS
+layout(binding = kUnitDirectGlassAll) uniform sampler2DArray glassAll;
+layout(binding = kUnitDirectGlassReal) uniform sampler2DArray glassReal;
+#endif
 layout(location = 0) out vec4 outRv;  // linear radiance
 layout(location = 1) out vec4 outR;
 
@@ -40,8 +44,13 @@ void main() {
         vec3 c = brdfCos(n, v, wi, A.rgb, A.a, N.w) * E;
         vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, NdotL,
                                     lights[li].realOnlyMap == 1);
-        rv += c * vis.x;  // all occluders
-        if (lights[li].isReal == 1 && pReal) r += c * vis.y;  // real occluders only
+        vec3 visAll = vec3(vis.x), visReal = vec3(vis.y);
+#ifdef MIRAGE_GLASS_SHADOWS
+        glassTransmittance(glassAll, glassReal, li, p, NdotL, lights[li].realOnlyMap == 1, visAll,
+                           visReal);
+#endif
+        rv += c * visAll;  // all occluders
+        if (lights[li].isReal == 1 && pReal) r += c * visReal;  // real occluders only
     }
     if (envOrigin != 0) {
         vec3 env = A.rgb * (1.0 - A.a) / PI * shIrradiance(n);

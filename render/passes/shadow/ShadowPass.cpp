@@ -5,14 +5,22 @@ namespace mirage::render {
 
 ShadowPass::ShadowPass()
     : program_(rasterProgram("shadow", "passes/shadow/shadow.vert", "passes/shadow/shadow.frag")),
-      fbo_("shadow fbo") {
+      glassProgram_(rasterProgram("shadow glass", "passes/shadow/shadow.vert",
+                                  "passes/shadow/shadow_glass.frag")),
+      fbo_("shadow fbo"),
+      glassFbo_("shadow glass fbo") {
     locViewProj_ = program_.uniformLocation("lightViewProj");
     locLight_ = program_.uniformLocation("lightIndex");
+    locGlassLayer_ = program_.uniformLocation("glassLayer");
+    locGlassViewProj_ = glassProgram_.uniformLocation("lightViewProj");
+    locGlassLight_ = glassProgram_.uniformLocation("lightIndex");
 }
 
 void ShadowPass::setup(PassBuilder& b) const {
     b.write(Resource::ShadowMaps, GL_R32F, SizeRule::ShadowAtlas);
     b.write(Resource::ShadowMapsReal, GL_R32F, SizeRule::ShadowAtlas);
+    b.write(Resource::ShadowGlass, GL_RGBA32F, SizeRule::ShadowAtlas);  // only with glass in a cone
+    b.write(Resource::ShadowGlassReal, GL_RGBA32F, SizeRule::ShadowAtlas);
     b.write(Resource::RsmFlux, GL_RGBA16F, SizeRule::ShadowAtlas);  // only when VPLs are needed
     b.write(Resource::RsmNormal, GL_RGBA16F, SizeRule::ShadowAtlas);
     b.write(Resource::RsmPosition, GL_RGBA32F, SizeRule::ShadowAtlas);
@@ -20,14 +28,17 @@ void ShadowPass::setup(PassBuilder& b) const {
 
 PassDecision ShadowPass::decide(const FrameContext& ctx) const {
     if (ctx.plan.shadowLayers == 0) return {false, "no light has a shadow caster in its cone"};
-    int n = 0, real = 0;
+    int n = 0, real = 0, glass = 0;
     for (const LightPlan& l : ctx.plan.lights) {
         n += l.castsShadow;
         real += l.needsRealOnlyMap;
+        glass += l.glassTransmits;
     }
     return {true, std::to_string(n) + " light(s) with casters in the cone, " +
                       std::to_string(ctx.plan.shadowLayers) + " layer(s); " + std::to_string(real) +
-                      " need a real-only map" + (ctx.plan.needVpls ? "; RSMs for VPLs" : "")};
+                      " need a real-only map" +
+                      (glass ? "; glass transmits in " + std::to_string(glass) : std::string()) +
+                      (ctx.plan.needVpls ? "; RSMs for VPLs" : "")};
 }
 
 void ShadowPass::resize(const FrameContext& ctx) {
@@ -40,6 +51,10 @@ void ShadowPass::resize(const FrameContext& ctx) {
     rsmPosition_ = gl::Texture::create2DArray("rsm position", s, s, layers, GL_RGBA32F);
     for (gl::Texture* t : {&distance_, &distanceReal_, &rsmFlux_, &rsmNormal_, &rsmPosition_})
         t->setFilter(GL_NEAREST, GL_NEAREST);
+    glass_ = gl::Texture::create2DArray("shadow glass", s, s, layers, GL_RGBA32F);
+    glassReal_ = gl::Texture::create2DArray("shadow glass real-only", s, s, layers, GL_RGBA32F);
+    glass_.setFilter(GL_NEAREST, GL_NEAREST);
+    glassReal_.setFilter(GL_NEAREST, GL_NEAREST);
     depth_ = gl::Texture::create2D("shadow depth", s, s, GL_DEPTH_COMPONENT32F);
     allocatedLayers_ = layers;
     allocatedSize_ = s;
@@ -67,10 +82,42 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
     const glm::mat4& vp = ctx.lightBlock.lights[light].viewProj[layer];
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
     glUniform1i(locLight_, light);
+    glUniform1i(locGlassLayer_, rsm && lp.glassTransmits ? atlasLayer : -1);
+    glBindTextureUnit(kUnitShadowGlassLayer, glass_.id());
     for (const DrawItem& d : ctx.scene.draws()) {
         if (realOnly && d.origin != Origin::Real) continue;
+        if (lp.glassTransmits && d.transmissive) continue;  // in the glass layer instead
         draw_.draw(ctx.scene, d);
     }
+}
+
+void ShadowPass::renderGlassLayer(FrameContext& ctx, int light, int layer, bool realOnly) {
+    const LightPlan& lp = ctx.plan.lights[size_t(light)];
+    const int atlasLayer = lp.firstLayer + layer;
+    glassFbo_.attachColorLayer(0, realOnly ? glassReal_ : glass_, atlasLayer);
+    glassFbo_.finalize(1);
+    glassFbo_.bind();
+    const float clear[4] = {0.0f, 0.0f, 0.0f, 1e30f};
+    glClearBufferfv(GL_COLOR, 0, clear);
+    glassProgram_.use();
+    const glm::mat4& vp = ctx.lightBlock.lights[light].viewProj[layer];
+    glUniformMatrix4fv(locGlassViewProj_, 1, GL_FALSE, &vp[0][0]);
+    glUniform1i(locGlassLight_, light);
+    // Every crossing counts (no depth test): rgb adds the ln(transmittance) terms, alpha keeps
+    // the nearest glass distance.
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendEquationSeparate(GL_FUNC_ADD, GL_MIN);
+    glBlendFunc(GL_ONE, GL_ONE);
+    for (const DrawItem& d : ctx.scene.draws()) {
+        if (!d.transmissive || (realOnly && d.origin != Origin::Real)) continue;
+        glassDraw_.draw(ctx.scene, d);
+    }
+    glDisable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glEnable(GL_DEPTH_TEST);
+    fbo_.bind();
+    program_.use();
 }
 
 void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
@@ -83,10 +130,20 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
     ctx.scene.bindGeometry();
+    if (ctx.plan.glassShadows) {  // layers of lights without glass: no glass anywhere
+        const float noGlass[4] = {0.0f, 0.0f, 0.0f, 1e30f};
+        glClearTexImage(glass_.id(), 0, GL_RGBA, GL_FLOAT, noGlass);
+        if (ctx.plan.needRealOnlyGlass)
+            glClearTexImage(glassReal_.id(), 0, GL_RGBA, GL_FLOAT, noGlass);
+    }
     for (size_t i = 0; i < ctx.plan.lights.size(); ++i) {
         const LightPlan& lp = ctx.plan.lights[i];
         if (!lp.castsShadow) continue;
         for (int layer = 0; layer < lp.layers; ++layer) {
+            if (lp.glassTransmits) {
+                renderGlassLayer(ctx, int(i), layer, false);
+                if (lp.needsRealOnlyGlass) renderGlassLayer(ctx, int(i), layer, true);
+            }
             renderLayer(ctx, int(i), layer, false, ctx.plan.needVpls && lp.hasRsm);
             if (lp.needsRealOnlyMap) renderLayer(ctx, int(i), layer, true, false);
         }
@@ -94,6 +151,10 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
     glDisable(GL_DEPTH_TEST);
     res.publish(Resource::ShadowMaps, distance_);
     res.publish(Resource::ShadowMapsReal, ctx.plan.needRealOnlyShadows ? distanceReal_ : distance_);
+    if (ctx.plan.glassShadows) {
+        res.publish(Resource::ShadowGlass, glass_);
+        res.publish(Resource::ShadowGlassReal, ctx.plan.needRealOnlyGlass ? glassReal_ : glass_);
+    }
     if (ctx.plan.needVpls) {
         res.publish(Resource::RsmFlux, rsmFlux_);
         res.publish(Resource::RsmNormal, rsmNormal_);

@@ -5,6 +5,9 @@
 // and against real occluders only (for L_r). The second map is rendered only for real lights
 // with a virtual caster in the cone; elsewhere it is the same as the first and aliases it.
 // When VPLs are needed the all-occluder pass also writes the reflective shadow maps.
+// Glass (DrawItem::transmissive) in a light's cone is left out of the occluder maps and drawn
+// into the glass atlases instead (shadow_glass.frag): the lookups colour the light behind it by
+// its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque.
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -21,12 +24,16 @@ public:
 
 private:
     void renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);
-    gl::Program program_;
+    void renderGlassLayer(FrameContext& ctx, int light, int layer, bool realOnly);
+    gl::Program program_, glassProgram_;
     gl::Texture distance_, distanceReal_, rsmFlux_, rsmNormal_, rsmPosition_, depth_;
-    gl::Framebuffer fbo_;
+    gl::Texture glass_, glassReal_;
+    gl::Framebuffer fbo_, glassFbo_;
     int allocatedLayers_ = 0, allocatedSize_ = 0;
     MaterialDraw draw_{program_};  // after program_
-    GLint locViewProj_ = -1, locLight_ = -1;
+    MaterialDraw glassDraw_{glassProgram_};
+    GLint locViewProj_ = -1, locLight_ = -1, locGlassLayer_ = -1;
+    GLint locGlassViewProj_ = -1, locGlassLight_ = -1;
 };
 
 }  // namespace mirage::render

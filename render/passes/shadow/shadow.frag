@@ -13,6 +13,9 @@ in vec3 worldPos;
 in vec3 worldNormal;
 in vec2 uv;
 layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
+// The glass layer of this light layer (shadow_glass.frag), rendered first; -1 = no glass.
+layout(binding = kUnitShadowGlassLayer) uniform sampler2DArray glassLayers;
+uniform int glassLayer;
 layout(location = 0) out float outDistance;  // metres from the light (see lightDistance)
 layout(location = 1) out vec4 outFlux;       // rgb W/sr * albedo (W/m^2 * albedo for dir.), a = real
 layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light
@@ -32,9 +35,14 @@ void main() {
     float atten = directional ? 1.0 : spotAttenuation(li, -toLight) * rangeWindow(li, dist);
     vec3 diffuseAlbedo = (m.baseColor.rgb * texture(baseColorMap, uv).rgb) * (1.0 - clamp(m.metallic, 0.0, 1.0));
     // Glass transmits instead of scattering diffusely (KHR_materials_transmission): only the
-    // opaque share bounces into VPLs (reflected/refracted VPLs on caustics are a later issue).
+    // opaque share bounces into VPLs.
     diffuseAlbedo *= 1.0 - clamp(m.transmission, 0.0, 1.0);
-    outFlux = vec4(lights[li].radiantIntensity * atten * diffuseAlbedo, origin == ORIGIN_REAL ? 1.0 : 0.0);
+    vec3 flux = lights[li].radiantIntensity * atten * diffuseAlbedo;
+    if (glassLayer >= 0) {  // behind glass the light arrives coloured by it
+        vec4 g = texelFetch(glassLayers, ivec3(ivec2(gl_FragCoord.xy), glassLayer), 0);
+        if (outDistance > g.a + 1e-3) flux *= exp(min(g.rgb, vec3(0.0)));
+    }
+    outFlux = vec4(flux, origin == ORIGIN_REAL ? 1.0 : 0.0);
     outNormal = vec4(n, 0.0);
     outPosition = vec4(worldPos, 1.0);
 }

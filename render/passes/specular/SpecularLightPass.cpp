@@ -25,8 +25,9 @@ void SpecularLightPass::setup(PassBuilder& b) const {
     for (Resource r : kHitBuffers) b.read(r);
     b.read(Resource::GBufferPosition);
     b.read(Resource::EnvironmentMap);
-    for (Resource r : {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::Vpls,
-                       Resource::ImperfectShadowMaps, Resource::ImperfectShadowMapsReal})
+    for (Resource r : {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::ShadowGlass,
+                       Resource::ShadowGlassReal, Resource::Vpls, Resource::ImperfectShadowMaps,
+                       Resource::ImperfectShadowMapsReal})
         b.readOptional(r);
     b.write(Resource::SpecularRv, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::SpecularR, GL_RGBA16F, SizeRule::Canvas);
@@ -67,6 +68,10 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
                       res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitSpecLightShadowReal,
                       res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitSpecLightGlassAll,
+                      res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
+    glBindTextureUnit(kUnitSpecLightGlassReal,
+                      res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
     const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
                       res.has(Resource::ImperfectShadowMaps);
     if (vpls) {

@@ -40,14 +40,138 @@ vec3 environmentRadiance(sampler2D envMap, vec3 l) {
     return textureLod(envMap, vec2(u, v), 0.0).rgb;
 }
 
+// Canvas-style pixel of world point x in a view (world -> clip `vp`, `size` texels): (0,0) = the
+// centre of the first texel; false behind the eye. The camera's view is projectToCanvas below.
+bool projectToView(mat4 vp, vec2 size, vec3 x, out vec2 px) {
+    vec4 c = vp * vec4(x, 1.0);
+    px = vec2(-1e4);
+    if (c.w <= 1e-6) return false;
+    px = (c.xy / c.w * 0.5 + 0.5) * size - 0.5;
+    return true;
+}
+
+// Reflection weight of a smooth surface with material m at cos(theta) = cosV (Fresnel of `ior`
+// for dielectrics, mixed by transmission / metallic as the reference does; Schlick(baseColour)
+// for a perfect mirror). transWeight = transmission (1 - metallic), 0 for mirrors.
+vec3 reflectionWeight(GpuMaterial m, float cosV, float transWeight) {
+    vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
+    if (m.mirror != 0) return schlickColour(base, cosV);  // perfect mirror
+    float F = fresnelDielectric(cosV, max(m.ior, 1e-3));
+    float opaque = 1.0 - transWeight;
+    float metal = opaque > 0.0 ? min(1.0, clamp(m.metallic, 0.0, 1.0) / opaque) : 0.0;
+    vec3 opaqueF = (1.0 - metal) * vec3(F) + metal * schlickColour(base, cosV);
+    return transWeight * vec3(F) + opaque * opaqueF;
+}
+
+// Exit of a ray inside the object with bounding sphere (c, r): the far intersection.
+vec3 sphereExit(vec3 o, vec3 d, vec3 centre, float radius) {
+    vec3 oc = o - centre;
+    float b = dot(oc, d);
+    float cc = dot(oc, oc) - radius * radius;
+    float disc = max(b * b - cc, 0.0);
+    return o + max(-b + sqrt(disc), 0.0) * d;
+}
+
+// Two-interface refraction (Wyman 2005) of the ray arriving along unit d at front-face point p
+// (unit normal n facing the ray's origin) of specular slot `slot`, seen from a view: `vp` world ->
+// clip, `eye` its centre (world), `size` its buffer size, and that view's nearest back faces of
+// the specular objects (backPosition: xyz world, w = slot + 1; backNormal: outward). The camera
+// path (specular_gbuffer.frag) and the photon path from a spot light (passes/caustic) both call
+// it with their own view. T1 = Snell at the front face; the exit P2 is where T1, marched in
+// `marchSteps` steps over the bounding diameter, passes the back face the view stores at its
+// pixel (same object), refined by 6 bisection steps; off the object's back-face footprint the far
+// bounding-sphere intersection stands in. T2 = Snell at the back face (outward normal N2); total
+// internal reflection there: ONE internal reflection T2 = reflect(T1, -N2) with F2 = 0
+// (docs/specular.md). Returns false when nothing is refracted (TIR at the front face, ior < 1).
+// Outputs the exit point P2 and unit direction T2, the two Fresnel reflectances and the distance
+// travelled inside (m).
+bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, float eta,
+                          mat4 vp, vec3 eye, vec2 size, sampler2D backPosition,
+                          sampler2D backNormal, int marchSteps, out vec3 P2, out vec3 T2,
+                          out float F1, out float F2, out float inside) {
+    P2 = p;
+    T2 = d;
+    F2 = 0.0;
+    inside = 0.0;
+    float cosV = clamp(dot(n, -d), 1e-4, 1.0);  // grazing: clamped, never 0
+    F1 = fresnelDielectric(cosV, eta);
+    vec3 T1 = refract(d, n, 1.0 / eta);
+    if (F1 >= 1.0 || dot(T1, T1) < 0.5) return false;  // TIR at the front face (ior < 1)
+    T1 = normalize(T1);
+    // March T1 through the back-face buffer: the exit is where the ray's distance from the eye
+    // passes the stored back face's (same object).
+    float maxLen = 2.0 * sd.radius + 1e-3;
+    int steps = clamp(marchSteps, 2, 128);
+    float prevT = 0.0, hitT = -1.0;
+    for (int i = 1; i <= steps; ++i) {
+        float t = maxLen * float(i) / float(steps);
+        vec3 q = p + T1 * t;
+        vec2 cp;
+        if (!projectToView(vp, size, q, cp)) break;
+        ivec2 qi = ivec2(floor(cp + 0.5));
+        if (any(lessThan(qi, ivec2(0))) || any(greaterThanEqual(qi, ivec2(size)))) break;
+        vec4 B = texelFetch(backPosition, qi, 0);
+        if (int(B.w + 0.5) - 1 != slot) break;  // left the object's back-face footprint
+        if (length(q - eye) >= length(B.xyz - eye)) {
+            hitT = t;
+            break;
+        }
+        prevT = t;
+    }
+    vec3 N2;
+    if (hitT > 0.0) {
+        float lo = prevT, hi = hitT;
+        for (int k = 0; k < 6; ++k) {  // bisection on the same crossing test
+            float mid = 0.5 * (lo + hi);
+            vec3 q = p + T1 * mid;
+            vec2 cp;
+            projectToView(vp, size, q, cp);
+            ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(size) - 1);
+            vec4 B = texelFetch(backPosition, qi, 0);
+            bool past = int(B.w + 0.5) - 1 != slot || length(q - eye) >= length(B.xyz - eye);
+            if (past) hi = mid; else lo = mid;
+        }
+        P2 = p + T1 * hi;
+        vec2 cp;
+        projectToView(vp, size, P2, cp);
+        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(size) - 1);
+        N2 = texelFetch(backNormal, qi, 0).xyz;
+        if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 != slot || dot(N2, N2) < 0.25)
+            N2 = normalize(P2 - sd.centre);
+    } else {
+        P2 = sphereExit(p, T1, sd.centre, sd.radius);
+        N2 = normalize(P2 - sd.centre);
+    }
+    N2 = normalize(N2);
+    if (!allFinite(N2)) N2 = T1;
+    if (dot(N2, T1) < 1e-3) N2 = normalize(N2 + T1 * (1e-3 - dot(N2, T1)));  // leaves outward
+    inside = length(P2 - p);
+    float cos2 = clamp(dot(T1, N2), 1e-4, 1.0);  // inside, towards the outward normal
+    F2 = fresnelDielectric(-cos2, eta);           // from the inside: relative ior 1 / eta
+    T2 = refract(T1, -N2, eta);
+    if (F2 >= 1.0 || dot(T2, T2) < 0.5) {
+        T2 = reflect(T1, -N2);  // TIR: one internal reflection, then out (documented)
+        F2 = 0.0;               // all of it continues along T2
+    }
+    T2 = normalize(T2);
+    return true;
+}
+
+// Weight of the light refracted through both interfaces: transmission (1 - F1)(1 - F2)
+// baseColour^2 (the reference tints each crossing by baseColour) x Beer-Lambert
+// attenuationColour^(inside / attenuationDistance) (KHR_materials_volume; inside in metres).
+vec3 refractionWeight(GpuMaterial m, float transWeight, float F1, float F2, float inside) {
+    vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
+    vec3 absorb = vec3(1.0);
+    if (m.attenuationDistance > 0.0)
+        absorb = pow(max(m.attenuationColor, vec3(1e-6)), vec3(inside / m.attenuationDistance));
+    return transWeight * (1.0 - F1) * (1.0 - F2) * base * base * absorb;
+}
+
 // Canvas pixel (OpenCV convention, (0,0) = centre of the top-left pixel) of world point x;
 // returns false behind the camera.
 bool projectToCanvas(vec3 x, out vec2 canvasPx) {
-    vec4 c = viewProj * vec4(x, 1.0);
-    canvasPx = vec2(-1e4);
-    if (c.w <= 1e-6) return false;
-    canvasPx = (c.xy / c.w * 0.5 + 0.5) * canvas.xy - 0.5;
-    return true;
+    return projectToView(viewProj, canvas.xy, x, canvasPx);
 }
 
 #endif

@@ -47,26 +47,6 @@ layout(location = 3) out vec4 outEmissive;  // hit emitted radiance, a = 1 on a 
 layout(location = 4) out vec4 outWeight;    // rgb Fresnel x transmittance weight, a = distance
                                             // travelled inside (m, refraction)
 
-// Reflection weight of a smooth surface with this material at cos(theta) = cosV.
-vec3 reflectionWeight(GpuMaterial m, float cosV, float transWeight) {
-    vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
-    if (m.mirror != 0) return schlickColour(base, cosV);  // perfect mirror
-    float F = fresnelDielectric(cosV, max(m.ior, 1e-3));
-    float opaque = 1.0 - transWeight;
-    float metal = opaque > 0.0 ? min(1.0, clamp(m.metallic, 0.0, 1.0) / opaque) : 0.0;
-    vec3 opaqueF = (1.0 - metal) * vec3(F) + metal * schlickColour(base, cosV);
-    return transWeight * vec3(F) + opaque * opaqueF;
-}
-
-// Exit of a ray inside the object with bounding sphere (c, r): the far intersection.
-vec3 sphereExit(vec3 o, vec3 d, vec3 centre, float radius) {
-    vec3 oc = o - centre;
-    float b = dot(oc, d);
-    float cc = dot(oc, oc) - radius * radius;
-    float disc = max(b * b - cc, 0.0);
-    return o + max(-b + sqrt(disc), 0.0) * d;
-}
-
 void writeHit(SurroundingHit h, vec3 dir, vec3 weight, float inside) {
     if (h.hit && allFinite(h.position)) {
         outPosition = vec4(h.position, float(h.origin));
@@ -119,75 +99,14 @@ void main() {
         outEmissive.a = 1.0;  // specular pixel, nothing refracted
         return;
     }
-    float F1 = fresnelDielectric(cosV, eta);
-    vec3 T1 = refract(d, n, 1.0 / eta);
-    if (F1 >= 1.0 || dot(T1, T1) < 0.5) {  // TIR at the front face (ior < 1): all reflected
-        outEmissive.a = 1.0;
+    vec3 P2, T2;
+    float F1, F2, inside;
+    if (!refractTwoInterfaces(p, n, d, slot, sd, eta, viewProj, cameraPos.xyz, canvas.xy,
+                              backPosition, backNormal, marchSteps, P2, T2, F1, F2, inside)) {
+        outEmissive.a = 1.0;  // TIR at the front face (ior < 1): all reflected
         return;
     }
-    T1 = normalize(T1);
-    // March T1 through the back-face buffer: the exit is where the ray's camera distance passes
-    // the stored back face's (same object).
-    float maxLen = 2.0 * sd.radius + 1e-3;
-    int steps = clamp(marchSteps, 2, 128);
-    float prevT = 0.0, hitT = -1.0;
-    for (int i = 1; i <= steps; ++i) {
-        float t = maxLen * float(i) / float(steps);
-        vec3 q = p + T1 * t;
-        vec2 cp;
-        if (!projectToCanvas(q, cp)) break;
-        ivec2 qi = ivec2(floor(cp + 0.5));
-        if (any(lessThan(qi, ivec2(0))) || any(greaterThanEqual(qi, ivec2(canvas.xy)))) break;
-        vec4 B = texelFetch(backPosition, qi, 0);
-        if (int(B.w + 0.5) - 1 != slot) break;  // left the object's back-face footprint
-        if (length(q - cameraPos.xyz) >= length(B.xyz - cameraPos.xyz)) {
-            hitT = t;
-            break;
-        }
-        prevT = t;
-    }
-    vec3 P2, N2;
-    if (hitT > 0.0) {
-        float lo = prevT, hi = hitT;
-        for (int k = 0; k < 6; ++k) {  // bisection on the same crossing test
-            float mid = 0.5 * (lo + hi);
-            vec3 q = p + T1 * mid;
-            vec2 cp;
-            projectToCanvas(q, cp);
-            ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
-            vec4 B = texelFetch(backPosition, qi, 0);
-            bool past = int(B.w + 0.5) - 1 != slot ||
-                        length(q - cameraPos.xyz) >= length(B.xyz - cameraPos.xyz);
-            if (past) hi = mid; else lo = mid;
-        }
-        P2 = p + T1 * hi;
-        vec2 cp;
-        projectToCanvas(P2, cp);
-        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
-        N2 = texelFetch(backNormal, qi, 0).xyz;
-        if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 != slot || dot(N2, N2) < 0.25)
-            N2 = normalize(P2 - sd.centre);
-    } else {
-        P2 = sphereExit(p, T1, sd.centre, sd.radius);
-        N2 = normalize(P2 - sd.centre);
-    }
-    N2 = normalize(N2);
-    if (!allFinite(N2)) N2 = T1;
-    if (dot(N2, T1) < 1e-3) N2 = normalize(N2 + T1 * (1e-3 - dot(N2, T1)));  // leaves outward
-    float inside = length(P2 - p);
-    float cos2 = clamp(dot(T1, N2), 1e-4, 1.0);  // inside, towards the outward normal
-    float F2 = fresnelDielectric(-cos2, eta);     // from the inside: relative ior 1 / eta
-    vec3 T2 = refract(T1, -N2, eta);
-    if (F2 >= 1.0 || dot(T2, T2) < 0.5) {
-        T2 = reflect(T1, -N2);  // TIR: one internal reflection, then out (documented)
-        F2 = 0.0;               // all of it continues along T2
-    }
-    T2 = normalize(T2);
-    vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
-    vec3 absorb = vec3(1.0);
-    if (m.attenuationDistance > 0.0)
-        absorb = pow(max(m.attenuationColor, vec3(1e-6)), vec3(inside / m.attenuationDistance));
-    vec3 weight = transWeight * (1.0 - F1) * (1.0 - F2) * base * base * absorb;
+    vec3 weight = refractionWeight(m, transWeight, F1, F2, inside);
     SurroundingHit h = traceSurroundings(slot, P2 + T2 * eps, T2);
     writeHit(h, T2, weight, inside);
 }

@@ -26,6 +26,10 @@ layout(binding = kUnitSpecLightRefrFirst + 3) uniform sampler2D refrEmissive;
 layout(binding = kUnitSpecLightRefrFirst + 4) uniform sampler2D refrWeight;
 layout(binding = kUnitSpecLightShadowAll) uniform sampler2DArray shadowAll;
 layout(binding = kUnitSpecLightShadowReal) uniform sampler2DArray shadowReal;
+#ifdef MIRAGE_GLASS_SHADOWS
+layout(binding = kUnitSpecLightGlassAll) uniform sampler2DArray glassAll;
+layout(binding = kUnitSpecLightGlassReal) uniform sampler2DArray glassReal;
+#endif
 layout(binding = kUnitSpecLightIsmAll) uniform usampler2D ismAll;
 layout(binding = kUnitSpecLightIsmReal) uniform usampler2D ismReal;
 layout(binding = kUnitSpecLightPosition) uniform sampler2D gPosition;  // primary G-buffer
@@ -58,8 +62,13 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
         vec3 c = brdfCos(n, v, wi, albedo, metallic, roughness) * E;
         vec2 vis = shadowVisibility(shadowAll, shadowReal, li, x, NdotL,
                                     lights[li].realOnlyMap == 1);
-        rv += c * vis.x;  // all occluders
-        if (lights[li].isReal == 1 && xReal) r += c * vis.y;  // real occluders only
+        vec3 visAll = vec3(vis.x), visReal = vec3(vis.y);
+#ifdef MIRAGE_GLASS_SHADOWS
+        glassTransmittance(glassAll, glassReal, li, x, NdotL, lights[li].realOnlyMap == 1, visAll,
+                           visReal);
+#endif
+        rv += c * visAll;  // all occluders
+        if (lights[li].isReal == 1 && xReal) r += c * visReal;  // real occluders only
     }
     if (envOrigin != 0) {
         vec3 env = albedo * (1.0 - metallic) / PI * shIrradiance(n);

@@ -1,0 +1,80 @@
+#include "render/passes/caustic/CausticPass.h"
+
+#include <algorithm>
+
+#include "render/FrameGraph.h"
+
+namespace mirage::render {
+
+CausticPass::CausticPass()
+    : splat_(computeProgram("caustic splat", "passes/caustic/caustic_splat.comp")),
+      resolve_(fullscreenProgram("caustic resolve", "passes/caustic/caustic_resolve.frag")),
+      fbo_("caustic fbo") {}
+
+void CausticPass::setup(PassBuilder& b) const {
+    for (Resource r : {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonHitRefr,
+                       Resource::PhotonPowerRefr, Resource::GBufferPosition,
+                       Resource::GBufferNormal, Resource::GBufferAlbedo, Resource::GBufferEmissive})
+        b.read(r);
+    b.write(Resource::CausticRv, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::CausticR, GL_RGBA16F, SizeRule::Canvas);
+}
+
+PassDecision CausticPass::decide(const FrameContext& ctx) const {
+    if (ctx.plan.causticLayers == 0) return {false, ctx.plan.causticReason};
+    return {true, "photon quads of " + std::to_string(ctx.plan.causticLayers) +
+                      " light(s) splatted (compute, atomics)"};
+}
+
+void CausticPass::resize(const FrameContext& ctx) {
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    if (w == width_ && h == height_) return;
+    width_ = w;
+    height_ = h;
+    accum_ = gl::Texture::create2DArray("caustic buffer (fixed point)", w, h, 6, GL_R32UI);
+    accum_.setFilter(GL_NEAREST, GL_NEAREST);
+    rv_ = gl::Texture::create2D("caustic L_rv", w, h, GL_RGBA16F);
+    r_ = gl::Texture::create2D("caustic L_r", w, h, GL_RGBA16F);
+    fbo_ = gl::Framebuffer("caustic fbo");
+    fbo_.attachColor(0, rv_);
+    fbo_.attachColor(1, r_);
+    fbo_.finalize(2);
+}
+
+void CausticPass::execute(FrameContext& ctx, PassResources& res) {
+    const GLuint zero = 0;
+    glClearTexImage(accum_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    // Fixed point: 2^24 units = 64 x the brightest caustic light's irradiance at its objects, so
+    // a counter wraps only past ~16,000 times that (a focus far beyond what a pixel can hold)
+    // while ~4e-6 of it still counts.
+    const float fixedScale = 16777216.0f / (64.0f * std::max(ctx.plan.causticIrradiance, 1e-6f));
+    splat_.use();
+    ctx.bindFrameBlocks();
+    glBindTextureUnit(kUnitSplatReflHit, res.texture(Resource::PhotonHitRefl).id());
+    glBindTextureUnit(kUnitSplatReflPower, res.texture(Resource::PhotonPowerRefl).id());
+    glBindTextureUnit(kUnitSplatRefrHit, res.texture(Resource::PhotonHitRefr).id());
+    glBindTextureUnit(kUnitSplatRefrPower, res.texture(Resource::PhotonPowerRefr).id());
+    glBindTextureUnit(kUnitSplatPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitSplatNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitSplatEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindImageTexture(kImageCausticAccum, accum_.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
+    const int s = ctx.options.causticMapSize;
+    glUniform1i(splat_.uniformLocation("mapSize"), s);
+    glUniform1f(splat_.uniformLocation("quadScale"), ctx.options.causticQuadScale);
+    glUniform1f(splat_.uniformLocation("fixedScale"), fixedScale);
+    glDispatchCompute(GLuint((s + 7) / 8), GLuint((s + 7) / 8), GLuint(2 * ctx.plan.causticLayers));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+
+    fbo_.bind();
+    ctx.beginFullscreen(resolve_, width_, height_);
+    glBindTextureUnit(kUnitResolveAccum, accum_.id());
+    glBindTextureUnit(kUnitResolvePosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitResolveAlbedo, res.texture(Resource::GBufferAlbedo).id());
+    glBindTextureUnit(kUnitResolveEmissive, res.texture(Resource::GBufferEmissive).id());
+    glUniform1f(resolve_.uniformLocation("invFixedScale"), 1.0f / fixedScale);
+    ctx.drawFullscreenTriangle();
+    res.publish(Resource::CausticRv, rv_);
+    res.publish(Resource::CausticR, r_);
+}
+
+}  // namespace mirage::render

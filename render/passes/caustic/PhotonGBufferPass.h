@@ -1,0 +1,31 @@
+#pragma once
+// Photon G-buffers (Knecht 2013 Sec. 5.2; docs/caustics.md): for every spot light whose cone
+// holds a mirror or glass object, the specular objects rendered from the light (a frustum
+// fitted to their bounding sphere, RendererOptions::causticMapSize^2 texels): per texel one
+// reflected and one refracted photon (PGBuf_refl, PGBuf_refr) with its power by pixel counting
+// and its receiver hit traced through the impostors. Camera-independent: reused while the scene,
+// lights and plan stay.
+#include "render/RenderPass.h"
+
+namespace mirage::render {
+
+class PhotonGBufferPass final : public RenderPass {
+public:
+    PhotonGBufferPass(const GpuScene& scene);
+    const char* name() const override { return "photongbuf"; }
+    void setup(PassBuilder& b) const override;
+    PassDecision decide(const FrameContext& ctx) const override;
+    void resize(const FrameContext& ctx) override;
+    void execute(FrameContext& ctx, PassResources& res) override;
+    bool cameraIndependent() const override { return true; }
+
+private:
+    gl::Program backProgram_, photonProgram_;
+    gl::Texture backPosition_, backNormal_, depth_;
+    gl::Texture reflHit_, reflPower_, refrHit_, refrPower_;
+    gl::Framebuffer backFbo_, photonFbo_;
+    int allocatedSize_ = 0, allocatedLayers_ = 0;
+    MaterialDraw photonDraw_{photonProgram_};  // after photonProgram_
+};
+
+}  // namespace mirage::render

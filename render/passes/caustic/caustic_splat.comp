@@ -1,0 +1,125 @@
+#version 450 core
+#include "common.glsl"
+// Caustic buffer (Knecht 2013 Sec. 5.2): every photon of the photon G-buffers is splatted as a
+// quad around its receiver hit, in camera space, into a fixed-point irradiance buffer with
+// integer atomics (on llvmpipe scattering is ~10x cheaper in compute than as GL_POINTS,
+// DESIGN.md). One invocation per photon texel; z = 2 x light layer + (0 reflected, 1 refracted).
+//
+// Quad size after Wyman 2008: the photon's footprint on the receiver is the spacing of its
+// neighbouring photons' hits (their divergence from the light through the object); the kernel
+// radius is quadScale x that spacing, at least 0.75 pixel (stretched by 1 / cos on a surface seen
+// obliquely) and at most kMaxQuadPx pixels. The
+// kernel is Epanechnikov in WORLD distance from the hit, so a pixel whose G-buffer surface is not
+// near the hit (an occluder in front, another surface behind) gets nothing: depth rejection
+// against the G-buffer. Weights are normalised over the pixels the photon reaches: the photon's
+// power P lands as irradiance E_i = P w_i / sum_j (w_j A_j) (A = the pixel's surface area, m^2),
+// so sum_i E_i A_i = P whatever the quad's size (a caustic focused to one pixel keeps its
+// energy and nothing more). Specular pixels (mirror / glass) receive nothing.
+// Output: 6 layers of uint irradiance x fixedScale: L_rv rgb (power x visibility), L_r rgb
+// (power x real-path visibility: light, object and — at resolve time — receiver real).
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = kUnitSplatReflHit) uniform sampler2DArray reflHit;
+layout(binding = kUnitSplatReflPower) uniform sampler2DArray reflPower;
+layout(binding = kUnitSplatRefrHit) uniform sampler2DArray refrHit;
+layout(binding = kUnitSplatRefrPower) uniform sampler2DArray refrPower;
+layout(binding = kUnitSplatPosition) uniform sampler2D gPosition;  // xyz world, w = origin
+layout(binding = kUnitSplatNormal) uniform sampler2D gNormal;
+layout(binding = kUnitSplatEmissive) uniform sampler2D gEmissive;  // a = specular slot + 1
+layout(r32ui, binding = kImageCausticAccum) uniform uimage2DArray accum;
+uniform int mapSize;
+uniform float quadScale;   // kernel radius in photon spacings
+uniform float fixedScale;  // irradiance (W/m^2) -> integer units
+const int kMaxQuadPx = 8;  // kernel radius cap (pixels): bounds the cost of diffuse photons
+const float kMaxSpacing = 0.25;  // m: neighbours farther apart lie on another surface
+
+vec4 hitAt(bool refracted, ivec3 t) {
+    return refracted ? texelFetch(refrHit, t, 0) : texelFetch(reflHit, t, 0);
+}
+
+int hitOrigin(vec4 h) { return int(floor((h.w + 0.5) / 4.0)); }
+
+// Surface area (m^2) of canvas pixel px whose surface is x with normal n: the pixel's solid
+// angle cos^3 / (fx fy) times distance^2 / |cos| at the surface.
+float pixelArea(vec3 x, vec3 n, float fx, float fy) {
+    vec3 toCam = cameraPos.xyz - x;
+    float dist = length(toCam);
+    float z = max((viewMatrix * vec4(x, 1.0)).z, 1e-4);
+    float cosS = max(abs(dot(n, toCam / max(dist, 1e-6))), 0.05);
+    return z * z * z / (dist * fx * fy * cosS);
+}
+
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (t.x >= mapSize || t.y >= mapSize) return;
+    int layer = int(gl_GlobalInvocationID.z) / 2;
+    bool refracted = (gl_GlobalInvocationID.z & 1u) == 1u;
+    ivec3 tl = ivec3(t, layer);
+    vec4 hit = hitAt(refracted, tl);
+    int origin = hitOrigin(hit);
+    if (origin == ORIGIN_NONE) return;
+    vec4 pw = refracted ? texelFetch(refrPower, tl, 0) : texelFetch(reflPower, tl, 0);
+    float realVis = hit.w - 4.0 * float(origin);
+    vec3 powerRv = pw.rgb * pw.a, powerR = pw.rgb * realVis;
+    if (max(max(powerRv.r, powerRv.g), max(powerRv.b, max(powerR.r, max(powerR.g, powerR.b)))) <=
+        0.0)
+        return;
+    // Footprint: the largest distance to a neighbouring photon's hit on the same surface.
+    float spacing = 0.0;
+    const ivec2 nb[4] = ivec2[4](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
+    for (int k = 0; k < 4; ++k) {
+        ivec2 q = t + nb[k];
+        if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(mapSize)))) continue;
+        vec4 h = hitAt(refracted, ivec3(q, layer));
+        if (hitOrigin(h) == ORIGIN_NONE) continue;
+        float dd = distance(h.xyz, hit.xyz);
+        if (dd < kMaxSpacing) spacing = max(spacing, dd);
+    }
+    // Project the hit onto the canvas.
+    vec4 c = viewProj * vec4(hit.xyz, 1.0);
+    if (c.w <= 1e-6) return;
+    vec2 cp = (c.xy / c.w * 0.5 + 0.5) * canvas.xy - 0.5;
+    float fx = abs(projMatrix[0][0]) * 0.5 * canvas.x, fy = abs(projMatrix[1][1]) * 0.5 * canvas.y;
+    float pixelWorld = c.w / fx;  // m per pixel at the hit's depth (facing the camera)
+    // On a surface seen obliquely a pixel's footprint stretches by 1 / cos: the smallest kernel
+    // must still reach a pixel centre, or the photon would be lost.
+    ivec2 centre = ivec2(floor(cp + 0.5));
+    vec3 nc = texelFetch(gNormal, clamp(centre, ivec2(0), ivec2(canvas.xy) - 1), 0).xyz;
+    float cosC = abs(dot(nc, normalize(cameraPos.xyz - hit.xyz)));
+    float rMin = 0.75 * pixelWorld / clamp(cosC, 0.2, 1.0);
+    float r = clamp(quadScale * spacing, rMin, float(kMaxQuadPx) * pixelWorld);
+    int rPx = int(ceil(r / pixelWorld));
+    ivec2 lo = max(centre - rPx, ivec2(0)), hi = min(centre + rPx, ivec2(canvas.xy) - 1);
+    if (any(greaterThan(lo, hi))) return;
+    float r2 = r * r, sumWA = 0.0;
+    for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+            vec4 g = texelFetch(gPosition, ivec2(x, y), 0);
+            if (int(g.w + 0.5) == ORIGIN_NONE) continue;
+            if (texelFetch(gEmissive, ivec2(x, y), 0).a > 0.5) continue;  // specular pixel
+            vec3 dv = g.xyz - hit.xyz;
+            float w = 1.0 - dot(dv, dv) / r2;
+            if (w <= 0.0) continue;
+            sumWA += w * pixelArea(g.xyz, texelFetch(gNormal, ivec2(x, y), 0).xyz, fx, fy);
+        }
+    if (!(sumWA > 0.0) || isinf(sumWA)) return;
+    vec3 eRv = powerRv * (fixedScale / sumWA), eR = powerR * (fixedScale / sumWA);
+    const float kMaxAdd = 268435456.0;  // 2^28: one photon can never wrap a counter
+    for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+            vec4 g = texelFetch(gPosition, ivec2(x, y), 0);
+            if (int(g.w + 0.5) == ORIGIN_NONE) continue;
+            if (texelFetch(gEmissive, ivec2(x, y), 0).a > 0.5) continue;
+            vec3 dv = g.xyz - hit.xyz;
+            float w = 1.0 - dot(dv, dv) / r2;
+            if (w <= 0.0) continue;
+            uvec3 a = uvec3(min(eRv * w, vec3(kMaxAdd)) + 0.5);
+            uvec3 b = uvec3(min(eR * w, vec3(kMaxAdd)) + 0.5);
+            ivec2 px = ivec2(x, y);
+            if (a.r > 0u) imageAtomicAdd(accum, ivec3(px, 0), a.r);
+            if (a.g > 0u) imageAtomicAdd(accum, ivec3(px, 1), a.g);
+            if (a.b > 0u) imageAtomicAdd(accum, ivec3(px, 2), a.b);
+            if (b.r > 0u) imageAtomicAdd(accum, ivec3(px, 3), b.r);
+            if (b.g > 0u) imageAtomicAdd(accum, ivec3(px, 4), b.g);
+            if (b.b > 0u) imageAtomicAdd(accum, ivec3(px, 5), b.b);
+        }
+}

@@ -1,0 +1,118 @@
+#version 450 core
+#include "common.glsl"
+#include "lighting.glsl"
+#include "passes/specular/specular.glsl"
+#include "passes/impostor/trace.glsl"
+// Photon G-buffers PGBuf_refl and PGBuf_refr of one spot light (Knecht 2013 Sec. 5.2, Wyman &
+// Davis 2006): the specular objects rendered from the light through a frustum fitted to them;
+// every texel is one photon. Its power by pixel counting (Shah et al. 2007): the texel's solid
+// angle x the light's radiant intensity x the spot profile and range window, times the reflection
+// weight (reflected photon) or the two-interface transmittance with Beer-Lambert absorption
+// (refracted photon) — the same functions as the camera path (specular.glsl). Each photon is
+// traced from the object to its receiver through the impostors (traceSurroundings), as the
+// camera path's reflected and refracted rays are. Frames: world (glTF, metres).
+//
+// Light inside the object (the nearest surface seen from the light faces away from it): one
+// refraction on the way out (TIR: one internal reflection), absorption over the distance from
+// the light; no reflected photon.
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = kBindingSpecularDraws) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
+layout(binding = kUnitPhotonBackPosition) uniform sampler2D backPosition;  // xyz, w = slot + 1
+layout(binding = kUnitPhotonBackNormal) uniform sampler2D backNormal;      // outward
+layout(binding = kUnitPhotonShadowAll) uniform sampler2DArray shadowAll;
+layout(binding = kUnitPhotonShadowReal) uniform sampler2DArray shadowReal;
+uniform int lightIndex;
+uniform int specularSlot;
+uniform int origin;           // of the specular object drawn
+uniform int materialIndex;    // (MaterialDraw; the slot's material is used)
+uniform mat4 lightViewProj;   // world -> clip of the fitted frustum
+uniform float mapSize;        // texels per side
+uniform float tanHalf;        // tan of the frustum's half angle
+uniform int marchSteps;
+in vec3 worldPos;
+in vec3 worldNormal;
+in vec2 uv;
+layout(location = 0) out vec4 outReflHit;    // xyz receiver (m), w = 4 origin + real visibility
+layout(location = 1) out vec4 outReflPower;  // rgb W, a = visibility (all occluders)
+layout(location = 2) out vec4 outRefrHit;
+layout(location = 3) out vec4 outRefrPower;
+
+vec4 photonHit(SurroundingHit h, float realVis) {
+    if (!h.hit || !allFinite(h.position)) return vec4(0.0);  // leaves the modelled scene
+    return vec4(h.position, 4.0 * float(h.origin) + clamp(realVis, 0.0, 1.0));
+}
+
+vec4 photonPower(vec3 power, float vis) {
+    return vec4(allFinite(power) ? max(power, vec3(0.0)) : vec3(0.0), clamp(vis, 0.0, 1.0));
+}
+
+void main() {
+    outReflHit = vec4(0.0);
+    outReflPower = vec4(0.0);
+    outRefrHit = vec4(0.0);
+    outRefrPower = vec4(0.0);
+    const int li = lightIndex;
+    vec3 p = worldPos;
+    vec3 d = p - lights[li].position;
+    float dist = length(d);
+    if (dist < 1e-6) return;
+    d /= dist;
+    vec3 nOut = normalize(worldNormal);
+    if (!allFinite(nOut)) return;
+    bool inside = dot(nOut, d) > 0.0;  // the light is inside the object
+    vec3 n = inside ? -nOut : nOut;    // faces the light
+    int slot = specularSlot;
+    GpuSpecularDraw sd = specularDraws[slot];
+    GpuMaterial m = materials[sd.material];
+    float cosL = clamp(dot(n, -d), 1e-4, 1.0);
+
+    // Pixel counting: the texel's solid angle in the fitted frustum (square, tanHalf).
+    vec2 ndc = gl_FragCoord.xy / mapSize * 2.0 - 1.0;
+    float texelTan = 2.0 * tanHalf / mapSize;
+    float solidAngle = texelTan * texelTan /
+                       pow(1.0 + tanHalf * tanHalf * dot(ndc, ndc), 1.5);
+    vec3 power = lights[li].radiantIntensity * spotAttenuation(li, d) * rangeWindow(li, dist) *
+                 solidAngle;
+    // Visibility from the light (occluders between light and object), both GI solutions.
+    vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, cosL, lights[li].realOnlyMap == 1);
+    float realVis = lights[li].isReal == 1 && origin == ORIGIN_REAL ? vis.y : 0.0;
+
+    bool mirror = m.mirror != 0;
+    float transWeight = mirror ? 0.0 : clamp(m.transmission, 0.0, 1.0) *
+                                           (1.0 - clamp(m.metallic, 0.0, 1.0));
+    float eta = max(m.ior, 1e-3);
+    float eps = 1e-4 + 1e-4 * dist;  // ray offset against self-intersection (m)
+
+    if (inside) {
+        if (transWeight <= 0.0) return;
+        float F = fresnelDielectric(-cosL, eta);  // from the inside
+        vec3 T = refract(d, n, eta);               // n faces the light (inwards): ratio eta / 1
+        if (F >= 1.0 || dot(T, T) < 0.5) {
+            T = reflect(d, n);  // TIR: one internal reflection, then out (as the camera path)
+            F = 0.0;
+        }
+        T = normalize(T);
+        vec3 base = clamp(m.baseColor.rgb, 0.0, 1.0);
+        vec3 absorb = vec3(1.0);
+        if (m.attenuationDistance > 0.0)
+            absorb = pow(max(m.attenuationColor, vec3(1e-6)), vec3(dist / m.attenuationDistance));
+        SurroundingHit h = traceSurroundings(slot, p + T * eps, T);
+        outRefrHit = photonHit(h, realVis);
+        outRefrPower = photonPower(power * transWeight * (1.0 - F) * base * absorb, vis.x);
+        return;
+    }
+    vec3 r = reflect(d, n);
+    SurroundingHit hr = traceSurroundings(slot, p + n * eps, r);
+    outReflHit = photonHit(hr, realVis);
+    outReflPower = photonPower(power * reflectionWeight(m, cosL, transWeight), vis.x);
+    if (transWeight <= 0.0) return;
+    vec3 P2, T2;
+    float F1, F2, travelled;
+    if (!refractTwoInterfaces(p, n, d, slot, sd, eta, lightViewProj, lights[li].position,
+                              vec2(mapSize), backPosition, backNormal, marchSteps, P2, T2, F1, F2,
+                              travelled))
+        return;
+    SurroundingHit ht = traceSurroundings(slot, P2 + T2 * eps, T2);
+    outRefrHit = photonHit(ht, realVis);
+    outRefrPower = photonPower(power * refractionWeight(m, transWeight, F1, F2, travelled), vis.x);
+}
