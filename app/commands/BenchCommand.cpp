@@ -182,7 +182,7 @@ void runBench(const BenchArgs& a) {
                         "no frame has both a ground-truth pose (frames.csv) and a "
                         "ground-truth composite to judge against");
 
-    // The session's environment camera, for configurations with environment=camera.
+    // The session's environment camera, for configurations with env_source=camera.
     std::optional<render::SessionEnvironment> env;
     if (std::any_of(grid.begin(), grid.end(),
                     [](const render::BenchConfig& c) { return c.environmentCamera; })) {
@@ -191,7 +191,7 @@ void runBench(const BenchArgs& a) {
         if (!env)
             throw FileError(
                 a.session,
-                "knob environment=camera: " +
+                "knob env_source=camera: " +
                     (why.empty() ? std::string("the session has no environment camera") : why));
     }
 

@@ -129,20 +129,20 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
          }},
         // The environment (docs/environment.md). Defaults keep the static map, so the default
-        // grid is unchanged; sweep with --knob environment=static,camera --knob env_resolution=...
-        {"environment",
+        // grid is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
+        {"env_source",
          "static: the scene's environment map; camera: the session's environment camera, a new "
          "frame every frame",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"static"}; },
          [](BenchConfig& c, const std::string& v) {
              if (v != "static" && v != "camera")
                  throw Error(
-                     fmt::format("bench: knob environment: '{}' is not static or camera", v));
+                     fmt::format("bench: knob env_source: '{}' is not static or camera", v));
              c.environmentCamera = v == "camera";
          }},
         {"env_resolution",
          "width of the environment map built from each environment-camera frame (height = width "
-         "/ 2; with environment=camera)",
+         "/ 2; with env_source=camera)",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"512"}; },
          [](BenchConfig& c, const std::string& v) {
              const int w = parseInt("env_resolution", v, 16, 4096);

@@ -129,7 +129,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
         (!environment || std::any_of(allFrames.begin(), allFrames.end(),
                                      [](const BenchFrame& f) { return f.environment.empty(); })))
         throw Error(
-            "bench: knob environment=camera needs a session with a usable environment camera "
+            "bench: knob env_source=camera needs a session with a usable environment camera "
             "(calibration with extrinsics, a frame for every row)");
     const int w = config.width > 0 ? config.width : sessionCamera.width;
     const int h = config.height > 0 ? config.height : sessionCamera.height;

@@ -31,7 +31,7 @@ struct BenchConfig {
     RendererOptions options;
     int width = 0, height = 0;                               // 0 = the session's size
     std::vector<std::pair<std::string, std::string>> knobs;  // (name, value) as applied
-    // Light with the session's environment camera, updated every frame (knob environment=camera;
+    // Light with the session's environment camera, updated every frame (knob env_source=camera;
     // docs/environment.md), instead of the scene's static environment map.
     bool environmentCamera = false;
     std::string label() const;  // "vpls=256 indirect_scale=2 ..."
