@@ -197,6 +197,37 @@ TEST_F(EnvironmentPassTest, FillOfTheUnseenPartIsStatedWithItsError) {
     EXPECT_LT(fillErr, 0.5);
 }
 
+// The CPU resampling (core/camera/EquirectProjection.h: mirage track --envmap, both renderers'
+// fish-eye scene environments) and the GPU pass give the same map, fill included.
+TEST_F(EnvironmentPassTest, CpuAndGpuMappingsAgreeFillIncluded) {
+    const CameraIntrinsics K = raytrace::equidistantFisheye(200, 190.0);
+    const Pose T = upwardPose();
+    const cv::Mat frame = test::renderEnvironmentView(K, T, smoothSky);
+    RendererOptions o;
+    o.environmentMapWidth = 128;
+    Renderer r(floorScene(0.5f), smallCamera(), o);
+    r.setEnvironmentCamera(fixedCamera(K, T));
+    r.updateEnvironment(frame, 0.0);
+    r.render({lookAtPose({0, 2, 2}, {0, 0, 0}), {}, false});
+    const cv::Mat gpu = r.readEnvironmentMap();
+    cv::Mat seen;
+    const cv::Mat cpu = equirectFromCamera(srgbBgr8ToLinearRgb(frame), K, T, 128, 64, -1, &seen);
+    double err = 0;
+    int maskDiff = 0;
+    for (int y = 0; y < cpu.rows; ++y)
+        for (int x = 0; x < cpu.cols; ++x) {
+            const cv::Vec4f g = gpu.at<cv::Vec4f>(y, x);
+            const cv::Vec3f c = cpu.at<cv::Vec3f>(y, x);
+            for (int k = 0; k < 3; ++k) err += std::abs(double(g[k]) - c[k]) / 3;
+            maskDiff += (g[3] > 0.5) != (seen.at<uchar>(y, x) != 0);
+        }
+    err /= double(cpu.total());
+    std::printf("[ env cpu/gpu ] mean |GPU - CPU| %.5f, mask differs at %d texels\n", err,
+                maskDiff);
+    EXPECT_LT(err, 0.002);   // half floats and the GPU's bilinear weights
+    EXPECT_LE(maskDiff, 8);  // texels on the border of the seen part
+}
+
 TEST_F(EnvironmentPassTest, GpuShMatchesTheCpuProjectionOfTheSameMap) {
     const CameraIntrinsics K = raytrace::equidistantFisheye(256, 190.0);
     const Pose T = upwardPose();
