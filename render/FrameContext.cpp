@@ -39,6 +39,9 @@ void RendererOptions::validate() const {
              std::to_string(causticQuadScale));
     if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
         fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
+    if (environmentMapWidth < 16 || environmentMapWidth > 4096 || environmentMapWidth % 2 != 0)
+        fail("environmentMapWidth must be even, 16..4096 texels, got " +
+             std::to_string(environmentMapWidth));
 }
 
 int ismTilesPerRow(int vplCount) {

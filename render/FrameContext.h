@@ -4,9 +4,11 @@
 // VPLs are needed) and the uniform buffers. The frame's textures are handed from pass to pass by
 // the frame graph (render/FrameGraph.h), not through this context.
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
+#include "core/camera/CameraModel.h"
 #include "core/gl/Objects.h"
 #include "core/math/Pose.h"
 #include "render/CameraProjection.h"
@@ -65,6 +67,10 @@ struct RendererOptions {
     int impostorRefineSteps = 4;           // secant refinement steps of the height-field search
     bool impostorCubeMapBaseline = false;  // true: plain G-buffer cube map, looked up by direction
 
+    // Live environment (render/passes/environment, docs/environment.md): width of the
+    // equirectangular map built from each environment-camera frame (height = width / 2).
+    int environmentMapWidth = 512;
+
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.
     void validate() const;
@@ -72,6 +78,18 @@ struct RendererOptions {
 
 // Tiles per row of the imperfect shadow map atlas (one square tile per VPL).
 int ismTilesPerRow(int vplCount);
+
+// The environment camera feeding the environment light, as the environment pass sees it
+// (Renderer::setEnvironmentCamera / updateEnvironment / useStaticEnvironment).
+struct EnvironmentInput {
+    bool live = false;        // a camera frame is the environment (false: the scene's map)
+    uint64_t generation = 0;  // changes with every new frame and every live <-> static switch
+    double time = 0.0;        // seconds: the frame's time on the environment camera's clock
+    CameraIntrinsics camera;  // the environment camera (fish-eye: Kannala-Brandt)
+    double reachDeg = -1.0;   // the calibration's reach off-axis (<= 0: whole projectable field)
+    Pose T_world_camera;      // the camera's pose (OpenCV axes) when the frame was taken
+    glm::vec3 gain{1.0f};     // linearised pixel value -> scene radiance, per channel (R, G, B)
+};
 
 struct LightPlan {
     bool castsShadow = false;       // some caster inside the light's cone
@@ -124,6 +142,7 @@ public:
     GpuLightBlock lightBlock{};
     int frameIndex = 0;
     bool historyValid = false;
+    EnvironmentInput environment;
     // Canvas pixels (GL window rect: x, y, width, height) that can show a mirror or glass object
     // this frame (width 0: none in view). The specular passes shade only these: on llvmpipe a
     // fragment costs its whole shader even where it exits at once.

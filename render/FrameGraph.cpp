@@ -159,6 +159,7 @@ void FrameGraph::compile() {
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
     }
     published_.assign(nodes_.size(), {});
+    outputHeld_.assign(nodes_.size(), false);
     report_.passes.assign(nodes_.size(), PassReport{});
     for (size_t i = 0; i < nodes_.size(); ++i) {
         report_.passes[i].name = nodes_[i].pass->name();
@@ -254,6 +255,13 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
         PassReport& rep = report_.passes[i];
         if (!run[i]) {
             staticOutputValid_[i] = false;
+            outputHeld_[i] = false;
+            continue;
+        }
+        if (outputHeld_[i] && p.upToDate(ctx)) {
+            for (const auto& [res, slot] : published_[i]) current_[size_t(res)] = slot;
+            rep.reused = true;
+            rep.reason = "reused: " + rep.reason;
             continue;
         }
         if (p.cameraIndependent() && o.reuseStaticPasses && staticOutputValid_[i]) {
@@ -272,6 +280,7 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
         timers_[i].end();
         rep.ran = true;
         staticOutputValid_[i] = p.cameraIndependent();
+        outputHeld_[i] = true;
     }
     for (size_t i = 0; i < nodes_.size(); ++i) {
         if (!report_.passes[i].ran) continue;
@@ -290,6 +299,13 @@ const gl::Texture& FrameGraph::texture(Resource r) const {
     if (!s.texture)
         throw Error(std::string("buffer ") + resourceName(r) + " was not produced this frame");
     return *s.texture;
+}
+
+const gl::Buffer& FrameGraph::buffer(Resource r) const {
+    const Slot& s = current_[size_t(r)];
+    if (!s.buffer)
+        throw Error(std::string("buffer ") + resourceName(r) + " was not produced this frame");
+    return *s.buffer;
 }
 
 std::vector<std::string> FrameGraph::passNames() const {

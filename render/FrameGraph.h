@@ -64,6 +64,7 @@ public:
     // This frame's resources (after execute()), for readbacks.
     bool has(Resource r) const;
     const gl::Texture& texture(Resource r) const;  // throws mirage::Error if not written
+    const gl::Buffer& buffer(Resource r) const;    // throws mirage::Error if not written
 
     // The pass list in frame order (report, CSV and bench columns come from it).
     std::vector<std::string> passNames() const;
@@ -114,6 +115,8 @@ private:
     std::vector<std::vector<std::pair<Resource, Slot>>> published_;
     std::string staticKey_;
     std::vector<bool> staticOutputValid_;
+    std::vector<bool> outputHeld_;  // published_[i] is the output of the pass's latest run and
+                                    // the pass ran (or was reused) in every frame since
     FrameReport report_;
 };
 

@@ -10,6 +10,8 @@
 
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/camera/CalibrationFile.h"
+#include "core/camera/EquirectProjection.h"
 #include "core/image/ImageIO.h"
 
 namespace mirage::render {
@@ -351,10 +353,26 @@ void GpuScene::buildSurfacePoints(const std::vector<Vertex>& verts,
 
 // Environment light: SH9 for diffuse lighting and the map itself for rays that leave the scene.
 void GpuScene::uploadEnvironment(const Scene& scene) {
+    cv::Mat env;
+    double rotationDeg = 0.0;
     if (scene.environment.kind == Environment::Kind::Equirectangular) {
-        cv::Mat env = readLinearRgb(scene.environment.image);
-        envSH_ =
-            projectEquirectToSH(env, scene.environment.intensity, scene.environment.rotationYDeg);
+        env = readLinearRgb(scene.environment.image);
+        rotationDeg = scene.environment.rotationYDeg;
+    } else if (scene.environment.kind == Environment::Kind::Fisheye) {
+        // A fish-eye image: resampled onto an equirectangular map with the mapping and fill of
+        // the live environment pass (core/camera/EquirectProjection.h, docs/environment.md), as
+        // the reference renderer does.
+        const CameraCalibration cal = loadCalibration(scene.environment.calibration);
+        const cv::Mat frame = readLinearRgb(scene.environment.image);
+        if (frame.cols != cal.intrinsics.width || frame.rows != cal.intrinsics.height)
+            throw FileError(scene.environment.image.string(),
+                            "the fish-eye image's size differs from its calibration " +
+                                scene.environment.calibration.string());
+        env = equirectFromCamera(frame, cal.intrinsics, scene.environment.T_world_camera, 1024, 512,
+                                 cal.reachDeg);
+    }
+    if (!env.empty()) {
+        envSH_ = projectEquirectToSH(env, scene.environment.intensity, rotationDeg);
         hasEnvironment_ = true;
         // The map itself, for what reflected / refracted rays see when they leave the modelled
         // scene (L_env, Knecht 2013 Sec. 4.1.3): linear RGB x intensity, RGBA16F, bilinear,
@@ -374,15 +392,8 @@ void GpuScene::uploadEnvironment(const Scene& scene) {
         envMap_.upload(GL_RGBA, GL_FLOAT, rgba.data);
         glTextureParameteri(envMap_.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
         glTextureParameteri(envMap_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        envRotationRad_ = float(scene.environment.rotationYDeg * 3.14159265358979 / 180.0);
+        envRotationRad_ = float(rotationDeg * 3.14159265358979 / 180.0);
         environmentOrigin_ = scene.environment.origin;
-    } else if (scene.environment.kind == Environment::Kind::Fisheye) {
-        // The fish-eye mapping lives with the tracking module; until it provides an
-        // equirectangular conversion the real-time renderer lights without it (and says so).
-        spdlog::warn(
-            "scene '{}': fish-eye environment not used by the real-time renderer yet "
-            "(convert it to an equirectangular map)",
-            scene.source.string());
     }
     if (envSH_.empty()) envSH_.assign(9, glm::vec3(0.0f));
     if (envMap_.id() == 0) {

@@ -84,6 +84,12 @@ public:
     // VPLs, imperfect shadow maps. Scenes are static, so while the plan is unchanged the graph
     // reuses their last output (republishing what they published) instead of re-running them.
     virtual bool cameraIndependent() const { return false; }
+
+    // True when the pass's persistent output from its last run is still what this frame needs
+    // (the pass knows its own input generation: the environment pass's "no new environment
+    // frame"). The graph then republishes that output instead of running the pass, provided the
+    // pass ran in the previous frame (a skipped pass always runs again).
+    virtual bool upToDate(const FrameContext& /*ctx*/) const { return false; }
 };
 
 }  // namespace mirage::render

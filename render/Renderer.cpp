@@ -14,6 +14,7 @@
 #include "render/passes/caustic/PhotonGBufferPass.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
@@ -128,7 +129,11 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     // The frame, in order. Passes know each other only through the resources they declare.
     FrameGraph& g = graph_;
     g.importTexture(Resource::CameraImage, GL_SRGB8_ALPHA8, SizeRule::Camera, "camera frame");
-    g.importTexture(Resource::EnvironmentMap, GL_RGBA16F, SizeRule::Scene, "scene environment");
+    g.importTexture(Resource::SceneEnvironmentMap, GL_RGBA16F, SizeRule::Scene,
+                    "scene environment");
+    g.importTexture(Resource::EnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene,
+                    "environment camera frame");
+    g.addPass(std::make_unique<EnvironmentPass>());
     g.addPass(std::make_unique<GBufferPass>());
     g.addPass(std::make_unique<ShadowPass>());
     g.addPass(std::make_unique<VplPass>());
@@ -152,7 +157,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     cameraImage_.setFilter(GL_NEAREST, GL_NEAREST);
     uploadCameraImage(cv::Mat());
     g.setImport(Resource::CameraImage, cameraImage_);
-    g.setImport(Resource::EnvironmentMap, scene_->environmentMap());
+    g.setImport(Resource::SceneEnvironmentMap, scene_->environmentMap());
     planFrame(FrameInput{});
     for (const FrameGraph::Node& n : g.nodes()) n.pass->resize(*ctx_);
 }
@@ -363,7 +368,9 @@ void Renderer::planFrame(const FrameInput& input) {
     f.vplCount = options_.vplCount;
     f.interleave = options_.interleave;
     f.frameIndex = c.frameIndex;
-    const int envFlag = !s.hasEnvironment()                     ? kOriginNone
+    // A live environment is the real world's, captured by a camera.
+    const int envFlag = c.environment.live                      ? kOriginReal
+                        : !s.hasEnvironment()                   ? kOriginNone
                         : s.environmentOrigin() == Origin::Real ? kOriginReal
                                                                 : kOriginVirtual;
     c.historyValid = !input.resetHistory && lastRanFilter_ && c.frameIndex > 0;
@@ -375,11 +382,9 @@ void Renderer::planFrame(const FrameInput& input) {
     f.shadowBias = options_.shadowBias;
     f.temporalBlend = options_.temporalBlend;
     f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
-    for (int i = 0; i < 9; ++i) f.envSH[i] = glm::vec4(s.environmentSH()[size_t(i)], 0.0f);
     f.exposure = options_.exposure;
     f.alphaMax = options_.alphaMax;
     f.alphaFadeLr = options_.alphaFadeLr;
-    f.envRotation = s.environmentRotation();
     c.frameUbo.upload(&f, sizeof(GpuFrame));
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
     prevViewProj_ = viewProj;
@@ -415,6 +420,12 @@ const FrameReport& Renderer::render(const FrameInput& input) {
             "camera pose is not finite; pass resetHistory and skip the frame when "
             "tracking is lost");
     uploadCameraImage(input.cameraImage);
+    if (envPosePending_) {
+        // A mounted environment camera: its frame was taken with the main camera where this
+        // frame's pose puts it.
+        ctx_->environment.T_world_camera = envCamera_->poseInWorld(input.T_world_camera);
+        envPosePending_ = false;
+    }
     planFrame(input);
     FrameContext& c = *ctx_;
     // What the camera-independent passes' output depends on: the light matrices and the plan.
@@ -422,6 +433,69 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     lastRanFilter_ = report.ran("gifilter");
     ++c.frameIndex;
     return report;
+}
+
+void Renderer::setEnvironmentCamera(const EnvironmentCameraSetup& camera) {
+    if (!camera.intrinsics.isValid())
+        throw Error("environment camera: invalid intrinsics (focal lengths and size must be > 0)");
+    MR_CHECK(camera.T_world_camera.has_value() != camera.T_main_camera.has_value(),
+             "environment camera: exactly one of T_world_camera and T_main_camera");
+    envCamera_ = camera;
+    const int w = camera.intrinsics.width, h = camera.intrinsics.height;
+    if (envImage_.width() != w || envImage_.height() != h) {
+        envImage_ = gl::Texture::create2D("environment camera frame", w, h, GL_SRGB8_ALPHA8);
+        envImage_.setFilter(GL_LINEAR, GL_LINEAR);
+        graph_.setImport(Resource::EnvironmentCamera, envImage_);
+    }
+    EnvironmentInput& e = ctx_->environment;
+    e.camera = camera.intrinsics;
+    e.reachDeg = camera.reachDeg;
+    e.gain = camera.gain;
+    if (e.live) ++e.generation;  // a live map is rebuilt with the new camera
+}
+
+bool Renderer::updateEnvironment(const cv::Mat& bgr, double time) {
+    if (!envCamera_)
+        throw Error("updateEnvironment: no environment camera set (setEnvironmentCamera first)");
+    const CameraIntrinsics& K = envCamera_->intrinsics;
+    if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.cols != K.width || bgr.rows != K.height)
+        throw Error(
+            fmt::format("environment camera frame is {}x{} (type {}), but its calibration "
+                        "is for {}x{} 8-bit BGR; use the calibration of this camera mode",
+                        bgr.cols, bgr.rows, bgr.type(), K.width, K.height));
+    EnvironmentInput& e = ctx_->environment;
+    if (e.live && time == e.time) return false;  // the same frame again: nothing new
+    cv::Mat rgba;
+    cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
+    envImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+    e.live = true;
+    e.time = time;
+    ++e.generation;
+    if (envCamera_->T_world_camera) {
+        e.T_world_camera = *envCamera_->T_world_camera;
+        envPosePending_ = false;
+    } else {
+        envPosePending_ = true;
+    }
+    return true;
+}
+
+void Renderer::setEnvironmentGain(const glm::vec3& gain) {
+    if (!std::isfinite(gain.r) || !std::isfinite(gain.g) || !std::isfinite(gain.b) || gain.r < 0 ||
+        gain.g < 0 || gain.b < 0)
+        throw Error("environment camera gain must be finite and >= 0 per channel");
+    if (envCamera_) envCamera_->gain = gain;
+    EnvironmentInput& e = ctx_->environment;
+    e.gain = gain;
+    if (e.live) ++e.generation;
+}
+
+void Renderer::useStaticEnvironment() {
+    EnvironmentInput& e = ctx_->environment;
+    if (!e.live) return;
+    e.live = false;
+    envPosePending_ = false;
+    ++e.generation;
 }
 
 std::vector<std::string> Renderer::passNames() const {
@@ -468,6 +542,18 @@ cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
     cv::Mat out(t.height(), t.width(), CV_32F);
     std::memcpy(out.data, bits.data(), bits.size() * 4);  // float bits were stored
     return out;
+}
+
+cv::Mat Renderer::readEnvironmentMap() const {
+    const gl::Texture& t = graph_.texture(Resource::EnvironmentMap);
+    auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
+    return cv::Mat(t.height(), t.width(), CV_32FC4, px.data()).clone();
+}
+
+GpuEnvironment Renderer::readEnvironmentLight() const {
+    GpuEnvironment g{};
+    glGetNamedBufferSubData(graph_.buffer(Resource::EnvironmentLight).id(), 0, sizeof(g), &g);
+    return g;
 }
 
 cv::Mat Renderer::readBuffer(Resource r) const {

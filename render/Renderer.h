@@ -8,6 +8,7 @@
 // (`mirage info --passes SCENE` prints it, docs/realtime-renderer.md draws it). Needs a current
 // GL 4.5 context (core/gl/Context.h).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "core/math/Pose.h"
 #include "core/scene/Scene.h"
 #include "render/CameraProjection.h"
+#include "render/EnvironmentCamera.h"
 #include "render/FrameContext.h"
 #include "render/FrameGraph.h"
 #include "render/GpuScene.h"
@@ -40,6 +42,29 @@ public:
 
     // Renders and composites one frame; blocks until its timer queries are available.
     const FrameReport& render(const FrameInput& input);
+
+    // The environment camera as a live light source (docs/environment.md). After
+    // setEnvironmentCamera, each updateEnvironment frame replaces the scene's static environment
+    // (map, diffuse SH9 and L_env) from the next render() on; the environment pass runs only in
+    // the frames after a new one arrived. A camera mounted on the main camera takes its pose
+    // from the next render()'s T_world_camera. Throws mirage::Error on invalid intrinsics.
+    void setEnvironmentCamera(const EnvironmentCameraSetup& camera);
+    // A new environment-camera frame: 8-bit BGR, sRGB-encoded, the calibration's size; `time` in
+    // seconds on its clock. Returns false and changes nothing when `time` is the last frame's (the
+    // same frame again). Throws mirage::Error (nothing changed) when no camera is set or the
+    // image's size or type differs from the calibration's.
+    bool updateEnvironment(const cv::Mat& frameBgr8, double time);
+    // Per-channel gain of the environment camera (EnvironmentCameraSetup::gain); rebuilds the
+    // live map at the next render().
+    void setEnvironmentGain(const glm::vec3& gain);
+    // Back to the scene's static environment (the environment stream ended or failed).
+    void useStaticEnvironment();
+    bool environmentLive() const { return ctx_->environment.live; }
+    // This frame's environment map, level 0, as CV_32FC4 (R, G, B linear radiance; A = 1 where
+    // the camera saw the direction, 0 where it was filled in; 1 everywhere for a static map),
+    // top row first, and its SH9 block. For tests, benchmarks and light estimation.
+    cv::Mat readEnvironmentMap() const;
+    GpuEnvironment readEnvironmentLight() const;
 
     // Readbacks (camera image size, top row first). Linear RGB float (CV_32FC3) / sRGB 8-bit
     // BGR (CV_8UC3) / coverage (CV_8U: 0 empty, 1 real, 2 virtual).
@@ -78,6 +103,9 @@ private:
     std::unique_ptr<FrameContext> ctx_;
     FrameGraph graph_;
     gl::Texture cameraImage_;
+    std::optional<EnvironmentCameraSetup> envCamera_;
+    gl::Texture envImage_;         // the environment camera's newest frame, sRGB8
+    bool envPosePending_ = false;  // a mounted camera's pose is taken at the next render()
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
     bool lastRanFilter_ = false;

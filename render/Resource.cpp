@@ -5,7 +5,10 @@ namespace mirage::render {
 const char* resourceName(Resource r) {
     static const char* const names[kResourceCount] = {
         "CameraImage",
+        "SceneEnvironmentMap",
+        "EnvironmentCamera",
         "EnvironmentMap",
+        "EnvironmentLight",
         "GBufferPosition",
         "GBufferNormal",
         "GBufferAlbedo",

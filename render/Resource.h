@@ -8,8 +8,15 @@ namespace mirage::render {
 
 enum class Resource {
     // Imported from outside the frame.
-    CameraImage,     // the camera frame, sRGB8 texture sampled as linear (camera image size)
-    EnvironmentMap,  // the scene's equirectangular environment map, linear (1x1 black: none)
+    CameraImage,          // the camera frame, sRGB8 texture sampled as linear (camera image size)
+    SceneEnvironmentMap,  // the scene's static equirectangular map, linear (1x1 black: none)
+    EnvironmentCamera,    // the environment (fish-eye) camera's newest frame, sRGB8; imported only
+                          // while a live environment is set (Renderer::setEnvironmentCamera)
+    // The environment light (render/passes/environment): the map every environment lookup uses
+    // (equirectangular RGBA16F, rgb linear radiance, a = 1 where the camera saw the direction,
+    // 0 where the unseen part was filled in; mip-mapped when live) and its SH9 (EnvironmentBlock).
+    EnvironmentMap,
+    EnvironmentLight,
     // Primary G-buffer (canvas size).
     GBufferPosition,  // xyz world (m), w = origin (ORIGIN_REAL / ORIGIN_VIRTUAL, 0 = empty)
     GBufferNormal,    // xyz unit world normal, w = roughness

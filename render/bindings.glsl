@@ -15,6 +15,7 @@ const int kBindingIsmPoints = 4;      // GpuSurfacePoint[] (ism.comp)
 const int kBindingSpecularDraws = 5;  // GpuSpecularDraw[]
 const int kBindingImpostorRecords = 6;  // GpuImpostor[] (trace.glsl)
 const int kBindingImpostorObjects = 7;  // header + GpuImpostorObject[] (trace.glsl)
+const int kBindingEnvironment = 8;      // EnvironmentBlock (std140; environment_sh.comp writes it)
 const int kBindingQueryRays = 4;        // query.comp (offline impostor queries, outside frames)
 const int kBindingQueryHits = 5;
 
@@ -32,6 +33,10 @@ const int kUnitDirectShadowAll = 4;
 const int kUnitDirectShadowReal = 5;
 const int kUnitDirectGlassAll = 6;  // ShadowGlass / ShadowGlassReal (glass in the shadow maps)
 const int kUnitDirectGlassReal = 7;
+
+// environment pass: fisheye_to_equirect.frag, environment_sh.comp
+const int kUnitEnvFisheye = 0;   // the environment camera's frame (sRGB8, sampled linear)
+const int kUnitEnvShSource = 0;  // the equirectangular map (a small mip level)
 
 // vpl.comp
 const int kUnitVplRsmFlux = 0;

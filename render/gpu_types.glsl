@@ -64,11 +64,22 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
                              // the texel footprint)
     float temporalBlend;     // history weight of the VPL lighting (0 = off)
     float ismPointsPerVpl;
-    vec4 envSH[9];  // environment irradiance SH (rgb), already scaled by intensity
     float exposure;     // rendered linear radiance -> camera linear units
     float alphaMax;     // cap of alpha = CI / L_r
     float alphaFadeLr;  // L_r below which alpha fades to 1
-    float envRotation;  // environment map rotation about +Y (radians)
+    float framePad0;    // std140: the block is a multiple of 16 bytes
+};
+
+// The environment light (kBindingEnvironment): written by the environment pass
+// (render/passes/environment) from the scene's static map or, per environment-camera frame, by
+// environment_sh.comp (which declares the same layout as a std430 storage block: vec4 arrays and
+// scalars have the same offsets in both). Read by every shader that lights with the environment.
+MIRAGE_UNIFORM_BLOCK(EnvironmentBlock, GpuEnvironment, kBindingEnvironment) {
+    vec4 envSH[9];          // radiance SH9 (rgb, linear, intensity / gain applied), world axes
+    float envRotation;      // environment map rotation about +Y (radians); 0 for a live map
+    float envSeenFraction;  // solid-angle fraction of the live map the camera saw (1: static)
+    float envPad0;
+    float envPad1;
 };
 
 MIRAGE_UNIFORM_BLOCK(LightBlock, GpuLightBlock, kBindingLights) {

@@ -9,6 +9,7 @@
 //   OUTDIR/bench.md          a markdown table of bench.csv with the command, date and load average
 // A "footage only" row per resolution judges the footage itself (the virtual contribution
 // removed): every real configuration should beat it in the influenced pixels.
+#include <algorithm>
 #include <cctype>
 #include <ctime>
 #include <filesystem>
@@ -35,6 +36,7 @@
 #include "core/image/ImageIO.h"
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
+#include "render/SessionEnvironment.h"
 #include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/RealtimeBench.h"
 
@@ -181,6 +183,19 @@ void runBench(const BenchArgs& a) {
                         "no frame has both a ground-truth pose (frames.csv) and a "
                         "ground-truth composite to judge against");
 
+    // The session's environment camera, for configurations with env_source=camera.
+    std::optional<render::SessionEnvironment> env;
+    if (std::any_of(grid.begin(), grid.end(),
+                    [](const render::BenchConfig& c) { return c.environmentCamera; })) {
+        std::string why;
+        env = render::SessionEnvironment::open(session, a.exposure, why);
+        if (!env)
+            throw FileError(
+                a.session,
+                "knob env_source=camera: " +
+                    (why.empty() ? std::string("the session has no environment camera") : why));
+    }
+
     gl::ContextOptions copt;
     copt.width = calib.intrinsics.width;
     copt.height = calib.intrinsics.height;
@@ -204,8 +219,8 @@ void runBench(const BenchArgs& a) {
                         shard.index, shard.count, grid.size()));
     for (int i : chosen) {
         const auto& c = grid[size_t(i)];
-        render::BenchResult r =
-            render::runBenchConfig(scene, calib.intrinsics, frames, c, a.repeats);
+        render::BenchResult r = render::runBenchConfig(scene, calib.intrinsics, frames, c,
+                                                       a.repeats, env ? &env->setup() : nullptr);
         spdlog::info(
             "bench [{}/{}] {}: {:.1f} GPU ms/frame (median), PSNR {:.2f} dB / "
             "influenced {:.2f} dB, SSIM {:.4f} / {:.4f}",

@@ -15,6 +15,13 @@
 // without a pose is "lost": the camera frame passes through unchanged and temporal history is
 // reset on the next tracked frame. An `uncertain` frame is composited with the last ok pose if
 // that is at most 0.25 s old (the reason says so), else treated as lost.
+//
+// Environment (docs/environment.md): a session with an environment camera (role "environment",
+// e.g. env.mkv) lights the scene with it, frame by frame (the renderer's environment pass runs
+// when a new environment frame arrives); --static-env FILE uses that equirectangular image
+// instead. An unusable environment camera (no calibration or extrinsics, a calibration of another
+// size, a video that ends early) is reported and the replay continues with the scene's static
+// environment; the CSV's last column, `environment`, says which one lit each frame.
 #include <unistd.h>
 #include <cctype>
 #include <chrono>
@@ -48,7 +55,10 @@
 #include "core/session/MatroskaWriter.h"
 #include "core/session/PosesCsv.h"
 #include "core/session/Session.h"
+#include "core/session/SessionReadOptions.h"
+#include "render/LightEstimation.h"
 #include "render/Renderer.h"
+#include "render/SessionEnvironment.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::app {
@@ -79,7 +89,7 @@ void progress(int done, int total, double fps) {
 }
 
 struct ReplayArgs {
-    std::string session, scene, output, poses, shard, placement;
+    std::string session, scene, output, poses, shard, placement, staticEnv;
     int vpls = 256;
     int maxFrames = -1;
     int start = 0;
@@ -93,11 +103,14 @@ struct ReplayArgs {
     bool verbose = false;
     bool groundTruth = false;
     bool force = false;
+    bool estimateLights = false;
 };
 
 void runReplay(const ReplayArgs& a) {
     SessionReadReport readReport;
-    Session session = readSession(a.session, &readReport);
+    // Rows need only the main camera: an environment video that ends early does not shorten the
+    // replay (the static environment takes over).
+    Session session = readSession(a.session, &readReport, SessionReadOptions{true});
     for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
     const SessionCamera* main = nullptr;
     for (const auto& c : session.cameras)
@@ -114,6 +127,7 @@ void runReplay(const ReplayArgs& a) {
     OutputRule rule{sessionInputs(session), a.force, "mirage replay"};
     rule.inputs.push_back(a.scene);
     if (!a.poses.empty()) rule.inputs.push_back(a.poses);
+    if (!a.staticEnv.empty()) rule.inputs.push_back(a.staticEnv);
     // A shard (--shard I/N: the I-th of N contiguous blocks of the frames) writes PNG frames and
     // its CSV rows into OUT.shards/I-of-N; `mirage merge OUT` makes OUT of them.
     std::optional<StagedPath> staged;
@@ -159,6 +173,18 @@ void runReplay(const ReplayArgs& a) {
                        boardPlane(tracking::Board::load(session.path(session.board))));
         spdlog::info("replay: virtual objects placed as {} says", placementFile.string());
     }
+    if (!a.staticEnv.empty()) {
+        // The given map replaces the scene's environment image; a scene's equirectangular
+        // intensity and rotation are kept (they describe the room, not the file).
+        readLinearRgb(a.staticEnv);  // a clear FileError now rather than at the renderer
+        if (scene.environment.kind != Environment::Kind::Equirectangular) {
+            scene.environment.intensity = 1.0f;
+            scene.environment.rotationYDeg = 0.0;
+        }
+        scene.environment.kind = Environment::Kind::Equirectangular;
+        scene.environment.image = std::filesystem::absolute(a.staticEnv);
+        scene.environment.origin = Origin::Real;
+    }
     if (!scene.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
 
@@ -187,6 +213,40 @@ void runReplay(const ReplayArgs& a) {
     ropt.exposure = a.exposure;
     render::Renderer renderer(scene, calib.intrinsics, ropt);
 
+    // The environment camera, unless --static-env overrides it.
+    std::optional<render::SessionEnvironment> env;
+    std::string envState = "static";
+    auto fallBack = [&](const std::string& why) {
+        spdlog::warn(
+            "replay: environment camera: {}; the replay continues with the scene's static "
+            "environment",
+            why);
+        renderer.useStaticEnvironment();
+        env.reset();
+        envState = "static";
+    };
+    if (a.staticEnv.empty()) {
+        std::string why;
+        env = render::SessionEnvironment::open(session, a.exposure, why);
+        if (env) {
+            renderer.setEnvironmentCamera(env->setup());
+            spdlog::info(
+                "replay: the environment is camera '{}' ({}), updated with each of its frames",
+                env->cameraName(), env->videoName());
+            if (!env->hasRadiometry())
+                spdlog::warn(
+                    "replay: the environment camera's calibration has no radiometry_to_main: its "
+                    "pixels are taken to be in the main camera's units (docs/environment.md)");
+        } else if (!why.empty()) {
+            fallBack(why);
+        }
+    } else {
+        for (const SessionCamera& c : session.cameras)
+            if (c.role == "environment")
+                spdlog::info("replay: --static-env {} is the environment; camera '{}' is not used",
+                             a.staticEnv, c.name);
+    }
+
     // Output.
     std::unique_ptr<MatroskaWriter> video;
     if (mkv) video = std::make_unique<MatroskaWriter>(videoOut->temp(), session.fps, a.jpegQuality);
@@ -195,7 +255,7 @@ void runReplay(const ReplayArgs& a) {
     const std::vector<std::string> passes = renderer.passNames();  // the frame graph's order
     csv << "frame,t,state,reason,decode_ms,tracking_ms";
     for (const std::string& p : passes) csv << "," << p << "_ms";
-    csv << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz\n";
+    csv << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz,environment\n";
 
     auto frames = openCameraFrames(session, main->name);
     const int listed = int(session.frames.size());
@@ -247,6 +307,31 @@ void runReplay(const ReplayArgs& a) {
         } else {
             given = PoseRow{"lost", "no ground-truth pose in frames.csv", std::nullopt};
         }
+        if (env) {
+            cv::Mat envFrame;
+            double envT = 0;
+            std::string envProblem;
+            switch (env->next(rec, envFrame, envT, envProblem)) {
+                case render::SessionEnvironment::Status::Frame:
+                    try {
+                        renderer.updateEnvironment(envFrame, envT);
+                        envState = "camera";
+                    } catch (const Error& e) {
+                        fallBack(e.what());
+                    }
+                    break;
+                case render::SessionEnvironment::Status::Lost:
+                    spdlog::warn("replay: {}; the last environment frame is kept", envProblem);
+                    envState = "camera (held)";
+                    break;
+                case render::SessionEnvironment::Status::None:
+                    envState = "camera (held)";
+                    break;
+                case render::SessionEnvironment::Status::Ended:
+                    fallBack(envProblem);
+                    break;
+            }
+        }
         CompositedFrame cf = compositor.process(bgr, tFrame, problem, given);
         const PoseRow& pr = cf.pose;
         if (bgr.empty()) spdlog::warn("replay: {}", pr.reason);
@@ -254,6 +339,27 @@ void runReplay(const ReplayArgs& a) {
         std::map<std::string, double>& passMs = cf.passMs;
         const double gpuMs = cf.gpuMs, readbackMs = cf.readbackMs;
         const cv::Mat& result = cf.image;
+        if (a.estimateLights && cf.report && cf.report->ran("environment")) {
+            // The dominant lights of the environment this frame lights with (report only:
+            // the environment light already holds them).
+            const std::vector<render::EstimatedLight> lights =
+                render::estimateLights(renderer.readEnvironmentMap());
+            if (lights.empty())
+                spdlog::info("frame {}: environment lights: none (no bright compact region)",
+                             rec.index);
+            for (size_t k = 0; k < lights.size(); ++k) {
+                const render::EstimatedLight& l = lights[k];
+                const glm::vec3 d = l.direction, c = l.color();
+                spdlog::info(
+                    "frame {}: environment light {}: direction {:.4f} {:.4f} {:.4f} "
+                    "(elevation {:.1f} deg, azimuth {:.1f} deg from -Z towards +X), colour "
+                    "{:.3f} {:.3f} {:.3f}, intensity {:.4g} W/m^2, {:.1f} % of the "
+                    "environment's light",
+                    rec.index, k + 1, d.x, d.y, d.z, glm::degrees(std::asin(d.y)),
+                    glm::degrees(std::atan2(d.x, -d.z)), c.r, c.g, c.b, l.intensity(),
+                    100.0 * l.share);
+            }
+        }
         if (cf.report && a.verbose && processed == 0)
             spdlog::info("frame {}:\n{}", rec.index, cf.report->summary());
         if (cf.report && a.window)
@@ -290,7 +396,7 @@ void runReplay(const ReplayArgs& a) {
         } else {
             csv << ",,,,,,,";
         }
-        csv << "\n";
+        csv << "," << envState << "\n";
         csv.flush();
         ++done;
         progress(done, total, done / std::max(1e-9, msSince(tStart) * 1e-3));
@@ -316,11 +422,12 @@ void runReplay(const ReplayArgs& a) {
         rs.warmup = begin - first;
         rs.written = written;
         rs.fingerprint = hex64(fingerprint64(fmt::format(
-            "{} {} {} {} {} {:.9g} {} {} {}", std::filesystem::absolute(a.session).string(),
+            "{} {} {} {} {} {:.9g} {} {} {} {}", std::filesystem::absolute(a.session).string(),
             a.poses, a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
             userMkv,
             std::filesystem::exists(placementFile) ? hex64(fileFingerprint(placementFile))
-                                                   : std::string())));
+                                                   : std::string(),
+            a.staticEnv.empty() ? "" : hex64(fileFingerprint(a.staticEnv)))));
         finishReplayShard(*staged, rs);
         return;
     }
@@ -369,6 +476,13 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
                     "frames, each warmed up) into OUT.shards/; join with `mirage merge OUT`");
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
+    cmd->add_option("--static-env", args->staticEnv,
+                    "Light with this equirectangular image (.exr/.hdr/.pfm, linear) instead of "
+                    "the session's environment camera")
+        ->check(CLI::ExistingFile);
+    cmd->add_flag("--estimate-lights", args->estimateLights,
+                  "Report the dominant lights of the environment (direction, colour, intensity) "
+                  "whenever it changes");
     cmd->add_flag("--ground-truth", args->groundTruth,
                   "Use the session's ground-truth poses (frames.csv) instead of tracking");
     cmd->add_flag("--force", args->force,

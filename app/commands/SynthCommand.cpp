@@ -3,9 +3,11 @@
 // camera path (orbit, hand-held shake, fast pan), with optional sensor effects, plus the fish-eye
 // environment camera. Writes the session format of docs/session.md (docs/reference-renderer.md).
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -29,6 +31,7 @@ namespace fs = std::filesystem;
 struct SynthArgs {
     std::string scene, output, board, shard, frames;
     bool force = false, noEnv = false;
+    std::vector<double> envWhiteBalance;  // --env-white-balance R,G,B (empty: 1,1,1)
     raytrace::SyntheticSessionOptions o;
 };
 
@@ -109,6 +112,13 @@ void run(SynthArgs a) {
     tracking::Board::load(boardPath);  // validates it before hours of rendering
     a.o.boardFile = boardPath;
     a.o.environmentCamera = !a.noEnv;
+    if (!a.envWhiteBalance.empty()) {
+        for (double g : a.envWhiteBalance)
+            if (!(std::isfinite(g) && g > 0 && g < 1e6))
+                throw Error("mirage synth: --env-white-balance gains must be positive numbers");
+        a.o.envWhiteBalance = glm::vec3(float(a.envWhiteBalance[0]), float(a.envWhiteBalance[1]),
+                                        float(a.envWhiteBalance[2]));
+    }
     // The scene's path as given (made absolute): ground_truth.json names it for `mirage bench`.
     a.o.sceneName = fs::absolute(a.scene).lexically_normal().string();
 
@@ -211,6 +221,19 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
     cmd->add_option("--env-fov", a->o.envFovDeg, "Fish-eye field of view (degrees)")
         ->capture_default_str()
         ->check(finiteIn(0, 360, true));
+    cmd->add_option("--env-exposure", a->o.envExposure,
+                    "Environment camera's exposure (multiplies the linear radiance it films)")
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e6, true));
+    cmd->add_option("--env-white-balance", a->envWhiteBalance,
+                    "Environment camera's white balance: gains R,G,B on the radiance it films")
+        ->delimiter(',')
+        ->expected(3);
+    cmd->add_option("--env-rotation", a->o.envRotationDegPerSecond,
+                    "The room light moves: the scene's environment turns about +Y at this rate "
+                    "(degrees per second; footage, environment camera and ground truth follow)")
+        ->capture_default_str()
+        ->check(finiteIn(-36000, 36000));
     cmd->add_flag("--no-env", a->noEnv, "Do not render the environment camera");
     cmd->add_flag("--image-sequence", a->o.imageSequence, "PNG folders instead of MKV videos");
     cmd->add_flag("--ground-truth-composite", a->o.groundTruthComposite,

@@ -1,4 +1,5 @@
 #include "core/session/Session.h"
+#include "core/session/SessionReadOptions.h"
 
 #include <cmath>
 
@@ -86,6 +87,11 @@ void checkRelative(const JsonReader& r, const std::string& field, const std::str
 }  // namespace
 
 Session readSession(const std::filesystem::path& dir, SessionReadReport* reportOut) {
+    return readSession(dir, reportOut, SessionReadOptions{});
+}
+
+Session readSession(const std::filesystem::path& dir, SessionReadReport* reportOut,
+                    const SessionReadOptions& options) {
     SessionReadReport report;
     if (!std::filesystem::is_directory(dir))
         throw FileError(dir.string(), "not a folder (a session is a folder with session.json)");
@@ -218,7 +224,11 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     }
     report.framesListed = int(rows.size());
 
-    // Keep the rows whose images every camera has.
+    // Keep the rows whose images every camera has (every camera but the environment cameras,
+    // when the reader can do without them).
+    auto required = [&](size_t ci) {
+        return !(options.environmentOptional && ci > 0 && s.cameras[ci].role == "environment");
+    };
     for (size_t ci = 0; ci < s.cameras.size(); ++ci) {
         int missing = 0, firstMissing = -1;
         for (const auto& row : rows)
@@ -227,7 +237,8 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
             report.warnings.push_back(
                 "camera '" + s.cameras[ci].name + "': " + std::to_string(missing) + " of " +
                 std::to_string(rows.size()) + " listed frames are not in " + s.cameras[ci].video +
-                " (first: frame " + std::to_string(firstMissing) + "); those rows are dropped");
+                " (first: frame " + std::to_string(firstMissing) + "); " +
+                (required(ci) ? "those rows are dropped" : "those frames have no image of it"));
         const int held = inventories[ci].count();
         const int lastListed = rows.empty() ? -1 : rows.back().index;
         if (!inventories[ci].isFolder && held > int64_t(lastListed) + 1 && !rows.empty())
@@ -238,7 +249,8 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     }
     for (auto& row : rows) {
         bool all = true;
-        for (const auto& inv : inventories) all = all && inv.has(row.index);
+        for (size_t ci = 0; ci < inventories.size(); ++ci)
+            all = all && (!required(ci) || inventories[ci].has(row.index));
         if (all) s.frames.push_back(std::move(row));
     }
     report.framesReadable = int(s.frames.size());

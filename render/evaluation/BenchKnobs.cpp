@@ -180,6 +180,32 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.causticQuadScale = q;
          },
          [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
+        // The environment (docs/environment.md). Defaults keep the static map, so the default
+        // grid is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
+        {"env_source",
+         "static: the scene's environment map; camera: the session's environment camera, a new "
+         "frame every frame",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"static"}; },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "static" && v != "camera")
+                 throw Error(
+                     fmt::format("bench: knob env_source: '{}' is not static or camera", v));
+             c.environmentCamera = v == "camera";
+         },
+         [](const BenchConfig& c) {
+             return std::string(c.environmentCamera ? "camera" : "static");
+         }},
+        {"env_resolution",
+         "width of the environment map built from each environment-camera frame (height = width "
+         "/ 2; with env_source=camera)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"512"}; },
+         [](BenchConfig& c, const std::string& v) {
+             const int w = parseInt("env_resolution", v, 16, 4096);
+             if (w % 2 != 0)
+                 throw Error(fmt::format("bench: knob env_resolution: '{}' is not even", v));
+             c.options.environmentMapWidth = w;
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.environmentMapWidth); }},
     };
     return knobs;
 }

@@ -73,11 +73,20 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
     if (!main) throw FileError(session.dir.string(), "the session lists no camera");
     std::vector<BenchFrame> frames;
     auto source = openCameraFrames(session, main->name);
-    cv::Mat bgr;
+    // The environment camera's frames, in step with the main camera's (every row has both).
+    std::unique_ptr<FrameSource> envSource;
+    int envIndex = -1;
+    for (const auto& c : session.cameras)
+        if (c.role == "environment" && !envSource) {
+            envSource = openCameraFrames(session, c.name);
+            envIndex = session.cameraIndex(c.name);
+        }
+    cv::Mat bgr, envBgr;
     int missing = 0;
     for (size_t i = 0; i < session.frames.size(); ++i) {
         if (maxFrames >= 0 && int(frames.size()) >= maxFrames) break;
         if (!source->read(bgr)) break;
+        if (envSource && !envSource->read(envBgr)) envSource.reset();
         if (int(i) < start) continue;
         if (bgr.empty()) {  // lost: its bytes in the video are damaged
             ++missing;
@@ -96,8 +105,17 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
                                         "calibration {}x{}",
                                         gt->compositeSrgb.cols, gt->compositeSrgb.rows, bgr.cols,
                                         bgr.rows, mainCamera.width, mainCamera.height));
-        frames.push_back(
-            {rec.index, *rec.groundTruth, bgr.clone(), gt->compositeSrgb, gt->influence});
+        BenchFrame bf;
+        bf.index = rec.index;
+        bf.T_world_camera = *rec.groundTruth;
+        bf.footage = bgr.clone();
+        bf.truth = gt->compositeSrgb;
+        bf.influence = gt->influence;
+        frames.push_back(std::move(bf));
+        if (envSource && !envBgr.empty()) {
+            frames.back().environment = envBgr.clone();
+            frames.back().environmentTime = rec.timestamps.at(size_t(envIndex));
+        }
     }
     if (skipped) *skipped = missing;
     return frames;
@@ -105,13 +123,23 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
 
 BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCamera,
                            const std::vector<BenchFrame>& allFrames, const BenchConfig& config,
-                           int repeats) {
+                           int repeats, const EnvironmentCameraSetup* environment) {
     if (allFrames.empty()) throw Error("bench: no frames to render");
+    if (config.environmentCamera &&
+        (!environment || std::any_of(allFrames.begin(), allFrames.end(),
+                                     [](const BenchFrame& f) { return f.environment.empty(); })))
+        throw Error(
+            "bench: knob env_source=camera needs a session with a usable environment camera "
+            "(calibration with extrinsics, a frame for every row)");
     const int w = config.width > 0 ? config.width : sessionCamera.width;
     const int h = config.height > 0 ? config.height : sessionCamera.height;
     const std::vector<BenchFrame> frames = scaleFrames(allFrames, w, h);
     const CameraIntrinsics cam = scaleIntrinsics(sessionCamera, w, h);
     Renderer renderer(scene, cam, config.options);
+    if (config.environmentCamera) {
+        renderer.setEnvironmentCamera(*environment);
+        renderer.updateEnvironment(frames.front().environment, frames.front().environmentTime - 1);
+    }
     // Warm-up: shader compilation and first allocations stay out of the timings.
     renderer.render({frames.front().T_world_camera, frames.front().footage, true});
 
@@ -128,6 +156,10 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
         for (size_t i = 0; i < frames.size(); ++i) {
             const BenchFrame& f = frames[i];
             const auto t0 = std::chrono::steady_clock::now();
+            // A new environment frame with every frame (its time differs from the last one's,
+            // also across repeats: the last frame's is never the first's).
+            if (config.environmentCamera)
+                renderer.updateEnvironment(f.environment, f.environmentTime + 1e-3 * double(rep));
             const FrameReport& report =
                 renderer.render({f.T_world_camera, f.footage, /*resetHistory=*/i == 0});
             const cv::Mat composite = renderer.compositeSrgb();

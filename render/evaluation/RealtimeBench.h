@@ -19,6 +19,7 @@
 #include "core/math/Pose.h"
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
+#include "render/EnvironmentCamera.h"
 #include "render/FrameContext.h"
 #include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/ImageComparison.h"
@@ -30,7 +31,10 @@ struct BenchConfig {
     RendererOptions options;
     int width = 0, height = 0;                               // 0 = the session's size
     std::vector<std::pair<std::string, std::string>> knobs;  // (name, value) as applied
-    std::string label() const;                               // "vpls=256 indirect_scale=2 ..."
+    // Light with the session's environment camera, updated every frame (knob env_source=camera;
+    // docs/environment.md), instead of the scene's static environment map.
+    bool environmentCamera = false;
+    std::string label() const;  // "vpls=256 indirect_scale=2 ..."
 };
 
 struct BenchKnob {
@@ -65,6 +69,8 @@ struct BenchFrame {
     cv::Mat footage;      // 8-bit BGR sRGB, as the session stores it
     cv::Mat truth;        // ground-truth composite, 8-bit BGR sRGB
     cv::Mat influence;    // CV_8U, nonzero = influenced by the virtual objects
+    cv::Mat environment;  // the environment camera's frame of this row (8-bit BGR sRGB), if any
+    double environmentTime = 0.0;  // its time (seconds, the environment camera's clock)
 };
 
 // The main camera's frames of `session` that have a ground-truth pose and a ground-truth
@@ -106,9 +112,11 @@ CameraIntrinsics scaleIntrinsics(const CameraIntrinsics& k, int width, int heigh
 // Runs one configuration over the frames (in order; temporal history reset on the first), each
 // pass `repeats` times over the sequence (timings pooled, error from the last). Needs a current
 // GL 4.5 context. `scene` is the scene with its virtual objects.
+// `environment`: the session's environment camera, needed by configurations with
+// environmentCamera (throws mirage::Error naming the knob without it or without frames).
 BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCamera,
                            const std::vector<BenchFrame>& frames, const BenchConfig& config,
-                           int repeats = 1);
+                           int repeats = 1, const EnvironmentCameraSetup* environment = nullptr);
 
 // The footage judged as if it were the composite: what a render with the virtual contribution
 // removed scores. Every real configuration must beat it in the influenced pixels.

@@ -3,7 +3,11 @@
 #include <array>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "core/Error.h"
+#include "core/camera/CalibrationFile.h"
+#include "core/camera/EquirectProjection.h"
 #include "core/image/ImageIO.h"
 
 namespace mirage::raytrace {
@@ -195,13 +199,31 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
 
     const Environment& env = scene.environment;
     if (env.kind != Environment::Kind::None && included(env.origin)) {
-        if (env.kind == Environment::Kind::Fisheye)
-            throw Error(
-                "scene environment: fish-eye environment images are not supported by the reference "
-                "renderer yet; convert it to an equirectangular image");
-        cv::Mat img = readLinearRgb(env.image);
-        environment_ = std::make_unique<EnvironmentLight>(img, env.intensity, env.rotationYDeg);
+        if (env.kind == Environment::Kind::Fisheye) {
+            // The camera frame resampled onto an equirectangular map exactly as the real-time
+            // renderer's environment pass does (core/camera/EquirectProjection.h: same
+            // directions, same fill of the unseen part), so ground truth exists for it.
+            const CameraCalibration cal = loadCalibration(env.calibration);
+            const cv::Mat frame = readLinearRgb(env.image);
+            if (frame.cols != cal.intrinsics.width || frame.rows != cal.intrinsics.height)
+                throw FileError(env.image.string(),
+                                fmt::format("the fish-eye image is {}x{}, but its calibration {} "
+                                            "is for {}x{}",
+                                            frame.cols, frame.rows, env.calibration.string(),
+                                            cal.intrinsics.width, cal.intrinsics.height));
+            const cv::Mat map = equirectFromCamera(frame, cal.intrinsics, env.T_world_camera,
+                                                   kFisheyeEnvironmentWidth,
+                                                   kFisheyeEnvironmentWidth / 2, cal.reachDeg);
+            environment_ = std::make_unique<EnvironmentLight>(map, env.intensity, 0.0);
+        } else {
+            cv::Mat img = readLinearRgb(env.image);
+            environment_ = std::make_unique<EnvironmentLight>(img, env.intensity, env.rotationYDeg);
+        }
     }
+}
+
+void RayTracingScene::setEnvironment(std::unique_ptr<EnvironmentLight> environment) {
+    environment_ = std::move(environment);
 }
 
 bool RayTracingScene::intersect(const glm::vec3& o, const glm::vec3& d, float tMax,

@@ -77,6 +77,11 @@ public:
 
     const std::vector<PunctualLight>& lights() const { return lights_; }
     const EnvironmentLight* environment() const { return environment_.get(); }
+    // Replaces the environment light (nullptr: none) between renders: a per-frame environment
+    // (a room light that moves, the environment camera's frame of that time).
+    void setEnvironment(std::unique_ptr<EnvironmentLight> environment);
+    // Width of the equirectangular map a fish-eye environment image is resampled onto.
+    static constexpr int kFisheyeEnvironmentWidth = 1024;
     SceneSubset subset() const { return subset_; }
 
     struct BoundingSphere {

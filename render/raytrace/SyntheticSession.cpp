@@ -5,6 +5,8 @@
 #include <memory>
 #include <optional>
 
+#include <opencv2/core.hpp>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include <fmt/format.h>
@@ -13,6 +15,7 @@
 #include "core/Log.h"
 #include "core/Timestamp.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/camera/Radiometry.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "render/evaluation/GroundTruthComposite.h"
@@ -84,12 +87,23 @@ public:
         gtInfo_.samplesPerPixel = a_.samplesPerPixel;
         gtInfo_.seed = a_.seed;
 
-        if (a_.environmentCamera) {
+        if (!(a_.envExposure > 0) || !std::isfinite(a_.envExposure) ||
+            !(a_.envWhiteBalance.r > 0 && a_.envWhiteBalance.g > 0 && a_.envWhiteBalance.b > 0))
+            throw Error(
+                "synthetic session: --env-exposure and --env-white-balance must be positive");
+        if (a_.envRotationDegPerSecond != 0) {
+            if (scene.environment.kind != Environment::Kind::Equirectangular)
+                throw Error(
+                    "synthetic session: --env-rotation needs a scene with an equirectangular "
+                    "environment (docs/scene.md)");
+            envImage_ = readLinearRgb(scene.environment.image);
+            envIntensity_ = scene.environment.intensity;
+            envRotation0_ = scene.environment.rotationYDeg;
+        }
+        if (a_.environmentCamera && a_.envRotationDegPerSecond == 0) {
             // The scene is static, so one environment render serves every frame (sensor noise
             // differs).
-            RenderSettings es = st_;
-            es.seed = a_.seed + 7777;
-            envLinear_ = render(*realScene_, RenderCamera{envK_, T_world_env_}, es).radiance;
+            envLinear_ = renderEnvironmentCamera();
         }
     }
 
@@ -112,6 +126,11 @@ public:
             envCal.T_parent_camera = T_world_env_;
             envCal.extrinsicParent = "world";
             saveCalibration(dir / "env.yaml", envCal);
+            // Exact by construction: the main camera's base exposure over the environment
+            // camera's exposure and white balance.
+            const glm::dvec3 wb(a_.envWhiteBalance);
+            saveRadiometryToMain(dir / "env.yaml",
+                                 double(a_.sensor.exposure) / (double(a_.envExposure) * wb));
         }
         if (!a_.boardFile.empty())
             fs::copy_file(a_.boardFile, dir / "board.json", fs::copy_options::overwrite_existing);
@@ -129,14 +148,23 @@ public:
         const double t = f / a_.fps;
         Frame out;
         out.groundTruth = cameraPathPose(a_.path, t);
+        if (a_.envRotationDegPerSecond != 0) setEnvironmentRotation(t);
         const LinearFrame real = renderSubset(*realScene_, f, t);
         const double exposure = exposureAt(a_.sensor, t, duration_);
         const uint64_t noiseSeed = a_.seed * 31 + uint64_t(f);
         out.images.push_back(applySensor(real.radiance, a_.sensor, exposure, noiseSeed));
         out.times.push_back(t);
         if (a_.environmentCamera) {
+            const cv::Mat envLinear =
+                a_.envRotationDegPerSecond != 0 ? renderEnvironmentCamera() : envLinear_;
+            // The environment camera's own white balance, then its own exposure.
+            cv::Mat balanced;
+            cv::multiply(
+                envLinear,
+                cv::Scalar(a_.envWhiteBalance.r, a_.envWhiteBalance.g, a_.envWhiteBalance.b),
+                balanced);
             out.images.push_back(
-                applySensor(envLinear_, a_.sensor, a_.sensor.exposure, a_.seed * 37 + uint64_t(f)));
+                applySensor(balanced, a_.sensor, a_.envExposure, a_.seed * 37 + uint64_t(f)));
             out.times.push_back(t);
         }
         if (a_.groundTruthComposite) {
@@ -157,6 +185,23 @@ public:
     }
 
 private:
+    // The environment camera's linear image of the real world (its scene's current environment).
+    cv::Mat renderEnvironmentCamera() const {
+        RenderSettings es = st_;
+        es.seed = a_.seed + 7777;
+        return render(*realScene_, RenderCamera{envK_, T_world_env_}, es).radiance;
+    }
+
+    // The environment of time t (seconds): rotation_y_deg + rate x t about +Y, in every scene.
+    void setEnvironmentRotation(double t) {
+        const double deg = envRotation0_ + a_.envRotationDegPerSecond * t;
+        realScene_->setEnvironment(
+            std::make_unique<EnvironmentLight>(envImage_, envIntensity_, deg));
+        if (mixedScene_)
+            mixedScene_->setEnvironment(
+                std::make_unique<EnvironmentLight>(envImage_, envIntensity_, deg));
+    }
+
     // One frame of a scene subset at time t, exactly as the footage is made: the same seeds for
     // L_r and L_rv, so where no path touches a virtual object the two renders are identical.
     LinearFrame renderSubset(const RayTracingScene& rt, int f, double t) {
@@ -195,6 +240,9 @@ private:
     double duration_ = 0;
     render::GroundTruthInfo gtInfo_;
     cv::Mat envLinear_;
+    cv::Mat envImage_;  // the scene's environment map, for a rotating environment
+    float envIntensity_ = 1.0f;
+    double envRotation0_ = 0.0;
 };
 
 std::string framePng(const std::string& camera, int frame) {
@@ -228,12 +276,13 @@ std::string syntheticFingerprint(const SyntheticSessionOptions& a, uint64_t scen
     const std::string all = fmt::format(
         "{}x{} hfov {:.17g} fps {:.17g} s {:.17g} spp {} seed {} shutter {:.17g} sub {} env {} "
         "{} {:.17g} seq {} gt {} thr {:.17g} sensor {:.17g} {} {:.17g} {:.17g} path {:.17g} "
-        "{:.17g} {:.17g} {:.17g} scene {} board {}",
+        "{:.17g} {:.17g} {:.17g} envcam {:.9g} {:.9g} {:.9g} {:.9g} {:.17g} scene {} board {}",
         a.width, a.height, a.hfovDeg, a.fps, a.seconds, a.samplesPerPixel, a.seed, a.shutter,
         a.blurSubframes, a.environmentCamera, a.envSize, a.envFovDeg, a.imageSequence,
         a.groundTruthComposite, a.influenceThreshold, a.sensor.exposure, a.sensor.exposureChange,
         a.sensor.vignette, a.sensor.noise, a.path.radius, a.path.height, a.path.panDeg,
-        a.path.shakeTranslation, hex64(sceneBytes), hex64(boardBytes));
+        a.path.shakeTranslation, a.envExposure, a.envWhiteBalance.r, a.envWhiteBalance.g,
+        a.envWhiteBalance.b, a.envRotationDegPerSecond, hex64(sceneBytes), hex64(boardBytes));
     return hex64(fingerprint64(all));
 }
 

@@ -31,6 +31,15 @@ struct SyntheticSessionOptions {
     bool environmentCamera = true;
     int envSize = 320;  // fish-eye image (square, pixels)
     double envFovDeg = 190.0;
+    // The environment camera's own radiometry: its exposure and white balance (per channel
+    // R, G, B) multiply the linear radiance it films. env.yaml states the resulting ratio to the
+    // main camera (radiometry_to_main = main exposure / (envExposure x envWhiteBalance)).
+    float envExposure = 0.5f;
+    glm::vec3 envWhiteBalance{1.0f};
+    // The room light moves: the scene's equirectangular environment turns about world +Y at this
+    // rate (degrees per second) from its rotation_y_deg; every frame (footage, environment camera
+    // and ground truth) is rendered with the rotation of its time. 0 = static.
+    double envRotationDegPerSecond = 0.0;
     bool imageSequence = false;  // PNG folders instead of MKV videos
     SensorOptions sensor;
     CameraPathOptions path;  // duration and seed are set from `seconds` and `seed`

@@ -14,6 +14,7 @@
 #include "render/Renderer.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "testscenes/RenderTestScenes.h"
 
@@ -216,6 +217,9 @@ TEST_F(FrameGraphTest, RealPassWithAMissingReadFails) {
     for (const bool drop : {true, false}) {
         FrameGraph g;
         g.importTexture(Resource::CameraImage, GL_SRGB8_ALPHA8, SizeRule::Camera, "camera");
+        g.importTexture(Resource::SceneEnvironmentMap, GL_RGBA16F, SizeRule::Scene, "env");
+        g.importTexture(Resource::EnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene, "env cam");
+        g.addPass(std::make_unique<EnvironmentPass>());  // the direct pass reads its SH9
         g.addPass(std::make_unique<GBufferPass>());
         auto direct = std::make_unique<DirectLightPass>(*gpu_);
         if (drop)
@@ -227,6 +231,7 @@ TEST_F(FrameGraphTest, RealPassWithAMissingReadFails) {
         g.markOutput(Resource::CompositeSrgb);
         g.compile();
         g.setImport(Resource::CameraImage, camera_);
+        g.setImport(Resource::SceneEnvironmentMap, gpu_->environmentMap());
         const std::string e = errorOf([&] { g.execute(*ctx_, ""); });
         if (drop) {
             EXPECT_NE(e.find("pass direct reads GBufferNormal, which its setup() does not "

@@ -12,6 +12,7 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.read(Resource::GBufferNormal);
     b.read(Resource::GBufferAlbedo);
     b.read(Resource::GBufferEmissive);
+    b.read(Resource::EnvironmentLight);
     b.readOptional(Resource::ShadowMaps);  // none: no light has a caster (unshadowed)
     b.readOptional(Resource::ShadowMapsReal);
     b.readOptional(Resource::ShadowGlass);  // none: no glass in a light's cone
@@ -22,7 +23,7 @@ void DirectLightPass::setup(PassBuilder& b) const {
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
-                      (ctx.scene.hasEnvironment() ? " + environment" : "")};
+                      (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "")};
 }
 
 void DirectLightPass::resize(const FrameContext& ctx) {
@@ -50,6 +51,8 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
                       res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
     glBindTextureUnit(kUnitDirectGlassReal,
                       res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
+                     res.buffer(Resource::EnvironmentLight).id());
     ctx.drawFullscreenTriangle();
     res.publish(Resource::DirectRv, rv_);
     res.publish(Resource::DirectR, r_);

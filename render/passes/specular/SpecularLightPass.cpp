@@ -25,6 +25,7 @@ void SpecularLightPass::setup(PassBuilder& b) const {
     for (Resource r : kHitBuffers) b.read(r);
     b.read(Resource::GBufferPosition);
     b.read(Resource::EnvironmentMap);
+    b.read(Resource::EnvironmentLight);
     for (Resource r : {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::ShadowGlass,
                        Resource::ShadowGlassReal, Resource::Vpls, Resource::ImperfectShadowMaps,
                        Resource::ImperfectShadowMapsReal})
@@ -38,7 +39,7 @@ void SpecularLightPass::setup(PassBuilder& b) const {
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
     const bool vpls = ctx.options.specularVpls && ctx.plan.needVpls;
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
-                      (ctx.scene.hasEnvironment() ? " + environment" : "") +
+                      (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
                       (vpls ? " + VPLs" : "") + " at the reflected/refracted hits"};
 }
 
@@ -87,6 +88,8 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     }
     glBindTextureUnit(kUnitSpecLightPosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitEnvironmentMap, res.texture(Resource::EnvironmentMap).id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
+                     res.buffer(Resource::EnvironmentLight).id());
     glUniform1i(locUseVpls_, vpls ? 1 : 0);
     glUniform1i(locVplStride_, ctx.options.specularVplStride);
     ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);  // 0 outside: not a specular pixel
