@@ -242,6 +242,41 @@ std::string svgScatter(const ScatterPlot& p) {
                 d, kPalette[1]);
         }
     }
+    // Labels are placed greedily: beside the point, else above or below it at growing distance,
+    // where they overlap no label placed before (settings that tie in error sit on one line).
+    struct Box {
+        double x0, y0, x1, y1;
+    };
+    std::vector<Box> placed;
+    const auto freeAt = [&](const Box& b) {
+        for (const Box& o : placed)
+            if (b.x0 < o.x1 && o.x0 < b.x1 && b.y0 < o.y1 && o.y0 < b.y1) return false;
+        return true;
+    };
+    for (const Point& q : p.points) {
+        if (!finite(q)) continue;
+        const double x = ax.map(q.x), y = ay.map(q.y);
+        if (q.label.empty()) continue;
+        const double w = 5.6 * double(q.label.size()), h = 11;
+        // Right of the point, or left when it would leave the plot.
+        const double lx = x + 7 + w > f.x1() ? x - 7 - w : x + 7;
+        Box best{lx, y - 6 - h, lx + w, y - 6};
+        for (int k = 0; k < 12; ++k) {
+            const double dy = (k % 2 == 0 ? -1.0 : 1.0) * double((k + 1) / 2) * (h + 1);
+            const Box b{lx, y - 6 - h + dy, lx + w, y - 6 + dy};
+            if (b.y0 < f.y1() || b.y1 > f.y0()) continue;
+            if (freeAt(b)) {
+                best = b;
+                break;
+            }
+        }
+        placed.push_back(best);
+        if (std::abs(best.y1 - (y - 6)) > 1)  // moved away: a leader line to its point
+            s += fmt::format(
+                "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#bbb\"/>\n",
+                x, y, best.x0 < x ? best.x1 : best.x0, best.y1 - 4);
+        s += text(best.x0, best.y1, q.label, "start", 10, q.flagged ? " fill=\"#D00000\"" : "");
+    }
     for (const Point& q : p.points) {
         if (!finite(q)) continue;
         const double x = ax.map(q.x), y = ay.map(q.y);
@@ -254,11 +289,9 @@ std::string svgScatter(const ScatterPlot& p) {
                 "<circle class=\"default\" cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"8\" fill=\"none\" "
                 "stroke=\"#000\" stroke-width=\"1.5\"/>\n",
                 x, y);
-        if (!q.label.empty())
-            s += text(x + 7, y - 6, q.label, "start", 10, q.flagged ? " fill=\"#D00000\"" : "");
     }
-    s += text(f.x0() + 6, f.y1() + 14,
-              "o default    - Pareto front (faster or better than every other point)", "start", 10,
+    s += text(f.x1(), f.y1() - 6,
+              "o default    - Pareto front (faster or better than every other point)", "end", 10,
               " fill=\"#555\"");
     s += "</svg>\n";
     return s;
