@@ -270,20 +270,23 @@ double tagRms(const CameraIntrinsics& cam, const Pose& T_world_camera, const Obs
 
 // The pose covariance under the corner noise model of PoseEstimatorOptions:
 //   C = N^-1 (sigma^2 N + sigma^2 (a^2 - 1) H_tag / 4 + s_t^2 S_tag + h^2 H_tag + s_c^2 g g^T)
-//       N^-1 k^2,  N = J^T J,
+//       N^-1 k^2,  N = J^T J,  k = k0 (1 + k_b b),
 // sigma^2 the independent corner noise (residuals pooled with the prior sigma0 by tag size and
 // blur), a the tag centre's share of it (sigma^2 H_tag / 4 is what independent noise puts on the
 // tags' centres; since a <= 1 the sum stays positive semi-definite), s_t / h the per-tag scale /
 // shift error and s_c the scale error common to all tags
 // (corner errors that move a tag's corners together: blur mixing the payload into the border,
-// clipping, compression), each proportional to sigma0; k the inflation.
+// clipping, compression), each proportional to sigma0; k the inflation, growing with the tags'
+// mean blur b (edge width beyond 2.2 px): a motion blur stretches every tag along one direction,
+// an error none of the modes above (all isotropic) holds.
 std::array<double, 36> modelCovariance(const Fit& f, const std::vector<const Observation*>& obs,
                                        const PoseEstimatorOptions& o) {
     std::array<double, 36> c{};
     if (obs.empty() || f.normalInverse[0] <= 0) return c;
-    double prior2 = 0;
+    double prior2 = 0, meanBlur = 0;
     for (const Observation* t : obs) {
         const double blur = std::max(0.0, t->edgeWidthPx - 2.2);
+        meanBlur += blur / double(obs.size());
         const double s0 = o.cornerNoisePx + o.cornerNoiseSidePx / std::max(1.0, t->sidePx) +
                           o.cornerNoiseBlur * blur * blur;
         prior2 += s0 * s0 / double(obs.size());
@@ -309,8 +312,11 @@ std::array<double, 36> modelCovariance(const Fit& f, const std::vector<const Obs
             M(a, b) = st2 * f.tagScale[i] + (sh2 + centre2) * f.tagShift[i] +
                       sc2 * f.commonScale[size_t(a)] * f.commonScale[size_t(b)];
         }
-    const cv::Matx66d C =
-        (Ninv * sigma2 + Ninv * M * Ninv) * (o.covarianceInflation * o.covarianceInflation);
+    // With one tag the prior already dominates sigma^2 (2 degrees of freedom), and the Monte
+    // Carlo shows its blurred poses inside their ellipsoids without the blur term.
+    const double k = o.covarianceInflation *
+                     (1.0 + (obs.size() > 1 ? o.covarianceBlurInflation * meanBlur : 0.0));
+    const cv::Matx66d C = (Ninv * sigma2 + Ninv * M * Ninv) * (k * k);
     for (int a = 0; a < 6; ++a)
         for (int b = 0; b < 6; ++b) c[size_t(a * 6 + b)] = 0.5 * (C(a, b) + C(b, a));
     return c;

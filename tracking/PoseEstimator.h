@@ -72,7 +72,9 @@ struct PoseEstimatorOptions {
     double cornerNoiseSidePx = 1.2;
     double cornerNoiseBlur = 0.12;  // 1 / pixel
     double cornerNoisePriorWeight = 8.0;
-    double covarianceInflation = 1.0;  // k
+    double covarianceInflation = 1.0;  // k0
+    // k_b: k = k0 (1 + k_b x mean edge width beyond 2.2 px) (1 / pixel).
+    double covarianceBlurInflation = 0.1;
     // t, h, c above (pixels per pixel of sigma0).
     double tagScaleNoise = 0.4;
     double tagShiftNoise = 0.1;
