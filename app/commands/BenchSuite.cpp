@@ -274,6 +274,9 @@ cv::Mat sideBySide(const BenchResult& r, const cv::Mat& influenceFull) {
     const cv::Mat gap(box.height, 4, CV_8UC3, cv::Scalar(255, 255, 255));
     cv::Mat row;
     cv::hconcat(std::vector<cv::Mat>{got(box), gap, truth(box), gap, diff}, row);
+    // At most 1200 px wide (three panels of 400): the page's crops stay small enough to commit.
+    if (row.cols > 1200)
+        cv::resize(row, row, {1200, std::max(1, row.rows * 1200 / row.cols)}, 0, 0, cv::INTER_AREA);
     return row;
 }
 
