@@ -10,7 +10,8 @@ CompositePass::CompositePass()
                                         "passes/composite/composite.frag",
                                         "#define MIRAGE_DIFFUSE_ONLY 1")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
-    locShowVirtual_ = programDiffuse_.uniformLocation("showVirtual");
+    locShowVirtualDiffuse_ = programDiffuse_.uniformLocation("showVirtual");
+    locShowVirtual_ = program_.uniformLocation("showVirtual");
 }
 
 void CompositePass::setup(PassBuilder& b) const {
@@ -102,7 +103,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
     // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
     ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
-    glUniform1i(locShowVirtual_, ctx.options.showVirtual ? 1 : 0);
+    glUniform1i(locShowVirtualDiffuse_, ctx.options.showVirtual ? 1 : 0);
     auto tex = [&](Resource a, Resource b) {
         return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
     };
@@ -140,6 +141,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     if (rect.z > 0 && rect.w > 0) {
         program_.use();
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
+        glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glEnable(GL_SCISSOR_TEST);
         glScissor(rect.x, rect.y, rect.z, rect.w);
         ctx.drawFullscreenTriangle();

@@ -29,7 +29,7 @@ private:
     gl::Texture canvasToCamera_;
     std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
     GLint locEpsilon_ = -1;
-    GLint locShowVirtual_ = -1;
+    GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
     gl::Framebuffer fbo_;
 };
 
