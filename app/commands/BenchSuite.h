@@ -45,7 +45,8 @@ SuiteSpec loadSuite(const std::filesystem::path& file);
 
 // Runs the suite into `out` (created; sessions cached under out/sessions/) and writes
 // out/results.md with its SVG plots and PNG crops in out/results/ (so that results.md and
-// results/ copied side by side, as docs/results.md is, keep their links). `commandLine` is quoted on the page.
+// results/ copied side by side, as docs/results.md is, keep their links). `commandLine` is quoted
+// on the page.
 void runSuite(const SuiteSpec& spec, const std::filesystem::path& out,
               const std::string& commandLine);
 
