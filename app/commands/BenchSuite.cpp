@@ -201,7 +201,11 @@ void loadFrames(EffectRun& run) {
     const SessionCamera* main = nullptr;
     for (const auto& c : session.cameras)
         if (c.role == "main") main = &c;
-    if (!main) main = &session.cameras.front();
+    if (!main && !session.cameras.empty()) main = &session.cameras.front();
+    if (!main || main->calibration.empty())
+        throw FileError(run.session.string(),
+                        "the session has no main camera with a calibration; delete the folder "
+                        "and the suite makes it again");
     run.camera = loadCalibration(session.path(main->calibration)).intrinsics;
     run.frames = render::loadBenchFrames(session, *gt, run.camera);
     if (run.frames.empty())
