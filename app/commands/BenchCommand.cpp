@@ -19,6 +19,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -26,6 +27,7 @@
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "app/commands/BenchSuite.h"
+#include "app/commands/MachineInfo.h"
 #include "app/commands/ShardMerge.h"
 #include "core/Error.h"
 #include "core/Log.h"
@@ -52,20 +54,6 @@ struct BenchArgs {
     int maxFrames = -1, start = 0, repeats = 1;
     float exposure = 1.0f;
 };
-
-std::string loadAverage() {
-    std::ifstream in("/proc/loadavg");
-    double a = 0, b = 0, c = 0;
-    if (!(in >> a >> b >> c)) return "unknown";
-    return fmt::format("{:.2f} {:.2f} {:.2f}", a, b, c);
-}
-
-std::string utcNow() {
-    std::time_t t = std::time(nullptr);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
-    return buf;
-}
 
 std::map<std::string, std::vector<std::string>> parseKnobs(const std::vector<std::string>& specs) {
     std::map<std::string, std::vector<std::string>> out;
@@ -239,15 +227,17 @@ void runBench(const BenchArgs& a) {
         "# mirage bench\n\n"
         "- command: `{}`\n"
         "- session: {} ({} frame(s), {}x{}), scene: {}\n"
-        "- machine: {} ({}), started {}, load average (1/5/15 min) {} before, {} after\n"
+        "- machine: {} CPU ({} cores), GL renderer {} ({}), started {}, load average (1/5/15 min) "
+        "{} "
+        "before, {} after\n"
         "- times: medians over frames (x{} repeats) of GPU ms per pass from GL timer queries with "
         "`syncPasses`; wall ms = render() + composite readback on the CPU\n"
         "- errors: 8-bit sRGB composite vs the ground-truth composite, pooled over frames; "
         "\"infl.\" = pixels the virtual objects influence ({} pixel(s) in all at the session's "
         "size)\n",
         commandLine(a), a.session, frames.size(), calib.intrinsics.width, calib.intrinsics.height,
-        scenePath, ctx.rendererName(), ctx.versionString(), startedAt, loadBefore, loadAfter,
-        a.repeats, [&] {
+        scenePath, cpuModel(), std::max(1u, std::thread::hardware_concurrency()),
+        ctx.rendererName(), ctx.versionString(), startedAt, loadBefore, loadAfter, a.repeats, [&] {
             double n = 0;
             for (const auto& f : frames) n += cv::countNonZero(f.influence);
             return n;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "app/commands/MachineInfo.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
@@ -34,34 +35,6 @@ namespace fs = std::filesystem;
 using render::BenchConfig;
 using render::BenchFrame;
 using render::BenchResult;
-
-std::string readLine(const fs::path& file, const std::string& key) {
-    std::ifstream in(file);
-    for (std::string line; std::getline(in, line);)
-        if (line.rfind(key, 0) == 0) {
-            const size_t colon = line.find(':');
-            if (colon != std::string::npos) {
-                std::string v = line.substr(colon + 1);
-                v.erase(0, v.find_first_not_of(" \t"));
-                return v;
-            }
-        }
-    return "unknown";
-}
-
-std::string loadAverageNow() {
-    std::ifstream in("/proc/loadavg");
-    double a = 0, b = 0, c = 0;
-    if (!(in >> a >> b >> c)) return "unknown";
-    return fmt::format("{:.2f} {:.2f} {:.2f}", a, b, c);
-}
-
-std::string utcNow() {
-    std::time_t t = std::time(nullptr);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
-    return buf;
-}
 
 // The scene with the named nodes' meshes left out (their lights and children stay).
 Scene sceneVariant(const Scene& full, const std::vector<std::string>& hide,
@@ -484,14 +457,14 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
     copt.width = spec.width;
     copt.height = spec.height;
     gl::Context ctx = gl::Context::headless(copt);
-    const std::string loadBefore = loadAverageNow();
+    const std::string loadBefore = loadAverage();
     const std::string started = utcNow();
     for (EffectRun& r : runs) runEffect(r, spec.repeats);
     ScalingCurves scaling;
     const bool haveScaling = !spec.scalingResolutions.empty() || !spec.scalingVpls.empty() ||
                              !spec.scalingTriangles.empty();
     if (haveScaling) scaling = runScaling(spec, runs.front(), spec.repeats);
-    const std::string loadAfter = loadAverageNow();
+    const std::string loadAfter = loadAverage();
 
     // The page.
     std::string md = "# Results: speed against error\n\n";
@@ -500,9 +473,9 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
         "rendered by the real-time renderer, one knob varied at a time from the default, each "
         "setting judged against the Embree reference's ground-truth composite.\n\n";
     md += fmt::format("- command: `{}`\n", commandLine);
-    md += fmt::format(
-        "- machine: {} ({} cores), GL renderer: {} ({})\n", readLine("/proc/cpuinfo", "model name"),
-        std::max(1u, std::thread::hardware_concurrency()), ctx.rendererName(), ctx.versionString());
+    md += fmt::format("- machine: {} ({} cores), GL renderer: {} ({})\n", cpuModel(),
+                      std::max(1u, std::thread::hardware_concurrency()), ctx.rendererName(),
+                      ctx.versionString());
     md += fmt::format("- started {}, load average (1/5/15 min) {} before, {} after\n", started,
                       loadBefore, loadAfter);
     md += fmt::format(
