@@ -305,6 +305,7 @@ void Renderer::planFrame(const FrameInput& input) {
         g.shadowLayers = lp.layers;
         g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
         g.isReal = l.origin == Origin::Real ? 1 : 0;
+        g.glassShadow = lp.glassTransmits ? 1 : 0;
         plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
         plan.glassShadows = plan.glassShadows || lp.glassTransmits;
         plan.needRealOnlyGlass = plan.needRealOnlyGlass || lp.needsRealOnlyGlass;

@@ -23,7 +23,7 @@ vec2 paraboloidUv(GpuVpl V, vec3 w) {
 }
 
 // glTF KHR_lights_punctual spot cone and range window (the spec's recommended falloff).
-// Lights are passed by index, never copied: a GpuLight is 464 bytes and llvmpipe copies it per
+// Lights are passed by index, never copied: a GpuLight is 480 bytes and llvmpipe copies it per
 // pixel if a shader takes it by value.
 float spotAttenuation(int li, vec3 lightToPoint) {
     if (lights[li].type != LIGHT_SPOT) return 1.0;

@@ -41,6 +41,10 @@ struct GpuLight {
     int shadowLayers;      // layer count (0 = no shadow map)
     int realOnlyMap;       // 1 if the real-only map differs from the all-occluder map
     int isReal;            // 1 if the light is real
+    int glassShadow;       // 1 if glass transmits this light (its ShadowGlass layers are drawn)
+    int pad0;              // std140: the struct is a multiple of 16 bytes
+    int pad1;
+    int pad2;
 };
 
 MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {

@@ -66,13 +66,8 @@ float bilinearGather(vec4 g, vec2 fr) { return mix(mix(g.w, g.z, fr.x), mix(g.x,
 // percentage-closer filtered. Bias grows with the texel footprint and the slope. The layer search
 // and footprint are shared and each atlas is read with one textureGather: on llvmpipe every
 // texel read is costly and both sides of a branch run, so this is ~2x cheaper than two lookups.
-vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
-                      bool withReal) {
-    int layer;
-    vec2 t, fr;
-    float d, bias;
-    if (!shadowFootprint(li, p, NdotL, float(textureSize(allMap, 0).x), layer, t, d, bias, fr))
-        return vec2(1.0);
+vec2 shadowVisibilityAt(sampler2DArray allMap, sampler2DArray realMap, int layer, vec2 t, float d,
+                        float bias, vec2 fr, bool withReal) {
     vec4 a = step(vec4(d - bias), textureGather(allMap, vec3(t, float(layer)), 0));
     float visAll = bilinearGather(a, fr);
     if (!withReal) return vec2(visAll);
@@ -80,19 +75,26 @@ vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec
     return vec2(visAll, bilinearGather(r, fr));
 }
 
-#ifdef MIRAGE_GLASS_SHADOWS
-// Coloured transmittance of the glass between light li and p (shadow_glass.frag): the layer's
-// summed ln(transmittance), applied in the fraction of the 2x2 footprint where the nearest glass
-// is closer to the light than p. Multiplies tAll (all glass) and, when `withReal`, tReal (real
-// glass only; else tReal = tAll's factor too). Every glass surface along the light's ray counts
-// once p is behind the nearest: a receiver between two glass objects on one ray is tinted by both.
-void glassTransmittance(sampler2DArray glassAll, sampler2DArray glassReal, int li, vec3 p,
-                        float NdotL, bool withReal, inout vec3 tAll, inout vec3 tReal) {
+vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
+                      bool withReal) {
     int layer;
     vec2 t, fr;
     float d, bias;
-    if (!shadowFootprint(li, p, NdotL, float(textureSize(glassAll, 0).x), layer, t, d, bias, fr))
-        return;
+    if (!shadowFootprint(li, p, NdotL, float(textureSize(allMap, 0).x), layer, t, d, bias, fr))
+        return vec2(1.0);
+    return shadowVisibilityAt(allMap, realMap, layer, t, d, bias, fr, withReal);
+}
+
+#ifdef MIRAGE_GLASS_SHADOWS
+// Coloured transmittance of the glass between the light and p (shadow_glass.frag) at the shadow
+// footprint (the glass atlases have the shadow atlases' size and layers): the layer's summed
+// ln(transmittance), applied in the fraction of the 2x2 footprint where the nearest glass is
+// closer to the light than p. Multiplies tAll (all glass) and, when `withReal`, tReal (real glass
+// only; else tReal = tAll's factor too). Every glass surface along the light's ray counts once p
+// is behind the nearest: a receiver between two glass objects on one ray is tinted by both.
+void glassTransmittanceAt(sampler2DArray glassAll, sampler2DArray glassReal, int layer, vec2 t,
+                          float d, float bias, vec2 fr, bool withReal, inout vec3 tAll,
+                          inout vec3 tReal) {
     vec3 tc = vec3(t, float(layer));
     float behind = bilinearGather(step(textureGather(glassAll, tc, 3), vec4(d - bias)), fr);
     vec3 ga = mix(vec3(1.0), exp(min(texture(glassAll, tc).rgb, vec3(0.0))), behind);
@@ -105,6 +107,36 @@ void glassTransmittance(sampler2DArray glassAll, sampler2DArray glassReal, int l
     tReal *= mix(vec3(1.0), exp(min(texture(glassReal, tc).rgb, vec3(0.0))), behindR);
 }
 #endif
+
+// Light li's visibility at p through every occluder (visAll) and through real occluders only
+// (visReal), coloured by the glass between when glass transmits this light. The layer search
+// runs once for the opaque and the glass atlases, and the glass atlases are read only for lights
+// whose cone holds glass (lights[li].glassShadow): a light without glass costs what it cost
+// before glass shadows existed.
+#ifdef MIRAGE_GLASS_SHADOWS
+#define MIRAGE_GLASS_ARGS , sampler2DArray glassAll, sampler2DArray glassReal
+#else
+#define MIRAGE_GLASS_ARGS
+#endif
+void lightVisibility(sampler2DArray allMap, sampler2DArray realMap MIRAGE_GLASS_ARGS, int li,
+                     vec3 p, float NdotL, out vec3 visAll, out vec3 visReal) {
+    visAll = vec3(1.0);
+    visReal = vec3(1.0);
+    int layer;
+    vec2 t, fr;
+    float d, bias;
+    if (!shadowFootprint(li, p, NdotL, float(textureSize(allMap, 0).x), layer, t, d, bias, fr))
+        return;
+    bool withReal = lights[li].realOnlyMap == 1;
+    vec2 vis = shadowVisibilityAt(allMap, realMap, layer, t, d, bias, fr, withReal);
+    visAll = vec3(vis.x);
+    visReal = vec3(vis.y);
+#ifdef MIRAGE_GLASS_SHADOWS
+    if (lights[li].glassShadow == 1)
+        glassTransmittanceAt(glassAll, glassReal, layer, t, d, bias, fr, withReal, visAll,
+                             visReal);
+#endif
+}
 
 // Lambert diffuse + GGX specular (Smith-Schlick G, Schlick F, F0 = 0.04 for dielectrics), glTF
 // metallic-roughness. Returns BRDF * cos (the factor multiplying incident irradiance).

@@ -161,6 +161,14 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.caustics = parseOnOff("caustics", v);
          },
          [](const BenchConfig& c) { return onOff(c.options.caustics); }},
+        {"glass_shadows",
+         "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
+         "off: glass is opaque there",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.glassShadows = parseOnOff("glass_shadows", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.glassShadows); }},
         {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
          [](BenchConfig& c, const std::string& v) {

@@ -12,6 +12,8 @@ CompositePass::CompositePass()
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
     locShowVirtualDiffuse_ = programDiffuse_.uniformLocation("showVirtual");
     locShowVirtual_ = program_.uniformLocation("showVirtual");
+    locWithCausticsDiffuse_ = programDiffuse_.uniformLocation("withCaustics");
+    locWithCaustics_ = program_.uniformLocation("withCaustics");
 }
 
 void CompositePass::setup(PassBuilder& b) const {
@@ -104,6 +106,9 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
     ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
     glUniform1i(locShowVirtualDiffuse_, ctx.options.showVirtual ? 1 : 0);
+    // Reading the black stand-in costs as much as a real caustic buffer on llvmpipe.
+    const int withCaustics = res.has(Resource::CausticRv) ? 1 : 0;
+    glUniform1i(locWithCausticsDiffuse_, withCaustics);
     auto tex = [&](Resource a, Resource b) {
         return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
     };
@@ -142,6 +147,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         program_.use();
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
+        glUniform1i(locWithCaustics_, withCaustics);
         glEnable(GL_SCISSOR_TEST);
         glScissor(rect.x, rect.y, rect.z, rect.w);
         ctx.drawFullscreenTriangle();

@@ -30,6 +30,7 @@ private:
     std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
     GLint locEpsilon_ = -1;
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
+    GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1;
     gl::Framebuffer fbo_;
 };
 

@@ -49,6 +49,7 @@ layout(binding = kUnitCompositeRealSurfaces) uniform sampler2D realSurfaces; // 
 layout(binding = kUnitCompositeCanvasToCamera) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
+uniform int withCaustics;    // 1: a caustic pass ran (else causticRv / causticR are not read)
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
 
@@ -126,8 +127,13 @@ void main() {
         vec2 cuv = (canvasPx + 0.5) * canvas.zw;
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
-        vec3 rv = max(texture(lRv, cuv).rgb + texture(causticRv, cuv).rgb, vec3(0.0)) * exposure;
-        vec3 r = max(texture(lR, cuv).rgb + texture(causticR, cuv).rgb, vec3(0.0)) * exposure;
+        vec3 rv = texture(lRv, cuv).rgb, r = texture(lR, cuv).rgb;
+        if (withCaustics != 0) {
+            rv += texture(causticRv, cuv).rgb;
+            r += texture(causticR, cuv).rgb;
+        }
+        rv = max(rv, vec3(0.0)) * exposure;
+        r = max(r, vec3(0.0)) * exposure;
 #ifndef MIRAGE_DIFFUSE_ONLY
         int slot = int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1;
         if (slot >= 0 && origin != ORIGIN_NONE) {

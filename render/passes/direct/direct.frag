@@ -42,12 +42,11 @@ void main() {
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, A.rgb, A.a, N.w) * E;
-        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, NdotL,
-                                    lights[li].realOnlyMap == 1);
-        vec3 visAll = vec3(vis.x), visReal = vec3(vis.y);
+        vec3 visAll, visReal;
 #ifdef MIRAGE_GLASS_SHADOWS
-        glassTransmittance(glassAll, glassReal, li, p, NdotL, lights[li].realOnlyMap == 1, visAll,
-                           visReal);
+        lightVisibility(shadowAll, shadowReal, glassAll, glassReal, li, p, NdotL, visAll, visReal);
+#else
+        lightVisibility(shadowAll, shadowReal, li, p, NdotL, visAll, visReal);
 #endif
         rv += c * visAll;  // all occluders
         if (lights[li].isReal == 1 && pReal) r += c * visReal;  // real occluders only

@@ -60,12 +60,11 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
         float NdotL = dot(n, wi);
         if (NdotL <= 0.0) continue;
         vec3 c = brdfCos(n, v, wi, albedo, metallic, roughness) * E;
-        vec2 vis = shadowVisibility(shadowAll, shadowReal, li, x, NdotL,
-                                    lights[li].realOnlyMap == 1);
-        vec3 visAll = vec3(vis.x), visReal = vec3(vis.y);
+        vec3 visAll, visReal;
 #ifdef MIRAGE_GLASS_SHADOWS
-        glassTransmittance(glassAll, glassReal, li, x, NdotL, lights[li].realOnlyMap == 1, visAll,
-                           visReal);
+        lightVisibility(shadowAll, shadowReal, glassAll, glassReal, li, x, NdotL, visAll, visReal);
+#else
+        lightVisibility(shadowAll, shadowReal, li, x, NdotL, visAll, visReal);
 #endif
         rv += c * visAll;  // all occluders
         if (lights[li].isReal == 1 && xReal) r += c * visReal;  // real occluders only
