@@ -38,6 +38,11 @@ struct RendererOptions {
     int refractionMarchSteps = 16;        // back-face depth march steps of the refracted ray
     float backProjectionEpsilon = 0.02f;  // depth validation: |d - d_gbuf| < eps * d + 0.005 m
     bool specularVpls = true;             // light GBuf_refl / GBuf_refr hits with the VPLs too
+    // A VPL whose reflective-shadow-map sample lands on a mirror or glass continues to the
+    // reflected or refracted photon's receiver (Knecht 2013 Sec. 5.2), for spot lights with
+    // photon G-buffers (caustics on); false: it stays on the mirror / glass, which scatters no
+    // diffuse light (the VPL is dark).
+    bool reflectedRefractedVpls = true;
     // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
     // false: glass is an opaque occluder, as mirrors are.
     bool glassShadows = true;

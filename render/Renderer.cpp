@@ -136,10 +136,10 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<EnvironmentPass>());
     g.addPass(std::make_unique<GBufferPass>());
     g.addPass(std::make_unique<ShadowPass>());
+    g.addPass(std::make_unique<ImpostorPass>());
+    g.addPass(std::make_unique<PhotonGBufferPass>(*scene_));  // before vpl: VPLs follow photons
     g.addPass(std::make_unique<VplPass>());
     g.addPass(std::make_unique<IsmPass>());
-    g.addPass(std::make_unique<ImpostorPass>());
-    g.addPass(std::make_unique<PhotonGBufferPass>(*scene_));
     g.addPass(std::make_unique<DirectLightPass>(*scene_));
     g.addPass(std::make_unique<IndirectLightPass>());
     g.addPass(std::make_unique<GiFilterPass>(options_.interleave));
@@ -543,6 +543,14 @@ cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
     cv::Mat out(t.height(), t.width(), CV_32F);
     std::memcpy(out.data, bits.data(), bits.size() * 4);  // float bits were stored
     return out;
+}
+
+std::vector<GpuVpl> Renderer::readVpls() const {
+    if (!graph_.has(Resource::Vpls)) throw Error("no VPLs were placed this frame");
+    const gl::Buffer& b = graph_.buffer(Resource::Vpls);
+    std::vector<GpuVpl> v(b.size() / sizeof(GpuVpl));
+    glGetNamedBufferSubData(b.id(), 0, GLsizeiptr(v.size() * sizeof(GpuVpl)), v.data());
+    return v;
 }
 
 cv::Mat Renderer::readEnvironmentMap() const {

@@ -77,6 +77,9 @@ public:
     // The imperfect shadow map atlas of this frame (all points, or real points only) as CV_32F
     // distances in metres, +inf where no point was splatted. Throws if no ISM ran.
     cv::Mat readIsmAtlas(bool realOnly) const;
+    // This frame's VPLs (RendererOptions::vplCount slots; unused ones have valid = 0). Throws if
+    // no VPL pass ran.
+    std::vector<GpuVpl> readVpls() const;
 
     // The composite as an sRGB8 texture (camera size, memory row 0 = image top row), e.g. to
     // blit into a window (flip vertically: GL windows put row 0 at the bottom). Valid after the

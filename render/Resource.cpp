@@ -62,6 +62,8 @@ const char* resourceName(Resource r) {
         "PhotonPowerRefl",
         "PhotonHitRefr",
         "PhotonPowerRefr",
+        "PhotonSurfaceRefl",
+        "PhotonSurfaceRefr",
         "CausticRv",
         "CausticR",
         "Composite",
@@ -113,6 +115,8 @@ const char* formatName(GLenum format) {
             return "R32F";
         case GL_R32UI:
             return "R32UI";
+        case GL_RGBA32UI:
+            return "RGBA32UI";
         case GL_SRGB8_ALPHA8:
             return "SRGB8_ALPHA8";
         case GL_DEPTH_COMPONENT32F:

@@ -81,6 +81,10 @@ enum class Resource {
     PhotonPowerRefl,
     PhotonHitRefr,
     PhotonPowerRefr,
+    // The receiver of each photon for reflected / refracted VPLs: packHalf2x16 of (normal.xy),
+    // (normal.z, diffuse albedo r), (albedo g, b); the normal faces the arriving photon.
+    PhotonSurfaceRefl,
+    PhotonSurfaceRefr,
     CausticRv,      // caustic radiance reflected by the receiver towards the camera (Eq. 12)
     CausticR,       // the same for L_r: light, specular object and receiver real (Eqs. 13-14)
     Composite,      // the output (camera image size): linear RGBA32F, a = coverage

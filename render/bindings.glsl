@@ -42,6 +42,12 @@ const int kUnitEnvShSource = 0;  // the equirectangular map (a small mip level)
 const int kUnitVplRsmFlux = 0;
 const int kUnitVplRsmNormal = 1;
 const int kUnitVplRsmPosition = 2;
+const int kUnitVplPhotonHitRefl = 3;  // photon G-buffers: VPLs that follow a specular bounce
+const int kUnitVplPhotonPowerRefl = 4;
+const int kUnitVplPhotonSurfaceRefl = 5;
+const int kUnitVplPhotonHitRefr = 6;
+const int kUnitVplPhotonPowerRefr = 7;
+const int kUnitVplPhotonSurfaceRefr = 8;
 
 // ism.comp (image units)
 const int kImageIsmAll = 0;

@@ -169,6 +169,14 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.glassShadows = parseOnOff("glass_shadows", v);
          },
          [](const BenchConfig& c) { return onOff(c.options.glassShadows); }},
+        {"refl_refr_vpls",
+         "on: a VPL on a mirror or glass follows the reflected / refracted photon to its "
+         "receiver (spot lights with caustics); off: it stays dark on the object",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.reflectedRefractedVpls = parseOnOff("refl_refr_vpls", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.reflectedRefractedVpls); }},
         {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
          [](BenchConfig& c, const std::string& v) {

@@ -191,7 +191,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on "
-              "caustics=on glass_shadows=on caustic_map=256 caustic_quad=1.5 env_source=static "
+              "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
+              "env_source=static "
               "env_resolution=512");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs

@@ -21,6 +21,8 @@ void PhotonGBufferPass::setup(PassBuilder& b) const {
     b.write(Resource::PhotonPowerRefl, GL_RGBA32F, SizeRule::CausticMap);
     b.write(Resource::PhotonHitRefr, GL_RGBA32F, SizeRule::CausticMap);
     b.write(Resource::PhotonPowerRefr, GL_RGBA32F, SizeRule::CausticMap);
+    b.write(Resource::PhotonSurfaceRefl, GL_RGBA32UI, SizeRule::CausticMap);
+    b.write(Resource::PhotonSurfaceRefr, GL_RGBA32UI, SizeRule::CausticMap);
 }
 
 PassDecision PhotonGBufferPass::decide(const FrameContext& ctx) const {
@@ -39,8 +41,10 @@ void PhotonGBufferPass::resize(const FrameContext& ctx) {
     reflPower_ = gl::Texture::create2DArray("PGBuf_refl power", s, s, layers, GL_RGBA32F);
     refrHit_ = gl::Texture::create2DArray("PGBuf_refr hit", s, s, layers, GL_RGBA32F);
     refrPower_ = gl::Texture::create2DArray("PGBuf_refr power", s, s, layers, GL_RGBA32F);
-    for (gl::Texture* t :
-         {&backPosition_, &backNormal_, &reflHit_, &reflPower_, &refrHit_, &refrPower_})
+    reflSurface_ = gl::Texture::create2DArray("PGBuf_refl receiver", s, s, layers, GL_RGBA32UI);
+    refrSurface_ = gl::Texture::create2DArray("PGBuf_refr receiver", s, s, layers, GL_RGBA32UI);
+    for (gl::Texture* t : {&backPosition_, &backNormal_, &reflHit_, &reflPower_, &refrHit_,
+                           &refrPower_, &reflSurface_, &refrSurface_})
         t->setFilter(GL_NEAREST, GL_NEAREST);
     backFbo_ = gl::Framebuffer("photon back-face fbo");
     backFbo_.attachColor(0, backPosition_);
@@ -94,10 +98,14 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         photonFbo_.attachColorLayer(1, reflPower_, lp.causticLayer);
         photonFbo_.attachColorLayer(2, refrHit_, lp.causticLayer);
         photonFbo_.attachColorLayer(3, refrPower_, lp.causticLayer);
+        photonFbo_.attachColorLayer(4, reflSurface_, lp.causticLayer);
+        photonFbo_.attachColorLayer(5, refrSurface_, lp.causticLayer);
         photonFbo_.attachDepth(depth_);
-        photonFbo_.finalize(4);
+        photonFbo_.finalize(6);
         photonFbo_.bind();
         for (int i = 0; i < 4; ++i) glClearBufferfv(GL_COLOR, i, zero);
+        const GLuint zeroU[4] = {0u, 0u, 0u, 0u};
+        for (int i = 4; i < 6; ++i) glClearBufferuiv(GL_COLOR, i, zeroU);
         glClearBufferfv(GL_DEPTH, 0, &one);
         photonProgram_.use();
         ctx.bindFrameBlocks();
@@ -124,6 +132,8 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(Resource::PhotonPowerRefl, reflPower_);
     res.publish(Resource::PhotonHitRefr, refrHit_);
     res.publish(Resource::PhotonPowerRefr, refrPower_);
+    res.publish(Resource::PhotonSurfaceRefl, reflSurface_);
+    res.publish(Resource::PhotonSurfaceRefr, refrSurface_);
 }
 
 }  // namespace mirage::render

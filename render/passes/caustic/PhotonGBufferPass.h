@@ -22,7 +22,7 @@ public:
 private:
     gl::Program backProgram_, photonProgram_;
     gl::Texture backPosition_, backNormal_, depth_;
-    gl::Texture reflHit_, reflPower_, refrHit_, refrPower_;
+    gl::Texture reflHit_, reflPower_, refrHit_, refrPower_, reflSurface_, refrSurface_;
     gl::Framebuffer backFbo_, photonFbo_;
     int allocatedSize_ = 0, allocatedLayers_ = 0;
     MaterialDraw photonDraw_{photonProgram_};  // after photonProgram_

@@ -36,6 +36,16 @@ layout(location = 0) out vec4 outReflHit;    // xyz receiver (m), w = 4 origin +
 layout(location = 1) out vec4 outReflPower;  // rgb W, a = visibility (all occluders)
 layout(location = 2) out vec4 outRefrHit;
 layout(location = 3) out vec4 outRefrPower;
+layout(location = 4) out uvec4 outReflSurface;  // the receiver, for reflected / refracted VPLs
+layout(location = 5) out uvec4 outRefrSurface;
+
+// Receiver normal (facing the photon) and diffuse albedo as halves (Resource::PhotonSurface*).
+uvec4 photonSurface(SurroundingHit h) {
+    if (!h.hit) return uvec4(0u);
+    vec3 n = allFinite(h.normal) ? h.normal : vec3(0.0);
+    vec3 a = clamp(h.albedo, 0.0, 1.0) * (1.0 - clamp(h.metallic, 0.0, 1.0));
+    return uvec4(packHalf2x16(n.xy), packHalf2x16(vec2(n.z, a.r)), packHalf2x16(a.gb), 0u);
+}
 
 vec4 photonHit(SurroundingHit h, float realVis) {
     if (!h.hit || !allFinite(h.position)) return vec4(0.0);  // leaves the modelled scene
@@ -51,6 +61,8 @@ void main() {
     outReflPower = vec4(0.0);
     outRefrHit = vec4(0.0);
     outRefrPower = vec4(0.0);
+    outReflSurface = uvec4(0u);
+    outRefrSurface = uvec4(0u);
     const int li = lightIndex;
     vec3 p = worldPos;
     vec3 d = p - lights[li].position;
@@ -99,12 +111,14 @@ void main() {
         SurroundingHit h = traceSurroundings(slot, p + T * eps, T);
         outRefrHit = photonHit(h, realVis);
         outRefrPower = photonPower(power * transWeight * (1.0 - F) * base * absorb, vis.x);
+        outRefrSurface = photonSurface(h);
         return;
     }
     vec3 r = reflect(d, n);
     SurroundingHit hr = traceSurroundings(slot, p + n * eps, r);
     outReflHit = photonHit(hr, realVis);
     outReflPower = photonPower(power * reflectionWeight(m, cosL, transWeight), vis.x);
+    outReflSurface = photonSurface(hr);
     if (transWeight <= 0.0) return;
     vec3 P2, T2;
     float F1, F2, travelled;
@@ -115,4 +129,5 @@ void main() {
     SurroundingHit ht = traceSurroundings(slot, P2 + T2 * eps, T2);
     outRefrHit = photonHit(ht, realVis);
     outRefrPower = photonPower(power * refractionWeight(m, transWeight, F1, F2, travelled), vis.x);
+    outRefrSurface = photonSurface(ht);
 }

@@ -18,7 +18,8 @@ layout(binding = kUnitShadowGlassLayer) uniform sampler2DArray glassLayers;
 uniform int glassLayer;
 layout(location = 0) out float outDistance;  // metres from the light (see lightDistance)
 layout(location = 1) out vec4 outFlux;       // rgb W/sr * albedo (W/m^2 * albedo for dir.), a = real
-layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light
+layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light, w = 1 on a
+                                             // mirror or glass (a VPL there follows the photon)
 layout(location = 3) out vec4 outPosition;   // xyz world position (m), w = 1
 
 void main() {
@@ -43,6 +44,6 @@ void main() {
         if (outDistance > g.a + 1e-3) flux *= exp(min(g.rgb, vec3(0.0)));
     }
     outFlux = vec4(flux, origin == ORIGIN_REAL ? 1.0 : 0.0);
-    outNormal = vec4(n, 0.0);
+    outNormal = vec4(n, m.mirror != 0 || m.transmission > 0.0 ? 1.0 : 0.0);
     outPosition = vec4(worldPos, 1.0);
 }

@@ -9,11 +9,22 @@ void VplPass::setup(PassBuilder& b) const {
     b.read(Resource::RsmFlux);
     b.read(Resource::RsmNormal);
     b.read(Resource::RsmPosition);
+    // Reflected / refracted VPLs follow the photons (none: no caustic light, or the option off).
+    for (Resource r :
+         {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonSurfaceRefl,
+          Resource::PhotonHitRefr, Resource::PhotonPowerRefr, Resource::PhotonSurfaceRefr})
+        b.readOptional(r);
     b.writeBuffer(Resource::Vpls, SizeRule::Vpl);
 }
 
 PassDecision VplPass::decide(const FrameContext& ctx) const {
-    return {ctx.plan.needVpls, ctx.plan.vplReason};
+    if (!ctx.plan.needVpls) return {false, ctx.plan.vplReason};
+    std::string reason = ctx.plan.vplReason;
+    if (ctx.plan.causticLayers > 0)
+        reason += ctx.options.reflectedRefractedVpls
+                      ? "; VPLs on mirror / glass follow the reflected / refracted photons"
+                      : "; reflected / refracted VPLs off";
+    return {true, reason};
 }
 
 void VplPass::resize(const FrameContext& ctx) {
@@ -30,12 +41,31 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitVplRsmFlux, res.texture(Resource::RsmFlux).id());
     glBindTextureUnit(kUnitVplRsmNormal, res.texture(Resource::RsmNormal).id());
     glBindTextureUnit(kUnitVplRsmPosition, res.texture(Resource::RsmPosition).id());
+    const bool follow = ctx.options.reflectedRefractedVpls && res.has(Resource::PhotonHitRefl);
+    const Resource photons[6] = {Resource::PhotonHitRefl,     Resource::PhotonPowerRefl,
+                                 Resource::PhotonSurfaceRefl, Resource::PhotonHitRefr,
+                                 Resource::PhotonPowerRefr,   Resource::PhotonSurfaceRefr};
+    const int units[6] = {kUnitVplPhotonHitRefl,     kUnitVplPhotonPowerRefl,
+                          kUnitVplPhotonSurfaceRefl, kUnitVplPhotonHitRefr,
+                          kUnitVplPhotonPowerRefr,   kUnitVplPhotonSurfaceRefr};
+    // Without photons the shader never samples these units (every layer is -1).
+    for (int i = 0; i < 6; ++i)
+        glBindTextureUnit(GLuint(units[i]), follow ? res.texture(photons[i]).id() : 0);
     glm::ivec4 ranges[kMaxLights] = {};
+    glm::mat4 causticViewProj[kMaxLights];
+    float causticTanHalf[kMaxLights] = {};
     for (size_t i = 0; i < ctx.plan.lights.size(); ++i) {
         const LightPlan& lp = ctx.plan.lights[i];
-        ranges[i] = glm::ivec4(lp.firstVpl, lp.vplCount, lp.hasRsm ? 1 : 0, 0);
+        const int photonLayer = follow && lp.caustics ? lp.causticLayer : -1;
+        ranges[i] = glm::ivec4(lp.firstVpl, lp.vplCount, lp.hasRsm ? 1 : 0, photonLayer);
+        causticViewProj[i] = lp.causticViewProj;
+        causticTanHalf[i] = lp.causticTanHalf;
     }
     glUniform4iv(program_.uniformLocation("lightVplFirst"), kMaxLights, &ranges[0][0]);
+    glUniformMatrix4fv(program_.uniformLocation("causticViewProj"), kMaxLights, GL_FALSE,
+                       &causticViewProj[0][0][0]);
+    glUniform1fv(program_.uniformLocation("causticTanHalf"), kMaxLights, causticTanHalf);
+    glUniform1i(program_.uniformLocation("photonMapSize"), ctx.options.causticMapSize);
     glDispatchCompute(GLuint((ctx.options.vplCount + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(Resource::Vpls, vpls_);
