@@ -25,6 +25,7 @@
 #include <ctime>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <thread>
 
@@ -48,6 +49,7 @@
 #include "core/Log.h"
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/camera/Radiometry.h"
 #include "core/capture/CameraCatalog.h"
 #include "core/capture/CameraControls.h"
 #include "core/capture/CaptureFormat.h"
@@ -89,6 +91,9 @@ struct LiveArgs {
     ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
     std::string screenshot;         // window: save a PNG after --screenshot-after frames, exit
     int screenshotAfter = 10;
+    // The fish-eye environment camera (docs/environment.md): a webcam, a video or a session's
+    // environment camera, and its calibration (intrinsics, extrinsics, radiometry_to_main).
+    std::string envCamera, envCalibration;
 };
 
 constexpr int kHudWidth = 330;  // pixels, right of the view
@@ -317,6 +322,82 @@ CameraInput openCamera(const LiveArgs& a) {
     return in;
 }
 
+// The environment camera of a live session: its frames (a capture thread of its own, paced as
+// the main camera's) and its calibration as the renderer's environment camera.
+struct EnvironmentInput {
+    std::unique_ptr<FrameSource> source;
+    LatestFrameCapture::Options pacing;
+    render::EnvironmentCameraSetup setup;
+    std::string description;
+    fs::path calibration;
+    std::vector<fs::path> inputs;
+    double fps = 30;  // nominal frame rate (pairing with the main camera's frames)
+};
+
+EnvironmentInput openEnvironmentCamera(const LiveArgs& a) {
+    EnvironmentInput in;
+    const std::string& src = a.envCamera;
+    fs::path calibration = a.envCalibration;
+    if (isDeviceName(src)) {
+        CaptureRequest req;
+        req.fps = 30;
+        auto cam = std::make_unique<V4l2Camera>(src, req);
+        // The environment's radiometry is the calibrated ratio to the main camera: its exposure
+        // must hold still too.
+        const ExposureLockReport lock = cam->lockExposure(a.exposureLock);
+        for (const auto& w : lock.warnings) spdlog::warn("live: environment camera: {}", w);
+        in.description = "camera " + v4l2DevicePath(src);
+        in.fps = cam->mode().fps > 0 ? cam->mode().fps : 30;
+        in.source = std::move(cam);
+        in.pacing.sourceClockIsMonotonic = true;
+    } else {
+        const fs::path p = src;
+        if (!fs::exists(p))
+            throw FileError(src,
+                            "no such environment camera, session or video (a webcam is "
+                            "/dev/videoN or N)");
+        if (fs::is_directory(p) && fs::exists(p / "session.json")) {
+            SessionReadReport rr;
+            const Session s = readSession(p, &rr);
+            const SessionCamera* env = nullptr;
+            for (const auto& c : s.cameras)
+                if (c.role == "environment") env = &c;
+            if (!env)
+                throw FileError((p / "session.json").string(),
+                                "has no camera with role \"environment\"; record one, or pass a "
+                                "video or webcam as --env-camera");
+            in.source = openCameraFrames(s, env->name);
+            if (s.fps > 0) in.fps = s.fps;
+            if (calibration.empty() && !env->calibration.empty())
+                calibration = s.path(env->calibration);
+            in.inputs = sessionInputs(s);
+            in.description = "session " + src + " (camera '" + env->name + "')";
+        } else {
+            in.source = openFrames(p);
+            in.inputs = {p};
+            in.description = "video " + src;
+        }
+        in.pacing.paceBySourceTime = true;
+        in.pacing.paceFps = in.fps;
+    }
+    if (calibration.empty())
+        throw Error("mirage live: no calibration for the environment camera " + in.description +
+                    "; pass --env-calibration ENV.yaml (its fish-eye calibration with the "
+                    "extrinsics from `mirage calibrate`)");
+    const CameraCalibration cal = loadCalibration(calibration);
+    in.setup = render::EnvironmentCameraSetup::fromCalibration(cal, calibration);
+    const std::optional<glm::dvec3> ratio = loadRadiometryToMain(calibration);
+    if (!ratio)
+        spdlog::warn(
+            "live: {} has no radiometry_to_main: the environment camera is taken to "
+            "see in the main camera's units (ratio 1)",
+            calibration.string());
+    in.setup.gain = glm::vec3(ratio.value_or(glm::dvec3(1.0)) / double(a.exposure));
+    in.calibration = calibration;
+    in.inputs.push_back(calibration);
+    return in;
+}
+
 double median(std::vector<double> v) {
     if (v.empty()) return 0;
     std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
@@ -393,8 +474,20 @@ void runLive(const LiveArgs& a) {
         return placed;
     };
 
+    std::optional<EnvironmentInput> envCam;
+    if (!a.envCamera.empty()) {
+        envCam = openEnvironmentCamera(a);
+        spdlog::info("live: environment camera {} (calibration {})", envCam->description,
+                     envCam->calibration.string());
+    } else if (!a.envCalibration.empty()) {
+        throw Error(
+            "mirage live: --env-calibration without --env-camera; name the environment "
+            "camera (a webcam, a video or a session) with --env-camera");
+    }
+
     // Outputs, checked before any work (as replay's).
     OutputRule rule{cam.inputs, a.force, "mirage live"};
+    if (envCam) rule.inputs.insert(rule.inputs.end(), envCam->inputs.begin(), envCam->inputs.end());
     rule.inputs.push_back(a.scene);
     rule.inputs.push_back(calibPath);
     rule.inputs.push_back(boardPath);
@@ -439,6 +532,16 @@ void runLive(const LiveArgs& a) {
     std::unique_ptr<render::Renderer> renderer =
         makeRenderer(a.vpls, kPresets[preset].indirectScale, kPresets[preset].impostorResolution);
     auto compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
+    // The environment camera's newest frame lights the scene from the next render on; a renderer
+    // built anew (quality, placement) gets the camera and the last frame again.
+    cv::Mat envFrame;
+    double envTime = 0;
+    auto attachEnvironment = [&] {
+        if (!envCam) return;
+        renderer->setEnvironmentCamera(envCam->setup);
+        if (!envFrame.empty()) renderer->updateEnvironment(envFrame, envTime);
+    };
+    attachEnvironment();
 
     std::unique_ptr<MatroskaWriter> video;
     if (mkv) video = std::make_unique<MatroskaWriter>(videoOut->temp(), cam.fps, a.jpegQuality);
@@ -447,7 +550,7 @@ void runLive(const LiveArgs& a) {
     if (csvOut) {
         csv.open(csvOut->temp());
         if (!csv) throw FileError(csvPath.string(), "cannot create the timing CSV");
-        csv << "frame,t,state,reason,camera_frame,dropped,driver_dropped,tracking_ms";
+        csv << "frame,t,state,reason,camera_frame,dropped,driver_dropped,env_age_ms,tracking_ms";
         for (const std::string& p : passes) csv << "," << p << "_ms";
         csv << ",gpu_ms,readback_ms,frame_ms,latency_ms,tx,ty,tz,qw,qx,qy,qz\n";
     }
@@ -493,6 +596,12 @@ void runLive(const LiveArgs& a) {
 
     installStopSignals();
     LatestFrameCapture capture(std::move(cam.source), cam.pacing);
+    std::optional<LatestFrameCapture> envCapture;
+    if (envCam) envCapture.emplace(std::move(envCam->source), envCam->pacing);
+    bool envEnded = false;
+    // Age of the environment frame lighting the current frame (main capture time minus the
+    // environment's, ms; empty in the CSV without an environment camera).
+    double envAgeMs = std::numeric_limits<double>::quiet_NaN();
     std::vector<double> latencies;
     int processed = 0;
     const auto tStart = Clock::now();
@@ -530,6 +639,41 @@ void runLive(const LiveArgs& a) {
                 "the calibration of this camera at this size (or ask the camera for {}x{})",
                 cam.description, f.bgr.cols, f.bgr.rows, calibPath.string(), width, height, width,
                 height));
+        if (got && envCapture) {
+            // The environment frame nearest in time to this one (both clocks are
+            // CLOCK_MONOTONIC): the newest in the slot, or, when that is more than half an
+            // environment frame older, the next one if it comes within that half frame (the
+            // cameras run side by side; the main camera sets the pace).
+            CapturedFrame ef;
+            bool haveEnv = envCapture->next(ef, 0.0) && !ef.bgr.empty();
+            const double newest = haveEnv ? ef.captureSeconds : envTime;
+            const double halfPeriod = 0.5 / envCam->fps;
+            if (!envCapture->ended() &&
+                (newest < f.captureSeconds - halfPeriod || (!haveEnv && envFrame.empty()))) {
+                CapturedFrame later;
+                if (envCapture->next(later, std::min(halfPeriod, 0.05)) && !later.bgr.empty()) {
+                    ef = std::move(later);
+                    haveEnv = true;
+                }
+            }
+            if (haveEnv) {
+                try {
+                    renderer->updateEnvironment(ef.bgr, ef.captureSeconds);
+                    envFrame = ef.bgr;
+                    envTime = ef.captureSeconds;
+                } catch (const Error& e) {
+                    spdlog::warn("live: environment frame not used: {}", e.what());
+                }
+            } else if (!envEnded && envCapture->ended()) {
+                envEnded = true;
+                spdlog::warn(
+                    "live: the environment camera ended ({}); lighting stays with its "
+                    "last frame",
+                    envCapture->error().empty() ? "end of its stream" : envCapture->error());
+            }
+            envAgeMs = envFrame.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                        : (f.captureSeconds - envTime) * 1e3;
+        }
         if (got) {
             const auto t0 = Clock::now();
             CompositedFrame cf =
@@ -561,8 +705,9 @@ void runLive(const LiveArgs& a) {
             if (csv.is_open()) {
                 csv << processed << "," << exactDecimal(f.captureSeconds) << ","
                     << csvField(cf.pose.state) << "," << csvField(cf.pose.reason) << ","
-                    << f.sequence << "," << f.droppedBefore << "," << f.deviceDroppedBefore << ","
-                    << cf.trackingMs;
+                    << f.sequence << "," << f.droppedBefore << "," << f.deviceDroppedBefore << ",";
+                if (std::isfinite(envAgeMs)) csv << envAgeMs;
+                csv << "," << cf.trackingMs;
                 for (const std::string& p : passes) {
                     auto it = cf.passMs.find(p);
                     csv << "," << (it == cf.passMs.end() ? 0.0 : it->second);
@@ -668,6 +813,13 @@ void runLive(const LiveArgs& a) {
         ImGui::PushTextWrapPos(0);
         if (!last.pose.reason.empty()) ImGui::TextWrapped("%s", last.pose.reason.c_str());
         ImGui::TextWrapped("exposure: %s", cam.exposureText.c_str());
+        if (envCam)
+            ImGui::TextWrapped("environment: %s%s", envCam->description.c_str(),
+                               envFrame.empty() ? ", waiting for a frame"
+                               : envEnded       ? ", ended (its last frame lights)"
+                               : std::isfinite(envAgeMs)
+                                   ? cv::format(", frame %.0f ms older", envAgeMs).c_str()
+                                   : "");
         for (const auto& w : cam.exposureWarnings) ImGui::TextColored(amber, "%s", w.c_str());
         ImGui::PopTextWrapPos();
         ImGui::Separator();
@@ -743,6 +895,7 @@ void runLive(const LiveArgs& a) {
             renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
                                     kPresets[preset].impostorResolution);
             compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
+            attachEnvironment();
             last.report = nullptr;
             try {
                 savePlacement(placementFile, placement);
@@ -757,12 +910,14 @@ void runLive(const LiveArgs& a) {
             renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
                                     kPresets[preset].impostorResolution);
             compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
+            attachEnvironment();
             last.report = nullptr;
             spdlog::info("live: quality {}", kPresets[preset].name);
         }
     }
     const std::string captureError = capture.error();
     capture.stop();
+    if (envCapture) envCapture->stop();
     const double seconds = msSince(tStart) * 1e-3;
     if (video) video->close();
     if (csv.is_open()) closeChecked(csv, csvPath);
@@ -787,6 +942,13 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_option("--camera", args->camera,
                     "/dev/videoN (or N) for a webcam (default: the first camera); a session "
                     "folder or a video stands in for a camera, paced at its frame rate");
+    cmd->add_option("--env-camera", args->envCamera,
+                    "The fish-eye environment camera that lights the scene every frame: "
+                    "/dev/videoN (or N), a video, or a session folder (its environment camera)");
+    cmd->add_option("--env-calibration", args->envCalibration,
+                    "The environment camera's calibration (fish-eye intrinsics, extrinsics, "
+                    "radiometry_to_main; default for a session: the one session.json names)")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--scene", args->scene,
                     "Scene (.gltf/.glb) with real proxies and virtual objects (required)")
         ->check(CLI::ExistingFile);
