@@ -297,8 +297,8 @@ CsvTable readCsvTable(const fs::path& path) {
 
 // mirage live with the environment camera: a session stands in for both cameras (paced by its
 // frame times); each main frame is lit by the environment frame nearest in time, so with the room
-// light turning 60 degrees per second the composite follows it as replay's does, and is closer to
-// the ground truth than the same live run lit by the scene's static map.
+// light turning the composite follows it exactly as replay's does (the same environment frames),
+// and differs from the same live run lit by the scene's static map.
 TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const fs::path dir = outputDir("live_env");
     const fs::path s = dir / "session";
