@@ -54,4 +54,54 @@ inline Primitive cavityPrimitive(glm::vec3 centre, float radius, int rings = 24,
     return p;
 }
 
+enum class TranslucentShape { Cube, CubeWithCavity, GradientCube };
+
+struct TranslucentSceneOptions {
+    TranslucentShape shape = TranslucentShape::Cube;
+    float extinction = 8.0f;  // 1/m: tau 4 across the 0.5 m cube
+    glm::vec3 albedo{0.9f, 0.8f, 0.6f};
+    float ior = 1.3f;
+    float cavityRadius = 0.17f;  // m, centred
+    // Behind the cube as the tests' camera sees it: the back-lit glow, where a cavity shows.
+    glm::vec3 lightPosition{-0.55f, -0.3f, -0.85f};
+    float lightIntensity = 3.0f;  // W/sr
+    float environment = 0.03f;    // uniform environment radiance
+    bool cavityInScene = true;    // false: the cube without its cavity (the "cavity ignored" case)
+};
+
+// A translucent cube [-0.25, 0.25]^3 (one mesh: the box, and for the cavity variant the inward
+// sphere wall, both with the same material), a point light behind it and a dim uniform
+// environment written under `dir`. The gradient cube's density rises along x from 0.2 to 1.8
+// (an 8^3 grid).
+inline Scene translucentTestScene(const TranslucentSceneOptions& o,
+                                  const std::filesystem::path& dir) {
+    Scene s;
+    setEnvironment(s, dir / "env.exr", constantImage(16, 8, o.environment));
+    std::shared_ptr<const DensityGrid> grid;
+    if (o.shape == TranslucentShape::GradientCube)
+        grid = makeDensityGrid(8, 8, 8, glm::vec3(-0.25f), glm::vec3(0.25f),
+                               [](glm::vec3 p) { return 0.2f + 1.6f * (p.x + 0.25f) / 0.5f; });
+    s.materials.push_back(translucentMaterial(o.extinction, o.albedo, o.ior, grid));
+    Mesh mesh;
+    mesh.name = "translucent";
+    Primitive box = boxPrimitive(glm::vec3(-0.25f), glm::vec3(0.25f));
+    box.material = 0;
+    mesh.primitives.push_back(std::move(box));
+    if (o.shape == TranslucentShape::CubeWithCavity && o.cavityInScene) {
+        Primitive cavity = cavityPrimitive(glm::vec3(0.0f), o.cavityRadius);
+        cavity.material = 0;
+        mesh.primitives.push_back(std::move(cavity));
+    }
+    s.meshes.push_back(std::move(mesh));
+    Node n;
+    n.name = "translucent";
+    n.mesh = 0;
+    mirage::test::addRootNode(s, std::move(n), glm::dmat4(1.0), Origin::Virtual);
+    Light l;
+    l.type = Light::Type::Point;
+    l.intensity = o.lightIntensity;
+    addLight(s, "light", l, translate(glm::dvec3(o.lightPosition)));
+    return s;
+}
+
 }  // namespace mirage::raytrace::test
