@@ -54,7 +54,7 @@ inline Primitive cavityPrimitive(glm::vec3 centre, float radius, int rings = 24,
     return p;
 }
 
-enum class TranslucentShape { Cube, CubeWithCavity, GradientCube };
+enum class TranslucentShape { Cube, CubeWithCavity, GradientCube, EmptyCore };
 
 struct TranslucentSceneOptions {
     TranslucentShape shape = TranslucentShape::Cube;
@@ -72,7 +72,8 @@ struct TranslucentSceneOptions {
 // A translucent cube [-0.25, 0.25]^3 (one mesh: the box, and for the cavity variant the inward
 // sphere wall, both with the same material), a point light behind it and a dim uniform
 // environment written under `dir`. The gradient cube's density rises along x from 0.2 to 1.8
-// (an 8^3 grid).
+// (an 8^3 grid); the empty-core cube's 16^3 grid is 0 within cavityRadius of the centre (a
+// cavity made by the density, not by the mesh).
 inline Scene translucentTestScene(const TranslucentSceneOptions& o,
                                   const std::filesystem::path& dir) {
     Scene s;
@@ -81,6 +82,10 @@ inline Scene translucentTestScene(const TranslucentSceneOptions& o,
     if (o.shape == TranslucentShape::GradientCube)
         grid = makeDensityGrid(8, 8, 8, glm::vec3(-0.25f), glm::vec3(0.25f),
                                [](glm::vec3 p) { return 0.2f + 1.6f * (p.x + 0.25f) / 0.5f; });
+    if (o.shape == TranslucentShape::EmptyCore)  // density 0 within the cavity's radius
+        grid = makeDensityGrid(16, 16, 16, glm::vec3(-0.25f), glm::vec3(0.25f), [&](glm::vec3 p) {
+            return glm::length(p) < o.cavityRadius ? 0.0f : 1.0f;
+        });
     s.materials.push_back(translucentMaterial(o.extinction, o.albedo, o.ior, grid));
     Mesh mesh;
     mesh.name = "translucent";
