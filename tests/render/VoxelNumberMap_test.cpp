@@ -230,5 +230,30 @@ TEST(VoxelNumberMap, HardCases) {
     }
 }
 
+// The bundled sample scene's translucent jade cube: one object (box + cavity wall), its density
+// grid read from the NRRD beside the glTF, and a map whose cavity walls are not on the outside.
+TEST(VoxelNumberMap, TabletopTranslucentSampleScene) {
+    const Scene scene =
+        loadScene(mirage::test::dataDir() / "scenes" / "tabletop" / "tabletop_translucent.gltf");
+    const auto objects = translucentObjects(scene);
+    ASSERT_EQ(objects.size(), 1u);
+    const TranslucentObject& jade = objects[0];
+    EXPECT_EQ(jade.name, "jade_cube");
+    ASSERT_TRUE(jade.medium.density);
+    EXPECT_EQ(jade.medium.density->nx, 8);
+    EXPECT_NEAR(jade.medium.majorant, 120.0f * (0.4f + 1.2f * 7.5f / 8.0f), 1e-3f);
+    VnmSettings settings;
+    settings.resolution = 12;
+    settings.threads = 2;
+    const VoxelNumberMap map = VoxelNumberMap::build(jade, settings);
+    int outer = 0, walls = 0;
+    for (const SurfaceVoxel& v : map.surface()) (v.exterior ? outer : walls)++;
+    // The cube is turned 15 degrees about +Y in a world-aligned grid: a shell of a few hundred
+    // voxels outside, the cavity's wall (r = 16 mm of a 60 mm cube) inside.
+    EXPECT_GT(outer, 300);
+    EXPECT_GT(walls, 20);
+    EXPECT_LT(walls, outer / 4);
+}
+
 }  // namespace
 }  // namespace mirage::translucency
