@@ -6,6 +6,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "core/image/ImageCompare.h"
+#include "render/raytrace/ReferenceRenderer.h"
 #include "render/translucency/VoxelNumberMap.h"
 #include "testscenes/TranslucentTestScenes.h"
 
@@ -68,6 +70,46 @@ void RunTime32x32(benchmark::State& state) {
     }
 }
 BENCHMARK(RunTime32x32)->Arg(16)->Arg(32)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Time against error per voxel resolution: precomputation + the run-time formula for a 32 x 32
+// image of the back-lit cube with a spherical cavity (the accuracy tests' scene), with the PSNR
+// over the object against the reference (multiple scattering, 256 spp, rendered once).
+void TimeVsError(benchmark::State& state) {
+    TranslucentSceneOptions o;
+    o.shape = TranslucentShape::CubeWithCavity;
+    const Scene scene = translucentTestScene(o, scratch());
+    const auto object = translucency::translucentObjects(scene).at(0);
+    raytrace::EmbreeDevice device("threads=2");
+    raytrace::RayTracingScene rt(scene, raytrace::SceneSubset::All, device);
+    auto cam = lookAtCamera(32, 32, 70.0, {0.9, 0.55, 1.3}, {0, 0, 0});
+    static const cv::Mat truth = [&] {
+        raytrace::RenderSettings st;
+        st.samplesPerPixel = 256;
+        st.threads = 2;
+        st.seed = 5;
+        return raytrace::render(rt, cam, st).radiance;
+    }();
+    translucency::VnmSettings s;
+    s.resolution = int(state.range(0));
+    s.threads = 2;
+    double psnrDb = 0.0;
+    for (auto _ : state) {
+        auto map = translucency::VoxelNumberMap::build(object, s);
+        auto img = translucency::renderVnm(map, object, rt, cam.intrinsics, cam.T_world_camera);
+        double peak;
+        cv::minMaxLoc(truth.reshape(1), nullptr, &peak);
+        psnrDb = psnr(img.radiance, truth, peak, img.mask);
+    }
+    state.counters["psnr_dB"] = psnrDb;
+}
+BENCHMARK(TimeVsError)
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Arg(24)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 
