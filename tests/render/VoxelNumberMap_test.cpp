@@ -91,6 +91,19 @@ TEST(VoxelNumberMap, LutLimitAndDiskCache) {
         EXPECT_NE(m.find("728 surface voxels"), std::string::npos) << m;
         EXPECT_NE(m.find("lower the voxel resolution"), std::string::npos) << m;
     }
+    // 128^3 under the default 2 GiB limit: refused before the 17.4 GiB LUT is allocated.
+    VnmSettings fine;
+    fine.resolution = 128;
+    fine.threads = 2;
+    try {
+        VoxelNumberMap::build(object, fine);
+        ADD_FAILURE() << "a 128^3 LUT was built";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("96776 surface voxels"), std::string::npos) << m;
+        EXPECT_NE(m.find("17863 MiB"), std::string::npos) << m;
+        EXPECT_NE(m.find("limit of 2048 MiB"), std::string::npos) << m;
+    }
     settings.maxLutBytes = size_t(1) << 30;
     settings.cacheDir = dir / "cache";
     const VoxelNumberMap first = VoxelNumberMap::build(object, settings);
