@@ -416,7 +416,19 @@ bool VoxelNumberMap::readCache(const fs::path& file) {
                      file.string());
         return false;
     }
-    number_.resize(size_t(dims_.x) * size_t(dims_.y) * size_t(dims_.z));
+    // Allocate only what the file holds: a damaged header must not ask for a huge LUT.
+    const uint64_t cells = uint64_t(dims_.x) * uint64_t(dims_.y) * uint64_t(dims_.z);
+    const uint64_t expected =
+        uint64_t(in.tellg()) + cells * 4 + S * sizeof(SurfaceVoxel) + S * S * 2;
+    std::error_code ec;
+    if (fs::file_size(file, ec) != expected || ec) {
+        spdlog::warn(
+            "voxel number map cache {} does not have the size its header states; "
+            "recomputing",
+            file.string());
+        return false;
+    }
+    number_.resize(size_t(cells));
     surface_.resize(S);
     tau_.resize(S * S);
     in.read(reinterpret_cast<char*>(number_.data()), std::streamsize(number_.size() * 4));

@@ -5,6 +5,8 @@
 // ignored, sigma_t doubled).
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <opencv2/imgproc.hpp>
 #include "core/Error.h"
 #include "core/image/ImageCompare.h"
@@ -126,6 +128,17 @@ TEST(VoxelNumberMap, LutLimitAndDiskCache) {
     const VoxelNumberMap third = VoxelNumberMap::build(object, settings);
     EXPECT_FALSE(third.fromCache());
     EXPECT_EQ(third.tau(3, 700), first.tau(3, 700));
+    // A header claiming ~10^6 surface voxels (a 2 TB LUT) is rejected by the file's size, not
+    // allocated. S is the 64-bit field after magic, version, dims, origin, voxel size and area.
+    {
+        std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+        const uint64_t huge = (uint64_t(1) << 20) - 1;
+        f.seekp(4 + 4 + 12 + 12 + 4 + 4);
+        f.write(reinterpret_cast<const char*>(&huge), sizeof huge);
+    }
+    const VoxelNumberMap fourth = VoxelNumberMap::build(object, settings);
+    EXPECT_FALSE(fourth.fromCache());
+    EXPECT_EQ(fourth.surface().size(), first.surface().size());
 }
 
 struct Accuracy {
