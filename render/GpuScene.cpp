@@ -27,7 +27,9 @@ GpuMaterial toGpu(const Material& m) {
     g.metallic = m.metallic;
     // KHR_materials_transmission / ior / volume. An infinite (or non-positive) attenuation
     // distance means no absorption: stored as 0.
-    g.transmission = std::clamp(m.transmission, 0.0f, 1.0f);
+    // A translucent material is not glass whatever its transmission factor
+    // (Material::isTransmissive).
+    g.transmission = m.isTranslucent() ? 0.0f : std::clamp(m.transmission, 0.0f, 1.0f);
     g.ior = std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.5f;
     g.attenuationDistance = std::isfinite(m.attenuationDistance) && m.attenuationDistance > 0.0f
                                 ? m.attenuationDistance
@@ -133,7 +135,17 @@ void GpuScene::uploadTextures(const Scene& scene) {
 int GpuScene::uploadMaterials(const Scene& scene) {
     std::vector<GpuMaterial> mats;
     mats.push_back(toGpu(Material()));  // glTF default: white, metallic 1, roughness 1
-    for (const Material& m : scene.materials) mats.push_back(toGpu(m));
+    for (const Material& m : scene.materials) {
+        // The voxel number map runs on the CPU only so far (docs/translucency.md): say that the
+        // real-time image shows such an object as an opaque surface of its base colour.
+        if (m.isTranslucent())
+            spdlog::warn(
+                "material '{}' is translucent; the real-time renderer draws it as an opaque "
+                "surface of its base colour (its voxel number map passes are not written "
+                "yet, docs/translucency.md)",
+                m.name);
+        mats.push_back(toGpu(m));
+    }
     materials_ = gl::Buffer("scene materials", mats.size() * sizeof(GpuMaterial), mats.data());
 
     return int(mats.size());

@@ -55,4 +55,5 @@ run session_fuzz "$corpus/session"
 run poses_csv_fuzz "$corpus/poses"
 run matroska_fuzz "$corpus/matroska"
 run env_image_fuzz "$corpus/envimage" "$root/tests/data/scenes/good"
+run density_grid_fuzz "$corpus/density" "$root/tests/data/scenes/good"
 exit $failed

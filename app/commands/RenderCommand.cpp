@@ -25,7 +25,8 @@ namespace mirage::app {
 namespace {
 
 struct RenderArgs {
-    std::string scene, camera, output, mode = "rv", cameraImage, shard, rows;
+    std::string scene, camera, output, mode = "rv", cameraImage, shard, rows,
+                                       scattering = "multiple";
     int spp = 64, width = 640, height = 0, threads = 0, photons = 0, maxDepth = 64;
     double seconds = 0.0;
     uint64_t seed = 1;
@@ -104,6 +105,8 @@ void run(const RenderArgs& a) {
     st.threads = a.threads;
     st.photonsPerPass = a.photons;
     st.maxDepth = a.maxDepth;
+    st.mediumScattering = a.scattering == "single" ? raytrace::MediumScattering::Single
+                                                   : raytrace::MediumScattering::Multiple;
     raytrace::EmbreeDevice device(a.threads > 0 ? fmt::format("threads={}", a.threads) : "");
 
     TerminalProgress bar("render");
@@ -176,10 +179,10 @@ void run(const RenderArgs& a) {
         rs.buffers = shardBuffers;
         // Everything that changes a pixel, and the scene's bytes; not threads.
         rs.fingerprint = hex64(fingerprint64(fmt::format(
-            "{} {} {} {}x{} spp {} seed {} photons {} depth {} exposure {:.9g} "
+            "{} {} {} {}x{} spp {} seed {} photons {} depth {} scattering {} exposure {:.9g} "
             "buffers {} scene {} image {}",
             a.camera, a.mode, ext, a.width, height, a.spp, a.seed, a.photons, a.maxDepth,
-            a.exposure, a.saveBuffers, hex64(fileFingerprint(a.scene)),
+            a.scattering, a.exposure, a.saveBuffers, hex64(fileFingerprint(a.scene)),
             a.cameraImage.empty() ? std::string("-") : hex64(fileFingerprint(a.cameraImage)))));
         writeRenderShard(out, rs);
         return;
@@ -242,6 +245,11 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
     cmd->add_option("--max-depth", a->maxDepth, "Maximum path vertices")
         ->capture_default_str()
         ->check(wholeIn(1, 1024));
+    cmd->add_option("--scattering", a->scattering,
+                    "Light transport in translucent objects' media: multiple (every order) or "
+                    "single (once-scattered light only, what the voxel number map models)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"single", "multiple"}));
     cmd->callback([a] { run(*a); });
 });
 

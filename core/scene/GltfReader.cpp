@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -380,8 +381,140 @@ private:
                 m.roughnessVariation = static_cast<float>(
                     number(*mirage, "roughness_variation", 0.0, name + " extras.mirage", 0, kInf));
             }
+            readScattering(src, name, m);
             scene_.materials.push_back(std::move(m));
         }
+    }
+
+    // A 3-vector of numbers in [lo, hi] at ext[key].
+    glm::vec3 vec3Field(const tinygltf::Value& ext, const char* key, const std::string& what,
+                        double lo, double hi) const {
+        const tinygltf::Value& c = ext.Get(key);
+        if (!c.IsArray() || c.ArrayLen() != 3)
+            fail(what + " field '" + key + "' must be an array of 3 numbers");
+        glm::vec3 out;
+        for (int k = 0; k < 3; ++k) {
+            const tinygltf::Value& v = c.Get(k);
+            if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()) ||
+                v.GetNumberAsDouble() < lo || v.GetNumberAsDouble() > hi)
+                fail(what + " " + key + "[" + std::to_string(k) + "] must be a number in [" +
+                     std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            out[k] = static_cast<float>(v.GetNumberAsDouble());
+        }
+        return out;
+    }
+
+    // Translucent interiors (docs/scene.md, "Translucent materials"): MIRAGE_materials_scattering
+    // (extinction, albedo, an optional density grid file), or the standard
+    // KHR_materials_diffuse_transmission together with KHR_materials_volume's attenuation for a
+    // homogeneous medium. KHR_materials_volume fills what the mirage extension leaves out:
+    // extinction = 1 / attenuationDistance, albedo = attenuationColor.
+    void readScattering(const tinygltf::Material& src, const std::string& name, Material& m) {
+        const tinygltf::Value* volume = extension(src.extensions, "KHR_materials_volume", name);
+        const tinygltf::Value* diffuse =
+            extension(src.extensions, "KHR_materials_diffuse_transmission", name);
+        const tinygltf::Value* ext = extension(src.extensions, "MIRAGE_materials_scattering", name);
+        double diffuseFactor = 0.0;
+        if (diffuse)
+            diffuseFactor = number(*diffuse, "diffuseTransmissionFactor", 0.0,
+                                   name + " KHR_materials_diffuse_transmission", 0, 1);
+        if (!ext && diffuseFactor <= 0) return;
+        const std::string what =
+            name + (ext ? " MIRAGE_materials_scattering" : " KHR_materials_diffuse_transmission");
+        if (volume && volume->Has("thicknessFactor") && m.thickness <= 0)
+            fail(what +
+                 ": KHR_materials_volume thicknessFactor is 0, which glTF defines as "
+                 "thin-walled (no inside); a translucent material needs a closed mesh "
+                 "with thicknessFactor > 0");
+        Material::Scattering& sc = m.scattering;
+        sc.present = true;
+        const bool volumeAttenuation = std::isfinite(m.attenuationDistance);
+        if (ext && ext->Has("extinction")) {
+            sc.extinction = static_cast<float>(number(*ext, "extinction", 0.0, what, 0, 1e9));
+        } else if (volumeAttenuation) {
+            sc.extinction = 1.0f / m.attenuationDistance;
+        } else {
+            fail(what +
+                 " has no extinction: give 'extinction' (1/m at density 1) or "
+                 "KHR_materials_volume attenuationDistance (extinction = 1 / distance)");
+        }
+        if (ext && ext->Has("albedo"))
+            sc.albedo = vec3Field(*ext, "albedo", what, 0, 1);
+        else if (volume && volume->Has("attenuationColor"))
+            sc.albedo = m.attenuationColor;
+        if (!ext || !ext->Has("density")) return;
+        const tinygltf::Value& d = ext->Get("density");
+        const std::string dwhat = what + " density";
+        if (!d.IsObject()) fail(dwhat + " must be an object with 'uri', 'boundsMin', 'boundsMax'");
+        if (!d.Has("uri") || !d.Get("uri").IsString() || d.Get("uri").Get<std::string>().empty())
+            fail(dwhat + " needs a string 'uri': the .nrrd or .raw file beside the glTF");
+        if (!d.Has("boundsMin") || !d.Has("boundsMax"))
+            fail(dwhat + " needs 'boundsMin' and 'boundsMax' (mesh-local box the grid fills)");
+        const std::string uri = d.Get("uri").Get<std::string>();
+        glm::vec3 lo = vec3Field(d, "boundsMin", dwhat, -1e9, 1e9);
+        glm::vec3 hi = vec3Field(d, "boundsMax", dwhat, -1e9, 1e9);
+        for (int k = 0; k < 3; ++k)
+            if (!(hi[k] > lo[k]))
+                fail(dwhat + " boundsMax[" + std::to_string(k) + "] must be > boundsMin[" +
+                     std::to_string(k) + "]; swap or fix the bounds");
+        const std::string bytes = readSideFile(uri, dwhat);
+        const std::string where = dwhat + " file " + quote(uri);
+        DensityGrid grid;
+        try {
+            const bool nrrd = uri.size() >= 5 && uri.compare(uri.size() - 5, 5, ".nrrd") == 0;
+            if (nrrd) {
+                if (d.Has("dimensions") || d.Has("type"))
+                    fail(where + ":" +
+                         " 'dimensions'/'type' are for .raw files; an NRRD header "
+                         "states them (remove the fields)");
+                grid = parseNrrdDensity(bytes);
+            } else {
+                if (!d.Has("dimensions") || !d.Get("dimensions").IsArray() ||
+                    d.Get("dimensions").ArrayLen() != 3)
+                    fail(where + ": a raw file needs 'dimensions': [nx, ny, nz] (or use .nrrd)");
+                int n[3];
+                for (int k = 0; k < 3; ++k) {
+                    const tinygltf::Value& v = d.Get("dimensions").Get(k);
+                    if (!v.IsInt())
+                        fail(dwhat + " dimensions[" + std::to_string(k) + "] must be an integer");
+                    n[k] = v.GetNumberAsInt();
+                }
+                std::string type = "float32";
+                if (d.Has("type")) {
+                    if (!d.Get("type").IsString()) fail(dwhat + " field 'type' must be a string");
+                    type = d.Get("type").Get<std::string>();
+                }
+                grid = parseRawDensity(bytes, n[0], n[1], n[2], densitySampleType(type));
+            }
+        } catch (const FileError&) {
+            throw;
+        } catch (const Error& e) {
+            fail(where + ": " + e.what());
+        }
+        grid.boundsMin = lo;
+        grid.boundsMax = hi;
+        sc.density = std::make_shared<const DensityGrid>(std::move(grid));
+        sc.densityUri = uri;
+    }
+
+    // A file beside the glTF (resolved against its folder only), at most 1 GiB.
+    std::string readSideFile(const std::string& uri, const std::string& what) const {
+        if (baseDir_.empty())
+            fail(what + " refers to file " + quote(uri) +
+                 ", but the scene was loaded from memory without a folder");
+        const fs::path path = baseDir_ / fs::path(uri);
+        std::error_code ec;
+        if (!fs::is_regular_file(path, ec))
+            fail(what + " file " + quote(uri) + " was not found (looked in " + baseDir_.string() +
+                 ", the glTF file's folder); put it there or fix the uri");
+        const auto size = fs::file_size(path, ec);
+        if (ec || size > (uintmax_t(1) << 30))
+            fail(what + " file " + quote(uri) + " is unreadable or larger than 1 GiB");
+        std::ifstream in(path, std::ios::binary);
+        std::string bytes(size_t(size), '\0');
+        if (!in.read(bytes.data(), std::streamsize(size)))
+            fail(what + " file " + quote(uri) + " could not be read");
+        return bytes;
     }
 
     // extras.mirage of an object, or null; throws if present but not an object.

@@ -15,9 +15,10 @@ uint32_t readLittleEndian32(const std::string& bytes, size_t at) {
 
 const std::set<std::string>& supportedExtensions() {
     static const std::set<std::string> kSupported = {
-        "KHR_lights_punctual",  "KHR_materials_emissive_strength",
-        "KHR_materials_ior",    "KHR_materials_transmission",
-        "KHR_materials_volume",
+        "KHR_lights_punctual",         "KHR_materials_emissive_strength",
+        "KHR_materials_ior",           "KHR_materials_transmission",
+        "KHR_materials_volume",        "KHR_materials_diffuse_transmission",
+        "MIRAGE_materials_scattering",
     };
     return kSupported;
 }

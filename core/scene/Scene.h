@@ -10,6 +10,7 @@
 //    spot cones in radians; a light shines down its node's -Z axis.
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 
 #include "core/camera/CameraModel.h"
 #include "core/math/Pose.h"
+#include "core/scene/DensityGrid.h"
 
 namespace mirage {
 
@@ -76,9 +78,23 @@ struct Material {
     float attenuationDistance = std::numeric_limits<float>::infinity();  // metres
     // mirage extras (docs/scene.md), filled as features arrive:
     float roughnessVariation = 0.0f;  // extras.mirage.roughness_variation (rough refraction)
+    // A translucent object: a closed mesh filled with a participating medium whose extinction is
+    // sigma_t(x) = extinction * density(x), from MIRAGE_materials_scattering or from
+    // KHR_materials_diffuse_transmission + KHR_materials_volume (docs/scene.md). Its boundary is
+    // a smooth interface of index `ior` that weights light by Fresnel but does not bend it.
+    struct Scattering {
+        bool present = false;
+        float extinction = 0.0f;  // sigma_t at density 1, 1/m (world metres)
+        glm::vec3 albedo{1.0f};   // single-scattering albedo sigma_s / sigma_t, linear
+        std::shared_ptr<const DensityGrid> density;  // null: density 1 everywhere inside
+        std::string densityUri;                      // as the glTF names it (messages, cache keys)
+    } scattering;
 
-    bool isMirror() const { return metallic >= 0.99f && roughness <= 0.05f && transmission == 0; }
-    bool isTransmissive() const { return transmission > 0.0f; }
+    bool isTranslucent() const { return scattering.present; }
+    bool isMirror() const {
+        return metallic >= 0.99f && roughness <= 0.05f && transmission == 0 && !isTranslucent();
+    }
+    bool isTransmissive() const { return transmission > 0.0f && !isTranslucent(); }
 };
 
 struct Primitive {

@@ -156,7 +156,22 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
             const Material& mat = materials_[size_t(g.material)].gltf;
             Bsdf probe(BsdfParams{glm::vec3(mat.baseColor), mat.metallic, mat.roughness, mat.ior,
                                   mat.transmission, mat.isMirror()});
-            g.deltaSpecular = probe.hasDelta();
+            g.deltaSpecular = probe.hasDelta() && !mat.isTranslucent();
+            if (mat.isTranslucent()) {
+                Medium md;
+                md.extinction = mat.scattering.extinction;
+                md.albedo = mat.scattering.albedo;
+                md.density = mat.scattering.density;
+                md.localFromWorld = glm::mat4(glm::inverse(world));
+                md.ior = mat.ior;
+                md.majorant = md.extinction * (md.density ? md.density->maxValue : 1.0f);
+                if (!std::isfinite(md.majorant) || !isFiniteVec(md.albedo) ||
+                    !(glm::determinant(glm::dmat3(world)) != 0))
+                    throw Error(where + ": translucent material '" + mat.name +
+                                "' has a non-finite extinction or a singular transform");
+                g.medium = int(media_.size());
+                media_.push_back(std::move(md));
+            }
             glm::vec3 glo(std::numeric_limits<float>::max()),
                 ghi(-std::numeric_limits<float>::max());
             for (const auto& p : g.positions) {

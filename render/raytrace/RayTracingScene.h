@@ -52,6 +52,24 @@ struct ShadingMaterial {
     bool hasVolume = false;
 };
 
+// The participating medium inside a translucent object (Material::Scattering placed in the
+// world): sigma_t(x) = extinction * density(localFromWorld x), 1/m; single-scattering albedo per
+// channel; isotropic phase function. Its boundary weights light by Fresnel (index `ior`) and does
+// not bend it (docs/reference-renderer.md, "Translucent objects").
+struct Medium {
+    float extinction = 0.0f;  // 1/m at density 1
+    glm::vec3 albedo{1.0f};
+    std::shared_ptr<const DensityGrid> density;  // null: density 1 everywhere inside
+    glm::mat4 localFromWorld{1.0f};
+    float ior = 1.0f;
+    float majorant = 0.0f;  // >= sigmaT anywhere (1/m), for delta and ratio tracking
+    bool homogeneous() const { return !density; }
+    float sigmaT(const glm::vec3& pWorld) const {
+        if (!density) return extinction;
+        return extinction * density->density(glm::vec3(localFromWorld * glm::vec4(pWorld, 1.0f)));
+    }
+};
+
 class RayTracingScene {
 public:
     // Builds the Embree scene. Throws mirage::Error on malformed geometry (indices out of range,
@@ -74,6 +92,13 @@ public:
     Origin origin(const SurfaceHit& hit) const { return geometries_[hit.geometry].origin; }
     // True when the geometry's material has a delta (perfectly specular) lobe: photon targets.
     bool isDeltaSpecular(uint32_t geometry) const { return geometries_[geometry].deltaSpecular; }
+
+    // The medium inside a translucent geometry, null for every other geometry.
+    const Medium* medium(uint32_t geometry) const {
+        int m = geometries_[geometry].medium;
+        return m >= 0 ? &media_[size_t(m)] : nullptr;
+    }
+    bool hasMedia() const { return !media_.empty(); }
 
     const std::vector<PunctualLight>& lights() const { return lights_; }
     const EnvironmentLight* environment() const { return environment_.get(); }
@@ -102,6 +127,7 @@ private:
         int material = -1;  // index into materials_
         Origin origin = Origin::Virtual;
         bool deltaSpecular = false;
+        int medium = -1;  // index into media_ (translucent materials)
         BoundingSphere bounds;
     };
     glm::vec3 sampleTexture(int texture, glm::vec2 uv) const;
@@ -110,7 +136,8 @@ private:
     EmbreeScene scene_;
     SceneSubset subset_ = SceneSubset::All;
     std::vector<Geometry> geometries_;
-    std::vector<ShadingMaterial> materials_;  // scene materials + the glTF default at the end
+    std::vector<ShadingMaterial> materials_;
+    std::vector<Medium> media_;  // scene materials + the glTF default at the end
     std::vector<Texture> textures_;
     std::vector<PunctualLight> lights_;
     std::unique_ptr<EnvironmentLight> environment_;

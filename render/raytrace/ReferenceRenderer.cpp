@@ -203,6 +203,9 @@ std::vector<Photon> tracePhotons(const RayTracingScene& scene, const PhotonEmitt
                 SurfaceHit hit;
                 if (!scene.intersect(o, d, std::numeric_limits<float>::infinity(), hit)) break;
                 if (medium) beta *= beerLambert(medium->sigmaA, hit.t);
+                // Light entering a translucent object is the path tracer's (its boundary has
+                // no delta lobe that a caustic photon could follow).
+                if (scene.medium(hit.geometry)) break;
                 Bsdf bsdf(scene.bsdfParams(hit));
                 orientHit(hit, d, bsdf.isTransmissive());
                 if (deltaBounces > 0 && bsdf.hasNonDelta()) {
@@ -246,7 +249,124 @@ struct PathContext {
     const RayTracingScene& scene;
     const PhotonMap* photons;  // null or empty: no caustic gathering
     int maxDepth;
+    MediumScattering scattering = MediumScattering::Multiple;
 };
+
+constexpr float kInvFourPi = 1.0f / (4.0f * kPi);
+// Steps of one delta or ratio tracking walk, and scattering events of one path, before giving
+// up (only reached by media far thicker than any mirage scene's; Russian roulette ends paths).
+constexpr int kMaxTrackingSteps = 1 << 16;
+constexpr int kMaxMediumEvents = 1 << 16;
+
+// Fresnel reflectance of a translucent object's boundary for a ray crossing it at |cos| =
+// `cosAbs` to the normal. The boundary does not bend light, so the outside angle is the ray's
+// angle either way and the same value holds both ways (reciprocal, no total internal reflection).
+float boundaryReflectance(const Medium& m, float cosAbs) {
+    return m.ior == 1.0f ? 0.0f : fresnelDielectric(std::clamp(cosAbs, 0.0f, 1.0f), m.ior);
+}
+
+// Delta tracking (Woodcock): the distance of the first real collision along o + t d (d unit)
+// before tMax, or false when the ray reaches tMax unscattered.
+bool deltaTrack(const Medium& m, const glm::vec3& o, const glm::vec3& d, float tMax, Rng& rng,
+                float& tOut) {
+    if (!(m.majorant > 0)) return false;
+    float t = 0.0f;
+    for (int i = 0; i < kMaxTrackingSteps; ++i) {
+        t -= std::log(1.0f - rng.uniform()) / m.majorant;
+        if (!(t < tMax)) return false;
+        if (m.homogeneous() || rng.uniform() * m.majorant < m.sigmaT(o + t * d)) {
+            tOut = t;
+            return true;
+        }
+    }
+    return false;
+}
+
+// Transmittance over [0, tMax) along o + t d: exact for a homogeneous medium, ratio tracking
+// (Novak et al. 2014) for a density grid.
+float mediumTransmittance(const Medium& m, const glm::vec3& o, const glm::vec3& d, float tMax,
+                          Rng& rng) {
+    if (!(m.majorant > 0)) return 1.0f;
+    if (!std::isfinite(tMax)) return 0.0f;
+    if (m.homogeneous()) return std::exp(-m.extinction * tMax);
+    float T = 1.0f, t = 0.0f;
+    for (int i = 0; i < kMaxTrackingSteps; ++i) {
+        t -= std::log(1.0f - rng.uniform()) / m.majorant;
+        if (!(t < tMax)) return T;
+        T *= std::max(0.0f, 1.0f - m.sigmaT(o + t * d) / m.majorant);
+        if (T < 0.05f) {  // Russian roulette on small transmittance: unbiased
+            if (rng.uniform() < 0.5f) return 0.0f;
+            T *= 2.0f;
+        }
+    }
+    return T;
+}
+
+// Visibility of a shadow ray from o along unit d over (0, tMax), starting inside `inside` (or
+// outside every medium): 0 behind an opaque surface or glass (caustics are the photon map's),
+// through translucent objects the product of their boundaries' Fresnel transmittance and their
+// media's transmittance. Without translucent objects it is the plain occlusion test.
+float shadowTransmittance(const RayTracingScene& scene, glm::vec3 o, const glm::vec3& d, float tMax,
+                          const Medium* inside, Rng& rng) {
+    if (!scene.hasMedia()) return scene.occluded(o, d, tMax) ? 0.0f : 1.0f;
+    float T = 1.0f;
+    for (int crossing = 0; crossing < 64; ++crossing) {
+        SurfaceHit h;
+        const bool found = scene.intersect(o, d, tMax, h);
+        const float segment = found ? h.t : tMax;
+        if (inside) T *= mediumTransmittance(*inside, o, d, segment, rng);
+        if (!found || !(T > 0)) return found ? 0.0f : T;
+        const Medium* m = scene.medium(h.geometry);
+        if (!m) return 0.0f;
+        T *= 1.0f - boundaryReflectance(*m, std::abs(glm::dot(d, h.ng)));
+        inside = glm::dot(d, h.ng) < 0 ? m : nullptr;
+        const glm::vec3 previous = o;
+        o = spawnOrigin(h, d);
+        if (std::isfinite(tMax)) tMax = std::max(0.0f, tMax - glm::length(o - previous));
+        if (!(tMax > 0)) return T;
+    }
+    return 0.0f;
+}
+
+// Light scattered towards the camera path at a medium point x (isotropic phase 1/4pi): every
+// punctual light and one environment sample, each through shadowTransmittance. `mis`: the path
+// continues by phase sampling, so the environment sample is weighted against it.
+glm::vec3 mediumDirectLight(const RayTracingScene& scene, const glm::vec3& x, const Medium& m,
+                            Rng& rng, bool mis) {
+    glm::vec3 L(0.0f);
+    for (const PunctualLight& l : scene.lights()) {
+        glm::vec3 wi, Li;
+        float dist;
+        if (l.type == Light::Type::Directional) {
+            wi = -l.direction;
+            dist = std::numeric_limits<float>::infinity();
+            Li = l.intensity;
+        } else {
+            glm::vec3 v = l.position - x;
+            float d2 = glm::dot(v, v);
+            if (!(d2 > 0)) continue;
+            dist = std::sqrt(d2);
+            wi = v / dist;
+            Li = l.intensity * (l.spotFactor(glm::dot(l.direction, -wi)) / d2);
+        }
+        if (maxComponent(Li) <= 0) continue;
+        float T = shadowTransmittance(scene, x, wi,
+                                      std::isfinite(dist) ? dist * (1.0f - 1e-4f) : dist, &m, rng);
+        L += Li * (T * kInvFourPi);
+    }
+    if (const EnvironmentLight* env = scene.environment()) {
+        glm::vec3 wi;
+        float pdfL;
+        glm::vec3 Le = env->sample(rng.uniform2(), wi, pdfL);
+        if (pdfL > 0 && maxComponent(Le) > 0) {
+            float T =
+                shadowTransmittance(scene, x, wi, std::numeric_limits<float>::infinity(), &m, rng);
+            float w = mis ? powerHeuristic(pdfL, kInvFourPi) : 1.0f;
+            L += Le * (T * kInvFourPi * w / pdfL);
+        }
+    }
+    return L;
+}
 
 glm::vec3 gatherPhotons(const PhotonMap& map, const Bsdf& bsdf, const Frame& frame,
                         const glm::vec3& woLocal, const SurfaceHit& hit) {
@@ -270,10 +390,40 @@ glm::vec3 tracePath(const PathContext& ctx, glm::vec3 o, glm::vec3 d, Rng& rng,
     bool deltaBounce = true;  // the camera ray counts as delta: no MIS for what it hits directly
     float prevPdf = 0.0f;
     const ShadingMaterial* medium = nullptr;
+    const Medium* volume = nullptr;  // the translucent object's medium the path is inside
+    int mediumEvents = 0;
     firstHitVirtual = false;
     for (int depth = 0; depth < ctx.maxDepth; ++depth) {
         SurfaceHit hit;
-        if (!scene.intersect(o, d, std::numeric_limits<float>::infinity(), hit)) {
+        const bool found = scene.intersect(o, d, std::numeric_limits<float>::infinity(), hit);
+        if (depth == 0 && found) firstHitVirtual = scene.origin(hit) == Origin::Virtual;
+        if (volume) {
+            if (!found) break;  // leaked out of a mesh that is not closed
+            float t;
+            if (deltaTrack(*volume, o, d, hit.t, rng, t)) {
+                // A real collision: scatter (albedo weights the survival of the photon).
+                if (ctx.scattering == MediumScattering::Single && mediumEvents > 0) break;
+                if (++mediumEvents > kMaxMediumEvents) break;
+                --depth;  // medium events do not count as surface vertices
+                const glm::vec3 x = o + t * d;
+                beta *= volume->albedo;
+                const bool single = ctx.scattering == MediumScattering::Single;
+                L += beta * mediumDirectLight(scene, x, *volume, rng, !single);
+                if (single) break;
+                if (mediumEvents > 32) {
+                    float q = std::max(0.02f, 1.0f - maxComponent(beta));
+                    if (rng.uniform() < q) break;
+                    beta /= 1.0f - q;
+                }
+                if (!(maxComponent(beta) > 0)) break;
+                d = sampleUniformSphere(rng.uniform2());
+                o = x;
+                deltaBounce = false;
+                prevPdf = kInvFourPi;
+                continue;
+            }
+        }
+        if (!found) {
             if (env) {
                 glm::vec3 Le = env->radiance(d);
                 float w = deltaBounce ? 1.0f : powerHeuristic(prevPdf, env->pdf(d));
@@ -281,8 +431,23 @@ glm::vec3 tracePath(const PathContext& ctx, glm::vec3 o, glm::vec3 d, Rng& rng,
             }
             break;
         }
-        if (depth == 0) firstHitVirtual = scene.origin(hit) == Origin::Virtual;
         if (medium) beta *= beerLambert(medium->sigmaA, hit.t);
+        if (const Medium* boundary = scene.medium(hit.geometry)) {
+            // A translucent object's boundary: Fresnel reflection (delta) or straight passage.
+            const float cosI = glm::dot(d, hit.ng);
+            if (rng.uniform() < boundaryReflectance(*boundary, std::abs(cosI))) {
+                glm::vec3 wi = d - 2.0f * cosI * hit.ng;
+                deltaBounce = true;
+                o = spawnOrigin(hit, wi);
+                d = wi;
+            } else {
+                // Passing straight on keeps the direction, so the MIS state of the vertex that
+                // chose it (deltaBounce, prevPdf) still applies where the ray ends.
+                volume = cosI < 0 ? boundary : nullptr;
+                o = spawnOrigin(hit, d);
+            }
+            continue;
+        }
         L += beta * scene.emission(hit);  // area emitters are found by BSDF sampling only
 
         Bsdf bsdf(scene.bsdfParams(hit));
@@ -313,11 +478,12 @@ glm::vec3 tracePath(const PathContext& ctx, glm::vec3 o, glm::vec3 d, Rng& rng,
                 glm::vec3 f = bsdf.eval(wo, wiLocal, TransportMode::Radiance);
                 if (maxComponent(f) <= 0) continue;
                 glm::vec3 so = spawnOrigin(hit, wi);
-                if (scene.occluded(
-                        so, wi,
-                        std::isfinite(dist) ? glm::length(l.position - so) * (1.0f - 1e-4f) : dist))
-                    continue;
-                L += beta * f * std::abs(wiLocal.z) * Li;
+                const float T = shadowTransmittance(
+                    scene, so, wi,
+                    std::isfinite(dist) ? glm::length(l.position - so) * (1.0f - 1e-4f) : dist,
+                    volume, rng);
+                if (!(T > 0)) continue;
+                L += beta * f * std::abs(wiLocal.z) * Li * T;
             }
             // Environment: light sample with MIS against BSDF sampling.
             if (env) {
@@ -327,11 +493,14 @@ glm::vec3 tracePath(const PathContext& ctx, glm::vec3 o, glm::vec3 d, Rng& rng,
                 if (pdfL > 0 && maxComponent(Le) > 0) {
                     glm::vec3 wiLocal = frame.toLocal(wi);
                     glm::vec3 f = bsdf.eval(wo, wiLocal, TransportMode::Radiance);
-                    if (maxComponent(f) > 0 &&
-                        !scene.occluded(spawnOrigin(hit, wi), wi,
-                                        std::numeric_limits<float>::infinity())) {
+                    const float T = maxComponent(f) > 0
+                                        ? shadowTransmittance(
+                                              scene, spawnOrigin(hit, wi), wi,
+                                              std::numeric_limits<float>::infinity(), volume, rng)
+                                        : 0.0f;
+                    if (T > 0) {
                         float w = powerHeuristic(pdfL, bsdf.pdf(wo, wiLocal));
-                        L += beta * f * std::abs(wiLocal.z) * Le * (w / pdfL);
+                        L += beta * f * std::abs(wiLocal.z) * Le * (T * w / pdfL);
                     }
                 }
             } else {
@@ -455,7 +624,8 @@ RenderResult render(const RayTracingScene& scene, const RenderCamera& camera,
             result.photonsStored += (long long)photons.size();
             photonMap = PhotonMap(std::move(photons), std::sqrt(radius2));
         }
-        PathContext ctx{scene, usePhotons ? &photonMap : nullptr, settings.maxDepth};
+        PathContext ctx{scene, usePhotons ? &photonMap : nullptr, settings.maxDepth,
+                        settings.mediumScattering};
         // Work items: square tiles, or for a subset of rows, strips of one row and kTile^2 pixels.
         const int items = rowSubset ? int(settings.rows.size()) * stripsPerRow : tilesX * tilesY;
         parallelFor(items, threads, [&](int item) {

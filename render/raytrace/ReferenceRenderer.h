@@ -35,6 +35,10 @@ struct RenderCamera {
 // nodes there are when no camera node has that name.
 RenderCamera cameraFromNode(const Scene& scene, const std::string& nodeName, int width, int height);
 
+// Light transport inside translucent objects' media: every order of scattering, or only the
+// light scattered once (plus what passes unscattered), the regime the voxel number map models.
+enum class MediumScattering { Single, Multiple };
+
 struct RenderSettings {
     int samplesPerPixel = 16;  // passes; each pass = 1 camera path per pixel + 1 photon pass
     double maxSeconds = 0.0;  // > 0: stop after the pass that crosses this time (spp = upper bound)
@@ -47,6 +51,7 @@ struct RenderSettings {
     float initialPhotonRadius = 0.0f;  // metres
     float radiusAlpha = 2.0f / 3.0f;   // Knaus-Zwicker radius reduction (0..1)
     bool caustics = true;              // false: photon map off (the path tracer alone)
+    MediumScattering mediumScattering = MediumScattering::Multiple;
     // Image rows to trace, ascending (empty: all). Other rows stay zero. A pixel's samples depend
     // on the seed, the pass and the pixel only, so a row comes out the same whichever rows are
     // traced with it: the rows of a split render (`mirage render --shard`) join bit for bit.

@@ -471,12 +471,111 @@ const std::vector<BadCase>& badCases() {
         {"invalid_mode.gltf", {"mesh 0 primitive 0", "mode 9"}},
         {"no_position.gltf", {"mesh 0 primitive 0", "POSITION"}},
         {"sparse_index_out_of_range.gltf", {"accessor 0", "sparse index 0 is 7"}},
+        {"scattering_no_extinction.gltf",
+         {"material 0 MIRAGE_materials_scattering", "no extinction", "attenuationDistance"}},
+        {"scattering_albedo_out_of_range.gltf", {"material 0", "albedo[1]"}},
+        {"scattering_density_missing.gltf", {"density", "nowhere.nrrd", "not found"}},
+        {"scattering_bounds_inverted.gltf", {"boundsMax[1]", "boundsMin[1]"}},
+        {"scattering_nrrd_short.gltf", {"grid_short.nrrd", "28 bytes", "need 32"}},
+        {"scattering_nrrd_compressed.gltf", {"grid_gzip.nrrd", "encoding 'gzip'", "raw"}},
+        {"scattering_negative_density.gltf", {"grid_negative.nrrd", "sample 5", ">= 0"}},
+        {"scattering_raw_no_dimensions.gltf", {"grid.raw", "dimensions"}},
+        {"scattering_thin_walled.gltf", {"material 0", "thicknessFactor", "thin-walled"}},
         {"deep_nesting.gltf", {"nesting"}},
         {"not_json.gltf", {"not a valid glTF file"}},
         {"empty.gltf", {"empty"}},
         {"truncated_glb.glb", {"binary"}},
     };
     return cases;
+}
+
+// Translucent materials: the mirage extension with NRRD and raw grids, and the standard
+// diffuse-transmission + volume pair (values from make_scenes.py).
+TEST(SceneLoader, TranslucentMaterialsAndDensityGrids) {
+    const Scene s = loadScene(goodScene("translucent.gltf"));
+    ASSERT_EQ(s.materials.size(), 3u);
+    const Material& jade = s.materials[0];
+    ASSERT_TRUE(jade.isTranslucent());
+    EXPECT_FALSE(jade.isTransmissive());
+    EXPECT_FALSE(jade.isMirror());
+    EXPECT_FLOAT_EQ(jade.scattering.extinction, 40.0f);
+    expectVec(jade.scattering.albedo, {0.6f, 0.9f, 0.7f});
+    EXPECT_FLOAT_EQ(jade.ior, 1.6f);
+    ASSERT_TRUE(jade.scattering.density);
+    const DensityGrid& g = *jade.scattering.density;
+    EXPECT_EQ(g.nx, 4);
+    EXPECT_EQ(g.ny, 3);
+    EXPECT_EQ(g.nz, 2);
+    EXPECT_NEAR(g.at(3, 2, 1), 2.3f, 1e-6f);
+    EXPECT_NEAR(g.maxValue, 2.3f, 1e-6f);
+    expectVec(g.boundsMin, {-0.5f, -0.25f, 0.0f});
+    // Cell centres: x at -0.375 + 0.25 i, y at -0.125 + 0.25 j, z at 0.05 + 0.1 k.
+    EXPECT_NEAR(g.density({-0.375f, -0.125f, 0.05f}), 0.0f, 1e-6f);
+    EXPECT_NEAR(g.density({0.375f, 0.375f, 0.15f}), 2.3f, 1e-5f);
+    // Half way between x = 0 and x = 1 (density 0 and 0.1), and between z planes (+1.2).
+    EXPECT_NEAR(g.density({-0.25f, -0.125f, 0.1f}), 0.05f + 0.6f, 1e-5f);
+    // Clamped to the outermost centres inside the box, zero outside.
+    EXPECT_NEAR(g.density({-0.49f, -0.24f, 0.01f}), 0.0f, 1e-6f);
+    EXPECT_NEAR(g.density({0.49f, 0.49f, 0.19f}), 2.3f, 1e-5f);
+    EXPECT_EQ(g.density({0.6f, 0.0f, 0.1f}), 0.0f);
+
+    const Material& milk = s.materials[1];
+    ASSERT_TRUE(milk.isTranslucent());
+    expectVec(milk.scattering.albedo, {1, 1, 1});
+    ASSERT_TRUE(milk.scattering.density);
+    EXPECT_NEAR(milk.scattering.density->at(1, 0, 1), 1.0f, 1e-6f);
+    EXPECT_NEAR(milk.scattering.density->at(1, 0, 0), 0.2f, 1e-6f);
+
+    const Material& wax = s.materials[2];
+    ASSERT_TRUE(wax.isTranslucent());
+    EXPECT_FLOAT_EQ(wax.scattering.extinction, 4.0f);  // 1 / attenuationDistance
+    expectVec(wax.scattering.albedo, {0.9f, 0.8f, 0.5f});
+    EXPECT_FALSE(wax.scattering.density);
+    // The loader warns about nothing here: every extension used is supported.
+    EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(SceneLoader, NrrdHeaderVariants) {
+    auto floats = [](std::vector<float> v) {
+        return std::string(reinterpret_cast<const char*>(v.data()), v.size() * 4);
+    };
+    // CRLF header, big-endian ushort, comments and key/value pairs.
+    std::string big =
+        "NRRD0005\r\n# c\r\ntype: ushort\r\ndimension: 3\r\nsizes: 1 1 2\r\n"
+        "encoding: raw\r\nendian: big\r\nunits:=mm\r\n\r\n";
+    big += std::string("\xff\xff\x00\x00", 4);
+    DensityGrid g = parseNrrdDensity(big);
+    EXPECT_FLOAT_EQ(g.at(0, 0, 0), 1.0f);
+    EXPECT_FLOAT_EQ(g.at(0, 0, 1), 0.0f);
+    const std::string head =
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\n"
+        "encoding: raw\nendian: little\n\n";
+    EXPECT_FLOAT_EQ(parseNrrdDensity(head + floats({0.5f, 2.0f})).maxValue, 2.0f);
+    auto rejects = [](const std::string& bytes, const std::string& part) {
+        try {
+            parseNrrdDensity(bytes);
+            ADD_FAILURE() << "accepted: " << part;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+        }
+    };
+    rejects(head + floats({0.5f, NAN}), "finite");
+    rejects(
+        "NRRD0004\ntype: float\ndimension: 2\nsizes: 2 1\nencoding: raw\nendian: "
+        "little\n\n" +
+            floats({1, 1}),
+        "dimension");
+    rejects(
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 2000 1 1\nencoding: raw\nendian: "
+        "little\n\n",
+        "outside 1..1024");
+    rejects("NRRD0004\ntype: int\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n\n", "type 'int'");
+    rejects("NRRD0004\ntype: float\ndimension: 3\n", "no end");
+    rejects("P6\n", "not an NRRD");
+    rejects(
+        "NRRD0004\ntype: float\ndimension: 3\nsizes: 1 1 1\nencoding: raw\nendian: "
+        "little\ndata file: x.raw\n\n",
+        "detached");
 }
 
 TEST(SceneLoader, BadFilesGiveFileErrorsNamingFileAndProblem) {

@@ -65,6 +65,11 @@ const std::vector<std::string> kGltfTokens = {
     "\"extensionsRequired\":[\"EXT_unknown\"]",
     "\"KHR_lights_punctual\":{\"light\":0}",
     "\"KHR_materials_volume\":{\"attenuationDistance\":0}",
+    "\"MIRAGE_materials_scattering\":{\"extinction\":5,\"density\":{\"uri\":\"density.nrrd\","
+    "\"boundsMin\":[0,0,0],\"boundsMax\":[1,1,1]}}",
+    "\"KHR_materials_diffuse_transmission\":{\"diffuseTransmissionFactor\":1}",
+    "\"uri\":\"density.raw\",\"dimensions\":[2,2,2],\"type\":\"uint8\"",
+    "\"uri\":\"density.nrrd\"",
     "\"extras\":{\"mirage\":{\"real\":true}}",
     "\"extras\":{\"mirage\":{\"environment\":{\"type\":\"fisheye\",\"image\":\"env.hdr\"}}}",
     "\"matrix\":[0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0]",

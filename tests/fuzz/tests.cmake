@@ -94,3 +94,5 @@ mirage_loader_fuzz(poses_csv_fuzz PosesCsvFuzz.cpp mirage_core ${_corpus}/poses)
 mirage_loader_fuzz(matroska_fuzz MatroskaFuzz.cpp mirage_core ${_corpus}/matroska)
 mirage_loader_fuzz(env_image_fuzz EnvImageFuzz.cpp mirage_core ${_corpus}/envimage
                    ${CMAKE_CURRENT_SOURCE_DIR}/data/scenes/good)
+mirage_loader_fuzz(density_grid_fuzz DensityGridFuzz.cpp mirage_core ${_corpus}/density
+                   ${CMAKE_CURRENT_SOURCE_DIR}/data/scenes/good)

@@ -11,6 +11,9 @@ good/showcase.gltf  every supported feature, buffer and one image as base64 data
 good/showcase.glb   the same scene as a binary glTF: buffer in the BIN chunk, image 0 in a
                     bufferView, image 1 still external
 good/fisheye.gltf   one triangle; a fish-eye environment in asset.extras
+good/translucent.gltf  one triangle, three translucent materials: MIRAGE_materials_scattering
+                    with an NRRD density grid (density.nrrd), with a raw grid (density.raw), and
+                    KHR_materials_diffuse_transmission + KHR_materials_volume (homogeneous)
 bad/*.gltf|.glb     one defect each (see BAD below); the loader must throw mirage::FileError
 """
 import base64
@@ -231,6 +234,45 @@ def triangle(extra_nodes=None):
     }
 
 
+def nrrd_float(nx, ny, nz, values, extra_header=""):
+    """An NRRD file of little-endian float32 samples, x fastest."""
+    header = ("NRRD0004\n# mirage test density grid\ntype: float\ndimension: 3\n"
+              "sizes: %d %d %d\nencoding: raw\nendian: little\n%s\n" % (nx, ny, nz, extra_header))
+    return header.encode() + struct.pack("<%df" % len(values), *values)
+
+
+# Test density: 4 x 3 x 2 samples, value = 0.1 * (x + 4 y + 12 z).
+DENSITY_NRRD = nrrd_float(4, 3, 2, [0.1 * i for i in range(24)])
+# 2 x 2 x 2 uint8 samples (normalised by 255).
+DENSITY_RAW = bytes([0, 51, 102, 153, 204, 255, 0, 255])
+
+
+def translucent_scene():
+    g = triangle()
+    g["extensionsUsed"] = ["MIRAGE_materials_scattering", "KHR_materials_volume",
+                           "KHR_materials_diffuse_transmission", "KHR_materials_ior"]
+    g["materials"] = [
+        {"name": "jade", "extensions": {
+            "KHR_materials_ior": {"ior": 1.6},
+            "KHR_materials_volume": {"thicknessFactor": 0.1},
+            "MIRAGE_materials_scattering": {
+                "extinction": 40.0, "albedo": [0.6, 0.9, 0.7],
+                "density": {"uri": "density.nrrd", "boundsMin": [-0.5, -0.25, 0.0],
+                            "boundsMax": [0.5, 0.5, 0.2]}}}},
+        {"name": "milk", "extensions": {
+            "MIRAGE_materials_scattering": {
+                "extinction": 12.5,
+                "density": {"uri": "density.raw", "dimensions": [2, 2, 2], "type": "uint8",
+                            "boundsMin": [0, 0, 0], "boundsMax": [1, 1, 1]}}}},
+        {"name": "wax", "extensions": {
+            "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0},
+            "KHR_materials_volume": {"thicknessFactor": 0.05, "attenuationDistance": 0.25,
+                                     "attenuationColor": [0.9, 0.8, 0.5]}}},
+    ]
+    g["meshes"][0]["primitives"][0]["material"] = 0
+    return g
+
+
 def with_buffer(g, data):
     g["buffers"] = [{"byteLength": len(data), "uri": data_uri(data)}]
     return g
@@ -352,6 +394,27 @@ def bad_cases():
                                        "values": {"bufferView": 3}}
     case("sparse_index_out_of_range", sparse_oob)
 
+    def scattering(density=None, **fields):
+        ext = dict(fields)
+        if density is not None:
+            ext["density"] = density
+        def edit(g):
+            g["materials"] = [{"extensions": {"MIRAGE_materials_scattering": ext}}]
+        return edit
+    box = {"boundsMin": [0, 0, 0], "boundsMax": [1, 1, 1]}
+    case("scattering_no_extinction", scattering(albedo=[1, 1, 1]))
+    case("scattering_albedo_out_of_range", scattering(extinction=5, albedo=[0.5, 1.5, 0.5]))
+    case("scattering_density_missing", scattering(dict(box, uri="nowhere.nrrd"), extinction=5))
+    case("scattering_bounds_inverted", scattering(
+        {"uri": "grid_good.nrrd", "boundsMin": [0, 2, 0], "boundsMax": [1, 1, 1]}, extinction=5))
+    case("scattering_nrrd_short", scattering(dict(box, uri="grid_short.nrrd"), extinction=5))
+    case("scattering_nrrd_compressed", scattering(dict(box, uri="grid_gzip.nrrd"), extinction=5))
+    case("scattering_negative_density", scattering(dict(box, uri="grid_negative.nrrd"), extinction=5))
+    case("scattering_raw_no_dimensions", scattering(dict(box, uri="grid.raw"), extinction=5))
+    case("scattering_thin_walled", lambda g: g.update(materials=[{"extensions": {
+        "KHR_materials_volume": {"thicknessFactor": 0, "attenuationDistance": 0.1},
+        "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1}}}]))
+
     def deep(g):
         g["asset"]["extras"] = json.loads("[" * 500 + "]" * 500)
     case("deep_nesting", deep)
@@ -399,6 +462,17 @@ distortion_coefficients: !!opencv-matrix
         "type": "fisheye", "image": "env.hdr", "calibration": "fisheye.yaml", "intensity": 0.5,
         "T_world_camera": [0.1, 2.0, -0.3, 0.0, 1.0, 0.0, 0.0]}}}
     write(os.path.join(GOOD, "fisheye.gltf"), json.dumps(fish, indent=1) + "\n")
+
+    write(os.path.join(GOOD, "translucent.gltf"), json.dumps(translucent_scene(), indent=1) + "\n")
+    write(os.path.join(GOOD, "density.nrrd"), DENSITY_NRRD)
+    write(os.path.join(GOOD, "density.raw"), DENSITY_RAW)
+    # Grid files the bad scenes refer to.
+    write(os.path.join(BAD, "grid_good.nrrd"), nrrd_float(2, 2, 2, [1.0] * 8))
+    write(os.path.join(BAD, "grid_short.nrrd"), nrrd_float(2, 2, 2, [1.0] * 7))
+    write(os.path.join(BAD, "grid_negative.nrrd"), nrrd_float(2, 2, 2, [1.0] * 5 + [-0.5] + [1.0] * 2))
+    write(os.path.join(BAD, "grid_gzip.nrrd"),
+          nrrd_float(2, 2, 2, [1.0] * 8).replace(b"encoding: raw", b"encoding: gzip"))
+    write(os.path.join(BAD, "grid.raw"), struct.pack("<8f", *([1.0] * 8)))
 
     for name, content in bad_cases().items():
         ext = ".glb" if name.endswith("_glb") else ".gltf"

@@ -1,0 +1,594 @@
+#include "render/translucency/VoxelNumberMap.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <thread>
+
+#include <glm/gtc/packing.hpp>
+
+#include "core/Error.h"
+#include "core/Log.h"
+#include "render/raytrace/Bsdf.h"
+#include "render/raytrace/Sampling.h"
+
+namespace mirage::translucency {
+namespace {
+
+namespace fs = std::filesystem;
+using raytrace::kPi;
+
+constexpr uint32_t kCacheMagic = 0x314D4E56;  // "VNM1"
+constexpr uint32_t kCacheVersion = 2;
+
+template <typename Fn>
+void parallelFor(int count, int threads, Fn&& fn) {
+    std::atomic<int> next{0};
+    auto worker = [&] {
+        for (int i = next++; i < count; i = next++) fn(i);
+    };
+    int n = std::max(1, std::min(threads, count));
+    std::vector<std::thread> pool;
+    for (int t = 1; t < n; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+}
+
+int threadCount(int requested) {
+    return requested > 0 ? requested : int(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+// FNV-1a over bytes.
+struct Hasher {
+    uint64_t h = 1469598103934665603ull;
+    void bytes(const void* p, size_t n) {
+        auto* c = static_cast<const unsigned char*>(p);
+        for (size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
+    }
+    template <typename T>
+    void value(const T& v) {
+        bytes(&v, sizeof(T));
+    }
+};
+
+float boundaryTransmittance(float ior, float cosAbs) {
+    return ior == 1.0f ? 1.0f
+                       : 1.0f - raytrace::fresnelDielectric(std::clamp(cosAbs, 0.0f, 1.0f), ior);
+}
+
+}  // namespace
+
+glm::vec3 effectiveAlbedo(const glm::vec3& albedo) {
+    glm::vec3 out;
+    for (int k = 0; k < 3; ++k) {
+        const float g = std::sqrt(std::max(0.0f, 1.0f - std::clamp(albedo[k], 0.0f, 1.0f)));
+        out[k] = (1.0f - g) / (1.0f + g);
+    }
+    return out;
+}
+
+std::vector<TranslucentObject> translucentObjects(const Scene& scene) {
+    std::vector<TranslucentObject> out;
+    for (const MeshInstance& mi : scene.meshInstances()) {
+        if (mi.mesh < 0 || mi.mesh >= int(scene.meshes.size())) continue;
+        const Mesh& mesh = scene.meshes[size_t(mi.mesh)];
+        std::vector<int> materials;
+        for (const Primitive& p : mesh.primitives)
+            if (scene.material(p.material).isTranslucent() &&
+                std::find(materials.begin(), materials.end(), p.material) == materials.end())
+                materials.push_back(p.material);
+        for (int mat : materials) {
+            const Material& m = scene.material(mat);
+            TranslucentObject o;
+            o.name = scene.nodes[size_t(mi.node)].name;
+            o.medium.extinction = m.scattering.extinction;
+            o.medium.albedo = m.scattering.albedo;
+            o.medium.density = m.scattering.density;
+            o.medium.localFromWorld = glm::mat4(glm::inverse(mi.world));
+            o.medium.ior = m.ior;
+            o.medium.majorant = m.scattering.extinction *
+                                (m.scattering.density ? m.scattering.density->maxValue : 1);
+            for (const Primitive& p : mesh.primitives) {
+                if (p.material != mat) continue;
+                auto base = uint32_t(o.positions.size());
+                for (const glm::vec3& v : p.positions)
+                    o.positions.push_back(glm::vec3(mi.world * glm::dvec4(v, 1.0)));
+                for (uint32_t i : p.indices) o.indices.push_back(base + i);
+            }
+            out.push_back(std::move(o));
+        }
+    }
+    return out;
+}
+
+std::string VoxelNumberMap::cacheKey(const TranslucentObject& o, int resolution) {
+    Hasher h;
+    h.value(kCacheVersion);
+    h.value(resolution);
+    h.bytes(o.positions.data(), o.positions.size() * sizeof(glm::vec3));
+    h.bytes(o.indices.data(), o.indices.size() * sizeof(uint32_t));
+    h.value(o.medium.extinction);
+    h.value(o.medium.localFromWorld);
+    if (o.medium.density) {
+        const DensityGrid& g = *o.medium.density;
+        h.value(g.nx);
+        h.value(g.ny);
+        h.value(g.nz);
+        h.value(g.boundsMin);
+        h.value(g.boundsMax);
+        h.bytes(g.values.data(), g.values.size() * sizeof(float));
+    }
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h.h));
+    return buf;
+}
+
+float VoxelNumberMap::tau(int i, int j) const {
+    return glm::unpackHalf1x16(tau_[size_t(i) * surface_.size() + size_t(j)]);
+}
+
+int VoxelNumberMap::surfaceVoxelAt(const glm::vec3& p) const {
+    glm::ivec3 c = glm::ivec3(glm::floor((p - origin_) / voxelSize_));
+    auto valid = [&](glm::ivec3 q) {
+        return glm::all(glm::greaterThanEqual(q, glm::ivec3(0))) &&
+               glm::all(glm::lessThan(q, dims_));
+    };
+    if (valid(c) && number_[size_t(cellIndex(c))] >= 0) return number_[size_t(cellIndex(c))];
+    int best = -1;
+    float bestD = std::numeric_limits<float>::max();
+    for (int dz = -2; dz <= 2; ++dz)
+        for (int dy = -2; dy <= 2; ++dy)
+            for (int dx = -2; dx <= 2; ++dx) {
+                glm::ivec3 q = c + glm::ivec3(dx, dy, dz);
+                if (!valid(q)) continue;
+                int n = number_[size_t(cellIndex(q))];
+                if (n < 0) continue;
+                float d = glm::length(surface_[size_t(n)].position - p);
+                if (d < bestD) {
+                    bestD = d;
+                    best = n;
+                }
+            }
+    return best;
+}
+
+VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettings& s) {
+    if (s.resolution < 2 || s.resolution > 512)
+        throw Error("voxel number map: resolution " + std::to_string(s.resolution) +
+                    " is outside 2..512");
+    if (o.indices.size() < 3 || o.indices.size() % 3)
+        throw Error("voxel number map: translucent object '" + o.name + "' has no triangles");
+    const auto start = std::chrono::steady_clock::now();
+    VoxelNumberMap m;
+    const std::string key = cacheKey(o, s.resolution);
+    const fs::path cacheFile =
+        s.cacheDir.empty() ? fs::path() : s.cacheDir / ("vnm-" + key + ".bin");
+    if (!cacheFile.empty() && m.readCache(cacheFile)) {
+        m.fromCache_ = true;
+        m.seconds_ =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return m;
+    }
+
+    // ---- voxelise: cubic voxels over the bounding box, one empty voxel of margin ----
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const auto& p : o.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    const glm::vec3 extent = hi - lo;
+    const float longest = std::max(extent.x, std::max(extent.y, extent.z));
+    if (!(longest > 0) || !std::isfinite(longest))
+        throw Error("voxel number map: translucent object '" + o.name + "' has no extent");
+    m.voxelSize_ = longest / float(s.resolution);
+    const float h = m.voxelSize_;
+    m.dims_ = glm::ivec3(glm::ceil(extent / h - 1e-4f)) + 2;
+    m.dims_ = glm::max(m.dims_, glm::ivec3(3));
+    m.origin_ = lo - glm::vec3(h);
+    const glm::ivec3 n = m.dims_;
+    const size_t cells = size_t(n.x) * size_t(n.y) * size_t(n.z);
+    std::vector<uint8_t> inside(cells, 0);
+    // Inside test by parity along +x rows through the voxel centres (rows nudged off the voxel
+    // lattice so that they do not run through mesh edges of axis-aligned meshes).
+    const float nudgeY = 1.234567e-3f * h, nudgeZ = 2.345678e-3f * h;
+    std::vector<std::vector<float>> crossings(size_t(n.y) * size_t(n.z));
+    for (size_t t = 0; t + 2 < o.indices.size(); t += 3) {
+        const glm::vec3 a = o.positions[o.indices[t]], b = o.positions[o.indices[t + 1]],
+                        c = o.positions[o.indices[t + 2]];
+        const glm::vec3 tlo = glm::min(a, glm::min(b, c)), thi = glm::max(a, glm::max(b, c));
+        int y0 = std::max(0, int(std::floor((tlo.y - m.origin_.y) / h - 0.5f)));
+        int y1 = std::min(n.y - 1, int(std::ceil((thi.y - m.origin_.y) / h - 0.5f)));
+        int z0 = std::max(0, int(std::floor((tlo.z - m.origin_.z) / h - 0.5f)));
+        int z1 = std::min(n.z - 1, int(std::ceil((thi.z - m.origin_.z) / h - 0.5f)));
+        for (int z = z0; z <= z1; ++z)
+            for (int y = y0; y <= y1; ++y) {
+                const float py = m.origin_.y + (float(y) + 0.5f) * h + nudgeY;
+                const float pz = m.origin_.z + (float(z) + 0.5f) * h + nudgeZ;
+                // Barycentric test in the yz projection.
+                const float d = (b.y - a.y) * (c.z - a.z) - (c.y - a.y) * (b.z - a.z);
+                if (std::abs(d) < 1e-20f) continue;
+                const float u = ((py - a.y) * (c.z - a.z) - (c.y - a.y) * (pz - a.z)) / d;
+                const float v = ((b.y - a.y) * (pz - a.z) - (py - a.y) * (b.z - a.z)) / d;
+                if (u < 0 || v < 0 || u + v > 1) continue;
+                crossings[size_t(z) * size_t(n.y) + size_t(y)].push_back(a.x + u * (b.x - a.x) +
+                                                                         v * (c.x - a.x));
+            }
+    }
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y) {
+            auto& xs = crossings[size_t(z) * size_t(n.y) + size_t(y)];
+            std::sort(xs.begin(), xs.end());
+            for (size_t k = 0; k + 1 < xs.size(); k += 2)
+                for (int x = 0; x < n.x; ++x) {
+                    float px = m.origin_.x + (float(x) + 0.5f) * h;
+                    if (px >= xs[k] && px < xs[k + 1]) inside[size_t(m.cellIndex({x, y, z}))] = 1;
+                }
+        }
+
+    // ---- extinction per voxel: mean of 8 sub-samples of sigma_t inside, 0 outside ----
+    std::vector<float> sigma(cells, 0.0f);
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                size_t idx = size_t(m.cellIndex({x, y, z}));
+                if (!inside[idx]) continue;
+                float sum = 0.0f;
+                for (int k = 0; k < 8; ++k) {
+                    glm::vec3 sub(k & 1 ? 0.75f : 0.25f, k & 2 ? 0.75f : 0.25f,
+                                  k & 4 ? 0.75f : 0.25f);
+                    sum += o.medium.sigmaT(m.origin_ + (glm::vec3(x, y, z) + sub) * h);
+                }
+                sigma[idx] = sum / 8.0f;
+            }
+
+    // ---- the exterior: empty voxels reached from the grid's border (the rest are cavities) ----
+    std::vector<uint8_t> exterior(cells, 0);
+    {
+        std::vector<glm::ivec3> stack;
+        for (int z = 0; z < n.z; ++z)
+            for (int y = 0; y < n.y; ++y)
+                for (int x = 0; x < n.x; ++x)
+                    if (x == 0 || y == 0 || z == 0 || x == n.x - 1 || y == n.y - 1 || z == n.z - 1)
+                        stack.push_back({x, y, z});
+        while (!stack.empty()) {
+            glm::ivec3 c = stack.back();
+            stack.pop_back();
+            if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, n)))
+                continue;
+            size_t idx = size_t(m.cellIndex(c));
+            if (inside[idx] || exterior[idx]) continue;
+            exterior[idx] = 1;
+            for (int axis = 0; axis < 3; ++axis)
+                for (int sgn : {-1, 1}) {
+                    glm::ivec3 q = c;
+                    q[axis] += sgn;
+                    stack.push_back(q);
+                }
+        }
+    }
+
+    // ---- surface voxels: inside with an outside 6-neighbour; normals from 26 neighbours ----
+    m.number_.assign(cells, -1);
+    int exposedTotal = 0;
+    std::vector<int> exposed;
+    auto isInside = [&](glm::ivec3 q) {
+        if (glm::any(glm::lessThan(q, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(q, n)))
+            return false;
+        return inside[size_t(m.cellIndex(q))] != 0;
+    };
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                glm::ivec3 c(x, y, z);
+                if (!isInside(c)) continue;
+                int faces = 0;
+                bool outer = false;
+                for (int axis = 0; axis < 3; ++axis)
+                    for (int sgn : {-1, 1}) {
+                        glm::ivec3 q = c;
+                        q[axis] += sgn;
+                        if (isInside(q)) continue;
+                        ++faces;
+                        outer = outer || exterior[size_t(m.cellIndex(q))];
+                    }
+                if (!faces) continue;
+                glm::vec3 normal(0.0f);
+                for (int dz = -1; dz <= 1; ++dz)
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            glm::ivec3 q = c + glm::ivec3(dx, dy, dz);
+                            if ((dx || dy || dz) && !isInside(q))
+                                normal += glm::normalize(glm::vec3(dx, dy, dz));
+                        }
+                SurfaceVoxel sv;
+                sv.cell = c;
+                sv.exterior = outer ? 1 : 0;
+                sv.position = m.origin_ + (glm::vec3(c) + 0.5f) * h;
+                sv.normal = glm::length(normal) > 0 ? glm::normalize(normal) : glm::vec3(0, 1, 0);
+                m.number_[size_t(m.cellIndex(c))] = int32_t(m.surface_.size());
+                m.surface_.push_back(sv);
+                exposed.push_back(faces);
+                exposedTotal += faces;
+            }
+    const size_t S = m.surface_.size();
+    if (S == 0)
+        throw Error("voxel number map: translucent object '" + o.name +
+                    "' has no inside voxel at "
+                    "resolution " +
+                    std::to_string(s.resolution) +
+                    " (an open or too thin mesh); close the mesh or raise the resolution");
+    const size_t bytes = lutBytes(S);
+    if (bytes > s.maxLutBytes)
+        throw Error("voxel number map: object '" + o.name + "' at resolution " +
+                    std::to_string(s.resolution) + " has " + std::to_string(S) +
+                    " surface voxels; its optical-thickness LUT would need " +
+                    std::to_string(bytes >> 20) + " MiB (S^2 x 2 bytes), more than the limit of " +
+                    std::to_string(s.maxLutBytes >> 20) + " MiB; lower the voxel resolution");
+    // Areas: the mesh's area shared in proportion to each voxel's exposed faces.
+    double area = 0.0;
+    for (size_t t = 0; t + 2 < o.indices.size(); t += 3)
+        area += 0.5 * double(glm::length(
+                          glm::cross(o.positions[o.indices[t + 1]] - o.positions[o.indices[t]],
+                                     o.positions[o.indices[t + 2]] - o.positions[o.indices[t]])));
+    for (size_t i = 0; i < S; ++i) m.surface_[i].area = float(area * exposed[i] / exposedTotal);
+    // The outer surface's area: light leaves the object only there (a cavity wall passes what
+    // reaches it on through the cavity, which the LUT's optical thickness already skips).
+    m.area_ = 0.0f;
+    for (const SurfaceVoxel& v : m.surface_) m.area_ += v.exterior ? v.area : 0.0f;
+
+    // ---- optical thickness between every pair: 3D DDA through the voxel extinctions ----
+    m.tau_.assign(S * S, 0);
+    auto march = [&](glm::vec3 a, glm::vec3 b) {
+        // Voxel-space coordinates.
+        glm::vec3 pa = (a - m.origin_) / h, pb = (b - m.origin_) / h;
+        glm::vec3 d = pb - pa;
+        float len = glm::length(d);
+        if (len <= 0) return 0.0f;
+        glm::ivec3 c = glm::ivec3(glm::floor(pa));
+        const glm::ivec3 last = glm::ivec3(glm::floor(pb));
+        glm::ivec3 step;
+        glm::vec3 tMax, tDelta;
+        for (int k = 0; k < 3; ++k) {
+            step[k] = d[k] > 0 ? 1 : (d[k] < 0 ? -1 : 0);
+            if (step[k] == 0) {
+                tMax[k] = std::numeric_limits<float>::infinity();
+                tDelta[k] = std::numeric_limits<float>::infinity();
+            } else {
+                float boundary = step[k] > 0 ? std::floor(pa[k]) + 1.0f : std::floor(pa[k]);
+                tMax[k] = (boundary - pa[k]) / d[k];
+                tDelta[k] = float(step[k]) / d[k];
+            }
+        }
+        float t = 0.0f, tau = 0.0f;
+        for (int guard = 0; guard < 4 * (n.x + n.y + n.z); ++guard) {
+            int k = tMax.x < tMax.y ? (tMax.x < tMax.z ? 0 : 2) : (tMax.y < tMax.z ? 1 : 2);
+            float tNext = std::min(tMax[k], 1.0f);
+            if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, n)))
+                tau += sigma[size_t(m.cellIndex(c))] * (tNext - t);
+            if (tNext >= 1.0f || c == last) break;
+            t = tNext;
+            c[k] += step[k];
+            tMax[k] += tDelta[k];
+        }
+        return tau * len * h;
+    };
+    parallelFor(int(S), threadCount(s.threads), [&](int i) {
+        for (size_t j = size_t(i) + 1; j < S; ++j) {
+            uint16_t v = glm::packHalf1x16(
+                std::min(65000.0f, march(m.surface_[size_t(i)].position, m.surface_[j].position)));
+            m.tau_[size_t(i) * S + j] = v;
+            m.tau_[j * S + size_t(i)] = v;
+        }
+    });
+    // Kernel scales c_i = 1/W_i - 1/A.
+    parallelFor(int(S), threadCount(s.threads), [&](int i) {
+        double W = 0.0;
+        for (size_t j = 0; j < S; ++j)
+            if (m.surface_[j].exterior)
+                W += m.surface_[j].area * std::exp(-double(m.tau(i, int(j))));
+        m.surface_[size_t(i)].kernelScale =
+            W > 0 ? float(std::max(0.0, 1.0 / W - 1.0 / double(m.area_))) : 0.0f;
+    });
+    m.seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!cacheFile.empty()) m.writeCache(cacheFile);
+    return m;
+}
+
+bool VoxelNumberMap::readCache(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return false;
+    uint32_t magic = 0, version = 0;
+    uint64_t S = 0;
+    in.read(reinterpret_cast<char*>(&magic), 4);
+    in.read(reinterpret_cast<char*>(&version), 4);
+    in.read(reinterpret_cast<char*>(&dims_), sizeof dims_);
+    in.read(reinterpret_cast<char*>(&origin_), sizeof origin_);
+    in.read(reinterpret_cast<char*>(&voxelSize_), sizeof voxelSize_);
+    in.read(reinterpret_cast<char*>(&area_), sizeof area_);
+    in.read(reinterpret_cast<char*>(&S), sizeof S);
+    if (!in || magic != kCacheMagic || version != kCacheVersion ||
+        glm::any(glm::lessThan(dims_, glm::ivec3(1))) ||
+        glm::any(glm::greaterThan(dims_, glm::ivec3(1024))) || S == 0 || S > (uint64_t(1) << 20)) {
+        spdlog::warn("voxel number map cache {} is damaged or of another version; recomputing",
+                     file.string());
+        return false;
+    }
+    // Allocate only what the file holds: a damaged header must not ask for a huge LUT.
+    const uint64_t cells = uint64_t(dims_.x) * uint64_t(dims_.y) * uint64_t(dims_.z);
+    const uint64_t expected =
+        uint64_t(in.tellg()) + cells * 4 + S * sizeof(SurfaceVoxel) + S * S * 2;
+    std::error_code ec;
+    if (fs::file_size(file, ec) != expected || ec) {
+        spdlog::warn(
+            "voxel number map cache {} does not have the size its header states; "
+            "recomputing",
+            file.string());
+        return false;
+    }
+    number_.resize(size_t(cells));
+    surface_.resize(S);
+    tau_.resize(S * S);
+    in.read(reinterpret_cast<char*>(number_.data()), std::streamsize(number_.size() * 4));
+    in.read(reinterpret_cast<char*>(surface_.data()), std::streamsize(S * sizeof(SurfaceVoxel)));
+    in.read(reinterpret_cast<char*>(tau_.data()), std::streamsize(tau_.size() * 2));
+    bool ok = bool(in);
+    for (int32_t v : number_) ok = ok && v >= -1 && v < int32_t(S);
+    if (!ok) {
+        spdlog::warn("voxel number map cache {} is truncated or damaged; recomputing",
+                     file.string());
+        number_.clear();
+        surface_.clear();
+        tau_.clear();
+        return false;
+    }
+    return true;
+}
+
+void VoxelNumberMap::writeCache(const fs::path& file) const {
+    std::error_code ec;
+    fs::create_directories(file.parent_path(), ec);
+    const fs::path temp = file.string() + ".tmp";
+    {
+        std::ofstream out(temp, std::ios::binary);
+        const uint64_t S = surface_.size();
+        out.write(reinterpret_cast<const char*>(&kCacheMagic), 4);
+        out.write(reinterpret_cast<const char*>(&kCacheVersion), 4);
+        out.write(reinterpret_cast<const char*>(&dims_), sizeof dims_);
+        out.write(reinterpret_cast<const char*>(&origin_), sizeof origin_);
+        out.write(reinterpret_cast<const char*>(&voxelSize_), sizeof voxelSize_);
+        out.write(reinterpret_cast<const char*>(&area_), sizeof area_);
+        out.write(reinterpret_cast<const char*>(&S), sizeof S);
+        out.write(reinterpret_cast<const char*>(number_.data()),
+                  std::streamsize(number_.size() * 4));
+        out.write(reinterpret_cast<const char*>(surface_.data()),
+                  std::streamsize(S * sizeof(SurfaceVoxel)));
+        out.write(reinterpret_cast<const char*>(tau_.data()), std::streamsize(tau_.size() * 2));
+        if (!out) {
+            spdlog::warn("could not write the voxel number map cache {}", file.string());
+            fs::remove(temp, ec);
+            return;
+        }
+    }
+    fs::rename(temp, file, ec);
+    if (ec)
+        spdlog::warn("could not write the voxel number map cache {}: {}", file.string(),
+                     ec.message());
+}
+
+// ---- run time -----------------------------------------------------------------------------------
+
+VnmShading::VnmShading(const VoxelNumberMap& map, const TranslucentObject& object,
+                       const raytrace::RayTracingScene& scene, int envSamples)
+    : map_(map), medium_(object.medium) {
+    const auto& sv = map.surface();
+    E_.assign(sv.size(), glm::vec3(0.0f));
+    const float offset = map.voxelSize();
+    const float ior = medium_.ior;
+    for (size_t i = 0; i < sv.size(); ++i) {
+        const glm::vec3 N = sv[i].normal;
+        // Visibility is tested from just outside the voxel, along its normal.
+        const glm::vec3 x = sv[i].position + N * offset;
+        glm::vec3 E(0.0f);
+        for (const raytrace::PunctualLight& l : scene.lights()) {
+            glm::vec3 wi, Li;
+            float dist;
+            if (l.type == Light::Type::Directional) {
+                wi = -l.direction;
+                dist = std::numeric_limits<float>::infinity();
+                Li = l.intensity;
+            } else {
+                glm::vec3 v = l.position - sv[i].position;
+                float d2 = glm::dot(v, v);
+                if (!(d2 > 0)) continue;
+                dist = std::sqrt(d2);
+                wi = v / dist;
+                Li = l.intensity * (l.spotFactor(glm::dot(l.direction, -wi)) / d2);
+            }
+            const float cosN = glm::dot(N, wi);
+            if (cosN <= 0) continue;
+            if (scene.occluded(x, wi, std::isfinite(dist) ? glm::length(l.position - x) : dist))
+                continue;
+            E += boundaryTransmittance(ior, cosN) * cosN * Li;
+        }
+        if (const raytrace::EnvironmentLight* env = scene.environment()) {
+            // Stratified cosine-weighted directions: E = pi/K sum F_t L.
+            const raytrace::Frame frame(N);
+            const int side = std::max(1, int(std::lround(std::sqrt(double(envSamples)))));
+            glm::vec3 sum(0.0f);
+            for (int a = 0; a < side; ++a)
+                for (int b = 0; b < side; ++b) {
+                    glm::vec2 u((float(a) + 0.5f) / float(side), (float(b) + 0.5f) / float(side));
+                    glm::vec3 wl = raytrace::sampleCosineHemisphere(u);
+                    glm::vec3 w = frame.toWorld(wl);
+                    if (scene.occluded(x, w, std::numeric_limits<float>::infinity())) continue;
+                    sum += boundaryTransmittance(ior, wl.z) * env->radiance(w);
+                }
+            E += sum * (kPi / float(side * side));
+        }
+        E_[i] = E;
+    }
+}
+
+glm::vec3 VnmShading::scattered(const glm::vec3& p, const glm::vec3& wOut) const {
+    const int out = map_.surfaceVoxelAt(p);
+    if (out < 0) return glm::vec3(0.0f);
+    const auto& sv = map_.surface();
+    glm::vec3 sum(0.0f);
+    for (size_t i = 0; i < sv.size(); ++i) {
+        if (E_[i] == glm::vec3(0.0f) || !sv[i].exterior) continue;
+        sum += E_[i] * (sv[i].area * sv[i].kernelScale * std::exp(-map_.tau(int(i), out)));
+    }
+    const float cosOut = std::abs(glm::dot(sv[size_t(out)].normal, wOut));
+    return sum * effectiveAlbedo(medium_.albedo) *
+           (boundaryTransmittance(medium_.ior, cosOut) / kPi);
+}
+
+VnmImage renderVnm(const VoxelNumberMap& map, const TranslucentObject& object,
+                   const raytrace::RayTracingScene& scene, const CameraIntrinsics& K,
+                   const Pose& T_world_camera, int envSamples) {
+    VnmShading shading(map, object, scene, envSamples);
+    VnmImage img;
+    img.radiance = cv::Mat(K.height, K.width, CV_32FC3, cv::Scalar::all(0));
+    img.mask = cv::Mat(K.height, K.width, CV_8U, cv::Scalar(0));
+    const glm::mat3 R(T_world_camera.rotationMatrix());
+    const glm::vec3 eye(T_world_camera.translation);
+    const raytrace::EnvironmentLight* env = scene.environment();
+    const float ior = object.medium.ior;
+    for (int y = 0; y < K.height; ++y)
+        for (int x = 0; x < K.width; ++x) {
+            auto dc = K.unproject({double(x), double(y)});
+            if (!dc) continue;
+            glm::vec3 d = glm::normalize(R * glm::vec3(*dc));
+            raytrace::SurfaceHit hit;
+            if (!scene.intersect(eye, d, std::numeric_limits<float>::infinity(), hit)) continue;
+            if (!scene.medium(hit.geometry)) continue;
+            img.mask.at<uint8_t>(y, x) = 255;
+            glm::vec3 L = shading.scattered(hit.p, -d);
+            const float cosF = std::abs(glm::dot(d, hit.ng));
+            const float F = 1.0f - boundaryTransmittance(ior, cosF);
+            if (env) {
+                glm::vec3 n = glm::dot(d, hit.ng) < 0 ? hit.ng : -hit.ng;
+                L += F * env->radiance(d - 2.0f * glm::dot(d, n) * n);
+            }
+            // The background straight through: the chord's optical thickness from the LUT.
+            raytrace::SurfaceHit back;
+            glm::vec3 o = hit.p + d * (1e-4f * std::max(1.0f, glm::length(hit.p)));
+            if (scene.intersect(o, d, std::numeric_limits<float>::infinity(), back) &&
+                scene.medium(back.geometry)) {
+                int a = map.surfaceVoxelAt(hit.p), b = map.surfaceVoxelAt(back.p);
+                float T = (1.0f - F) * boundaryTransmittance(ior, std::abs(glm::dot(d, back.ng)));
+                if (a >= 0 && b >= 0) T *= std::exp(-map.tau(a, b));
+                raytrace::SurfaceHit beyond;
+                glm::vec3 o2 = back.p + d * (1e-4f * std::max(1.0f, glm::length(back.p)));
+                if (!scene.intersect(o2, d, std::numeric_limits<float>::infinity(), beyond) && env)
+                    L += T * env->radiance(d);
+            }
+            img.radiance.at<cv::Vec3f>(y, x) = {L.x, L.y, L.z};
+        }
+    return img;
+}
+
+}  // namespace mirage::translucency
