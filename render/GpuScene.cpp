@@ -157,11 +157,15 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                     glm::vec3(0.0f),
                     0.0f,
                     false,
+                    false,
                     false};
             const Material& mat = scene.material(p.material);
-            // Mirror: metallic ~1 with low roughness; glass: any transmission (rough glass too).
-            r.specular = mat.isMirror() || mat.isTransmissive();
+            // Mirror: metallic ~1 with low roughness; rough reflector: a metal up to
+            // Material::kRoughReflectorMaxRoughness (fuzzy reflections); glass: any transmission
+            // (rough glass too).
+            r.specular = mat.isMirror() || mat.isRoughReflector() || mat.isTransmissive();
             r.transmissive = mat.isTransmissive() && !mat.isMirror();
+            r.roughReflector = mat.isRoughReflector();
             const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
             if (mat.baseColorTexture.valid() &&
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
@@ -236,6 +240,7 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             d.origin = inst.origin;
             d.specular = r.specular;
             d.transmissive = r.transmissive;
+            d.roughReflector = r.roughReflector;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
             d.indexCount = r.count;
@@ -281,6 +286,12 @@ void GpuScene::buildLights(const Scene& scene) {
     }
 }
 
+int GpuScene::roughReflectorCount() const {
+    int n = 0;
+    for (int di : specularDraws_) n += draws_[size_t(di)].roughReflector ? 1 : 0;
+    return n;
+}
+
 // The specular draw table (GpuSpecularDraw per specular slot).
 void GpuScene::uploadSpecularDraws() {
     std::vector<GpuSpecularDraw> spec;
@@ -292,6 +303,7 @@ void GpuScene::uploadSpecularDraws() {
         g.material = d.material;
         g.origin = d.origin == Origin::Real ? kOriginReal : kOriginVirtual;
         g.drawIndex = di;
+        g.roughReflector = d.roughReflector ? 1 : 0;
         spec.push_back(g);
     }
     if (spec.empty()) spec.push_back(GpuSpecularDraw{});

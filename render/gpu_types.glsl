@@ -124,8 +124,8 @@ struct GpuSpecularDraw {
     float radius;
     int material;   // index into the material table
     int origin;     // kOriginReal / kOriginVirtual
-    int drawIndex;  // index into GpuScene::draws()
-    int pad0;       // std430: the struct is a multiple of 16 bytes
+    int drawIndex;       // index into GpuScene::draws()
+    int roughReflector;  // 1: a rough metal whose reflection the fuzzy filter blurs, else 0
 };
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).
