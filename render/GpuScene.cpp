@@ -158,6 +158,7 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                     0.0f,
                     false,
                     false,
+                    false,
                     false};
             const Material& mat = scene.material(p.material);
             // Mirror: metallic ~1 with low roughness; rough reflector: a metal up to
@@ -166,6 +167,7 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
             r.specular = mat.isMirror() || mat.isRoughReflector() || mat.isTransmissive();
             r.transmissive = mat.isTransmissive() && !mat.isMirror();
             r.roughReflector = mat.isRoughReflector();
+            r.roughGlass = mat.isRoughGlass();
             const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
             if (mat.baseColorTexture.valid() &&
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
@@ -241,6 +243,7 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             d.specular = r.specular;
             d.transmissive = r.transmissive;
             d.roughReflector = r.roughReflector;
+            d.roughGlass = r.roughGlass;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
             d.indexCount = r.count;
@@ -292,6 +295,12 @@ int GpuScene::roughReflectorCount() const {
     return n;
 }
 
+int GpuScene::roughGlassCount() const {
+    int n = 0;
+    for (int di : specularDraws_) n += draws_[size_t(di)].roughGlass ? 1 : 0;
+    return n;
+}
+
 // The specular draw table (GpuSpecularDraw per specular slot).
 void GpuScene::uploadSpecularDraws() {
     std::vector<GpuSpecularDraw> spec;
@@ -303,7 +312,7 @@ void GpuScene::uploadSpecularDraws() {
         g.material = d.material;
         g.origin = d.origin == Origin::Real ? kOriginReal : kOriginVirtual;
         g.drawIndex = di;
-        g.roughReflector = d.roughReflector ? 1 : 0;
+        g.rough = d.roughReflector ? kRoughMetal : d.roughGlass ? kRoughGlass : kRoughNone;
         spec.push_back(g);
     }
     if (spec.empty()) spec.push_back(GpuSpecularDraw{});

@@ -145,6 +145,10 @@ const int kUnitFuzzyRealSurfaces = 5;
 const int kUnitFuzzyCanvasToCamera = 6;
 const int kUnitFuzzySpecRRefl = 7;
 const int kUnitFuzzyInputFirst = 8;  // .. + 4: L'_rv, L'_r, reflection share, L_env, video
+const int kUnitFuzzyRefrHit = 13;
+const int kUnitFuzzyRefrWeight = 14;
+const int kUnitFuzzySpecR = 15;
+const int kUnitFuzzyNormal = 16;
 
 // Reflected-scene impostors (trace.glsl): the ONLY units traceSurroundings() uses, above every
 // pass's own units so a consumer shader can sample both.

@@ -24,6 +24,10 @@ const int kLightDirectional = 2;
 const int kOriginNone = 0;
 const int kOriginReal = 1;
 const int kOriginVirtual = 2;
+// GpuSpecularDraw::rough: which surfaces the fuzzy filter (render/passes/fuzzy) blurs.
+const int kRoughNone = 0;   // a mirror or smooth glass
+const int kRoughMetal = 1;  // Material::isRoughReflector: the reflection
+const int kRoughGlass = 2;  // Material::isRoughGlass: what is seen through it (and reflected)
 
 struct GpuLight {
     mat4 viewProj[6];       // world -> light clip space, one per shadow layer (spot/dir use [0])
@@ -125,7 +129,7 @@ struct GpuSpecularDraw {
     int material;   // index into the material table
     int origin;     // kOriginReal / kOriginVirtual
     int drawIndex;       // index into GpuScene::draws()
-    int roughReflector;  // 1: a rough metal whose reflection the fuzzy filter blurs, else 0
+    int rough;           // kRoughNone, kRoughMetal or kRoughGlass (the fuzzy filter's input)
 };
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).

@@ -91,6 +91,11 @@ struct Material {
                roughness <= kRoughReflectorMaxRoughness;
     }
     bool isTransmissive() const { return transmission > 0.0f; }
+    // Frosted glass: transmissive with roughness above the mirror threshold (the real-time
+    // renderer blurs what is seen through it with the same filter, docs/specular.md).
+    bool isRoughGlass() const {
+        return isTransmissive() && !isMirror() && roughness > kMirrorMaxRoughness;
+    }
 };
 
 struct Primitive {

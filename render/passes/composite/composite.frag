@@ -29,11 +29,11 @@
 // used whatever the reflection does (the seed's exception for virtual refractive objects),
 // without taking an unvalidated colour for the reflection. alpha' is guarded like alpha.
 //
-// Rough metals (fuzzy reflections, render/passes/fuzzy): where the fuzzy pass marked the pixel,
-// L'_rv, L'_r, its reflection share and L_env come from the filtered buffers, and the
-// reflection's CI_r term from the filtered, already resolved video term (each neighbour's
-// eta1 CI_r(p_refl), or its rendered real share where it could not be back-projected): the same
-// equations on blurred lookups. Whether all of p, p_refl are real is the pixel's own.
+// Rough metals and rough glass (render/passes/fuzzy): where the fuzzy pass marked the pixel,
+// L'_rv, L'_r, its reflection share and L_env come from the filtered buffers, and CI_bp from the
+// filtered, already resolved video term (each neighbour's eta CI_r(hit) per component, or its
+// rendered real share where it could not be back-projected): the same equations on blurred
+// lookups. Whether all of p, p_refl, p_refr are real is the pixel's own.
 in vec2 uv;
 layout(binding = kUnitCompositeCamera) uniform sampler2D cameraImage;  // sRGB8 texture: samples are linear
 layout(binding = kUnitCompositeLRv) uniform sampler2D lRv;           // canvas, linear
@@ -94,8 +94,7 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
         vec3 w = (k == 0 ? texelFetch(reflWeight, cpi, 0) : texelFetch(refrWeight, cpi, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;  // no such component
         int origin = int(P.w + 0.5);
-        if (k == 0 && fuzzy) {  // the neighbours' resolved video, filtered (virtual / miss: 0)
-            ciBp += max(fuzzyBp.rgb, vec3(0.0));
+        if (fuzzy) {  // the filtered video term stands for both components (below)
             if (origin != ORIGIN_REAL) allReal = allReal && origin == ORIGIN_NONE && envReal;
             continue;
         }
@@ -114,6 +113,7 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
             ciBp += k == 0 ? rRefl : max(r - rRefl, vec3(0.0));  // rendered real share
         }
     }
+    if (fuzzy) ciBp = max(fuzzyBp.rgb, vec3(0.0));  // the neighbours' resolved CI_bp, filtered
     vec3 dL = rv - r;  // Eq. 6
     if (allReal) return ci + guardedAlpha(ci, r + (envReal ? env : vec3(0.0))) * dL;
     return env + ciBp + guardedAlpha(ciBp, r) * dL;

@@ -33,8 +33,9 @@ FuzzyReflectionPass::FuzzyReflectionPass()
 
 void FuzzyReflectionPass::setup(PassBuilder& b) const {
     for (Resource r :
-         {Resource::GBufferPosition, Resource::GBufferEmissive, Resource::ReflectionGBuffer,
-          Resource::ReflectionWeight, Resource::RealSurfaces, Resource::CameraImage})
+         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
+          Resource::ReflectionGBuffer, Resource::ReflectionWeight, Resource::RefractionGBuffer,
+          Resource::RefractionWeight, Resource::RealSurfaces, Resource::CameraImage})
         b.read(r);
     for (Resource r : kInputs) b.read(r);
     // The video term in float32, as the composite computes it for a sharp pixel: a kernel of one
@@ -44,15 +45,16 @@ void FuzzyReflectionPass::setup(PassBuilder& b) const {
 }
 
 PassDecision FuzzyReflectionPass::decide(const FrameContext& ctx) const {
-    const int n = ctx.scene.roughReflectorCount();
-    if (n == 0)
+    const int metals = ctx.scene.roughReflectorCount(), glass = ctx.scene.roughGlassCount();
+    if (metals + glass == 0)
         return {false,
-                fmt::format("no rough metal (roughness {} .. {})", Material::kMirrorMaxRoughness,
-                            Material::kRoughReflectorMaxRoughness)};
+                fmt::format("no rough metal (roughness {} .. {}) or rough glass",
+                            Material::kMirrorMaxRoughness, Material::kRoughReflectorMaxRoughness)};
     if (!ctx.options.fuzzyReflections)
-        return {false, "fuzzy reflections off: rough metals reflect sharply"};
-    return {true, fmt::format("{} rough metal(s): cone {:g} deg, separable, {} taps per side", n,
-                              ctx.options.fuzzyConeDeg, ctx.options.fuzzyTaps)};
+        return {false, "fuzzy filter off: rough metals and glass render as smooth"};
+    return {true, fmt::format("{} rough metal(s), {} rough glass: cone {:g} deg, separable, {} "
+                              "taps per side",
+                              metals, glass, ctx.options.fuzzyConeDeg, ctx.options.fuzzyTaps)};
 }
 
 void FuzzyReflectionPass::resize(const FrameContext& ctx) {
@@ -92,6 +94,10 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitFuzzyRealSurfaces, res.texture(Resource::RealSurfaces).id());
     glBindTextureUnit(kUnitFuzzyCanvasToCamera, canvasToCamera_.id());
     glBindTextureUnit(kUnitFuzzySpecRRefl, res.texture(Resource::SpecularRReflection).id());
+    glBindTextureUnit(kUnitFuzzySpecR, res.texture(Resource::SpecularR).id());
+    glBindTextureUnit(kUnitFuzzyRefrHit, res.texture(Resource::RefractionGBuffer).id());
+    glBindTextureUnit(kUnitFuzzyRefrWeight, res.texture(Resource::RefractionWeight).id());
+    glBindTextureUnit(kUnitFuzzyNormal, res.texture(Resource::GBufferNormal).id());
     const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
 
     // 1. The reflection's video term per rough pixel (the composite's back-projection).

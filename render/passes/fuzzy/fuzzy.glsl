@@ -9,12 +9,12 @@
 layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 layout(std430, binding = kBindingSpecularDraws) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
 
-// The rough-metal slot of a G-buffer pixel (gEmissive.a = specular slot + 1), -1 if the pixel is
-// not a rough reflector.
+// The specular slot of a G-buffer pixel (gEmissive.a = slot + 1) if it shows a rough metal or
+// rough glass, else -1.
 int roughSlot(float emissiveA) {
     int slot = int(emissiveA + 0.5) - 1;
     if (slot < 0) return -1;
-    return specularDraws[slot].roughReflector != 0 ? slot : -1;
+    return specularDraws[slot].rough != kRoughNone ? slot : -1;
 }
 
 // Phong exponent p of the reflected-direction lobe from glTF perceptual roughness r: GGX / Beckmann
@@ -25,6 +25,17 @@ int roughSlot(float emissiveA) {
 float phongExponent(float roughness) {
     float a = roughness * roughness;
     return max(0.5 / max(a * a, 1e-30) - 0.5, 0.0);
+}
+
+// Phong exponent of the TRANSMITTED lobe of rough glass (both interfaces rough, as the
+// reference's GGX dielectric): a facet tilt d turns the ray by d (1 - 1/ior) entering and by
+// d (ior - 1) leaving, so with sigma_h = alpha / sqrt(2) per interface the exit ray spreads by
+// sigma_t^2 = alpha^2 ((1 - 1/ior)^2 + (ior - 1)^2) / 2, and p = 1 / sigma_t^2. (ior 1.5:
+// sigma_t = 0.42 alpha, a third of the reflected lobe's.) Infinite at roughness 0 or ior 1.
+float transmissionExponent(float roughness, float ior) {
+    float a = roughness * roughness;
+    float k2 = 0.5 * ((1.0 - 1.0 / ior) * (1.0 - 1.0 / ior) + (ior - 1.0) * (ior - 1.0));
+    return 1.0 / max(a * a * k2, 1e-30);
 }
 
 // Unit direction from surface point a to the reflected hit (GBuf_refl texel: xyz hit, w =

@@ -11,6 +11,12 @@
 //   kernel: neighbours whose camera ray is within alpha = Theta' / (1 + s / r) of x's   (Eq. 4),
 //   radius alpha x focal length in pixels (Eq. 5), Theta' = min(Theta, 2.5 / sqrt(p)): the
 //   cone bound Theta (RendererOptions::fuzzyConeDeg), or the lobe's 2.5 sigma when narrower.
+// Rough glass (kRoughGlass): the same filter on what is seen THROUGH it, with the refracted
+// geometry: the origin is the centre pixel's exit point P2 = a + T1 d_in (T1 = Snell at the
+// front face, d_in the distance inside from GBuf_refr), b and b' the refracted hits, p the
+// transmitted lobe's exponent (fuzzy.glsl), s the camera distance plus d_in. Its (weak) Fresnel
+// reflection is blurred with the same weights. Where nothing is refracted (TIR at the front face)
+// the pixel is filtered as a reflection.
 // Separable approximation: the second pass weights each column tap by its own hit. A kernel
 // wider than `taps` per side is sampled every ceil(radius / taps) pixels. Only taps on the same
 // object (specular slot) and within 10 % of x's camera distance count, so the filter never
@@ -20,6 +26,9 @@ in vec2 uv;
 layout(binding = kUnitFuzzyPosition) uniform sampler2D gPosition;  // xyz world, w = origin
 layout(binding = kUnitFuzzyEmissive) uniform sampler2D gEmissive;  // a = specular slot + 1
 layout(binding = kUnitFuzzyReflHit) uniform sampler2D reflHit;     // xyz hit, w = origin
+layout(binding = kUnitFuzzyRefrHit) uniform sampler2D refrHit;     // GBuf_refr: xyz, w = origin
+layout(binding = kUnitFuzzyRefrWeight) uniform sampler2D refrWeight;  // rgb eta2 T, a = d_in (m)
+layout(binding = kUnitFuzzyNormal) uniform sampler2D gNormal;      // xyz unit normal (to the camera)
 layout(binding = kUnitFuzzyInputFirst + 0) uniform sampler2D in0;  // L'_rv
 layout(binding = kUnitFuzzyInputFirst + 1) uniform sampler2D in1;  // L'_r
 layout(binding = kUnitFuzzyInputFirst + 2) uniform sampler2D in2;  // reflection share of L'_r
@@ -41,11 +50,28 @@ void main() {
     int slot = roughSlot(texelFetch(gEmissive, px, 0).a);
     if (slot < 0) return;
     vec3 a = texelFetch(gPosition, px, 0).xyz;
-    vec4 hit = texelFetch(reflHit, px, 0);
-    vec3 u = hitDirection(a, hit);
-    float s = length(a - cameraPos.xyz);
-    float r = hitDistance(a, hit);
-    float p = phongExponent(clamp(materials[specularDraws[slot].material].roughness, 0.0, 1.0));
+    float s = length(a - cameraPos.xyz), sa = s;
+    GpuMaterial m = materials[specularDraws[slot].material];
+    float roughness = clamp(m.roughness, 0.0, 1.0);
+    // Which rays the kernel compares (see above): the refracted ones through rough glass, else
+    // the reflected ones; o is where they leave the object.
+    vec3 o = a;
+    bool refracted = false;
+    float p = phongExponent(roughness);
+    if (specularDraws[slot].rough == kRoughGlass) {
+        vec4 W = texelFetch(refrWeight, px, 0);
+        vec3 T1 = refract((a - cameraPos.xyz) / max(s, 1e-9), texelFetch(gNormal, px, 0).xyz,
+                          1.0 / max(m.ior, 1e-3));
+        if (any(greaterThan(W.rgb, vec3(0.0))) && dot(T1, T1) > 0.5) {
+            refracted = true;
+            o = a + normalize(T1) * max(W.a, 0.0);
+            s += max(W.a, 0.0);
+            p = transmissionExponent(roughness, max(m.ior, 1e-3));
+        }
+    }
+    vec4 hit = refracted ? texelFetch(refrHit, px, 0) : texelFetch(reflHit, px, 0);
+    vec3 u = hitDirection(o, hit);
+    float r = hitDistance(o, hit);
     float theta = min(coneBound, 2.5 * inversesqrt(max(p, 1e-12)));
     float alpha = theta / (1.0 + s / max(r, 1e-6));               // Eq. 4 (radians)
     float radius = min(alpha * focalPx, 4096.0);                  // Eq. 5 (pixels)
@@ -60,9 +86,10 @@ void main() {
         if (k != 0) {
             if (int(texelFetch(gEmissive, q, 0).a + 0.5) - 1 != slot) continue;  // other object
             float sq = length(texelFetch(gPosition, q, 0).xyz - cameraPos.xyz);
-            if (abs(sq - s) > 0.1 * s) continue;  // a fold of the object: not its neighbour
+            if (abs(sq - sa) > 0.1 * sa) continue;  // a fold of the object: not its neighbour
         }
-        float c = k == 0 ? 1.0 : dot(u, hitDirection(a, texelFetch(reflHit, q, 0)));
+        vec4 hq = refracted ? texelFetch(refrHit, q, 0) : texelFetch(reflHit, q, 0);
+        float c = k == 0 ? 1.0 : dot(u, hitDirection(o, hq));
         float w = k == 0 ? 1.0 : (c > 0.0 ? pow(min(c, 1.0), p) : 0.0);  // Eq. 3
         if (!(w > 0.0)) continue;
         s0 += w * texelFetch(in0, q, 0);
