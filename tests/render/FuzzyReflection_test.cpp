@@ -301,7 +301,8 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
 
 // Hard cases: roughness 1 (beyond the filter's range: the glossy path, no fuzzy pass), a
 // grazing view over a rough plate, and a rough plate that fills the image past its edges (its
-// reflection of things outside the image falls back to the rendered radiance): every buffer finite.
+// reflection of things outside the image falls back to the rendered radiance); rough glass at
+// roughness 1 and at a grazing view with total internal reflection: every buffer finite.
 TEST(FuzzyReflection, HardCasesStayFinite) {
     gl::Context context = gl::Context::headless();
     const auto envDir = test::outputDir("fuzzy_env_hard");
@@ -322,6 +323,18 @@ TEST(FuzzyReflection, HardCasesStayFinite) {
             RendererOptions o = singleFrame();
             o.fuzzyConeDeg = 60.0f;  // the widest cone: the longest kernels
             const Frame f = realtime(s, footage, o);
+            EXPECT_TRUE(f.report.ran("fuzzy")) << f.report.summary();
+            EXPECT_LT(cv::norm(f.linear, cv::NORM_INF), 10.0);
+        }
+    }
+    // Rough glass at roughness 1 and seen at grazing angles through its 6 cm block, where the
+    // refracted rays meet the side faces under total internal reflection.
+    for (const Pose& pose : {test::lookAtPose({0.0, 0.25, 0.8}, {0.0, 0.12, -0.1}),
+                             test::lookAtPose({0.7, 0.15, 0.05}, {0.0, 0.15, 0.0})}) {
+        for (float roughness : {0.3f, 1.0f}) {
+            PlateScene s = makeSlab(roughness, envDir);
+            s.pose = pose;
+            const Frame f = realtime(s, footage);
             EXPECT_TRUE(f.report.ran("fuzzy")) << f.report.summary();
             EXPECT_LT(cv::norm(f.linear, cv::NORM_INF), 10.0);
         }
