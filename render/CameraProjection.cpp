@@ -75,4 +75,16 @@ glm::dvec2 CameraProjection::projectToCanvas(const glm::dvec3& pc) const {
     return {camera.fx * pc.x / pc.z + canvasCx, camera.fy * pc.y / pc.z + canvasCy};
 }
 
+std::vector<glm::vec2> CameraProjection::canvasToCameraTable() const {
+    const int cw = canvasWidth, ch = canvasHeight;
+    std::vector<glm::vec2> table(size_t(cw) * size_t(ch), glm::vec2(-1e4f));
+    for (int y = 0; y < ch; ++y)
+        for (int x = 0; x < cw; ++x) {
+            const glm::dvec3 ray((x - canvasCx) / camera.fx, (y - canvasCy) / camera.fy, 1.0);
+            if (auto q = camera.project(ray))
+                table[size_t(y) * size_t(cw) + size_t(x)] = glm::vec2(*q);
+        }
+    return table;
+}
+
 }  // namespace mirage::render

@@ -35,6 +35,10 @@ struct CameraProjection {
     glm::mat4 projectionMatrix(float nearM, float farM) const;
     // Point in the OpenCV camera frame -> canvas pixel (undistorted pinhole).
     glm::dvec2 projectToCanvas(const glm::dvec3& pointCamera) const;
+    // For every canvas pixel (row-major, top row first): the camera-image pixel (OpenCV
+    // convention, lens distortion applied) that sees its ray, (-1e4, -1e4) where none does.
+    // What back-projection into the video (Knecht 2013 Eqs. 8-10) looks up.
+    std::vector<glm::vec2> canvasToCameraTable() const;
 };
 
 }  // namespace mirage::render

@@ -39,6 +39,11 @@ void RendererOptions::validate() const {
              std::to_string(causticQuadScale));
     if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
         fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
+    if (!(fuzzyConeDeg > 0.0f && fuzzyConeDeg <= 60.0f))
+        fail("fuzzyConeDeg must be in (0, 60] degrees (the fuzzy-reflection cone bound), got " +
+             std::to_string(fuzzyConeDeg));
+    if (fuzzyTaps < 1 || fuzzyTaps > 64)
+        fail("fuzzyTaps must be 1..64 taps per side, got " + std::to_string(fuzzyTaps));
     if (environmentMapWidth < 16 || environmentMapWidth > 4096 || environmentMapWidth % 2 != 0)
         fail("environmentMapWidth must be even, 16..4096 texels, got " +
              std::to_string(environmentMapWidth));

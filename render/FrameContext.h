@@ -53,6 +53,14 @@ struct RendererOptions {
     bool caustics = true;
     int causticMapSize = 256;
     float causticQuadScale = 1.5f;
+    // Fuzzy reflections of rough metals (render/passes/fuzzy, docs/specular.md): the image-space
+    // filter (Kulikova and Dmitriev, Eqs. 1-5) over the mirror-ray buffers. fuzzyConeDeg is the
+    // cone bound Theta (degrees) that limits each pixel's kernel (Eq. 4); fuzzyTaps the taps per
+    // side of each separable pass (a wider kernel is sampled with a stride). false: the rough
+    // metal's reflection stays sharp (its roughness ignored; for comparison).
+    bool fuzzyReflections = true;
+    float fuzzyConeDeg = 20.0f;
+    int fuzzyTaps = 12;
     int specularVplStride = 4;  // 1, 4 or 16: each hit sums every stride-th VPL (x stride),
                                 // interleaved over 2x2 / 4x4 pixels (cheaper, noisier)
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the

@@ -19,6 +19,12 @@ namespace {
 
 using Vertex = GpuSceneVertex;
 
+// The materials the real-time renderer draws as specular objects (traced rays, photons,
+// reflected / refracted VPLs): mirrors, rough reflectors and glass.
+bool isSpecularMaterial(const Material& m) {
+    return m.isMirror() || m.isRoughReflector() || m.isTransmissive();
+}
+
 GpuMaterial toGpu(const Material& m) {
     GpuMaterial g{};
     g.baseColor = m.baseColor;
@@ -36,6 +42,7 @@ GpuMaterial toGpu(const Material& m) {
                                 : 0.0f;
     g.attenuationColor = glm::clamp(m.attenuationColor, 0.0f, 1.0f);
     g.mirror = m.isMirror() ? 1 : 0;
+    g.specular = isSpecularMaterial(m) ? 1 : 0;
     g.thickness = std::max(m.thickness, 0.0f);
     return g;
 }
@@ -169,11 +176,17 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                     glm::vec3(0.0f),
                     0.0f,
                     false,
+                    false,
+                    false,
                     false};
             const Material& mat = scene.material(p.material);
-            // Mirror: metallic ~1 with low roughness; glass: any transmission (rough glass too).
-            r.specular = mat.isMirror() || mat.isTransmissive();
+            // Mirror: metallic ~1 with low roughness; rough reflector: a metal up to
+            // Material::kRoughReflectorMaxRoughness (fuzzy reflections); glass: any transmission
+            // (rough glass too).
+            r.specular = isSpecularMaterial(mat);
             r.transmissive = mat.isTransmissive() && !mat.isMirror();
+            r.roughReflector = mat.isRoughReflector();
+            r.roughGlass = mat.isRoughGlass();
             const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
             if (mat.baseColorTexture.valid() &&
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
@@ -248,6 +261,8 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             d.origin = inst.origin;
             d.specular = r.specular;
             d.transmissive = r.transmissive;
+            d.roughReflector = r.roughReflector;
+            d.roughGlass = r.roughGlass;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
             d.indexCount = r.count;
@@ -293,6 +308,18 @@ void GpuScene::buildLights(const Scene& scene) {
     }
 }
 
+int GpuScene::roughReflectorCount() const {
+    int n = 0;
+    for (int di : specularDraws_) n += draws_[size_t(di)].roughReflector ? 1 : 0;
+    return n;
+}
+
+int GpuScene::roughGlassCount() const {
+    int n = 0;
+    for (int di : specularDraws_) n += draws_[size_t(di)].roughGlass ? 1 : 0;
+    return n;
+}
+
 // The specular draw table (GpuSpecularDraw per specular slot).
 void GpuScene::uploadSpecularDraws() {
     std::vector<GpuSpecularDraw> spec;
@@ -304,6 +331,7 @@ void GpuScene::uploadSpecularDraws() {
         g.material = d.material;
         g.origin = d.origin == Origin::Real ? kOriginReal : kOriginVirtual;
         g.drawIndex = di;
+        g.rough = d.roughReflector ? kRoughMetal : d.roughGlass ? kRoughGlass : kRoughNone;
         spec.push_back(g);
     }
     if (spec.empty()) spec.push_back(GpuSpecularDraw{});

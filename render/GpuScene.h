@@ -42,6 +42,11 @@ struct DrawItem {
     // Glass (transmission > 0, not a mirror): it transmits light in the shadow maps (coloured,
     // Fresnel- and absorption-weighted) instead of blocking it.
     bool transmissive = false;
+    // A rough metal (Material::isRoughReflector): specular, and its reflection is blurred by the
+    // fuzzy-reflection filter (render/passes/fuzzy).
+    bool roughReflector = false;
+    // Rough glass (Material::isRoughGlass): what is seen through it is blurred by the same filter.
+    bool roughGlass = false;
     GLint baseVertex = 0;
     GLuint firstIndex = 0;
     GLsizei indexCount = 0;
@@ -77,6 +82,9 @@ public:
     bool hasTransmissive() const;
     // Indices into draws() of the specular (mirror / glass) items, in draw order.
     const std::vector<int>& specularDraws() const { return specularDraws_; }
+    // How many specular draws are rough reflectors (fuzzy reflections) / rough glass.
+    int roughReflectorCount() const;
+    int roughGlassCount() const;
     const BoundingSphere& bounds() const { return bounds_; }
     bool hasVirtual() const;
     bool hasEnvironment() const { return hasEnvironment_; }
@@ -123,6 +131,8 @@ private:
         float radius;
         bool specular;
         bool transmissive;
+        bool roughReflector;
+        bool roughGlass;
     };
     // The constructor's steps, in order.
     void uploadTextures(const Scene& scene);

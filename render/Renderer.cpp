@@ -15,6 +15,7 @@
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/environment/EnvironmentPass.h"
+#include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
@@ -147,6 +148,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<BackFacePass>());
     g.addPass(std::make_unique<SpecularGBufferPass>());
     g.addPass(std::make_unique<SpecularLightPass>(*scene_));
+    g.addPass(std::make_unique<FuzzyReflectionPass>());
     g.addPass(std::make_unique<CompositePass>());
     g.markOutput(Resource::Composite);
     g.markOutput(Resource::CompositeSrgb);

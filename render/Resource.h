@@ -72,6 +72,14 @@ enum class Resource {
     SpecularR,            // L'_r (Eq. 4)
     SpecularRReflection,  // the reflection's share of L'_r
     Lenv,                 // L_env: environment seen where a ray leaves the modelled scene
+    // Fuzzy reflections of rough metals (render/passes/fuzzy): the four above filtered over each
+    // rough pixel's reflection cone, and the filtered video term of the reflection (rgb camera
+    // units: eta1 CI_r(p_refl) or the rendered real share; a = 1 on a rough-metal pixel).
+    FuzzySpecularRv,
+    FuzzySpecularR,
+    FuzzySpecularRReflection,
+    FuzzyLenv,
+    FuzzyReflectionVideo,
     // Caustics (Knecht 2013 Sec. 5.2; docs/caustics.md). Photon G-buffers, one layer per caustic
     // spot light (causticMapSize^2): per texel of the specular objects seen from the light, the
     // receiver hit of the reflected / refracted photon (xyz world; w = 4 x hit origin + the

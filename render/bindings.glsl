@@ -135,6 +135,26 @@ const int kUnitCompositeRealSurfaces = 14;
 const int kUnitCompositeCanvasToCamera = 15;
 const int kUnitCompositeCausticRv = 16;  // CausticRv / CausticR (black without caustics)
 const int kUnitCompositeCausticR = 17;
+const int kUnitCompositeFuzzyRv = 18;  // the fuzzy pass's filtered buffers (rough metals)
+const int kUnitCompositeFuzzyR = 19;
+const int kUnitCompositeFuzzyRRefl = 20;
+const int kUnitCompositeFuzzyLenv = 21;
+const int kUnitCompositeFuzzyVideo = 22;
+
+// passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
+const int kUnitFuzzyPosition = 0;
+const int kUnitFuzzyEmissive = 1;
+const int kUnitFuzzyReflHit = 2;
+const int kUnitFuzzyReflWeight = 3;
+const int kUnitFuzzyCamera = 4;
+const int kUnitFuzzyRealSurfaces = 5;
+const int kUnitFuzzyCanvasToCamera = 6;
+const int kUnitFuzzySpecRRefl = 7;
+const int kUnitFuzzyInputFirst = 8;  // .. + 4: L'_rv, L'_r, reflection share, L_env, video
+const int kUnitFuzzyRefrHit = 13;
+const int kUnitFuzzyRefrWeight = 14;
+const int kUnitFuzzySpecR = 15;
+const int kUnitFuzzyNormal = 16;
 
 // Reflected-scene impostors (trace.glsl): the ONLY units traceSurroundings() uses, above every
 // pass's own units so a consumer shader can sample both.

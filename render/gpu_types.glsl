@@ -24,6 +24,10 @@ const int kLightDirectional = 2;
 const int kOriginNone = 0;
 const int kOriginReal = 1;
 const int kOriginVirtual = 2;
+// GpuSpecularDraw::rough: which surfaces the fuzzy filter (render/passes/fuzzy) blurs.
+const int kRoughNone = 0;   // a mirror or smooth glass
+const int kRoughMetal = 1;  // Material::isRoughReflector: the reflection
+const int kRoughGlass = 2;  // Material::isRoughGlass: what is seen through it (and reflected)
 
 struct GpuLight {
     mat4 viewProj[6];       // world -> light clip space, one per shadow layer (spot/dir use [0])
@@ -116,8 +120,8 @@ struct GpuMaterial {
     vec3 attenuationColor;      // linear, 0..1
     int mirror;                 // 1 for a perfect mirror (docs/scene.md), else 0
     float thickness;            // KHR_materials_volume thickness (mesh units, informational)
-    float pad0;                 // std430: the struct is a multiple of 16 bytes
-    float pad1;
+    int specular;               // 1: a specular object here (mirror, rough reflector, glass)
+    float pad1;                 // std430: the struct is a multiple of 16 bytes
     float pad2;
 };
 
@@ -128,8 +132,8 @@ struct GpuSpecularDraw {
     float radius;
     int material;   // index into the material table
     int origin;     // kOriginReal / kOriginVirtual
-    int drawIndex;  // index into GpuScene::draws()
-    int pad0;       // std430: the struct is a multiple of 16 bytes
+    int drawIndex;       // index into GpuScene::draws()
+    int rough;           // kRoughNone, kRoughMetal or kRoughGlass (the fuzzy filter's input)
 };
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).

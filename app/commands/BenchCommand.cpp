@@ -87,17 +87,25 @@ std::string commandLine(const BenchArgs& a) {
     return s;
 }
 
-// The first frame of every configuration beside its ground truth (sRGB PNG).
+// The first frame of every configuration beside its ground truth (sRGB PNG). File names are the
+// configuration's number and its label, cut to stay under the file systems' 255-byte limit (the
+// full grid's labels are longer); labels.txt maps each file to its whole label.
 void writeBenchImages(const fs::path& folder, const std::vector<render::BenchResult>& results) {
     fs::create_directories(folder);
-    for (const auto& r : results) {
-        std::string name = r.baseline ? "footage " + r.config.label() : r.config.label();
+    std::string index;
+    for (size_t i = 0; i < results.size(); ++i) {
+        const auto& r = results[i];
+        const std::string label = r.baseline ? "footage " + r.config.label() : r.config.label();
+        std::string name = label.substr(0, 200);
         for (char& ch : name)
             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-        writeBgr8(folder / (name + ".png"), r.firstComposite);
+        name = fmt::format("{:02d}_{}.png", i, name);
+        writeBgr8(folder / name, r.firstComposite);
         writeBgr8(folder / fmt::format("truth_{}x{}.png", r.config.width, r.config.height),
                   r.firstTruth);
+        index += name + " " + label + "\n";
     }
+    std::ofstream(folder / "labels.txt") << index;
 }
 
 void runBench(const BenchArgs& a) {

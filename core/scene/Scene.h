@@ -91,10 +91,25 @@ struct Material {
     } scattering;
 
     bool isTranslucent() const { return scattering.present; }
-    bool isMirror() const {
-        return metallic >= 0.99f && roughness <= 0.05f && transmission == 0 && !isTranslucent();
+    // Metals (metallic >= 0.99, no transmission) are specular up to kRoughReflectorMaxRoughness:
+    // a perfect mirror up to kMirrorMaxRoughness, a rough reflector above it (the real-time
+    // renderer traces its mirror ray and blurs the reflection with the fuzzy-reflection filter,
+    // docs/specular.md). Rougher metals stay glossy surfaces (punctual GGX + environment): a
+    // reflection lobe that wide no longer fits the filter's cone.
+    static constexpr float kMirrorMaxRoughness = 0.05f;
+    static constexpr float kRoughReflectorMaxRoughness = 0.5f;
+    bool isMetal() const { return metallic >= 0.99f && transmission == 0 && !isTranslucent(); }
+    bool isMirror() const { return isMetal() && roughness <= kMirrorMaxRoughness; }
+    bool isRoughReflector() const {
+        return isMetal() && roughness > kMirrorMaxRoughness &&
+               roughness <= kRoughReflectorMaxRoughness;
     }
     bool isTransmissive() const { return transmission > 0.0f && !isTranslucent(); }
+    // Frosted glass: transmissive with roughness above the mirror threshold (the real-time
+    // renderer blurs what is seen through it with the same filter, docs/specular.md).
+    bool isRoughGlass() const {
+        return isTransmissive() && !isMirror() && roughness > kMirrorMaxRoughness;
+    }
 };
 
 struct Primitive {

@@ -196,6 +196,32 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.causticQuadScale = q;
          },
          [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
+        // Fuzzy reflections of rough metals (docs/specular.md): one default value each.
+        {"fuzzy",
+         "on: the fuzzy-reflection filter over rough metals' mirror reflections; off: rough "
+         "metals reflect sharply (their roughness ignored)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.fuzzyReflections = parseOnOff("fuzzy", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.fuzzyReflections); }},
+        {"fuzzy_cone", "the fuzzy filter's cone bound Theta in degrees (0 < Theta <= 60)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"20"}; },
+         [](BenchConfig& c, const std::string& v) {
+             char* end = nullptr;
+             const float q = std::strtof(v.c_str(), &end);
+             if (v.empty() || end != v.c_str() + v.size() || !(q > 0.0f && q <= 60.0f))
+                 throw Error(
+                     fmt::format("bench: knob fuzzy_cone: '{}' is not a number in (0, 60]", v));
+             c.options.fuzzyConeDeg = q;
+         },
+         [](const BenchConfig& c) { return fmt::format("{:g}", c.options.fuzzyConeDeg); }},
+        {"fuzzy_taps", "taps per side of each separable fuzzy-filter pass (1..64)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"12"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.fuzzyTaps = parseInt("fuzzy_taps", v, 1, 64);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.fuzzyTaps); }},
         // The environment (docs/environment.md). Defaults keep the static map, so the default
         // grid is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
         {"env_source",

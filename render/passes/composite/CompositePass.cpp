@@ -3,6 +3,12 @@
 #include "render/FrameGraph.h"
 
 namespace mirage::render {
+namespace {
+constexpr Resource kFuzzyBuffers[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
+                                       Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
+                                       Resource::FuzzyReflectionVideo};
+static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
+}  // namespace
 
 CompositePass::CompositePass()
     : program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
@@ -14,6 +20,7 @@ CompositePass::CompositePass()
     locShowVirtual_ = program_.uniformLocation("showVirtual");
     locWithCausticsDiffuse_ = programDiffuse_.uniformLocation("withCaustics");
     locWithCaustics_ = program_.uniformLocation("withCaustics");
+    locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
 }
 
 void CompositePass::setup(PassBuilder& b) const {
@@ -28,6 +35,8 @@ void CompositePass::setup(PassBuilder& b) const {
                        Resource::RefractionWeight, Resource::SpecularRv, Resource::SpecularR,
                        Resource::SpecularRReflection, Resource::Lenv, Resource::RealSurfaces})
         b.readOptional(r);
+    // Rough metals: the fuzzy pass's filtered buffers, when it ran.
+    for (Resource r : kFuzzyBuffers) b.readOptional(r);
     b.write(Resource::Composite, GL_RGBA32F, SizeRule::Camera);
     b.write(Resource::CompositeSrgb, GL_SRGB8_ALPHA8, SizeRule::Camera);
 }
@@ -50,15 +59,9 @@ void CompositePass::resize(const FrameContext& ctx) {
     remap_.setFilter(GL_NEAREST, GL_NEAREST);
     remap_.upload(GL_RG, GL_FLOAT, p.remap.data());
     {
-        const int cw = p.canvasWidth, ch = p.canvasHeight;
-        std::vector<glm::vec2> table(size_t(cw) * size_t(ch), glm::vec2(-1e4f));
-        for (int y = 0; y < ch; ++y)
-            for (int x = 0; x < cw; ++x) {
-                const glm::dvec3 ray((x - p.canvasCx) / p.camera.fx, (y - p.canvasCy) / p.camera.fy,
-                                     1.0);
-                if (auto q = p.camera.project(ray)) table[size_t(y) * cw + x] = glm::vec2(*q);
-            }
-        canvasToCamera_ = gl::Texture::create2D("canvas to camera", cw, ch, GL_RG32F);
+        std::vector<glm::vec2> table = p.canvasToCameraTable();
+        canvasToCamera_ =
+            gl::Texture::create2D("canvas to camera", p.canvasWidth, p.canvasHeight, GL_RG32F);
         canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
         canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
         canvasToCameraTable_ = std::move(table);
@@ -148,6 +151,11 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
+        const bool fuzzy = res.has(Resource::FuzzyReflectionVideo);
+        for (int i = 0; i < 5; ++i)
+            glBindTextureUnit(GLuint(kUnitCompositeFuzzyRv + i),
+                              res.textureOr(kFuzzyBuffers[i], ctx.blackTexture()).id());
+        glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
         glEnable(GL_SCISSOR_TEST);
         glScissor(rect.x, rect.y, rect.z, rect.w);
         ctx.drawFullscreenTriangle();

@@ -28,7 +28,7 @@ private:
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
     gl::Texture canvasToCamera_;
     std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
-    GLint locEpsilon_ = -1;
+    GLint locEpsilon_ = -1, locFuzzyOn_ = -1;
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
     GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1;
     gl::Framebuffer fbo_;

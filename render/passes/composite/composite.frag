@@ -28,6 +28,12 @@
 // Eq. 9's "otherwise L'_r", and when p is virtual and p_refr is valid the refracted video is
 // used whatever the reflection does (the seed's exception for virtual refractive objects),
 // without taking an unvalidated colour for the reflection. alpha' is guarded like alpha.
+//
+// Rough metals and rough glass (render/passes/fuzzy): where the fuzzy pass marked the pixel,
+// L'_rv, L'_r, its reflection share and L_env come from the filtered buffers, and CI_bp from the
+// filtered, already resolved video term (each neighbour's eta CI_r(hit) per component, or its
+// rendered real share where it could not be back-projected): the same equations on blurred
+// lookups. Whether all of p, p_refl, p_refr are real is the pixel's own.
 in vec2 uv;
 layout(binding = kUnitCompositeCamera) uniform sampler2D cameraImage;  // sRGB8 texture: samples are linear
 layout(binding = kUnitCompositeLRv) uniform sampler2D lRv;           // canvas, linear
@@ -47,6 +53,12 @@ layout(binding = kUnitCompositeSpecRRefl) uniform sampler2D specRRefl;    // the
 layout(binding = kUnitCompositeLenv) uniform sampler2D lEnv;         // L_env
 layout(binding = kUnitCompositeRealSurfaces) uniform sampler2D realSurfaces; // nearest real surface, xyz world
 layout(binding = kUnitCompositeCanvasToCamera) uniform sampler2D canvasToCamera;  // canvas: camera pixel of the ray
+layout(binding = kUnitCompositeFuzzyRv) uniform sampler2D fuzzyRv;  // filtered L'_rv
+layout(binding = kUnitCompositeFuzzyR) uniform sampler2D fuzzyR;    // filtered L'_r
+layout(binding = kUnitCompositeFuzzyRRefl) uniform sampler2D fuzzyRRefl;
+layout(binding = kUnitCompositeFuzzyLenv) uniform sampler2D fuzzyLenv;
+layout(binding = kUnitCompositeFuzzyVideo) uniform sampler2D fuzzyVideo;  // rgb camera units, a = 1: fuzzy pixel
+uniform int fuzzyOn;         // 1 when the fuzzy pass ran this frame
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
 uniform int withCaustics;    // 1: a caustic pass ran (else causticRv / causticR are not read)
@@ -61,33 +73,20 @@ vec3 guardedAlpha(vec3 ci, vec3 r) {
     return mix(vec3(1.0), ratio, t);
 }
 
-// CI(x): the camera image where world point x appears, if the video shows x there.
-bool backProject(vec3 x, out vec3 colour) {
-    colour = vec3(0.0);
-    vec2 cp;
-    if (!projectToCanvas(x, cp)) return false;
-    ivec2 ci = ivec2(floor(cp + 0.5));
-    if (any(lessThan(ci, ivec2(0))) || any(greaterThanEqual(ci, ivec2(canvas.xy)))) return false;
-    vec4 S = texelFetch(realSurfaces, ci, 0);
-    if (int(S.w + 0.5) != ORIGIN_REAL) return false;
-    float dx = length(x - cameraPos.xyz), ds = length(S.xyz - cameraPos.xyz);
-    if (abs(dx - ds) > depthEpsilon * dx + 0.005) return false;
-    vec2 camPx = texture(canvasToCamera, (cp + 0.5) * canvas.zw).xy;
-    ivec2 size = textureSize(cameraImage, 0);
-    if (camPx.x < -0.5 || camPx.y < -0.5 || camPx.x > float(size.x) - 0.5 ||
-        camPx.y > float(size.y) - 0.5)
-        return false;  // outside the video's frustum
-    colour = texelFetch(cameraImage, clamp(ivec2(floor(camPx + 0.5)), ivec2(0), size - 1), 0).rgb;
-    return true;
-}
-
 // Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci.
 vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
     float ex = exposure;
-    vec3 rv = max(texelFetch(specRv, cpi, 0).rgb, vec3(0.0)) * ex;
-    vec3 r = max(texelFetch(specR, cpi, 0).rgb, vec3(0.0)) * ex;
-    vec3 rRefl = clamp(texelFetch(specRRefl, cpi, 0).rgb * ex, vec3(0.0), r);
-    vec3 env = max(texelFetch(lEnv, cpi, 0).rgb, vec3(0.0)) * ex;
+    vec4 fuzzyBp = fuzzyOn != 0 ? texelFetch(fuzzyVideo, cpi, 0) : vec4(0.0);
+    bool fuzzy = fuzzyBp.a > 0.5;
+    vec3 rv = max((fuzzy ? texelFetch(fuzzyRv, cpi, 0) : texelFetch(specRv, cpi, 0)).rgb,
+                  vec3(0.0)) * ex;
+    vec3 r = max((fuzzy ? texelFetch(fuzzyR, cpi, 0) : texelFetch(specR, cpi, 0)).rgb,
+                 vec3(0.0)) * ex;
+    vec3 rRefl =
+        clamp((fuzzy ? texelFetch(fuzzyRRefl, cpi, 0) : texelFetch(specRRefl, cpi, 0)).rgb * ex,
+              vec3(0.0), r);
+    vec3 env = max((fuzzy ? texelFetch(fuzzyLenv, cpi, 0) : texelFetch(lEnv, cpi, 0)).rgb,
+                   vec3(0.0)) * ex;
     bool envReal = envOrigin == ORIGIN_REAL;
     bool allReal = pReal;
     vec3 ciBp = vec3(0.0);
@@ -96,6 +95,10 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
         vec3 w = (k == 0 ? texelFetch(reflWeight, cpi, 0) : texelFetch(refrWeight, cpi, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;  // no such component
         int origin = int(P.w + 0.5);
+        if (fuzzy) {  // the filtered video term stands for both components (below)
+            if (origin != ORIGIN_REAL) allReal = allReal && origin == ORIGIN_NONE && envReal;
+            continue;
+        }
         if (origin == ORIGIN_NONE) {  // left the scene: L_env carries it
             allReal = allReal && envReal;
             continue;
@@ -105,12 +108,13 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
             continue;
         }
         vec3 c;
-        if (backProject(P.xyz, c)) {
+        if (backProject(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, c)) {
             ciBp += w * c;
         } else {
             ciBp += k == 0 ? rRefl : max(r - rRefl, vec3(0.0));  // rendered real share
         }
     }
+    if (fuzzy) ciBp = max(fuzzyBp.rgb, vec3(0.0));  // the neighbours' resolved CI_bp, filtered
     vec3 dL = rv - r;  // Eq. 6
     if (allReal) return ci + guardedAlpha(ci, r + (envReal ? env : vec3(0.0))) * dL;
     return env + ciBp + guardedAlpha(ciBp, r) * dL;

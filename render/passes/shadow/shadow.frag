@@ -44,6 +44,6 @@ void main() {
         if (outDistance > g.a + 1e-3) flux *= exp(min(g.rgb, vec3(0.0)));
     }
     outFlux = vec4(flux, origin == ORIGIN_REAL ? 1.0 : 0.0);
-    outNormal = vec4(n, m.mirror != 0 || m.transmission > 0.0 ? 1.0 : 0.0);
+    outNormal = vec4(n, m.specular != 0 ? 1.0 : 0.0);
     outPosition = vec4(worldPos, 1.0);
 }

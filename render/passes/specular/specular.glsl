@@ -174,4 +174,29 @@ bool projectToCanvas(vec3 x, out vec2 canvasPx) {
     return projectToView(viewProj, canvas.xy, x, canvasPx);
 }
 
+// CI(x) (Knecht 2013 Eqs. 8-10): the camera image where world point x appears, if the video shows
+// x there. Valid when x is in front of the camera, inside the canvas and the camera image, and
+// the nearest REAL surface at that pixel (realSurfaces: xyz world, w = origin) has the same camera
+// distance within depthEpsilon * distance + 5 mm. canvasToCamera: canvas -> camera-image pixel
+// (lens distortion); cameraImage: sRGB8 texture, so `colour` is linear camera units.
+bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampler2D cameraImage,
+                 float depthEpsilon, out vec3 colour) {
+    colour = vec3(0.0);
+    vec2 cp;
+    if (!projectToCanvas(x, cp)) return false;
+    ivec2 ci = ivec2(floor(cp + 0.5));
+    if (any(lessThan(ci, ivec2(0))) || any(greaterThanEqual(ci, ivec2(canvas.xy)))) return false;
+    vec4 S = texelFetch(realSurfaces, ci, 0);
+    if (int(S.w + 0.5) != ORIGIN_REAL) return false;
+    float dx = length(x - cameraPos.xyz), ds = length(S.xyz - cameraPos.xyz);
+    if (abs(dx - ds) > depthEpsilon * dx + 0.005) return false;
+    vec2 camPx = texture(canvasToCamera, (cp + 0.5) * canvas.zw).xy;
+    ivec2 size = textureSize(cameraImage, 0);
+    if (camPx.x < -0.5 || camPx.y < -0.5 || camPx.x > float(size.x) - 0.5 ||
+        camPx.y > float(size.y) - 0.5)
+        return false;  // outside the video's frustum
+    colour = texelFetch(cameraImage, clamp(ivec2(floor(camPx + 0.5)), ivec2(0), size - 1), 0).rgb;
+    return true;
+}
+
 #endif

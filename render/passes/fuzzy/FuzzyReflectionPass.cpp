@@ -1,0 +1,129 @@
+#include "render/passes/fuzzy/FuzzyReflectionPass.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "render/FrameGraph.h"
+
+namespace mirage::render {
+namespace {
+constexpr Resource kOutputs[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
+                                  Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
+                                  Resource::FuzzyReflectionVideo};
+constexpr Resource kInputs[4] = {Resource::SpecularRv, Resource::SpecularR,
+                                 Resource::SpecularRReflection, Resource::Lenv};
+constexpr float kPi = 3.14159265358979f;
+
+void attachAll(gl::Framebuffer& fbo, gl::Texture (&t)[5]) {
+    for (int i = 0; i < 5; ++i) fbo.attachColor(i, t[i]);
+    fbo.finalize(5);
+}
+}  // namespace
+
+FuzzyReflectionPass::FuzzyReflectionPass()
+    : resolve_(fullscreenProgram("fuzzy resolve", "passes/fuzzy/fuzzy_resolve.frag")),
+      filter_(fullscreenProgram("fuzzy filter", "passes/fuzzy/fuzzy_filter.frag")) {
+    locEpsilon_ = resolve_.uniformLocation("depthEpsilon");
+    locStep_ = filter_.uniformLocation("stepDir");
+    locCone_ = filter_.uniformLocation("coneBound");
+    locFocal_ = filter_.uniformLocation("focalPx");
+    locTaps_ = filter_.uniformLocation("taps");
+}
+
+void FuzzyReflectionPass::setup(PassBuilder& b) const {
+    for (Resource r :
+         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
+          Resource::ReflectionGBuffer, Resource::ReflectionWeight, Resource::RefractionGBuffer,
+          Resource::RefractionWeight, Resource::RealSurfaces, Resource::CameraImage})
+        b.read(r);
+    for (Resource r : kInputs) b.read(r);
+    // The video term in float32, as the composite computes it for a sharp pixel: a kernel of one
+    // pixel then reproduces the mirror path exactly (the L' buffers pass through RGBA16F exactly).
+    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::FuzzyReflectionVideo, GL_RGBA32F, SizeRule::Canvas);
+}
+
+PassDecision FuzzyReflectionPass::decide(const FrameContext& ctx) const {
+    const int metals = ctx.scene.roughReflectorCount(), glass = ctx.scene.roughGlassCount();
+    if (metals + glass == 0)
+        return {false,
+                fmt::format("no rough metal (roughness {} .. {}) or rough glass",
+                            Material::kMirrorMaxRoughness, Material::kRoughReflectorMaxRoughness)};
+    if (!ctx.options.fuzzyReflections)
+        return {false, "fuzzy filter off: rough metals and glass render as smooth"};
+    return {true, fmt::format("{} rough metal(s), {} rough glass: cone {:g} deg, separable, {} "
+                              "taps per side",
+                              metals, glass, ctx.options.fuzzyConeDeg, ctx.options.fuzzyTaps)};
+}
+
+void FuzzyReflectionPass::resize(const FrameContext& ctx) {
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    if (w == width_ && h == height_) return;
+    width_ = w;
+    height_ = h;
+    video_ = gl::Texture::create2D("fuzzy video term", w, h, GL_RGBA32F);
+    static const char* names[5] = {"L'_rv", "L'_r", "L'_r reflection share", "L_env", "video"};
+    for (int i = 0; i < 5; ++i) {
+        const GLenum format = i == 4 ? GL_RGBA32F : GL_RGBA16F;
+        rows_[i] = gl::Texture::create2D(std::string("fuzzy rows ") + names[i], w, h, format);
+        out_[i] = gl::Texture::create2D(std::string("fuzzy ") + names[i], w, h, format);
+    }
+    videoFbo_ = gl::Framebuffer("fuzzy video fbo");
+    videoFbo_.attachColor(0, video_);
+    videoFbo_.finalize(1);
+    rowsFbo_ = gl::Framebuffer("fuzzy rows fbo");
+    attachAll(rowsFbo_, rows_);
+    outFbo_ = gl::Framebuffer("fuzzy fbo");
+    attachAll(outFbo_, out_);
+    const std::vector<glm::vec2> table = ctx.projection.canvasToCameraTable();
+    canvasToCamera_ = gl::Texture::create2D("fuzzy canvas to camera", w, h, GL_RG32F);
+    canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
+    canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
+}
+
+void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
+                     ctx.scene.specularDrawBuffer().id());
+    glBindTextureUnit(kUnitFuzzyPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitFuzzyEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitFuzzyReflHit, res.texture(Resource::ReflectionGBuffer).id());
+    glBindTextureUnit(kUnitFuzzyReflWeight, res.texture(Resource::ReflectionWeight).id());
+    glBindTextureUnit(kUnitFuzzyCamera, res.texture(Resource::CameraImage).id());
+    glBindTextureUnit(kUnitFuzzyRealSurfaces, res.texture(Resource::RealSurfaces).id());
+    glBindTextureUnit(kUnitFuzzyCanvasToCamera, canvasToCamera_.id());
+    glBindTextureUnit(kUnitFuzzySpecRRefl, res.texture(Resource::SpecularRReflection).id());
+    glBindTextureUnit(kUnitFuzzySpecR, res.texture(Resource::SpecularR).id());
+    glBindTextureUnit(kUnitFuzzyRefrHit, res.texture(Resource::RefractionGBuffer).id());
+    glBindTextureUnit(kUnitFuzzyRefrWeight, res.texture(Resource::RefractionWeight).id());
+    glBindTextureUnit(kUnitFuzzyNormal, res.texture(Resource::GBufferNormal).id());
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+
+    // 1. The reflection's video term per rough pixel (the composite's back-projection).
+    videoFbo_.bind();
+    ctx.beginFullscreen(resolve_, w, h);
+    glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 1);
+
+    // 2. Rows, then columns of the rows' result. The canvas has the camera's focal lengths
+    // (pixels per radian near the axis: Eq. 5's image size / view angle).
+    const float focalPx = float(0.5 * (ctx.projection.camera.fx + ctx.projection.camera.fy));
+    const float cone = ctx.options.fuzzyConeDeg * kPi / 180.0f;
+    for (int pass = 0; pass < 2; ++pass) {
+        (pass == 0 ? rowsFbo_ : outFbo_).bind();
+        ctx.beginFullscreen(filter_, w, h);
+        for (int i = 0; i < 5; ++i) {
+            const gl::Texture& in = pass == 1 ? rows_[i] : i < 4 ? res.texture(kInputs[i]) : video_;
+            glBindTextureUnit(GLuint(kUnitFuzzyInputFirst + i), in.id());
+        }
+        glUniform2i(locStep_, pass == 0 ? 1 : 0, pass == 0 ? 0 : 1);
+        glUniform1f(locCone_, cone);
+        glUniform1f(locFocal_, focalPx);
+        glUniform1i(locTaps_, ctx.options.fuzzyTaps);
+        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);
+    }
+    for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);
+}
+
+}  // namespace mirage::render
