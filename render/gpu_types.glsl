@@ -116,7 +116,7 @@ struct GpuMaterial {
     vec3 attenuationColor;      // linear, 0..1
     int mirror;                 // 1 for a perfect mirror (docs/scene.md), else 0
     float thickness;            // KHR_materials_volume thickness (mesh units, informational)
-    float pad0;                 // std430: the struct is a multiple of 16 bytes
+    int translucent;            // 1: a participating medium (docs/translucency.md), else 0
     float pad1;
     float pad2;
 };
