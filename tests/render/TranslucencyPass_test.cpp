@@ -155,6 +155,31 @@ TEST_F(TranslucencyPass, CubeWithCavityAgreesWithTheCpuFormula) {
     expectAgreement(TranslucentShape::CubeWithCavity, "cavity");
 }
 
+// A REAL translucent object enters L_r with the real lights only: under a real light and the real
+// environment L_r equals L_rv over it; with the light virtual, L_r keeps only the environment's
+// share (the cube is back-lit: most of its light comes from the light behind it).
+TEST_F(TranslucencyPass, RealObjectEntersLrWithRealLightsOnly) {
+    const fs::path dir = mirage::test::outputDir("translucency_pass_real");
+    TranslucentSceneOptions o;
+    o.objectOrigin = Origin::Real;
+    const Scene scene = translucentTestScene(o, dir);
+    const Realtime all = renderRealtime(scene);
+    ASSERT_TRUE(all.ran) << all.summary;
+    const CpuImage cpu = cpuScattered(scene, all.position);
+    ASSERT_GT(cv::countNonZero(cpu.mask), 300);
+    const double rv = cv::mean(all.rv, cpu.mask)[0];
+    const double r = cv::mean(all.r, cpu.mask)[0];
+    EXPECT_GT(rv, 0.0);
+    EXPECT_NEAR(r, rv, 2e-3 * rv);
+    o.lightOrigin = Origin::Virtual;
+    const Realtime virtualLight = renderRealtime(translucentTestScene(o, dir));
+    const double rvV = cv::mean(virtualLight.rv, cpu.mask)[0];
+    const double rV = cv::mean(virtualLight.r, cpu.mask)[0];
+    EXPECT_NEAR(rvV, rv, 2e-3 * rv);  // L_rv does not depend on what is real
+    EXPECT_GT(rV, 0.0);               // the real environment
+    EXPECT_LT(rV, 0.5 * rvV);
+}
+
 TEST_F(TranslucencyPass, SkippedWithoutATranslucentObject) {
     const fs::path dir = mirage::test::outputDir("translucency_pass_none");
     TranslucentSceneOptions o;
