@@ -12,6 +12,8 @@ void RendererOptions::validate() const {
     auto fail = [](const std::string& what) { throw Error("renderer option " + what); };
     if (vplCount < 0 || vplCount > 16384)
         fail("vplCount is " + std::to_string(vplCount) + ", out of range (0..16384)");
+    if (vnmResolution < 2 || vnmResolution > 512)
+        fail("vnmResolution must be 2..512, got " + std::to_string(vnmResolution));
     if (interleave < 1 || interleave > 8)
         fail("interleave must be 1..8, got " + std::to_string(interleave));
     if (indirectScale != 1 && indirectScale != 2)

@@ -84,6 +84,15 @@ struct RendererOptions {
     // equirectangular map built from each environment-camera frame (height = width / 2).
     int environmentMapWidth = 512;
 
+    // Translucent objects (render/passes/translucency, docs/translucency.md): the voxel number
+    // map of the first translucent object, vnmResolution voxels along its longest side (the tau
+    // LUT grows with the square of the surface voxels, ~36 n^4 bytes for a cube), its LUT cached
+    // in vnmCacheDir (empty: precomputed every time a renderer is created). false: translucent
+    // objects are drawn as opaque surfaces of their base colour.
+    bool translucency = true;
+    int vnmResolution = 16;
+    std::string vnmCacheDir;
+
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.
     void validate() const;

@@ -44,6 +44,7 @@ GpuMaterial toGpu(const Material& m) {
     g.mirror = m.isMirror() ? 1 : 0;
     g.specular = isSpecularMaterial(m) ? 1 : 0;
     g.thickness = std::max(m.thickness, 0.0f);
+    g.translucent = m.isTranslucent() ? 1 : 0;
     return g;
 }
 
@@ -142,17 +143,8 @@ void GpuScene::uploadTextures(const Scene& scene) {
 int GpuScene::uploadMaterials(const Scene& scene) {
     std::vector<GpuMaterial> mats;
     mats.push_back(toGpu(Material()));  // glTF default: white, metallic 1, roughness 1
-    for (const Material& m : scene.materials) {
-        // The voxel number map runs on the CPU only so far (docs/translucency.md): say that the
-        // real-time image shows such an object as an opaque surface of its base colour.
-        if (m.isTranslucent())
-            spdlog::warn(
-                "material '{}' is translucent; the real-time renderer draws it as an opaque "
-                "surface of its base colour (its voxel number map passes are not written "
-                "yet, docs/translucency.md)",
-                m.name);
-        mats.push_back(toGpu(m));
-    }
+    // Translucent materials are shaded by the translucency pass (render/passes/translucency).
+    for (const Material& m : scene.materials) mats.push_back(toGpu(m));
     materials_ = gl::Buffer("scene materials", mats.size() * sizeof(GpuMaterial), mats.data());
 
     return int(mats.size());

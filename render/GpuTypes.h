@@ -38,6 +38,7 @@ static_assert(offsetof(GpuMaterial, emissive) == 16 && offsetof(GpuMaterial, rou
 static_assert(offsetof(GpuMaterial, metallic) == 32 && offsetof(GpuMaterial, ior) == 40);
 static_assert(offsetof(GpuMaterial, attenuationColor) == 48 && offsetof(GpuMaterial, mirror) == 60);
 static_assert(offsetof(GpuMaterial, thickness) == 64 && offsetof(GpuMaterial, specular) == 68);
+static_assert(offsetof(GpuMaterial, translucent) == 72);
 static_assert(sizeof(GpuSpecularDraw) == 32);
 static_assert(offsetof(GpuSpecularDraw, radius) == 12 && offsetof(GpuSpecularDraw, material) == 16);
 static_assert(sizeof(GpuSurfacePoint) == 16 && offsetof(GpuSurfacePoint, isReal) == 12);

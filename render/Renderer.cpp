@@ -24,6 +24,7 @@
 #include "render/passes/shadow/ShadowPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
 #include "render/passes/specular/SpecularLightPass.h"
+#include "render/passes/translucency/TranslucencyPass.h"
 #include "render/passes/vpl/VplPass.h"
 
 namespace mirage::render {
@@ -141,6 +142,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<PhotonGBufferPass>(*scene_));  // before vpl: VPLs follow photons
     g.addPass(std::make_unique<VplPass>());
     g.addPass(std::make_unique<IsmPass>());
+    g.addPass(std::make_unique<TranslucencyPass>(scene, *scene_, options_));
     g.addPass(std::make_unique<DirectLightPass>(*scene_));
     g.addPass(std::make_unique<IndirectLightPass>());
     g.addPass(std::make_unique<GiFilterPass>(options_.interleave));

@@ -23,6 +23,8 @@ const char* resourceName(Resource r) {
         "Vpls",
         "ImperfectShadowMaps",
         "ImperfectShadowMapsReal",
+        "TranslucentGrid",
+        "TranslucentRadiance",
         "DirectRv",
         "DirectR",
         "IndirectRv",

@@ -21,7 +21,8 @@ enum class Resource {
     GBufferPosition,  // xyz world (m), w = origin (ORIGIN_REAL / ORIGIN_VIRTUAL, 0 = empty)
     GBufferNormal,    // xyz unit world normal, w = roughness
     GBufferAlbedo,    // rgb linear base colour, a = metallic
-    GBufferEmissive,  // rgb linear emitted radiance, a = specular slot + 1 (0 = not specular)
+    GBufferEmissive,  // rgb linear emitted radiance, a = specular slot + 1 (0 = not specular,
+                      // -1 = translucent)
     // Per light layer (shadow atlas: shadowMapSize^2 x layers).
     ShadowMaps,               // distance to the nearest occluder (m), all geometry
     ShadowMapsReal,           // the same with real occluders only (aliases ShadowMaps where equal)
@@ -34,7 +35,14 @@ enum class Resource {
     Vpls,                     // SSBO of GpuVpl (vplCount entries)
     ImperfectShadowMaps,      // r32ui atlas, one paraboloid tile per VPL (all occluders)
     ImperfectShadowMapsReal,  // the same with real points only (aliases the first without them)
-    DirectRv,                 // direct + environment + emission (canvas size)
+    // Translucent objects (voxel number map, docs/translucency.md): SSBOs of the first
+    // translucent object. TranslucentGrid: header + the voxel number of every grid cell
+    // (persistent, uploaded once); TranslucentRadiance: per surface voxel the radiance
+    // (1/pi) a_eff sum E A c e^{-tau} leaving it before the exit F_t, S vec4 for L_rv then S
+    // vec4 for L_r.
+    TranslucentGrid,
+    TranslucentRadiance,
+    DirectRv,  // direct + environment + emission (canvas size)
     DirectR,
     IndirectRv,  // interleaved VPL gather, deinterleaved and unfiltered (gather size)
     IndirectR,

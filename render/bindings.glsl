@@ -16,6 +16,12 @@ const int kBindingSpecularDraws = 5;  // GpuSpecularDraw[]
 const int kBindingImpostorRecords = 6;  // GpuImpostor[] (trace.glsl)
 const int kBindingImpostorObjects = 7;  // header + GpuImpostorObject[] (trace.glsl)
 const int kBindingEnvironment = 8;      // EnvironmentBlock (std140; environment_sh.comp writes it)
+// Translucent objects (render/passes/translucency, direct.frag), std430.
+const int kBindingTranslucentVoxels = 9;       // per surface voxel: 2 vec4 (see translucency.comp)
+const int kBindingTranslucentLut = 10;         // tau LUT, S x S half floats, 2 per uint
+const int kBindingTranslucentIrradiance = 11;  // E per surface voxel: S vec4 (L_rv), S vec4 (L_r)
+const int kBindingTranslucentRadiance = 12;    // same layout: radiance leaving each voxel
+const int kBindingTranslucentGrid = 13;        // header + voxel number per grid cell
 const int kBindingQueryRays = 4;        // query.comp (offline impostor queries, outside frames)
 const int kBindingQueryHits = 5;
 
@@ -33,6 +39,12 @@ const int kUnitDirectShadowAll = 4;
 const int kUnitDirectShadowReal = 5;
 const int kUnitDirectGlassAll = 6;  // ShadowGlass / ShadowGlassReal (glass in the shadow maps)
 const int kUnitDirectGlassReal = 7;
+
+// translucency.comp: the shadow atlases
+const int kUnitTranslucencyShadowAll = 0;
+const int kUnitTranslucencyShadowReal = 1;
+const int kUnitTranslucencyGlassAll = 2;
+const int kUnitTranslucencyGlassReal = 3;
 
 // environment pass: fisheye_to_equirect.frag, environment_sh.comp
 const int kUnitEnvFisheye = 0;   // the environment camera's frame (sRGB8, sampled linear)

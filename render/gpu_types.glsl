@@ -121,7 +121,7 @@ struct GpuMaterial {
     int mirror;                 // 1 for a perfect mirror (docs/scene.md), else 0
     float thickness;            // KHR_materials_volume thickness (mesh units, informational)
     int specular;               // 1: a specular object here (mirror, rough reflector, glass)
-    float pad1;                 // std430: the struct is a multiple of 16 bytes
+    int translucent;            // 1: a participating medium (docs/translucency.md), else 0
     float pad2;
 };
 

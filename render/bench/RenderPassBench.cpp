@@ -19,6 +19,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "testscenes/SpecularTestScenes.h"
+#include "testscenes/TranslucentTestScenes.h"
 
 namespace {
 
@@ -192,6 +193,38 @@ void curveArgs(benchmark::internal::Benchmark* b) {
     for (int res : {64, 128, 256, 512}) b->Args({res, 0, 1});
 }
 
+// The translucency pass (voxel number map on the GPU, docs/translucency.md) on the back-lit
+// translucent cube of the accuracy tests at 320x240, per voxel resolution (argument). Reported
+// time = frame GPU time; counters: translucency_ms (both dispatches), direct_ms.
+void BM_Translucency(benchmark::State& state) {
+    context();
+    render::RendererOptions opt;
+    opt.syncPasses = true;
+    opt.vnmResolution = int(state.range(0));
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "mirage_bench_translucency";
+    std::filesystem::create_directories(dir);  // the scene's environment map is written there
+    const Scene scene =
+        raytrace::test::translucentTestScene(raytrace::test::TranslucentSceneOptions{}, dir);
+    const auto cam = raytrace::test::lookAtCamera(320, 240, 700.0, {0.9, 0.55, 1.3}, {0, 0, 0});
+    render::Renderer r(scene, cam.intrinsics, opt);
+    r.render({cam.T_world_camera, cv::Mat(), true});  // warm-up: shader compile, first allocations
+    double translucencyMs = 0, directMs = 0;
+    for (auto _ : state) {
+        const render::FrameReport& rep = r.render({cam.T_world_camera, cv::Mat(), false});
+        if (!rep.ran("translucency")) {
+            state.SkipWithError("the translucency pass did not run");
+            return;
+        }
+        for (const auto& p : rep.passes) {
+            if (p.name == "translucency") translucencyMs += p.gpuMs;
+            if (p.name == "direct") directMs += p.gpuMs;
+        }
+        state.SetIterationTime(rep.totalGpuMs * 1e-3);
+    }
+    state.counters["translucency_ms"] = translucencyMs / double(state.iterations());
+    state.counters["direct_ms"] = directMs / double(state.iterations());
+}
 }  // namespace
 
 BENCHMARK(BM_SpecularImpostorCurve)
@@ -199,5 +232,12 @@ BENCHMARK(BM_SpecularImpostorCurve)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
+BENCHMARK(BM_Translucency)
+    ->Arg(8)
+    ->Arg(16)
+    ->Arg(24)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
 BENCHMARK(BM_Frame)->Apply(args)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_MAIN();

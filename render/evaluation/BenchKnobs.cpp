@@ -222,6 +222,14 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.fuzzyTaps = parseInt("fuzzy_taps", v, 1, 64);
          },
          [](const BenchConfig& c) { return std::to_string(c.options.fuzzyTaps); }},
+        {"vnm_resolution",
+         "voxels along a translucent object's longest side in its voxel number map (2..512; "
+         "the LUT grows with the 4th power)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.vnmResolution = parseInt("vnm_resolution", v, 2, 512);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.vnmResolution); }},
         // The environment (docs/environment.md). Defaults keep the static map, so the default
         // grid is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
         {"env_source",

@@ -54,12 +54,23 @@ struct Hasher {
     }
 };
 
+}  // namespace
+
 float boundaryTransmittance(float ior, float cosAbs) {
     return ior == 1.0f ? 1.0f
                        : 1.0f - raytrace::fresnelDielectric(std::clamp(cosAbs, 0.0f, 1.0f), ior);
 }
 
-}  // namespace
+float hemisphericalTransmittance(float ior) {
+    // Midpoint rule in mu; F_t is smooth, 256 steps are exact to ~1e-5.
+    constexpr int kSteps = 256;
+    double sum = 0.0;
+    for (int k = 0; k < kSteps; ++k) {
+        const float mu = (float(k) + 0.5f) / float(kSteps);
+        sum += double(boundaryTransmittance(ior, mu)) * mu;
+    }
+    return float(2.0 * sum / kSteps);
+}
 
 glm::vec3 effectiveAlbedo(const glm::vec3& albedo) {
     glm::vec3 out;

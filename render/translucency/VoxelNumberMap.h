@@ -53,6 +53,13 @@ struct TranslucentObject {
 // (1 stays 1: a white medium loses nothing).
 glm::vec3 effectiveAlbedo(const glm::vec3& albedo);
 
+// F_t: the fraction of light crossing the smooth boundary of a medium of index `ior` at
+// |cos| = cosAbs to the normal (1 - Fresnel reflectance; 1 for ior 1).
+float boundaryTransmittance(float ior, float cosAbs);
+// F_t averaged over a cosine-weighted hemisphere, 2 int_0^1 F_t(mu) mu dmu: the share of a
+// uniform environment's irradiance that enters the medium.
+float hemisphericalTransmittance(float ior);
+
 // The scene's translucent objects (one per mesh instance and translucent material).
 std::vector<TranslucentObject> translucentObjects(const Scene& scene);
 
@@ -94,6 +101,12 @@ public:
     bool fromCache() const { return fromCache_; }
     size_t lutBytes() const { return tau_.size() * 2; }
     float surfaceArea() const { return area_; }  // outer surface, m^2
+    // For uploading to the GPU: the world corner of voxel (0,0,0), the voxel number per cell
+    // (x fastest, then y, then z; -1 = no surface voxel) and the S x S LUT of tau (IEEE half
+    // floats, row i = from surface voxel i).
+    glm::vec3 origin() const { return origin_; }
+    const std::vector<int32_t>& numbers() const { return number_; }
+    const std::vector<uint16_t>& tauHalf() const { return tau_; }
 
 private:
     int cellIndex(glm::ivec3 c) const { return (c.z * dims_.y + c.y) * dims_.x + c.x; }

@@ -192,7 +192,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on "
               "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
-              "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 env_source=static env_resolution=512");
+              "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 vnm_resolution=16 env_source=static "
+              "env_resolution=512");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";
@@ -307,6 +308,8 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"fuzzy_cone", {"wide"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"fuzzy_taps", {"0"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"caustics", {"sometimes"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"vnm_resolution", {"1"}}}), Error);
+    EXPECT_EQ(benchGrid(cam, true, {{"vnm_resolution", {"48"}}})[0].options.vnmResolution, 48);
     const auto caustic = benchGrid(cam, true, {{"caustic_map", {"128", "512"}}});
     ASSERT_EQ(caustic.size(), 4u);  // x the quick grid's 64 / 256 VPLs
     EXPECT_EQ(caustic[0].options.causticMapSize, 128);

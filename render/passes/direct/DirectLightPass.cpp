@@ -17,6 +17,8 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.readOptional(Resource::ShadowMapsReal);
     b.readOptional(Resource::ShadowGlass);  // none: no glass in a light's cone
     b.readOptional(Resource::ShadowGlassReal);
+    b.readOptional(Resource::TranslucentGrid);  // none: no translucent object (or its pass off)
+    b.readOptional(Resource::TranslucentRadiance);
     b.write(Resource::DirectRv, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::DirectR, GL_RGBA16F, SizeRule::Canvas);
 }
@@ -53,6 +55,15 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
                       res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
     glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
                      res.buffer(Resource::EnvironmentLight).id());
+    const bool translucent =
+        res.has(Resource::TranslucentGrid) && res.has(Resource::TranslucentRadiance);
+    if (translucent) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentGrid,
+                         res.buffer(Resource::TranslucentGrid).id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentRadiance,
+                         res.buffer(Resource::TranslucentRadiance).id());
+    }
+    glUniform1i(program_.uniformLocation("translucentOn"), translucent ? 1 : 0);
     ctx.drawFullscreenTriangle();
     res.publish(Resource::DirectRv, rv_);
     res.publish(Resource::DirectR, r_);

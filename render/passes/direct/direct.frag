@@ -1,6 +1,7 @@
 #version 450 core
 #include "common.glsl"
 #include "lighting.glsl"
+#include "passes/translucency/translucency.glsl"
 // Direct light, environment light and emission, routed into the two GI solutions
 // (DESIGN.md "Real and virtual"; Knecht 2010's decision flags):
 //   L_rv: every light, visibility against all occluders;
@@ -17,6 +18,12 @@ layout(binding = kUnitDirectShadowReal) uniform sampler2DArray shadowReal;
 layout(binding = kUnitDirectGlassAll) uniform sampler2DArray glassAll;
 layout(binding = kUnitDirectGlassReal) uniform sampler2DArray glassReal;
 #endif
+// The translucency pass's radiance leaving each surface voxel of the translucent object
+// (before the exit F_t): S vec4 for L_rv, then S vec4 for L_r. Read only when translucentOn.
+layout(std430, binding = kBindingTranslucentRadiance) readonly buffer TranslucentRadianceBlock {
+    vec4 translucentL[];
+};
+uniform int translucentOn;  // 1: the translucency pass ran this frame
 layout(location = 0) out vec4 outRv;  // linear radiance
 layout(location = 1) out vec4 outR;
 
@@ -36,6 +43,22 @@ void main() {
     vec4 A = texelFetch(gAlbedo, px, 0);
     vec3 v = normalize(cameraPos.xyz - p);
     vec3 rv = vec3(0.0), r = vec3(0.0);
+    vec4 Em = texelFetch(gEmissive, px, 0);
+    // A translucent pixel (gEmissive.a = -1) takes the light scattered through the object to its
+    // nearest surface voxel, times F_t towards the camera (VnmShading::scattered), instead of
+    // the surface BRDF: L_rv from all lights, L_r from real lights with the real-only shadow
+    // maps (and nothing on a virtual object, as for any virtual pixel).
+    int voxel = translucentOn == 1 && Em.a < -0.5 ? surfaceVoxelAt(p) : -1;
+    if (voxel >= 0) {
+        float Ft = boundaryTransmittance(gridParams.x, abs(dot(n, v)));
+        rv = Ft * translucentL[voxel].rgb;
+        if (pReal) r = Ft * translucentL[gridDims.w + voxel].rgb;
+        rv += Em.rgb;
+        if (pReal) r += Em.rgb;
+        outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
+        outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
+        return;
+    }
     for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, p, wi, E);
@@ -56,7 +79,7 @@ void main() {
         rv += env;
         if (envOrigin == ORIGIN_REAL && pReal) r += env;
     }
-    vec3 e = texelFetch(gEmissive, px, 0).rgb;
+    vec3 e = Em.rgb;
     rv += e;
     if (pReal) r += e;
     outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);

@@ -14,7 +14,7 @@ layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
 layout(location = 3) out vec4 gEmissive;  // rgb linear emitted radiance, a = specular slot + 1
-                                          // (0: not a mirror / glass pixel)
+                                          // (0: not a mirror / glass pixel; -1: translucent)
 void main() {
     GpuMaterial m = materials[materialIndex];
     vec3 n = normalize(worldNormal);
@@ -24,5 +24,5 @@ void main() {
     gPosition = vec4(worldPos, float(origin));
     gNormal = vec4(n, clamp(m.roughness, 0.02, 1.0));
     gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.metallic, 0.0, 1.0));
-    gEmissive = vec4(m.emissive, float(specularSlot + 1));
+    gEmissive = vec4(m.emissive, m.translucent == 1 ? -1.0 : float(specularSlot + 1));
 }

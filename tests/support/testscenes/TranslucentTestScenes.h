@@ -67,6 +67,8 @@ struct TranslucentSceneOptions {
     float lightIntensity = 3.0f;  // W/sr
     float environment = 0.03f;    // uniform environment radiance
     bool cavityInScene = true;    // false: the cube without its cavity (the "cavity ignored" case)
+    Origin objectOrigin = Origin::Virtual;  // the cube
+    Origin lightOrigin = Origin::Real;
 };
 
 // A translucent cube [-0.25, 0.25]^3 (one mesh: the box, and for the cavity variant the inward
@@ -101,11 +103,11 @@ inline Scene translucentTestScene(const TranslucentSceneOptions& o,
     Node n;
     n.name = "translucent";
     n.mesh = 0;
-    mirage::test::addRootNode(s, std::move(n), glm::dmat4(1.0), Origin::Virtual);
+    mirage::test::addRootNode(s, std::move(n), glm::dmat4(1.0), o.objectOrigin);
     Light l;
     l.type = Light::Type::Point;
     l.intensity = o.lightIntensity;
-    addLight(s, "light", l, translate(glm::dvec3(o.lightPosition)));
+    addLight(s, "light", l, translate(glm::dvec3(o.lightPosition)), o.lightOrigin);
     return s;
 }
 

@@ -1,0 +1,37 @@
+#pragma once
+// The voxel number map at run time (docs/translucency.md): for the scene's first translucent
+// object, the irradiance at its surface voxels from every light (visibility from the shadow
+// maps) and the environment (SH irradiance), then the radiance leaving every surface voxel,
+// L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-tau(i, o)} (compute, two dispatches), for L_rv and
+// L_r. The precomputation (surface voxels, tau LUT) is the CPU VoxelNumberMap's, built (or read
+// from its disk cache) when the renderer is created and uploaded once. direct.frag shades the
+// object's pixels from the result. Runs only when the scene has a translucent object.
+#include <memory>
+#include <string>
+
+#include "core/scene/Scene.h"
+#include "render/RenderPass.h"
+
+namespace mirage::render {
+
+class TranslucencyPass final : public RenderPass {
+public:
+    TranslucencyPass(const Scene& scene, const GpuScene& gpu, const RendererOptions& options);
+    const char* name() const override { return "translucency"; }
+    void setup(PassBuilder& b) const override;
+    PassDecision decide(const FrameContext& ctx) const override;
+    void resize(const FrameContext& /*ctx*/) override {}  // sized by the scene, once
+    void execute(FrameContext& ctx, PassResources& res) override;
+
+    int surfaceVoxels() const { return surfaceVoxels_; }
+
+private:
+    std::string why_;  // decide()'s reason
+    int surfaceVoxels_ = 0;
+    float envTransmittance_ = 1.0f;
+    glm::vec3 albedoOverPi_{0.0f};
+    gl::Program program_;
+    gl::Buffer grid_, voxels_, lut_, irradiance_, radiance_;
+};
+
+}  // namespace mirage::render

@@ -1,0 +1,99 @@
+#version 450 core
+#include "common.glsl"
+#include "lighting.glsl"
+#include "passes/translucency/translucency.glsl"
+// The voxel number map at run time (Mochida et al.; docs/translucency.md), in two dispatches
+// over the S surface voxels of one translucent object:
+//  stage 0: irradiance E_i = sum_lights F_t(cos) cos I vis + F_t-weighted environment
+//           irradiance at every outer surface voxel i; for L_rv every light with visibility
+//           through all occluders, for L_r only real lights with the real-only shadow maps and
+//           a real environment (DESIGN.md "Real and virtual");
+//  stage 1: per output voxel o, L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-tau(i, o)}, the
+//           radiance leaving o before the exit boundary's F_t (direct.frag applies it per pixel).
+layout(local_size_x = 64) in;
+
+// Per surface voxel: (centre xyz world m, A_i c_i if on the outer surface else 0),
+// (outward unit normal xyz, 0).
+struct TranslucentVoxel {
+    vec4 positionWeight;
+    vec4 normal;
+};
+layout(std430, binding = kBindingTranslucentVoxels) readonly buffer Voxels {
+    TranslucentVoxel voxels[];
+};
+layout(std430, binding = kBindingTranslucentLut) readonly buffer Lut { uint tauHalf[]; };
+layout(std430, binding = kBindingTranslucentIrradiance) buffer Irradiance { vec4 E[]; };
+layout(std430, binding = kBindingTranslucentRadiance) writeonly buffer Radiance { vec4 L[]; };
+layout(binding = kUnitTranslucencyShadowAll) uniform sampler2DArray shadowAll;
+layout(binding = kUnitTranslucencyShadowReal) uniform sampler2DArray shadowReal;
+#ifdef MIRAGE_GLASS_SHADOWS
+layout(binding = kUnitTranslucencyGlassAll) uniform sampler2DArray glassAll;
+layout(binding = kUnitTranslucencyGlassReal) uniform sampler2DArray glassReal;
+#endif
+uniform int stage;
+uniform float envTransmittance;  // F_t averaged over the cosine-weighted hemisphere
+uniform vec3 albedoOverPi;       // a_eff / pi
+
+float tau(int i, int o, int S) {
+    uint k = uint(i) * uint(S) + uint(o);
+    vec2 h = unpackHalf2x16(tauHalf[k >> 1u]);
+    return (k & 1u) == 0u ? h.x : h.y;
+}
+
+void irradiance(int i, int S) {
+    TranslucentVoxel v = voxels[i];
+    vec3 rv = vec3(0.0), r = vec3(0.0);
+    if (v.positionWeight.w > 0.0) {  // cavity walls receive no outside light
+        vec3 p = v.positionWeight.xyz;
+        vec3 N = v.normal.xyz;
+        float ior = gridParams.x;
+        // Visibility from just outside the voxel, along its normal (as the CPU code).
+        vec3 x = p + N * gridOrigin.w;
+        for (int li = 0; li < lightCount; ++li) {
+            vec3 wi, Ei;
+            incidentLight(li, p, wi, Ei);
+            float cosN = dot(N, wi);
+            if (cosN <= 0.0) continue;
+            vec3 visAll, visReal;
+#ifdef MIRAGE_GLASS_SHADOWS
+            lightVisibility(shadowAll, shadowReal, glassAll, glassReal, li, x, cosN, visAll,
+                            visReal);
+#else
+            lightVisibility(shadowAll, shadowReal, li, x, cosN, visAll, visReal);
+#endif
+            vec3 c = boundaryTransmittance(ior, cosN) * cosN * Ei;
+            rv += c * visAll;
+            if (lights[li].isReal == 1) r += c * visReal;
+        }
+        if (envOrigin != 0) {
+            vec3 e = envTransmittance * shIrradiance(N);
+            rv += e;
+            if (envOrigin == ORIGIN_REAL) r += e;
+        }
+    }
+    E[i] = vec4(allFinite(rv) ? rv : vec3(0.0), 0.0);
+    E[S + i] = vec4(allFinite(r) ? r : vec3(0.0), 0.0);
+}
+
+void scatter(int o, int S) {
+    vec3 rv = vec3(0.0), r = vec3(0.0);
+    for (int i = 0; i < S; ++i) {
+        float w = voxels[i].positionWeight.w;
+        if (w <= 0.0) continue;
+        float k = w * exp(-tau(i, o, S));
+        rv += E[i].rgb * k;
+        r += E[S + i].rgb * k;
+    }
+    L[o] = vec4(rv * albedoOverPi, 0.0);
+    L[S + o] = vec4(r * albedoOverPi, 0.0);
+}
+
+void main() {
+    int S = gridDims.w;
+    int i = int(gl_GlobalInvocationID.x);
+    if (i >= S) return;
+    if (stage == 0)
+        irradiance(i, S);
+    else
+        scatter(i, S);
+}
