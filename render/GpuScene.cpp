@@ -474,11 +474,11 @@ void MaterialDraw::draw(const GpuScene& scene, const DrawItem& d) const {
     scene.drawItem(d);
 }
 
-std::string GpuScene::lightingDefines() const {
+std::string GpuScene::lightingDefines(bool withGlass) const {
     int faces = 0;
     for (const SceneLight& l : lights_) faces = std::max(faces, l.type == kLightPoint ? 6 : 1);
     std::string defines = "#define MIRAGE_MAX_SHADOW_FACES " + std::to_string(faces) + "\n";
-    if (hasTransmissive()) defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
+    if (withGlass && hasTransmissive()) defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
     return defines;
 }
 

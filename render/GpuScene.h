@@ -78,7 +78,9 @@ public:
     // (MIRAGE_MAX_SHADOW_FACES: 6 with a point light, 1 with spot / directional only, 0 without
     // lights; see lighting.glsl for why a constant loop bound matters on llvmpipe;
     // MIRAGE_GLASS_SHADOWS when some draw is glass: the shadow lookups read the glass atlases).
-    std::string lightingDefines() const;
+    // withGlass false: without MIRAGE_GLASS_SHADOWS whatever the scene holds (the variant for
+    // frames in which glass transmits no light).
+    std::string lightingDefines(bool withGlass = true) const;
     bool hasTransmissive() const;
     // Indices into draws() of the specular (mirror / glass) items, in draw order.
     const std::vector<int>& specularDraws() const { return specularDraws_; }

@@ -14,11 +14,15 @@ CompositePass::CompositePass()
     : program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
       programDiffuse_(fullscreenProgram("composite (diffuse only)",
                                         "passes/composite/composite.frag",
-                                        "#define MIRAGE_DIFFUSE_ONLY 1")) {
+                                        "#define MIRAGE_DIFFUSE_ONLY 1")),
+      programDiffuseNoCaustics_(fullscreenProgram(
+          "composite (diffuse only, no caustics)", "passes/composite/composite.frag",
+          "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_NO_CAUSTICS 1")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
     locShowVirtualDiffuse_ = programDiffuse_.uniformLocation("showVirtual");
     locShowVirtual_ = program_.uniformLocation("showVirtual");
     locWithCausticsDiffuse_ = programDiffuse_.uniformLocation("withCaustics");
+    locShowVirtualNoCaustics_ = programDiffuseNoCaustics_.uniformLocation("showVirtual");
     locWithCaustics_ = program_.uniformLocation("withCaustics");
     locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
 }
@@ -107,11 +111,19 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                           res.has(Resource::ReflectionGBuffer);
     // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
     // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
-    ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width, ctx.projection.camera.height);
-    glUniform1i(locShowVirtualDiffuse_, ctx.options.showVirtual ? 1 : 0);
-    // Reading the black stand-in costs as much as a real caustic buffer on llvmpipe.
+    // Without a caustic pass the variant that never reads the caustic buffers: reading the black
+    // stand-in costs as much as a real buffer on llvmpipe, even behind a uniform branch.
     const int withCaustics = res.has(Resource::CausticRv) ? 1 : 0;
-    glUniform1i(locWithCausticsDiffuse_, withCaustics);
+    if (withCaustics) {
+        ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width,
+                            ctx.projection.camera.height);
+        glUniform1i(locShowVirtualDiffuse_, ctx.options.showVirtual ? 1 : 0);
+        glUniform1i(locWithCausticsDiffuse_, 1);
+    } else {
+        ctx.beginFullscreen(programDiffuseNoCaustics_, ctx.projection.camera.width,
+                            ctx.projection.camera.height);
+        glUniform1i(locShowVirtualNoCaustics_, ctx.options.showVirtual ? 1 : 0);
+    }
     auto tex = [&](Resource a, Resource b) {
         return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
     };

@@ -21,8 +21,9 @@ private:
 
     // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
     // compositing code would cost every frame even behind a uniform that turns it off.
-    gl::Program program_;         // with Eqs. 6-11 for mirror / glass pixels
-    gl::Program programDiffuse_;  // MIRAGE_DIFFUSE_ONLY: frames without specular objects
+    gl::Program program_;                   // with Eqs. 6-11 for mirror / glass pixels
+    gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
+    gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
     gl::Texture linear_, srgb_, remap_;
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
@@ -30,7 +31,7 @@ private:
     std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
     GLint locEpsilon_ = -1, locFuzzyOn_ = -1;
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
-    GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1;
+    GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
     gl::Framebuffer fbo_;
 };
 

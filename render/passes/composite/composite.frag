@@ -132,10 +132,12 @@ void main() {
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
         vec3 rv = texture(lRv, cuv).rgb, r = texture(lR, cuv).rgb;
+#ifndef MIRAGE_NO_CAUSTICS  // the variant for frames without a caustic pass never reads them
         if (withCaustics != 0) {
             rv += texture(causticRv, cuv).rgb;
             r += texture(causticR, cuv).rgb;
         }
+#endif
         rv = max(rv, vec3(0.0)) * exposure;
         r = max(r, vec3(0.0)) * exposure;
 #ifndef MIRAGE_DIFFUSE_ONLY

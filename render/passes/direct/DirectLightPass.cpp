@@ -5,7 +5,9 @@
 namespace mirage::render {
 
 DirectLightPass::DirectLightPass(const GpuScene& scene)
-    : program_(fullscreenProgram("direct", "passes/direct/direct.frag", scene.lightingDefines())) {}
+    : program_(fullscreenProgram("direct", "passes/direct/direct.frag", scene.lightingDefines())),
+      programNoGlass_(fullscreenProgram("direct (no glass shadows)", "passes/direct/direct.frag",
+                                        scene.lightingDefines(false))) {}
 
 void DirectLightPass::setup(PassBuilder& b) const {
     b.read(Resource::GBufferPosition);
@@ -40,7 +42,10 @@ void DirectLightPass::resize(const FrameContext& ctx) {
 
 void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
-    ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
+    // Frames in which no light goes through glass use the variant without the glass lookups:
+    // llvmpipe pays for a branch's texture reads even when no pixel takes it.
+    gl::Program& program = ctx.plan.glassShadows ? program_ : programNoGlass_;
+    ctx.beginFullscreen(program, ctx.canvasWidth(), ctx.canvasHeight());
     glBindTextureUnit(kUnitDirectPosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitDirectNormal, res.texture(Resource::GBufferNormal).id());
     glBindTextureUnit(kUnitDirectAlbedo, res.texture(Resource::GBufferAlbedo).id());
@@ -63,7 +68,7 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentRadiance,
                          res.buffer(Resource::TranslucentRadiance).id());
     }
-    glUniform1i(program_.uniformLocation("translucentOn"), translucent ? 1 : 0);
+    glUniform1i(program.uniformLocation("translucentOn"), translucent ? 1 : 0);
     ctx.drawFullscreenTriangle();
     res.publish(Resource::DirectRv, rv_);
     res.publish(Resource::DirectR, r_);

@@ -14,7 +14,7 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    gl::Program program_;
+    gl::Program program_, programNoGlass_;  // with / without MIRAGE_GLASS_SHADOWS
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;
 };
