@@ -599,6 +599,7 @@ void runLive(const LiveArgs& a) {
     std::optional<LatestFrameCapture> envCapture;
     if (envCam) envCapture.emplace(std::move(envCam->source), envCam->pacing);
     bool envEnded = false;
+    std::string envProblem;  // the last environment frame's problem (warned once)
     // Age of the environment frame lighting the current frame (main capture time minus the
     // environment's, ms; empty in the CSV without an environment camera).
     double envAgeMs = std::numeric_limits<double>::quiet_NaN();
@@ -662,7 +663,11 @@ void runLive(const LiveArgs& a) {
                     envFrame = ef.bgr;
                     envTime = ef.captureSeconds;
                 } catch (const Error& e) {
-                    spdlog::warn("live: environment frame not used: {}", e.what());
+                    // Once per distinct problem: a wrong calibration fails every frame alike.
+                    if (envProblem != e.what()) {
+                        envProblem = e.what();
+                        spdlog::warn("live: environment frames not used: {}", envProblem);
+                    }
                 }
             } else if (!envEnded && envCapture->ended()) {
                 envEnded = true;

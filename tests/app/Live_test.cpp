@@ -122,10 +122,11 @@ fs::path frameFile(const fs::path& dir, int k) {
 
 TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
     const fs::path dir = outputDir("live_headless");
-    // 6 frames/s: faster than llvmpipe renders this scene at 640x480 (about 2-4 frames/s on
-    // the 2-core test machine), so the stand-in drops frames like a camera.
+    // 15 frames/s: faster than llvmpipe renders this scene at 640x480 (2-4 frames/s on the
+    // loaded 2-core test machine, about 7 when it is quiet), so the stand-in drops frames like a
+    // camera; its 36 frames last 2.4 s, enough for 4 frames at 0.5 s each.
     auto live = runMirage({"live", "--camera", sampleSession().string(), "--scene", diffuseScene(),
-                           "--headless", "--camera-fps", "6", "--frames", "4", "-o",
+                           "--headless", "--camera-fps", "15", "--frames", "4", "-o",
                            (dir / "live").string()});
     ASSERT_EQ(live.exitCode, 0) << live.output;
     const std::vector<LiveRow> rows = readLiveCsv(dir / "live" / "frames.csv");
@@ -156,7 +157,7 @@ TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
         fs::copy_file(sampleSession() / "board.json", same / "board.json");
         SessionWriter::Options o;
         o.imageSequence = true;
-        o.fps = 6;
+        o.fps = 15;
         SessionWriter w(same, meta, o);
         const std::vector<cv::Mat> frames = sampleFrames(rows);
         for (size_t k = 0; k < rows.size(); ++k) w.append({frames[k]}, {rows[k].t}, std::nullopt);
