@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "core/Error.h"
+#include "core/ParallelFor.h"
 #include "render/raytrace/PhotonMap.h"
 #include "render/raytrace/Sampling.h"
 
@@ -15,34 +16,6 @@ namespace {
 
 constexpr uint64_t kPhotonDomain = 0x9E3779B97F4A7C15ull;  // separates photon and pixel streams
 constexpr int kTile = 16;
-
-// Runs fn(i) for i in [0, count) on `threads` threads; work is claimed through an atomic counter
-// so the assignment of items to threads varies but each item's result does not.
-template <typename Fn>
-void parallelFor(int count, int threads, Fn&& fn) {
-    std::atomic<int> next{0};
-    auto worker = [&] {
-        for (int i = next++; i < count; i = next++) fn(i);
-    };
-    int n = std::max(1, std::min(threads, count));
-    std::vector<std::thread> pool;
-    pool.reserve(size_t(n - 1));
-    std::exception_ptr error;
-    std::mutex errorMutex;
-    auto guarded = [&] {
-        try {
-            worker();
-        } catch (...) {
-            std::lock_guard lock(errorMutex);
-            if (!error) error = std::current_exception();
-            next = count;
-        }
-    };
-    for (int t = 1; t < n; ++t) pool.emplace_back(guarded);
-    guarded();
-    for (auto& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
-}
 
 // Offsets a ray origin off the surface to the side `dir` leaves towards.
 glm::vec3 spawnOrigin(const SurfaceHit& hit, const glm::vec3& dir) {

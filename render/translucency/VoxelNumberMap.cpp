@@ -12,6 +12,7 @@
 
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/ParallelFor.h"
 #include "render/raytrace/Bsdf.h"
 #include "render/raytrace/Sampling.h"
 
@@ -23,19 +24,6 @@ using raytrace::kPi;
 
 constexpr uint32_t kCacheMagic = 0x314D4E56;  // "VNM1"
 constexpr uint32_t kCacheVersion = 2;
-
-template <typename Fn>
-void parallelFor(int count, int threads, Fn&& fn) {
-    std::atomic<int> next{0};
-    auto worker = [&] {
-        for (int i = next++; i < count; i = next++) fn(i);
-    };
-    int n = std::max(1, std::min(threads, count));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < n; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
-}
 
 int threadCount(int requested) {
     return requested > 0 ? requested : int(std::max(1u, std::thread::hardware_concurrency()));
