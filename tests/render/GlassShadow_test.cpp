@@ -45,11 +45,6 @@ Reference referenceComposite(const test::CausticScene& s) {
     return r;
 }
 
-double meanLuminance(const cv::Mat& linearRgb, const cv::Mat& mask) {
-    const cv::Scalar m = cv::mean(linearRgb, mask);
-    return 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2];
-}
-
 // Mean luminance (linear) over the glass's straight shadow in the reference composite, the
 // real-time composite with glass transmitting in the shadow maps, and with glass opaque.
 TEST(GlassShadow, ShadowOfGlassIsLitLikeTheReferenceAndOpaqueFails) {
@@ -80,9 +75,10 @@ TEST(GlassShadow, ShadowOfGlassIsLitLikeTheReferenceAndOpaqueFails) {
     };
     cv::Mat lr;
     const cv::Mat glass = realtime(true, &lr), opaque = realtime(false);
-    const double yRef = meanLuminance(ref.composite, mask), yGlass = meanLuminance(glass, mask),
-                 yOpaque = meanLuminance(opaque, mask),
-                 yFootage = meanLuminance(srgbBgr8ToLinearRgb(ref.footage), mask);
+    const double yRef = test::meanLuminance(ref.composite, mask),
+                 yGlass = test::meanLuminance(glass, mask),
+                 yOpaque = test::meanLuminance(opaque, mask),
+                 yFootage = test::meanLuminance(srgbBgr8ToLinearRgb(ref.footage), mask);
     const cv::Scalar cRef = cv::mean(ref.composite, mask), cGlass = cv::mean(glass, mask);
     std::cout << "[ glass shadow ] mean luminance over " << cv::countNonZero(mask)
               << " shadow pixels: reference " << yRef << ", glass transmits " << yGlass
@@ -96,7 +92,7 @@ TEST(GlassShadow, ShadowOfGlassIsLitLikeTheReferenceAndOpaqueFails) {
     EXPECT_GT(cGlass[0] / cGlass[2], 1.3);
     EXPECT_NEAR((cGlass[0] / cGlass[2]) / (cRef[0] / cRef[2]), 1.0, 0.1);
     // Routing: a virtual plate does not shadow L_r (the real-only maps hold no glass).
-    EXPECT_GT(meanLuminance(lr, mask), yGlass);
+    EXPECT_GT(test::meanLuminance(lr, mask), yGlass);
 }
 
 }  // namespace
@@ -127,7 +123,8 @@ TEST(GlassShadow, PointLightThroughCurvedGlassIsTheDocumentedError) {
     EXPECT_FALSE(rep.ran("photongbuf")) << rep.summary();
     const cv::Mat rt = r.compositeLinear();
     ASSERT_TRUE(cv::checkRange(rt));
-    const double yRef = meanLuminance(ref.composite, mask), yRt = meanLuminance(rt, mask);
+    const double yRef = test::meanLuminance(ref.composite, mask),
+                 yRt = test::meanLuminance(rt, mask);
     const double psnr =
         test::psnr(linearRgbToSrgbBgr8(rt), linearRgbToSrgbBgr8(ref.composite), 255.0, mask);
     std::cout << "[ glass shadow ] point light through the sphere, " << cv::countNonZero(mask)

@@ -191,11 +191,6 @@ TEST(SpecularVpl, GlassGrazingAndEscapingPhotonsStayFiniteAndConserveEnergy) {
 // by the wall 1.0x the reference's (option off: 0.2x).
 constexpr double kFloorLrvRatioTolerance = 0.25, kFloorLrvRatioOff = 0.5;
 
-double meanLuminance(const cv::Mat& rgb, const cv::Mat& mask) {
-    const cv::Scalar m = cv::mean(rgb, mask);
-    return 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2];
-}
-
 TEST(SpecularVpl, FloorLitByTheMirrorsBounceMatchesReference) {
     gl::Context context = gl::Context::headless();
     const RelayScene s = makeRelay();
@@ -219,9 +214,9 @@ TEST(SpecularVpl, FloorLitByTheMirrorsBounceMatchesReference) {
     ASSERT_EQ(on.lrv.size(), ref.realAndVirtual.size());  // an undistorted camera: canvas = image
     // L_rv there is the light the mirror throws onto the wall, bounced once (the light's cone
     // falls on the mirror alone): the reflected VPLs' work.
-    const double lrvRef = meanLuminance(ref.realAndVirtual, region);
-    const double ratioOn = meanLuminance(on.lrv, region) / lrvRef;
-    const double ratioOff = meanLuminance(off.lrv, region) / lrvRef;
+    const double lrvRef = test::meanLuminance(ref.realAndVirtual, region);
+    const double ratioOn = test::meanLuminance(on.lrv, region) / lrvRef;
+    const double ratioOff = test::meanLuminance(off.lrv, region) / lrvRef;
     const double psnrOn = test::psnr(on.composite, refComposite, 255.0, region);
     const double psnrOff = test::psnr(off.composite, refComposite, 255.0, region);
     std::cout << "[ vpl ] floor by the wall (" << cv::countNonZero(region)

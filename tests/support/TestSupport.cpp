@@ -26,6 +26,11 @@ std::filesystem::path outputDir(const std::string& name) {
     return p;
 }
 
+double meanLuminance(const cv::Mat& linearRgb, const cv::Mat& mask) {
+    const cv::Scalar m = cv::mean(linearRgb, mask);
+    return 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2];
+}
+
 double psnr(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask) {
     return mirage::psnr(a, b, peak, mask);
 }

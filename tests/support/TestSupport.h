@@ -17,6 +17,8 @@ std::filesystem::path outputDir(const std::string& name);
 // mask != 0 (CV_8U): core/image/ImageCompare.h's, the figures the benchmark reports too.
 // `peak` is the signal's maximum (1 for linear float, 255 for 8-bit). PSNR is +inf if identical.
 double psnr(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
+// Mean Rec. 709 luminance of a linear RGB (channel order R, G, B) image over `mask`.
+double meanLuminance(const cv::Mat& linearRgb, const cv::Mat& mask = cv::Mat());
 double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
 // The q-quantile (0..1) of the per-pixel absolute difference (max over channels).
 double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q);
