@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/Csv.h"
 #include "tests/support/TestSupport.h"
 
 namespace mirage::test {
@@ -270,26 +271,11 @@ CsvTable readCsvTable(const fs::path& path) {
     CsvTable t;
     std::ifstream in(path);
     EXPECT_TRUE(in.good()) << path;
-    auto split = [](const std::string& line) {
-        std::vector<std::string> f;
-        std::string cur;
-        bool quoted = false;
-        for (char ch : line) {
-            if (ch == '"')
-                quoted = !quoted;
-            else if (ch == ',' && !quoted)
-                f.push_back(cur), cur.clear();
-            else
-                cur += ch;
-        }
-        f.push_back(cur);
-        return f;
-    };
     std::string line;
-    if (std::getline(in, line)) t.header = split(line);
+    if (std::getline(in, line)) t.header = splitCsvLine(line);
     while (std::getline(in, line))
         if (!line.empty()) {
-            t.rows.push_back(split(line));
+            t.rows.push_back(splitCsvLine(line));
             EXPECT_EQ(t.rows.back().size(), t.header.size()) << line;
         }
     return t;

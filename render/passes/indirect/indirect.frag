@@ -8,23 +8,7 @@
 // shadow maps. Routing (DESIGN.md): a VPL at q lights p in L_rv always; in L_r only if the light,
 // q and p are all real, with visibility against real points only. Diffuse receivers.
 in vec2 uv;
-// The VPLs read as four vec4 words each (the GpuVpl layout): llvmpipe loads a vec4 member in one
-// access and a vec3 + int pair in several.
-layout(std430, binding = kBindingVpls) readonly buffer VplWords { vec4 vplWords[]; };
-GpuVpl loadVpl(int i) {
-    vec4 a = vplWords[4 * i], b = vplWords[4 * i + 1], c = vplWords[4 * i + 2],
-         d = vplWords[4 * i + 3];
-    GpuVpl v;
-    v.position = a.xyz;
-    v.isReal = floatBitsToInt(a.w);
-    v.normal = b.xyz;
-    v.valid = floatBitsToInt(b.w);
-    v.flux = c.xyz;
-    v.pad0 = c.w;
-    v.tangent = d.xyz;
-    v.pad1 = d.w;
-    return v;
-}
+layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
 layout(binding = kUnitIndirectPosition) uniform sampler2D gPosition;
 layout(binding = kUnitIndirectNormal) uniform sampler2D gNormal;
 layout(binding = kUnitIndirectAlbedo) uniform sampler2D gAlbedo;
@@ -62,7 +46,7 @@ void main() {
     float clamp2 = vplDistanceClamp * vplDistanceClamp;
     vec3 rv = vec3(0.0), r = vec3(0.0);
     for (int i = first; i < vplCount; i += K * K) {
-        GpuVpl V = loadVpl(i);
+        GpuVpl V = vpls[i];
         if (V.valid == 0) continue;
         vec3 d = p - V.position;
         float dist2 = dot(d, d);
