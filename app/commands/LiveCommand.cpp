@@ -556,6 +556,11 @@ void runLive(const LiveArgs& a) {
     }
     std::unique_ptr<LiveRecording> recording;
     bool recordNameUsed = false;
+    // With an environment camera every recorded row holds both cameras' frames: main frames
+    // processed before its first frame arrived are not recorded (counted here, said at the end).
+    int recordWaitsForEnv = 0;
+    cv::Mat envLatest;  // the environment camera's newest frame as delivered, and its time
+    double envLatestTime = 0;
     auto startRecording = [&] {
         fs::path dir = !a.record.empty() && !recordNameUsed ? fs::path(a.record)
                                                             : fs::path(timestampName("live-", ""));
@@ -563,12 +568,20 @@ void runLive(const LiveArgs& a) {
         LiveRecording::Options ro;
         ro.fps = cam.fps;
         ro.jpegQuality = a.jpegQuality;
+        if (envCam) ro.environmentCalibration = envCam->calibration;
         recording = std::make_unique<LiveRecording>(dir, calibPath, boardPath, ro);
-        spdlog::info("live: recording into {}", dir.string());
+        recordWaitsForEnv = 0;
+        spdlog::info("live: recording into {}{}", dir.string(),
+                     envCam ? " (with the environment camera)" : "");
     };
     auto stopRecording = [&] {
         if (!recording) return;
         recording->close();
+        if (recordWaitsForEnv > 0)
+            spdlog::warn(
+                "live: the first {} processed frames were not recorded: the environment camera "
+                "had delivered no frame yet",
+                recordWaitsForEnv);
         spdlog::info(
             "live: recorded {} frames into {} (replay: mirage replay {} --scene {} --poses "
             "{}/poses.csv -o OUT)",
@@ -658,6 +671,8 @@ void runLive(const LiveArgs& a) {
                 }
             }
             if (haveEnv) {
+                envLatest = ef.bgr;
+                envLatestTime = ef.captureSeconds;
                 try {
                     renderer->updateEnvironment(ef.bgr, ef.captureSeconds);
                     envFrame = ef.bgr;
@@ -706,7 +721,16 @@ void runLive(const LiveArgs& a) {
             const double latencyMs = (steadySeconds() - f.captureSeconds) * 1e3;
             latencies.push_back(latencyMs);
             lastLatencyMs = latencyMs;
-            if (recording && !f.bgr.empty()) recording->append(f.bgr, f.captureSeconds, cf.pose);
+            if (recording && !f.bgr.empty()) {
+                if (!recording->hasEnvironment())
+                    recording->append(f.bgr, f.captureSeconds, cf.pose);
+                else if (envLatest.empty())
+                    ++recordWaitsForEnv;
+                else
+                    // The newest environment frame delivered, used or not: a frame the renderer
+                    // refused is refused again in replay with the same calibration.
+                    recording->append(f.bgr, f.captureSeconds, cf.pose, envLatest, envLatestTime);
+            }
             if (csv.is_open()) {
                 csv << processed << "," << exactDecimal(f.captureSeconds) << ","
                     << csvField(cf.pose.state) << "," << csvField(cf.pose.reason) << ","

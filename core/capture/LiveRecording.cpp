@@ -41,6 +41,16 @@ LiveRecording::LiveRecording(const std::filesystem::path& dir,
     if (ec)
         throw FileError(calibration.string(),
                         "cannot copy the calibration into the recording: " + ec.message());
+    if (!options.environmentCalibration.empty()) {
+        meta.cameras.push_back({"env", "env.mkv", "env.yaml", "environment"});
+        fs::copy_file(options.environmentCalibration, dir / "env.yaml", ec);
+        if (ec)
+            throw FileError(options.environmentCalibration.string(),
+                            "cannot copy the environment camera's calibration into the "
+                            "recording: " +
+                                ec.message());
+        hasEnvironment_ = true;
+    }
     meta.board.clear();
     if (!board.empty()) {
         fs::copy_file(board, dir / "board.json", ec);
@@ -78,9 +88,22 @@ LiveRecording::~LiveRecording() {
 }
 
 void LiveRecording::append(const cv::Mat& bgr, double t, const PoseRow& pose) {
+    if (hasEnvironment_)
+        throw Error(
+            "LiveRecording::append: the recording has an environment camera; give its frame");
     if (posesFd_ < 0) throw Error("LiveRecording::append after close()");
     const int frame = writer_->framesWritten();
     writer_->append({bgr}, {t}, std::nullopt);  // image, then its frames.csv row
+    writeAll(posesFd_, posesCsvRow(frame, t, pose), dir_ / "poses.csv");
+}
+
+void LiveRecording::append(const cv::Mat& bgr, double t, const PoseRow& pose, const cv::Mat& envBgr,
+                           double envT) {
+    if (!hasEnvironment_)
+        throw Error("LiveRecording::append: the recording has no environment camera");
+    if (posesFd_ < 0) throw Error("LiveRecording::append after close()");
+    const int frame = writer_->framesWritten();
+    writer_->append({bgr, envBgr}, {t, envT}, std::nullopt);  // images, then the frames.csv row
     writeAll(posesFd_, posesCsvRow(frame, t, pose), dir_ / "poses.csv");
 }
 

@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/Csv.h"
+#include "core/session/Session.h"
 #include "tests/support/TestSupport.h"
 
 namespace mirage::test {
@@ -288,9 +289,12 @@ CsvTable readCsvTable(const fs::path& path) {
 TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const fs::path dir = outputDir("live_env");
     const fs::path s = dir / "session";
-    for (const char* d : {"session", "env", "static", "replay"}) fs::remove_all(dir / d);  // reruns
+    for (const char* d : {"session", "env", "static", "replay", "rec", "rec_replay", "rec_static"})
+        fs::remove_all(dir / d);  // reruns
     // 640x480 (live tracks the board: at 320x240 this scene's tags are too small for an ok pose),
-    // 3 frames at 4 fps, the room light turning 240 degrees per second (60 per frame).
+    // 5 frames at 2 fps, the room light turning 120 degrees per second (60 per frame). Live takes
+    // 3 of them: a frame slower than the camera's 500 ms drops the next, and the session still
+    // has frames left for the third.
     const std::vector<std::string> synthArgs = {"synth",
                                                 scene(),
                                                 "-o",
@@ -300,9 +304,9 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
                                                 "--height",
                                                 "480",
                                                 "--fps",
-                                                "4",
+                                                "2",
                                                 "--seconds",
-                                                "0.75",
+                                                "2.5",
                                                 "--spp",
                                                 "2",
                                                 "--env-size",
@@ -312,14 +316,16 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
                                                 "--image-sequence",
                                                 "--ground-truth-composite",
                                                 "--env-rotation",
-                                                "240"};
+                                                "120"};
     const CommandResult synth = runMirage(synthArgs);
     ASSERT_EQ(synth.exitCode, 0) << synth.output;
     auto live = [&](const std::string& name, bool env) {
         std::vector<std::string> args = {"live",  "--camera",           s.string(), "--scene",
                                          scene(), "--headless",         "--frames", "3",
                                          "-o",    (dir / name).string()};
-        if (env) args.insert(args.end(), {"--env-camera", s.string()});
+        if (env)
+            args.insert(args.end(),
+                        {"--env-camera", s.string(), "--record", (dir / "rec").string()});
         return runMirage(args);
     };
     const CommandResult withEnv = live("env", true), staticEnv = live("static", false);
@@ -327,7 +333,7 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     ASSERT_EQ(staticEnv.exitCode, 0) << staticEnv.output;
     EXPECT_NE(withEnv.output.find("environment camera session"), std::string::npos)
         << withEnv.output;
-    // Every frame is paired with an environment frame taken within half a frame (125 ms) of it.
+    // Every frame is paired with an environment frame taken within half a frame (250 ms) of it.
     // A loaded machine may drop frames: each output frame is judged against the session frame it
     // shows (camera_frame).
     const CsvTable envCsv = readCsvTable(dir / "env" / "frames.csv");
@@ -338,7 +344,7 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     for (size_t k = 0; k < envCsv.rows.size(); ++k) {
         const std::string age = envCsv.field(k, "env_age_ms");
         ASSERT_FALSE(age.empty()) << "frame " << k << " has no environment frame";
-        EXPECT_LT(std::abs(std::stod(age)), 125.0) << "frame " << k;
+        EXPECT_LT(std::abs(std::stod(age)), 250.0) << "frame " << k;
         EXPECT_GT(std::stod(envCsv.field(k, "environment_ms")), 0.0)
             << "the environment pass did not run in frame " << k;
         envShown.push_back(std::stoi(envCsv.field(k, "camera_frame")));
@@ -372,6 +378,58 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
         differsFromStatic += toStatic < 40.0;
     }
     EXPECT_GT(differsFromStatic, 0) << "the environment camera changed nothing";
+
+    // The live recording holds the environment camera too: per frame the environment frame that
+    // lit it, with its time, and a copy of its calibration. Its replay with the live poses
+    // composites what live showed, up to the recording's JPEG encoding of both cameras.
+    const fs::path rec = dir / "rec";
+    SessionReadReport report;
+    const Session recorded = readSession(rec, &report);
+    EXPECT_TRUE(report.ok());
+    ASSERT_EQ(recorded.cameras.size(), 2u);
+    EXPECT_EQ(recorded.cameras[1].role, "environment");
+    EXPECT_TRUE(fs::exists(rec / "env.yaml"));
+    ASSERT_EQ(recorded.frames.size(), 3u);
+    auto replayRecording = [&](const std::string& name, bool staticEnv) {
+        std::vector<std::string> args = {"replay",  rec.string(),
+                                         "--scene", scene(),
+                                         "--poses", (rec / "poses.csv").string(),
+                                         "-o",      (dir / name).string()};
+        if (staticEnv) args.insert(args.end(), {"--static-env", envFile()});
+        const CommandResult r = runMirage(args);
+        EXPECT_EQ(r.exitCode, 0) << r.output;
+        return r;
+    };
+    const CommandResult recReplay = replayRecording("rec_replay", false);
+    EXPECT_NE(recReplay.output.find("the environment is camera"), std::string::npos)
+        << recReplay.output;
+    replayRecording("rec_static", true);
+    const std::vector<cv::Mat> footage = sessionFrames(rec);
+    ASSERT_EQ(footage.size(), 3u);
+    // What the recording's JPEG encoding of the main footage does not explain (the environment
+    // frames' own JPEG encoding is left in). Measured: 50.2-52.7 dB with the recorded environment
+    // camera, 34.1-42.4 dB for the same recording lit by the static map; 45 dB between them.
+    auto unexplained = [&](const std::string& name, int k) {
+        const cv::Mat live = cv::imread((dir / "env" / cv::format("frame_%06d.png", k)).string());
+        const cv::Mat replayed =
+            cv::imread((dir / name / cv::format("frame_%06d.png", k)).string());
+        const cv::Mat original =
+            cv::imread((s / "main" / cv::format("%06d.png", envShown[size_t(k)])).string());
+        if (live.empty() || replayed.empty() || original.empty()) return 0.0;
+        return unexplainedDb(live, replayed, original, footage[size_t(k)]);
+    };
+    double worstRecorded = 1e9, worstStatic = 1e9;
+    for (int k = 0; k < 3; ++k) {
+        const double withEnv = unexplained("rec_replay", k), still = unexplained("rec_static", k);
+        std::printf(
+            "[ live env ] recording frame %d: replay with its environment camera %.1f dB "
+            "unexplained, with the static map %.1f dB\n",
+            k, withEnv, still);
+        worstRecorded = std::min(worstRecorded, withEnv);
+        worstStatic = std::min(worstStatic, still);
+    }
+    EXPECT_GT(worstRecorded, 45.0);
+    EXPECT_LT(worstStatic, 45.0) << "the tolerance cannot tell the recorded environment apart";
 }
 
 }  // namespace

@@ -192,33 +192,6 @@ TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
 }
 
 // The footage as recorded (main.mkv, JPEG) against the frames the stand-in delivered.
-std::vector<cv::Mat> recordedFrames(const fs::path& session) {
-    const Session s = readSession(session);
-    auto src = openCameraFrames(s, "main");
-    std::vector<cv::Mat> out;
-    cv::Mat bgr;
-    while (src->read(bgr)) out.push_back(bgr.clone());
-    return out;
-}
-
-// PSNR (dB) of the part of the composites' difference that the footage's difference does not
-// explain: r = (replay - live) - (recorded - original), per pixel and channel. Where the virtual
-// objects change nothing the composite is the footage, so r = 0 there by construction; what is
-// left is the rendering's response to the JPEG error (through alpha = CI / L_r and the video
-// seen in the glass) and any difference in the rendering itself.
-double unexplainedDb(const cv::Mat& live, const cv::Mat& replay, const cv::Mat& original,
-                     const cv::Mat& recorded) {
-    cv::Mat a, b, c, d;
-    live.convertTo(a, CV_32F);
-    replay.convertTo(b, CV_32F);
-    original.convertTo(c, CV_32F);
-    recorded.convertTo(d, CV_32F);
-    const cv::Mat r = (b - a) - (d - c);
-    const cv::Scalar m = cv::mean(r.mul(r));
-    const double mse = (m[0] + m[1] + m[2]) / 3;
-    return mse <= 0 ? 1e9 : 10 * std::log10(255.0 * 255.0 / mse);
-}
-
 TEST(LiveRecording, ReplayOfTheRecordingReproducesTheLiveComposite) {
     const fs::path dir = outputDir("live_record");
     const std::string scene = (dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
@@ -246,7 +219,7 @@ TEST(LiveRecording, ReplayOfTheRecordingReproducesTheLiveComposite) {
     auto replay = runMirage({"replay", rec.string(), "--scene", scene, "--poses",
                              (rec / "poses.csv").string(), "-o", (dir / "replay").string()});
     ASSERT_EQ(replay.exitCode, 0) << replay.output;
-    const std::vector<cv::Mat> original = sampleFrames(rows), recorded = recordedFrames(rec);
+    const std::vector<cv::Mat> original = sampleFrames(rows), recorded = sessionFrames(rec);
     ASSERT_EQ(recorded.size(), rows.size());
     // The recording stores the footage as JPEG (quality 92), so the replay composites slightly
     // different footage; everything else is the same (frames, order, times, poses). Tolerance:
@@ -460,7 +433,7 @@ TEST(LivePlacement, ReplayAppliesTheSamePlacement) {
     EXPECT_NE(live.output.find("placement from"), std::string::npos) << live.output;
     const std::vector<LiveRow> rows = readLiveCsv(dir / "live" / "frames.csv");
     ASSERT_EQ(rows.size(), 2u);
-    const std::vector<cv::Mat> original = sampleFrames(rows), recorded = recordedFrames(rec);
+    const std::vector<cv::Mat> original = sampleFrames(rows), recorded = sessionFrames(rec);
     auto worstUnexplained = [&](const std::string& placementFile, const std::string& name) {
         auto r = runMirage({"replay", rec.string(), "--scene", diffuseScene(), "--poses",
                             (rec / "poses.csv").string(), "--placement", placementFile, "-o",

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/image/ImageCompare.h"
+#include "core/session/Session.h"
 
 namespace mirage::test {
 
@@ -72,6 +73,29 @@ CommandResult runMirage(const std::vector<std::string>& args) {
     int status = pclose(p);
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
+}
+
+double unexplainedDb(const cv::Mat& live, const cv::Mat& replay, const cv::Mat& original,
+                     const cv::Mat& recorded) {
+    cv::Mat a, b, c, d;
+    live.convertTo(a, CV_32F);
+    replay.convertTo(b, CV_32F);
+    original.convertTo(c, CV_32F);
+    recorded.convertTo(d, CV_32F);
+    const cv::Mat r = (b - a) - (d - c);
+    const cv::Scalar m = cv::mean(r.mul(r));
+    const double mse = (m[0] + m[1] + m[2]) / 3;
+    return mse <= 0 ? 1e9 : 10 * std::log10(255.0 * 255.0 / mse);
+}
+
+std::vector<cv::Mat> sessionFrames(const std::filesystem::path& session,
+                                   const std::string& camera) {
+    const Session s = readSession(session);
+    auto src = openCameraFrames(s, camera);
+    std::vector<cv::Mat> out;
+    cv::Mat bgr;
+    while (src->read(bgr)) out.push_back(bgr.clone());
+    return out;
 }
 
 }  // namespace mirage::test

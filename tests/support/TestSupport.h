@@ -3,6 +3,7 @@
 // tolerances (never bytes), and running the `mirage` binary for end-to-end tests.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -22,6 +23,17 @@ double meanLuminance(const cv::Mat& linearRgb, const cv::Mat& mask = cv::Mat());
 double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
 // The q-quantile (0..1) of the per-pixel absolute difference (max over channels).
 double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q);
+// PSNR (dB, 8-bit peak) of the part of two composites' difference that their footage's difference
+// does not explain: r = (replay - live) - (recorded - original), per pixel and channel. For a
+// recording replayed: where the virtual objects change nothing the composite is the footage, so
+// r = 0 there by construction; what is left is the rendering's response to the re-encoded
+// footage (through alpha = CI / L_r and the video seen in the glass) and any difference in the
+// rendering itself. +inf-like (1e9) when nothing is left.
+double unexplainedDb(const cv::Mat& live, const cv::Mat& replay, const cv::Mat& original,
+                     const cv::Mat& recorded);
+// Every frame of a session's camera (8-bit BGR), decoded in order.
+std::vector<cv::Mat> sessionFrames(const std::filesystem::path& session,
+                                   const std::string& camera = "main");
 
 struct CommandResult {
     int exitCode = -1;
