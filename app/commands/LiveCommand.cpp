@@ -39,6 +39,7 @@
 
 #include "app/BoardPlane.h"
 #include "app/Command.h"
+#include "app/EffectSwitches.h"
 #include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
@@ -77,7 +78,8 @@ double msSince(Clock::time_point t0) {
 
 struct LiveArgs {
     std::string camera, scene, calibration, board, output, record;
-    double cameraFps = 0;  // 0: the stand-in's own rate
+    std::vector<std::string> effectsOff;  // bench knob names of effects switched off
+    double cameraFps = 0;                 // 0: the stand-in's own rate
     int width = 640, height = 480;
     int maxFrames = -1;
     int vpls = 256;
@@ -521,16 +523,19 @@ void runLive(const LiveArgs& a) {
     // A renderer for the scene as placed. Built anew when the quality or the placement changes:
     // every pass (shadows, VPLs, imperfect shadow maps, impostors) then runs for the new scene in
     // the next frame; while nothing changes the camera-independent passes are reused.
-    auto makeRenderer = [&](int vpls, int indirectScale, int impostorResolution) {
-        render::RendererOptions ropt;
+    int vpls = a.vpls;  // --vpls, until a preset is chosen
+    // The effects as switched (--off, then the HUD's checkboxes): RendererOptions' switches.
+    render::RendererOptions effects;
+    switchEffectsOff(a.effectsOff, effects);
+    auto makeRenderer = [&] {
+        render::RendererOptions ropt = effects;
         ropt.vplCount = vpls;
-        ropt.indirectScale = indirectScale;
-        ropt.impostorResolution = impostorResolution;
+        ropt.indirectScale = kPresets[preset].indirectScale;
+        ropt.impostorResolution = kPresets[preset].impostorResolution;
         ropt.exposure = a.exposure;
         return std::make_unique<render::Renderer>(placedScene(placement), calib.intrinsics, ropt);
     };
-    std::unique_ptr<render::Renderer> renderer =
-        makeRenderer(a.vpls, kPresets[preset].indirectScale, kPresets[preset].impostorResolution);
+    std::unique_ptr<render::Renderer> renderer = makeRenderer();
     auto compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
     // The environment camera's newest frame lights the scene from the next render on; a renderer
     // built anew (quality, placement) gets the camera and the last frame again.
@@ -879,6 +884,19 @@ void runLive(const LiveArgs& a) {
             ImGui::EndCombo();
         }
         if (!viewProblem.empty()) ImGui::TextColored(amber, "%s", viewProblem.c_str());
+        // Effects on/off: each switch rebuilds the renderer (its passes leave the frame graph,
+        // and the pass table above says why they did not run).
+        bool effectsChanged = false;
+        if (ImGui::CollapsingHeader("effects")) {
+            for (const EffectSwitch& e : kEffectSwitches) {
+                bool on = effects.*e.member;
+                if (ImGui::Checkbox(e.label, &on)) {
+                    effects.*e.member = on;
+                    effectsChanged = true;
+                    spdlog::info("live: {} {}", e.name, on ? "on" : "off");
+                }
+            }
+        }
         ImGui::Text("placement %+.2f %+.2f m, %+.0f deg, x%.2f%s", placement.moveU, placement.moveV,
                     placement.turnDeg, placement.scale, placementPending ? " (moving)" : "");
         ImGui::TextDisabled("drag or arrows move, Q/E turn, +/- scale, 0 reset");
@@ -921,8 +939,7 @@ void runLive(const LiveArgs& a) {
         // second on llvmpipe), and saved beside the scene.
         if (placementPending && msSince(placementChangedAt) > 300 && !dragStart) {
             placementPending = false;
-            renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
-                                    kPresets[preset].impostorResolution);
+            renderer = makeRenderer();
             compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
             attachEnvironment();
             last.report = nullptr;
@@ -933,15 +950,18 @@ void runLive(const LiveArgs& a) {
                 spdlog::warn("live: placement not saved: {}", e.what());
             }
         }
-        if (newPreset != preset) {
-            // A new renderer with the preset's options; the temporal history starts again.
-            preset = newPreset;
-            renderer = makeRenderer(kPresets[preset].vpls, kPresets[preset].indirectScale,
-                                    kPresets[preset].impostorResolution);
+        if (newPreset != preset || effectsChanged) {
+            // A new renderer with the preset's options and the effects as switched; the
+            // temporal history starts again.
+            if (newPreset != preset) {
+                preset = newPreset;
+                vpls = kPresets[preset].vpls;
+                spdlog::info("live: quality {}", kPresets[preset].name);
+            }
+            renderer = makeRenderer();
             compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
             attachEnvironment();
             last.report = nullptr;
-            spdlog::info("live: quality {}", kPresets[preset].name);
         }
     }
     const std::string captureError = capture.error();
@@ -1012,6 +1032,12 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_option("-o,--output", args->output,
                     "Write the composites: OUT.mkv (MJPEG video) or a folder of PNG frames, with "
                     "a per-frame CSV beside it");
+    cmd->add_option("--off", args->effectsOff,
+                    "Start with these effects off (comma-separated, as `mirage bench` names "
+                    "them; the HUD switches them): " +
+                        effectSwitchNames())
+        ->delimiter(',')
+        ->check(effectSwitchName());
     cmd->add_option("--record", args->record,
                     "Record the session (the camera's frames and the live poses) into this new "
                     "folder; replay it with `mirage replay`");

@@ -36,6 +36,7 @@
 
 #include "app/BoardPlane.h"
 #include "app/Command.h"
+#include "app/EffectSwitches.h"
 #include "app/FrameCompositor.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
@@ -90,6 +91,7 @@ void progress(int done, int total, double fps) {
 
 struct ReplayArgs {
     std::string session, scene, output, poses, shard, placement, staticEnv;
+    std::vector<std::string> effectsOff;  // bench knob names of effects switched off
     int vpls = 256;
     int maxFrames = -1;
     int start = 0;
@@ -211,6 +213,7 @@ void runReplay(const ReplayArgs& a) {
     render::RendererOptions ropt;
     ropt.vplCount = a.vpls;
     ropt.exposure = a.exposure;
+    switchEffectsOff(a.effectsOff, ropt);
     render::Renderer renderer(scene, calib.intrinsics, ropt);
 
     // The environment camera, unless --static-env overrides it.
@@ -480,6 +483,11 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
                     "Light with this equirectangular image (.exr/.hdr/.pfm, linear) instead of "
                     "the session's environment camera")
         ->check(CLI::ExistingFile);
+    cmd->add_option("--off", args->effectsOff,
+                    "Switch these effects off (comma-separated, as `mirage bench` names them): " +
+                        effectSwitchNames())
+        ->delimiter(',')
+        ->check(effectSwitchName());
     cmd->add_flag("--estimate-lights", args->estimateLights,
                   "Report the dominant lights of the environment (direction, colour, intensity) "
                   "whenever it changes");

@@ -257,31 +257,6 @@ TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
         EXPECT_EQ(e, "camera");
 }
 
-// A CSV with a header (quoted fields may hold commas), looked up by column name.
-struct CsvTable {
-    std::vector<std::string> header;
-    std::vector<std::vector<std::string>> rows;
-    std::string field(size_t row, const std::string& name) const {
-        const auto it = std::find(header.begin(), header.end(), name);
-        EXPECT_NE(it, header.end()) << "no column " << name;
-        if (it == header.end() || row >= rows.size()) return {};
-        return rows[row][size_t(it - header.begin())];
-    }
-};
-CsvTable readCsvTable(const fs::path& path) {
-    CsvTable t;
-    std::ifstream in(path);
-    EXPECT_TRUE(in.good()) << path;
-    std::string line;
-    if (std::getline(in, line)) t.header = splitCsvLine(line);
-    while (std::getline(in, line))
-        if (!line.empty()) {
-            t.rows.push_back(splitCsvLine(line));
-            EXPECT_EQ(t.rows.back().size(), t.header.size()) << line;
-        }
-    return t;
-}
-
 // mirage live with the environment camera: a session stands in for both cameras (paced by its
 // frame times); each main frame is lit by the environment frame nearest in time, so with the room
 // light turning the composite follows it exactly as replay's does (the same environment frames),

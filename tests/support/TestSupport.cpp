@@ -1,13 +1,17 @@
 #include "tests/support/TestSupport.h"
 
 #include <sys/wait.h>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 
+#include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "core/Csv.h"
 #include "core/image/ImageCompare.h"
 #include "core/session/Session.h"
 
@@ -96,6 +100,27 @@ std::vector<cv::Mat> sessionFrames(const std::filesystem::path& session,
     cv::Mat bgr;
     while (src->read(bgr)) out.push_back(bgr.clone());
     return out;
+}
+
+std::string CsvTable::field(size_t row, const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << "no column " << name;
+    if (it == header.end() || row >= rows.size()) return {};
+    return rows[row][size_t(it - header.begin())];
+}
+
+CsvTable readCsvTable(const std::filesystem::path& path) {
+    CsvTable t;
+    std::ifstream in(path);
+    EXPECT_TRUE(in.good()) << path;
+    std::string line;
+    if (std::getline(in, line)) t.header = splitCsvLine(line);
+    while (std::getline(in, line))
+        if (!line.empty()) {
+            t.rows.push_back(splitCsvLine(line));
+            EXPECT_EQ(t.rows.back().size(), t.header.size()) << line;
+        }
+    return t;
 }
 
 }  // namespace mirage::test

@@ -31,6 +31,14 @@ double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q);
 // rendering itself. +inf-like (1e9) when nothing is left.
 double unexplainedDb(const cv::Mat& live, const cv::Mat& replay, const cv::Mat& original,
                      const cv::Mat& recorded);
+// A CSV with a header (quoted fields may hold commas), looked up by column name: a test fails
+// when the file cannot be read, a row has another number of fields, or a column is missing.
+struct CsvTable {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    std::string field(size_t row, const std::string& name) const;
+};
+CsvTable readCsvTable(const std::filesystem::path& path);
 // Every frame of a session's camera (8-bit BGR), decoded in order.
 std::vector<cv::Mat> sessionFrames(const std::filesystem::path& session,
                                    const std::string& camera = "main");

@@ -1,0 +1,70 @@
+#pragma once
+// The renderer's effects a user can switch off: `mirage live` (HUD checkboxes and --off) and
+// `mirage replay` (--off). Each is named as the `mirage bench` knob that switches it
+// (docs/bench.md), so that a frame seen live can be replayed and benchmarked the same way.
+// Switching an effect off removes its passes from the frame graph (the report says why they did
+// not run); it never changes what the scene holds.
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "core/Error.h"
+#include "render/FrameContext.h"
+
+namespace mirage::app {
+
+struct EffectSwitch {
+    const char* name;   // as the bench knob
+    const char* label;  // as the HUD shows it
+    bool render::RendererOptions::*member;
+};
+
+inline constexpr EffectSwitch kEffectSwitches[] = {
+    {"caustics", "caustics", &render::RendererOptions::caustics},
+    {"glass_shadows", "shadows through glass", &render::RendererOptions::glassShadows},
+    {"refl_refr_vpls", "VPLs through mirror/glass",
+     &render::RendererOptions::reflectedRefractedVpls},
+    {"specular_vpls", "VPLs in reflections", &render::RendererOptions::specularVpls},
+    {"fuzzy", "fuzzy reflections", &render::RendererOptions::fuzzyReflections},
+    {"translucency", "translucency", &render::RendererOptions::translucency},
+};
+
+inline std::string effectSwitchNames() {
+    std::string s;
+    for (const EffectSwitch& e : kEffectSwitches)
+        s += (s.empty() ? "" : ", ") + std::string(e.name);
+    return s;
+}
+
+inline const EffectSwitch* findEffectSwitch(const std::string& name) {
+    for (const EffectSwitch& e : kEffectSwitches)
+        if (name == e.name) return &e;
+    return nullptr;
+}
+
+// `--off NAME[,NAME...]`: each name checked while the arguments are parsed, before any work.
+inline CLI::Validator effectSwitchName() {
+    return CLI::Validator(
+        [](std::string& name) -> std::string {
+            if (findEffectSwitch(name)) return {};
+            return "'" + name + "' is not an effect; the effects are: " + effectSwitchNames();
+        },
+        "EFFECT");
+}
+
+// Switches the named effects off in `options`; throws Error for a name it does not know, with
+// the names it does.
+inline void switchEffectsOff(const std::vector<std::string>& names,
+                             render::RendererOptions& options) {
+    for (const std::string& n : names) {
+        const EffectSwitch* e = findEffectSwitch(n);
+        if (!e)
+            throw Error(fmt::format("--off: '{}' is not an effect; the effects are: {}", n,
+                                    effectSwitchNames()));
+        options.*e->member = false;
+    }
+}
+
+}  // namespace mirage::app
