@@ -62,12 +62,15 @@ bool V4l2Camera::read(cv::Mat& bgr) {
         RawFrame raw;
         if (!device_->dequeue(raw, timeoutMs)) return false;
         const double host = steadySeconds();
+        // Stamped even when it does not decode: its sequence number is a frame the driver
+        // delivered (counted as corrupt), not one it dropped.
+        const double t = clock_.stamp(raw, host);
+        dropped_ = clock_.droppedFrames();
         if (!convertToBgr(raw, bgr)) {
             ++corrupt_;
             continue;
         }
-        last_ = clock_.stamp(raw, host);
-        dropped_ = clock_.droppedFrames();
+        last_ = t;
         return true;
     }
     throw Error(device_->name() +

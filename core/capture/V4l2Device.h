@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/capture/CaptureDevice.h"
+#include "core/capture/V4l2Kernel.h"
 
 namespace mirage {
 
@@ -12,7 +13,9 @@ class V4l2Device final : public CaptureDevice {
 public:
     // Opens the device; throws mirage::Error naming the device and what to check (is a camera
     // plugged in? permissions: the `video` group?) if it is missing or not a capture device.
-    explicit V4l2Device(const std::string& devicePath);
+    // `kernel`: the calls into the kernel (a fake driver in tests).
+    explicit V4l2Device(const std::string& devicePath,
+                        std::shared_ptr<V4l2Kernel> kernel = libv4l2Kernel());
     ~V4l2Device() override;
     V4l2Device(const V4l2Device&) = delete;
     V4l2Device& operator=(const V4l2Device&) = delete;
