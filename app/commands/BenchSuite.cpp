@@ -134,9 +134,14 @@ std::string safeName(std::string s) {
     return s;
 }
 
+fs::path effectSceneFile(const SuiteSpec& spec, const SuiteEffect& e) {
+    return e.scene.empty() ? spec.scene : e.scene;
+}
+
 // Makes (or reuses) the effect's synthetic session under out/sessions/.
 fs::path effectSession(const SuiteSpec& spec, const SuiteEffect& e, const Scene& scene,
                        const fs::path& out) {
+    const fs::path sceneFile = effectSceneFile(spec, e);
     raytrace::SyntheticSessionOptions o;
     o.width = spec.width;
     o.height = spec.height;
@@ -145,20 +150,21 @@ fs::path effectSession(const SuiteSpec& spec, const SuiteEffect& e, const Scene&
     o.samplesPerPixel = spec.samplesPerPixel;
     o.environmentCamera = false;
     o.groundTruthComposite = true;
-    o.boardFile = spec.board.empty() ? spec.scene.parent_path() / "board.json" : spec.board;
+    o.boardFile = spec.board.empty() ? sceneFile.parent_path() / "board.json" : spec.board;
     std::string hidden;
     for (const auto& h : e.hideNodes) hidden += h + ";";
-    o.sceneName = fs::absolute(spec.scene).lexically_normal().string() +
+    o.sceneName = fs::absolute(sceneFile).lexically_normal().string() +
                   (hidden.empty() ? "" : " without " + hidden);
     const std::string fp = raytrace::syntheticFingerprint(
-        o, fileFingerprint(spec.scene) ^ fingerprint64(hidden), fileFingerprint(o.boardFile));
+        o, fileFingerprint(sceneFile) ^ fingerprint64(hidden), fileFingerprint(o.boardFile));
     const fs::path dir = out / "sessions" / (safeName(e.name) + "-" + fp.substr(0, 12));
     if (fs::exists(dir / "session.json") && render::readGroundTruthInfo(dir)) {
         spdlog::info("suite: {}: reusing the session {}", e.name, dir.string());
         return dir;
     }
-    spdlog::info("suite: {}: synthesising {}x{}, {} frame(s) at {} spp into {}", e.name, o.width,
-                 o.height, raytrace::syntheticFrameCount(o), o.samplesPerPixel, dir.string());
+    spdlog::info("suite: {}: synthesising {} at {}x{}, {} frame(s) at {} spp into {}", e.name,
+                 sceneFile.filename().string(), o.width, o.height, raytrace::syntheticFrameCount(o),
+                 o.samplesPerPixel, dir.string());
     fs::create_directories(dir.parent_path());
     StagedPath staged(dir);
     raytrace::writeSyntheticSession(scene, staged.temp(), o);
@@ -341,22 +347,53 @@ SuiteSpec defaultSuite() {
          {"glass_sphere", "mirror"},
          {{"vpls", {"64", "128", "256", "512", "1024"}},
           {"indirect_scale", {"1", "2"}},
-          {"static_reuse", {"on", "off"}}}},
+          {"static_reuse", {"on", "off"}}},
+         {}},
         {"mirror",
          "the mirror and the yellow box (the glass sphere left out)",
          {"glass_sphere"},
-         specularSweeps},
+         specularSweeps,
+         {}},
         {"glass",
          "the glass sphere and the yellow box (the mirror left out)",
          {"mirror"},
-         specularSweeps},
+         specularSweeps,
+         {}},
         {"both",
          "the whole tabletop: glass sphere, mirror and yellow box",
          {},
          {{"vpls", {"64", "256", "1024"}},
           {"impostor_resolution", {"128", "256"}},
-          {"specular_trace", {"impostors", "cubemap"}}}},
+          {"specular_trace", {"impostors", "cubemap"}}},
+         {}},
+        {"caustics",
+         "light through the glass sphere: its caustic, its tinted shadow and the VPLs it "
+         "refracts onto the table (the mirror left out)",
+         {"mirror"},
+         {{"caustics", {"on", "off"}},
+          {"caustic_map", {"128", "256", "512"}},
+          {"glass_shadows", {"on", "off"}},
+          {"refl_refr_vpls", {"on", "off"}}},
+         {}},
     };
+    const fs::path dir = s.scene.parent_path();
+    SuiteEffect rough{"rough",
+                      "frosted glass and brushed metal beside the yellow box "
+                      "(tabletop_rough.gltf): fuzzy reflections and rough refraction",
+                      {},
+                      {{"fuzzy", {"on", "off"}},
+                       {"fuzzy_cone", {"10", "20", "40"}},
+                       {"fuzzy_taps", {"6", "12", "24"}}},
+                      dir / "tabletop_rough.gltf"};
+    SuiteEffect translucent{"translucent",
+                            "the jade cube with a cavity and a density gradient beside the "
+                            "yellow box (tabletop_translucent.gltf; glass sphere and mirror left "
+                            "out): the voxel number map",
+                            {"glass_sphere", "mirror"},
+                            {{"vnm_resolution", {"8", "12", "16"}}},
+                            dir / "tabletop_translucent.gltf"};
+    s.effects.push_back(std::move(rough));
+    s.effects.push_back(std::move(translucent));
     s.scalingResolutions = {"320x240", "640x480", "1024x768", "1600x1200", "1920x1440"};
     s.scalingVpls = {"64", "128", "256", "512", "1024"};
     s.scalingTriangles = {1000, 10000, 100000, 1000000};
@@ -403,6 +440,7 @@ SuiteSpec loadSuite(const fs::path& file) {
             x.name = e.at("name").get<std::string>();
             x.title = e.value("title", x.name);
             x.hideNodes = e.value("hide", std::vector<std::string>{});
+            if (e.contains("scene")) x.scene = dir / e.at("scene").get<std::string>();
             if (e.contains("sweeps"))
                 for (const auto& [knob, values] : e.at("sweeps").items())
                     x.sweeps.emplace_back(knob, values.get<std::vector<std::string>>());
@@ -424,9 +462,17 @@ SuiteSpec loadSuite(const fs::path& file) {
 }
 
 void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& commandLine) {
-    if (!fs::exists(spec.scene))
-        throw FileError(spec.scene.string(), "the suite's scene does not exist");
-    const Scene full = loadScene(spec.scene);
+    // Every scene is loaded (and every knob checked) before hours of synthesis.
+    std::map<fs::path, Scene> loaded;
+    for (const auto& e : spec.effects) {
+        const fs::path file = effectSceneFile(spec, e);
+        if (loaded.count(file)) continue;
+        if (!fs::exists(file))
+            throw FileError(file.string(),
+                            e.scene.empty() ? "the suite's scene does not exist"
+                                            : "effect '" + e.name + "': its scene does not exist");
+        loaded.emplace(file, loadScene(file));
+    }
     // Knob names and values are checked before hours of synthesis.
     {
         CameraIntrinsics probe;
@@ -441,8 +487,10 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
             }
     }
     std::vector<Scene> scenes;
-    for (const auto& e : spec.effects)
-        scenes.push_back(sceneVariant(full, e.hideNodes, spec.scene));
+    for (const auto& e : spec.effects) {
+        const fs::path file = effectSceneFile(spec, e);
+        scenes.push_back(sceneVariant(loaded.at(file), e.hideNodes, file));
+    }
     fs::create_directories(out / "results" / "images");
 
     std::vector<EffectRun> runs(spec.effects.size());

@@ -20,11 +20,12 @@ struct SuiteEffect {
     std::vector<std::string> hideNodes;  // node names of the scene left out (their meshes)
     // Each sweep varies one knob from the default (`mirage bench --list-knobs`).
     std::vector<std::pair<std::string, std::vector<std::string>>> sweeps;
+    std::filesystem::path scene;  // its own glTF (empty: the suite's scene)
 };
 
 struct SuiteSpec {
     std::filesystem::path scene;  // glTF with real and virtual parts
-    std::filesystem::path board;  // empty: board.json beside the scene
+    std::filesystem::path board;  // empty: board.json beside each effect's scene
     int width = 640, height = 480;
     double fps = 6.0, seconds = 1.0;  // session length: fps x seconds frames
     int samplesPerPixel = 32;         // reference renderer passes per frame (ground truth)
@@ -37,7 +38,8 @@ struct SuiteSpec {
     std::vector<int> scalingTriangles;
 };
 
-// The standard suite: the bundled tabletop scene as diffuse, mirror, glass and both.
+// The standard suite: the bundled tabletop scene as diffuse, mirror, glass, both and caustics,
+// and its rough and translucent variants.
 SuiteSpec defaultSuite();
 // A suite file (JSON, docs/results.md); relative paths are relative to the file. Throws
 // FileError naming the file and the field.

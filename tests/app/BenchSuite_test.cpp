@@ -32,6 +32,9 @@ fs::path writeSuite(const fs::path& dir, const std::string& body) {
 
 std::string tinySuite() {
     const std::string scene = (test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
+    // The second effect in a scene of its own (the translucent tabletop, which holds the mirror).
+    const std::string translucent =
+        (test::dataDir() / "scenes" / "tabletop" / "tabletop_translucent.gltf").string();
     return R"({
   "scene": ")" +
            scene + R"(",
@@ -39,7 +42,9 @@ std::string tinySuite() {
   "effects": [
     {"name": "diffuse", "hide": ["glass_sphere", "mirror"],
      "sweeps": {"vpls": ["16", "64"], "virtual": ["on", "off"]}},
-    {"name": "mirror", "hide": ["glass_sphere"], "sweeps": {"impostor_resolution": ["32", "64"]}}
+    {"name": "mirror", "scene": ")" +
+           translucent + R"(", "hide": ["glass_sphere", "jade_cube"],
+     "sweeps": {"impostor_resolution": ["32", "64"]}}
   ],
   "scaling": {"resolutions": ["40x30", "80x60"], "vpls": ["16", "32"], "triangles": [200, 2000]}
 })";
@@ -55,6 +60,8 @@ TEST(BenchSuite, TinySuiteWritesEveryPlotTableAndCropAndFlagsABrokenRenderer) {
 
     const std::string md = readAll(out / "results.md");
     ASSERT_FALSE(md.empty());
+    EXPECT_NE(md.find("sessions/mirror-"), std::string::npos) << md;
+    EXPECT_NE(r.output.find("tabletop_translucent.gltf"), std::string::npos) << r.output;
     for (const char* needle :
          {"## diffuse", "## mirror", "## Scaling", "machine:", "GL renderer:", "load average",
           "footage only", "passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg"})
@@ -104,6 +111,8 @@ TEST(BenchSuite, BadSuiteFilesAreRefusedWithTheirField) {
         {"{\"effects\": [{\"name\": \"a\", \"sweeps\": {\"warp\": [\"1\"]}}]}", "unknown knob"},
         {"{\"effects\": [{\"name\": \"a\", \"hide\": [\"no_such_node\"]}]}", "no_such_node"},
         {"not json", "not valid JSON"},
+        {"{\"effects\": [{\"name\": \"a\", \"scene\": \"nope.gltf\"}]}",
+         "effect 'a': its scene does not exist"},
     };
     for (const auto& c : cases) {
         const fs::path suite = writeSuite(dir, c.body);
