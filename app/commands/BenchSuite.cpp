@@ -24,6 +24,7 @@
 #include "core/plot/SvgPlot.h"
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
+#include "render/SessionEnvironment.h"
 #include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/RealtimeBench.h"
 #include "render/raytrace/SyntheticSession.h"
@@ -122,7 +123,8 @@ struct EffectRun {
     CameraIntrinsics camera;
     std::vector<BenchFrame> frames;
     Scene scene;
-    std::vector<BenchResult> results;  // unique configurations, default first
+    std::optional<render::SessionEnvironment> environment;  // SuiteEffect::environmentCamera
+    std::vector<BenchResult> results;                       // unique configurations, default first
     std::vector<std::string> pointLabels;
     BenchResult baseline;
     size_t cheapest = 0;
@@ -148,7 +150,7 @@ fs::path effectSession(const SuiteSpec& spec, const SuiteEffect& e, const Scene&
     o.fps = spec.fps;
     o.seconds = spec.seconds;
     o.samplesPerPixel = spec.samplesPerPixel;
-    o.environmentCamera = false;
+    o.environmentCamera = e.environmentCamera;
     o.groundTruthComposite = true;
     o.boardFile = spec.board.empty() ? sceneFile.parent_path() / "board.json" : spec.board;
     std::string hidden;
@@ -189,6 +191,16 @@ void loadFrames(EffectRun& run) {
     run.frames = render::loadBenchFrames(session, *gt, run.camera);
     if (run.frames.empty())
         throw FileError(run.session.string(), "no frame with a ground-truth composite");
+    if (run.effect->environmentCamera) {
+        std::string why;
+        run.environment =
+            render::SessionEnvironment::open(session, render::RendererOptions{}.exposure, why);
+        if (!run.environment)
+            throw FileError(run.session.string(),
+                            "the effect needs the session's environment camera: " +
+                                (why.empty() ? std::string("it has none") : why) +
+                                "; delete the folder and the suite makes it again");
+    }
 }
 
 // The varied knob of a configuration against the defaults ("default" when none differs).
@@ -222,7 +234,8 @@ void runEffect(EffectRun& run, int repeats) {
     }
     for (size_t i = 0; i < configs.size(); ++i) {
         BenchResult r =
-            render::runBenchConfig(run.scene, run.camera, run.frames, configs[i], repeats);
+            render::runBenchConfig(run.scene, run.camera, run.frames, configs[i], repeats,
+                                   run.environment ? &run.environment->setup() : nullptr);
         run.pointLabels.push_back(pointLabel(configs[i], defaults, run.camera));
         spdlog::info("suite: {} [{}/{}] {}: {:.1f} ms/frame, influenced PSNR {:.2f} dB",
                      run.effect->name, i + 1, configs.size(), run.pointLabels.back(),
@@ -392,6 +405,15 @@ SuiteSpec defaultSuite() {
                             {"glass_sphere", "mirror"},
                             {{"vnm_resolution", {"8", "12", "16"}}},
                             dir / "tabletop_translucent.gltf"};
+    SuiteEffect environment{
+        "environment",
+        "the yellow box lit by the room as the fish-eye environment camera "
+        "films it, frame by frame, against the exact environment map",
+        {"glass_sphere", "mirror"},
+        {{"env_source", {"static", "camera"}}, {"env_resolution", {"64", "128", "256", "512"}}},
+        {},
+        true};
+    s.effects.push_back(std::move(environment));
     s.effects.push_back(std::move(rough));
     s.effects.push_back(std::move(translucent));
     s.scalingResolutions = {"320x240", "640x480", "1024x768", "1600x1200", "1920x1440"};
@@ -441,6 +463,7 @@ SuiteSpec loadSuite(const fs::path& file) {
             x.title = e.value("title", x.name);
             x.hideNodes = e.value("hide", std::vector<std::string>{});
             if (e.contains("scene")) x.scene = dir / e.at("scene").get<std::string>();
+            x.environmentCamera = e.value("environment_camera", false);
             if (e.contains("sweeps"))
                 for (const auto& [knob, values] : e.at("sweeps").items())
                     x.sweeps.emplace_back(knob, values.get<std::vector<std::string>>());

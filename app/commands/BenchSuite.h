@@ -21,6 +21,9 @@ struct SuiteEffect {
     // Each sweep varies one knob from the default (`mirage bench --list-knobs`).
     std::vector<std::pair<std::string, std::vector<std::string>>> sweeps;
     std::filesystem::path scene;  // its own glTF (empty: the suite's scene)
+    // The session films the room with a fish-eye environment camera too, for the knobs
+    // env_source and env_resolution (docs/environment.md).
+    bool environmentCamera = false;
 };
 
 struct SuiteSpec {

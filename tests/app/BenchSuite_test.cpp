@@ -40,8 +40,8 @@ std::string tinySuite() {
            scene + R"(",
   "width": 80, "height": 60, "fps": 2, "seconds": 1, "spp": 4, "repeats": 1,
   "effects": [
-    {"name": "diffuse", "hide": ["glass_sphere", "mirror"],
-     "sweeps": {"vpls": ["16", "64"], "virtual": ["on", "off"]}},
+    {"name": "diffuse", "hide": ["glass_sphere", "mirror"], "environment_camera": true,
+     "sweeps": {"vpls": ["16", "64"], "virtual": ["on", "off"], "env_source": ["static", "camera"]}},
     {"name": "mirror", "scene": ")" +
            translucent + R"(", "hide": ["glass_sphere", "jade_cube"],
      "sweeps": {"impostor_resolution": ["32", "64"]}}
@@ -84,13 +84,15 @@ TEST(BenchSuite, TinySuiteWritesEveryPlotTableAndCropAndFlagsABrokenRenderer) {
     EXPECT_NE(diffuse.find("#D00000"), std::string::npos);
     const std::string mirror = readAll(out / "results" / "mirror_time_error.svg");
     EXPECT_EQ(mirror.find("#D00000"), std::string::npos) << "no mirror setting should be broken";
-    // One point per setting: diffuse has default, vpls=16, vpls=64, virtual=off (vpls=256 and
-    // virtual=on are the default).
+    // One point per setting: diffuse has default, vpls=16, vpls=64, virtual=off and
+    // env_source=camera, lit by the session's environment camera (vpls=256, virtual=on and
+    // env_source=static are the default).
     size_t points = 0;
     for (size_t p = diffuse.find("class=\"point\""); p != std::string::npos;
          p = diffuse.find("class=\"point\"", p + 1))
         ++points;
-    EXPECT_EQ(points, 4u);
+    EXPECT_EQ(points, 5u);
+    EXPECT_NE(md.find("| env_source=camera |"), std::string::npos) << md;
 
     // A second run reuses the sessions.
     const auto again =
