@@ -39,6 +39,9 @@ struct SuiteSpec {
     // about this many triangles added to the first effect's scene.
     std::vector<std::string> scalingResolutions, scalingVpls;
     std::vector<int> scalingTriangles;
+    // The tracker against OpenCV ArUco (tracking/ArucoComparison.h) at these image widths (640
+    // and/or 1280; empty: no such section).
+    std::vector<int> trackingWidths;
 };
 
 // The standard suite: the bundled tabletop scene as diffuse, mirror, glass, both and caustics,

@@ -8,6 +8,16 @@ Pose Pose::fromMatrix(const glm::dmat4& m) {
     return fromRotationTranslation(glm::dmat3(m), glm::dvec3(m[3]));
 }
 
+Pose cameraLookingAt(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up,
+                     double rollRad) {
+    const glm::dvec3 fwd = glm::normalize(target - eye);
+    const glm::dvec3 right = glm::normalize(glm::cross(fwd, up));
+    const glm::dvec3 down = glm::cross(fwd, right);
+    const glm::dvec3 rolledRight = std::cos(rollRad) * right + std::sin(rollRad) * down;
+    return Pose::fromRotationTranslation(glm::dmat3(rolledRight, glm::cross(fwd, rolledRight), fwd),
+                                         eye);
+}
+
 Pose Pose::fromRotationTranslation(const glm::dmat3& r, const glm::dvec3& t) {
     Pose p;
     // quat_cast followed by normalisation is a projection onto the nearest rotation for the

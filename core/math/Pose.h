@@ -29,6 +29,11 @@ struct Pose {
     bool isFinite() const;
 };
 
+// T_world_camera (OpenCV camera axes) at `eye` looking at `target`; `up` is the world direction
+// that appears up in the image; `rollRad` turns the camera about its optical axis.
+Pose cameraLookingAt(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up,
+                     double rollRad = 0.0);
+
 // Angle of the rotation between a and b (radians, in [0, pi]).
 double rotationAngleBetween(const glm::dquat& a, const glm::dquat& b);
 

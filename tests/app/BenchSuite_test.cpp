@@ -46,7 +46,8 @@ std::string tinySuite() {
            translucent + R"(", "hide": ["glass_sphere", "jade_cube"],
      "sweeps": {"impostor_resolution": ["32", "64"]}}
   ],
-  "scaling": {"resolutions": ["40x30", "80x60"], "vpls": ["16", "32"], "triangles": [200, 2000]}
+  "scaling": {"resolutions": ["40x30", "80x60"], "vpls": ["16", "32"], "triangles": [200, 2000]},
+  "tracking": {"widths": [640]}
 })";
 }
 
@@ -61,13 +62,20 @@ TEST(BenchSuite, TinySuiteWritesEveryPlotTableAndCropAndFlagsABrokenRenderer) {
     const std::string md = readAll(out / "results.md");
     ASSERT_FALSE(md.empty());
     EXPECT_NE(md.find("sessions/mirror-"), std::string::npos) << md;
+    // The tracker against ArUco: both methods on the video and on single frames, each with
+    // every frame's pose and none wrong (the synthetic views are easy: both find the board).
+    for (const char* row : {"| video | mirage | 640x480 |", "| video | ArUco | 640x480 |",
+                            "| single | mirage | 640x480 |", "| single | ArUco | 640x480 |"})
+        EXPECT_NE(md.find(row), std::string::npos) << row;
+    EXPECT_NE(md.find("| 60/60 | 0 |"), std::string::npos) << md;
     EXPECT_NE(r.output.find("tabletop_translucent.gltf"), std::string::npos) << r.output;
     for (const char* needle :
          {"## diffuse", "## mirror", "## Scaling", "machine:", "GL renderer:", "load average",
           "footage only", "passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg"})
         EXPECT_NE(md.find(needle), std::string::npos) << needle;
-    for (const char* svg : {"passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg",
-                            "scaling_pixels.svg", "scaling_vpls.svg", "scaling_triangles.svg"}) {
+    for (const char* svg :
+         {"passes.svg", "diffuse_time_error.svg", "mirror_time_error.svg", "scaling_pixels.svg",
+          "scaling_vpls.svg", "scaling_triangles.svg", "tracking_time_error.svg"}) {
         const std::string s = readAll(out / "results" / svg);
         EXPECT_GT(s.size(), 500u) << svg;
         EXPECT_NE(s.find("</svg>"), std::string::npos) << svg;
@@ -113,6 +121,8 @@ TEST(BenchSuite, BadSuiteFilesAreRefusedWithTheirField) {
         {"{\"effects\": [{\"name\": \"a\", \"sweeps\": {\"warp\": [\"1\"]}}]}", "unknown knob"},
         {"{\"effects\": [{\"name\": \"a\", \"hide\": [\"no_such_node\"]}]}", "no_such_node"},
         {"not json", "not valid JSON"},
+        {"{\"tracking\": {\"widths\": [800]}, \"effects\": [{\"name\": \"a\"}]}",
+         "tracking.widths"},
         {"{\"effects\": [{\"name\": \"a\", \"scene\": \"nope.gltf\"}]}",
          "effect 'a': its scene does not exist"},
     };
