@@ -235,9 +235,20 @@ void main() {
                 vec4 m1 = texelFetch(leanMean, q, lg);
                 GsrLobe g = momentLobe(m1, texelFetch(leanSquares, q, lg),
                                        texelFetch(leanProducts, q, lg), N0, t, b, w * m1.a);
+                // A texel of another face (mean normal beyond 60 degrees of N0) is outside the
+                // small-angle slope model: its own lobe would point anywhere.
+                if (m1.a > 1e-4 && dot(normalize(m1.xyz), N0) < 0.5) g.weight = 0.0;
                 int k = gsrSector(g.mean, sectors);
                 lobes[k] = gsrMerge(lobes[k], g);
             }
+        float gathered = 0.0;
+        for (int k = 0; k < kMaxSectors; ++k) gathered += lobes[k].weight;
+        if (!(gathered > 0.0)) {  // nothing of the object's back faces there: LEAN's lobe
+            lobes[0] = momentLobe(textureLod(leanMean, st2, levelB),
+                                  textureLod(leanSquares, st2, levelB),
+                                  textureLod(leanProducts, st2, levelB), N0, t, b, 1.0);
+            sectors = 1;
+        }
     } else if (footPx >= 0.5) {
         lobes[0] = momentLobe(textureLod(leanMean, st2, levelB), textureLod(leanSquares, st2, levelB),
                               textureLod(leanProducts, st2, levelB), N0, t, b, 1.0);
