@@ -46,9 +46,26 @@ void RendererOptions::validate() const {
              std::to_string(fuzzyConeDeg));
     if (fuzzyTaps < 1 || fuzzyTaps > 64)
         fail("fuzzyTaps must be 1..64 taps per side, got " + std::to_string(fuzzyTaps));
+    if (gsrSubdivisions < 1 || gsrSubdivisions > 8)
+        fail("gsrSubdivisions must be 1..8 hemisphere sectors, got " +
+             std::to_string(gsrSubdivisions));
+    if (roughMipLevels < 1 || roughMipLevels > 12)
+        fail("roughMipLevels must be 1..12 mip levels, got " + std::to_string(roughMipLevels));
     if (environmentMapWidth < 16 || environmentMapWidth > 4096 || environmentMapWidth % 2 != 0)
         fail("environmentMapWidth must be even, 16..4096 texels, got " +
              std::to_string(environmentMapWidth));
+}
+
+const char* roughRefractionMethodName(RoughRefractionMethod m) {
+    switch (m) {
+        case RoughRefractionMethod::Filter:
+            return "filter";
+        case RoughRefractionMethod::Lean:
+            return "lean";
+        case RoughRefractionMethod::Gsr:
+            return "gsr";
+    }
+    return "?";
 }
 
 int ismTilesPerRow(int vplCount) {

@@ -18,6 +18,14 @@
 
 namespace mirage::render {
 
+// How rough glass blurs what is seen through it (docs/specular.md, "Rough refraction").
+enum class RoughRefractionMethod {
+    Filter,  // the fuzzy pass's image-space filter with the transmitted lobe (render/passes/fuzzy)
+    Lean,    // LEAN-mapped back-face normals, one Gaussian lobe per pixel (render/passes/rough)
+    Gsr,     // the same with the back NDF reduced to one Gaussian per hemisphere subdivision
+};
+const char* roughRefractionMethodName(RoughRefractionMethod m);  // "filter", "lean", "gsr"
+
 struct RendererOptions {
     int vplCount = 256;                  // total VPLs per frame, split over the lights with RSMs
     int shadowMapSize = 512;             // texels per side of each shadow / RSM layer
@@ -61,6 +69,13 @@ struct RendererOptions {
     bool fuzzyReflections = true;
     float fuzzyConeDeg = 20.0f;
     int fuzzyTaps = 12;
+    // Rough glass (render/passes/rough, docs/specular.md): which method blurs the refraction;
+    // gsrSubdivisions = the hemisphere sectors of the Gaussian sum reduction (1..8);
+    // roughMipLevels = levels of the LEAN moment chains and of the prefiltered lookups (camera
+    // image, rough-glass radiance; 1..12): a lobe wider than the last level is cut there.
+    RoughRefractionMethod roughRefraction = RoughRefractionMethod::Lean;
+    int gsrSubdivisions = 4;
+    int roughMipLevels = 8;
     int specularVplStride = 4;  // 1, 4 or 16: each hit sums every stride-th VPL (x stride),
                                 // interleaved over 2x2 / 4x4 pixels (cheaper, noisier)
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the

@@ -170,7 +170,8 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                     false,
                     false,
                     false,
-                    false};
+                    false,
+                    -1};
             const Material& mat = scene.material(p.material);
             // Mirror: metallic ~1 with low roughness; rough reflector: a metal up to
             // Material::kRoughReflectorMaxRoughness (fuzzy reflections); glass: any transmission
@@ -184,6 +185,13 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
                 uvs.size() == p.positions.size())
                 r.texture = mat.baseColorTexture.texture;
+            // The mesh carries one UV set, the base colour's: a metallic-roughness texture on
+            // another set is not sampled (docs/scene.md).
+            if (mat.metallicRoughnessTexture.valid() &&
+                size_t(mat.metallicRoughnessTexture.texture) < scene.textures.size() &&
+                mat.metallicRoughnessTexture.texCoord == mat.baseColorTexture.texCoord &&
+                uvs.size() == p.positions.size())
+                r.metallicRoughnessTexture = mat.metallicRoughnessTexture.texture;
             glm::vec3 lo(1e30f), hi(-1e30f);
             for (size_t i = 0; i < p.positions.size(); ++i) {
                 glm::vec3 n = i < p.normals.size() ? p.normals[i] : glm::vec3(0, 1, 0);
@@ -250,6 +258,7 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             d.normalMatrix = glm::inverseTranspose(world);
             d.material = r.material;
             d.baseColorTexture = r.texture;
+            d.metallicRoughnessTexture = r.metallicRoughnessTexture;
             d.origin = inst.origin;
             d.specular = r.specular;
             d.transmissive = r.transmissive;
@@ -452,6 +461,9 @@ void GpuScene::bindMaterialTextures(const DrawItem& d, GLuint unit) const {
     const bool has = d.baseColorTexture >= 0 && size_t(d.baseColorTexture) < textures_.size() &&
                      textures_[size_t(d.baseColorTexture)].id() != 0;
     glBindTextureUnit(unit, has ? textures_[size_t(d.baseColorTexture)].id() : white_.id());
+    const int mr = d.metallicRoughnessTexture;
+    const bool hasMr = mr >= 0 && size_t(mr) < textures_.size() && textures_[size_t(mr)].id() != 0;
+    glBindTextureUnit(kUnitMetallicRoughnessMap, hasMr ? textures_[size_t(mr)].id() : white_.id());
 }
 
 void GpuScene::drawItem(const DrawItem& d) const {

@@ -30,11 +30,12 @@ struct GpuSceneVertex {
 static_assert(sizeof(GpuSceneVertex) == 32);
 
 struct DrawItem {
-    std::string name;              // node name, for reports
-    glm::mat4 model{1.0f};         // world-from-mesh
-    glm::mat4 normalMatrix{1.0f};  // inverse transpose of model (upper 3x3 used)
-    int material = 0;              // index into the material buffer (0 = glTF default)
-    int baseColorTexture = -1;     // index into the uploaded textures, -1 = none
+    std::string name;                   // node name, for reports
+    glm::mat4 model{1.0f};              // world-from-mesh
+    glm::mat4 normalMatrix{1.0f};       // inverse transpose of model (upper 3x3 used)
+    int material = 0;                   // index into the material buffer (0 = glTF default)
+    int baseColorTexture = -1;          // index into the uploaded textures, -1 = none
+    int metallicRoughnessTexture = -1;  // the same (glTF: G = roughness, B = metallic factors)
     Origin origin = Origin::Virtual;
     // A specular object (mirror or glass): its pixels are shaded from the reflected / refracted
     // ray hits (GBuf_refl / GBuf_refr, Knecht 2013 Sec. 4.1), not from its own surface.
@@ -135,6 +136,7 @@ private:
         bool transmissive;
         bool roughReflector;
         bool roughGlass;
+        int metallicRoughnessTexture = -1;
     };
     // The constructor's steps, in order.
     void uploadTextures(const Scene& scene);

@@ -21,6 +21,7 @@
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
+#include "render/passes/rough/RoughRefractionPass.h"
 #include "render/passes/shadow/ShadowPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
 #include "render/passes/specular/SpecularLightPass.h"
@@ -151,6 +152,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<SpecularGBufferPass>());
     g.addPass(std::make_unique<SpecularLightPass>(*scene_));
     g.addPass(std::make_unique<FuzzyReflectionPass>());
+    g.addPass(std::make_unique<RoughRefractionPass>());
     g.addPass(std::make_unique<CompositePass>());
     g.markOutput(Resource::Composite);
     g.markOutput(Resource::CompositeSrgb);

@@ -88,6 +88,15 @@ enum class Resource {
     FuzzySpecularRReflection,
     FuzzyLenv,
     FuzzyReflectionVideo,
+    // Rough refraction (render/passes/rough, docs/specular.md): the same five buffers with the
+    // rough-glass pixels replaced by the LEAN or GSR lobe's blurred lookups (a = 1 in
+    // RoughVideo on a filtered pixel); every other pixel passes the fuzzy pass's (or the sharp)
+    // values through.
+    RoughSpecularRv,
+    RoughSpecularR,
+    RoughSpecularRReflection,
+    RoughLenv,
+    RoughVideo,
     // Caustics (Knecht 2013 Sec. 5.2; docs/caustics.md). Photon G-buffers, one layer per caustic
     // spot light (causticMapSize^2): per texel of the specular objects seen from the light, the
     // receiver hit of the reflected / refracted photon (xyz world; w = 4 x hit origin + the

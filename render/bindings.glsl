@@ -27,6 +27,9 @@ const int kBindingQueryHits = 5;
 
 // Material textures of scene draws (gbuffer, shadow, impostor capture).
 const int kUnitBaseColorMap = 7;
+// The metallic-roughness texture (linear; G scales roughness, B metallic; white without one):
+// bound with every material draw, so above every pass's own units.
+const int kUnitMetallicRoughnessMap = 31;
 // shadow.frag: the glass layer of the light layer being rendered (RSM flux behind glass).
 const int kUnitShadowGlassLayer = 8;
 
@@ -167,6 +170,25 @@ const int kUnitFuzzyRefrHit = 13;
 const int kUnitFuzzyRefrWeight = 14;
 const int kUnitFuzzySpecR = 15;
 const int kUnitFuzzyNormal = 16;
+
+// passes/rough: rough_prefilter.frag, rough_refraction.frag
+const int kUnitRoughPosition = 0;
+const int kUnitRoughNormal = 1;
+const int kUnitRoughEmissive = 2;
+const int kUnitRoughReflHit = 3;
+const int kUnitRoughReflWeight = 4;
+const int kUnitRoughRefrHit = 5;
+const int kUnitRoughRefrWeight = 6;
+const int kUnitRoughRealSurfaces = 7;
+const int kUnitRoughCanvasToCamera = 8;
+const int kUnitRoughCamera = 9;             // the camera frame (sRGB8, sampled linear)
+const int kUnitRoughLeanFirst = 12;         // .. + 2: LEAN moment chains of the back-face normals
+const int kUnitRoughPrefilteredFirst = 15;  // .. + 4: coverage-weighted L'_rv, L'_r, reflection
+                                            // share, L_env, video term
+const int kUnitRoughInputFirst = 20;  // .. + 4: what passes through (fuzzy's or the sharp ones)
+const int kUnitRoughBackPosition = 25;
+const int kUnitRoughBackNormal = 26;
+const int kUnitRoughSpecFirst = 27;  // .. + 3: L'_rv, L'_r, reflection share, L_env (prefilter)
 
 // Reflected-scene impostors (trace.glsl): the ONLY units traceSurroundings() uses, above every
 // pass's own units so a consumer shader can sample both.

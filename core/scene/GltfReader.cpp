@@ -378,8 +378,10 @@ private:
                 }
             }
             if (const tinygltf::Value* mirage = mirageExtras(src.extras, name)) {
-                m.roughnessVariation = static_cast<float>(
-                    number(*mirage, "roughness_variation", 0.0, name + " extras.mirage", 0, kInf));
+                if (mirage->Has("roughness_variation"))
+                    warn(name +
+                         " extras.mirage.roughness_variation is not read: vary the "
+                         "roughness across the surface with a metallicRoughnessTexture");
             }
             readScattering(src, name, m);
             scene_.materials.push_back(std::move(m));

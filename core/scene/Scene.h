@@ -77,7 +77,6 @@ struct Material {
     glm::vec3 attenuationColor{1.0f};  // linear
     float attenuationDistance = std::numeric_limits<float>::infinity();  // metres
     // mirage extras (docs/scene.md), filled as features arrive:
-    float roughnessVariation = 0.0f;  // extras.mirage.roughness_variation (rough refraction)
     // A translucent object: a closed mesh filled with a participating medium whose extinction is
     // sigma_t(x) = extinction * density(x), from MIRAGE_materials_scattering or from
     // KHR_materials_diffuse_transmission + KHR_materials_volume (docs/scene.md). Its boundary is

@@ -222,6 +222,40 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.fuzzyTaps = parseInt("fuzzy_taps", v, 1, 64);
          },
          [](const BenchConfig& c) { return std::to_string(c.options.fuzzyTaps); }},
+        // Rough glass (docs/specular.md, "Rough refraction"): one default value each.
+        {"rough_method",
+         "how rough glass blurs what is seen through it: lean (LEAN-mapped back faces, one "
+         "lobe), gsr (Gaussian sum reduction, one lobe per hemisphere subdivision) or filter "
+         "(the fuzzy pass's image-space filter)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"lean"}; },
+         [](BenchConfig& c, const std::string& v) {
+             if (v == "lean")
+                 c.options.roughRefraction = RoughRefractionMethod::Lean;
+             else if (v == "gsr")
+                 c.options.roughRefraction = RoughRefractionMethod::Gsr;
+             else if (v == "filter")
+                 c.options.roughRefraction = RoughRefractionMethod::Filter;
+             else
+                 throw Error(fmt::format(
+                     "bench: knob rough_method: '{}' is not one of lean, gsr, filter", v));
+         },
+         [](const BenchConfig& c) {
+             return std::string(roughRefractionMethodName(c.options.roughRefraction));
+         }},
+        {"gsr_subdivisions", "hemisphere sectors of the Gaussian sum reduction (1..8)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.gsrSubdivisions = parseInt("gsr_subdivisions", v, 1, 8);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.gsrSubdivisions); }},
+        {"lean_mip_levels",
+         "mip levels of the rough-refraction chains (LEAN moments, camera image, rough-glass "
+         "radiance; 1..12): a wider lobe is cut at the last",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"8"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.roughMipLevels = parseInt("lean_mip_levels", v, 1, 12);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.roughMipLevels); }},
         {"vnm_resolution",
          "voxels along a translucent object's longest side in its voxel number map (2..512; "
          "the LUT grows with the 4th power)",

@@ -21,7 +21,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
-#include "testscenes/SpecularTestScenes.h"
+#include "testscenes/RoughTestScenes.h"
 
 namespace mirage::render {
 namespace {
@@ -30,21 +30,17 @@ namespace {
 constexpr float kTop = 0.04f;
 const glm::vec3 kPlateLo{-0.35f, 0.0f, -0.25f}, kPlateHi{0.35f, kTop, 0.3f};
 
-struct PlateScene {
-    Scene scene;
-    CameraIntrinsics cam = test::smallCamera(128, 96, 120.0);
-    Pose pose = test::lookAtPose({0.0, 0.5, 0.9}, {0.0, 0.05, -0.1});
-    int metal = -1;
-};
+using PlateScene = test::RoughTestScene;
+using Frame = test::RoughFrame;
 
 PlateScene makePlate(float roughness, const std::filesystem::path& envDir,
                      Origin plateOrigin = Origin::Virtual) {
     PlateScene s;
     const int table = test::addMaterial(s.scene, glm::vec3(0.6f, 0.55f, 0.5f));
     const int red = test::addMaterial(s.scene, glm::vec3(0.8f, 0.15f, 0.1f));
-    s.metal = test::addMaterial(s.scene, glm::vec3(0.9f, 0.85f, 0.8f), roughness, 1.0f);
+    s.material = test::addMaterial(s.scene, glm::vec3(0.9f, 0.85f, 0.8f), roughness, 1.0f);
     test::addFloor(s.scene, "table", 0.0f, 3.0f, table, Origin::Real);
-    test::addBox(s.scene, "plate", kPlateLo, kPlateHi, s.metal, plateOrigin);
+    test::addBox(s.scene, "plate", kPlateLo, kPlateHi, s.material, plateOrigin);
     // Behind the plate: its reflection has a sharp red / sky edge for the roughness to blur.
     test::addBox(s.scene, "red box", {-0.12f, 0.0f, -0.55f}, {0.12f, 0.3f, -0.4f}, red,
                  Origin::Real);
@@ -76,47 +72,16 @@ cv::Mat topMask(const PlateScene& s) {
     return m;
 }
 
-struct Reference {
-    cv::Mat footage, refSrgb;
-};
-
-Reference reference(const PlateScene& s, int spp = 64) {
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = spp;
-    st.threads = 2;
-    st.seed = 5;
-    st.caustics = false;  // the rough plate's glossy light on the table is not judged here
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-    Reference r;
-    r.footage = linearRgbToSrgbBgr8(ref.realOnly);
-    r.refSrgb =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), ref));
-    return r;
-}
-
 RendererOptions singleFrame() {
-    RendererOptions o;
-    o.temporalBlend = 0.0f;
-    o.caustics = false;
-    return o;
+    return test::roughSingleFrame();
 }
 
-struct Frame {
-    cv::Mat srgb, linear;
-    FrameReport report;
-};
+test::RoughReference reference(const PlateScene& s) {
+    return test::roughReference(s);
+}
 
 Frame realtime(const PlateScene& s, const cv::Mat& footage, RendererOptions opt = singleFrame()) {
-    Renderer r(s.scene, s.cam, opt);
-    Frame f;
-    f.report = r.render({s.pose, footage, true});
-    f.srgb = r.compositeSrgb();
-    f.linear = r.compositeLinear();
-    EXPECT_TRUE(cv::checkRange(f.linear)) << "NaN/Inf in the composite";
-    return f;
+    return test::renderRough(s, footage, opt);
 }
 
 void save(const std::string& name, const cv::Mat& footage, const cv::Mat& sharp,
@@ -144,7 +109,7 @@ TEST(FuzzyReflection, RoughMetalMatchesReferenceAndIgnoringRoughnessFails) {
         const PlateScene s = makePlate(fl.roughness, envDir);
         const cv::Mat mask = topMask(s);
         ASSERT_GT(cv::countNonZero(mask), 1500);
-        const Reference ref = reference(s);
+        const test::RoughReference ref = reference(s);
         const Frame fuzzy = realtime(s, ref.footage);
         EXPECT_TRUE(fuzzy.report.ran("fuzzy")) << fuzzy.report.summary();
         RendererOptions off = singleFrame();
@@ -166,46 +131,14 @@ TEST(FuzzyReflection, RoughMetalMatchesReferenceAndIgnoringRoughnessFails) {
     }
 }
 
-// Rough glass: a virtual frosted slab (50 x 30 x 6 cm, IOR 1.5) stands on the real table in front
-// of a real red box; what is seen through it is blurred by the same filter with the refracted
-// geometry. Compared over the slab's front face against the reference's GGX dielectric.
-PlateScene makeSlab(float roughness, const std::filesystem::path& envDir) {
-    PlateScene s;
-    s.pose = test::lookAtPose({0.0, 0.25, 0.8}, {0.0, 0.12, -0.1});
-    const int table = test::addMaterial(s.scene, glm::vec3(0.6f, 0.55f, 0.5f));
-    const int red = test::addMaterial(s.scene, glm::vec3(0.8f, 0.15f, 0.1f));
-    const int green = test::addMaterial(s.scene, glm::vec3(0.15f, 0.7f, 0.2f));
-    s.metal = test::addGlass(s.scene);
-    s.scene.materials[size_t(s.metal)].roughness = roughness;
-    test::addFloor(s.scene, "table", 0.0f, 3.0f, table, Origin::Real);
-    test::addBox(s.scene, "slab", {-0.25f, 0.0f, -0.03f}, {0.25f, 0.3f, 0.03f}, s.metal,
-                 Origin::Virtual);
-    test::addBox(s.scene, "red box", {-0.12f, 0.0f, -0.35f}, {0.04f, 0.2f, -0.2f}, red,
-                 Origin::Real);
-    test::addBox(s.scene, "green box", {0.04f, 0.0f, -0.4f}, {0.16f, 0.12f, -0.28f}, green,
-                 Origin::Real);
-    const glm::vec3 lightPos(0.6f, 1.4f, 0.5f);
-    test::addLight(s.scene, Light::Type::Spot, lightPos,
-                   glm::normalize(glm::vec3(0.0f, 0.0f, -0.3f) - lightPos), 3.0f, Origin::Real,
-                   1.0f, 0.8f);
-    test::addSkyEnvironment(s.scene, envDir);
-    return s;
-}
-
-// Pixels whose camera ray meets the slab's front face (z = 0.03), 1 px in from its outline.
-cv::Mat slabMask(const PlateScene& s) {
-    cv::Mat m(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
-    const glm::dvec3 eye = s.pose * glm::dvec3(0.0);
-    for (int y = 0; y < m.rows; ++y)
-        for (int x = 0; x < m.cols; ++x) {
-            const glm::dvec3 dirCam((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0);
-            const glm::dvec3 d = s.pose * dirCam - eye;
-            if (d.z >= 0) continue;
-            const glm::dvec3 p = eye + ((0.03 - eye.z) / d.z) * d;
-            if (p.x > -0.25 && p.x < 0.25 && p.y > 0.0 && p.y < 0.3) m.at<uint8_t>(y, x) = 255;
-        }
-    cv::erode(m, m, cv::Mat::ones(3, 3, CV_8U));
-    return m;
+// Rough glass: a virtual frosted slab (tests/support/testscenes/RoughTestScenes.h) on the real
+// table in front of a real red and green box; what is seen through it is blurred by the same
+// filter with the refracted geometry (rough_method=filter; the default, LEAN, is tested in
+// RoughRefraction_test.cpp). Compared over the slab's front face against the reference's GGX
+// dielectric.
+RendererOptions filterGlass(RendererOptions o = singleFrame()) {
+    o.roughRefraction = RoughRefractionMethod::Filter;
+    return o;
 }
 
 TEST(FuzzyReflection, RoughGlassMatchesReferenceAndIgnoringRoughnessFails) {
@@ -215,13 +148,13 @@ TEST(FuzzyReflection, RoughGlassMatchesReferenceAndIgnoringRoughnessFails) {
     // / 0.641 with the filter, 24.5 dB / 0.591 as smooth glass; 0.5: 25.1 dB / 0.530, 22.7 dB /
     // 0.450. Floors ~0.5-0.7 dB / 0.02 below.
     for (const Floor& fl : {Floor{0.3f, 25.1, 0.62}, Floor{0.5f, 24.4, 0.51}}) {
-        const PlateScene s = makeSlab(fl.roughness, envDir);
-        const cv::Mat mask = slabMask(s);
+        const PlateScene s = test::makeRoughSlab(fl.roughness, envDir);
+        const cv::Mat mask = test::slabFrontMask(s);
         ASSERT_GT(cv::countNonZero(mask), 1500);
-        const Reference ref = reference(s);
-        const Frame fuzzy = realtime(s, ref.footage);
+        const test::RoughReference ref = reference(s);
+        const Frame fuzzy = realtime(s, ref.footage, filterGlass());
         EXPECT_TRUE(fuzzy.report.ran("fuzzy")) << fuzzy.report.summary();
-        RendererOptions off = singleFrame();
+        RendererOptions off = filterGlass();
         off.fuzzyReflections = false;
         const Frame sharp = realtime(s, ref.footage, off);
         const double pF = test::psnr(fuzzy.srgb, ref.refSrgb, 255.0, mask);
@@ -251,8 +184,8 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     cv::randu(footage, 0, 255);
     const PlateScene mirror = makePlate(0.0f, envDir);
     const PlateScene limit = makePlate(0.051f, envDir);
-    ASSERT_TRUE(limit.scene.materials[size_t(limit.metal)].isRoughReflector());
-    ASSERT_TRUE(mirror.scene.materials[size_t(mirror.metal)].isMirror());
+    ASSERT_TRUE(limit.scene.materials[size_t(limit.material)].isRoughReflector());
+    ASSERT_TRUE(mirror.scene.materials[size_t(mirror.material)].isMirror());
     // Without VPLs: the plate's roughness changes the light it bounces onto the table (the
     // reflective shadow map's flux), which is not the filter's business.
     RendererOptions noVpl = singleFrame();
@@ -309,7 +242,7 @@ TEST(FuzzyReflection, HardCasesStayFinite) {
     cv::Mat footage(96, 128, CV_8UC3, cv::Scalar(90, 110, 130));
     {
         PlateScene s = makePlate(1.0f, envDir);
-        EXPECT_FALSE(s.scene.materials[size_t(s.metal)].isRoughReflector());
+        EXPECT_FALSE(s.scene.materials[size_t(s.material)].isRoughReflector());
         const Frame f = realtime(s, footage);
         EXPECT_FALSE(f.report.ran("fuzzy"));
         EXPECT_FALSE(f.report.ran("specgbuf"));  // a glossy surface, not a specular object
@@ -332,9 +265,9 @@ TEST(FuzzyReflection, HardCasesStayFinite) {
     for (const Pose& pose : {test::lookAtPose({0.0, 0.25, 0.8}, {0.0, 0.12, -0.1}),
                              test::lookAtPose({0.7, 0.15, 0.05}, {0.0, 0.15, 0.0})}) {
         for (float roughness : {0.3f, 1.0f}) {
-            PlateScene s = makeSlab(roughness, envDir);
+            PlateScene s = test::makeRoughSlab(roughness, envDir);
             s.pose = pose;
-            const Frame f = realtime(s, footage);
+            const Frame f = realtime(s, footage, filterGlass());
             EXPECT_TRUE(f.report.ran("fuzzy")) << f.report.summary();
             EXPECT_LT(cv::norm(f.linear, cv::NORM_INF), 10.0);
         }

@@ -7,6 +7,11 @@ namespace {
 constexpr Resource kFuzzyBuffers[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
                                        Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
                                        Resource::FuzzyReflectionVideo};
+// Rough glass by LEAN / GSR (render/passes/rough): the same five buffers, the fuzzy pass's
+// passed through on every other pixel; preferred when that pass ran.
+constexpr Resource kRoughBuffers[5] = {Resource::RoughSpecularRv, Resource::RoughSpecularR,
+                                       Resource::RoughSpecularRReflection, Resource::RoughLenv,
+                                       Resource::RoughVideo};
 static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
 }  // namespace
 
@@ -41,6 +46,7 @@ void CompositePass::setup(PassBuilder& b) const {
         b.readOptional(r);
     // Rough metals: the fuzzy pass's filtered buffers, when it ran.
     for (Resource r : kFuzzyBuffers) b.readOptional(r);
+    for (Resource r : kRoughBuffers) b.readOptional(r);
     b.write(Resource::Composite, GL_RGBA32F, SizeRule::Camera);
     b.write(Resource::CompositeSrgb, GL_SRGB8_ALPHA8, SizeRule::Camera);
 }
@@ -163,10 +169,13 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
-        const bool fuzzy = res.has(Resource::FuzzyReflectionVideo);
+        const bool rough = res.has(Resource::RoughVideo);
+        const bool fuzzy = rough || res.has(Resource::FuzzyReflectionVideo);
         for (int i = 0; i < 5; ++i)
-            glBindTextureUnit(GLuint(kUnitCompositeFuzzyRv + i),
-                              res.textureOr(kFuzzyBuffers[i], ctx.blackTexture()).id());
+            glBindTextureUnit(
+                GLuint(kUnitCompositeFuzzyRv + i),
+                res.textureOr(rough ? kRoughBuffers[i] : kFuzzyBuffers[i], ctx.blackTexture())
+                    .id());
         glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
         glEnable(GL_SCISSOR_TEST);
         glScissor(rect.x, rect.y, rect.z, rect.w);

@@ -25,6 +25,8 @@ FuzzyReflectionPass::FuzzyReflectionPass()
     : resolve_(fullscreenProgram("fuzzy resolve", "passes/fuzzy/fuzzy_resolve.frag")),
       filter_(fullscreenProgram("fuzzy filter", "passes/fuzzy/fuzzy_filter.frag")) {
     locEpsilon_ = resolve_.uniformLocation("depthEpsilon");
+    locGlassResolve_ = resolve_.uniformLocation("filterGlass");
+    locGlassFilter_ = filter_.uniformLocation("filterGlass");
     locStep_ = filter_.uniformLocation("stepDir");
     locCone_ = filter_.uniformLocation("coneBound");
     locFocal_ = filter_.uniformLocation("focalPx");
@@ -45,7 +47,13 @@ void FuzzyReflectionPass::setup(PassBuilder& b) const {
 }
 
 PassDecision FuzzyReflectionPass::decide(const FrameContext& ctx) const {
-    const int metals = ctx.scene.roughReflectorCount(), glass = ctx.scene.roughGlassCount();
+    // Rough glass is this pass's only with rough_method=filter (else render/passes/rough).
+    const bool filterGlass = ctx.options.roughRefraction == RoughRefractionMethod::Filter;
+    const int metals = ctx.scene.roughReflectorCount(),
+              glass = filterGlass ? ctx.scene.roughGlassCount() : 0;
+    if (metals == 0 && glass == 0 && ctx.scene.roughGlassCount() > 0)
+        return {false, fmt::format("no rough metal; rough glass by rough_method={}",
+                                   roughRefractionMethodName(ctx.options.roughRefraction))};
     if (metals + glass == 0)
         return {false,
                 fmt::format("no rough metal (roughness {} .. {}) or rough glass",
@@ -104,6 +112,8 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     videoFbo_.bind();
     ctx.beginFullscreen(resolve_, w, h);
     glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
+    const int filterGlass = ctx.options.roughRefraction == RoughRefractionMethod::Filter ? 1 : 0;
+    glUniform1i(locGlassResolve_, filterGlass);
     ctx.drawFullscreenTriangleIn(ctx.specularScissor, 1);
 
     // 2. Rows, then columns of the rows' result. The canvas has the camera's focal lengths
@@ -121,6 +131,7 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locCone_, cone);
         glUniform1f(locFocal_, focalPx);
         glUniform1i(locTaps_, ctx.options.fuzzyTaps);
+        glUniform1i(locGlassFilter_, filterGlass);
         ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);
     }
     for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);

@@ -9,12 +9,17 @@
 layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 layout(std430, binding = kBindingSpecularDraws) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
 
-// The specular slot of a G-buffer pixel (gEmissive.a = slot + 1) if it shows a rough metal or
-// rough glass, else -1.
+// 1: rough glass is filtered here too (RendererOptions::roughRefraction = Filter); 0: only
+// rough metals (the rough-refraction pass, render/passes/rough, takes the glass).
+uniform int filterGlass;
+
+// The specular slot of a G-buffer pixel (gEmissive.a = slot + 1) if it shows a rough metal, or
+// rough glass when filterGlass, else -1.
 int roughSlot(float emissiveA) {
     int slot = int(emissiveA + 0.5) - 1;
     if (slot < 0) return -1;
-    return specularDraws[slot].rough != kRoughNone ? slot : -1;
+    int rough = specularDraws[slot].rough;
+    return rough == kRoughMetal || (rough == kRoughGlass && filterGlass != 0) ? slot : -1;
 }
 
 // Phong exponent p of the reflected-direction lobe from glTF perceptual roughness r: GGX / Beckmann

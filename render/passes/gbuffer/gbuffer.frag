@@ -10,6 +10,7 @@ in vec3 worldPos;
 in vec3 worldNormal;
 in vec2 uv;
 layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
+layout(binding = kUnitMetallicRoughnessMap) uniform sampler2D metallicRoughnessMap;  // linear
 layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
@@ -22,7 +23,10 @@ void main() {
     // Shade the side the camera sees (proxies are often single quads seen from either side).
     if (dot(n, cameraPos.xyz - worldPos) < 0.0) n = -n;
     gPosition = vec4(worldPos, float(origin));
-    gNormal = vec4(n, clamp(m.roughness, 0.02, 1.0));
-    gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.metallic, 0.0, 1.0));
+    // glTF: the factors times the texture's G (roughness) and B (metallic), per pixel, so a
+    // rough-glass object can be frosted in parts (render/passes/rough reads gNormal.w).
+    vec4 mr = texture(metallicRoughnessMap, uv);
+    gNormal = vec4(n, clamp(m.roughness * mr.g, 0.02, 1.0));
+    gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.metallic * mr.b, 0.0, 1.0));
     gEmissive = vec4(m.emissive, m.translucent == 1 ? -1.0 : float(specularSlot + 1));
 }

@@ -1,0 +1,153 @@
+#include "render/passes/rough/RoughRefractionPass.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "render/FrameGraph.h"
+
+namespace mirage::render {
+namespace {
+constexpr Resource kOutputs[5] = {Resource::RoughSpecularRv, Resource::RoughSpecularR,
+                                  Resource::RoughSpecularRReflection, Resource::RoughLenv,
+                                  Resource::RoughVideo};
+constexpr Resource kSharp[4] = {Resource::SpecularRv, Resource::SpecularR,
+                                Resource::SpecularRReflection, Resource::Lenv};
+constexpr Resource kFuzzy[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
+                                Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
+                                Resource::FuzzyReflectionVideo};
+static_assert(kUnitRoughPrefilteredFirst == kUnitRoughLeanFirst + 3);
+
+int fullChain(int w, int h) {
+    int levels = 1;
+    while ((std::max(w, h) >> levels) > 0) ++levels;
+    return levels;
+}
+}  // namespace
+
+RoughRefractionPass::RoughRefractionPass()
+    : prefilter_(fullscreenProgram("rough prefilter", "passes/rough/rough_prefilter.frag")),
+      refraction_(fullscreenProgram("rough refraction", "passes/rough/rough_refraction.frag")) {
+    locPrefilterEpsilon_ = prefilter_.uniformLocation("depthEpsilon");
+    locMethod_ = refraction_.uniformLocation("method");
+    locSubdivisions_ = refraction_.uniformLocation("subdivisions");
+    locFocal_ = refraction_.uniformLocation("focalPx");
+    locMaxLevel_ = refraction_.uniformLocation("maxLevel");
+}
+
+void RoughRefractionPass::setup(PassBuilder& b) const {
+    for (Resource r :
+         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
+          Resource::ReflectionGBuffer, Resource::ReflectionWeight, Resource::RefractionGBuffer,
+          Resource::RefractionWeight, Resource::RealSurfaces, Resource::CameraImage,
+          Resource::BackFacePosition, Resource::BackFaceNormal})
+        b.read(r);
+    for (Resource r : kSharp) b.read(r);
+    for (Resource r : kFuzzy) b.readOptional(r);  // rough metals filtered in the same frame
+    // The video term in float32 as the fuzzy pass's: the limit of a one-texel lobe reproduces
+    // the smooth path exactly.
+    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::RoughVideo, GL_RGBA32F, SizeRule::Canvas);
+}
+
+PassDecision RoughRefractionPass::decide(const FrameContext& ctx) const {
+    const int glass = ctx.scene.roughGlassCount();
+    if (glass == 0)
+        return {false,
+                fmt::format("no rough glass (roughness above {})", Material::kMirrorMaxRoughness)};
+    const RendererOptions& o = ctx.options;
+    if (o.roughRefraction == RoughRefractionMethod::Filter)
+        return {false, "rough glass by the fuzzy pass's image-space filter (rough_method=filter)"};
+    if (o.roughRefraction == RoughRefractionMethod::Gsr)
+        return {true, fmt::format("{} rough glass: GSR, {} hemisphere subdivisions, {} mip levels",
+                                  glass, o.gsrSubdivisions, o.roughMipLevels)};
+    return {true, fmt::format("{} rough glass: LEAN, {} mip levels", glass, o.roughMipLevels)};
+}
+
+void RoughRefractionPass::resize(const FrameContext& ctx) {
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    const int levels = std::min(ctx.options.roughMipLevels, fullChain(w, h));
+    if (w == width_ && h == height_ && levels == levels_) return;
+    width_ = w;
+    height_ = h;
+    levels_ = levels;
+    static const char* chainNames[kChains] = {"LEAN mean",         "LEAN squares",
+                                              "LEAN products",     "prefiltered L'_rv",
+                                              "prefiltered L'_r",  "prefiltered reflection share",
+                                              "prefiltered L_env", "prefiltered video term"};
+    chainsFbo_ = gl::Framebuffer("rough chains fbo");
+    for (int i = 0; i < kChains; ++i) {
+        // The moments in float32 (the covariance is a difference of them), and the video term
+        // as the composite's.
+        const GLenum format = i < 3 || i == kChains - 1 ? GL_RGBA32F : GL_RGBA16F;
+        chains_[i] =
+            gl::Texture::create2D(std::string("rough ") + chainNames[i], w, h, format, levels);
+        chains_[i].setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
+        chains_[i].setWrap(GL_CLAMP_TO_EDGE);
+        chainsFbo_.attachColor(i, chains_[i]);
+    }
+    chainsFbo_.finalize(kChains);
+    static const char* names[5] = {"L'_rv", "L'_r", "L'_r reflection share", "L_env", "video"};
+    outFbo_ = gl::Framebuffer("rough refraction fbo");
+    for (int i = 0; i < 5; ++i) {
+        out_[i] = gl::Texture::create2D(std::string("rough ") + names[i], w, h,
+                                        i == 4 ? GL_RGBA32F : GL_RGBA16F);
+        outFbo_.attachColor(i, out_[i]);
+    }
+    outFbo_.finalize(5);
+    const std::vector<glm::vec2> table = ctx.projection.canvasToCameraTable();
+    canvasToCamera_ = gl::Texture::create2D("rough canvas to camera", w, h, GL_RG32F);
+    canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
+    canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
+}
+
+void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
+                     ctx.scene.specularDrawBuffer().id());
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
+    glBindTextureUnit(kUnitRoughPosition, res.texture(Resource::GBufferPosition).id());
+    glBindTextureUnit(kUnitRoughNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitRoughEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitRoughReflHit, res.texture(Resource::ReflectionGBuffer).id());
+    glBindTextureUnit(kUnitRoughReflWeight, res.texture(Resource::ReflectionWeight).id());
+    glBindTextureUnit(kUnitRoughRefrHit, res.texture(Resource::RefractionGBuffer).id());
+    glBindTextureUnit(kUnitRoughRefrWeight, res.texture(Resource::RefractionWeight).id());
+    glBindTextureUnit(kUnitRoughRealSurfaces, res.texture(Resource::RealSurfaces).id());
+    glBindTextureUnit(kUnitRoughCanvasToCamera, canvasToCamera_.id());
+    glBindTextureUnit(kUnitRoughCamera, res.texture(Resource::CameraImage).id());
+    glBindTextureUnit(kUnitRoughBackPosition, res.texture(Resource::BackFacePosition).id());
+    glBindTextureUnit(kUnitRoughBackNormal, res.texture(Resource::BackFaceNormal).id());
+    for (int i = 0; i < 4; ++i)
+        glBindTextureUnit(GLuint(kUnitRoughSpecFirst + i), res.texture(kSharp[i]).id());
+
+    // 1. Level 0 of the chains over the specular rectangle (zero elsewhere: no coverage), then
+    // the box-filtered levels.
+    chainsFbo_.bind();
+    ctx.beginFullscreen(prefilter_, w, h);
+    glUniform1f(locPrefilterEpsilon_, ctx.options.backProjectionEpsilon);
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, kChains);
+    for (gl::Texture& t : chains_) glGenerateTextureMipmap(t.id());
+
+    // 2. The lobes per rough-glass pixel.
+    for (int i = 0; i < kChains; ++i)
+        glBindTextureUnit(GLuint(kUnitRoughLeanFirst + i), chains_[i].id());
+    const bool fuzzy = res.has(Resource::FuzzyReflectionVideo);
+    for (int i = 0; i < 5; ++i) {
+        const gl::Texture& in = fuzzy   ? res.texture(kFuzzy[i])
+                                : i < 4 ? res.texture(kSharp[i])
+                                        : ctx.blackTexture();
+        glBindTextureUnit(GLuint(kUnitRoughInputFirst + i), in.id());
+    }
+    outFbo_.bind();
+    ctx.beginFullscreen(refraction_, w, h);
+    glUniform1i(locMethod_, ctx.options.roughRefraction == RoughRefractionMethod::Gsr ? 1 : 0);
+    glUniform1i(locSubdivisions_, ctx.options.gsrSubdivisions);
+    const CameraIntrinsics& K = ctx.projection.camera;
+    glUniform1f(locFocal_, float(0.5 * (K.fx + K.fy)));
+    glUniform1f(locMaxLevel_, float(levels_ - 1));
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);
+    for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);
+}
+
+}  // namespace mirage::render
