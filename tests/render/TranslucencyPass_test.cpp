@@ -14,6 +14,7 @@
 #include "core/image/ImageCompare.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/raytrace/SyntheticFootage.h"
 #include "render/translucency/VoxelNumberMap.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/TranslucentTestScenes.h"
@@ -178,6 +179,73 @@ TEST_F(TranslucencyPass, RealObjectEntersLrWithRealLightsOnly) {
     EXPECT_NEAR(rvV, rv, 2e-3 * rv);  // L_rv does not depend on what is real
     EXPECT_GT(rV, 0.0);               // the real environment
     EXPECT_LT(rV, 0.5 * rvV);
+}
+
+// Reuse: while neither the lights, the environment nor the object change, the pass republishes
+// its last radiance without dispatching ("nothing changed"), also when the camera moves; a new
+// environment-camera frame, and the switch back to the static map, make it run again, and the
+// result follows the environment. Lights are fixed for a renderer's life; they enter the same
+// key (FrameContext::staticKey), as for the shadow maps.
+TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes) {
+    const fs::path dir = mirage::test::outputDir("translucency_pass_reuse");
+    const Scene scene = translucentTestScene({}, dir);
+    const raytrace::RenderCamera cam = testCamera();
+    RendererOptions opt;
+    opt.vnmResolution = 8;
+    Renderer r(scene, cam.intrinsics, opt);
+    auto objectMean = [&](const cv::Mat& rv) {
+        const cv::Mat pos = r.readBuffer(Resource::GBufferPosition);
+        cv::Mat mask(pos.size(), CV_8U, cv::Scalar(0));
+        for (int y = 0; y < pos.rows; ++y)
+            for (int x = 0; x < pos.cols; ++x) {
+                const cv::Vec3f q = pos.at<cv::Vec3f>(y, x);
+                if (std::abs(q[0]) < 0.2501f && std::abs(q[1]) < 0.2501f &&
+                    std::abs(q[2]) < 0.2501f && cv::norm(q) > 0)
+                    mask.at<uint8_t>(y, x) = 255;
+            }
+        EXPECT_GT(cv::countNonZero(mask), 100);
+        return cv::mean(rv, mask)[0];
+    };
+    const FrameReport& first = r.render({cam.T_world_camera, cv::Mat(), true});
+    ASSERT_TRUE(first.ran("translucency")) << first.summary();
+    const double mean1 = objectMean(r.readBuffer(Resource::DirectRv));
+
+    // Same lights and environment, the camera moved a little: reused, the same light.
+    Pose moved = cam.T_world_camera;
+    moved.translation += glm::dvec3(0.01, 0.0, 0.0);
+    const FrameReport& second = r.render({moved, cv::Mat(), false});
+    EXPECT_FALSE(second.ran("translucency"));
+    EXPECT_TRUE(second.reused("translucency"));
+    const std::string summary = second.summary();
+    EXPECT_NE(summary.find("translucency reused"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("nothing changed"), std::string::npos) << summary;
+    EXPECT_NEAR(objectMean(r.readBuffer(Resource::DirectRv)), mean1, 0.02 * mean1);
+
+    // A live environment (a bright uniform fish-eye frame): recomputed, and brighter.
+    EnvironmentCameraSetup env;
+    env.intrinsics = raytrace::equidistantFisheye(64, 190.0);
+    env.T_world_camera = lookAtCamera(64, 64, 90.0, {0, 2, 0}, {0, 3, 0.3}).T_world_camera;
+    r.setEnvironmentCamera(env);
+    ASSERT_TRUE(r.updateEnvironment(
+        cv::Mat(env.intrinsics.height, env.intrinsics.width, CV_8UC3, cv::Scalar::all(255)), 1.0));
+    const FrameReport& third = r.render({cam.T_world_camera, cv::Mat(), false});
+    EXPECT_TRUE(third.ran("translucency")) << third.summary();
+    const double mean3 = objectMean(r.readBuffer(Resource::DirectRv));
+    EXPECT_GT(mean3, 1.5 * mean1);
+    const FrameReport& fourth = r.render({cam.T_world_camera, cv::Mat(), false});
+    EXPECT_TRUE(fourth.reused("translucency")) << fourth.summary();
+
+    // Back to the static environment: recomputed, the first frame's light again.
+    r.useStaticEnvironment();
+    const FrameReport& fifth = r.render({cam.T_world_camera, cv::Mat(), false});
+    EXPECT_TRUE(fifth.ran("translucency")) << fifth.summary();
+    EXPECT_NEAR(objectMean(r.readBuffer(Resource::DirectRv)), mean1, 0.02 * mean1);
+
+    // Reuse off (RendererOptions::reuseStaticPasses): every frame dispatches.
+    opt.reuseStaticPasses = false;
+    Renderer always(scene, cam.intrinsics, opt);
+    always.render({cam.T_world_camera, cv::Mat(), true});
+    EXPECT_TRUE(always.render({cam.T_world_camera, cv::Mat(), false}).ran("translucency"));
 }
 
 TEST_F(TranslucencyPass, SkippedWithoutATranslucentObject) {

@@ -2,6 +2,7 @@
 
 #include <cstring>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "render/FrameGraph.h"
@@ -77,8 +78,21 @@ void TranslucencyPass::setup(PassBuilder& b) const {
     b.writeBuffer(Resource::TranslucentRadiance, SizeRule::Scene);
 }
 
-PassDecision TranslucencyPass::decide(const FrameContext&) const {
+PassDecision TranslucencyPass::decide(const FrameContext& ctx) const {
+    if (surfaceVoxels_ > 0 && upToDate(ctx))
+        return {true,
+                "nothing changed: lights, environment and translucent objects as in the last "
+                "frame"};
     return {surfaceVoxels_ > 0, why_};
+}
+
+std::string TranslucencyPass::inputKey(const FrameContext& ctx) const {
+    return ctx.staticKey + fmt::format("|env {} {} {}", ctx.environment.generation,
+                                       int(ctx.environment.live), ctx.frame.envOrigin);
+}
+
+bool TranslucencyPass::upToDate(const FrameContext& ctx) const {
+    return ctx.options.reuseStaticPasses && !doneKey_.empty() && doneKey_ == inputKey(ctx);
 }
 
 void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
@@ -110,6 +124,7 @@ void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(Resource::TranslucentGrid, grid_);
     res.publish(Resource::TranslucentRadiance, radiance_);
+    doneKey_ = inputKey(ctx);
 }
 
 }  // namespace mirage::render

@@ -5,7 +5,8 @@
 // L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-tau(i, o)} (compute, two dispatches), for L_rv and
 // L_r. The precomputation (surface voxels, tau LUT) is the CPU VoxelNumberMap's, built (or read
 // from its disk cache) when the renderer is created and uploaded once. direct.frag shades the
-// object's pixels from the result. Runs only when the scene has a translucent object.
+// object's pixels from the result. Runs only when the scene has a translucent object, and
+// dispatches only when a light, the shadow maps or the environment changed since the last frame.
 #include <memory>
 #include <string>
 
@@ -20,13 +21,19 @@ public:
     const char* name() const override { return "translucency"; }
     void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
+    // True while nothing its result depends on changed since it last ran: the lights and the
+    // shadow maps (FrameContext::staticKey), the environment (its generation and origin); the
+    // objects are static. The graph then republishes the last radiance without dispatching.
+    bool upToDate(const FrameContext& ctx) const override;
     void resize(const FrameContext& /*ctx*/) override {}  // sized by the scene, once
     void execute(FrameContext& ctx, PassResources& res) override;
 
     int surfaceVoxels() const { return surfaceVoxels_; }
 
 private:
-    std::string why_;  // decide()'s reason
+    std::string inputKey(const FrameContext& ctx) const;
+    std::string why_;      // decide()'s reason
+    std::string doneKey_;  // inputKey() of the last run
     int surfaceVoxels_ = 0;
     float envTransmittance_ = 1.0f;
     glm::vec3 albedoOverPi_{0.0f};
