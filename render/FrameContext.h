@@ -84,8 +84,8 @@ struct RendererOptions {
     // equirectangular map built from each environment-camera frame (height = width / 2).
     int environmentMapWidth = 512;
 
-    // Translucent objects (render/passes/translucency, docs/translucency.md): the voxel number
-    // map of the first translucent object, vnmResolution voxels along its longest side (the tau
+    // Translucent objects (render/passes/translucency, docs/translucency.md): a voxel number
+    // map per translucent object (up to 8), vnmResolution voxels along its longest side (the tau
     // LUT grows with the square of the surface voxels, ~36 n^4 bytes for a cube), its LUT cached
     // in vnmCacheDir (empty: precomputed every time a renderer is created). false: translucent
     // objects are drawn as opaque surfaces of their base colour.

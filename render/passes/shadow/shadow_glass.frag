@@ -70,13 +70,15 @@ void main() {
     float d = lightDistance(li, worldPos);
     if (translucent == 1) {
         bool directional = lights[li].type == LIGHT_DIRECTIONAL;
-        vec3 toLight = directional ? -lights[li].direction : normalize(lights[li].position - worldPos);
+        vec3 toLight =
+            directional ? -lights[li].direction : normalize(lights[li].position - worldPos);
         vec3 n = normalize(worldNormal);
         float cosL = allFinite(n) ? dot(n, toLight) : 1.0;
         float Ft = 1.0 - fresnelDielectric(max(abs(cosL), 1e-4), max(mediumIor, 1e-3));
         // Optical depth from the light's side to this crossing (the same origin along the ray).
         float D = mediumExtinction * (mediumHasDensity == 1 ? densityDepth(li, worldPos, d) : d);
-        vec3 logT = vec3(log(max(Ft, 1e-6))) + (cosL >= 0.0 ? 1.0 : -1.0) * mediumShadowScale * D;
+        vec3 logT =
+            vec3(log(max(Ft, 1e-6))) + (cosL >= 0.0 ? 1.0 : -1.0) * mediumShadowScale * D;
         outGlass = vec4(logT, d);
         return;
     }
