@@ -99,12 +99,16 @@ struct RendererOptions {
     // equirectangular map built from each environment-camera frame (height = width / 2).
     int environmentMapWidth = 512;
 
-    // Translucent objects (render/passes/translucency, docs/translucency.md): the voxel number
-    // map of the first translucent object, vnmResolution voxels along its longest side (the tau
+    // Translucent objects (render/passes/translucency, docs/translucency.md): a voxel number
+    // map per translucent object (up to 8), vnmResolution voxels along its longest side (the tau
     // LUT grows with the square of the surface voxels, ~36 n^4 bytes for a cube), its LUT cached
     // in vnmCacheDir (empty: precomputed every time a renderer is created). false: translucent
     // objects are drawn as opaque surfaces of their base colour.
     bool translucency = true;
+    // A translucent object lets light through in the shadow maps (Fresnel at each crossing, its
+    // optical thickness along the light's ray; docs/translucency.md "Shadows"); false: it is an
+    // opaque occluder.
+    bool translucentShadows = true;
     int vnmResolution = 16;
     std::string vnmCacheDir;
 
@@ -136,7 +140,12 @@ struct LightPlan {
     // Glass in the cone transmits this light in the shadow maps (ShadowGlass atlases); a light
     // with a real-only shadow map also gets a real-only glass layer (real glass only).
     bool glassTransmits = false;
+    // A translucent object in the cone transmits this light in the same atlases (its medium's
+    // optical thickness), whether or not the light has caustics.
+    bool translucentTransmits = false;
     bool needsRealOnlyGlass = false;
+    // The light has glass atlases: glass or a translucent object transmits it.
+    bool hasGlassLayer() const { return glassTransmits || translucentTransmits; }
     // Caustics: a spot light with a specular object in its cone gets photon G-buffers (layer
     // causticLayer) rendered through causticViewProj (world -> clip, fitted to the specular
     // objects' bounding sphere; tan of its half angle causticTanHalf). Glass is then opaque in
@@ -180,6 +189,10 @@ public:
     int frameIndex = 0;
     bool historyValid = false;
     EnvironmentInput environment;
+    // What the camera-independent passes' output depends on besides the static scene: the light
+    // matrices and parameters and the frame plan (Renderer sets it before every frame; equal keys
+    // mean equal shadow maps).
+    std::string staticKey;
     // Canvas pixels (GL window rect: x, y, width, height) that can show a mirror or glass object
     // this frame (width 0: none in view). The specular passes shade only these: on llvmpipe a
     // fragment costs its whole shader even where it exits at once.

@@ -146,6 +146,24 @@ int GpuScene::uploadMaterials(const Scene& scene) {
     // Translucent materials are shaded by the translucency pass (render/passes/translucency).
     for (const Material& m : scene.materials) mats.push_back(toGpu(m));
     materials_ = gl::Buffer("scene materials", mats.size() * sizeof(GpuMaterial), mats.data());
+    media_.resize(mats.size());
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        if (!m.isTranslucent()) continue;
+        GpuMedium& g = media_[i + 1];
+        g.present = true;
+        g.extinction = m.scattering.extinction;
+        g.albedo = m.scattering.albedo;
+        g.ior = std::isfinite(m.ior) && m.ior > 0.0f ? m.ior : 1.0f;
+        if (const DensityGrid* d = m.scattering.density.get()) {
+            g.hasDensity = true;
+            g.boundsMin = d->boundsMin;
+            g.boundsMax = d->boundsMax;
+            g.gridSize = glm::ivec3(d->nx, d->ny, d->nz);
+            g.density = gl::Texture::create3D(m.name + " density", d->nx, d->ny, d->nz, GL_R32F);
+            g.density.upload(GL_RED, GL_FLOAT, d->values.data());
+        }
+    }
 
     return int(mats.size());
 }
@@ -171,6 +189,7 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
                     false,
                     false,
                     false,
+                    false,
                     -1};
             const Material& mat = scene.material(p.material);
             // Mirror: metallic ~1 with low roughness; rough reflector: a metal up to
@@ -180,6 +199,7 @@ std::vector<std::vector<GpuScene::Range>> GpuScene::uploadGeometry(const Scene& 
             r.transmissive = mat.isTransmissive() && !mat.isMirror();
             r.roughReflector = mat.isRoughReflector();
             r.roughGlass = mat.isRoughGlass();
+            r.translucent = mat.isTranslucent();
             const std::vector<glm::vec2>& uvs = mat.baseColorTexture.texCoord == 1 ? p.uv1 : p.uv0;
             if (mat.baseColorTexture.valid() &&
                 size_t(mat.baseColorTexture.texture) < scene.textures.size() &&
@@ -264,6 +284,7 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             d.transmissive = r.transmissive;
             d.roughReflector = r.roughReflector;
             d.roughGlass = r.roughGlass;
+            d.translucent = r.translucent;
             d.baseVertex = r.baseVertex;
             d.firstIndex = r.firstIndex;
             d.indexCount = r.count;
@@ -490,7 +511,9 @@ std::string GpuScene::lightingDefines(bool withGlass) const {
     int faces = 0;
     for (const SceneLight& l : lights_) faces = std::max(faces, l.type == kLightPoint ? 6 : 1);
     std::string defines = "#define MIRAGE_MAX_SHADOW_FACES " + std::to_string(faces) + "\n";
-    if (withGlass && hasTransmissive()) defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
+    // Translucent objects use the glass atlases too (their light through them).
+    if (withGlass && (hasTransmissive() || hasTranslucent()))
+        defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
     return defines;
 }
 
@@ -498,6 +521,18 @@ bool GpuScene::hasTransmissive() const {
     for (const DrawItem& d : draws_)
         if (d.transmissive) return true;
     return false;
+}
+
+bool GpuScene::hasTranslucent() const {
+    for (const DrawItem& d : draws_)
+        if (d.translucent) return true;
+    return false;
+}
+
+const GpuMedium* GpuScene::medium(int material) const {
+    if (material < 0 || size_t(material) >= media_.size()) return nullptr;
+    const GpuMedium& m = media_[size_t(material)];
+    return m.present ? &m : nullptr;
 }
 
 }  // namespace mirage::render

@@ -43,6 +43,9 @@ struct DrawItem {
     // Glass (transmission > 0, not a mirror): it transmits light in the shadow maps (coloured,
     // Fresnel- and absorption-weighted) instead of blocking it.
     bool transmissive = false;
+    // A translucent object (Material::isTranslucent): its medium lets light through in the shadow
+    // maps (GpuScene::medium(material)), attenuated by its optical thickness.
+    bool translucent = false;
     // A rough metal (Material::isRoughReflector): specular, and its reflection is blurred by the
     // fuzzy-reflection filter (render/passes/fuzzy).
     bool roughReflector = false;
@@ -52,6 +55,21 @@ struct DrawItem {
     GLuint firstIndex = 0;
     GLsizei indexCount = 0;
     BoundingSphere bounds;  // world
+};
+
+// The participating medium of a translucent material as the shadow maps need it (the light
+// through the object, docs/translucency.md "Shadows"): sigma_t(x) = extinction * density(x_local),
+// x_local = inverse(model) x, the density trilinear in a box of mesh-local units (1 everywhere
+// without a grid).
+struct GpuMedium {
+    bool present = false;     // the material is translucent
+    float extinction = 0.0f;  // 1/m at density 1
+    glm::vec3 albedo{1.0f};   // single-scattering albedo
+    float ior = 1.0f;
+    bool hasDensity = false;
+    glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // the density grid's box (mesh-local)
+    glm::ivec3 gridSize{0};                      // samples per axis
+    gl::Texture density;                         // R32F 3D, samples at the cell centres
 };
 
 struct SceneLight {
@@ -78,11 +96,15 @@ public:
     // GLSL #defines that specialise the lighting shaders to this scene's lights
     // (MIRAGE_MAX_SHADOW_FACES: 6 with a point light, 1 with spot / directional only, 0 without
     // lights; see lighting.glsl for why a constant loop bound matters on llvmpipe;
-    // MIRAGE_GLASS_SHADOWS when some draw is glass: the shadow lookups read the glass atlases).
+    // MIRAGE_GLASS_SHADOWS when some draw is glass or translucent: the shadow lookups read the
+    // glass atlases).
     // withGlass false: without MIRAGE_GLASS_SHADOWS whatever the scene holds (the variant for
     // frames in which glass transmits no light).
     std::string lightingDefines(bool withGlass = true) const;
     bool hasTransmissive() const;
+    bool hasTranslucent() const;
+    // The medium of GPU material index `material` (DrawItem::material); null unless translucent.
+    const GpuMedium* medium(int material) const;
     // Indices into draws() of the specular (mirror / glass) items, in draw order.
     const std::vector<int>& specularDraws() const { return specularDraws_; }
     // How many specular draws are rough reflectors (fuzzy reflections) / rough glass.
@@ -136,6 +158,7 @@ private:
         bool transmissive;
         bool roughReflector;
         bool roughGlass;
+        bool translucent;
         int metallicRoughnessTexture = -1;
     };
     // The constructor's steps, in order.
@@ -159,6 +182,7 @@ private:
     gl::Texture envMap_;
     float envRotationRad_ = 0.0f;
     gl::VertexArray vao_;
+    std::vector<GpuMedium> media_;       // per GPU material index (empty entries for the others)
     std::vector<gl::Texture> textures_;  // scene.textures: sRGB8_ALPHA8 or RGBA8, mipmapped
     gl::Texture white_;
     bool hasEnvironment_ = false;

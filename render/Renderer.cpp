@@ -213,11 +213,13 @@ void Renderer::planFrame(const FrameInput& input) {
         const SceneLight& l = s.lights()[i];
         GpuLight& g = c.lightBlock.lights[i];
         LightPlan lp;
-        bool real = false, virt = false, glassReal = false, glassVirtual = false;
+        bool real = false, virt = false, glassReal = false, glassVirtual = false,
+             translucentInCone = false;
         for (const DrawItem& d : s.draws()) {
             if (!inLightCone(l, d.bounds)) continue;
             (d.origin == Origin::Real ? real : virt) = true;
             if (d.transmissive) (d.origin == Origin::Real ? glassReal : glassVirtual) = true;
+            translucentInCone = translucentInCone || d.translucent;
         }
         lp.castsShadow = real || virt;
         lp.reachesVirtual = virt;
@@ -261,7 +263,8 @@ void Renderer::planFrame(const FrameInput& input) {
             }
         }
         lp.glassTransmits = options_.glassShadows && (glassReal || glassVirtual) && !lp.caustics;
-        lp.needsRealOnlyGlass = lp.needsRealOnlyMap && lp.glassTransmits;
+        lp.translucentTransmits = options_.translucentShadows && translucentInCone;
+        lp.needsRealOnlyGlass = lp.needsRealOnlyMap && lp.hasGlassLayer();
         anyReachesVirtual = anyReachesVirtual || virt;
         anyCaster = anyCaster || lp.castsShadow;
 
@@ -311,9 +314,9 @@ void Renderer::planFrame(const FrameInput& input) {
         g.shadowLayers = lp.layers;
         g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
         g.isReal = l.origin == Origin::Real ? 1 : 0;
-        g.glassShadow = lp.glassTransmits ? 1 : 0;
+        g.glassShadow = lp.hasGlassLayer() ? 1 : 0;
         plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
-        plan.glassShadows = plan.glassShadows || lp.glassTransmits;
+        plan.glassShadows = plan.glassShadows || lp.hasGlassLayer();
         plan.needRealOnlyGlass = plan.needRealOnlyGlass || lp.needsRealOnlyGlass;
         plan.lights.push_back(lp);
     }
@@ -407,9 +410,10 @@ std::string staticPlanKey(const FrameContext& c) {
     const FramePlan& p = c.plan;
     for (const LightPlan& l : p.lights)
         key +=
-            fmt::format("|{}{}{}{}{}{} {} {} {} {}", int(l.castsShadow), int(l.needsRealOnlyMap),
+            fmt::format("|{}{}{}{}{}{}{} {} {} {} {}", int(l.castsShadow), int(l.needsRealOnlyMap),
                         int(l.reachesVirtual), int(l.hasRsm), int(l.glassTransmits),
-                        int(l.needsRealOnlyGlass), l.firstLayer, l.layers, l.firstVpl, l.vplCount);
+                        int(l.translucentTransmits), int(l.needsRealOnlyGlass), l.firstLayer,
+                        l.layers, l.firstVpl, l.vplCount);
     for (const LightPlan& l : p.lights)
         key += fmt::format("|c{} {}", int(l.caustics), l.causticLayer) +
                std::string(reinterpret_cast<const char*>(&l.causticViewProj), sizeof(glm::mat4));
@@ -436,7 +440,8 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     planFrame(input);
     FrameContext& c = *ctx_;
     // What the camera-independent passes' output depends on: the light matrices and the plan.
-    const FrameReport& report = graph_.execute(c, staticPlanKey(c));
+    c.staticKey = staticPlanKey(c);
+    const FrameReport& report = graph_.execute(c, c.staticKey);
     lastRanFilter_ = report.ran("gifilter");
     ++c.frameIndex;
     return report;

@@ -32,6 +32,8 @@ const int kUnitBaseColorMap = 7;
 const int kUnitMetallicRoughnessMap = 31;
 // shadow.frag: the glass layer of the light layer being rendered (RSM flux behind glass).
 const int kUnitShadowGlassLayer = 8;
+// shadow_glass.frag: the density grid of the translucent draw being rendered.
+const int kUnitShadowDensity = 9;
 
 // direct.frag
 const int kUnitDirectPosition = 0;

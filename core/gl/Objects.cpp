@@ -74,7 +74,7 @@ Texture Texture::allocate(GLenum target, std::string_view lbl, int w, int h, int
     t.layers_ = layers;
     t.format_ = fmt;
     t.target_ = target;
-    if (target == GL_TEXTURE_2D_ARRAY)
+    if (target == GL_TEXTURE_2D_ARRAY || target == GL_TEXTURE_3D)
         glTextureStorage3D(id, levels, fmt, w, h, layers);
     else  // 2D, or a cube map (6 faces from one 2D storage call)
         glTextureStorage2D(id, levels, fmt, w, h);
@@ -92,6 +92,10 @@ Texture Texture::create2D(std::string_view lbl, int w, int h, GLenum fmt, int le
 Texture Texture::create2DArray(std::string_view lbl, int w, int h, int layers, GLenum fmt,
                                int levels) {
     return allocate(GL_TEXTURE_2D_ARRAY, lbl, w, h, layers, fmt, levels, GL_LINEAR);
+}
+
+Texture Texture::create3D(std::string_view lbl, int w, int h, int d, GLenum fmt) {
+    return allocate(GL_TEXTURE_3D, lbl, w, h, d, fmt, 1, GL_LINEAR);
 }
 
 Texture Texture::createCube(std::string_view lbl, int size, GLenum fmt, int levels) {
@@ -113,6 +117,9 @@ void Texture::upload(GLenum pixelFormat, GLenum pixelType, const void* pixels, i
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     if (target_ == GL_TEXTURE_2D)
         glTextureSubImage2D(id(), 0, 0, 0, width_, height_, pixelFormat, pixelType, pixels);
+    else if (target_ == GL_TEXTURE_3D)
+        glTextureSubImage3D(id(), 0, 0, 0, 0, width_, height_, layers_, pixelFormat, pixelType,
+                            pixels);
     else
         glTextureSubImage3D(id(), 0, 0, 0, layer, width_, height_, 1, pixelFormat, pixelType,
                             pixels);

@@ -76,7 +76,10 @@ public:
                                  GLenum internalFormat, int levels = 1);
     static Texture createCube(std::string_view label, int size, GLenum internalFormat,
                               int levels = 1);
-    // Textures created so far by this process (all three factories): lets a test check that a
+    // 3D texture (width x height x depth, depth reported as layers()), trilinear, clamp to edge.
+    static Texture create3D(std::string_view label, int width, int height, int depth,
+                            GLenum internalFormat);
+    // Textures created so far by this process (all the factories): lets a test check that a
     // per-frame loop allocates nothing once it runs (a renderer that did cost page faults on
     // every target and lost its temporal history).
     static std::uint64_t createdCount();
@@ -87,7 +90,8 @@ public:
     GLenum format() const { return format_; }
     void setFilter(GLenum minFilter, GLenum magFilter);
     void setWrap(GLenum wrap);
-    // Uploads level 0 (or a layer of an array texture) from tightly packed pixels.
+    // Uploads level 0 (or a layer of an array texture; all of a 3D texture) from tightly packed
+    // pixels.
     void upload(GLenum pixelFormat, GLenum pixelType, const void* pixels, int layer = 0);
     // Reads level 0 back (glGetTextureImage) into a tightly packed vector of `T`.
     template <class T>
@@ -98,7 +102,7 @@ public:
     }
 
 private:
-    // The three factories: immutable storage, label, min filter `minFilter`, clamp to edge.
+    // The factories: immutable storage, label, min filter `minFilter`, clamp to edge.
     static Texture allocate(GLenum target, std::string_view label, int width, int height,
                             int layers, GLenum internalFormat, int levels, GLenum minFilter);
     void readInto(GLenum pixelFormat, GLenum pixelType, void* dst, size_t bytes) const;

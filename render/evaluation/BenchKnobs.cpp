@@ -256,6 +256,14 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.roughMipLevels = parseInt("lean_mip_levels", v, 1, 12);
          },
          [](const BenchConfig& c) { return std::to_string(c.options.roughMipLevels); }},
+        {"translucent_shadows",
+         "on: a translucent object lets light through in the shadow maps (its optical "
+         "thickness along the light's ray, coloured by its medium); off: it is opaque there",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.translucentShadows = parseOnOff("translucent_shadows", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.translucentShadows); }},
         {"vnm_resolution",
          "voxels along a translucent object's longest side in its voxel number map (2..512; "
          "the LUT grows with the 4th power)",

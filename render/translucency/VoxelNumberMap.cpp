@@ -69,6 +69,15 @@ glm::vec3 effectiveAlbedo(const glm::vec3& albedo) {
     return out;
 }
 
+glm::vec3 shadowExtinctionScale(const glm::vec3& albedo) {
+    // The light removed from the shadow ray over tau, e^{-tau} aside, is scattered; a_eff of it
+    // leaves the object (effectiveAlbedo), about half of that on the side away from the light,
+    // and a receiver near that side sees it over about half its hemisphere: a quarter of
+    // a_eff (1 - e^{-tau}) arrives, which e^{-(1 - a_eff / 4) tau} follows to within a few per
+    // cent for tau up to ~2 (docs/translucency.md "Shadows").
+    return glm::vec3(1.0f) - 0.25f * effectiveAlbedo(albedo);
+}
+
 std::vector<TranslucentObject> translucentObjects(const Scene& scene) {
     std::vector<TranslucentObject> out;
     for (const MeshInstance& mi : scene.meshInstances()) {

@@ -53,6 +53,10 @@ struct TranslucentObject {
 // (1 stays 1: a white medium loses nothing).
 glm::vec3 effectiveAlbedo(const glm::vec3& albedo);
 
+// The scale k of the optical thickness in the transmittance a translucent object's shadow lets
+// through, T = F_t,in F_t,out e^{-k tau} per channel (docs/translucency.md "Shadows").
+glm::vec3 shadowExtinctionScale(const glm::vec3& albedo);
+
 // F_t: the fraction of light crossing the smooth boundary of a medium of index `ior` at
 // |cos| = cosAbs to the normal (1 - Fresnel reflectance; 1 for ior 1).
 float boundaryTransmittance(float ior, float cosAbs);

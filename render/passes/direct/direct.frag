@@ -18,8 +18,9 @@ layout(binding = kUnitDirectShadowReal) uniform sampler2DArray shadowReal;
 layout(binding = kUnitDirectGlassAll) uniform sampler2DArray glassAll;
 layout(binding = kUnitDirectGlassReal) uniform sampler2DArray glassReal;
 #endif
-// The translucency pass's radiance leaving each surface voxel of the translucent object
-// (before the exit F_t): S vec4 for L_rv, then S vec4 for L_r. Read only when translucentOn.
+// The translucency pass's radiance leaving each surface voxel of the translucent objects
+// (before the exit F_t): per object its S vec4 for L_rv, then its S for L_r (translucency.glsl).
+// Read only when translucentOn.
 layout(std430, binding = kBindingTranslucentRadiance) readonly buffer TranslucentRadianceBlock {
     vec4 translucentL[];
 };
@@ -44,15 +45,18 @@ void main() {
     vec3 v = normalize(cameraPos.xyz - p);
     vec3 rv = vec3(0.0), r = vec3(0.0);
     vec4 Em = texelFetch(gEmissive, px, 0);
-    // A translucent pixel (gEmissive.a = -1) takes the light scattered through the object to its
-    // nearest surface voxel, times F_t towards the camera (VnmShading::scattered), instead of
-    // the surface BRDF: L_rv from all lights, L_r from real lights with the real-only shadow
-    // maps (and nothing on a virtual object, as for any virtual pixel).
-    int voxel = translucentOn == 1 && Em.a < -0.5 ? surfaceVoxelAt(p) : -1;
-    if (voxel >= 0) {
-        float Ft = boundaryTransmittance(gridParams.x, abs(dot(n, v)));
-        rv = Ft * translucentL[voxel].rgb;
-        if (pReal) r = Ft * translucentL[gridDims.w + voxel].rgb;
+    // A translucent pixel (gEmissive.a = -1) takes the light scattered through its object (the
+    // one whose map has the nearest surface voxel) to that surface voxel, times F_t towards the
+    // camera (VnmShading::scattered), instead of the surface BRDF: L_rv from all lights, L_r from
+    // real lights with the real-only shadow maps (and nothing on a virtual object, as for any
+    // virtual pixel). An object beyond the ones with a map has no voxel: shaded as a surface.
+    int object, voxel;
+    if (translucentOn == 1 && Em.a < -0.5 && translucentVoxelAt(p, object, voxel)) {
+        TranslucentObjectGpu obj = translucentObjects[object];
+        int base = 2 * obj.offsets.y;  // the object's slice: S for L_rv, then S for L_r
+        float Ft = boundaryTransmittance(obj.params.x, abs(dot(n, v)));
+        rv = Ft * translucentL[base + voxel].rgb;
+        if (pReal) r = Ft * translucentL[base + obj.gridDims.w + voxel].rgb;
         rv += Em.rgb;
         if (pReal) r += Em.rgb;
         outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);

@@ -1,6 +1,7 @@
 #include "render/passes/shadow/ShadowPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/translucency/VoxelNumberMap.h"
 namespace mirage::render {
 
 ShadowPass::ShadowPass()
@@ -14,6 +15,15 @@ ShadowPass::ShadowPass()
     locGlassLayer_ = program_.uniformLocation("glassLayer");
     locGlassViewProj_ = glassProgram_.uniformLocation("lightViewProj");
     locGlassLight_ = glassProgram_.uniformLocation("lightIndex");
+    locTranslucent_ = glassProgram_.uniformLocation("translucent");
+    locExtinction_ = glassProgram_.uniformLocation("mediumExtinction");
+    locShadowScale_ = glassProgram_.uniformLocation("mediumShadowScale");
+    locIor_ = glassProgram_.uniformLocation("mediumIor");
+    locHasDensity_ = glassProgram_.uniformLocation("mediumHasDensity");
+    locLocalFromWorld_ = glassProgram_.uniformLocation("mediumLocalFromWorld");
+    locDensityMin_ = glassProgram_.uniformLocation("densityMin");
+    locDensityMax_ = glassProgram_.uniformLocation("densityMax");
+    locDensityCells_ = glassProgram_.uniformLocation("densityCells");
 }
 
 void ShadowPass::setup(PassBuilder& b) const {
@@ -28,17 +38,21 @@ void ShadowPass::setup(PassBuilder& b) const {
 
 PassDecision ShadowPass::decide(const FrameContext& ctx) const {
     if (ctx.plan.shadowLayers == 0) return {false, "no light has a shadow caster in its cone"};
-    int n = 0, real = 0, glass = 0;
+    int n = 0, real = 0, glass = 0, translucent = 0;
     for (const LightPlan& l : ctx.plan.lights) {
         n += l.castsShadow;
         real += l.needsRealOnlyMap;
         glass += l.glassTransmits;
+        translucent += l.translucentTransmits;
     }
-    return {true, std::to_string(n) + " light(s) with casters in the cone, " +
-                      std::to_string(ctx.plan.shadowLayers) + " layer(s); " + std::to_string(real) +
-                      " need a real-only map" +
-                      (glass ? "; glass transmits in " + std::to_string(glass) : std::string()) +
-                      (ctx.plan.needVpls ? "; RSMs for VPLs" : "")};
+    return {true,
+            std::to_string(n) + " light(s) with casters in the cone, " +
+                std::to_string(ctx.plan.shadowLayers) + " layer(s); " + std::to_string(real) +
+                " need a real-only map" +
+                (glass ? "; glass transmits in " + std::to_string(glass) : std::string()) +
+                (translucent ? "; a translucent object transmits in " + std::to_string(translucent)
+                             : std::string()) +
+                (ctx.plan.needVpls ? "; RSMs for VPLs" : "")};
 }
 
 void ShadowPass::resize(const FrameContext& ctx) {
@@ -82,13 +96,33 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
     const glm::mat4& vp = ctx.lightBlock.lights[light].viewProj[layer];
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
     glUniform1i(locLight_, light);
-    glUniform1i(locGlassLayer_, rsm && lp.glassTransmits ? atlasLayer : -1);
+    glUniform1i(locGlassLayer_, rsm && lp.hasGlassLayer() ? atlasLayer : -1);
     glBindTextureUnit(kUnitShadowGlassLayer, glass_.id());
     for (const DrawItem& d : ctx.scene.draws()) {
         if (realOnly && d.origin != Origin::Real) continue;
         if (lp.glassTransmits && d.transmissive) continue;  // in the glass layer instead
+        if (lp.translucentTransmits && d.translucent) continue;
         draw_.draw(ctx.scene, d);
     }
+}
+
+// The translucent draw's medium for shadow_glass.frag (translucent = 0 for glass).
+void ShadowPass::setMediumUniforms(const DrawItem& d, const GpuMedium* medium) {
+    const GLuint p = glassProgram_.id();
+    glProgramUniform1i(p, locTranslucent_, medium ? 1 : 0);
+    if (!medium) return;
+    glProgramUniform1f(p, locExtinction_, medium->extinction);
+    const glm::vec3 k = translucency::shadowExtinctionScale(medium->albedo);
+    glProgramUniform3fv(p, locShadowScale_, 1, &k[0]);
+    glProgramUniform1f(p, locIor_, medium->ior);
+    glProgramUniform1i(p, locHasDensity_, medium->hasDensity ? 1 : 0);
+    const glm::mat4 localFromWorld = glm::inverse(d.model);
+    glProgramUniformMatrix4fv(p, locLocalFromWorld_, 1, GL_FALSE, &localFromWorld[0][0]);
+    glProgramUniform3fv(p, locDensityMin_, 1, &medium->boundsMin[0]);
+    glProgramUniform3fv(p, locDensityMax_, 1, &medium->boundsMax[0]);
+    const glm::vec3 cells(medium->gridSize);
+    glProgramUniform3fv(p, locDensityCells_, 1, &cells[0]);
+    if (medium->hasDensity) glBindTextureUnit(kUnitShadowDensity, medium->density.id());
 }
 
 void ShadowPass::renderGlassLayer(FrameContext& ctx, int light, int layer, bool realOnly) {
@@ -110,7 +144,11 @@ void ShadowPass::renderGlassLayer(FrameContext& ctx, int light, int layer, bool 
     glBlendEquationSeparate(GL_FUNC_ADD, GL_MIN);
     glBlendFunc(GL_ONE, GL_ONE);
     for (const DrawItem& d : ctx.scene.draws()) {
-        if (!d.transmissive || (realOnly && d.origin != Origin::Real)) continue;
+        if (realOnly && d.origin != Origin::Real) continue;
+        const GpuMedium* medium = d.translucent ? ctx.scene.medium(d.material) : nullptr;
+        if (!(lp.glassTransmits && d.transmissive) && !(lp.translucentTransmits && medium))
+            continue;
+        setMediumUniforms(d, medium);
         glassDraw_.draw(ctx.scene, d);
     }
     glDisable(GL_BLEND);
@@ -140,7 +178,7 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
         const LightPlan& lp = ctx.plan.lights[i];
         if (!lp.castsShadow) continue;
         for (int layer = 0; layer < lp.layers; ++layer) {
-            if (lp.glassTransmits) {
+            if (lp.hasGlassLayer()) {
                 renderGlassLayer(ctx, int(i), layer, false);
                 if (lp.needsRealOnlyGlass) renderGlassLayer(ctx, int(i), layer, true);
             }

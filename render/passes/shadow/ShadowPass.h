@@ -7,7 +7,9 @@
 // When VPLs are needed the all-occluder pass also writes the reflective shadow maps.
 // Glass (DrawItem::transmissive) in a light's cone is left out of the occluder maps and drawn
 // into the glass atlases instead (shadow_glass.frag): the lookups colour the light behind it by
-// its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque.
+// its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque. A
+// translucent object (DrawItem::translucent) goes into the same atlases for every light (caustic
+// lights too): its boundary's Fresnel and its medium's optical thickness along the light's ray.
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -25,6 +27,7 @@ public:
 private:
     void renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);
     void renderGlassLayer(FrameContext& ctx, int light, int layer, bool realOnly);
+    void setMediumUniforms(const DrawItem& d, const GpuMedium* medium);
     gl::Program program_, glassProgram_;
     gl::Texture distance_, distanceReal_, rsmFlux_, rsmNormal_, rsmPosition_, depth_;
     gl::Texture glass_, glassReal_;
@@ -34,6 +37,9 @@ private:
     MaterialDraw glassDraw_{glassProgram_};
     GLint locViewProj_ = -1, locLight_ = -1, locGlassLayer_ = -1;
     GLint locGlassViewProj_ = -1, locGlassLight_ = -1;
+    GLint locTranslucent_ = -1, locExtinction_ = -1, locShadowScale_ = -1, locIor_ = -1,
+          locHasDensity_ = -1, locLocalFromWorld_ = -1, locDensityMin_ = -1, locDensityMax_ = -1,
+          locDensityCells_ = -1;
 };
 
 }  // namespace mirage::render

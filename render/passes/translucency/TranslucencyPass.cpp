@@ -2,12 +2,29 @@
 
 #include <cstring>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "core/Error.h"
 #include "render/FrameGraph.h"
 #include "render/translucency/VoxelNumberMap.h"
 
 namespace mirage::render {
+
+namespace {
+
+// One translucent object in the header of the grid buffer (translucency.glsl
+// TranslucentObjectGpu, std430): 5 vec4.
+struct ObjectHeader {
+    glm::vec4 gridOrigin;    // world corner of cell (0,0,0), voxel edge (m)
+    glm::ivec4 gridDims;     // cells per axis, S
+    glm::vec4 params;        // ior, F_t over the cosine-weighted hemisphere, 0, 0
+    glm::ivec4 offsets;      // first cell number, first surface voxel, first LUT entry, 0
+    glm::vec4 albedoOverPi;  // a_eff / pi, 0
+};
+static_assert(sizeof(ObjectHeader) == 80);
+
+}  // namespace
 
 TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
                                    const RendererOptions& options) {
@@ -20,49 +37,72 @@ TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
         why_ = "no translucent object in the scene";
         return;
     }
-    for (size_t k = 1; k < objects.size(); ++k)
+    for (size_t k = kMaxObjects; k < objects.size(); ++k)
         spdlog::warn(
-            "translucent object '{}': the real-time renderer shades only the first translucent "
-            "object ('{}') with its voxel number map; this one is drawn as an opaque surface of "
-            "its base colour",
-            objects[k].name, objects[0].name);
-    const translucency::TranslucentObject& object = objects[0];
+            "translucent object '{}': the real-time renderer shades at most {} translucent "
+            "objects with voxel number maps; this one is drawn as an opaque surface of its base "
+            "colour",
+            objects[k].name, kMaxObjects);
+    if (objects.size() > size_t(kMaxObjects)) objects.resize(size_t(kMaxObjects));
+
     translucency::VnmSettings settings;
     settings.resolution = options.vnmResolution;
     settings.cacheDir = options.vnmCacheDir;
-    const translucency::VoxelNumberMap map = translucency::VoxelNumberMap::build(object, settings);
-    const auto& sv = map.surface();
-    const size_t S = sv.size();
-    surfaceVoxels_ = int(S);
-    why_ = "translucent '" + object.name + "': " + std::to_string(S) + " surface voxels";
-    envTransmittance_ = translucency::hemisphericalTransmittance(object.medium.ior);
-    albedoOverPi_ = translucency::effectiveAlbedo(object.medium.albedo) / 3.14159265358979f;
-
-    // Header (gridOrigin, gridDims, gridParams: translucency.glsl) + one int per cell.
-    const std::vector<int32_t>& numbers = map.numbers();
-    std::vector<int32_t> grid(12 + numbers.size());
-    const glm::vec4 origin(map.origin(), map.voxelSize());
-    const glm::ivec4 dims(map.dims(), int(S));
-    const glm::vec4 params(object.medium.ior, 0.0f, 0.0f, 0.0f);
-    std::memcpy(&grid[0], &origin, 16);
-    std::memcpy(&grid[4], &dims, 16);
-    std::memcpy(&grid[8], &params, 16);
-    std::memcpy(&grid[12], numbers.data(), numbers.size() * sizeof(int32_t));
-    grid_ = gl::Buffer("translucent grid", grid.size() * sizeof(int32_t), grid.data(), 0);
-
-    std::vector<glm::vec4> voxels(2 * S);
-    for (size_t i = 0; i < S; ++i) {
-        voxels[2 * i] =
-            glm::vec4(sv[i].position, sv[i].exterior ? sv[i].area * sv[i].kernelScale : 0.0f);
-        voxels[2 * i + 1] = glm::vec4(sv[i].normal, 0.0f);
+    std::vector<ObjectHeader> headers;
+    std::vector<int32_t> numbers;
+    std::vector<glm::vec4> voxels;
+    std::vector<uint16_t> lut;
+    size_t lutTotal = 0;
+    for (const translucency::TranslucentObject& object : objects) {
+        const translucency::VoxelNumberMap map =
+            translucency::VoxelNumberMap::build(object, settings);
+        const auto& sv = map.surface();
+        const size_t S = sv.size();
+        // Every map was checked against the limit alone; together they must fit it too.
+        lutTotal += map.lutBytes();
+        if (lutTotal > settings.maxLutBytes)
+            throw Error(fmt::format(
+                "voxel number maps: the LUTs of the first {} translucent objects need {} MiB "
+                "together, more than the limit of {} MiB; lower the voxel resolution "
+                "(vnmResolution) or make fewer objects translucent",
+                headers.size() + 1, lutTotal >> 20, settings.maxLutBytes >> 20));
+        ObjectHeader h{};
+        h.gridOrigin = glm::vec4(map.origin(), map.voxelSize());
+        h.gridDims = glm::ivec4(map.dims(), int(S));
+        h.params = glm::vec4(object.medium.ior,
+                             translucency::hemisphericalTransmittance(object.medium.ior), 0, 0);
+        h.offsets = glm::ivec4(int(numbers.size()), surfaceVoxels_, int(lut.size()), 0);
+        h.albedoOverPi =
+            glm::vec4(translucency::effectiveAlbedo(object.medium.albedo) / 3.14159265358979f, 0);
+        headers.push_back(h);
+        numbers.insert(numbers.end(), map.numbers().begin(), map.numbers().end());
+        for (size_t i = 0; i < S; ++i) {
+            voxels.emplace_back(sv[i].position,
+                                sv[i].exterior ? sv[i].area * sv[i].kernelScale : 0.0f);
+            voxels.emplace_back(sv[i].normal, 0.0f);
+        }
+        lut.insert(lut.end(), map.tauHalf().begin(), map.tauHalf().end());
+        surfaceVoxels_ += int(S);
+        objectVoxels_.push_back(int(S));
+        why_ += (why_.empty() ? "" : ", ") + fmt::format("'{}': {} surface voxels", object.name, S);
     }
+    why_ = fmt::format("{} translucent object(s): ", headers.size()) + why_;
+
+    // Grid buffer: the object count, kMaxObjects headers, then every object's voxel numbers.
+    const size_t headerBytes = 16 + kMaxObjects * sizeof(ObjectHeader);
+    std::vector<uint8_t> grid(headerBytes + numbers.size() * sizeof(int32_t), 0);
+    const glm::ivec4 count(int(headers.size()), 0, 0, 0);
+    std::memcpy(grid.data(), &count, 16);
+    std::memcpy(grid.data() + 16, headers.data(), headers.size() * sizeof(ObjectHeader));
+    std::memcpy(grid.data() + headerBytes, numbers.data(), numbers.size() * sizeof(int32_t));
+    grid_ = gl::Buffer("translucent grid", grid.size(), grid.data(), 0);
     voxels_ = gl::Buffer("translucent voxels", voxels.size() * sizeof(glm::vec4), voxels.data(), 0);
     // Half floats two per uint (the shader's unpackHalf2x16), padded to whole uints.
-    std::vector<uint16_t> lut = map.tauHalf();
     if (lut.size() % 2) lut.push_back(0);
     lut_ = gl::Buffer("translucent tau LUT", lut.size() * sizeof(uint16_t), lut.data(), 0);
-    irradiance_ = gl::Buffer("translucent irradiance", 2 * S * sizeof(glm::vec4), nullptr, 0);
-    radiance_ = gl::Buffer("translucent radiance", 2 * S * sizeof(glm::vec4), nullptr, 0);
+    const size_t total = size_t(surfaceVoxels_);
+    irradiance_ = gl::Buffer("translucent irradiance", 2 * total * sizeof(glm::vec4), nullptr, 0);
+    radiance_ = gl::Buffer("translucent radiance", 2 * total * sizeof(glm::vec4), nullptr, 0);
     program_ = computeProgram("translucency", "passes/translucency/translucency.comp",
                               gpu.lightingDefines());
 }
@@ -77,8 +117,21 @@ void TranslucencyPass::setup(PassBuilder& b) const {
     b.writeBuffer(Resource::TranslucentRadiance, SizeRule::Scene);
 }
 
-PassDecision TranslucencyPass::decide(const FrameContext&) const {
+PassDecision TranslucencyPass::decide(const FrameContext& ctx) const {
+    if (surfaceVoxels_ > 0 && upToDate(ctx))
+        return {true,
+                "nothing changed: lights, environment and translucent objects as in the last "
+                "frame"};
     return {surfaceVoxels_ > 0, why_};
+}
+
+std::string TranslucencyPass::inputKey(const FrameContext& ctx) const {
+    return ctx.staticKey + fmt::format("|env {} {} {}", ctx.environment.generation,
+                                       int(ctx.environment.live), ctx.frame.envOrigin);
+}
+
+bool TranslucencyPass::upToDate(const FrameContext& ctx) const {
+    return ctx.options.reuseStaticPasses && !doneKey_.empty() && doneKey_ == inputKey(ctx);
 }
 
 void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
@@ -99,17 +152,21 @@ void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
                       res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
     glBindTextureUnit(kUnitTranslucencyGlassReal,
                       res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
-    glUniform1f(program_.uniformLocation("envTransmittance"), envTransmittance_);
-    glUniform3fv(program_.uniformLocation("albedoOverPi"), 1, &albedoOverPi_[0]);
-    const GLuint groups = GLuint((surfaceVoxels_ + 63) / 64);
-    glUniform1i(program_.uniformLocation("stage"), 0);
-    glDispatchCompute(groups, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUniform1i(program_.uniformLocation("stage"), 1);
-    glDispatchCompute(groups, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    const GLint stage = program_.uniformLocation("stage");
+    const GLint object = program_.uniformLocation("objectIndex");
+    // Stage 0 (irradiance) of every object, then stage 1 (radiance out) of every object: one
+    // invocation per surface voxel of the object.
+    for (int s = 0; s < 2; ++s) {
+        glUniform1i(stage, s);
+        for (size_t k = 0; k < objectVoxels_.size(); ++k) {
+            glUniform1i(object, int(k));
+            glDispatchCompute(GLuint((objectVoxels_[k] + 63) / 64), 1, 1);
+        }
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
     res.publish(Resource::TranslucentGrid, grid_);
     res.publish(Resource::TranslucentRadiance, radiance_);
+    doneKey_ = inputKey(ctx);
 }
 
 }  // namespace mirage::render

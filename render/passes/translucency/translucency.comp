@@ -3,7 +3,8 @@
 #include "lighting.glsl"
 #include "passes/translucency/translucency.glsl"
 // The voxel number map at run time (Mochida et al.; docs/translucency.md), in two dispatches
-// over the S surface voxels of one translucent object:
+// over the S surface voxels of one translucent object (objectIndex; its buffers' slices from
+// translucentObjects[objectIndex].offsets):
 //  stage 0: irradiance E_i = sum_lights F_t(cos) cos I vis + F_t-weighted environment
 //           irradiance at every outer surface voxel i; for L_rv every light with visibility
 //           through all occluders, for L_r only real lights with the real-only shadow maps and
@@ -12,7 +13,8 @@
 //           radiance leaving o before the exit boundary's F_t (direct.frag applies it per pixel).
 layout(local_size_x = 64) in;
 
-// Per surface voxel: (centre xyz world m, A_i c_i if on the outer surface else 0),
+// Per surface voxel (all objects' in order): (centre xyz world m, A_i c_i if on the outer
+// surface else 0),
 // (outward unit normal xyz, 0).
 struct TranslucentVoxel {
     vec4 positionWeight;
@@ -31,24 +33,25 @@ layout(binding = kUnitTranslucencyGlassAll) uniform sampler2DArray glassAll;
 layout(binding = kUnitTranslucencyGlassReal) uniform sampler2DArray glassReal;
 #endif
 uniform int stage;
-uniform float envTransmittance;  // F_t averaged over the cosine-weighted hemisphere
-uniform vec3 albedoOverPi;       // a_eff / pi
+uniform int objectIndex;
 
-float tau(int i, int o, int S) {
-    uint k = uint(i) * uint(S) + uint(o);
+// tau between the object's surface voxels i and o (local numbers); lutFirst = its first entry.
+float tau(int i, int o, int S, int lutFirst) {
+    uint k = uint(lutFirst) + uint(i) * uint(S) + uint(o);
     vec2 h = unpackHalf2x16(tauHalf[k >> 1u]);
     return (k & 1u) == 0u ? h.x : h.y;
 }
 
-void irradiance(int i, int S) {
-    TranslucentVoxel v = voxels[i];
+// Surface voxel i of the object (local number); v0 = its first voxel in the buffers.
+void irradiance(int i, int S, int v0, TranslucentObjectGpu obj) {
+    TranslucentVoxel v = voxels[v0 + i];
     vec3 rv = vec3(0.0), r = vec3(0.0);
     if (v.positionWeight.w > 0.0) {  // cavity walls receive no outside light
         vec3 p = v.positionWeight.xyz;
         vec3 N = v.normal.xyz;
-        float ior = gridParams.x;
+        float ior = obj.params.x;
         // Visibility from just outside the voxel, along its normal (as the CPU code).
-        vec3 x = p + N * gridOrigin.w;
+        vec3 x = p + N * obj.gridOrigin.w;
         for (int li = 0; li < lightCount; ++li) {
             vec3 wi, Ei;
             incidentLight(li, p, wi, Ei);
@@ -66,34 +69,37 @@ void irradiance(int i, int S) {
             if (lights[li].isReal == 1) r += c * visReal;
         }
         if (envOrigin != 0) {
-            vec3 e = envTransmittance * shIrradiance(N);
+            vec3 e = obj.params.y * shIrradiance(N);
             rv += e;
             if (envOrigin == ORIGIN_REAL) r += e;
         }
     }
-    E[i] = vec4(allFinite(rv) ? rv : vec3(0.0), 0.0);
-    E[S + i] = vec4(allFinite(r) ? r : vec3(0.0), 0.0);
+    E[2 * v0 + i] = vec4(allFinite(rv) ? rv : vec3(0.0), 0.0);
+    E[2 * v0 + S + i] = vec4(allFinite(r) ? r : vec3(0.0), 0.0);
 }
 
-void scatter(int o, int S) {
+void scatter(int o, int S, int v0, TranslucentObjectGpu obj) {
     vec3 rv = vec3(0.0), r = vec3(0.0);
+    int lutFirst = obj.offsets.z;
     for (int i = 0; i < S; ++i) {
-        float w = voxels[i].positionWeight.w;
+        float w = voxels[v0 + i].positionWeight.w;
         if (w <= 0.0) continue;
-        float k = w * exp(-tau(i, o, S));
-        rv += E[i].rgb * k;
-        r += E[S + i].rgb * k;
+        float k = w * exp(-tau(i, o, S, lutFirst));
+        rv += E[2 * v0 + i].rgb * k;
+        r += E[2 * v0 + S + i].rgb * k;
     }
-    L[o] = vec4(rv * albedoOverPi, 0.0);
-    L[S + o] = vec4(r * albedoOverPi, 0.0);
+    L[2 * v0 + o] = vec4(rv * obj.albedoOverPi.rgb, 0.0);
+    L[2 * v0 + S + o] = vec4(r * obj.albedoOverPi.rgb, 0.0);
 }
 
 void main() {
-    int S = gridDims.w;
+    TranslucentObjectGpu obj = translucentObjects[objectIndex];
+    int S = obj.gridDims.w;
+    int v0 = obj.offsets.y;
     int i = int(gl_GlobalInvocationID.x);
     if (i >= S) return;
     if (stage == 0)
-        irradiance(i, S);
+        irradiance(i, S, v0, obj);
     else
-        scatter(i, S);
+        scatter(i, S, v0, obj);
 }

@@ -1,16 +1,29 @@
-// Shared by translucency.comp and direct.frag: the SSBOs of the first translucent object's voxel
-// number map (render/passes/translucency/TranslucencyPass.cpp uploads them) and the boundary
+// Shared by translucency.comp and direct.frag: the voxel number maps of the scene's translucent
+// objects (render/passes/translucency/TranslucencyPass.cpp uploads them) and the boundary
 // transmittance. World metres; radiance linear W/(m^2 sr).
 #ifndef MIRAGE_TRANSLUCENCY_GLSL
 #define MIRAGE_TRANSLUCENCY_GLSL
 
-// The grid of the voxel number map: gridOrigin.xyz = world corner of cell (0,0,0), .w = voxel
-// edge (m); gridDims.xyz = cells per axis, .w = S (surface voxels); gridParams.x = the medium's
-// index of refraction. gridNumber: per cell (x fastest) its surface voxel or -1.
-layout(std430, binding = kBindingTranslucentGrid) readonly buffer TranslucentGridBlock {
+// At most this many objects have a map (TranslucencyPass::kMaxObjects: the same number).
+const int kMaxTranslucentObjects = 8;
+
+// One object's map: gridOrigin.xyz = world corner of its cell (0,0,0), .w = voxel edge (m);
+// gridDims.xyz = cells per axis, .w = S (its surface voxels); params.x = the medium's index of
+// refraction, .y = F_t averaged over the cosine-weighted hemisphere; offsets.x = its first cell
+// in gridNumber, .y = its first surface voxel in the voxel, irradiance and radiance buffers
+// (which hold 2 entries per voxel: an object's S for L_rv, then its S for L_r, from 2 * .y on),
+// .z = its first entry in the tau LUT; albedoOverPi.rgb = a_eff / pi.
+struct TranslucentObjectGpu {
     vec4 gridOrigin;
     ivec4 gridDims;
-    vec4 gridParams;
+    vec4 params;
+    ivec4 offsets;
+    vec4 albedoOverPi;
+};
+// objectCount.x objects; gridNumber: per cell (x fastest) the object's surface voxel or -1.
+layout(std430, binding = kBindingTranslucentGrid) readonly buffer TranslucentGridBlock {
+    ivec4 objectCount;
+    TranslucentObjectGpu translucentObjects[kMaxTranslucentObjects];
     int gridNumber[];
 };
 
@@ -27,32 +40,57 @@ float boundaryTransmittance(float ior, float c) {
     return 1.0 - 0.5 * (rPar * rPar + rPerp * rPerp);
 }
 
-// The surface voxel standing for world point p (VoxelNumberMap::surfaceVoxelAt): the number in
-// p's cell, else the numbered cell within 2 cells whose centre is nearest to p; -1 if none.
-int surfaceVoxelAt(vec3 p) {
-    ivec3 c = ivec3(floor((p - gridOrigin.xyz) / gridOrigin.w));
-    ivec3 dims = gridDims.xyz;
+// The surface voxel of object k standing for world point p (VoxelNumberMap::surfaceVoxelAt):
+// the number in p's cell (dist = 0), else the numbered cell within 2 cells whose centre is
+// nearest to p (dist = that distance, m); -1 if none.
+int surfaceVoxelAt(int k, vec3 p, out float dist) {
+    TranslucentObjectGpu o = translucentObjects[k];
+    dist = 1e30;
+    ivec3 c = ivec3(floor((p - o.gridOrigin.xyz) / o.gridOrigin.w));
+    ivec3 dims = o.gridDims.xyz;
+    int first = o.offsets.x;
+    if (any(lessThan(c, ivec3(-2))) || any(greaterThan(c, dims + 1))) return -1;
     if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, dims))) {
-        int n = gridNumber[(c.z * dims.y + c.y) * dims.x + c.x];
-        if (n >= 0) return n;
+        int n = gridNumber[first + (c.z * dims.y + c.y) * dims.x + c.x];
+        if (n >= 0) {
+            dist = 0.0;
+            return n;
+        }
     }
     int best = -1;
-    float bestD = 1e30;
     for (int dz = -2; dz <= 2; ++dz)
         for (int dy = -2; dy <= 2; ++dy)
             for (int dx = -2; dx <= 2; ++dx) {
                 ivec3 q = c + ivec3(dx, dy, dz);
                 if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, dims))) continue;
-                int n = gridNumber[(q.z * dims.y + q.y) * dims.x + q.x];
+                int n = gridNumber[first + (q.z * dims.y + q.y) * dims.x + q.x];
                 if (n < 0) continue;
-                vec3 centre = gridOrigin.xyz + (vec3(q) + 0.5) * gridOrigin.w;
+                vec3 centre = o.gridOrigin.xyz + (vec3(q) + 0.5) * o.gridOrigin.w;
                 float d = length(centre - p);
-                if (d < bestD) {
-                    bestD = d;
+                if (d < dist) {
+                    dist = d;
                     best = n;
                 }
             }
     return best;
+}
+
+// The translucent object and surface voxel standing for world point p: the object whose map has
+// a surface voxel nearest to p (objects may share cells only where they touch). False if none.
+bool translucentVoxelAt(vec3 p, out int object, out int voxel) {
+    object = -1;
+    voxel = -1;
+    float best = 1e30;
+    for (int k = 0; k < objectCount.x; ++k) {
+        float d;
+        int n = surfaceVoxelAt(k, p, d);
+        if (n >= 0 && d < best) {
+            best = d;
+            object = k;
+            voxel = n;
+        }
+    }
+    return voxel >= 0;
 }
 
 #endif
