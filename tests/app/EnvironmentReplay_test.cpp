@@ -57,8 +57,10 @@ std::string envFile() {
 }
 
 // A tiny synthetic session with an environment camera (and the ground-truth composite).
+// `orbitHeight`: of the main camera above the table (metres); 0.7 looks down at the table.
 fs::path synthesise(const std::string& name, const std::string& seconds, bool groundTruth,
-                    const std::vector<std::string>& extra = {}) {
+                    const std::vector<std::string>& extra = {},
+                    const std::string& orbitHeight = "0.7") {
     const fs::path dir = outputDir(name) / "session";
     std::vector<std::string> args = {"synth",
                                      scene(),
@@ -82,7 +84,7 @@ fs::path synthesise(const std::string& name, const std::string& seconds, bool gr
                                      "--orbit-radius",
                                      "0.9",
                                      "--orbit-height",
-                                     "0.7"};
+                                     orbitHeight};
     if (groundTruth) args.push_back("--ground-truth-composite");
     args.insert(args.end(), extra.begin(), extra.end());
     const CommandResult r = runMirage(args);
@@ -152,11 +154,21 @@ TEST(EnvironmentReplay, EnvironmentCameraIsAsGoodAsTheExactEnvironmentFile) {
     ASSERT_EQ(file.exitCode, 0) << file.output;
     for (const std::string& e : environmentColumn(dir / "file" / "frames.csv"))
         EXPECT_EQ(e, "static");
+    // The window of the room placed as a shadow-casting light (the ground truth has the box's
+    // shadow from it).
+    const CommandResult placed = replay(s, dir / "placed", {"--estimate-lights"});
+    ASSERT_EQ(placed.exitCode, 0) << placed.output;
+    EXPECT_NE(placed.output.find("placed as a shadow-casting light"), std::string::npos)
+        << placed.output;
     const double psnrCamera = influencedPsnr(s, dir / "camera", 2);
     const double psnrFile = influencedPsnr(s, dir / "file", 2);
-    std::printf("[ env replay ] influenced PSNR: env.mkv %.2f dB, exact file %.2f dB\n", psnrCamera,
-                psnrFile);
+    const double psnrPlaced = influencedPsnr(s, dir / "placed", 2);
+    std::printf(
+        "[ env replay ] influenced PSNR: env.mkv %.2f dB, exact file %.2f dB, env.mkv with its "
+        "light placed %.2f dB\n",
+        psnrCamera, psnrFile, psnrPlaced);
     EXPECT_LE(std::abs(psnrCamera - psnrFile), 1.5);
+    EXPECT_GT(psnrPlaced, psnrCamera + 0.8);  // fails when nothing is placed
 
     // Must fail: the environment camera's extrinsic turned 90 degrees about X (it would look at
     // the horizon, not up), so the window lands in the wrong place.
@@ -226,7 +238,8 @@ TEST(EnvironmentReplay, BadEnvironmentInputFallsBackToTheStaticEnvironmentAndSay
 
 // The room light moves (the environment turns 60 degrees per second about +Y, 15 degrees between
 // frames at 4 fps): the light found in the environment camera's frames turns with it, frame by
-// frame, and the environment pass runs in every frame.
+// frame, is placed as a shadow-casting light, and the environment pass runs in every frame (the
+// shadow that follows it: tests/render/EnvironmentLightPlacement_test.cpp).
 TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
     const fs::path s = synthesise("env_replay_rotating", "0.75", false, {"--env-rotation", "60"});
     const fs::path dir = s.parent_path();
@@ -243,6 +256,12 @@ TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
         azimuth.push_back(std::stod((*it)[3]));
     }
     ASSERT_EQ(azimuth.size(), 3u) << r.output;
+    // Placed: the scene has no light of its own, so the direct pass lights with the one found,
+    // and its shadow map is rendered.
+    EXPECT_NE(r.output.find("placed as a shadow-casting light"), std::string::npos) << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(direct\s+ran\s.*1 light\(s\))")))
+        << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(shadow\s+ran\s)"))) << r.output;
     for (size_t f = 1; f < azimuth.size(); ++f) {
         double step = azimuth[f] - azimuth[f - 1];
         step = std::remainder(step, 360.0);
@@ -283,8 +302,9 @@ CsvTable readCsvTable(const fs::path& path) {
 
 // mirage live with the environment camera: a session stands in for both cameras (paced by its
 // frame times); each main frame is lit by the environment frame nearest in time, so with the room
-// light turning the composite follows it exactly as replay's does (the same environment frames),
-// and differs from the same live run lit by the scene's static map.
+// light turning the composite follows it exactly as replay's does (the same environment frames,
+// the light found in them placed by both), and differs from the same live run lit by the scene's
+// static map.
 TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const fs::path dir = outputDir("live_env");
     const fs::path s = dir / "session";
@@ -319,7 +339,7 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
         std::vector<std::string> args = {"live",  "--camera",           s.string(), "--scene",
                                          scene(), "--headless",         "--frames", "3",
                                          "-o",    (dir / name).string()};
-        if (env) args.insert(args.end(), {"--env-camera", s.string()});
+        if (env) args.insert(args.end(), {"--env-camera", s.string(), "--estimate-lights"});
         return runMirage(args);
     };
     const CommandResult withEnv = live("env", true), staticEnv = live("static", false);
@@ -349,8 +369,8 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const double psnrStatic = influencedPsnr(s, dir / "static", 3, staticShown);
     // replay of the session (tracked poses, env.mkv) renders the same frames with the same
     // environment frames: live must agree with it, and differ from the static-lit run.
-    const CommandResult rep =
-        runMirage({"replay", s.string(), "--scene", scene(), "-o", (dir / "replay").string()});
+    const CommandResult rep = runMirage({"replay", s.string(), "--scene", scene(), "-o",
+                                         (dir / "replay").string(), "--estimate-lights"});
     ASSERT_EQ(rep.exitCode, 0) << rep.output;
     const double psnrReplay = influencedPsnr(s, dir / "replay", 3);
     std::printf(
@@ -372,6 +392,17 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
         differsFromStatic += toStatic < 40.0;
     }
     EXPECT_GT(differsFromStatic, 0) << "the environment camera changed nothing";
+}
+
+// Lights are found in the environment camera's frames: live without one says so.
+TEST(LiveEnvironment, EstimateLightsWithoutAnEnvironmentCameraIsRefused) {
+    const fs::path dir = outputDir("live_estimate_lights_no_env");
+    const CommandResult r = runMirage(
+        {"live", "--camera", (dataDir() / "sessions" / "sample").string(), "--scene", scene(),
+         "--headless", "--frames", "1", "--estimate-lights", "-o", (dir / "out").string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("name the environment camera with --env-camera"), std::string::npos)
+        << r.output;
 }
 
 }  // namespace
