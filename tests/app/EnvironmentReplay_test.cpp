@@ -302,13 +302,15 @@ CsvTable readCsvTable(const fs::path& path) {
 
 // mirage live with the environment camera: a session stands in for both cameras (paced by its
 // frame times); each main frame is lit by the environment frame nearest in time, so with the room
-// light turning the composite follows it exactly as replay's does (the same environment frames,
-// the light found in them placed by both), and differs from the same live run lit by the scene's
-// static map.
+// light turning the composite follows it exactly as replay's does (the same environment frames),
+// and differs from the same live run lit by the scene's static map. With --estimate-lights the
+// window found in the environment frames is placed: the scene has no light of its own, so the
+// shadow pass runs only then.
 TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const fs::path dir = outputDir("live_env");
     const fs::path s = dir / "session";
-    for (const char* d : {"session", "env", "static", "replay"}) fs::remove_all(dir / d);  // reruns
+    for (const char* d : {"session", "env", "static", "replay", "placed"})
+        fs::remove_all(dir / d);  // reruns
     // 640x480 (live tracks the board: at 320x240 this scene's tags are too small for an ok pose),
     // 3 frames at 4 fps, the room light turning 240 degrees per second (60 per frame).
     const std::vector<std::string> synthArgs = {"synth",
@@ -339,7 +341,7 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
         std::vector<std::string> args = {"live",  "--camera",           s.string(), "--scene",
                                          scene(), "--headless",         "--frames", "3",
                                          "-o",    (dir / name).string()};
-        if (env) args.insert(args.end(), {"--env-camera", s.string(), "--estimate-lights"});
+        if (env) args.insert(args.end(), {"--env-camera", s.string()});
         return runMirage(args);
     };
     const CommandResult withEnv = live("env", true), staticEnv = live("static", false);
@@ -369,8 +371,8 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const double psnrStatic = influencedPsnr(s, dir / "static", 3, staticShown);
     // replay of the session (tracked poses, env.mkv) renders the same frames with the same
     // environment frames: live must agree with it, and differ from the static-lit run.
-    const CommandResult rep = runMirage({"replay", s.string(), "--scene", scene(), "-o",
-                                         (dir / "replay").string(), "--estimate-lights"});
+    const CommandResult rep =
+        runMirage({"replay", s.string(), "--scene", scene(), "-o", (dir / "replay").string()});
     ASSERT_EQ(rep.exitCode, 0) << rep.output;
     const double psnrReplay = influencedPsnr(s, dir / "replay", 3);
     std::printf(
@@ -392,6 +394,15 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
         differsFromStatic += toStatic < 40.0;
     }
     EXPECT_GT(differsFromStatic, 0) << "the environment camera changed nothing";
+
+    const CommandResult placed = runMirage(
+        {"live", "--camera", s.string(), "--scene", scene(), "--headless", "--frames", "2", "-o",
+         (dir / "placed").string(), "--env-camera", s.string(), "--estimate-lights"});
+    ASSERT_EQ(placed.exitCode, 0) << placed.output;
+    const CsvTable placedCsv = readCsvTable(dir / "placed" / "frames.csv");
+    ASSERT_GE(placedCsv.rows.size(), 1u);
+    EXPECT_GT(std::stod(placedCsv.field(0, "shadow_ms")), 0.0) << "no light was placed";
+    EXPECT_EQ(std::stod(envCsv.field(0, "shadow_ms")), 0.0);
 }
 
 // Lights are found in the environment camera's frames: live without one says so.
