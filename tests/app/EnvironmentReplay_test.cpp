@@ -8,14 +8,17 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <sstream>
 
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/Csv.h"
+#include "core/camera/Radiometry.h"
 #include "tests/support/TestSupport.h"
 
 namespace mirage::test {
@@ -273,6 +276,78 @@ TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
     }
     for (const std::string& e : environmentColumn(dir / "out" / "frames.csv"))
         EXPECT_EQ(e, "camera");
+}
+
+// The ratio `mirage env-radiometry` prints ("radiometry_to_main: R G B ..."), if it printed one.
+std::optional<glm::dvec3> printedRatio(const std::string& output) {
+    std::smatch m;
+    if (!std::regex_search(output, m,
+                           std::regex(R"(radiometry_to_main: (\S+) (\S+) (\S+) \(R, G, B)")))
+        return std::nullopt;
+    return glm::dvec3(std::stod(m[1]), std::stod(m[2]), std::stod(m[3]));
+}
+
+// Both cameras in one radiometry: the environment camera's gain and white balance relative to
+// the main camera, estimated from the directions both see (the main camera, 5 cm above the table,
+// sees the room above the horizon, as the upward fish-eye does), against the exact ratio synth
+// writes, for several exposures and white balances of the environment camera.
+TEST(EnvironmentRadiometry, EstimatedFromDirectionsBothCamerasSee) {
+    struct Setting {
+        std::string exposure, whiteBalance;
+    };
+    const std::vector<Setting> settings = {
+        {"0.5", "1,1,1"}, {"0.25", "1.2,1.0,0.8"}, {"1.5", "0.7,1.0,1.3"}};
+    for (size_t k = 0; k < settings.size(); ++k) {
+        const Setting& c = settings[k];
+        const fs::path s = synthesise(
+            "env_radiometry_" + std::to_string(k), "0.5", false,
+            {"--env-exposure", c.exposure, "--env-white-balance", c.whiteBalance}, "0.05");
+        const std::optional<glm::dvec3> truth = loadRadiometryToMain(s / "env.yaml");
+        ASSERT_TRUE(truth.has_value());
+        const CommandResult r = runMirage({"env-radiometry", s.string(), "--scene", scene()});
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        const std::optional<glm::dvec3> got = printedRatio(r.output);
+        ASSERT_TRUE(got.has_value()) << r.output;
+        std::printf(
+            "[ env radiometry ] exposure %s, white balance %s: estimated %.4f %.4f %.4f, exact "
+            "%.4f %.4f %.4f (ratio %.4f %.4f %.4f)\n",
+            c.exposure.c_str(), c.whiteBalance.c_str(), got->r, got->g, got->b, truth->r, truth->g,
+            truth->b, got->r / truth->r, got->g / truth->g, got->b / truth->b);
+        for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR((*got)[ch] / (*truth)[ch], 1.0, 0.02) << k;
+        if (k + 1 == settings.size()) {
+            // --write stores it in the environment camera's calibration.
+            const CommandResult w =
+                runMirage({"env-radiometry", s.string(), "--scene", scene(), "--write"});
+            ASSERT_EQ(w.exitCode, 0) << w.output;
+            const std::optional<glm::dvec3> stored = loadRadiometryToMain(s / "env.yaml");
+            ASSERT_TRUE(stored.has_value());
+            for (int ch = 0; ch < 3; ++ch)
+                EXPECT_NEAR((*stored)[ch], (*got)[ch], 1e-3 * (*got)[ch]);
+        }
+    }
+}
+
+// The main camera looking down at the table (0.7 m above it) never sees what the upward fish-eye
+// sees: a message saying what is missing, exit status 1, and no number.
+TEST(EnvironmentRadiometry, ViewsThatDoNotOverlapGiveAMessageInsteadOfANumber) {
+    const fs::path s = synthesise("env_radiometry_no_overlap", "0.5", false);
+    const CommandResult r = runMirage({"env-radiometry", s.string(), "--scene", scene()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("that the environment camera also sees"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("Film part of the room beyond the modelled scene"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(printedRatio(r.output).has_value()) << r.output;
+    // No environment camera at all.
+    const fs::path none = outputDir("env_radiometry_no_env") / "session";
+    const CommandResult synth = runMirage(
+        {"synth", scene(), "-o", none.string(), "--width", "80", "--height", "60", "--fps", "4",
+         "--seconds", "0.25", "--spp", "1", "--threads", "2", "--image-sequence", "--no-env"});
+    ASSERT_EQ(synth.exitCode, 0) << synth.output;
+    const CommandResult noEnv = runMirage({"env-radiometry", none.string(), "--scene", scene()});
+    EXPECT_EQ(noEnv.exitCode, 1) << noEnv.output;
+    EXPECT_NE(noEnv.output.find("no camera with role \"environment\""), std::string::npos)
+        << noEnv.output;
 }
 
 // A CSV with a header (quoted fields may hold commas), looked up by column name.
