@@ -83,7 +83,9 @@ EnvironmentLightSplit EnvironmentLightFinder::find(const cv::Mat& bgr, const Cam
         const float l = srgbToLinear(float(v) / 255.0f);
         lut[size_t(v)] = cv::Vec3f(l * gain.r, l * gain.g, l * gain.b);
     }
-    cv::Mat linear(bgr.rows, bgr.cols, CV_32FC3);
+    // Reused between frames: the first touch of fresh pages costs more than the work.
+    linear_.create(bgr.rows, bgr.cols, CV_32FC3);
+    cv::Mat& linear = linear_;
     for (int y = 0; y < bgr.rows; ++y) {
         const cv::Vec3b* in = bgr.ptr<cv::Vec3b>(y);
         cv::Vec3f* out = linear.ptr<cv::Vec3f>(y);
@@ -115,7 +117,9 @@ EnvironmentLightSplit EnvironmentLightFinder::find(const cv::Mat& bgr, const Cam
     // 3. Each light's region (grown by a texel) painted over in the frame with its surroundings.
     const cv::Mat seen = lookup_.seen;
     cv::Mat anyRegion = (regions >= 0) & seen;
-    cv::Mat painted(bgr.rows, bgr.cols, CV_8U, cv::Scalar(0));  // light index + 1
+    painted_.create(bgr.rows, bgr.cols, CV_8U);
+    painted_.setTo(0);
+    cv::Mat& painted = painted_;  // light index + 1
     const auto allSeen = medianWhere(map, seen);
     for (size_t k = 0; k < out.lights.size(); ++k) {
         const cv::Mat region = (regions == int(k)) & seen;
@@ -141,15 +145,18 @@ EnvironmentLightSplit EnvironmentLightFinder::find(const cv::Mat& bgr, const Cam
                            int(std::ceil(radius)) + 1, cv::Scalar(double(k + 1)), cv::FILLED);
             }
     }
-    cv::Mat paintedLinear = linear.clone();
-    for (int y = 0; y < bgr.rows; ++y)
+    // The frame as the camera saw it is not needed any more: painted over in place.
+    for (int y = 0; y < bgr.rows; ++y) {
+        const uint8_t* p = painted.ptr<uint8_t>(y);
+        cv::Vec3f* l = linear.ptr<cv::Vec3f>(y);
         for (int x = 0; x < bgr.cols; ++x)
-            if (const int k = painted.at<uint8_t>(y, x); k > 0) {
-                const glm::vec3& f = out.fill[size_t(k - 1)];
-                paintedLinear.at<cv::Vec3f>(y, x) = cv::Vec3f(f.r, f.g, f.b);
+            if (p[x] > 0) {
+                const glm::vec3& f = out.fill[size_t(p[x] - 1)];
+                l[x] = cv::Vec3f(f.r, f.g, f.b);
             }
+    }
     cv::Mat lightFree;
-    cv::remap(paintedLinear, lightFree, lookup_.mapX, lookup_.mapY, cv::INTER_LINEAR,
+    cv::remap(linear, lightFree, lookup_.mapX, lookup_.mapY, cv::INTER_LINEAR,
               cv::BORDER_REPLICATE);
     out.lightFree = withAlpha(lightFree, seen);
 

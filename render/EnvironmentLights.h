@@ -56,6 +56,7 @@ private:
     bool lookupValid(const CameraIntrinsics& camera, double reachDeg, const Pose& T_world_camera,
                      int width) const;
     EquirectLookup lookup_;
+    cv::Mat linear_, painted_;  // per-frame buffers of the camera's size, kept between frames
     CameraIntrinsics camera_;
     double reachDeg_ = 0.0;
     Pose pose_;
