@@ -289,8 +289,8 @@ std::optional<glm::dvec3> printedRatio(const std::string& output) {
 
 // Both cameras in one radiometry: the environment camera's gain and white balance relative to
 // the main camera, estimated from the directions both see (the main camera, 5 cm above the table,
-// sees the room above the horizon, as the upward fish-eye does), against the exact ratio synth
-// writes, for several exposures and white balances of the environment camera.
+// sees the room above the horizon, as the upward fish-eye does; one frame), against the exact
+// ratio synth writes, for several exposures and white balances of the environment camera.
 TEST(EnvironmentRadiometry, EstimatedFromDirectionsBothCamerasSee) {
     struct Setting {
         std::string exposure, whiteBalance;
@@ -300,7 +300,7 @@ TEST(EnvironmentRadiometry, EstimatedFromDirectionsBothCamerasSee) {
     for (size_t k = 0; k < settings.size(); ++k) {
         const Setting& c = settings[k];
         const fs::path s = synthesise(
-            "env_radiometry_" + std::to_string(k), "0.5", false,
+            "env_radiometry_" + std::to_string(k), "0.25", false,
             {"--env-exposure", c.exposure, "--env-white-balance", c.whiteBalance}, "0.05");
         const std::optional<glm::dvec3> truth = loadRadiometryToMain(s / "env.yaml");
         ASSERT_TRUE(truth.has_value());
@@ -330,7 +330,7 @@ TEST(EnvironmentRadiometry, EstimatedFromDirectionsBothCamerasSee) {
 // The main camera looking down at the table (0.7 m above it) never sees what the upward fish-eye
 // sees: a message saying what is missing, exit status 1, and no number.
 TEST(EnvironmentRadiometry, ViewsThatDoNotOverlapGiveAMessageInsteadOfANumber) {
-    const fs::path s = synthesise("env_radiometry_no_overlap", "0.5", false);
+    const fs::path s = synthesise("env_radiometry_no_overlap", "0.25", false);
     const CommandResult r = runMirage({"env-radiometry", s.string(), "--scene", scene()});
     EXPECT_EQ(r.exitCode, 1) << r.output;
     EXPECT_NE(r.output.find("that the environment camera also sees"), std::string::npos)
