@@ -54,6 +54,13 @@ void RendererOptions::validate() const {
     if (environmentMapWidth < 16 || environmentMapWidth > 4096 || environmentMapWidth % 2 != 0)
         fail("environmentMapWidth must be even, 16..4096 texels, got " +
              std::to_string(environmentMapWidth));
+    if (environmentLights < 0 || environmentLights > kMaxLights)
+        fail("environmentLights must be 0.." + std::to_string(kMaxLights) + ", got " +
+             std::to_string(environmentLights));
+    if (environmentLightMapWidth < 16 || environmentLightMapWidth > 2048 ||
+        environmentLightMapWidth % 2 != 0)
+        fail("environmentLightMapWidth must be even, 16..2048 texels, got " +
+             std::to_string(environmentLightMapWidth));
 }
 
 const char* roughRefractionMethodName(RoughRefractionMethod m) {

@@ -98,6 +98,14 @@ struct RendererOptions {
     // Live environment (render/passes/environment, docs/environment.md): width of the
     // equirectangular map built from each environment-camera frame (height = width / 2).
     int environmentMapWidth = 512;
+    // The real light, placed (docs/environment.md, "Light estimation"): at most this many of the
+    // dominant lights found in each live environment frame become shadow-casting REAL
+    // directional lights, and the diffuse environment light is projected from the map without
+    // them (render/EnvironmentLights.h). 0: none (the environment's SH9 holds all its light).
+    // The scene's lights plus these are at most kMaxLights.
+    int environmentLights = 0;
+    // Width of the map the lights are found on (CPU, height = width / 2).
+    int environmentLightMapWidth = 256;
 
     // Translucent objects (render/passes/translucency, docs/translucency.md): a voxel number
     // map per translucent object (up to 8), vnmResolution voxels along its longest side (the tau
@@ -130,6 +138,12 @@ struct EnvironmentInput {
     double reachDeg = -1.0;   // the calibration's reach off-axis (<= 0: whole projectable field)
     Pose T_world_camera;      // the camera's pose (OpenCV axes) when the frame was taken
     glm::vec3 gain{1.0f};     // linearised pixel value -> scene radiance, per channel (R, G, B)
+    // Lights placed from this frame (RendererOptions::environmentLights): the diffuse light is
+    // then the SH9 of the map without them, computed on the CPU (render/EnvironmentLights.h),
+    // instead of the projection of the map on the GPU.
+    bool lightFreeSHValid = false;
+    std::array<glm::vec3, 9> lightFreeSH{};
+    float lightFreeSeenFraction = 1.0f;  // solid-angle fraction of the map the camera saw
 };
 
 struct LightPlan {

@@ -101,7 +101,8 @@ std::vector<glm::vec3> GpuScene::projectEquirectToSH(const cv::Mat& img, float i
     return sh;
 }
 
-GpuScene::GpuScene(const Scene& scene, int surfacePoints) : vao_("scene vao") {
+GpuScene::GpuScene(const Scene& scene, int surfacePoints, int environmentLightSlots)
+    : environmentLightSlots_(environmentLightSlots), vao_("scene vao") {
     uploadTextures(scene);
     const int materialCount = uploadMaterials(scene);
     // Geometry: one vertex and one index buffer for all primitives.
@@ -328,6 +329,20 @@ void GpuScene::buildLights(const Scene& scene) {
                         " lights; the real-time renderer supports at most that many");
         lights_.push_back(s);
     }
+    sceneLightCount_ = int(lights_.size());
+    if (sceneLightCount_ + environmentLightSlots_ > kMaxLights)
+        throw Error("scene '" + scene.source.string() + "' has " +
+                    std::to_string(sceneLightCount_) + " lights; with " +
+                    std::to_string(environmentLightSlots_) +
+                    " found in the environment that is more than the real-time renderer's " +
+                    std::to_string(kMaxLights) + "; place fewer environment lights");
+}
+
+void GpuScene::setEnvironmentLights(const std::vector<SceneLight>& lights) {
+    MR_CHECK(int(lights.size()) <= environmentLightSlots_,
+             "more environment lights than the renderer reserved slots for");
+    lights_.resize(size_t(sceneLightCount_));
+    lights_.insert(lights_.end(), lights.begin(), lights.end());
 }
 
 int GpuScene::roughReflectorCount() const {
@@ -510,6 +525,7 @@ void MaterialDraw::draw(const GpuScene& scene, const DrawItem& d) const {
 std::string GpuScene::lightingDefines(bool withGlass) const {
     int faces = 0;
     for (const SceneLight& l : lights_) faces = std::max(faces, l.type == kLightPoint ? 6 : 1);
+    if (environmentLightSlots_ > 0) faces = std::max(faces, 1);  // directional lights
     std::string defines = "#define MIRAGE_MAX_SHADOW_FACES " + std::to_string(faces) + "\n";
     // Translucent objects use the glass atlases too (their light through them).
     if (withGlass && (hasTransmissive() || hasTranslucent()))

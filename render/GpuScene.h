@@ -89,10 +89,18 @@ public:
     // Uploads everything; `surfacePoints` is the size of the ISM point pool. The environment map
     // (equirectangular, linear) is read from scene.environment.image when the scene has one;
     // throws mirage::FileError if it cannot be read.
-    explicit GpuScene(const Scene& scene, int surfacePoints = 16384);
+    // `environmentLightSlots`: how many lights found in a live environment may be added to the
+    // scene's lights (setEnvironmentLights); the lighting shaders are specialised for them too.
+    // Throws mirage::Error when the scene's lights plus these exceed kMaxLights.
+    explicit GpuScene(const Scene& scene, int surfacePoints = 16384, int environmentLightSlots = 0);
 
     const std::vector<DrawItem>& draws() const { return draws_; }
+    // The scene's lights, then the environment's (setEnvironmentLights).
     const std::vector<SceneLight>& lights() const { return lights_; }
+    int sceneLightCount() const { return sceneLightCount_; }
+    // Replaces the lights found in the environment (REAL directional lights; at most
+    // environmentLightSlots, MR_CHECK).
+    void setEnvironmentLights(const std::vector<SceneLight>& lights);
     // GLSL #defines that specialise the lighting shaders to this scene's lights
     // (MIRAGE_MAX_SHADOW_FACES: 6 with a point light, 1 with spot / directional only, 0 without
     // lights; see lighting.glsl for why a constant loop bound matters on llvmpipe;
@@ -176,6 +184,8 @@ private:
 
     std::vector<DrawItem> draws_;
     std::vector<SceneLight> lights_;
+    int sceneLightCount_ = 0;
+    int environmentLightSlots_ = 0;
     std::vector<int> specularDraws_;
     BoundingSphere bounds_;
     gl::Buffer vertices_, indices_, materials_, points_, specularBuffer_;

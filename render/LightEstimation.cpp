@@ -25,7 +25,8 @@ float EstimatedLight::intensity() const {
     return std::max({irradiance.r, irradiance.g, irradiance.b});
 }
 
-std::vector<EstimatedLight> estimateLights(const cv::Mat& map, const LightEstimationOptions& o) {
+std::vector<EstimatedLight> estimateLights(const cv::Mat& map, const LightEstimationOptions& o,
+                                           cv::Mat* regions) {
     if (map.empty() || (map.type() != CV_32FC3 && map.type() != CV_32FC4))
         throw Error("light estimation: the map must be linear RGB(A) float");
     const int W = map.cols, H = map.rows;
@@ -53,6 +54,7 @@ std::vector<EstimatedLight> estimateLights(const cv::Mat& map, const LightEstima
             }
         }
     }
+    if (regions) *regions = cv::Mat(H, W, CV_32S, cv::Scalar(-1));
     if (seenLum.empty() || budget <= 0) return {};
     // Background: the median of the seen texels (per channel for the excess).
     auto median = [](std::vector<float> v) {
@@ -110,12 +112,25 @@ std::vector<EstimatedLight> estimateLights(const cv::Mat& map, const LightEstima
         l.share = float(excessSum / budget);
         lights.push_back(l);
     }
+    std::vector<int> kept;  // region ids, strongest first
+    for (size_t i = 0; i < lights.size(); ++i)
+        if (lights[i].solidAngleSr <= o.maxSolidAngleSr && lights[i].share >= o.minShare)
+            kept.push_back(int(i));
+    std::stable_sort(kept.begin(), kept.end(), [&](int a, int b) {
+        return lights[size_t(a)].share > lights[size_t(b)].share;
+    });
+    if (int(kept.size()) > o.maxLights) kept.resize(size_t(std::max(o.maxLights, 0)));
     std::vector<EstimatedLight> out;
-    for (const EstimatedLight& l : lights)
-        if (l.solidAngleSr <= o.maxSolidAngleSr && l.share >= o.minShare) out.push_back(l);
-    std::sort(out.begin(), out.end(),
-              [](const EstimatedLight& a, const EstimatedLight& b) { return a.share > b.share; });
-    if (int(out.size()) > o.maxLights) out.resize(size_t(o.maxLights));
+    std::vector<int> outIndex(lights.size(), -1);
+    for (int id : kept) {
+        outIndex[size_t(id)] = int(out.size());
+        out.push_back(lights[size_t(id)]);
+    }
+    if (regions)
+        for (size_t i = 0; i < label.size(); ++i)
+            if (label[i] >= 0)
+                regions->at<int>(int(i / size_t(W)), int(i % size_t(W))) =
+                    outIndex[size_t(label[i])];
     return out;
 }
 

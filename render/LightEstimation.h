@@ -38,8 +38,10 @@ struct EstimatedLight {
 };
 
 // `map`: equirectangular (docs/environment.md layout), CV_32FC3 (all seen) or CV_32FC4 (alpha =
-// seen). Strongest first.
+// seen). Strongest first. `regions` (optional) receives the map's texels of each light: CV_32S of
+// the map's size, the light's index in the result, -1 elsewhere.
 std::vector<EstimatedLight> estimateLights(const cv::Mat& map,
-                                           const LightEstimationOptions& options = {});
+                                           const LightEstimationOptions& options = {},
+                                           cv::Mat* regions = nullptr);
 
 }  // namespace mirage::render

@@ -125,7 +125,7 @@ glm::vec3 anyPerpendicular(const glm::vec3& d) {
 Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererOptions options)
     : options_(options) {
     options_.validate();
-    scene_ = std::make_unique<GpuScene>(scene, 16384);
+    scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environmentLights);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 
@@ -437,6 +437,7 @@ const FrameReport& Renderer::render(const FrameInput& input) {
         ctx_->environment.T_world_camera = envCamera_->poseInWorld(input.T_world_camera);
         envPosePending_ = false;
     }
+    placeEnvironmentLights();
     planFrame(input);
     FrameContext& c = *ctx_;
     // What the camera-independent passes' output depends on: the light matrices and the plan.
@@ -480,6 +481,7 @@ bool Renderer::updateEnvironment(const cv::Mat& bgr, double time) {
     cv::Mat rgba;
     cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
     envImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+    if (options_.environmentLights > 0) bgr.copyTo(envFrame_);
     e.live = true;
     e.time = time;
     ++e.generation;
@@ -490,6 +492,40 @@ bool Renderer::updateEnvironment(const cv::Mat& bgr, double time) {
         envPosePending_ = true;
     }
     return true;
+}
+
+// The lights of a new live environment frame (or none, for the static environment) become the
+// scene's environment lights, and the diffuse environment light that of the map without them.
+// Runs before the frame is planned, so that the frame's shadow maps are the new lights'.
+void Renderer::placeEnvironmentLights() {
+    EnvironmentInput& e = ctx_->environment;
+    if (options_.environmentLights <= 0 || envLightsGeneration_ == e.generation) return;
+    envLightsGeneration_ = e.generation;
+    envLights_ = EnvironmentLightSplit{};
+    e.lightFreeSHValid = false;
+    std::vector<SceneLight> placed;
+    if (e.live && !envFrame_.empty()) {
+        LightEstimationOptions o;
+        o.maxLights = options_.environmentLights;
+        envLights_ = envLightFinder_.find(envFrame_, e.camera, e.reachDeg, e.T_world_camera, e.gain,
+                                          options_.environmentLightMapWidth, o);
+        for (size_t k = 0; k < envLights_.lights.size(); ++k) {
+            const EstimatedLight& found = envLights_.lights[k];
+            SceneLight l;
+            l.name = "environment light " + std::to_string(k + 1);
+            l.type = kLightDirectional;
+            l.direction = -found.direction;  // it shines away from where it is
+            l.radiantIntensity = found.irradiance;
+            l.origin = Origin::Real;  // the room's light: it lights and shadows real and virtual
+            placed.push_back(l);
+        }
+        if (!placed.empty()) {
+            e.lightFreeSH = envLights_.lightFreeSH;
+            e.lightFreeSeenFraction = envLights_.seenFraction;
+            e.lightFreeSHValid = true;
+        }
+    }
+    scene_->setEnvironmentLights(placed);
 }
 
 void Renderer::setEnvironmentGain(const glm::vec3& gain) {

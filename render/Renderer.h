@@ -20,6 +20,7 @@
 #include "core/scene/Scene.h"
 #include "render/CameraProjection.h"
 #include "render/EnvironmentCamera.h"
+#include "render/EnvironmentLights.h"
 #include "render/FrameContext.h"
 #include "render/FrameGraph.h"
 #include "render/GpuScene.h"
@@ -60,6 +61,10 @@ public:
     // Back to the scene's static environment (the environment stream ended or failed).
     void useStaticEnvironment();
     bool environmentLive() const { return ctx_->environment.live; }
+    // The lights found in the live environment and placed as shadow-casting REAL directional
+    // lights (RendererOptions::environmentLights > 0), with the maps they were found on: updated
+    // in the render() after each new environment frame; empty without a live environment.
+    const EnvironmentLightSplit& environmentLights() const { return envLights_; }
     // This frame's environment map, level 0, as CV_32FC4 (R, G, B linear radiance; A = 1 where
     // the camera saw the direction, 0 where it was filled in; 1 everywhere for a static map),
     // top row first, and its SH9 block. For tests, benchmarks and light estimation.
@@ -98,6 +103,7 @@ public:
 
 private:
     void planFrame(const FrameInput& input);
+    void placeEnvironmentLights();
     void uploadCameraImage(const cv::Mat& bgr);
 
     RendererOptions options_;
@@ -109,6 +115,10 @@ private:
     std::optional<EnvironmentCameraSetup> envCamera_;
     gl::Texture envImage_;         // the environment camera's newest frame, sRGB8
     bool envPosePending_ = false;  // a mounted camera's pose is taken at the next render()
+    cv::Mat envFrame_;             // the newest environment frame (BGR8), to find lights in
+    EnvironmentLightFinder envLightFinder_;
+    EnvironmentLightSplit envLights_;
+    uint64_t envLightsGeneration_ = UINT64_MAX;  // the environment generation they were found in
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
     bool lastRanFilter_ = false;

@@ -64,6 +64,7 @@
 #include "core/scene/ScenePlacement.h"
 #include "core/session/MatroskaWriter.h"
 #include "core/session/Session.h"
+#include "render/LightEstimation.h"
 #include "render/Renderer.h"
 #include "tracking/Tracker.h"
 
@@ -96,6 +97,7 @@ struct LiveArgs {
     // The fish-eye environment camera (docs/environment.md): a webcam, a video or a session's
     // environment camera, and its calibration (intrinsics, extrinsics, radiometry_to_main).
     std::string envCamera, envCalibration;
+    bool estimateLights = false;  // place the environment camera's dominant lights
 };
 
 constexpr int kHudWidth = 330;  // pixels, right of the view
@@ -485,7 +487,22 @@ void runLive(const LiveArgs& a) {
         throw Error(
             "mirage live: --env-calibration without --env-camera; name the environment "
             "camera (a webcam, a video or a session) with --env-camera");
+    } else if (a.estimateLights) {
+        throw Error(
+            "mirage live: --estimate-lights finds the lights in the environment camera's "
+            "frames; name the environment camera with --env-camera");
     }
+    // Lights found in the environment camera's frames, as many as light estimation reports
+    // within the renderer's light budget.
+    const int environmentLights =
+        a.estimateLights ? std::min(render::LightEstimationOptions{}.maxLights,
+                                    render::kMaxLights - int(scene.lightInstances().size()))
+                         : 0;
+    if (a.estimateLights && environmentLights <= 0)
+        throw Error(fmt::format(
+            "mirage live --estimate-lights: scene {} already has {} lights, the real-time "
+            "renderer's limit; remove one",
+            a.scene, render::kMaxLights));
 
     // Outputs, checked before any work (as replay's).
     OutputRule rule{cam.inputs, a.force, "mirage live"};
@@ -533,6 +550,7 @@ void runLive(const LiveArgs& a) {
         ropt.indirectScale = kPresets[preset].indirectScale;
         ropt.impostorResolution = kPresets[preset].impostorResolution;
         ropt.exposure = a.exposure;
+        ropt.environmentLights = environmentLights;
         return std::make_unique<render::Renderer>(placedScene(placement), calib.intrinsics, ropt);
     };
     std::unique_ptr<render::Renderer> renderer = makeRenderer();
@@ -998,6 +1016,10 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
                     "The environment camera's calibration (fish-eye intrinsics, extrinsics, "
                     "radiometry_to_main; default for a session: the one session.json names)")
         ->check(CLI::ExistingFile);
+    cmd->add_flag("--estimate-lights", args->estimateLights,
+                  "Find the dominant lights of each environment-camera frame and place them as "
+                  "shadow-casting real directional lights (their regions taken out of the "
+                  "environment light)");
     cmd->add_option("--scene", args->scene,
                     "Scene (.gltf/.glb) with real proxies and virtual objects (required)")
         ->check(CLI::ExistingFile);

@@ -22,6 +22,8 @@
 // instead. An unusable environment camera (no calibration or extrinsics, a calibration of another
 // size, a video that ends early) is reported and the replay continues with the scene's static
 // environment; the CSV's last column, `environment`, says which one lit each frame.
+// --estimate-lights places the dominant lights of each environment frame as shadow-casting real
+// directional lights (render/EnvironmentLights.h); --report-lights only logs them.
 #include <unistd.h>
 #include <cctype>
 #include <chrono>
@@ -105,8 +107,27 @@ struct ReplayArgs {
     bool verbose = false;
     bool groundTruth = false;
     bool force = false;
-    bool estimateLights = false;
+    bool estimateLights = false;  // place the environment's lights (and report them)
+    bool reportLights = false;    // report them only
 };
+
+// One log line per light found in the environment of frame `index`.
+void logEnvironmentLights(int index, const std::vector<render::EstimatedLight>& lights,
+                          const char* what) {
+    if (lights.empty())
+        spdlog::info("frame {}: environment lights: none (no bright compact region)", index);
+    for (size_t k = 0; k < lights.size(); ++k) {
+        const render::EstimatedLight& l = lights[k];
+        const glm::vec3 d = l.direction, c = l.color();
+        spdlog::info(
+            "frame {}: environment light {}: direction {:.4f} {:.4f} {:.4f} (elevation {:.1f} deg, "
+            "azimuth {:.1f} deg from -Z towards +X), colour {:.3f} {:.3f} {:.3f}, intensity "
+            "{:.4g} W/m^2, {:.1f} % of the environment's light; {}",
+            index, k + 1, d.x, d.y, d.z, glm::degrees(std::asin(d.y)),
+            glm::degrees(std::atan2(d.x, -d.z)), c.r, c.g, c.b, l.intensity(), 100.0 * l.share,
+            what);
+    }
+}
 
 void runReplay(const ReplayArgs& a) {
     SessionReadReport readReport;
@@ -214,6 +235,16 @@ void runReplay(const ReplayArgs& a) {
     ropt.vplCount = a.vpls;
     ropt.exposure = a.exposure;
     switchEffectsOff(a.effectsOff, ropt);
+    if (a.estimateLights) {
+        // As many as light estimation reports, within the renderer's light budget.
+        const int room = render::kMaxLights - int(scene.lightInstances().size());
+        if (room <= 0)
+            throw Error(fmt::format(
+                "mirage replay --estimate-lights: scene {} already has {} lights, the real-time "
+                "renderer's limit; remove one or use --report-lights",
+                a.scene, render::kMaxLights));
+        ropt.environmentLights = std::min(render::LightEstimationOptions{}.maxLights, room);
+    }
     render::Renderer renderer(scene, calib.intrinsics, ropt);
 
     // The environment camera, unless --static-env overrides it.
@@ -342,26 +373,18 @@ void runReplay(const ReplayArgs& a) {
         std::map<std::string, double>& passMs = cf.passMs;
         const double gpuMs = cf.gpuMs, readbackMs = cf.readbackMs;
         const cv::Mat& result = cf.image;
-        if (a.estimateLights && cf.report && cf.report->ran("environment")) {
-            // The dominant lights of the environment this frame lights with (report only:
-            // the environment light already holds them).
-            const std::vector<render::EstimatedLight> lights =
-                render::estimateLights(renderer.readEnvironmentMap());
-            if (lights.empty())
-                spdlog::info("frame {}: environment lights: none (no bright compact region)",
-                             rec.index);
-            for (size_t k = 0; k < lights.size(); ++k) {
-                const render::EstimatedLight& l = lights[k];
-                const glm::vec3 d = l.direction, c = l.color();
-                spdlog::info(
-                    "frame {}: environment light {}: direction {:.4f} {:.4f} {:.4f} "
-                    "(elevation {:.1f} deg, azimuth {:.1f} deg from -Z towards +X), colour "
-                    "{:.3f} {:.3f} {:.3f}, intensity {:.4g} W/m^2, {:.1f} % of the "
-                    "environment's light",
-                    rec.index, k + 1, d.x, d.y, d.z, glm::degrees(std::asin(d.y)),
-                    glm::degrees(std::atan2(d.x, -d.z)), c.r, c.g, c.b, l.intensity(),
-                    100.0 * l.share);
-            }
+        if ((a.estimateLights || a.reportLights) && cf.report && cf.report->ran("environment")) {
+            if (a.estimateLights && renderer.environmentLive())
+                logEnvironmentLights(rec.index, renderer.environmentLights().lights,
+                                     "placed as a shadow-casting light, its region taken out of "
+                                     "the environment light");
+            else
+                logEnvironmentLights(rec.index,
+                                     render::estimateLights(renderer.readEnvironmentMap()),
+                                     renderer.environmentLive()
+                                         ? "reported, not placed (--estimate-lights places it)"
+                                         : "reported, not placed (lights are placed from an "
+                                           "environment camera only)");
         }
         if (cf.report && a.verbose && processed == 0)
             spdlog::info("frame {}:\n{}", rec.index, cf.report->summary());
@@ -425,12 +448,12 @@ void runReplay(const ReplayArgs& a) {
         rs.warmup = begin - first;
         rs.written = written;
         rs.fingerprint = hex64(fingerprint64(fmt::format(
-            "{} {} {} {} {} {:.9g} {} {} {} {}", std::filesystem::absolute(a.session).string(),
+            "{} {} {} {} {} {:.9g} {} {} {} {} {}", std::filesystem::absolute(a.session).string(),
             a.poses, a.vpls, a.groundTruth, a.warmup, a.exposure, hex64(fileFingerprint(a.scene)),
             userMkv,
             std::filesystem::exists(placementFile) ? hex64(fileFingerprint(placementFile))
                                                    : std::string(),
-            a.staticEnv.empty() ? "" : hex64(fileFingerprint(a.staticEnv)))));
+            a.staticEnv.empty() ? "" : hex64(fileFingerprint(a.staticEnv)), a.estimateLights)));
         finishReplayShard(*staged, rs);
         return;
     }
@@ -489,8 +512,12 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
         ->delimiter(',')
         ->check(effectSwitchName());
     cmd->add_flag("--estimate-lights", args->estimateLights,
+                  "Find the dominant lights of the environment camera's frames and place them as "
+                  "shadow-casting real directional lights (their regions taken out of the "
+                  "environment light); reports them whenever the environment changes");
+    cmd->add_flag("--report-lights", args->reportLights,
                   "Report the dominant lights of the environment (direction, colour, intensity) "
-                  "whenever it changes");
+                  "whenever it changes, without placing them");
     cmd->add_flag("--ground-truth", args->groundTruth,
                   "Use the session's ground-truth poses (frames.csv) instead of tracking");
     cmd->add_flag("--force", args->force,

@@ -5,6 +5,10 @@
 // sphere + mirror box), specularVplStride (1, 4, 16).
 // Reported time = the frame's total GPU time (manual time); counters = per-pass ms (mean over the
 // iterations; use --benchmark_repetitions and the median aggregate for figures).
+// BM_EnvironmentLightSplit: the CPU work of placing the environment's lights per new environment
+// frame (render/EnvironmentLights.h), wall time; arguments: fish-eye size, map width, and 1 = a
+// camera fixed in the world (the resampling table kept) / 0 = its pose changes every frame (a
+// camera mounted on the main camera: the table recomputed).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -15,9 +19,12 @@
 
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
+#include "render/EnvironmentLights.h"
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
+#include "render/raytrace/SyntheticFootage.h"
+#include "testscenes/EnvironmentViews.h"
 #include "testscenes/SpecularTestScenes.h"
 #include "testscenes/TranslucentTestScenes.h"
 
@@ -237,6 +244,43 @@ BENCHMARK(BM_Translucency)
     ->Arg(16)
     ->Arg(24)
     ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+// A sun (8 degrees radius, 40 degrees up, radiance 8) over a sky, filmed by an upward equidistant
+// fish-eye (190 degrees) at exposure 0.1.
+void BM_EnvironmentLightSplit(benchmark::State& state) {
+    const int size = int(state.range(0)), width = int(state.range(1));
+    const bool fixedPose = state.range(2) != 0;
+    const CameraIntrinsics K = raytrace::equidistantFisheye(size, 190.0);
+    const Pose up = Pose::fromRotationTranslation(glm::dmat3(1, 0, 0, 0, 0, -1, 0, 1, 0),
+                                                  glm::dvec3(0.0, 0.02, -0.4));
+    const glm::dvec3 sun = glm::normalize(glm::dvec3(-0.66, 0.64, -0.38));
+    const cv::Mat frame = test::renderEnvironmentView(K, up, [&](const glm::dvec3& d) {
+        if (glm::dot(d, sun) > std::cos(glm::radians(8.0))) return glm::vec3(0.8f);
+        return glm::vec3(float(0.01 + 0.01 * std::max(d.y, 0.0)));
+    });
+    render::EnvironmentLightFinder finder;
+    int lights = 0;
+    double turn = 0;
+    for (auto _ : state) {
+        Pose T = up;
+        if (!fixedPose) {
+            turn += 1e-3;  // a new pose every frame
+            T.rotation = glm::angleAxis(turn, glm::dvec3(0, 1, 0)) * up.rotation;
+        }
+        const render::EnvironmentLightSplit split =
+            finder.find(frame, K, -1.0, T, glm::vec3(10.0f), width);
+        lights = int(split.lights.size());
+        benchmark::DoNotOptimize(split.lightFreeSH);
+    }
+    state.counters["lights"] = lights;
+}
+BENCHMARK(BM_EnvironmentLightSplit)
+    ->Args({480, 128, 1})
+    ->Args({480, 256, 1})
+    ->Args({480, 512, 1})
+    ->Args({480, 256, 0})
+    ->Args({960, 256, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
 BENCHMARK(BM_Frame)->Apply(args)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(1.0);

@@ -298,6 +298,14 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.environmentMapWidth = w;
          },
          [](const BenchConfig& c) { return std::to_string(c.options.environmentMapWidth); }},
+        {"env_lights",
+         "lights found in each environment-camera frame placed as shadow-casting lights, taken "
+         "out of the environment light (0 = none; with env_source=camera)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.environmentLights = parseInt("env_lights", v, 0, kMaxLights);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.environmentLights); }},
     };
     return knobs;
 }

@@ -8,14 +8,17 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <sstream>
 
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/Csv.h"
+#include "core/camera/Radiometry.h"
 #include "core/session/Session.h"
 #include "tests/support/TestSupport.h"
 
@@ -58,8 +61,10 @@ std::string envFile() {
 }
 
 // A tiny synthetic session with an environment camera (and the ground-truth composite).
+// `orbitHeight`: of the main camera above the table (metres); 0.7 looks down at the table.
 fs::path synthesise(const std::string& name, const std::string& seconds, bool groundTruth,
-                    const std::vector<std::string>& extra = {}) {
+                    const std::vector<std::string>& extra = {},
+                    const std::string& orbitHeight = "0.7") {
     const fs::path dir = outputDir(name) / "session";
     std::vector<std::string> args = {"synth",
                                      scene(),
@@ -83,7 +88,7 @@ fs::path synthesise(const std::string& name, const std::string& seconds, bool gr
                                      "--orbit-radius",
                                      "0.9",
                                      "--orbit-height",
-                                     "0.7"};
+                                     orbitHeight};
     if (groundTruth) args.push_back("--ground-truth-composite");
     args.insert(args.end(), extra.begin(), extra.end());
     const CommandResult r = runMirage(args);
@@ -153,11 +158,21 @@ TEST(EnvironmentReplay, EnvironmentCameraIsAsGoodAsTheExactEnvironmentFile) {
     ASSERT_EQ(file.exitCode, 0) << file.output;
     for (const std::string& e : environmentColumn(dir / "file" / "frames.csv"))
         EXPECT_EQ(e, "static");
+    // The window of the room placed as a shadow-casting light (the ground truth has the box's
+    // shadow from it).
+    const CommandResult placed = replay(s, dir / "placed", {"--estimate-lights"});
+    ASSERT_EQ(placed.exitCode, 0) << placed.output;
+    EXPECT_NE(placed.output.find("placed as a shadow-casting light"), std::string::npos)
+        << placed.output;
     const double psnrCamera = influencedPsnr(s, dir / "camera", 2);
     const double psnrFile = influencedPsnr(s, dir / "file", 2);
-    std::printf("[ env replay ] influenced PSNR: env.mkv %.2f dB, exact file %.2f dB\n", psnrCamera,
-                psnrFile);
+    const double psnrPlaced = influencedPsnr(s, dir / "placed", 2);
+    std::printf(
+        "[ env replay ] influenced PSNR: env.mkv %.2f dB, exact file %.2f dB, env.mkv with its "
+        "light placed %.2f dB\n",
+        psnrCamera, psnrFile, psnrPlaced);
     EXPECT_LE(std::abs(psnrCamera - psnrFile), 1.5);
+    EXPECT_GT(psnrPlaced, psnrCamera + 0.8);  // fails when nothing is placed
 
     // Must fail: the environment camera's extrinsic turned 90 degrees about X (it would look at
     // the horizon, not up), so the window lands in the wrong place.
@@ -227,7 +242,8 @@ TEST(EnvironmentReplay, BadEnvironmentInputFallsBackToTheStaticEnvironmentAndSay
 
 // The room light moves (the environment turns 60 degrees per second about +Y, 15 degrees between
 // frames at 4 fps): the light found in the environment camera's frames turns with it, frame by
-// frame, and the environment pass runs in every frame.
+// frame, is placed as a shadow-casting light, and the environment pass runs in every frame (the
+// shadow that follows it: tests/render/EnvironmentLightPlacement_test.cpp).
 TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
     const fs::path s = synthesise("env_replay_rotating", "0.75", false, {"--env-rotation", "60"});
     const fs::path dir = s.parent_path();
@@ -244,6 +260,12 @@ TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
         azimuth.push_back(std::stod((*it)[3]));
     }
     ASSERT_EQ(azimuth.size(), 3u) << r.output;
+    // Placed: the scene has no light of its own, so the direct pass lights with the one found,
+    // and its shadow map is rendered.
+    EXPECT_NE(r.output.find("placed as a shadow-casting light"), std::string::npos) << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(direct\s+ran\s.*1 light\(s\))")))
+        << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(shadow\s+ran\s)"))) << r.output;
     for (size_t f = 1; f < azimuth.size(); ++f) {
         double step = azimuth[f] - azimuth[f - 1];
         step = std::remainder(step, 360.0);
@@ -257,14 +279,89 @@ TEST(EnvironmentReplay, RotatingEnvironmentIsFollowedWithinOneFrame) {
         EXPECT_EQ(e, "camera");
 }
 
+// The ratio `mirage env-radiometry` prints ("radiometry_to_main: R G B ..."), if it printed one.
+std::optional<glm::dvec3> printedRatio(const std::string& output) {
+    std::smatch m;
+    if (!std::regex_search(output, m,
+                           std::regex(R"(radiometry_to_main: (\S+) (\S+) (\S+) \(R, G, B)")))
+        return std::nullopt;
+    return glm::dvec3(std::stod(m[1]), std::stod(m[2]), std::stod(m[3]));
+}
+
+// Both cameras in one radiometry: the environment camera's gain and white balance relative to
+// the main camera, estimated from the directions both see (the main camera, 5 cm above the table,
+// sees the room above the horizon, as the upward fish-eye does; one frame), against the exact
+// ratio synth writes, for several exposures and white balances of the environment camera.
+TEST(EnvironmentRadiometry, EstimatedFromDirectionsBothCamerasSee) {
+    struct Setting {
+        std::string exposure, whiteBalance;
+    };
+    const std::vector<Setting> settings = {
+        {"0.5", "1,1,1"}, {"0.25", "1.2,1.0,0.8"}, {"1.5", "0.7,1.0,1.3"}};
+    for (size_t k = 0; k < settings.size(); ++k) {
+        const Setting& c = settings[k];
+        const fs::path s = synthesise(
+            "env_radiometry_" + std::to_string(k), "0.25", false,
+            {"--env-exposure", c.exposure, "--env-white-balance", c.whiteBalance}, "0.05");
+        const std::optional<glm::dvec3> truth = loadRadiometryToMain(s / "env.yaml");
+        ASSERT_TRUE(truth.has_value());
+        const CommandResult r = runMirage({"env-radiometry", s.string(), "--scene", scene()});
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        const std::optional<glm::dvec3> got = printedRatio(r.output);
+        ASSERT_TRUE(got.has_value()) << r.output;
+        std::printf(
+            "[ env radiometry ] exposure %s, white balance %s: estimated %.4f %.4f %.4f, exact "
+            "%.4f %.4f %.4f (ratio %.4f %.4f %.4f)\n",
+            c.exposure.c_str(), c.whiteBalance.c_str(), got->r, got->g, got->b, truth->r, truth->g,
+            truth->b, got->r / truth->r, got->g / truth->g, got->b / truth->b);
+        for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR((*got)[ch] / (*truth)[ch], 1.0, 0.02) << k;
+        if (k + 1 == settings.size()) {
+            // --write stores it in the environment camera's calibration.
+            const CommandResult w =
+                runMirage({"env-radiometry", s.string(), "--scene", scene(), "--write"});
+            ASSERT_EQ(w.exitCode, 0) << w.output;
+            const std::optional<glm::dvec3> stored = loadRadiometryToMain(s / "env.yaml");
+            ASSERT_TRUE(stored.has_value());
+            for (int ch = 0; ch < 3; ++ch)
+                EXPECT_NEAR((*stored)[ch], (*got)[ch], 1e-3 * (*got)[ch]);
+        }
+    }
+}
+
+// The main camera looking down at the table (0.7 m above it) never sees what the upward fish-eye
+// sees: a message saying what is missing, exit status 1, and no number.
+TEST(EnvironmentRadiometry, ViewsThatDoNotOverlapGiveAMessageInsteadOfANumber) {
+    const fs::path s = synthesise("env_radiometry_no_overlap", "0.25", false);
+    const CommandResult r = runMirage({"env-radiometry", s.string(), "--scene", scene()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("that the environment camera also sees"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("Film part of the room beyond the modelled scene"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(printedRatio(r.output).has_value()) << r.output;
+    // No environment camera at all.
+    const fs::path none = outputDir("env_radiometry_no_env") / "session";
+    const CommandResult synth = runMirage(
+        {"synth", scene(), "-o", none.string(), "--width", "80", "--height", "60", "--fps", "4",
+         "--seconds", "0.25", "--spp", "1", "--threads", "2", "--image-sequence", "--no-env"});
+    ASSERT_EQ(synth.exitCode, 0) << synth.output;
+    const CommandResult noEnv = runMirage({"env-radiometry", none.string(), "--scene", scene()});
+    EXPECT_EQ(noEnv.exitCode, 1) << noEnv.output;
+    EXPECT_NE(noEnv.output.find("no camera with role \"environment\""), std::string::npos)
+        << noEnv.output;
+}
+
 // mirage live with the environment camera: a session stands in for both cameras (paced by its
 // frame times); each main frame is lit by the environment frame nearest in time, so with the room
 // light turning the composite follows it exactly as replay's does (the same environment frames),
-// and differs from the same live run lit by the scene's static map.
+// and differs from the same live run lit by the scene's static map. With --estimate-lights the
+// window found in the environment frames is placed: the scene has no light of its own, so the
+// shadow pass runs only then.
 TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const fs::path dir = outputDir("live_env");
     const fs::path s = dir / "session";
-    for (const char* d : {"session", "env", "static", "replay", "rec", "rec_replay", "rec_static"})
+    for (const char* d :
+         {"session", "env", "static", "replay", "rec", "rec_replay", "rec_static", "placed"})
         fs::remove_all(dir / d);  // reruns
     // 640x480 (live tracks the board: at 320x240 this scene's tags are too small for an ok pose),
     // 5 frames at 2 fps, the room light turning 120 degrees per second (60 per frame). Live takes
@@ -405,6 +502,26 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     }
     EXPECT_GT(worstRecorded, 45.0);
     EXPECT_LT(worstStatic, 45.0) << "the tolerance cannot tell the recorded environment apart";
+
+    const CommandResult placed = runMirage(
+        {"live", "--camera", s.string(), "--scene", scene(), "--headless", "--frames", "2", "-o",
+         (dir / "placed").string(), "--env-camera", s.string(), "--estimate-lights"});
+    ASSERT_EQ(placed.exitCode, 0) << placed.output;
+    const CsvTable placedCsv = readCsvTable(dir / "placed" / "frames.csv");
+    ASSERT_GE(placedCsv.rows.size(), 1u);
+    EXPECT_GT(std::stod(placedCsv.field(0, "shadow_ms")), 0.0) << "no light was placed";
+    EXPECT_EQ(std::stod(envCsv.field(0, "shadow_ms")), 0.0);
+}
+
+// Lights are found in the environment camera's frames: live without one says so.
+TEST(LiveEnvironment, EstimateLightsWithoutAnEnvironmentCameraIsRefused) {
+    const fs::path dir = outputDir("live_estimate_lights_no_env");
+    const CommandResult r = runMirage(
+        {"live", "--camera", (dataDir() / "sessions" / "sample").string(), "--scene", scene(),
+         "--headless", "--frames", "1", "--estimate-lights", "-o", (dir / "out").string()});
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("name the environment camera with --env-camera"), std::string::npos)
+        << r.output;
 }
 
 }  // namespace

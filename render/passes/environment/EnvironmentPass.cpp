@@ -117,6 +117,17 @@ void EnvironmentPass::executeLive(FrameContext& ctx, PassResources& res) {
     // The levels below serve the SH9 projection now and blurrier lookups (rough reflections).
     glGenerateTextureMipmap(map_.id());
 
+    if (e.lightFreeSHValid) {
+        // Lights found in this frame are placed as lights of their own: the diffuse light is
+        // the SH9 of the map without them (projected on the CPU, render/EnvironmentLights.h).
+        GpuEnvironment g{};
+        for (int i = 0; i < 9; ++i) g.envSH[i] = glm::vec4(e.lightFreeSH[size_t(i)], 0.0f);
+        g.envRotation = 0.0f;
+        g.envSeenFraction = e.lightFreeSeenFraction;
+        light_.upload(&g, sizeof(g));
+        res.publish(Resource::EnvironmentMap, map_);
+        return;
+    }
     int level = 0;
     while ((map_.width() >> level) > kShMaxWidth) ++level;
     sh_.use();
