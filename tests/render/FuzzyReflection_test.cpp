@@ -20,6 +20,7 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
+#include "tests/support/RenderMasks.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RoughTestScenes.h"
 
@@ -207,27 +208,9 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     offOpt.fuzzyReflections = false;
     const Frame off = realtime(rough, footage, offOpt);
     EXPECT_NE(off.report.summary().find("fuzzy filter off"), std::string::npos);
-    cv::Mat diff;
-    cv::absdiff(on.linear, off.linear, diff);
-    std::vector<cv::Mat> ch;
-    cv::split(diff, ch);
-    const cv::Mat changed = (ch[0] + ch[1] + ch[2]) > 1e-6f;
+    const cv::Mat changed = test::changedPixels(on.linear, off.linear);
     // The plate (top and sides), 1 px dilated for the composite's rounding to canvas pixels.
-    cv::Mat plate(96, 128, CV_8U, cv::Scalar(0));
-    {
-        std::vector<cv::Point> pts;
-        for (float x : {kPlateLo.x, kPlateHi.x})
-            for (float y : {kPlateLo.y, kPlateHi.y})
-                for (float z : {kPlateLo.z, kPlateHi.z}) {
-                    const glm::dvec3 c = rough.pose.inverse() * glm::dvec3(x, y, z);
-                    pts.emplace_back(int(std::lround(rough.cam.fx * c.x / c.z + rough.cam.cx)),
-                                     int(std::lround(rough.cam.fy * c.y / c.z + rough.cam.cy)));
-                }
-        std::vector<cv::Point> hull;
-        cv::convexHull(pts, hull);
-        cv::fillConvexPoly(plate, hull, cv::Scalar(255));
-        cv::dilate(plate, plate, cv::Mat::ones(3, 3, CV_8U));
-    }
+    const cv::Mat plate = test::boxSilhouette(rough.cam, rough.pose, kPlateLo, kPlateHi);
     EXPECT_GT(cv::countNonZero(changed & plate), 200);  // the filter does something
     EXPECT_EQ(cv::countNonZero(changed & ~plate), 0);   // and only on the plate
 }

@@ -16,6 +16,7 @@
 
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
+#include "tests/support/RenderMasks.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RoughTestScenes.h"
 
@@ -122,27 +123,10 @@ TEST(RoughRefraction, RoughnessZeroLimitEqualsSmoothPathAndOnlyTheGlassChanges) 
     RoughTestScene ignored = rough;
     ignored.scene.materials[size_t(rough.material)].roughness = 0.0f;
     const RoughFrame off = test::renderRough(ignored, footage);
-    cv::Mat diff;
-    cv::absdiff(on.linear, off.linear, diff);
-    std::vector<cv::Mat> ch;
-    cv::split(diff, ch);
-    const cv::Mat changed = (ch[0] + ch[1] + ch[2]) > 1e-6f;
+    const cv::Mat changed = test::changedPixels(on.linear, off.linear);
     // The slab's box, 1 px dilated (the composite's rounding to canvas pixels).
-    cv::Mat slab(96, 128, CV_8U, cv::Scalar(0));
-    {
-        std::vector<cv::Point> pts;
-        for (float x : {-0.25f, 0.25f})
-            for (float y : {0.0f, 0.3f})
-                for (float z : {-0.03f, 0.03f}) {
-                    const glm::dvec3 c = rough.pose.inverse() * glm::dvec3(x, y, z);
-                    pts.emplace_back(int(std::lround(rough.cam.fx * c.x / c.z + rough.cam.cx)),
-                                     int(std::lround(rough.cam.fy * c.y / c.z + rough.cam.cy)));
-                }
-        std::vector<cv::Point> hull;
-        cv::convexHull(pts, hull);
-        cv::fillConvexPoly(slab, hull, cv::Scalar(255));
-        cv::dilate(slab, slab, cv::Mat::ones(3, 3, CV_8U));
-    }
+    const cv::Mat slab = test::boxSilhouette(rough.cam, rough.pose, glm::vec3(-0.25f, 0.0f, -0.03f),
+                                             glm::vec3(0.25f, 0.3f, 0.03f));
     EXPECT_GT(cv::countNonZero(changed & slab), 1000);  // the blur does something
     EXPECT_EQ(cv::countNonZero(changed & ~slab), 0);    // and only on the slab
 }

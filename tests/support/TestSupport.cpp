@@ -1,4 +1,5 @@
 #include "tests/support/TestSupport.h"
+#include "tests/support/RenderMasks.h"
 
 #include <sys/wait.h>
 #include <algorithm>
@@ -121,6 +122,35 @@ CsvTable readCsvTable(const std::filesystem::path& path) {
             EXPECT_EQ(t.rows.back().size(), t.header.size()) << line;
         }
     return t;
+}
+
+cv::Mat changedPixels(const cv::Mat& a, const cv::Mat& b) {
+    cv::Mat diff;
+    cv::absdiff(a, b, diff);
+    std::vector<cv::Mat> ch;
+    cv::split(diff, ch);
+    cv::Mat sum = ch[0].clone();
+    for (size_t c = 1; c < ch.size(); ++c) sum += ch[c];
+    return sum > 1e-6f;
+}
+
+cv::Mat boxSilhouette(const CameraIntrinsics& camera, const Pose& T_world_camera,
+                      const glm::vec3& lo, const glm::vec3& hi) {
+    cv::Mat mask(camera.height, camera.width, CV_8U, cv::Scalar(0));
+    std::vector<cv::Point> pts;
+    const Pose T_camera_world = T_world_camera.inverse();
+    for (float x : {lo.x, hi.x})
+        for (float y : {lo.y, hi.y})
+            for (float z : {lo.z, hi.z}) {
+                const glm::dvec3 c = T_camera_world * glm::dvec3(x, y, z);
+                pts.emplace_back(int(std::lround(camera.fx * c.x / c.z + camera.cx)),
+                                 int(std::lround(camera.fy * c.y / c.z + camera.cy)));
+            }
+    std::vector<cv::Point> hull;
+    cv::convexHull(pts, hull);
+    cv::fillConvexPoly(mask, hull, cv::Scalar(255));
+    cv::dilate(mask, mask, cv::Mat::ones(3, 3, CV_8U));
+    return mask;
 }
 
 }  // namespace mirage::test
