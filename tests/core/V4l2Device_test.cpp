@@ -307,6 +307,14 @@ std::unique_ptr<V4l2Camera> camera(const std::shared_ptr<FakeDriver>& driver,
                                         request);
 }
 
+// A device on the fake driver, streaming MJPEG 640x480 at 30 frames/s.
+std::unique_ptr<V4l2Device> streamingVga(const std::shared_ptr<FakeDriver>& driver) {
+    auto dev = std::make_unique<V4l2Device>("/dev/fake0", driver);
+    dev->configure({PixelFormat::Mjpeg, 640, 480, 30});
+    dev->start();
+    return dev;
+}
+
 // Many more frames than buffers: each buffer goes back to the driver before the next dequeue,
 // every frame decodes to the picture the camera filmed, and the driver's monotonic clock stamps
 // it. The pictures are compared with a tolerance for the JPEG (measured: 50.5-50.8 dB); a
@@ -345,11 +353,9 @@ TEST(V4l2Device, EagainAfterAWakeIsWaitedOut) {
     auto driver = std::make_shared<FakeDriver>();
     driver->script = {FakeDriver::Event::EagainAfterWake, FakeDriver::Event::EagainAfterWake,
                       FakeDriver::Event::Frame};
-    V4l2Device dev("/dev/fake0", driver);
-    dev.configure({PixelFormat::Mjpeg, 640, 480, 30});
-    dev.start();
+    const auto dev = streamingVga(driver);
     RawFrame raw;
-    ASSERT_TRUE(dev.dequeue(raw, 500));
+    ASSERT_TRUE(dev->dequeue(raw, 500));
     EXPECT_EQ(raw.sequence, 0);
     EXPECT_GT(raw.size, 0u);
     EXPECT_TRUE(driver->script.empty());
@@ -359,14 +365,12 @@ TEST(V4l2Device, EagainAfterAWakeIsWaitedOut) {
 // timeout (poll with 0 ms left returns at once, so a loop without a deadline check spins).
 TEST(V4l2Device, EndlessEagainEndsAtTheTimeout) {
     auto driver = std::make_shared<FakeDriver>();
-    V4l2Device dev("/dev/fake0", driver);
-    dev.configure({PixelFormat::Mjpeg, 640, 480, 30});
-    dev.start();
+    const auto dev = streamingVga(driver);
     driver->eagainForever = true;
     RawFrame raw;
     const double t0 = steadySeconds();
     try {
-        dev.dequeue(raw, 50);
+        dev->dequeue(raw, 50);
         ADD_FAILURE() << "a frame out of a driver that has none";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("no frame for 50 ms"), std::string::npos) << e.what();
@@ -465,11 +469,9 @@ TEST(V4l2Device, BadBuffersGapsAndForeignClocks) {
 
     auto foreign = std::make_shared<FakeDriver>();
     foreign->monotonicClock = false;
-    V4l2Device dev("/dev/fake0", foreign);
-    dev.configure({PixelFormat::Mjpeg, 640, 480, 30});
-    dev.start();
+    const auto dev = streamingVga(foreign);
     RawFrame raw;
-    ASSERT_TRUE(dev.dequeue(raw, 500));
+    ASSERT_TRUE(dev->dequeue(raw, 500));
     EXPECT_LT(raw.deviceSeconds, 0.0);
 }
 
