@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -268,7 +269,12 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
         if (!finite(world))
             throw Error("scene '" + scene.source.string() + "': node '" + nodeName +
                         "' has a non-finite transform");
-        if (inst.mesh < 0 || size_t(inst.mesh) >= meshRanges.size()) continue;
+        if (inst.mesh < 0 || size_t(inst.mesh) >= meshRanges.size()) {
+            instanceMeshes_.push_back(-1);
+            continue;
+        }
+        const int instanceIndex = int(instanceMeshes_.size());
+        instanceMeshes_.push_back(inst.mesh);
         const float scale =
             std::max({glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])),
                       glm::length(glm::vec3(world[2]))});
@@ -295,6 +301,8 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
             hi = glm::max(hi, d.bounds.center + glm::vec3(d.bounds.radius));
             if (d.specular) specularDraws_.push_back(int(draws_.size()));
             draws_.push_back(d);
+            localBounds_.push_back({r.center, r.radius});
+            drawInstances_.push_back(instanceIndex);
         }
     }
     if (!draws_.empty()) {
@@ -304,7 +312,8 @@ void GpuScene::buildDraws(const Scene& scene, const std::vector<std::vector<Rang
 }
 
 // Lights reachable from the scene's roots (Scene::lightInstances), at most kMaxLights.
-void GpuScene::buildLights(const Scene& scene) {
+std::vector<SceneLight> GpuScene::readLights(const Scene& scene) const {
+    std::vector<SceneLight> lights;
     for (const LightInstance& inst : scene.lightInstances()) {
         if (inst.light < 0 || size_t(inst.light) >= scene.lights.size()) continue;
         const Light& l = scene.lights[size_t(inst.light)];
@@ -323,12 +332,17 @@ void GpuScene::buildLights(const Scene& scene) {
         s.cosOuter = std::cos(outer);
         s.cosInner = std::cos(inner);
         s.origin = inst.origin;
-        if (lights_.size() >= size_t(kMaxLights))
+        if (lights.size() >= size_t(kMaxLights))
             throw Error("scene '" + scene.source.string() + "' has more than " +
                         std::to_string(kMaxLights) +
                         " lights; the real-time renderer supports at most that many");
-        lights_.push_back(s);
+        lights.push_back(s);
     }
+    return lights;
+}
+
+void GpuScene::buildLights(const Scene& scene) {
+    lights_ = readLights(scene);
     sceneLightCount_ = int(lights_.size());
     if (sceneLightCount_ + environmentLightSlots_ > kMaxLights)
         throw Error("scene '" + scene.source.string() + "' has " +
@@ -372,8 +386,89 @@ void GpuScene::uploadSpecularDraws() {
         spec.push_back(g);
     }
     if (spec.empty()) spec.push_back(GpuSpecularDraw{});
-    specularBuffer_ =
-        gl::Buffer("specular draws", spec.size() * sizeof(GpuSpecularDraw), spec.data());
+    const size_t bytes = spec.size() * sizeof(GpuSpecularDraw);
+    if (specularBuffer_.size() == bytes)
+        specularBuffer_.upload(spec.data(), bytes);  // moved objects: the same buffer
+    else
+        specularBuffer_ = gl::Buffer("specular draws", bytes, spec.data());
+}
+
+GpuScene::TransformUpdate GpuScene::updateTransforms(const Scene& scene) {
+    const std::string what = "scene '" + scene.source.string() + "': ";
+    const std::string rebuild = "; build a new renderer for another scene";
+    const std::vector<MeshInstance> instances = scene.meshInstances();
+    if (instances.size() != instanceMeshes_.size())
+        throw Error(what + "the moved scene has " + std::to_string(instances.size()) +
+                    " mesh instances, the uploaded one " + std::to_string(instanceMeshes_.size()) +
+                    rebuild);
+    const std::vector<SceneLight> lights = readLights(scene);
+    if (int(lights.size()) != sceneLightCount_)
+        throw Error(what + "the moved scene has " + std::to_string(lights.size()) +
+                    " lights, the uploaded one " + std::to_string(sceneLightCount_) + rebuild);
+    // Everything is checked before anything changes.
+    for (size_t k = 0; k < instances.size(); ++k) {
+        if (instanceMeshes_[k] < 0) continue;
+        if (instances[k].mesh != instanceMeshes_[k])
+            throw Error(what + "the moved scene draws other meshes than the uploaded one" +
+                        rebuild);
+        if (!finite(glm::mat4(instances[k].world)))
+            throw Error(what + "node '" + scene.nodes[size_t(instances[k].node)].name +
+                        "' has a non-finite transform");
+    }
+    for (size_t k = 0; k < lights.size(); ++k)
+        if (lights[k].type != lights_[k].type)
+            throw Error(what + "light '" + lights[k].name + "' changed its type" + rebuild);
+
+    TransformUpdate u;
+    for (size_t di = 0; di < draws_.size(); ++di)
+        if (draws_[di].translucent &&
+            glm::mat4(instances[size_t(drawInstances_[di])].world) != draws_[di].model)
+            u.translucentMoved = true;
+    if (u.translucentMoved) return u;  // nothing changed: the renderer is built anew
+
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (size_t di = 0; di < draws_.size(); ++di) {
+        DrawItem& d = draws_[di];
+        const glm::mat4 world(instances[size_t(drawInstances_[di])].world);
+        if (world != d.model) {
+            const float scale =
+                std::max({glm::length(glm::vec3(world[0])), glm::length(glm::vec3(world[1])),
+                          glm::length(glm::vec3(world[2]))});
+            ++u.movedDraws;
+            d.model = world;
+            d.normalMatrix = glm::inverseTranspose(world);
+            d.bounds.center = glm::vec3(world * glm::vec4(localBounds_[di].center, 1.0f));
+            d.bounds.radius = localBounds_[di].radius * scale;
+        }
+        lo = glm::min(lo, d.bounds.center - glm::vec3(d.bounds.radius));
+        hi = glm::max(hi, d.bounds.center + glm::vec3(d.bounds.radius));
+    }
+    for (size_t k = 0; k < lights.size(); ++k) {
+        if (lights[k].position == lights_[k].position &&
+            lights[k].direction == lights_[k].direction)
+            continue;
+        ++u.movedLights;
+        lights_[k].position = lights[k].position;
+        lights_[k].direction = lights[k].direction;
+    }
+    if (!u.any()) return u;
+    ++generation_;
+    if (!draws_.empty()) {
+        bounds_.center = 0.5f * (lo + hi);
+        bounds_.radius = 0.5f * glm::length(hi - lo);
+    }
+    if (u.movedDraws == 0) return u;
+    if (!specularDraws_.empty()) uploadSpecularDraws();
+    if (surfacePointCount_ > 0) {
+        std::vector<GpuSurfacePoint> pts(pointSources_.size());
+        for (size_t k = 0; k < pts.size(); ++k) {
+            const DrawItem& d = draws_[size_t(pointSources_[k].draw)];
+            pts[k] = {glm::vec3(d.model * glm::vec4(pointSources_[k].local, 1.0f)),
+                      d.origin == Origin::Real ? 1 : 0};
+        }
+        points_.upload(pts.data(), pts.size() * sizeof(GpuSurfacePoint));
+    }
+    return u;
 }
 
 // Surface point pool for imperfect shadow maps: area-weighted samples over all triangles
@@ -383,22 +478,23 @@ void GpuScene::buildSurfacePoints(const std::vector<Vertex>& verts,
     std::vector<GpuSurfacePoint> pts;
     {
         struct Tri {
-            glm::vec3 a, b, c;
+            glm::vec3 a, b, c;     // world
+            glm::vec3 la, lb, lc;  // mesh-local
+            int draw;
             float real;
         };
         std::vector<Tri> tris;
         std::vector<double> cdf;
         double total = 0.0;
-        for (const DrawItem& d : draws_) {
+        for (size_t di = 0; di < draws_.size(); ++di) {
+            const DrawItem& d = draws_[di];
             for (GLsizei i = 0; i + 2 < d.indexCount; i += 3) {
-                auto P = [&](GLsizei k) {
-                    return glm::vec3(
-                        d.model *
-                        glm::vec4(
-                            verts[size_t(d.baseVertex) + idx[d.firstIndex + size_t(k)]].position,
-                            1.0f));
+                auto L = [&](GLsizei k) {
+                    return verts[size_t(d.baseVertex) + idx[d.firstIndex + size_t(k)]].position;
                 };
-                Tri t{P(i), P(i + 1), P(i + 2), d.origin == Origin::Real ? 1.0f : 0.0f};
+                auto P = [&](GLsizei k) { return glm::vec3(d.model * glm::vec4(L(k), 1.0f)); };
+                Tri t{P(i),     P(i + 1), P(i + 2), L(i),
+                      L(i + 1), L(i + 2), int(di),  d.origin == Origin::Real ? 1.0f : 0.0f};
                 total += 0.5 * glm::length(glm::cross(t.b - t.a, t.c - t.a));
                 tris.push_back(t);
                 cdf.push_back(total);
@@ -418,9 +514,21 @@ void GpuScene::buildSurfacePoints(const std::vector<Vertex>& verts,
                 const Tri& t = tris[k];
                 glm::vec3 p = t.a + u * (t.b - t.a) + v * (t.c - t.a);
                 pts.push_back({p, t.real != 0.0f ? 1 : 0});
+                pointSources_.push_back({t.draw, t.la + u * (t.lb - t.la) + v * (t.lc - t.la)});
                 if (t.real == 0.0f) pointsHaveVirtual_ = true;
             }
-            std::shuffle(pts.begin(), pts.end(), rng);
+            // One permutation for the points and their sources.
+            std::vector<size_t> order(pts.size());
+            std::iota(order.begin(), order.end(), size_t(0));
+            std::shuffle(order.begin(), order.end(), rng);
+            std::vector<GpuSurfacePoint> shuffled(pts.size());
+            std::vector<PointSource> sources(pts.size());
+            for (size_t k = 0; k < order.size(); ++k) {
+                shuffled[k] = pts[order[k]];
+                sources[k] = pointSources_[order[k]];
+            }
+            pts = std::move(shuffled);
+            pointSources_ = std::move(sources);
         }
     }
     surfacePointCount_ = int(pts.size());

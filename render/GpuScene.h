@@ -128,6 +128,28 @@ public:
     bool surfacePointsHaveVirtual() const { return pointsHaveVirtual_; }
     float surfaceArea() const { return surfaceArea_; }  // m^2, all triangles
 
+    // What updateTransforms() moved.
+    struct TransformUpdate {
+        int movedDraws = 0;   // draw items whose world matrix changed
+        int movedLights = 0;  // scene lights whose position or direction changed
+        // A translucent object would move: its voxel number map (TranslucencyPass) lies in the
+        // world, so the renderer has to be built anew; nothing was changed.
+        bool translucentMoved = false;
+        bool any() const { return movedDraws > 0 || movedLights > 0; }
+    };
+    // Moves the uploaded scene to `scene`'s node transforms in place: `scene` is the scene this
+    // was built from with other node matrices (a placement, an animation). Updates the draws'
+    // world matrices and bounds, the specular table, the scene's lights and the ISM point pool
+    // (each point keeps its place on its triangle; the pool's split between objects stays the
+    // one of the first upload, so a scaled object keeps its share of points). Bumps
+    // generation() when anything moved. Changes nothing when a translucent object would move
+    // (TransformUpdate::translucentMoved). Throws mirage::Error, changing nothing, when `scene`
+    // has other mesh or light instances than the uploaded scene, or a non-finite transform.
+    TransformUpdate updateTransforms(const Scene& scene);
+    // Bumped by every updateTransforms() that moved something: whatever was computed from where
+    // the geometry stands (shadow maps, VPLs, ISMs, impostors) is stale when it changes.
+    uint64_t generation() const { return generation_; }
+
     // Binds the vertex array and the material buffer; then drawItem() per item.
     void bindGeometry() const;
     // Binds the draw's base colour texture (or a white 1x1) to texture unit `unit`.
@@ -182,7 +204,20 @@ private:
                             const std::vector<uint32_t>& idx, int surfacePoints);
     void uploadEnvironment(const Scene& scene);
 
+    // Where a pool point lies: the draw and its mesh-local position (updateTransforms moves it).
+    struct PointSource {
+        int draw = 0;
+        glm::vec3 local{0.0f};
+    };
+    // The lights of `scene` as buildLights() reads them (throws when there are too many).
+    std::vector<SceneLight> readLights(const Scene& scene) const;
+
     std::vector<DrawItem> draws_;
+    std::vector<BoundingSphere> localBounds_;  // per draw, mesh-local (scaled by the model)
+    std::vector<int> instanceMeshes_;          // per mesh instance: its mesh (-1: not drawn)
+    std::vector<int> drawInstances_;           // per draw: its mesh instance
+    std::vector<PointSource> pointSources_;    // per ISM pool point
+    uint64_t generation_ = 0;
     std::vector<SceneLight> lights_;
     int sceneLightCount_ = 0;
     int environmentLightSlots_ = 0;

@@ -383,7 +383,8 @@ void Renderer::planFrame(const FrameInput& input) {
                         : !s.hasEnvironment()                   ? kOriginNone
                         : s.environmentOrigin() == Origin::Real ? kOriginReal
                                                                 : kOriginVirtual;
-    c.historyValid = !input.resetHistory && lastRanFilter_ && c.frameIndex > 0;
+    // Moved objects leave their history where they stood: start afresh (as after a cut).
+    c.historyValid = !input.resetHistory && !objectsMoved_ && lastRanFilter_ && c.frameIndex > 0;
     f.envOrigin = envFlag;
     f.historyValid = c.historyValid ? 1 : 0;
     f.ismTileSize = options_.ismTileSize;
@@ -441,11 +442,20 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     planFrame(input);
     FrameContext& c = *ctx_;
     // What the camera-independent passes' output depends on: the light matrices and the plan.
-    c.staticKey = staticPlanKey(c);
+    // Camera-independent passes (shadow maps, VPLs, ISMs, photons) are redone when objects moved.
+    c.staticKey = staticPlanKey(c) + fmt::format("|g{}", scene_->generation());
     const FrameReport& report = graph_.execute(c, c.staticKey);
     lastRanFilter_ = report.ran("gifilter");
+    objectsMoved_ = false;
     ++c.frameIndex;
     return report;
+}
+
+bool Renderer::updateTransforms(const Scene& scene) {
+    const GpuScene::TransformUpdate u = scene_->updateTransforms(scene);
+    if (u.translucentMoved) return false;
+    objectsMoved_ = objectsMoved_ || u.any();
+    return true;
 }
 
 void Renderer::setEnvironmentCamera(const EnvironmentCameraSetup& camera) {

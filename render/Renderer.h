@@ -44,6 +44,15 @@ public:
     // Renders and composites one frame; blocks until its timer queries are available.
     const FrameReport& render(const FrameInput& input);
 
+    // Moves objects and lights to `scene`'s node transforms: `scene` is the scene this renderer
+    // was built from with other node matrices (a placement being dragged, an animation). The
+    // next render() redoes in that frame what depends on where things stand (shadow maps, VPLs,
+    // ISMs, the specular objects' impostors, caustics; the report says why each ran) and drops
+    // the temporal history. Returns false, changing nothing, when a translucent object would
+    // move (its voxel number map is precomputed in the world: build a new Renderer). Throws
+    // mirage::Error, changing nothing, when `scene` has other meshes or lights.
+    bool updateTransforms(const Scene& scene);
+
     // The environment camera as a live light source (docs/environment.md). After
     // setEnvironmentCamera, each updateEnvironment frame replaces the scene's static environment
     // (map, diffuse SH9 and L_env) from the next render() on; the environment pass runs only in
@@ -122,6 +131,7 @@ private:
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
     bool lastRanFilter_ = false;
+    bool objectsMoved_ = false;  // updateTransforms moved something since the last render()
 };
 
 }  // namespace mirage::render

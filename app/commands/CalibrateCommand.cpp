@@ -21,6 +21,8 @@
 #include "core/Log.h"
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/capture/CameraCatalog.h"
+#include "core/capture/V4l2Device.h"
 
 namespace mirage::app {
 namespace {
@@ -215,7 +217,9 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
     cmd->add_option("--board", a->board,
                     "Board file (JSON), chessboard:COLSxROWS:SQUARE_METRES (inner corners) or "
                     "charuco:SQUARESXxSQUARESY:SQUARE_M:MARKER_M[:DICT] (squares)");
-    cmd->add_option("-o,--output", a->output, "Calibration file to write (OpenCV YAML)");
+    cmd->add_option("-o,--output", a->output,
+                    "Calibration file to write (OpenCV YAML); with --camera the default is the "
+                    "camera folder mirage live reads");
     cmd->add_option("--model", a->model, "pinhole (Brown-Conrady) or fisheye (Kannala-Brandt)")
         ->capture_default_str();
     cmd->add_option("--ros", a->ros, "Also export a ROS camera_info YAML here");
@@ -234,7 +238,10 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
     cmd->add_option("--world-image", a->worldImage,
                     "Extrinsics: an image from this camera with the board at its world place; "
                     "gives the pose relative to the world");
-    cmd->add_option("--camera", a->camera, "Wizard: live V4L2 camera device (e.g. /dev/video0)");
+    cmd->add_option(
+        "--camera", a->camera,
+        "Wizard: live V4L2 camera device (e.g. /dev/video0); without -o the calibration is "
+        "saved where mirage live looks for this camera (docs/live.md)");
     cmd->add_option("--screenshot", a->screenshot,
                     "Wizard: save a PNG of the window after --screenshot-after frames, then exit");
     cmd->add_option("--screenshot-after", a->screenshotAfterFrames,
@@ -255,11 +262,28 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
         w.cameraDevice = a->camera;
         w.board = a->board;
         w.output = a->output;
+        // A webcam calibrated without -o is saved where `mirage live` looks for that camera's
+        // calibration (core/capture/CameraCatalog.h), and the board beside it if it has none.
+        std::optional<CameraFiles> kept;
+        if (w.output.empty() && !a->camera.empty() && a->writeSynthetic.empty()) {
+            const std::string card = V4l2Device(a->camera).card();
+            kept = cameraFiles(card);
+            std::filesystem::create_directories(kept->calibration.parent_path());
+            w.output = kept->calibration.string();
+            spdlog::info("calibrate: camera '{}': saving to {} (where mirage live looks for it)",
+                         card, w.output);
+        }
         w.model = modelOf(a->model);
         w.fixK3 = a->fixK3;
         w.screenshot = a->screenshot;
         w.screenshotAfterFrames = a->screenshotAfterFrames;
         commandExitCode() = runCalibrationWizard(w);
+        // (A board given as a file; a "chessboard:..." spec is not one live can track.)
+        if (kept && std::filesystem::exists(kept->calibration) &&
+            std::filesystem::is_regular_file(a->board) && !std::filesystem::exists(kept->board())) {
+            std::filesystem::copy_file(a->board, kept->ownBoard);
+            spdlog::info("calibrate: board copied to {} for mirage live", kept->ownBoard.string());
+        }
     });
 });
 

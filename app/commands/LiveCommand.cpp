@@ -214,12 +214,10 @@ CameraDefaults cameraDefaults(const std::string& node) {
     CameraDefaults d;
     V4l2Device dev(node);
     d.card = dev.card();
-    const fs::path dir = cameraConfigDir();
-    const std::string stem = cameraFileStem(d.card);
-    d.calibration = dir / (stem + ".yaml");
+    const CameraFiles files = cameraFiles(d.card);
+    d.calibration = files.calibration;
     d.haveCalibration = fs::exists(d.calibration);
-    d.board = dir / (stem + ".board.json");
-    if (!fs::exists(d.board)) d.board = dir / "board.json";
+    d.board = files.board();
     d.haveBoard = fs::exists(d.board);
     return d;
 }
@@ -238,8 +236,9 @@ void defaultsFor(const std::string& node, CameraInput& in) {
     in.calibrationHint = d.haveCalibration
                              ? ""
                              : "looked for " + d.calibration.string() + " (camera '" + d.card +
-                                   "'); calibrate it there: mirage calibrate --camera " + node +
-                                   " --board BOARD.json -o " + d.calibration.string();
+                                   "'); calibrate it, which saves it there: mirage calibrate "
+                                   "--camera " +
+                                   node + " --board BOARD.json";
     in.boardHint = d.haveBoard ? ""
                                : "looked for " + d.board.string() + "; copy the board file of " +
                                      "your printed board there";
@@ -537,9 +536,11 @@ void runLive(const LiveArgs& a) {
     copt.title = "mirage live";
     gl::Context ctx = a.headless ? gl::Context::headless(copt) : gl::Context::window(copt);
     int preset = 1;  // medium: the defaults
-    // A renderer for the scene as placed. Built anew when the quality or the placement changes:
-    // every pass (shadows, VPLs, imperfect shadow maps, impostors) then runs for the new scene in
-    // the next frame; while nothing changes the camera-independent passes are reused.
+    // A renderer for the scene as placed. Built anew when the quality or the effects change;
+    // a new placement moves the objects in place (Renderer::updateTransforms). Either way every
+    // pass that depends on where things stand (shadows, VPLs, imperfect shadow maps, caustics,
+    // impostors) runs again in the next frame; while nothing changes the camera-independent
+    // passes are reused.
     int vpls = a.vpls;  // --vpls, until a preset is chosen
     // The effects as switched (--off, then the HUD's checkboxes): RendererOptions' switches.
     render::RendererOptions effects;
@@ -645,7 +646,8 @@ void runLive(const LiveArgs& a) {
     bool windowClosed = false, reportedLost = false;
     bool paused = false, hideVirtual = false;
     int view = 0;
-    bool placementPending = false;
+    bool placementPending = false;        // moved, not yet saved
+    bool needsRebuild = false;            // moved, but not in place (a translucent object)
     std::optional<glm::dvec3> dragStart;  // where a left-drag started on the board plane
     ScenePlacement dragFrom;
     auto placementChangedAt = Clock::now();
@@ -845,6 +847,10 @@ void runLive(const LiveArgs& a) {
                 placement = p;
                 placementChangedAt = Clock::now();
                 placementPending = true;
+                // The objects follow in the next frame: moved in place (shadows, indirect light,
+                // caustics and impostors redone in that frame), or, for a translucent object
+                // whose voxel number map lies in the world, by a new renderer once the keys rest.
+                needsRebuild = needsRebuild || !renderer->updateTransforms(placedScene(placement));
             }
         }
         ImGui::SetNextWindowPos({float(fbw - kHudWidth), 0});
@@ -953,14 +959,18 @@ void runLive(const LiveArgs& a) {
                 recording.reset();
             }
         }
-        // A placement change is applied once the keys rest for 0.3 s (a rebuild takes about a
-        // second on llvmpipe), and saved beside the scene.
+        // A placement change is saved beside the scene once the keys rest for 0.3 s; a move that
+        // could not be made in place is applied then by a new renderer (a rebuild takes about a
+        // second on llvmpipe).
         if (placementPending && msSince(placementChangedAt) > 300 && !dragStart) {
             placementPending = false;
-            renderer = makeRenderer();
-            compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
-            attachEnvironment();
-            last.report = nullptr;
+            if (needsRebuild) {
+                needsRebuild = false;
+                renderer = makeRenderer();
+                compositor = std::make_unique<FrameCompositor>(*renderer, &tracker);
+                attachEnvironment();
+                last.report = nullptr;
+            }
             try {
                 savePlacement(placementFile, placement);
                 spdlog::info("live: placement saved to {}", placementFile.string());

@@ -29,6 +29,16 @@ std::string cameraFileStem(const std::string& card) {
     return out.empty() ? "camera" : out;
 }
 
+std::filesystem::path CameraFiles::board() const {
+    return std::filesystem::exists(ownBoard) ? ownBoard : sharedBoard;
+}
+
+CameraFiles cameraFiles(const std::string& card) {
+    const std::filesystem::path dir = cameraConfigDir();
+    const std::string stem = cameraFileStem(card);
+    return {dir / (stem + ".yaml"), dir / (stem + ".board.json"), dir / "board.json"};
+}
+
 std::vector<std::string> v4l2DeviceNodes() {
     std::vector<std::pair<long, std::string>> found;
     std::error_code ec;

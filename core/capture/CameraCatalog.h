@@ -15,6 +15,15 @@ std::filesystem::path cameraConfigDir();
 // A file-name stem for a camera's card name: lower case, runs of anything but letters and digits
 // become one '-', no '-' at either end; "camera" if nothing is left.
 std::string cameraFileStem(const std::string& card);
+// The files kept for the camera whose V4L2 card name is `card`, in cameraConfigDir().
+struct CameraFiles {
+    std::filesystem::path calibration;  // <stem>.yaml: what `mirage calibrate --camera` saves
+    std::filesystem::path ownBoard;     // <stem>.board.json: the board used with this camera
+    std::filesystem::path sharedBoard;  // board.json: the board of every camera without its own
+    // ownBoard if it exists, else sharedBoard (which need not exist either).
+    std::filesystem::path board() const;
+};
+CameraFiles cameraFiles(const std::string& card);
 // The V4L2 device nodes present (/dev/videoN), in the order of N.
 std::vector<std::string> v4l2DeviceNodes();
 

@@ -272,6 +272,15 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.vnmResolution = parseInt("vnm_resolution", v, 2, 512);
          },
          [](const BenchConfig& c) { return std::to_string(c.options.vnmResolution); }},
+        {"moving_objects",
+         "on: the virtual objects move before every frame (to 1 cm along +X and back), so "
+         "every frame redoes what depends on where they stand: shadows, VPLs, ISMs, caustics, "
+         "impostors (docs/live.md)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.movingObjects = parseOnOff("moving_objects", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.movingObjects); }},
         // The environment (docs/environment.md). Defaults keep the static map, so the default
         // grid is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
         {"env_source",

@@ -11,6 +11,7 @@
 
 #include "core/Error.h"
 #include "core/image/ImageIO.h"
+#include "core/scene/ScenePlacement.h"
 #include "render/Renderer.h"
 
 namespace mirage::render {
@@ -140,6 +141,21 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
         renderer.setEnvironmentCamera(*environment);
         renderer.updateEnvironment(frames.front().environment, frames.front().environmentTime - 1);
     }
+    // moving_objects: the scene with its virtual objects 1 cm along +X (world), to move to and
+    // back from before each frame.
+    Scene away;
+    if (config.movingObjects) {
+        away = scene;
+        ScenePlacement step;
+        step.moveU = 0.01;
+        if (applyPlacement(away, step, PlacementPlane{}) == 0)
+            throw Error("bench: knob moving_objects=on needs a scene with virtual objects");
+        if (!renderer.updateTransforms(away))
+            throw Error(
+                "bench: knob moving_objects=on: a translucent object moves only with a new "
+                "renderer (its voxel number map is precomputed in the world)");
+        renderer.updateTransforms(scene);
+    }
     // Warm-up: shader compilation and first allocations stay out of the timings.
     renderer.render({frames.front().T_world_camera, frames.front().footage, true});
 
@@ -160,6 +176,10 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
             // also across repeats: the last frame's is never the first's).
             if (config.environmentCamera)
                 renderer.updateEnvironment(f.environment, f.environmentTime + 1e-3 * double(rep));
+            if (config.movingObjects) {
+                renderer.updateTransforms(away);
+                renderer.updateTransforms(scene);
+            }
             const FrameReport& report =
                 renderer.render({f.T_world_camera, f.footage, /*resetHistory=*/i == 0});
             const cv::Mat composite = renderer.compositeSrgb();

@@ -34,6 +34,11 @@ struct BenchConfig {
     // Light with the session's environment camera, updated every frame (knob env_source=camera;
     // docs/environment.md), instead of the scene's static environment map.
     bool environmentCamera = false;
+    // Objects moving (knob moving_objects=on): before each frame the virtual objects are moved
+    // 1 cm along the table and back in place (Renderer::updateTransforms), so every frame pays
+    // for a move (shadow maps, VPLs, ISMs, caustics and impostors redone, history dropped) while
+    // its image stays comparable with the session's ground truth.
+    bool movingObjects = false;
     std::string label() const;  // "vpls=256 indirect_scale=2 ..."
 };
 

@@ -1,6 +1,8 @@
 // Where `mirage live` looks for a webcam's calibration: the camera folder from the environment,
 // and file names from the camera model's name.
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +39,28 @@ TEST(CameraCatalog, FolderFromTheEnvironment) {
         else
             ::unsetenv(names[i]);
     }
+}
+
+TEST(CameraCatalog, FilesOfACameraInTheFolder) {
+    const char* saved = std::getenv("MIRAGE_CAMERA_DIR");
+    const std::string keep = saved ? saved : "";
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "mirage_camera_catalog_test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    ::setenv("MIRAGE_CAMERA_DIR", dir.c_str(), 1);
+    const CameraFiles f = cameraFiles("HD Webcam C270");
+    EXPECT_EQ(f.calibration, dir / "hd-webcam-c270.yaml");
+    EXPECT_EQ(f.ownBoard, dir / "hd-webcam-c270.board.json");
+    EXPECT_EQ(f.sharedBoard, dir / "board.json");
+    EXPECT_EQ(f.board(), f.sharedBoard);  // neither exists: the shared one is named
+    std::ofstream(f.ownBoard) << "{}";
+    EXPECT_EQ(f.board(), f.ownBoard);  // the camera's own board wins
+    if (saved)
+        ::setenv("MIRAGE_CAMERA_DIR", keep.c_str(), 1);
+    else
+        ::unsetenv("MIRAGE_CAMERA_DIR");
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

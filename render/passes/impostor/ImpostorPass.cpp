@@ -123,9 +123,10 @@ PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
     const size_t n = ctx.scene.specularDraws().size();
     if (n == 0) return {false, "no specular object"};
     const char* method = ctx.options.impostorCubeMapBaseline ? "cube-map baseline" : "impostors";
-    if (builtScene_ != &ctx.scene || builtResolution_ != ctx.options.impostorResolution)
-        return {true, fmt::format("build for {} specular object(s) at {}^2 ({})", n,
-                                  ctx.options.impostorResolution, method)};
+    if (stale(ctx.scene, ctx.options.impostorResolution))
+        return {true, fmt::format("{} for {} specular object(s) at {}^2 ({})",
+                                  builtScene_ == &ctx.scene ? "rebuild (objects moved)" : "build",
+                                  n, ctx.options.impostorResolution, method)};
     return {true, fmt::format("cached ({}, {} refinement steps; built once: {})", method,
                               ctx.options.impostorRefineSteps, stats_.summary())};
 }
@@ -151,12 +152,17 @@ bool ImpostorPass::update(const GpuScene& scene, const RendererOptions& o) {
 
 bool ImpostorPass::ensureBuilt(const GpuScene& scene, const RendererOptions& o) {
     bool rebuilt = false;
-    if (builtScene_ != &scene || builtResolution_ != o.impostorResolution) {
+    if (stale(scene, o.impostorResolution)) {
         build(scene, o.impostorResolution);
         rebuilt = true;
     }
     uploadMode(o);
     return rebuilt;
+}
+
+bool ImpostorPass::stale(const GpuScene& scene, int resolution) const {
+    return builtScene_ != &scene || builtResolution_ != resolution ||
+           builtGeneration_ != scene.generation();
 }
 
 void ImpostorPass::uploadMode(const RendererOptions& o) {
@@ -207,15 +213,21 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
 // points, box, and plane if it is planar.
 std::vector<ImpostorPass::DrawShape> ImpostorPass::drawShapes(const GpuScene& scene) {
     const std::vector<DrawItem>& draws = scene.draws();
-    std::vector<GpuSceneVertex> verts;
-    std::vector<uint32_t> indices;
-    if (scene.vertexBuffer().id() != 0) {
-        verts.resize(scene.vertexBuffer().size() / sizeof(GpuSceneVertex));
-        indices.resize(scene.indexBuffer().size() / sizeof(uint32_t));
-        glGetNamedBufferSubData(scene.vertexBuffer().id(), 0,
-                                GLsizeiptr(verts.size() * sizeof(GpuSceneVertex)), verts.data());
-        glGetNamedBufferSubData(scene.indexBuffer().id(), 0,
-                                GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data());
+    // Mesh-local geometry never changes within a scene (moving objects changes only their
+    // matrices): read back once per scene.
+    std::vector<GpuSceneVertex>& verts = meshVertices_;
+    std::vector<uint32_t>& indices = meshIndices_;
+    if (meshesOf_ != &scene) {
+        verts.assign(scene.vertexBuffer().size() / sizeof(GpuSceneVertex), GpuSceneVertex{});
+        indices.assign(scene.indexBuffer().size() / sizeof(uint32_t), 0u);
+        if (scene.vertexBuffer().id() != 0) {
+            glGetNamedBufferSubData(scene.vertexBuffer().id(), 0,
+                                    GLsizeiptr(verts.size() * sizeof(GpuSceneVertex)),
+                                    verts.data());
+            glGetNamedBufferSubData(scene.indexBuffer().id(), 0,
+                                    GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data());
+        }
+        meshesOf_ = &scene;
     }
     auto worldPoints = [&](const DrawItem& d) {
         std::vector<glm::vec3> pts;
@@ -358,24 +370,10 @@ void ImpostorPass::allocate(const GpuScene& scene, const Layout& layout, int res
             "the scene needs {} impostor layers and {} cube-map layers, but this GL allows {} "
             "array layers; merge small surrounding meshes or use fewer specular objects",
             impLayers, cubeLayers, maxLayers));
-    cubePosition_ =
-        gl::Texture::create2DArray("impostor cube position", res, res, cubeLayers, GL_RGBA32F);
-    cubeNormal_ =
-        gl::Texture::create2DArray("impostor cube normal", res, res, cubeLayers, GL_RGBA16F);
-    cubeAlbedo_ =
-        gl::Texture::create2DArray("impostor cube albedo", res, res, cubeLayers, GL_RGBA8);
-    cubeEmissive_ =
-        gl::Texture::create2DArray("impostor cube emissive", res, res, cubeLayers, GL_RGBA16F);
-    depth_ = gl::Texture::create2DArray("impostor depth", res, res, impLayers, GL_RG32F);
-    normal_ = gl::Texture::create2DArray("impostor normal", res, res, impLayers, GL_RGBA16F);
-    albedo_ = gl::Texture::create2DArray("impostor albedo", res, res, impLayers, GL_RGBA8);
-    emissive_ = gl::Texture::create2DArray("impostor emissive", res, res, impLayers, GL_RGBA16F);
-    for (gl::Texture* t : {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_, &normal_,
-                           &albedo_, &emissive_})
-        t->setFilter(GL_NEAREST, GL_NEAREST);
-    depth_.setFilter(GL_LINEAR, GL_LINEAR);  // bilinear height field (trace.glsl impDepthAt)
-    captureDepthBuffer_ =
-        gl::Texture::create2D("impostor capture depth", res, res, GL_DEPTH_COMPONENT32F);
+    // Objects moved within the scene: the same layers at the same resolution, re-captured.
+    const bool sameSize = cubePosition_.width() == res && cubePosition_.layers() == cubeLayers &&
+                          depth_.layers() == impLayers;
+    if (!sameSize) allocateTextures(res, cubeLayers, impLayers);
     stats_.textureBytes = 0;
     for (const gl::Texture* t : {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
                                  &depth_, &normal_, &albedo_, &emissive_})
@@ -396,6 +394,28 @@ void ImpostorPass::allocate(const GpuScene& scene, const Layout& layout, int res
     objects_ = gl::Buffer("impostor objects", objectBytes_.size(), objectBytes_.data());
     builtScene_ = &scene;
     builtResolution_ = res;
+    builtGeneration_ = scene.generation();
+}
+
+void ImpostorPass::allocateTextures(int res, int cubeLayers, int impLayers) {
+    cubePosition_ =
+        gl::Texture::create2DArray("impostor cube position", res, res, cubeLayers, GL_RGBA32F);
+    cubeNormal_ =
+        gl::Texture::create2DArray("impostor cube normal", res, res, cubeLayers, GL_RGBA16F);
+    cubeAlbedo_ =
+        gl::Texture::create2DArray("impostor cube albedo", res, res, cubeLayers, GL_RGBA8);
+    cubeEmissive_ =
+        gl::Texture::create2DArray("impostor cube emissive", res, res, cubeLayers, GL_RGBA16F);
+    depth_ = gl::Texture::create2DArray("impostor depth", res, res, impLayers, GL_RG32F);
+    normal_ = gl::Texture::create2DArray("impostor normal", res, res, impLayers, GL_RGBA16F);
+    albedo_ = gl::Texture::create2DArray("impostor albedo", res, res, impLayers, GL_RGBA8);
+    emissive_ = gl::Texture::create2DArray("impostor emissive", res, res, impLayers, GL_RGBA16F);
+    for (gl::Texture* t : {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_, &normal_,
+                           &albedo_, &emissive_})
+        t->setFilter(GL_NEAREST, GL_NEAREST);
+    depth_.setFilter(GL_LINEAR, GL_LINEAR);  // bilinear height field (trace.glsl impDepthAt)
+    captureDepthBuffer_ =
+        gl::Texture::create2D("impostor capture depth", res, res, GL_DEPTH_COMPONENT32F);
 }
 
 // Renders the cube maps (baseline and enclosing items) and every impostor.

@@ -11,15 +11,17 @@
 //    items get an impostor lying in their own plane (exact ray-plane intersection);
 //  - a G-buffer cube map of the items that enclose the object or reach behind their billboard's
 //    near face as seen from it (a room, a large non-planar table), searched along the ray.
-// The scene is static within a session: everything is built once (the frame it happens, the
-// report says "build ...", with its GPU time in the pass timer) and cached afterwards; it is
-// rebuilt only when the scene or RendererOptions::impostorResolution changes. Refinement steps and
+// Everything is built once (the frame it happens, the report says "build ...", with its GPU time
+// in the pass timer) and cached while nothing moves; it is rebuilt in the frame after objects
+// moved (GpuScene::generation(), "rebuild (objects moved)") or when
+// RendererOptions::impostorResolution changes. Refinement steps and
 // the baseline switch are per-frame uniforms (no rebuild). World = glTF frame (metres, +Y up).
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "render/GpuScene.h"
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -92,11 +94,16 @@ private:
     struct Layout;
     // build(): drawShapes -> classify -> allocate -> capture.
     void build(const GpuScene& scene, int resolution);
-    static std::vector<DrawShape> drawShapes(const GpuScene& scene);
+    std::vector<DrawShape> drawShapes(const GpuScene& scene);
     Layout classify(const GpuScene& scene, const std::vector<DrawShape>& shapes, int resolution);
     void allocate(const GpuScene& scene, const Layout& layout, int resolution);
     void capture(const GpuScene& scene, const Layout& layout, int resolution);
     void uploadMode(const RendererOptions& options);
+    // True when the captures are not of this scene as it stands now at this resolution (another
+    // scene, its objects moved, another resolution).
+    bool stale(const GpuScene& scene, int resolution) const;
+    // The cube-map and impostor arrays and the capture depth buffer.
+    void allocateTextures(int res, int cubeLayers, int impLayers);
     // Builds if the scene or resolution changed (options already validated).
     bool ensureBuilt(const GpuScene& scene, const RendererOptions& options);
     // Binds the impostors of this pass for the offline query.
@@ -115,6 +122,11 @@ private:
     gl::Framebuffer captureFbo_;
     const GpuScene* builtScene_ = nullptr;
     int builtResolution_ = 0;
+    uint64_t builtGeneration_ = 0;  // GpuScene::generation() the captures show
+    // The scene's mesh-local vertices and indices, read back once per scene (meshesOf_).
+    const GpuScene* meshesOf_ = nullptr;
+    std::vector<GpuSceneVertex> meshVertices_;
+    std::vector<uint32_t> meshIndices_;
     ImpostorBuildStats stats_;
     std::vector<std::vector<ItemKind>> kinds_;  // [slot][draw]
 };
