@@ -194,6 +194,8 @@ struct ImpostorPass::Layout {
 
 void ImpostorPass::build(const GpuScene& scene, int res) {
     const auto wallStart = std::chrono::steady_clock::now();
+    // A rebuild after objects moved happens in every frame of a drag: not worth a log line each.
+    const bool moved = builtScene_ == &scene && builtResolution_ == res;
     const Layout layout = classify(scene, drawShapes(scene), res);
     allocate(scene, layout, res);
     // Captures, timed by the wall clock between two glFinish: llvmpipe's GL_TIME_ELAPSED gave
@@ -206,7 +208,10 @@ void ImpostorPass::build(const GpuScene& scene, int res) {
     const auto end = std::chrono::steady_clock::now();
     stats_.captureMs = std::chrono::duration<double, std::milli>(end - captureStart).count();
     stats_.wallMs = std::chrono::duration<double, std::milli>(end - wallStart).count();
-    spdlog::info("impostors built: {}", stats_.summary());
+    if (moved)
+        spdlog::debug("impostors rebuilt (objects moved): {}", stats_.summary());
+    else
+        spdlog::info("impostors built: {}", stats_.summary());
 }
 
 // The geometry on the CPU once (planes and tight boxes need the vertices): every draw's world
