@@ -182,13 +182,20 @@ TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
     auto wrong = runMirage({"replay", same.string(), "--scene", diffuseScene(), "--poses",
                             off.string(), "-o", (dir / "replay_3mm").string()});
     ASSERT_EQ(wrong.exitCode, 0) << wrong.output;
-    int caught = 0;
+    // Only where the virtual objects show: a frame whose composite is its footage (the box out
+    // of view, as in the sample's last frames, which a loaded machine reaches) cannot show a
+    // pose error.
+    int showing = 0, caught = 0;
     for (size_t k = 0; k < rows.size(); ++k) {
+        const fs::path footage = same / "main" / cv::format("%06d.png", int(k));
+        if (compareFrame(frameFile(dir / "live", int(k)), footage).psnrDb > kSameImageDb) continue;
+        ++showing;
         const Diff d =
             compareFrame(frameFile(dir / "live", int(k)), frameFile(dir / "replay_3mm", int(k)));
         caught += d.psnrDb <= kSameImageDb;
     }
-    EXPECT_EQ(caught, int(rows.size()));
+    EXPECT_GE(showing, 2);
+    EXPECT_EQ(caught, showing);
 }
 
 // The footage as recorded (main.mkv, JPEG) against the frames the stand-in delivered.
@@ -196,8 +203,10 @@ TEST(LiveRecording, ReplayOfTheRecordingReproducesTheLiveComposite) {
     const fs::path dir = outputDir("live_record");
     const std::string scene = (dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
     const fs::path rec = dir / "rec";
+    // 2 frames/s: the sample's 36 frames last 18 s, so 3 frames get processed even on a loaded
+    // machine (at 6 frames/s the stand-in ended after 2 frames under a load average of 10).
     auto live = runMirage({"live", "--camera", sampleSession().string(), "--scene", scene,
-                           "--headless", "--camera-fps", "6", "--frames", "3", "-o",
+                           "--headless", "--camera-fps", "2", "--frames", "3", "-o",
                            (dir / "live").string(), "--record", rec.string()});
     ASSERT_EQ(live.exitCode, 0) << live.output;
     const std::vector<LiveRow> rows = readLiveCsv(dir / "live" / "frames.csv");
