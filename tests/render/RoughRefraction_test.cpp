@@ -131,6 +131,57 @@ TEST(RoughRefraction, RoughnessZeroLimitEqualsSmoothPathAndOnlyTheGlassChanges) 
     EXPECT_EQ(cv::countNonZero(changed & ~slab), 0);    // and only on the slab
 }
 
+// GSR reduces the back faces' 4 x 4 window itself at every pixel whose footprint covers more than
+// a texel: a frosted sphere (curved back, so the window's texels fall into different sectors) at
+// roughness 0.5 rendered with 1 and with 8 hemisphere subdivisions must differ at (nearly) every
+// interior pixel. A pixel where both equal LEAN to the digit took LEAN's lobe because the window
+// held no back face: that happened along a line across the object (an iso-line of the window's
+// mip level, 40 of the sphere's 1276 interior pixels) while the window's level size came from
+// textureSize() with a per-pixel lod, which llvmpipe answers with another fragment's level.
+TEST(RoughRefraction, GsrGathersTheBackFacesEverywhere) {
+    gl::Context context = gl::Context::headless();
+    const auto envDir = test::outputDir("rough_env_gsr");
+    cv::Mat footage(96, 128, CV_8UC3);
+    cv::randu(footage, 0, 255);
+    RoughTestScene s = test::makeRoughSlab(0.5f, envDir);
+    const glm::vec3 centre(0.0f, 0.15f, 0.0f);
+    const float radius = 0.15f;
+    for (Mesh& m : s.scene.meshes) {
+        if (m.name != "slab") continue;
+        Primitive p = test::uvSpherePrimitive(centre, radius, 32, 48);
+        p.material = s.material;
+        m.primitives = {p};
+    }
+    // The sphere's pixels, 2 px in from its outline (the rim refracts at grazing angles).
+    cv::Mat inside(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
+    const glm::dvec3 eye = s.pose * glm::dvec3(0.0);
+    for (int y = 0; y < inside.rows; ++y)
+        for (int x = 0; x < inside.cols; ++x) {
+            const glm::dvec3 d = glm::normalize(
+                s.pose * glm::dvec3((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0) -
+                eye);
+            const glm::dvec3 oc = eye - glm::dvec3(centre);
+            const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - double(radius * radius);
+            if (b * b - c > 0.0) inside.at<uint8_t>(y, x) = 255;
+        }
+    cv::erode(inside, inside, cv::Mat::ones(5, 5, CV_8U));
+    ASSERT_GT(cv::countNonZero(inside), 800);
+    const RoughFrame one = test::renderRough(s, footage, withMethod(RoughRefractionMethod::Gsr, 1));
+    const RoughFrame eight =
+        test::renderRough(s, footage, withMethod(RoughRefractionMethod::Gsr, 8));
+    const RoughFrame lean = test::renderRough(s, footage, withMethod(RoughRefractionMethod::Lean));
+    const cv::Mat subdivisionsMatter = test::changedPixels(one.linear, eight.linear);
+    const cv::Mat asLean = ~test::changedPixels(eight.linear, lean.linear);
+    const int same = cv::countNonZero(~subdivisionsMatter & inside);
+    const int fellBack = cv::countNonZero(~subdivisionsMatter & asLean & inside);
+    std::cout << "[ rough ] GSR on a frosted sphere: " << same << " of " << cv::countNonZero(inside)
+              << " interior px independent of the subdivisions, " << fellBack
+              << " of them LEAN's\n";
+    // Measured: 0 of 1276 px; with the textureSize() query 40, all of them LEAN's.
+    EXPECT_LE(fellBack, 5);
+    EXPECT_LE(same, 12);
+}
+
 // Runs only for rough glass, with LEAN or GSR: smooth glass and rough_method=filter skip it (the
 // fuzzy pass then takes the glass); a rough metal alone runs the fuzzy pass, not this one.
 TEST(RoughRefraction, RunsOnlyForRoughGlassAndSaysWhichMethod) {
