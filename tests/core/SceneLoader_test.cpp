@@ -116,8 +116,8 @@ void checkShowcase(const Scene& s) {
     EXPECT_FLOAT_EQ(glass.attenuationDistance, 0.3f);
     expectVec(glass.attenuationColor, {0.9f, 0.8f, 0.7f});
     EXPECT_FLOAT_EQ(glass.roughness, 0.02f);
-    // The retired extras.mirage.roughness_variation is warned about, not read.
-    EXPECT_NE(std::find_if(s.warnings.begin(), s.warnings.end(),
+    // No retired extras: the showcase loads without that warning (RetiredRoughnessVariation).
+    EXPECT_EQ(std::find_if(s.warnings.begin(), s.warnings.end(),
                            [](const std::string& w) {
                                return w.find("roughness_variation") != std::string::npos;
                            }),
@@ -300,6 +300,24 @@ TEST(SceneLoader, LoadFromMemoryMatchesLoadFromFile) {
         loadSceneFromMemory(readFile(goodScene("showcase.glb")), "in-memory.glb", goodScene(""));
     EXPECT_EQ(s.source, "in-memory.glb");
     checkShowcase(s);
+}
+
+// The retired extras.mirage.roughness_variation (roughness now varies through the
+// metallicRoughnessTexture) is warned about, naming the material, and not read.
+TEST(SceneLoader, RetiredRoughnessVariationIsWarnedAboutNotRead) {
+    std::string json = readFile(goodScene("showcase.gltf"));
+    const std::string glass = "\"name\": \"Glass\"";
+    ASSERT_NE(json.find(glass), std::string::npos);
+    json.replace(json.find(glass), glass.size(),
+                 glass + ", \"extras\": {\"mirage\": {\"roughness_variation\": 0.1}}");
+    const Scene s = loadSceneFromMemory(json, "retired.gltf", goodScene(""));
+    const auto w = std::find_if(s.warnings.begin(), s.warnings.end(), [](const std::string& w) {
+        return w.find("roughness_variation") != std::string::npos;
+    });
+    ASSERT_NE(w, s.warnings.end());
+    EXPECT_NE(w->find("material 1"), std::string::npos) << *w;
+    EXPECT_NE(w->find("metallicRoughnessTexture"), std::string::npos) << *w;
+    EXPECT_FLOAT_EQ(s.materials[1].roughness, 0.02f);
 }
 
 TEST(SceneLoader, FisheyeEnvironmentFromAssetExtras) {

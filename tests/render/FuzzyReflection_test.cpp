@@ -53,9 +53,9 @@ PlateScene makePlate(float roughness, const std::filesystem::path& envDir,
     return s;
 }
 
-// Pixels whose camera ray meets the plate's top face, 1 px in from its outline (the silhouette
-// is mixed in the reference).
-cv::Mat topMask(const PlateScene& s) {
+// Pixels whose camera ray meets the plate's top face with x in (xLo, xHi) (world, metres), 1 px
+// in from its outline (the silhouette is mixed in the reference).
+cv::Mat topMask(const PlateScene& s, double xLo = kPlateLo.x, double xHi = kPlateHi.x) {
     cv::Mat m(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
     const Pose inv = s.pose;  // T_world_camera
     const glm::dvec3 eye = inv * glm::dvec3(0.0);
@@ -66,7 +66,7 @@ cv::Mat topMask(const PlateScene& s) {
             if (d.y >= 0) continue;
             const double t = (kTop - eye.y) / d.y;
             const glm::dvec3 p = eye + t * d;
-            if (p.x > kPlateLo.x && p.x < kPlateHi.x && p.z > kPlateLo.z && p.z < kPlateHi.z)
+            if (p.x > xLo && p.x < xHi && p.z > kPlateLo.z && p.z < kPlateHi.z)
                 m.at<uint8_t>(y, x) = 255;
         }
     cv::erode(m, m, cv::Mat::ones(3, 3, CV_8U));
@@ -213,6 +213,83 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     const cv::Mat plate = test::boxSilhouette(rough.cam, rough.pose, kPlateLo, kPlateHi);
     EXPECT_GT(cv::countNonZero(changed & plate), 200);  // the filter does something
     EXPECT_EQ(cv::countNonZero(changed & ~plate), 0);   // and only on the plate
+}
+
+// Roughness varying across a rough metal: the plate's metallicRoughness texture (64x1, linear)
+// has G = `left` on its left half and `right` on its right (factor 0.3), read per pixel by the
+// G-buffer and by the filter. The texture spans u = 0.25 .. 0.75 over the plate (clear of the
+// repeat wrap's blend at u = 0 / 1), so its bilinear seam is one texel = 11 mm wide (about 1.3 px
+// here) about x = 0.
+PlateScene texturedPlate(const std::filesystem::path& envDir, unsigned char left,
+                         unsigned char right) {
+    PlateScene s = makePlate(0.3f, envDir);
+    Texture t;
+    t.name = "half rough";
+    t.width = 64;
+    t.height = 1;
+    t.srgb = false;
+    for (int x = 0; x < t.width; ++x) {
+        const unsigned char g = x < t.width / 2 ? left : right;
+        t.pixels.insert(t.pixels.end(), {0, g, 0, 255});
+    }
+    s.scene.textures.push_back(t);
+    s.scene.materials[size_t(s.material)].metallicRoughnessTexture.texture =
+        int(s.scene.textures.size()) - 1;
+    for (Mesh& m : s.scene.meshes) {
+        if (m.name != "plate") continue;
+        for (Primitive& p : m.primitives) {
+            p.uv0.clear();
+            for (const glm::vec3& v : p.positions)
+                p.uv0.emplace_back(0.25f + 0.5f * (v.x - kPlateLo.x) / (kPlateHi.x - kPlateLo.x),
+                                   0.5f);
+        }
+    }
+    return s;
+}
+
+// The filter follows the per-pixel roughness: with the plate half smooth (G = 0: roughness 0.02
+// after the G-buffer's floor) and half rough (G = 1: 0.3), every smooth-half pixel more than
+// kBleedPx beyond the seam's ramp equals the sharp mirror render (the same plate, filter off) to
+// the digit, and the rough half is blurred exactly as the all-rough plate (G = 1 everywhere,
+// which is also the texture ignored). The must-fail: the texture ignored blurs the smooth half.
+TEST(FuzzyReflection, HalfRoughTextureSmoothHalfStaysSharp) {
+    gl::Context context = gl::Context::headless();
+    const auto envDir = test::outputDir("fuzzy_env_half");
+    const PlateScene s = texturedPlate(envDir, 0, 255);
+    // Footage: the reference's real-only render (16 spp: only its look matters here).
+    const cv::Mat footage = test::roughReference(s, 16).footage;
+    const Frame half = realtime(s, footage);
+    RendererOptions off = singleFrame();
+    off.fuzzyReflections = false;
+    const Frame sharp = realtime(s, footage, off);
+    const Frame rough = realtime(texturedPlate(envDir, 255, 255), footage);  // = texture ignored
+    EXPECT_TRUE(half.report.ran("fuzzy")) << half.report.summary();
+    // The seam's bilinear ramp is x in +-11 mm; kBleedPx more on each side.
+    constexpr int kBleedPx = 1;
+    const cv::Mat horizontal = cv::Mat::ones(1, 2 * kBleedPx + 1, CV_8U);
+    cv::Mat smoothZone, roughZone;
+    cv::erode(topMask(s, kPlateLo.x, -0.011), smoothZone, horizontal);
+    cv::erode(topMask(s, 0.011, kPlateHi.x), roughZone, horizontal);
+    ASSERT_GT(cv::countNonZero(smoothZone), 800);
+    ASSERT_GT(cv::countNonZero(roughZone), 800);
+    const int smoothChanged =
+        cv::countNonZero(test::changedPixels(half.linear, sharp.linear) & smoothZone);
+    const int ignoredChanged =
+        cv::countNonZero(test::changedPixels(rough.linear, sharp.linear) & smoothZone);
+    const int roughBlurred =
+        cv::countNonZero(test::changedPixels(half.linear, sharp.linear) & roughZone);
+    const double roughAsAllRough = test::psnr(half.srgb, rough.srgb, 255.0, roughZone);
+    std::cout << "[ fuzzy ] half-rough plate: " << smoothChanged << " of "
+              << cv::countNonZero(smoothZone) << " smooth-half px differ from the sharp render "
+              << "(texture ignored: " << ignoredChanged << "); rough half: " << roughBlurred
+              << " of " << cv::countNonZero(roughZone) << " px blurred, " << roughAsAllRough
+              << " dB against the all-rough plate\n";
+    save("half_rough", footage, sharp.srgb, half.srgb, rough.srgb);
+    EXPECT_EQ(smoothChanged, 0) << "smooth-half pixels blurred";
+    EXPECT_GT(roughBlurred, cv::countNonZero(roughZone) / 2) << "the rough half is not blurred";
+    EXPECT_GE(roughAsAllRough, 40.0);
+    // The must-fail: the texture ignored (the whole plate at the factor's roughness).
+    EXPECT_GT(ignoredChanged, cv::countNonZero(smoothZone) / 2);
 }
 
 // Hard cases: roughness 1 (beyond the filter's range: the glossy path, no fuzzy pass), a

@@ -8,6 +8,8 @@
 // ran, and hard cases (roughness 1, grazing views, total internal reflection) stay finite.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -131,6 +133,57 @@ TEST(RoughRefraction, RoughnessZeroLimitEqualsSmoothPathAndOnlyTheGlassChanges) 
     EXPECT_EQ(cv::countNonZero(changed & ~slab), 0);    // and only on the slab
 }
 
+// GSR reduces the back faces' 4 x 4 window itself at every pixel whose footprint covers more than
+// a texel: a frosted sphere (curved back, so the window's texels fall into different sectors) at
+// roughness 0.5 rendered with 1 and with 8 hemisphere subdivisions must differ at (nearly) every
+// interior pixel. A pixel where both equal LEAN to the digit took LEAN's lobe because the window
+// held no back face: that happened along a line across the object (an iso-line of the window's
+// mip level, 40 of the sphere's 1276 interior pixels) while the window's level size came from
+// textureSize() with a per-pixel lod, which llvmpipe answers with another fragment's level.
+TEST(RoughRefraction, GsrGathersTheBackFacesEverywhere) {
+    gl::Context context = gl::Context::headless();
+    const auto envDir = test::outputDir("rough_env_gsr");
+    cv::Mat footage(96, 128, CV_8UC3);
+    cv::randu(footage, 0, 255);
+    RoughTestScene s = test::makeRoughSlab(0.5f, envDir);
+    const glm::vec3 centre(0.0f, 0.15f, 0.0f);
+    const float radius = 0.15f;
+    for (Mesh& m : s.scene.meshes) {
+        if (m.name != "slab") continue;
+        Primitive p = test::uvSpherePrimitive(centre, radius, 32, 48);
+        p.material = s.material;
+        m.primitives = {p};
+    }
+    // The sphere's pixels, 2 px in from its outline (the rim refracts at grazing angles).
+    cv::Mat inside(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
+    const glm::dvec3 eye = s.pose * glm::dvec3(0.0);
+    for (int y = 0; y < inside.rows; ++y)
+        for (int x = 0; x < inside.cols; ++x) {
+            const glm::dvec3 d = glm::normalize(
+                s.pose * glm::dvec3((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0) -
+                eye);
+            const glm::dvec3 oc = eye - glm::dvec3(centre);
+            const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - double(radius * radius);
+            if (b * b - c > 0.0) inside.at<uint8_t>(y, x) = 255;
+        }
+    cv::erode(inside, inside, cv::Mat::ones(5, 5, CV_8U));
+    ASSERT_GT(cv::countNonZero(inside), 800);
+    const RoughFrame one = test::renderRough(s, footage, withMethod(RoughRefractionMethod::Gsr, 1));
+    const RoughFrame eight =
+        test::renderRough(s, footage, withMethod(RoughRefractionMethod::Gsr, 8));
+    const RoughFrame lean = test::renderRough(s, footage, withMethod(RoughRefractionMethod::Lean));
+    const cv::Mat subdivisionsMatter = test::changedPixels(one.linear, eight.linear);
+    const cv::Mat asLean = ~test::changedPixels(eight.linear, lean.linear);
+    const int same = cv::countNonZero(~subdivisionsMatter & inside);
+    const int fellBack = cv::countNonZero(~subdivisionsMatter & asLean & inside);
+    std::cout << "[ rough ] GSR on a frosted sphere: " << same << " of " << cv::countNonZero(inside)
+              << " interior px independent of the subdivisions, " << fellBack
+              << " of them LEAN's\n";
+    // Measured: 0 of 1276 px; with the textureSize() query 40, all of them LEAN's.
+    EXPECT_LE(fellBack, 5);
+    EXPECT_LE(same, 12);
+}
+
 // Runs only for rough glass, with LEAN or GSR: smooth glass and rough_method=filter skip it (the
 // fuzzy pass then takes the glass); a rough metal alone runs the fuzzy pass, not this one.
 TEST(RoughRefraction, RunsOnlyForRoughGlassAndSaysWhichMethod) {
@@ -185,17 +238,18 @@ TEST(RoughRefraction, HardCasesStayFinite) {
 // masks keep 4 px away from). Stated: the error over each half; the smooth half stays sharp: away
 // from the seam its pixels equal an all-smooth render to the digit; the must-fail: the texture
 // ignored (the whole slab frosted) falls below the smooth half's floor.
-RoughTestScene texturedSlab(const std::filesystem::path& envDir, bool withTexture) {
-    RoughTestScene s = test::makeRoughSlab(0.4f, envDir);
+// The slab at roughness factor `factor` with a 64x1 linear metallicRoughness texture whose G is
+// green(texel) (u runs 0 .. 1 from x = -0.25 to 0.25), or with the texture left off.
+template <class Green>
+RoughTestScene texturedSlab(const std::filesystem::path& envDir, bool withTexture, float factor,
+                            Green green) {
+    RoughTestScene s = test::makeRoughSlab(factor, envDir);
     Texture t;
-    t.name = "half frosted";
+    t.name = "roughness";
     t.width = 64;
     t.height = 1;
     t.srgb = false;
-    for (int x = 0; x < t.width; ++x) {
-        const unsigned char g = x < t.width / 2 ? 0 : 255;
-        t.pixels.insert(t.pixels.end(), {0, g, 0, 255});
-    }
+    for (int x = 0; x < t.width; ++x) t.pixels.insert(t.pixels.end(), {0, green(x), 0, 255});
     s.scene.textures.push_back(t);
     if (withTexture)
         s.scene.materials[size_t(s.material)].metallicRoughnessTexture.texture =
@@ -208,6 +262,11 @@ RoughTestScene texturedSlab(const std::filesystem::path& envDir, bool withTextur
         }
     }
     return s;
+}
+
+RoughTestScene texturedSlab(const std::filesystem::path& envDir, bool withTexture) {
+    return texturedSlab(envDir, withTexture, 0.4f,
+                        [](int x) { return static_cast<unsigned char>(x < 32 ? 0 : 255); });
 }
 
 TEST(RoughRefraction, HalfFrostedTextureSmoothHalfStaysSharp) {
@@ -259,6 +318,85 @@ TEST(RoughRefraction, HalfFrostedTextureSmoothHalfStaysSharp) {
     const cv::Mat changed = ((ch[0] + ch[1] + ch[2]) > 0.0f) & zone;
     EXPECT_EQ(cv::countNonZero(changed), 0) << "smooth-half pixels blurred";
     EXPECT_GT(cv::countNonZero(zone), 600);
+}
+
+// A roughness gradient: G rises linearly across the slab (factor 0.5: roughness 0 at its left
+// edge to 0.5 at its right). The reference renderer has no roughness textures, so its slab is
+// four strips of constant roughness, the gradient's value at each strip's centre (0.0625, 0.1875,
+// 0.3125, 0.4375; the masks keep 2 cm, about 3 px, from the strips' inner walls and the slab's
+// ends, where the texture's repeat wrap blends both ends). Stated: the error over each half; the
+// roughness follows the gradient (each strip is closest to the slab at its constant roughness);
+// the must-fail: the texture ignored (the whole slab at 0.5) falls below the left half's floor.
+TEST(RoughRefraction, GradientTextureAgainstSteppedReference) {
+    gl::Context context = gl::Context::headless();
+    const auto envDir = test::outputDir("rough_env_gradient");
+    auto ramp = [](int x) {
+        return static_cast<unsigned char>(std::lround(255.0 * (x + 0.5) / 64.0));
+    };
+    const RoughTestScene s = texturedSlab(envDir, true, 0.5f, ramp);
+    RoughTestScene refScene = test::makeRoughSlab(0.0f, envDir);
+    constexpr float kStrip = 0.125f;  // m
+    {
+        Scene& sc = refScene.scene;
+        sc.materials[size_t(refScene.material)].roughness = 0.5f * 0.125f;
+        for (Mesh& m : sc.meshes)
+            if (m.name == "slab")
+                for (Primitive& p : m.primitives)
+                    for (glm::vec3& v : p.positions) v.x = std::min(v.x, -0.25f + kStrip);
+        for (int k = 1; k < 4; ++k) {
+            const int glass = test::addGlass(sc);
+            sc.materials[size_t(glass)].roughness = 0.5f * (float(k) + 0.5f) / 4.0f;
+            test::addBox(sc, "strip " + std::to_string(k),
+                         {-0.25f + kStrip * float(k), 0.0f, -0.03f},
+                         {-0.25f + kStrip * float(k + 1), 0.3f, 0.03f}, glass, Origin::Virtual);
+        }
+    }
+    const test::RoughReference ref = test::roughReference(refScene);
+    cv::Mat strips[4];
+    for (int k = 0; k < 4; ++k)
+        strips[k] =
+            test::slabFrontMask(s, -0.25 + kStrip * k + 0.02, -0.25 + kStrip * (k + 1) - 0.02);
+    const cv::Mat left = strips[0] | strips[1], right = strips[2] | strips[3];
+    ASSERT_GT(cv::countNonZero(left), 500);
+    ASSERT_GT(cv::countNonZero(right), 500);
+    const RoughFrame textured = test::renderRough(s, ref.footage);
+    const RoughFrame ignored =
+        test::renderRough(texturedSlab(envDir, false, 0.5f, ramp), ref.footage);
+    EXPECT_TRUE(textured.report.ran("roughrefr")) << textured.report.summary();
+    const double pl = test::psnr(textured.srgb, ref.refSrgb, 255.0, left);
+    const double pr = test::psnr(textured.srgb, ref.refSrgb, 255.0, right);
+    const double il = test::psnr(ignored.srgb, ref.refSrgb, 255.0, left);
+    const double ir = test::psnr(ignored.srgb, ref.refSrgb, 255.0, right);
+    // Each strip is closest to the slab at the constant roughness of its centre (mean absolute
+    // difference over the strip, linear RGB): the roughness follows the texture across the slab.
+    cv::Mat uniform[4];
+    for (int j = 0; j < 4; ++j)
+        uniform[j] = test::renderRough(test::makeRoughSlab(0.5f * (float(j) + 0.5f) / 4.0f, envDir),
+                                       ref.footage)
+                         .linear;
+    int closest[4];
+    for (int k = 0; k < 4; ++k) {
+        double best = 1e30;
+        for (int j = 0; j < 4; ++j) {
+            cv::Mat diff;
+            cv::absdiff(textured.linear, uniform[j], diff);
+            const cv::Scalar m = cv::mean(diff, strips[k]);
+            if (m[0] + m[1] + m[2] < best) {
+                best = m[0] + m[1] + m[2];
+                closest[k] = j;
+            }
+        }
+    }
+    std::cout << "[ rough ] gradient: left half " << pl << " dB, right half " << pr
+              << " dB; texture ignored (all 0.5): " << il << " / " << ir
+              << " dB; strips closest to the constant roughness of strip " << closest[0] << ", "
+              << closest[1] << ", " << closest[2] << ", " << closest[3] << "\n";
+    save("gradient", {ref.footage, ignored.srgb, textured.srgb, ref.refSrgb});
+    // Measured: 24.17 / 25.96 dB; the texture ignored 22.31 / 24.72 dB.
+    EXPECT_GE(pl, 23.7);
+    EXPECT_GE(pr, 25.5);
+    EXPECT_LT(il, 23.7);  // the must-fail: the texture ignored blurs the near-smooth half
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(closest[k], k) << "strip " << k;
 }
 
 }  // namespace

@@ -7,7 +7,8 @@
 // distance r:
 //   L(x) = sum_x' f(x, x') L0(x') / sum_x' f(x, x'),  f = cos^p J            (Eqs. 1, 3)
 //   J = angle between (b - a) and (b' - a), b' the neighbour's hit (a direction on a miss)
-//   p = phongExponent(roughness)   (fuzzy.glsl: the stated GGX -> Phong mapping)
+//   p = phongExponent(roughness)   (fuzzy.glsl: the stated GGX -> Phong mapping; roughness per
+//       pixel from the G-buffer: factor x metallicRoughness texture)
 //   kernel: neighbours whose camera ray is within alpha = Theta' / (1 + s / r) of x's   (Eq. 4),
 //   radius alpha x focal length in pixels (Eq. 5), Theta' = min(Theta, 2.5 / sqrt(p)): the
 //   cone bound Theta (RendererOptions::fuzzyConeDeg), or the lobe's 2.5 sigma when narrower.
@@ -28,7 +29,7 @@ layout(binding = kUnitFuzzyEmissive) uniform sampler2D gEmissive;  // a = specul
 layout(binding = kUnitFuzzyReflHit) uniform sampler2D reflHit;     // xyz hit, w = origin
 layout(binding = kUnitFuzzyRefrHit) uniform sampler2D refrHit;     // GBuf_refr: xyz, w = origin
 layout(binding = kUnitFuzzyRefrWeight) uniform sampler2D refrWeight;  // rgb eta2 T, a = d_in (m)
-layout(binding = kUnitFuzzyNormal) uniform sampler2D gNormal;      // xyz unit normal (to the camera)
+layout(binding = kUnitFuzzyNormal) uniform sampler2D gNormal;      // xyz unit normal, w = roughness
 layout(binding = kUnitFuzzyInputFirst + 0) uniform sampler2D in0;  // L'_rv
 layout(binding = kUnitFuzzyInputFirst + 1) uniform sampler2D in1;  // L'_r
 layout(binding = kUnitFuzzyInputFirst + 2) uniform sampler2D in2;  // reflection share of L'_r
@@ -52,7 +53,11 @@ void main() {
     vec3 a = texelFetch(gPosition, px, 0).xyz;
     float s = length(a - cameraPos.xyz), sa = s;
     GpuMaterial m = materials[specularDraws[slot].material];
-    float roughness = clamp(m.roughness, 0.0, 1.0);
+    // Per pixel, as the G-buffer wrote it: the factor x the metallicRoughness texture's G, so one
+    // object can be smooth in parts (a kernel of one pixel: exactly the mirror value) and rough
+    // in others. Which objects are filtered is decided by the factor (Material::isRoughReflector).
+    vec4 nr = texelFetch(gNormal, px, 0);
+    float roughness = clamp(nr.w, 0.0, 1.0);
     // Which rays the kernel compares (see above): the refracted ones through rough glass, else
     // the reflected ones; o is where they leave the object.
     vec3 o = a;
@@ -60,7 +65,7 @@ void main() {
     float p = phongExponent(roughness);
     if (specularDraws[slot].rough == kRoughGlass) {
         vec4 W = texelFetch(refrWeight, px, 0);
-        vec3 T1 = refract((a - cameraPos.xyz) / max(s, 1e-9), texelFetch(gNormal, px, 0).xyz,
+        vec3 T1 = refract((a - cameraPos.xyz) / max(s, 1e-9), nr.xyz,
                           1.0 / max(m.ior, 1e-3));
         if (any(greaterThan(W.rgb, vec3(0.0))) && dot(T1, T1) > 0.5) {
             refracted = true;

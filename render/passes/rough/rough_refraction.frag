@@ -224,8 +224,15 @@ void main() {
     if (method == 1 && footPx >= 0.5) {
         int lg = max(int(floor(levelB)) - 2, 0);
         float scale = exp2(float(lg));
-        ivec2 sizeG = textureSize(leanMean, lg);
-        ivec2 base = ivec2(floor(cp2 / scale - 1.5));
+        // Level lg's size from the canvas (GL: floor(size / 2^lg), at least 1), not
+        // textureSize(leanMean, lg): llvmpipe answers that query for a group of fragments with
+        // one fragment's lod, so where neighbouring pixels differ in lg (an iso-line of the
+        // footprint across the slab) it returned another level's size and the clamp below
+        // pulled the window off the back face.
+        ivec2 sizeG = max(ivec2(canvas.xy) >> lg, ivec2(1));
+        // cp2 in level-lg texel units (texel q's centre at q): the 4 x 4 texels whose centres
+        // are nearest, two on each side.
+        ivec2 base = ivec2(floor((cp2 + 0.5) / scale - 1.5));
         for (int j = 0; j < 4; ++j)
             for (int i = 0; i < 4; ++i) {
                 ivec2 q = clamp(base + ivec2(i, j), ivec2(0), sizeG - 1);
