@@ -217,6 +217,47 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     EXPECT_EQ(cv::countNonZero(changed & ~plate), 0);   // and only on the plate
 }
 
+// A rough REAL plate: the video already shows its real, blurred reflection, so the filter may only
+// blur what the virtual objects change in it (Delta L' = L'_rv - L'_r, Eqs. 6-11). A virtual box
+// beside the real red box is reflected in the plate's right half: with the filter on, its
+// reflection spreads over more plate pixels than the sharp one, and the plate's left half, which
+// reflects only real things, is the footage exactly (no VPLs, whose bounce off the virtual box
+// would change every real pixel a little).
+TEST(FuzzyReflection, RoughRealPlateBlursOnlyTheVirtualReflection) {
+    gl::Context context = gl::Context::headless();
+    const auto envDir = test::outputDir("fuzzy_env_real");
+    cv::Mat footage(96, 128, CV_8UC3);
+    cv::randu(footage, 0, 255);
+    PlateScene s = makePlate(0.3f, envDir, Origin::Real);
+    const int green = test::addMaterial(s.scene, glm::vec3(0.15f, 0.7f, 0.2f));
+    test::addBox(s.scene, "virtual box", {0.16f, 0.0f, -0.55f}, {0.3f, 0.25f, -0.4f}, green,
+                 Origin::Virtual);
+    RendererOptions on = singleFrame();
+    on.vplCount = 0;
+    RendererOptions off = on;
+    off.fuzzyReflections = false;
+    const Frame blurred = realtime(s, footage, on), sharp = realtime(s, footage, off);
+    EXPECT_TRUE(blurred.report.ran("fuzzy")) << blurred.report.summary();
+    const cv::Mat plate = topMask(s), leftHalf = topMask(s, kPlateLo.x, -0.05);
+    // Plate pixels whose 8-bit composite differs from the footage by more than one level.
+    auto changed = [&](const cv::Mat& srgb) {
+        cv::Mat d;
+        cv::absdiff(srgb, footage, d);
+        cv::Mat m;
+        cv::transform(d, m, cv::Matx13f(1, 1, 1));
+        return cv::countNonZero((m > 1.5) & plate);
+    };
+    const int changedOn = changed(blurred.srgb), changedOff = changed(sharp.srgb);
+    const double leftError = cv::norm(blurred.srgb, footage, cv::NORM_INF, leftHalf);
+    std::cout << "[ fuzzy ] real plate: " << changedOff << " plate px show the virtual box sharp, "
+              << changedOn << " blurred; left half max |composite - footage| " << leftError
+              << " (8-bit)\n";
+    save("real_plate", footage, sharp.srgb, blurred.srgb, footage);
+    EXPECT_GT(changedOff, 20);
+    EXPECT_GT(changedOn, changedOff + 20);
+    EXPECT_EQ(leftError, 0.0);
+}
+
 // Roughness varying across a rough metal: the plate's metallicRoughness texture (64x1, linear)
 // has G = `left` on its left half and `right` on its right (factor 0.3), read per pixel by the
 // G-buffer and by the filter. The texture spans u = 0.25 .. 0.75 over the plate (clear of the
