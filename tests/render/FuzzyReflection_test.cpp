@@ -2,10 +2,10 @@
 // reference renderer (GGX conductors): a virtual brushed-metal plate on a real table reflects a
 // red box standing behind it and the sky. Over the plate's top face the real-time composite is
 // compared with the reference differential composite (footage = the reference's real-only
-// render as 8-bit sRGB) at two roughness values; the same render with the filter off (the
-// roughness ignored: a sharp mirror image) must fall below the floor. Also: the filter in its
-// roughness -> 0 limit equals the mirror path to the digit, it never changes a pixel outside the
-// rough object, it runs only when the scene has a rough metal, and hard cases stay finite.
+// render as 8-bit sRGB) at three roughness values (0.15, 0.3, 0.5); the same render with the filter
+// off (the roughness ignored: a sharp mirror image) must fall below the floor. Also: the filter in
+// its roughness -> 0 limit equals the mirror path to the digit, it never changes a pixel outside
+// the rough object, it runs only when the scene has a rough metal, and hard cases stay finite.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -105,8 +105,10 @@ TEST(FuzzyReflection, RoughMetalMatchesReferenceAndIgnoringRoughnessFails) {
     gl::Context context = gl::Context::headless();
     const auto envDir = test::outputDir("fuzzy_env");
     // Measured (llvmpipe; reference 64 spp, seed 5): 0.15: 35.8 dB / 0.954 with the filter, 33.2
-    // dB ignored; 0.3: 33.8 dB / 0.881, 26.8 dB ignored. Floors ~1.3-1.8 dB / 0.025 below.
-    for (const Floor& fl : {Floor{0.15f, 34.5, 0.93}, Floor{0.3f, 32.0, 0.855}}) {
+    // dB ignored; 0.3: 33.8 dB / 0.881, 26.8 dB ignored; 0.5 (the filter's upper end): 28.4 dB /
+    // 0.778, 22.5 dB ignored. Floors ~1.3-1.8 dB / 0.025 below.
+    for (const Floor& fl :
+         {Floor{0.15f, 34.5, 0.93}, Floor{0.3f, 32.0, 0.855}, Floor{0.5f, 27.0, 0.75}}) {
         const PlateScene s = makePlate(fl.roughness, envDir);
         const cv::Mat mask = topMask(s);
         ASSERT_GT(cv::countNonZero(mask), 1500);
@@ -213,6 +215,47 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     const cv::Mat plate = test::boxSilhouette(rough.cam, rough.pose, kPlateLo, kPlateHi);
     EXPECT_GT(cv::countNonZero(changed & plate), 200);  // the filter does something
     EXPECT_EQ(cv::countNonZero(changed & ~plate), 0);   // and only on the plate
+}
+
+// A rough REAL plate: the video already shows its real, blurred reflection, so the filter may only
+// blur what the virtual objects change in it (Delta L' = L'_rv - L'_r, Eqs. 6-11). A virtual box
+// beside the real red box is reflected in the plate's right half: with the filter on, its
+// reflection spreads over more plate pixels than the sharp one, and the plate's left half, which
+// reflects only real things, is the footage exactly (no VPLs, whose bounce off the virtual box
+// would change every real pixel a little).
+TEST(FuzzyReflection, RoughRealPlateBlursOnlyTheVirtualReflection) {
+    gl::Context context = gl::Context::headless();
+    const auto envDir = test::outputDir("fuzzy_env_real");
+    cv::Mat footage(96, 128, CV_8UC3);
+    cv::randu(footage, 0, 255);
+    PlateScene s = makePlate(0.3f, envDir, Origin::Real);
+    const int green = test::addMaterial(s.scene, glm::vec3(0.15f, 0.7f, 0.2f));
+    test::addBox(s.scene, "virtual box", {0.16f, 0.0f, -0.55f}, {0.3f, 0.25f, -0.4f}, green,
+                 Origin::Virtual);
+    RendererOptions on = singleFrame();
+    on.vplCount = 0;
+    RendererOptions off = on;
+    off.fuzzyReflections = false;
+    const Frame blurred = realtime(s, footage, on), sharp = realtime(s, footage, off);
+    EXPECT_TRUE(blurred.report.ran("fuzzy")) << blurred.report.summary();
+    const cv::Mat plate = topMask(s), leftHalf = topMask(s, kPlateLo.x, -0.05);
+    // Plate pixels whose 8-bit composite differs from the footage by more than one level.
+    auto changed = [&](const cv::Mat& srgb) {
+        cv::Mat d;
+        cv::absdiff(srgb, footage, d);
+        cv::Mat m;
+        cv::transform(d, m, cv::Matx13f(1, 1, 1));
+        return cv::countNonZero((m > 1.5) & plate);
+    };
+    const int changedOn = changed(blurred.srgb), changedOff = changed(sharp.srgb);
+    const double leftError = cv::norm(blurred.srgb, footage, cv::NORM_INF, leftHalf);
+    std::cout << "[ fuzzy ] real plate: " << changedOff << " plate px show the virtual box sharp, "
+              << changedOn << " blurred; left half max |composite - footage| " << leftError
+              << " (8-bit)\n";
+    save("real_plate", footage, sharp.srgb, blurred.srgb, footage);
+    EXPECT_GT(changedOff, 20);
+    EXPECT_GT(changedOn, changedOff + 20);
+    EXPECT_EQ(leftError, 0.0);
 }
 
 // Roughness varying across a rough metal: the plate's metallicRoughness texture (64x1, linear)
