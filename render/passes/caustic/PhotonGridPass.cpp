@@ -26,8 +26,8 @@ PassDecision PhotonGridPass::gatherDecision(const FrameContext& ctx) {
     if (!ctx.options.causticGather) return {false, "caustic gather off"};
     if (ctx.specularScissor.z <= 0 || ctx.specularScissor.w <= 0)
         return {false, "no mirror or glass object in view: no reflected or refracted hit"};
-    return {true, "photons of " + std::to_string(ctx.plan.causticLayers) +
-                      " light(s) for the hits of the mirror / glass in view"};
+    return {true, "the photons of " + std::to_string(ctx.plan.causticLayers) +
+                      " light(s), for the reflected / refracted hits in view"};
 }
 
 bool PhotonGridPass::sceneCanGather(const GpuScene& scene, const RendererOptions& options) {
@@ -40,7 +40,7 @@ bool PhotonGridPass::sceneCanGather(const GpuScene& scene, const RendererOptions
 PassDecision PhotonGridPass::decide(const FrameContext& ctx) const {
     PassDecision d = gatherDecision(ctx);
     if (d.run)
-        d.reason = fmt::format("{} in a hashed grid of {} cells, {:.3g} cm", d.reason,
+        d.reason = fmt::format("{}: hashed grid of {} buckets, {:.3g} cm cells", d.reason,
                                kPhotonGridCells, 100.0 * cellSize(ctx.options));
     return d;
 }

@@ -117,7 +117,11 @@ void gatherCaustic(vec3 x, vec3 n, float footprint, out vec3 eRv, out vec3 eR) {
     int visited[8];
     int nVisited = 0;
     for (int k = 0; k < 8; ++k) {
-        int b = photonBucket(base + ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+        ivec3 cell = base + ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+        // A cell farther than h / 2 (the largest kernel) from x holds no photon that reaches it.
+        vec3 lo = vec3(cell) * h, nearest = clamp(x, lo, lo + h);
+        if (dot(x - nearest, x - nearest) > 0.25 * h * h) continue;
+        int b = photonBucket(cell);
         bool seen = false;  // two cells hashed to one bucket: its list once
         for (int j = 0; j < nVisited; ++j) seen = seen || visited[j] == b;
         if (seen) continue;
