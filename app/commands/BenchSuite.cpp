@@ -438,7 +438,7 @@ SuiteSpec defaultSuite() {
           {"glass_shadows", {"on", "off"}},
           {"refl_refr_vpls", {"on", "off"}},
           {"caustic_gather", {"on", "off"}},
-          {"caustic_radius", {"1", "2", "4"}}},
+          {"caustic_radius", {"0.5", "1", "2", "4"}}},
          {}},
     };
     const fs::path dir = s.scene.parent_path();

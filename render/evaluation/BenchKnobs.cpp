@@ -205,9 +205,9 @@ const std::vector<BenchKnob>& benchKnobs() {
          },
          [](const BenchConfig& c) { return onOff(c.options.causticGather); }},
         {"caustic_radius",
-         "largest photon kernel radius of the caustic gather, in cm (0.1..50; grid cells are "
-         "twice that)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"2"}; },
+         "photon kernel radius cap of the caustic gather, in cm (0.1..50; grid cells are twice "
+         "that)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1"}; },
          [](BenchConfig& c, const std::string& v) {
              char* end = nullptr;
              const float q = std::strtof(v.c_str(), &end);

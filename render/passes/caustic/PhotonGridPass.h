@@ -25,7 +25,7 @@ public:
     // Whether the scene can ever gather (a spot light and a mirror or glass object, caustics and
     // the gather on): the specular light pass compiles its gather variant only then.
     static bool sceneCanGather(const GpuScene& scene, const RendererOptions& options);
-    // Grid cell edge (m): twice the largest kernel radius RendererOptions::causticGatherRadius.
+    // Grid cell edge (m): twice RendererOptions::causticGatherRadius.
     static float cellSize(const RendererOptions& options) {
         return 2.0f * options.causticGatherRadius;
     }

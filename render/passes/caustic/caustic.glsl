@@ -83,7 +83,7 @@ vec3 unpackNormalOct(int bits) {
 // hold (the camera does not see that point).
 layout(std430, binding = kBindingPhotonGrid) readonly buffer PhotonGridCells { uint photonGrid[]; };
 layout(std430, binding = kBindingPhotons) readonly buffer PhotonRecords { GpuPhoton photons[]; };
-uniform float photonCellSize;  // m: 2 x the largest kernel radius
+uniform float photonCellSize;  // m: 2 x RendererOptions::causticGatherRadius
 
 // A gather point's footprint (m): the spacing of the neighbouring pixels' hits on its surface,
 // from the screen-space derivatives dx, dy of the hit position. Across a silhouette (another
@@ -101,44 +101,48 @@ float gatherFootprint(vec3 dx, vec3 dy, float pathLength, float cosHit) {
 
 // Kernel density estimate of the caustic irradiance (W/m^2) at receiver point x with unit
 // normal n (facing the ray that found x), for L_rv and for L_r: the sum over photons i of
-// power_i K(|x - x_i|), K the 2D Epanechnikov kernel of radius r = max(r_i, footprint),
-// K(d) = 2 / (pi r^2) (1 - d^2 / r^2) (integrates to 1 over the receiver's plane: each photon
-// deposits its power, as in the splat), r = clamp(max(r_i, 1.5 footprint), .., h / 2): sampled at
-// the pixels' hits, a kernel narrower than 1.5 pixel spacings would alias (a focused caustic
-// landing on one pixel centre would be counted up to 2x, or missed). Only photons on x's surface count: the photon's
-// receiver normal within 60 degrees of n, and x within r / 2 of the photon's tangent plane.
-// No photon in range: 0.
+// power_i K(|x - x_i|), K the 2D Epanechnikov kernel K(d) = 2 / (pi r^2) (1 - d^2 / r^2) (it
+// integrates to 1 over the receiver's plane: each photon deposits its power, as in the splat) of
+// radius r = min(max(r_i, 1.5 footprint), R), R = max(h / 2, min(1.5 footprint, h)): sampled at
+// the pixels' hits, a kernel narrower than 1.5 pixel spacings would alias (a caustic focused onto
+// one pixel centre would count up to 2x, or be missed), so where the pixels are coarser than the
+// grid the gather reaches up to a whole cell (3x3x3 cells) instead of half a cell (2x2x2). Only
+// photons on x's surface count: the photon's receiver normal within 60 degrees of n, and x
+// within r / 2 of the photon's tangent plane. No photon in range: 0.
 void gatherCaustic(vec3 x, vec3 n, float footprint, out vec3 eRv, out vec3 eR) {
     eRv = vec3(0.0);
     eR = vec3(0.0);
     float h = photonCellSize;
-    // The 2x2x2 cells around the cell corner nearest x: every point within h / 2 of x.
-    ivec3 base = ivec3(floor(x / h - 0.5));
-    int visited[8];
+    float reach = max(0.5 * h, min(1.5 * footprint, h));
+    ivec3 lo = ivec3(floor((x - reach) / h)), hi = ivec3(floor((x + reach) / h));
+    int visited[27];
     int nVisited = 0;
-    for (int k = 0; k < 8; ++k) {
-        ivec3 cell = base + ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-        // A cell farther than h / 2 (the largest kernel) from x holds no photon that reaches it.
-        vec3 lo = vec3(cell) * h, nearest = clamp(x, lo, lo + h);
-        if (dot(x - nearest, x - nearest) > 0.25 * h * h) continue;
-        int b = photonBucket(cell);
-        bool seen = false;  // two cells hashed to one bucket: its list once
-        for (int j = 0; j < nVisited; ++j) seen = seen || visited[j] == b;
-        if (seen) continue;
-        visited[nVisited++] = b;
-        uint first = photonGrid[kPhotonGridCells + b], last = photonGrid[kPhotonGridCells + b + 1];
-        for (uint i = first; i < last; ++i) {
-            vec3 d = x - photons[i].position;
-            float r = min(max(photons[i].radius, 1.5 * footprint), 0.5 * h);
-            float d2 = dot(d, d), r2 = r * r;
-            if (d2 >= r2) continue;
-            vec3 np = unpackNormalOct(photons[i].normal);
-            if (dot(np, n) < 0.5 || abs(dot(d, np)) > 0.5 * r) continue;
-            float w = 2.0 / (PI * r2) * (1.0 - d2 / r2);
-            eRv += photons[i].powerRv * w;
-            eR += photons[i].powerR * w;
-        }
-    }
+    for (int cz = lo.z; cz <= hi.z; ++cz)
+        for (int cy = lo.y; cy <= hi.y; ++cy)
+            for (int cx = lo.x; cx <= hi.x; ++cx) {
+                ivec3 cell = ivec3(cx, cy, cz);
+                // A cell farther than the reach from x holds no photon whose kernel reaches x.
+                vec3 c0 = vec3(cell) * h, nearest = clamp(x, c0, c0 + h);
+                if (dot(x - nearest, x - nearest) > reach * reach) continue;
+                int b = photonBucket(cell);
+                bool seen = false;  // two cells hashed to one bucket: its list once
+                for (int j = 0; j < nVisited; ++j) seen = seen || visited[j] == b;
+                if (seen || nVisited >= 27) continue;
+                visited[nVisited++] = b;
+                uint first = photonGrid[kPhotonGridCells + b];
+                uint last = photonGrid[kPhotonGridCells + b + 1];
+                for (uint i = first; i < last; ++i) {
+                    vec3 d = x - photons[i].position;
+                    float r = min(max(photons[i].radius, 1.5 * footprint), reach);
+                    float d2 = dot(d, d), r2 = r * r;
+                    if (d2 >= r2) continue;
+                    vec3 np = unpackNormalOct(photons[i].normal);
+                    if (dot(np, n) < 0.5 || abs(dot(d, np)) > 0.5 * r) continue;
+                    float w = 2.0 / (PI * r2) * (1.0 - d2 / r2);
+                    eRv += photons[i].powerRv * w;
+                    eR += photons[i].powerR * w;
+                }
+            }
 }
 #endif
 
