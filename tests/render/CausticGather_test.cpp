@@ -40,7 +40,8 @@ cv::Mat mirrorMask(const test::CausticScene& s) {
                 s.pose.rotation * glm::normalize(glm::dvec3((x - s.cam.cx) / s.cam.fx,
                                                             (y - s.cam.cy) / s.cam.fy, 1.0));
             const glm::dvec3 far = eye + 10.0 * d;
-            if (!test::segmentHitsBox(eye, far, {-0.55, 0.005, -0.31}, {0.2, 0.4, -0.3})) continue;
+            if (!test::segmentHitsBox(eye, far, glm::dvec3(s.mirrorLo), glm::dvec3(s.mirrorHi)))
+                continue;
             if (test::segmentNearPoint(eye, far, glm::dvec3(s.sphereCentre), s.sphereRadius + 0.01))
                 continue;
             m.at<uint8_t>(y, x) = 255;
@@ -49,7 +50,7 @@ cv::Mat mirrorMask(const test::CausticScene& s) {
     return m;
 }
 
-// Does pixel (x, y)'s ray, reflected by the mirror's front (z = -0.3, facing +Z), leave the
+// Does pixel (x, y)'s ray, reflected by the mirror's front (z = mirrorHi.z, facing +Z), leave the
 // modelled scene (miss the 3 m table and the sphere)?
 bool reflectionLeaves(const test::CausticScene& s, int x, int y) {
     const glm::dvec3 eye = s.pose.translation;
@@ -57,7 +58,7 @@ bool reflectionLeaves(const test::CausticScene& s, int x, int y) {
         s.pose.rotation *
         glm::normalize(glm::dvec3((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0));
     if (d.z >= 0) return false;
-    const glm::dvec3 m = eye + d * ((-0.3 - eye.z) / d.z);
+    const glm::dvec3 m = eye + d * ((double(s.mirrorHi.z) - eye.z) / d.z);
     const glm::dvec3 r(d.x, d.y, -d.z);
     if (test::segmentNearPoint(m, m + 10.0 * r, glm::dvec3(s.sphereCentre), s.sphereRadius + 0.02))
         return false;

@@ -28,6 +28,8 @@ struct CausticScene {
     glm::vec3 sphereCentre{0.0f, 0.175f, 0.0f};
     float sphereRadius = 0.1f;
     glm::vec3 lightPos{0.5f, 1.041f, 0.0f};
+    // The mirror of CausticSceneOptions::mirror (world box, m): its front face is z = mirrorHi.z.
+    glm::vec3 mirrorLo{-0.55f, 0.005f, -0.31f}, mirrorHi{0.2f, 0.4f, -0.3f};
 };
 
 struct CausticSceneOptions {
@@ -73,8 +75,7 @@ inline CausticScene makeCausticScene(const CausticSceneOptions& o) {
         s.sphereRadius = 0.5f * glm::length(s.boxHi - s.boxLo);
     }
     if (o.mirror)
-        addBox(s.scene, "mirror", {-0.55f, 0.005f, -0.31f}, {0.2f, 0.4f, -0.3f}, addMirror(s.scene),
-               Origin::Virtual);
+        addBox(s.scene, "mirror", s.mirrorLo, s.mirrorHi, addMirror(s.scene), Origin::Virtual);
     addLight(s.scene, o.lightType, s.lightPos, glm::normalize(s.sphereCentre - s.lightPos),
              o.intensity, o.lightReal ? Origin::Real : Origin::Virtual, o.mirror ? 0.15f : 0.5f,
              o.mirror ? 0.12f : 0.4f);
