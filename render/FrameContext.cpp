@@ -39,6 +39,9 @@ void RendererOptions::validate() const {
     if (!(causticQuadScale >= 0.25f && causticQuadScale <= 8.0f))
         fail("causticQuadScale must be in [0.25, 8] (photon spacings), got " +
              std::to_string(causticQuadScale));
+    if (!(causticGatherRadius >= 0.001f && causticGatherRadius <= 0.5f))
+        fail("causticGatherRadius must be in [0.001, 0.5] (metres), got " +
+             std::to_string(causticGatherRadius));
     if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
         fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
     if (!(fuzzyConeDeg > 0.0f && fuzzyConeDeg <= 60.0f))

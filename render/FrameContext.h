@@ -61,6 +61,14 @@ struct RendererOptions {
     bool caustics = true;
     int causticMapSize = 256;
     float causticQuadScale = 1.5f;
+    // Caustics seen in reflections and refractions (docs/caustics.md): the photons sorted into a
+    // world-space hashed grid (render/passes/caustic PhotonGridPass) and gathered at every
+    // reflected / refracted hit by the specular light pass, with each photon's kernel radius
+    // (causticQuadScale photon spacings, widened to 1.5 of the hit's pixel footprints) at most
+    // causticGatherRadius metres, or up to twice that where the pixels are coarser (the grid's
+    // cells are twice it: the gather's cost grows with it). false: those hits get no caustic.
+    bool causticGather = true;
+    float causticGatherRadius = 0.01f;
     // Fuzzy reflections of rough metals (render/passes/fuzzy, docs/specular.md): the image-space
     // filter (Kulikova and Dmitriev, Eqs. 1-5) over the mirror-ray buffers. fuzzyConeDeg is the
     // cone bound Theta (degrees) that limits each pixel's kernel (Eq. 4); fuzzyTaps the taps per

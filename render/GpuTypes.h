@@ -41,6 +41,7 @@ static_assert(offsetof(GpuMaterial, thickness) == 64 && offsetof(GpuMaterial, sp
 static_assert(offsetof(GpuMaterial, translucent) == 72);
 static_assert(sizeof(GpuSpecularDraw) == 32);
 static_assert(offsetof(GpuSpecularDraw, radius) == 12 && offsetof(GpuSpecularDraw, material) == 16);
+static_assert(sizeof(GpuPhoton) == 48 && offsetof(GpuPhoton, normal) == 28);
 static_assert(sizeof(GpuSurfacePoint) == 16 && offsetof(GpuSurfacePoint, isReal) == 12);
 
 }  // namespace mirage::render

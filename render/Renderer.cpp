@@ -12,6 +12,7 @@
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
+#include "render/passes/caustic/PhotonGridPass.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/environment/EnvironmentPass.h"
@@ -150,7 +151,8 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<CausticPass>());
     g.addPass(std::make_unique<BackFacePass>());
     g.addPass(std::make_unique<SpecularGBufferPass>());
-    g.addPass(std::make_unique<SpecularLightPass>(*scene_));
+    g.addPass(std::make_unique<PhotonGridPass>());  // caustics at the reflected/refracted hits
+    g.addPass(std::make_unique<SpecularLightPass>(*scene_, options_));
     g.addPass(std::make_unique<FuzzyReflectionPass>());
     g.addPass(std::make_unique<RoughRefractionPass>());
     g.addPass(std::make_unique<CompositePass>());

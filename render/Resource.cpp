@@ -76,6 +76,8 @@ const char* resourceName(Resource r) {
         "PhotonPowerRefr",
         "PhotonSurfaceRefl",
         "PhotonSurfaceRefr",
+        "PhotonGrid",
+        "PhotonRecords",
         "CausticRv",
         "CausticR",
         "Composite",

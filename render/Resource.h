@@ -110,6 +110,12 @@ enum class Resource {
     // (normal.z, diffuse albedo r), (albedo g, b); the normal faces the arriving photon.
     PhotonSurfaceRefl,
     PhotonSurfaceRefr,
+    // The world-space photon grid (render/passes/caustic PhotonGridPass): a hashed uniform grid
+    // of the photons' receiver hits, for the caustics seen in reflections and refractions.
+    // PhotonGrid: uint per hash cell (kPhotonGridCells counts, then kPhotonGridCells + 1 first
+    // indices); PhotonRecords: GpuPhoton per photon, sorted by cell.
+    PhotonGrid,
+    PhotonRecords,
     CausticRv,      // caustic radiance reflected by the receiver towards the camera (Eq. 12)
     CausticR,       // the same for L_r: light, specular object and receiver real (Eqs. 13-14)
     Composite,      // the output (camera image size): linear RGBA32F, a = coverage

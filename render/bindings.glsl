@@ -22,6 +22,9 @@ const int kBindingTranslucentLut = 10;         // tau LUT, S x S half floats, 2 
 const int kBindingTranslucentIrradiance = 11;  // E per surface voxel: S vec4 (L_rv), S vec4 (L_r)
 const int kBindingTranslucentRadiance = 12;    // same layout: radiance leaving each voxel
 const int kBindingTranslucentGrid = 13;        // header + voxel number per grid cell
+// The world-space photon grid (passes/caustic photon_grid.comp; specular_light.frag), std430.
+const int kBindingPhotonGrid = 14;  // uint per hash cell: count (scratch), then the first photon
+const int kBindingPhotons = 15;     // GpuPhoton[], sorted by cell
 const int kBindingQueryRays = 4;        // query.comp (offline impostor queries, outside frames)
 const int kBindingQueryHits = 5;
 
@@ -127,6 +130,13 @@ const int kUnitSplatPosition = 4;
 const int kUnitSplatNormal = 5;
 const int kUnitSplatEmissive = 6;
 const int kImageCausticAccum = 0;
+// photon_grid.comp: the photon G-buffers (receiver hits, powers, receiver normals)
+const int kUnitGridReflHit = 0;
+const int kUnitGridReflPower = 1;
+const int kUnitGridReflSurface = 2;
+const int kUnitGridRefrHit = 3;
+const int kUnitGridRefrPower = 4;
+const int kUnitGridRefrSurface = 5;
 // caustic_resolve.frag
 const int kUnitResolveAccum = 0;
 const int kUnitResolvePosition = 1;

@@ -18,6 +18,8 @@
 #endif
 
 const int kMaxLights = 8;
+// Hash cells of the world-space photon grid (a power of two; PhotonGridPass).
+const int kPhotonGridCells = 65536;
 const int kLightPoint = 0;
 const int kLightSpot = 1;
 const int kLightDirectional = 2;
@@ -134,6 +136,18 @@ struct GpuSpecularDraw {
     int origin;     // kOriginReal / kOriginVirtual
     int drawIndex;       // index into GpuScene::draws()
     int rough;           // kRoughNone, kRoughMetal or kRoughGlass (the fuzzy filter's input)
+};
+
+// One photon of the world-space photon grid (std430, kBindingPhotons; render/passes/caustic
+// photon_grid.comp builds it, the specular light pass gathers it): the photon's receiver hit and
+// its disc kernel's radius, its power for L_rv and for L_r (Eqs. 12-14, as the caustic splat).
+struct GpuPhoton {
+    vec3 position;  // world receiver hit (metres)
+    float radius;   // kernel radius (metres): causticQuadScale x the photon spacing, capped
+    vec3 powerRv;   // W: power x visibility through all occluders
+    int normal;     // the receiver's unit normal facing the photon: packSnorm2x16 (octahedral)
+    vec3 powerR;    // W: power x real-path visibility (0 unless light and object are real)
+    float pad0;
 };
 
 // A surface sample for imperfect shadow maps (std430, kBindingIsmPoints).

@@ -436,7 +436,9 @@ SuiteSpec defaultSuite() {
          {{"caustics", {"on", "off"}},
           {"caustic_map", {"128", "256", "512"}},
           {"glass_shadows", {"on", "off"}},
-          {"refl_refr_vpls", {"on", "off"}}},
+          {"refl_refr_vpls", {"on", "off"}},
+          {"caustic_gather", {"on", "off"}},
+          {"caustic_radius", {"0.5", "1", "2", "4"}}},
          {}},
     };
     const fs::path dir = s.scene.parent_path();

@@ -196,6 +196,29 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.causticQuadScale = q;
          },
          [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
+        {"caustic_gather",
+         "on: the photons in a world-space grid, gathered at the reflected / refracted hits "
+         "(caustics seen in mirrors and through glass); off: those hits get no caustic",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.causticGather = parseOnOff("caustic_gather", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.causticGather); }},
+        {"caustic_radius",
+         "photon kernel radius cap of the caustic gather, in cm (0.1..50; grid cells are twice "
+         "that)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1"}; },
+         [](BenchConfig& c, const std::string& v) {
+             char* end = nullptr;
+             const float q = std::strtof(v.c_str(), &end);
+             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.1f && q <= 50.0f))
+                 throw Error(fmt::format(
+                     "bench: knob caustic_radius: '{}' is not a number of cm in [0.1, 50]", v));
+             c.options.causticGatherRadius = 0.01f * q;
+         },
+         [](const BenchConfig& c) {
+             return fmt::format("{:g}", 100.0f * c.options.causticGatherRadius);
+         }},
         // Fuzzy reflections of rough metals (docs/specular.md): one default value each.
         {"fuzzy",
          "on: the fuzzy-reflection filter over rough metals' mirror reflections; off: rough "

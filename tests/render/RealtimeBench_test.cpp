@@ -192,6 +192,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on "
               "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
+              "caustic_gather=on caustic_radius=1 "
               "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
               "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 moving_objects=off "
               "env_source=static env_resolution=512 env_lights=0");
@@ -321,6 +322,8 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"caustic_map", {"100"}}}), Error);  // not a multiple of 8
     EXPECT_THROW(benchGrid(cam, true, {{"caustic_quad", {"wide"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"caustic_quad", {"9"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_gather", {"maybe"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"caustic_radius", {"0"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"fuzzy_cone", {"0"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"fuzzy_cone", {"wide"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"fuzzy_taps", {"0"}}}), Error);

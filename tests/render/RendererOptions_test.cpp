@@ -47,6 +47,11 @@ TEST(RendererOptions, OtherRangesNameTheOption) {
     o = {};
     o.backProjectionEpsilon = std::numeric_limits<float>::quiet_NaN();
     EXPECT_NE(refusal(o).find("backProjectionEpsilon"), std::string::npos);
+    for (float bad : {0.0f, 0.6f, std::numeric_limits<float>::quiet_NaN()}) {
+        o = {};
+        o.causticGatherRadius = bad;
+        EXPECT_NE(refusal(o).find("causticGatherRadius"), std::string::npos) << bad;
+    }
 }
 
 }  // namespace

@@ -33,18 +33,19 @@ void expectFiniteBuffers(const Renderer& r) {
     }
 }
 
-// The reference composite (8-bit sRGB) and footage of a scene.
+// The reference composite (8-bit sRGB) and footage of a scene; `caustics`: the reference's
+// photon map on (as the real-time renderer's caustics, which run for spot lights on glass).
 struct Reference {
     cv::Mat footage, composite;
 };
-Reference reference(const Scene& scene, const CameraIntrinsics& cam, const Pose& pose,
-                    int spp = 48) {
+Reference reference(const Scene& scene, const CameraIntrinsics& cam, const Pose& pose, int spp = 48,
+                    bool caustics = false) {
     const raytrace::EmbreeDevice device("threads=2");
     raytrace::RenderSettings st;
     st.samplesPerPixel = spp;
     st.threads = 2;
     st.seed = 5;
-    st.caustics = false;
+    st.caustics = caustics;
     const auto ref = raytrace::renderDifferential(scene, device, {cam, pose}, st);
     EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
     Reference out;
@@ -132,7 +133,7 @@ TEST(SpecularHardCases, TotalInternalReflectionAndGrazingViewsStayFinite) {
                        1.0f, 0.8f);
         test::addSkyEnvironment(s.scene, envDir);
         s.pose = test::lookAtPose({0.5, elevation + 0.2, 0.9}, {0.0, 0.1, 0.0});
-        const Reference ref = reference(s.scene, s.cam, s.pose);
+        const Reference ref = reference(s.scene, s.cam, s.pose, 48, true);
         Renderer r(s.scene, s.cam, singleFrame());
         r.render({s.pose, ref.footage, true});
         expectFiniteBuffers(r);
@@ -160,7 +161,7 @@ TEST(SpecularHardCases, TotalInternalReflectionAndGrazingViewsStayFinite) {
                 cv::resize(side, side, cv::Size(), 3.0, 3.0, cv::INTER_NEAREST);
                 return side;
             }());
-        EXPECT_GT(p, 19.5);  // measured 21.4 / 22.0 dB
+        EXPECT_GT(p, 19.5);  // measured 21.1 / 22.3 dB (reference caustics on)
     }
 }
 

@@ -1,5 +1,6 @@
 #version 450 core
 #include "common.glsl"
+#include "passes/caustic/caustic.glsl"
 // Caustic radiance from the caustic buffer (fixed-point irradiance, caustic_splat.comp), routed
 // by Eqs. 12-14 of Knecht 2013: L_rv gets every caustic; L_r only the photons whose light and
 // specular object are real (their power is in layers 3-5) landing on a REAL receiver. The
@@ -20,13 +21,9 @@ void main() {
     int origin = int(texelFetch(gPosition, px, 0).w + 0.5);
     if (origin == ORIGIN_NONE || texelFetch(gEmissive, px, 0).a > 0.5) return;
     vec4 A = texelFetch(gAlbedo, px, 0);
-    vec3 brdf = A.rgb * (1.0 - clamp(A.a, 0.0, 1.0)) / PI;
     vec3 eRv = vec3(texelFetch(accum, ivec3(px, 0), 0).r, texelFetch(accum, ivec3(px, 1), 0).r,
                     texelFetch(accum, ivec3(px, 2), 0).r) * invFixedScale;
-    outRv.rgb = brdf * eRv;
-    if (origin == ORIGIN_REAL) {
-        vec3 eR = vec3(texelFetch(accum, ivec3(px, 3), 0).r, texelFetch(accum, ivec3(px, 4), 0).r,
-                       texelFetch(accum, ivec3(px, 5), 0).r) * invFixedScale;
-        outR.rgb = brdf * eR;
-    }
+    vec3 eR = vec3(texelFetch(accum, ivec3(px, 3), 0).r, texelFetch(accum, ivec3(px, 4), 0).r,
+                   texelFetch(accum, ivec3(px, 5), 0).r) * invFixedScale;
+    causticRadiance(eRv, eR, A.rgb, A.a, origin == ORIGIN_REAL, outRv.rgb, outR.rgb);
 }

@@ -1,5 +1,6 @@
 #version 450 core
 #include "common.glsl"
+#include "passes/caustic/caustic.glsl"
 // Caustic buffer (Knecht 2013 Sec. 5.2): every photon of the photon G-buffers is splatted as a
 // quad around its receiver hit, in camera space, into a fixed-point irradiance buffer with
 // integer atomics (on llvmpipe scattering is ~10x cheaper in compute than as GL_POINTS,
@@ -30,13 +31,6 @@ uniform int mapSize;
 uniform float quadScale;   // kernel radius in photon spacings
 uniform float fixedScale;  // irradiance (W/m^2) -> integer units
 const int kMaxQuadPx = 8;  // kernel radius cap (pixels): bounds the cost of diffuse photons
-const float kMaxSpacing = 0.25;  // m: neighbours farther apart lie on another surface
-
-vec4 hitAt(bool refracted, ivec3 t) {
-    return refracted ? texelFetch(refrHit, t, 0) : texelFetch(reflHit, t, 0);
-}
-
-int hitOrigin(vec4 h) { return int(floor((h.w + 0.5) / 4.0)); }
 
 // Surface area (m^2) of canvas pixel px whose surface is x with normal n: the pixel's solid
 // angle cos^3 / (fx fy) times distance^2 / |cos| at the surface.
@@ -54,26 +48,12 @@ void main() {
     int layer = int(gl_GlobalInvocationID.z) / 2;
     bool refracted = (gl_GlobalInvocationID.z & 1u) == 1u;
     ivec3 tl = ivec3(t, layer);
-    vec4 hit = hitAt(refracted, tl);
-    int origin = hitOrigin(hit);
-    if (origin == ORIGIN_NONE) return;
+    vec4 hit = refracted ? texelFetch(refrHit, tl, 0) : texelFetch(reflHit, tl, 0);
     vec4 pw = refracted ? texelFetch(refrPower, tl, 0) : texelFetch(reflPower, tl, 0);
-    float realVis = hit.w - 4.0 * float(origin);
-    vec3 powerRv = pw.rgb * pw.a, powerR = pw.rgb * realVis;
-    if (max(max(powerRv.r, powerRv.g), max(powerRv.b, max(powerR.r, max(powerR.g, powerR.b)))) <=
-        0.0)
-        return;
-    // Footprint: the largest distance to a neighbouring photon's hit on the same surface.
-    float spacing = 0.0;
-    const ivec2 nb[4] = ivec2[4](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
-    for (int k = 0; k < 4; ++k) {
-        ivec2 q = t + nb[k];
-        if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(mapSize)))) continue;
-        vec4 h = hitAt(refracted, ivec3(q, layer));
-        if (hitOrigin(h) == ORIGIN_NONE) continue;
-        float dd = distance(h.xyz, hit.xyz);
-        if (dd < kMaxSpacing) spacing = max(spacing, dd);
-    }
+    vec3 powerRv, powerR;
+    if (!photonPowers(hit, pw, powerRv, powerR)) return;
+    float spacing = refracted ? photonSpacing(refrHit, tl, mapSize, hit.xyz)
+                              : photonSpacing(reflHit, tl, mapSize, hit.xyz);
     // Project the hit onto the canvas.
     vec4 c = viewProj * vec4(hit.xyz, 1.0);
     if (c.w <= 1e-6) return;

@@ -1,6 +1,7 @@
 #include "render/passes/specular/SpecularLightPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/passes/caustic/PhotonGridPass.h"
 
 namespace mirage::render {
 
@@ -14,11 +15,21 @@ constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::Re
 static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
 }  // namespace
 
-SpecularLightPass::SpecularLightPass(const GpuScene& scene)
-    : program_(fullscreenProgram("specular light", "passes/specular/specular_light.frag",
-                                 scene.lightingDefines())) {
-    locUseVpls_ = program_.uniformLocation("useVpls");
-    locVplStride_ = program_.uniformLocation("vplStride");
+SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
+                                                          const std::string& defines) {
+    Variant v;
+    v.program = fullscreenProgram(label, "passes/specular/specular_light.frag", defines);
+    v.useVpls = v.program.uniformLocation("useVpls");
+    v.vplStride = v.program.uniformLocation("vplStride");
+    v.cellSize = v.program.uniformLocation("photonCellSize");
+    return v;
+}
+
+SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOptions& options)
+    : plain_(makeVariant("specular light", scene.lightingDefines())) {
+    if (PhotonGridPass::sceneCanGather(scene, options))
+        gather_ = makeVariant("specular light (caustic gather)",
+                              scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
 }
 
 void SpecularLightPass::setup(PassBuilder& b) const {
@@ -26,9 +37,10 @@ void SpecularLightPass::setup(PassBuilder& b) const {
     b.read(Resource::GBufferPosition);
     b.read(Resource::EnvironmentMap);
     b.read(Resource::EnvironmentLight);
-    for (Resource r : {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::ShadowGlass,
-                       Resource::ShadowGlassReal, Resource::Vpls, Resource::ImperfectShadowMaps,
-                       Resource::ImperfectShadowMapsReal})
+    for (Resource r :
+         {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::ShadowGlass,
+          Resource::ShadowGlassReal, Resource::Vpls, Resource::ImperfectShadowMaps,
+          Resource::ImperfectShadowMapsReal, Resource::PhotonGrid, Resource::PhotonRecords})
         b.readOptional(r);
     b.write(Resource::SpecularRv, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::SpecularR, GL_RGBA16F, SizeRule::Canvas);
@@ -40,7 +52,9 @@ PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
     const bool vpls = ctx.options.specularVpls && ctx.plan.needVpls;
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
                       (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
-                      (vpls ? " + VPLs" : "") + " at the reflected/refracted hits"};
+                      (vpls ? " + VPLs" : "") +
+                      (PhotonGridPass::gatherDecision(ctx).run ? " + caustic photons" : "") +
+                      " at the reflected/refracted hits"};
 }
 
 void SpecularLightPass::resize(const FrameContext& ctx) {
@@ -62,7 +76,12 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
 
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
-    ctx.beginFullscreen(program_, ctx.canvasWidth(), ctx.canvasHeight());
+    // The gather variant only in frames with a photon grid: llvmpipe pays for a branch's buffer
+    // reads even when no pixel takes it.
+    const bool gather = gather_.program.id() != 0 && res.has(Resource::PhotonGrid) &&
+                        res.has(Resource::PhotonRecords);
+    const Variant& v = gather ? gather_ : plain_;
+    ctx.beginFullscreen(v.program, ctx.canvasWidth(), ctx.canvasHeight());
     for (int i = 0; i < 10; ++i)
         glBindTextureUnit(GLuint(kUnitSpecLightReflFirst + i), res.texture(kHitBuffers[i]).id());
     glBindTextureUnit(kUnitSpecLightShadowAll,
@@ -90,8 +109,15 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitEnvironmentMap, res.texture(Resource::EnvironmentMap).id());
     glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
                      res.buffer(Resource::EnvironmentLight).id());
-    glUniform1i(locUseVpls_, vpls ? 1 : 0);
-    glUniform1i(locVplStride_, ctx.options.specularVplStride);
+    if (gather) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotonGrid,
+                         res.buffer(Resource::PhotonGrid).id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons,
+                         res.buffer(Resource::PhotonRecords).id());
+        glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
+    }
+    glUniform1i(v.useVpls, vpls ? 1 : 0);
+    glUniform1i(v.vplStride, ctx.options.specularVplStride);
     ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);  // 0 outside: not a specular pixel
     res.publish(Resource::SpecularRv, rv_);
     res.publish(Resource::SpecularR, r_);

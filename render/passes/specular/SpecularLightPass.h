@@ -2,14 +2,16 @@
 // L'_rv, L'_r and L_env (Knecht 2013 Eqs. 3-5, Sec. 4.1.3): the reflected and refracted hits of
 // GBuf_refl / GBuf_refr lit by every light (shadow maps), the environment (SH) and the VPLs
 // (imperfect shadow maps), Fresnel-weighted and routed real / virtual; rays that hit nothing
-// modelled look up the environment map into L_env (specular_light.frag).
+// modelled look up the environment map into L_env (specular_light.frag). In frames with a
+// world-space photon grid (PhotonGridPass) the hits also gather the caustic photons around them
+// (a shader variant: without a grid the frame pays nothing for it).
 #include "render/RenderPass.h"
 
 namespace mirage::render {
 
 class SpecularLightPass final : public RenderPass {
 public:
-    explicit SpecularLightPass(const GpuScene& scene);
+    SpecularLightPass(const GpuScene& scene, const RendererOptions& options);
     const char* name() const override { return "speclight"; }
     void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
@@ -17,10 +19,14 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    gl::Program program_;
+    struct Variant {
+        gl::Program program;
+        GLint useVpls = -1, vplStride = -1, cellSize = -1;
+    };
+    static Variant makeVariant(const char* label, const std::string& defines);
+    Variant plain_, gather_;  // gather_: only for scenes that can have caustics
     gl::Texture rv_, r_, rRefl_, env_;
     gl::Framebuffer fbo_;
-    GLint locUseVpls_ = -1, locVplStride_ = -1;
     int width_ = 0, height_ = 0;
 };
 

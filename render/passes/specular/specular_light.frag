@@ -2,6 +2,7 @@
 #include "common.glsl"
 #include "lighting.glsl"
 #include "passes/specular/specular.glsl"
+#include "passes/caustic/caustic.glsl"
 // Lighting of the reflected / refracted ray hits (GBuf_refl, GBuf_refr) by every light (shadow
 // maps), the environment (SH irradiance) and the VPLs (imperfect shadow maps), routed by
 // Knecht 2013 Eqs. 3-5:
@@ -12,6 +13,8 @@
 // routing table). The Fresnel / transmittance weights (eta1, eta2 T) are pre-multiplied (Sec.
 // 5.1). A ray that hit nothing modelled writes the weighted environment radiance into L_env
 // instead (Sec. 4.1.3); L'_rv and L'_r stay untouched there. Linear radiance throughout.
+// Variant MIRAGE_CAUSTIC_GATHER (frames with a world-space photon grid): each hit also gathers
+// the caustic photons around it (caustic.glsl gatherCaustic), routed as the camera's caustic.
 in vec2 uv;
 layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
 layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
@@ -105,6 +108,19 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef MIRAGE_CAUSTIC_GATHER
+    // The gather points' footprints, from the hits of the neighbouring pixels (derivatives:
+    // before any branch) and, across silhouettes, from the path length and the hit's obliquity.
+    vec3 pSpec = texelFetch(gPosition, px, 0).xyz;
+    float toCamera = distance(cameraPos.xyz, pSpec);
+    float footprint[2];
+    for (int k = 0; k < 2; ++k) {
+        vec3 h = (k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0)).xyz;
+        vec3 nh = (k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0)).xyz;
+        float cosHit = abs(dot(nh, normalize(pSpec - h + vec3(0.0, 0.0, 1e-9))));
+        footprint[k] = gatherFootprint(dFdx(h), dFdy(h), toCamera + distance(pSpec, h), cosHit);
+    }
+#endif
     outRv = vec4(0.0);
     outR = vec4(0.0);
     outRRefl = vec4(0.0);
@@ -132,6 +148,13 @@ void main() {
         int st = max(vplStride, 1), side = st >= 16 ? 4 : (st >= 4 ? 2 : 1);
         int firstVpl = (px.x % side + side * (px.y % side)) % st;
         shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, e, firstVpl, hrv, hr);
+#ifdef MIRAGE_CAUSTIC_GATHER
+        vec3 eRv, eR, crv, cr;
+        gatherCaustic(P.xyz, N.xyz, footprint[k], eRv, eR);
+        causticRadiance(eRv, eR, A.rgb, A.a, origin == ORIGIN_REAL, crv, cr);
+        hrv += crv;
+        hr += cr;
+#endif
         rv += w * hrv;
         r += w * hr;
         if (k == 0) rRefl = w * hr;

@@ -28,6 +28,8 @@ struct CausticScene {
     glm::vec3 sphereCentre{0.0f, 0.175f, 0.0f};
     float sphereRadius = 0.1f;
     glm::vec3 lightPos{0.5f, 1.041f, 0.0f};
+    // The mirror of CausticSceneOptions::mirror (world box, m): its front face is z = mirrorHi.z.
+    glm::vec3 mirrorLo{-0.55f, 0.005f, -0.31f}, mirrorHi{0.2f, 0.4f, -0.3f};
 };
 
 struct CausticSceneOptions {
@@ -42,6 +44,10 @@ struct CausticSceneOptions {
     std::optional<glm::vec3> lightPos, sphereCentre;
     std::optional<float> sphereRadius;
     float tableSize = 3.0f;
+    // A virtual mirror (a 1 cm plate standing on the table behind the caustic, facing +Z) that
+    // shows the table's caustic to the camera of mirrorView(); the spot's cone is then narrowed
+    // to the sphere (outer 0.15 rad) so the mirror itself stays out of it.
+    bool mirror = false;
 };
 
 inline CausticScene makeCausticScene(const CausticSceneOptions& o) {
@@ -68,9 +74,19 @@ inline CausticScene makeCausticScene(const CausticSceneOptions& o) {
         s.sphereCentre = 0.5f * (s.boxLo + s.boxHi);
         s.sphereRadius = 0.5f * glm::length(s.boxHi - s.boxLo);
     }
+    if (o.mirror)
+        addBox(s.scene, "mirror", s.mirrorLo, s.mirrorHi, addMirror(s.scene), Origin::Virtual);
     addLight(s.scene, o.lightType, s.lightPos, glm::normalize(s.sphereCentre - s.lightPos),
-             o.intensity, o.lightReal ? Origin::Real : Origin::Virtual, 0.5f, 0.4f);
+             o.intensity, o.lightReal ? Origin::Real : Origin::Virtual, o.mirror ? 0.15f : 0.5f,
+             o.mirror ? 0.12f : 0.4f);
     return s;
+}
+
+// The camera of a scene with the mirror (CausticSceneOptions::mirror): looking down at the
+// mirror past the sphere, so that the table's caustic is seen in the mirror (and directly).
+inline void mirrorView(CausticScene& s, int width, int height, double f) {
+    s.cam = smallCamera(width, height, f);
+    s.pose = lookAtPose({-0.45, 0.4, 0.7}, {-0.15, 0.06, -0.25});
 }
 
 // Does the segment a -> b pass within r of c?

@@ -1,0 +1,93 @@
+#include "render/passes/caustic/PhotonGridPass.h"
+
+#include <fmt/format.h>
+
+#include "render/FrameGraph.h"
+
+namespace mirage::render {
+
+PhotonGridPass::PhotonGridPass()
+    : count_(computeProgram("photon grid count", "passes/caustic/photon_grid_count.comp")),
+      scan_(computeProgram("photon grid scan", "passes/caustic/photon_grid_scan.comp")),
+      scatter_(computeProgram("photon grid scatter", "passes/caustic/photon_grid_scatter.comp")),
+      grid_("photon grid", (2 * size_t(kPhotonGridCells) + 1) * sizeof(GLuint)) {}
+
+void PhotonGridPass::setup(PassBuilder& b) const {
+    for (Resource r :
+         {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonSurfaceRefl,
+          Resource::PhotonHitRefr, Resource::PhotonPowerRefr, Resource::PhotonSurfaceRefr})
+        b.read(r);
+    b.writeBuffer(Resource::PhotonGrid, SizeRule::CausticMap);
+    b.writeBuffer(Resource::PhotonRecords, SizeRule::CausticMap);
+}
+
+PassDecision PhotonGridPass::gatherDecision(const FrameContext& ctx) {
+    if (ctx.plan.causticLayers == 0) return {false, ctx.plan.causticReason};
+    if (!ctx.options.causticGather) return {false, "caustic gather off"};
+    if (ctx.specularScissor.z <= 0 || ctx.specularScissor.w <= 0)
+        return {false, "no mirror or glass object in view: no reflected or refracted hit"};
+    return {true, "the photons of " + std::to_string(ctx.plan.causticLayers) +
+                      " light(s), for the reflected / refracted hits in view"};
+}
+
+bool PhotonGridPass::sceneCanGather(const GpuScene& scene, const RendererOptions& options) {
+    if (!options.caustics || !options.causticGather || scene.specularDraws().empty()) return false;
+    for (const SceneLight& l : scene.lights())
+        if (l.type == kLightSpot) return true;
+    return false;
+}
+
+PassDecision PhotonGridPass::decide(const FrameContext& ctx) const {
+    PassDecision d = gatherDecision(ctx);
+    if (d.run)
+        d.reason = fmt::format("{}: hashed grid of {} buckets, {:.3g} cm cells", d.reason,
+                               kPhotonGridCells, 100.0 * cellSize(ctx.options));
+    return d;
+}
+
+void PhotonGridPass::resize(const FrameContext& ctx) {
+    const size_t s = size_t(ctx.options.causticMapSize);
+    const size_t n = s * s * 2 * size_t(std::max(1, ctx.plan.causticLayers));
+    if (n == capacity_) return;
+    records_ = gl::Buffer("photon records", n * sizeof(GpuPhoton));
+    capacity_ = n;
+    // The counts start at zero (the scatter step counts them back down after every build).
+    const GLuint zero = 0;
+    glClearNamedBufferData(grid_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+}
+
+void PhotonGridPass::execute(FrameContext& ctx, PassResources& res) {
+    const int s = ctx.options.causticMapSize;
+    const GLuint groups = GLuint((s + 7) / 8), layers = GLuint(2 * ctx.plan.causticLayers);
+    const float cell = cellSize(ctx.options);
+    glBindTextureUnit(kUnitGridReflHit, res.texture(Resource::PhotonHitRefl).id());
+    glBindTextureUnit(kUnitGridReflPower, res.texture(Resource::PhotonPowerRefl).id());
+    glBindTextureUnit(kUnitGridReflSurface, res.texture(Resource::PhotonSurfaceRefl).id());
+    glBindTextureUnit(kUnitGridRefrHit, res.texture(Resource::PhotonHitRefr).id());
+    glBindTextureUnit(kUnitGridRefrPower, res.texture(Resource::PhotonPowerRefr).id());
+    glBindTextureUnit(kUnitGridRefrSurface, res.texture(Resource::PhotonSurfaceRefr).id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotonGrid, grid_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons, records_.id());
+
+    count_.use();
+    glUniform1i(count_.uniformLocation("mapSize"), s);
+    glUniform1f(count_.uniformLocation("cellSize"), cell);
+    glDispatchCompute(groups, groups, layers);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+    scan_.use();
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+    scatter_.use();
+    glUniform1i(scatter_.uniformLocation("mapSize"), s);
+    glUniform1f(scatter_.uniformLocation("cellSize"), cell);
+    glUniform1f(scatter_.uniformLocation("quadScale"), ctx.options.causticQuadScale);
+    glUniform1ui(scatter_.uniformLocation("capacity"), GLuint(capacity_));
+    glDispatchCompute(groups, groups, layers);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    res.publish(Resource::PhotonGrid, grid_);
+    res.publish(Resource::PhotonRecords, records_);
+}
+
+}  // namespace mirage::render
