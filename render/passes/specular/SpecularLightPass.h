@@ -20,6 +20,7 @@ private:
     gl::Program program_;
     gl::Texture rv_, r_, rRefl_, env_;
     gl::Framebuffer fbo_;
+    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
     GLint locUseVpls_ = -1, locVplStride_ = -1;
     int width_ = 0, height_ = 0;
 };
