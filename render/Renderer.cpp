@@ -625,7 +625,11 @@ GpuEnvironment Renderer::readEnvironmentLight() const {
 }
 
 cv::Mat Renderer::readBuffer(Resource r) const {
-    const gl::Texture& t = graph_.texture(r);  // throws if the frame did not produce it
+    const gl::Texture& t = graph_.texture(r);   // throws if the frame did not produce it
+    if (t.format() == GL_DEPTH_COMPONENT32F) {  // a depth buffer (SpecularMask): one channel
+        auto depth = t.read<float>(GL_DEPTH_COMPONENT, GL_FLOAT, 1);
+        return cv::Mat(t.height(), t.width(), CV_32FC1, depth.data()).clone();
+    }
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     cv::Mat rgba(t.height(), t.width(), CV_32FC4, px.data()), rgb;
     cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);

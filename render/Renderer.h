@@ -86,7 +86,8 @@ public:
     cv::Mat compositeSrgb() const;
     cv::Mat coverage() const;
     // Any canvas-size linear buffer of this frame (LRv, LR, DirectRv, ...) as CV_32FC3 RGB,
-    // top row first. Throws mirage::Error if the frame did not produce it.
+    // top row first; a depth buffer (SpecularMask) as CV_32FC1. Throws mirage::Error if the frame
+    // did not produce it.
     cv::Mat readBuffer(Resource r) const;
     // The imperfect shadow map atlas of this frame (all points, or real points only) as CV_32F
     // distances in metres, +inf where no point was splatted. Throws if no ISM ran.

@@ -56,6 +56,7 @@ const char* resourceName(Resource r) {
         "RefractionAlbedo",
         "RefractionEmissive",
         "RefractionWeight",
+        "SpecularMask",
         "SpecularRv",
         "SpecularR",
         "SpecularRReflection",

@@ -76,6 +76,8 @@ enum class Resource {
     RefractionAlbedo,
     RefractionEmissive,
     RefractionWeight,
+    SpecularMask,         // depth 0 on specular pixels, 1 elsewhere: the passes that shade only
+                          // those test against it (early depth test skips the rest)
     SpecularRv,           // L'_rv (Eq. 3), Fresnel-weighted
     SpecularR,            // L'_r (Eq. 4)
     SpecularRReflection,  // the reflection's share of L'_r

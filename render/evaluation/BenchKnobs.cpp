@@ -140,11 +140,31 @@ const std::vector<BenchKnob>& benchKnobs() {
          },
          [](const BenchConfig& c) { return std::to_string(c.options.impostorResolution); }},
         {"impostor_steps", "refinement steps of the impostor height-field search",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"2"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
          },
          [](const BenchConfig& c) { return std::to_string(c.options.impostorRefineSteps); }},
+        {"refraction_steps",
+         "march steps of the refracted ray through the back-face buffer (the exit point; also "
+         "the caustic photons')",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.refractionMarchSteps = parseInt("refraction_steps", v, 2, 128);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.refractionMarchSteps); }},
+        {"specular_vpl_stride",
+         "VPL interleaving at the reflected/refracted hits: each hit sums every N-th VPL (x N) "
+         "over an N-pixel tile: 1 (all), 4 (2x2) or 16 (4x4)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
+         [](BenchConfig& c, const std::string& v) {
+             const int n = parseInt("specular_vpl_stride", v, 1, 16);
+             if (n != 1 && n != 4 && n != 16)
+                 throw Error(
+                     fmt::format("bench: knob specular_vpl_stride: '{}' is not 1, 4 or 16", v));
+             c.options.specularVplStride = n;
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.specularVplStride); }},
         {"virtual",
          "on: composite the virtual objects; off: the composite is the footage unchanged (a "
          "sanity point: it must score as the footage-only row, and any configuration that does "

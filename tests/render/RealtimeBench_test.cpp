@@ -190,7 +190,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     ASSERT_EQ(grid.size(), 1u);
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
-              "specular_trace=impostors impostor_resolution=256 impostor_steps=4 virtual=on "
+              "specular_trace=impostors impostor_resolution=256 impostor_steps=2 "
+              "refraction_steps=16 specular_vpl_stride=4 virtual=on "
               "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
               "caustic_gather=on caustic_radius=1 "
               "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
@@ -350,6 +351,13 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_EQ(defaults.at("vpls"), std::to_string(RendererOptions{}.vplCount));
     EXPECT_EQ(defaults.at("resolution"), "session");
     EXPECT_EQ(defaults.at("virtual"), "on");
+    EXPECT_EQ(defaults.at("impostor_steps"), std::to_string(RendererOptions{}.impostorRefineSteps));
+    EXPECT_EQ(defaults.at("refraction_steps"),
+              std::to_string(RendererOptions{}.refractionMarchSteps));
+    EXPECT_EQ(defaults.at("specular_vpl_stride"),
+              std::to_string(RendererOptions{}.specularVplStride));
+    EXPECT_THROW(benchGrid(cam, true, {{"specular_vpl_stride", {"8"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"refraction_steps", {"1"}}}), Error);
 }
 
 TEST(RealtimeBench, CommandRunsOnASynthesisedSessionAndRejectsBadInput) {

@@ -307,7 +307,8 @@ TEST(SpecularHardCases, UniformEnvironmentGivesTheFresnelWeights) {
 // whole in view (a rectangle too tight would cut its rim), and a mirror slab so close that its
 // bounds reach behind the camera (whole canvas) must be shaded at every pixel they cover: in a
 // uniform environment of radiance 1 each of them is its Fresnel weight (>= F0 = 0.95), where an
-// unshaded pixel would be 0.
+// unshaded pixel would be 0. Within the rectangle they shade only through the specular-pixel
+// depth mask, which must hold exactly the mirror pixels.
 TEST(SpecularHardCases, EveryMirrorPixelIsShadedAtTheImageEdgeAndUpClose) {
     gl::Context context = gl::Context::headless();
     const auto dir = test::outputDir("specular_scissor");
@@ -359,6 +360,18 @@ TEST(SpecularHardCases, EveryMirrorPixelIsShadedAtTheImageEdgeAndUpClose) {
         }
         EXPECT_GT(mirrorPixels, int(coverage.total() / 20)) << v.what;
         EXPECT_EQ(unshaded, 0) << v.what;
+        // The early-depth mask the specular passes shade through (docs/specular.md): depth 0
+        // on exactly the mirror pixels, 1 everywhere else (this camera has no lens distortion,
+        // so canvas and camera pixels coincide).
+        const cv::Mat mask = r.readBuffer(Resource::SpecularMask);
+        ASSERT_EQ(mask.size(), coverage.size()) << v.what;
+        int maskWrong = 0;
+        for (int y = 0; y < mask.rows; ++y)
+            for (int x = 0; x < mask.cols; ++x) {
+                const float m = mask.at<float>(y, x);
+                if (m != (coverage.at<uchar>(y, x) == 2 ? 0.0f : 1.0f)) ++maskWrong;
+            }
+        EXPECT_EQ(maskWrong, 0) << v.what;
     }
 }
 

@@ -1,5 +1,7 @@
 #include "render/passes/composite/CompositePass.h"
 
+#include <array>
+
 #include "render/FrameGraph.h"
 
 namespace mirage::render {
@@ -22,7 +24,9 @@ CompositePass::CompositePass()
                                         "#define MIRAGE_DIFFUSE_ONLY 1")),
       programDiffuseNoCaustics_(fullscreenProgram(
           "composite (diffuse only, no caustics)", "passes/composite/composite.frag",
-          "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_NO_CAUSTICS 1")) {
+          "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_NO_CAUSTICS 1")),
+      maskProgram_(
+          fullscreenProgram("composite specular mask", "passes/composite/composite_mask.frag")) {
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
     locShowVirtualDiffuse_ = programDiffuse_.uniformLocation("showVirtual");
     locShowVirtual_ = program_.uniformLocation("showVirtual");
@@ -79,7 +83,12 @@ void CompositePass::resize(const FrameContext& ctx) {
     fbo_ = gl::Framebuffer("composite fbo");
     fbo_.attachColor(0, linear_);
     fbo_.attachColor(1, srgb_);
+    mask_ = gl::Texture::create2D("composite specular mask", w, h, GL_DEPTH_COMPONENT32F);
+    fbo_.attachDepth(mask_);
     fbo_.finalize(2);
+    maskFbo_ = gl::Framebuffer("composite specular mask fbo");
+    maskFbo_.attachDepth(mask_);
+    maskFbo_.finalize(0);
 }
 
 glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const {
@@ -165,6 +174,20 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     const glm::ivec4 rect =
         specular && ctx.options.showVirtual ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);
     if (rect.z > 0 && rect.w > 0) {
+        // The mask of the camera pixels that see a specular pixel (inside the rectangle; 1
+        // outside), then the full variant on those only (early depth test).
+        maskFbo_.bind();
+        maskProgram_.use();
+        glDepthMask(GL_TRUE);  // also lets the clear write
+        glClearBufferfv(GL_DEPTH, 0, std::array<float, 1>{1.0f}.data());
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_ALWAYS);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(rect.x, rect.y, rect.z, rect.w);
+        ctx.drawFullscreenTriangle();
+        fbo_.bind();
+        glDepthFunc(GL_GREATER);  // the triangle lies at depth 0.5
+        glDepthMask(GL_FALSE);
         program_.use();
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
@@ -177,10 +200,11 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                 res.textureOr(rough ? kRoughBuffers[i] : kFuzzyBuffers[i], ctx.blackTexture())
                     .id());
         glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
-        glEnable(GL_SCISSOR_TEST);
-        glScissor(rect.x, rect.y, rect.z, rect.w);
         ctx.drawFullscreenTriangle();
         glDisable(GL_SCISSOR_TEST);
+        glDepthMask(GL_TRUE);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_DEPTH_TEST);
     }
     glDisable(GL_FRAMEBUFFER_SRGB);
     res.publish(Resource::Composite, linear_);

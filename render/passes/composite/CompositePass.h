@@ -33,6 +33,11 @@ private:
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
     GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
     gl::Framebuffer fbo_;
+    // composite_mask.frag: depth 0 on the camera pixels that see a mirror or glass pixel, 1
+    // elsewhere; fbo_'s depth attachment, so the full variant shades only those pixels.
+    gl::Program maskProgram_;
+    gl::Texture mask_;
+    gl::Framebuffer maskFbo_;
 };
 
 }  // namespace mirage::render

@@ -1,12 +1,15 @@
 #include "render/passes/specular/SpecularGBufferPass.h"
 
+#include <array>
+
 #include "render/FrameGraph.h"
 #include "render/passes/impostor/ImpostorPass.h"
 
 namespace mirage::render {
 namespace {
 
-void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h) {
+void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h,
+              const gl::Texture& mask) {
     b.position = gl::Texture::create2D(what + " position", w, h, GL_RGBA32F);
     b.normal = gl::Texture::create2D(what + " normal", w, h, GL_RGBA16F);
     b.albedo = gl::Texture::create2D(what + " albedo", w, h, GL_RGBA16F);
@@ -20,6 +23,7 @@ void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h) {
     b.fbo.attachColor(2, b.albedo);
     b.fbo.attachColor(3, b.emissive);
     b.fbo.attachColor(4, b.weight);
+    b.fbo.attachDepth(mask);
     b.fbo.finalize(5);
 }
 
@@ -46,7 +50,9 @@ SpecularGBufferPass::SpecularGBufferPass()
                                   "#define MIRAGE_SPECULAR_MODE 0"),
                 fullscreenProgram("specular gbuffer (refraction)",
                                   "passes/specular/specular_gbuffer.frag",
-                                  "#define MIRAGE_SPECULAR_MODE 1")} {}
+                                  "#define MIRAGE_SPECULAR_MODE 1")},
+      maskProgram_(fullscreenProgram("specular pixel mask", "passes/specular/specular_mask.frag")) {
+}
 
 void SpecularGBufferPass::setup(PassBuilder& b) const {
     for (Resource r :
@@ -56,6 +62,7 @@ void SpecularGBufferPass::setup(PassBuilder& b) const {
     ImpostorPass::declareTracing(b);
     declare(b, Resource::ReflectionGBuffer, Resource::ReflectionNormal, Resource::ReflectionAlbedo,
             Resource::ReflectionEmissive, Resource::ReflectionWeight);
+    b.write(Resource::SpecularMask, GL_DEPTH_COMPONENT32F, SizeRule::Canvas);
     declare(b, Resource::RefractionGBuffer, Resource::RefractionNormal, Resource::RefractionAlbedo,
             Resource::RefractionEmissive, Resource::RefractionWeight);
 }
@@ -70,8 +77,12 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
     if (w == width_ && h == height_) return;
     width_ = w;
     height_ = h;
-    allocate(refl_, "GBuf_refl", w, h);
-    allocate(refr_, "GBuf_refr", w, h);
+    mask_ = gl::Texture::create2D("specular pixel mask", w, h, GL_DEPTH_COMPONENT32F);
+    maskFbo_ = gl::Framebuffer("specular pixel mask fbo");
+    maskFbo_.attachDepth(mask_);
+    maskFbo_.finalize(0);
+    allocate(refl_, "GBuf_refl", w, h, mask_);
+    allocate(refr_, "GBuf_refr", w, h, mask_);
 }
 
 void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
@@ -84,16 +95,32 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
     glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
     ImpostorPass::bindForTracing(res);  // kUnitImpostor*, kBindingImpostorRecords / Objects
+    // The specular-pixel depth mask: outside the scissor it stays cleared (1, not specular).
+    maskFbo_.bind();
+    ctx.beginFullscreen(maskProgram_, ctx.canvasWidth(), ctx.canvasHeight());
+    glDepthMask(GL_TRUE);  // also lets the clear write
+    glClearBufferfv(GL_DEPTH, 0, std::array<float, 1>{1.0f}.data());
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 0);
     for (int mode = 0; mode < 2; ++mode) {
         (mode == 0 ? refl_ : refr_).fbo.bind();
         const gl::Program& program = programs_[mode];
         ctx.beginFullscreen(program, ctx.canvasWidth(), ctx.canvasHeight());
         if (mode == 1)
             glUniform1i(program.uniformLocation("marchSteps"), ctx.options.refractionMarchSteps);
-        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);  // 0 outside: no specular pixel
+        // Only specular pixels pass the early depth test (the triangle lies at depth 0.5).
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);  // 0 elsewhere: no specular pixel
     }
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
     publish(res, refl_, Resource::ReflectionGBuffer, Resource::ReflectionNormal,
             Resource::ReflectionAlbedo, Resource::ReflectionEmissive, Resource::ReflectionWeight);
+    res.publish(Resource::SpecularMask, mask_);
     publish(res, refr_, Resource::RefractionGBuffer, Resource::RefractionNormal,
             Resource::RefractionAlbedo, Resource::RefractionEmissive, Resource::RefractionWeight);
 }

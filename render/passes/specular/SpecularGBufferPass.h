@@ -26,6 +26,9 @@ public:
 
 private:
     gl::Program programs_[2];  // [0] reflection, [1] refraction (MIRAGE_SPECULAR_MODE)
+    gl::Program maskProgram_;  // specular_mask.frag: depth 0 on specular pixels, 1 elsewhere
+    gl::Texture mask_;         // that depth mask, attached to both hit buffers' framebuffers
+    gl::Framebuffer maskFbo_;
     SpecularHitBuffer refl_, refr_;
     int width_ = 0, height_ = 0;
 };

@@ -35,6 +35,7 @@ SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOption
 void SpecularLightPass::setup(PassBuilder& b) const {
     for (Resource r : kHitBuffers) b.read(r);
     b.read(Resource::GBufferPosition);
+    b.read(Resource::SpecularMask);  // depth attachment: shade specular pixels only
     b.read(Resource::EnvironmentMap);
     b.read(Resource::EnvironmentLight);
     for (Resource r :
@@ -72,9 +73,16 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(2, rRefl_);
     fbo_.attachColor(3, env_);
     fbo_.finalize(4);
+    attachedMask_ = 0;  // execute() attaches the specular mask
 }
 
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
+    const gl::Texture& mask = res.texture(Resource::SpecularMask);
+    if (mask.id() != attachedMask_) {  // specgbuf reallocates it only on a resize
+        fbo_.attachDepth(mask);
+        fbo_.finalize(4);
+        attachedMask_ = mask.id();
+    }
     fbo_.bind();
     // The gather variant only in frames with a photon grid: llvmpipe pays for a branch's buffer
     // reads even when no pixel takes it.
@@ -118,7 +126,15 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     }
     glUniform1i(v.useVpls, vpls ? 1 : 0);
     glUniform1i(v.vplStride, ctx.options.specularVplStride);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);  // 0 outside: not a specular pixel
+    // Only specular pixels pass the early depth test against the mask (the triangle lies at
+    // depth 0.5); the rest stay 0 (not a specular pixel).
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_FALSE);
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
     res.publish(Resource::SpecularRv, rv_);
     res.publish(Resource::SpecularR, r_);
     res.publish(Resource::SpecularRReflection, rRefl_);

@@ -27,6 +27,7 @@ private:
     Variant plain_, gather_;  // gather_: only for scenes that can have caustics
     gl::Texture rv_, r_, rRefl_, env_;
     gl::Framebuffer fbo_;
+    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
     int width_ = 0, height_ = 0;
 };
 
