@@ -18,6 +18,7 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
+#include "tests/render/CausticReference.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
 
@@ -76,23 +77,12 @@ struct Reference {
 };
 
 Reference reference(const test::CausticScene& s, int spp) {
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = spp;
-    st.threads = 2;
-    st.seed = 11;
-    st.caustics = true;
-    const raytrace::DifferentialImages on =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    EXPECT_EQ(on.realStats.nonFiniteSamples + on.mixedStats.nonFiniteSamples, 0);
-    st.caustics = false;
-    const raytrace::RayTracingScene mixed(s.scene, raytrace::SceneSubset::All, device);
-    const raytrace::RenderResult off = raytrace::render(mixed, {s.cam, s.pose}, st);
+    const test::CausticReferenceRender ref = test::renderCausticReference(s, spp, 11);
+    const raytrace::DifferentialImages& on = ref.on;
     Reference r;
-    r.footage = linearRgbToSrgbBgr8(on.realOnly);
-    r.compositeSrgb =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), on));
-    r.caustic = cv::max(on.realAndVirtual - off.radiance, 0.0);
+    r.footage = ref.footage;
+    r.compositeSrgb = ref.compositeSrgb;
+    r.caustic = ref.caustic;
     r.mirror = mirrorMask(s);
     // As the camera-space caustic's region (CausticAccuracy_test.cpp): the caustic smoothed over
     // 5x5 px against the photon map's noise adds > 5 % to L_rv, where L_rv > 5 % of the

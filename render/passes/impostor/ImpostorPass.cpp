@@ -125,7 +125,10 @@ PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
     const char* method = ctx.options.impostorCubeMapBaseline ? "cube-map baseline" : "impostors";
     if (stale(ctx.scene, ctx.options.impostorResolution))
         return {true, fmt::format("{} for {} specular object(s) at {}^2 ({})",
-                                  builtScene_ == &ctx.scene ? "rebuild (objects moved)" : "build",
+                                  builtScene_ == &ctx.scene &&
+                                          builtResolution_ == ctx.options.impostorResolution
+                                      ? "rebuild (objects moved)"
+                                      : "build",
                                   n, ctx.options.impostorResolution, method)};
     return {true, fmt::format("cached ({}, {} refinement steps; built once: {})", method,
                               ctx.options.impostorRefineSteps, stats_.summary())};
