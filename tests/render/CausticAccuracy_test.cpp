@@ -35,11 +35,7 @@ struct CausticReference {
     cv::Mat region;         // CV_8U: caustic adds > 5 % to L_rv
 };
 
-cv::Mat luminance(const cv::Mat& rgb) {
-    cv::Mat y;
-    cv::transform(rgb, y, cv::Matx13f(0.2126f, 0.7152f, 0.0722f));
-    return y;
-}
+using test::linearLuminance;
 
 test::SpecularScene sphereView(const test::CausticScene& s) {
     test::SpecularScene v;
@@ -58,16 +54,10 @@ CausticReference causticReference(const test::CausticScene& s, int spp = 32) {
     r.compositeSrgb = ref.compositeSrgb;
     r.lrvOn = on.realAndVirtual;
     r.caustic = ref.caustic;
-    // The region: the caustic (smoothed over 5x5 px against the photon map's noise) adds > 5 %
-    // to L_rv, where L_rv > 5 % of the brightest directly lit real surface (on the lit table, not
-    // the dark room), off the glass (compared separately).
-    cv::Mat yc = luminance(r.caustic), yon = luminance(on.realAndVirtual);
-    cv::GaussianBlur(yc, yc, cv::Size(5, 5), 1.0);
-    double peak = 0;  // the brightest directly lit real surface
-    cv::minMaxLoc(luminance(on.realOnly), nullptr, &peak);
+    // The caustic region (CausticReference.h), off the glass (compared separately).
     cv::Mat off_;
     cv::bitwise_not(test::sphereMask(sphereView(s), -1.5), off_);
-    r.region = (yc > 0.05 * yon) & (yon > 0.05 * peak) & off_;
+    r.region = ref.region & off_;
     return r;
 }
 
@@ -141,15 +131,15 @@ CausticFigures measure(const test::CausticScene& s, const CausticReference& ref,
     f.spherePsnr =
         test::psnr(rt.composite, ref.compositeSrgb, 255.0, test::sphereMask(sphereView(s)));
     double totalRef = 0, totalRt = 0;
-    const cv::Point2d cRef = centroid(luminance(ref.caustic), ref.region, totalRef);
-    const cv::Point2d cRt = centroid(luminance(rt.caustic), ref.region, totalRt);
+    const cv::Point2d cRef = centroid(linearLuminance(ref.caustic), ref.region, totalRef);
+    const cv::Point2d cRt = centroid(linearLuminance(rt.caustic), ref.region, totalRt);
     f.fluxRatio = totalRef > 0 ? totalRt / totalRef : 0.0;
     {
         cv::Mat all;
         cv::bitwise_not(test::sphereMask(sphereView(s), -1.5), all);
         double a = 0, b = 0;
-        centroid(luminance(ref.caustic), all, a);
-        centroid(luminance(rt.caustic), all, b);
+        centroid(linearLuminance(ref.caustic), all, a);
+        centroid(linearLuminance(rt.caustic), all, b);
         std::cout << "[ caustics ] flux ratio over the whole image (sphere excluded): " << b / a
                   << "\n";
     }
@@ -255,7 +245,7 @@ std::vector<HardCase> hardCases() {
 }
 
 double smoothedPeak(const cv::Mat& rgb) {
-    cv::Mat y = luminance(rgb);
+    cv::Mat y = linearLuminance(rgb);
     cv::blur(y, y, cv::Size(3, 3));
     double peak = 0;
     cv::minMaxLoc(y, nullptr, &peak);
@@ -273,10 +263,10 @@ TEST_P(CausticHardCase, FiniteNoFireflyNoExtraEnergy) {
     save("hard_" + GetParam().name, ref, rt);
     EXPECT_TRUE(rt.report.ran("caustic")) << rt.report.summary();
     double lit = 0;
-    cv::minMaxLoc(luminance(srgbBgr8ToLinearRgb(ref.footage)), nullptr, &lit);
+    cv::minMaxLoc(linearLuminance(srgbBgr8ToLinearRgb(ref.footage)), nullptr, &lit);
     const double peakRt = smoothedPeak(rt.caustic), peakRef = smoothedPeak(ref.caustic);
-    const double sumRt = cv::sum(luminance(rt.caustic))[0],
-                 sumRef = cv::sum(luminance(ref.caustic))[0];
+    const double sumRt = cv::sum(linearLuminance(rt.caustic))[0],
+                 sumRef = cv::sum(linearLuminance(ref.caustic))[0];
     std::cout << "[ caustics ] hard case " << GetParam().name << ": peak " << peakRt
               << " (reference " << peakRef << "), total " << sumRt << " (reference " << sumRef
               << "), lit peak " << lit << "\n";
@@ -309,8 +299,8 @@ TEST(CausticRouting, CausticReachesLrOnlyWhenLightObjectAndReceiverAreReal) {
         Renderer r(s.scene, s.cam, opt);
         const FrameReport& rep = r.render({s.pose, cv::Mat(), true});
         ASSERT_TRUE(rep.ran("caustic")) << rep.summary();
-        const double rv = cv::sum(luminance(r.readBuffer(Resource::CausticRv)))[0];
-        const double lr = cv::sum(luminance(r.readBuffer(Resource::CausticR)))[0];
+        const double rv = cv::sum(linearLuminance(r.readBuffer(Resource::CausticRv)))[0];
+        const double lr = cv::sum(linearLuminance(r.readBuffer(Resource::CausticR)))[0];
         std::cout << "[ caustics ] light " << (o.lightReal ? "R" : "V") << ", glass "
                   << (o.sphereReal ? "R" : "V") << ", table " << (o.tableReal ? "R" : "V")
                   << ": caustic in L_rv " << rv << ", in L_r " << lr << "\n";

@@ -25,11 +25,7 @@
 namespace mirage::render {
 namespace {
 
-cv::Mat luminance(const cv::Mat& rgb) {
-    cv::Mat y;
-    cv::transform(rgb, y, cv::Matx13f(0.2126f, 0.7152f, 0.0722f));
-    return y;
-}
+using test::linearLuminance;
 
 // Pixels that see the mirror's front (not the sphere), 1 px in from its outline. CV_8U 255 / 0.
 cv::Mat mirrorMask(const test::CausticScene& s) {
@@ -78,20 +74,13 @@ struct Reference {
 
 Reference reference(const test::CausticScene& s, int spp) {
     const test::CausticReferenceRender ref = test::renderCausticReference(s, spp, 11);
-    const raytrace::DifferentialImages& on = ref.on;
     Reference r;
     r.footage = ref.footage;
     r.compositeSrgb = ref.compositeSrgb;
     r.caustic = ref.caustic;
     r.mirror = mirrorMask(s);
-    // As the camera-space caustic's region (CausticAccuracy_test.cpp): the caustic smoothed over
-    // 5x5 px against the photon map's noise adds > 5 % to L_rv, where L_rv > 5 % of the
-    // brightest directly lit real surface; here only in the mirror.
-    cv::Mat yc = luminance(r.caustic), yon = luminance(on.realAndVirtual);
-    cv::GaussianBlur(yc, yc, cv::Size(5, 5), 1.0);
-    double peak = 0;
-    cv::minMaxLoc(luminance(on.realOnly), nullptr, &peak);
-    r.region = (yc > 0.05 * yon) & (yon > 0.05 * peak) & r.mirror;
+    // The camera-space caustic's region (CausticReference.h), here only in the mirror.
+    r.region = ref.region & r.mirror;
     return r;
 }
 
@@ -132,7 +121,7 @@ void save(const std::string& name, const Reference& ref, const Realtime& on, con
 // The caustic seen in the mirror alone: L'_rv with the gather on minus off, over the mirror.
 cv::Mat gatheredCaustic(const Realtime& on, const Realtime& off, const cv::Mat& mirror) {
     cv::Mat d = cv::Mat::zeros(on.specRv.size(), CV_32F);
-    cv::Mat(cv::max(luminance(on.specRv - off.specRv), 0.0f)).copyTo(d, mirror);
+    cv::Mat(cv::max(linearLuminance(on.specRv - off.specRv), 0.0f)).copyTo(d, mirror);
     return d;
 }
 
@@ -162,7 +151,7 @@ TEST(CausticGather, CausticSeenInMirrorMatchesReferenceAndGatherOffFails) {
     const double psnrOn = test::psnr(on.composite, ref.compositeSrgb, 255.0, ref.region);
     const double psnrOff = test::psnr(off.composite, ref.compositeSrgb, 255.0, ref.region);
     const double fluxRatio = cv::sum(gatheredCaustic(on, off, ref.mirror))[0] /
-                             cv::sum(masked(luminance(ref.caustic), ref.mirror))[0];
+                             cv::sum(masked(linearLuminance(ref.caustic), ref.mirror))[0];
     std::cout << "[ caustic gather ] mirror " << cv::countNonZero(ref.mirror) << " px, region "
               << regionPx << " px: PSNR " << psnrOn << " dB (gather off " << psnrOff
               << " dB); caustic flux seen in the mirror " << fluxRatio << " x the reference's\n";
@@ -210,9 +199,9 @@ TEST(CausticGather, FocusedCausticInMirrorHasNoFirefly) {
     save("gather_mirror_focused", ref, on, off);
     ASSERT_TRUE(on.report.ran("photongrid")) << on.report.summary();
     double lit = 0;
-    cv::minMaxLoc(luminance(srgbBgr8ToLinearRgb(ref.footage)), nullptr, &lit);
+    cv::minMaxLoc(linearLuminance(srgbBgr8ToLinearRgb(ref.footage)), nullptr, &lit);
     cv::Mat rt = gatheredCaustic(on, off, ref.mirror),
-            rf = masked(luminance(ref.caustic), ref.mirror);
+            rf = masked(linearLuminance(ref.caustic), ref.mirror);
     cv::blur(rt, rt, cv::Size(3, 3));
     cv::blur(rf, rf, cv::Size(3, 3));
     double peakRt = 0, peakRef = 0;
@@ -238,8 +227,8 @@ TEST(CausticGather, GatheredCausticReachesLrOnlyWhenLightObjectAndReceiverAreRea
         test::mirrorView(s, 64, 48, 88.0);
         const cv::Mat none(s.cam.height, s.cam.width, CV_8UC3, cv::Scalar(0, 0, 0));
         const Realtime on = realtime(s, none, true), off = realtime(s, none, false);
-        const double rv = cv::sum(luminance(on.specRv - off.specRv))[0];
-        const double lr = cv::sum(luminance(on.specR - off.specR))[0];
+        const double rv = cv::sum(linearLuminance(on.specRv - off.specRv))[0];
+        const double lr = cv::sum(linearLuminance(on.specR - off.specR))[0];
         std::cout << "[ caustic gather ] light " << (o.lightReal ? "R" : "V") << ", glass "
                   << (o.sphereReal ? "R" : "V") << ", table " << (o.tableReal ? "R" : "V")
                   << ": caustic in L'_rv " << rv << ", in L'_r " << lr << "\n";

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/image/ImageIO.h"
 #include "render/raytrace/DifferentialRendering.h"
@@ -19,7 +20,18 @@ struct CausticReferenceRender {
     cv::Mat footage;                  // 8-bit sRGB BGR: L_r as footage
     cv::Mat compositeSrgb;            // 8-bit sRGB BGR: the reference composite
     cv::Mat caustic;                  // linear RGB: L_rv(caustics on) - L_rv(caustics off), >= 0
+    // CV_8U: the caustic region, where the caustic (smoothed over 5x5 px against the photon
+    // map's noise) adds > 5 % to L_rv and L_rv > 5 % of the brightest directly lit real surface
+    // (the lit table, not the dark room). Each test narrows it to what it judges.
+    cv::Mat region;
 };
+
+// Luminance (Rec. 709 weights) of a linear RGB float image, CV_32F.
+inline cv::Mat linearLuminance(const cv::Mat& rgb) {
+    cv::Mat y;
+    cv::transform(rgb, y, cv::Matx13f(0.2126f, 0.7152f, 0.0722f));
+    return y;
+}
 
 inline CausticReferenceRender renderCausticReference(const CausticScene& s, int spp,
                                                      uint64_t seed) {
@@ -39,6 +51,12 @@ inline CausticReferenceRender renderCausticReference(const CausticScene& s, int 
     r.compositeSrgb =
         linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), r.on));
     r.caustic = cv::max(r.on.realAndVirtual - off.radiance, 0.0);
+    cv::Mat yc = linearLuminance(r.caustic);
+    const cv::Mat yon = linearLuminance(r.on.realAndVirtual);
+    cv::GaussianBlur(yc, yc, cv::Size(5, 5), 1.0);
+    double peak = 0;
+    cv::minMaxLoc(linearLuminance(r.on.realOnly), nullptr, &peak);
+    r.region = (yc > 0.05 * yon) & (yon > 0.05 * peak);
     return r;
 }
 
