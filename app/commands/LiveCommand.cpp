@@ -476,6 +476,14 @@ void runLive(const LiveArgs& a) {
         applyPlacement(placed, p, plane);
         return placed;
     };
+    // The scene as placed for in-place moves, in every frame of a drag: copied once (meshes,
+    // textures), then only its node matrices are reset and placed again.
+    Scene moving = scene;
+    auto movedScene = [&](const ScenePlacement& p) -> const Scene& {
+        moving.nodes = scene.nodes;
+        applyPlacement(moving, p, plane);
+        return moving;
+    };
 
     std::optional<EnvironmentInput> envCam;
     if (!a.envCamera.empty()) {
@@ -850,7 +858,7 @@ void runLive(const LiveArgs& a) {
                 // The objects follow in the next frame: moved in place (shadows, indirect light,
                 // caustics and impostors redone in that frame), or, for a translucent object
                 // whose voxel number map lies in the world, by a new renderer once the keys rest.
-                needsRebuild = needsRebuild || !renderer->updateTransforms(placedScene(placement));
+                needsRebuild = needsRebuild || !renderer->updateTransforms(movedScene(placement));
             }
         }
         ImGui::SetNextWindowPos({float(fbw - kHudWidth), 0});
