@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -131,6 +132,10 @@ TEST_F(MovingObjects, AnotherSceneIsRefusedAndNothingChanges) {
     std::erase_if(fewer.roots, [&](int n) { return fewer.nodes[size_t(n)].name == "yellow_box"; });
     ASSERT_EQ(fewer.meshInstances().size() + 1, t.scene.meshInstances().size());
     EXPECT_THROW(r.updateTransforms(fewer), Error);
+    Scene broken = moved(t.scene);  // a NaN transform (a broken animation) is refused
+    for (Node& n : broken.nodes)
+        if (n.name == "yellow_box") n.world[3][0] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THROW(r.updateTransforms(broken), Error);
     Scene noLights = moved(t.scene);
     noLights.lights.clear();
     EXPECT_THROW(r.updateTransforms(noLights), Error);
