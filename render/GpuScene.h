@@ -111,6 +111,8 @@ public:
     std::string lightingDefines(bool withGlass = true) const;
     bool hasTransmissive() const;
     bool hasTranslucent() const;
+    // Some draw has a metallic-roughness texture (else the G-buffer skips that texture read).
+    bool hasMetallicRoughnessTextures() const;
     // The medium of GPU material index `material` (DrawItem::material); null unless translucent.
     const GpuMedium* medium(int material) const;
     // Indices into draws() of the specular (mirror / glass) items, in draw order.

@@ -3,9 +3,10 @@
 #include "render/FrameGraph.h"
 namespace mirage::render {
 
-GBufferPass::GBufferPass()
-    : program_(
-          rasterProgram("gbuffer", "passes/gbuffer/gbuffer.vert", "passes/gbuffer/gbuffer.frag")) {
+GBufferPass::GBufferPass(bool metallicRoughnessMaps)
+    : program_(rasterProgram(
+          "gbuffer", "passes/gbuffer/gbuffer.vert", "passes/gbuffer/gbuffer.frag",
+          metallicRoughnessMaps ? "#define MIRAGE_METALLIC_ROUGHNESS_MAPS 1\n" : "")) {
     locSpecularSlot_ = program_.uniformLocation("specularSlot");
 }
 

@@ -7,7 +7,9 @@ namespace mirage::render {
 
 class GBufferPass final : public RenderPass {
 public:
-    GBufferPass();
+    // metallicRoughnessMaps false: the shader skips the metallic-roughness texture read (a scene
+    // without such textures; llvmpipe pays for every texture read).
+    explicit GBufferPass(bool metallicRoughnessMaps = true);
     const char* name() const override { return "gbuffer"; }
     void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;

@@ -25,7 +25,11 @@ void main() {
     gPosition = vec4(worldPos, float(origin));
     // glTF: the factors times the texture's G (roughness) and B (metallic), per pixel, so a
     // rough-glass object can be frosted in parts (render/passes/rough reads gNormal.w).
+#ifdef MIRAGE_METALLIC_ROUGHNESS_MAPS
     vec4 mr = texture(metallicRoughnessMap, uv);
+#else
+    const vec4 mr = vec4(1.0);  // no draw of the scene has the texture: the factors alone
+#endif
     gNormal = vec4(n, clamp(m.roughness * mr.g, 0.02, 1.0));
     gAlbedo = vec4((m.baseColor.rgb * texture(baseColorMap, uv).rgb), clamp(m.metallic * mr.b, 0.0, 1.0));
     gEmissive = vec4(m.emissive, m.translucent == 1 ? -1.0 : float(specularSlot + 1));
