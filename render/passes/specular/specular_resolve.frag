@@ -81,10 +81,11 @@ void main() {
         vec3 sumRv = vec3(0.0), sumR = vec3(0.0), bestRv = vec3(0.0), bestR = vec3(0.0);
         float sumW = 0.0, bestScore = -1.0;
         for (int c = 0; c < 4; ++c) {
-            vec4 Pc = k == 0 ? texelFetch(reflPosition, rep[c], 0) : texelFetch(refrPosition, rep[c], 0);
-            vec3 Nc = (k == 0 ? texelFetch(reflNormal, rep[c], 0) : texelFetch(refrNormal, rep[c], 0)).xyz;
-            vec3 hrv = (k == 0 ? texelFetch(halfReflRv, q[c], 0) : texelFetch(halfRefrRv, q[c], 0)).rgb;
-            vec3 hr = (k == 0 ? texelFetch(halfReflR, q[c], 0) : texelFetch(halfRefrR, q[c], 0)).rgb;
+            ivec2 rc = rep[c], qc = q[c];
+            vec4 Pc = k == 0 ? texelFetch(reflPosition, rc, 0) : texelFetch(refrPosition, rc, 0);
+            vec3 Nc = (k == 0 ? texelFetch(reflNormal, rc, 0) : texelFetch(refrNormal, rc, 0)).xyz;
+            vec3 hrv = (k == 0 ? texelFetch(halfReflRv, qc, 0) : texelFetch(halfRefrRv, qc, 0)).rgb;
+            vec3 hr = (k == 0 ? texelFetch(halfReflR, qc, 0) : texelFetch(halfRefrR, qc, 0)).rgb;
             float plane = dot(N, Pc.xyz - P.xyz) / sigma;
             float geometry = int(Pc.w + 0.5) == origin && sameSlot[c]
                                  ? exp(-min(plane * plane, 30.0)) * pow(max(dot(N, Nc), 0.0), 8.0)
