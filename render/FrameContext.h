@@ -88,6 +88,16 @@ struct RendererOptions {
     // pixels. 16 costs a third of 4's speclight time and the tabletop bench cannot tell them
     // apart, but the 4x4 pattern costs 0.07 SSIM over a small glass sphere (docs/specular.md).
     int specularVplStride = 4;
+    // Specular lighting (speclight) at half the canvas resolution per axis: each 2x2 block's
+    // first specular pixel is shaded (lights, VPLs, caustic photons at its hits) and the canvas
+    // pixels take the hit radiance from the four half pixels around them, weighted by how well
+    // the representatives' hits match theirs (same object, tangent plane, normal), multiplied
+    // back by their own hit albedo, Fresnel weight and emission; L_env stays per pixel
+    // (specular_resolve.frag, docs/specular.md "Cost"). false: every specular pixel is shaded.
+    bool specularHalfResolution = false;
+    // Tests only: false drops the upsample's geometry test (plain bilinear weights; halos at
+    // depth steps in the reflections).
+    bool specularUpsampleGeometry = true;
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
     // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
     bool reuseStaticPasses = true;

@@ -112,6 +112,11 @@ const int kUnitSpecLightPosition = 14;
 const int kUnitEnvironmentMap = 15;
 const int kUnitSpecLightGlassAll = 24;  // above the impostor units
 const int kUnitSpecLightGlassReal = 25;
+// specular_resolve.frag (the half-resolution upsample): GBuf_refl / GBuf_refr at the units above,
+// the half-resolution hit radiance (reflected L_rv, L_r, refracted L_rv, L_r) and the primary
+// G-buffer's emissive (a = specular slot + 1).
+const int kUnitSpecResolveHalfFirst = 10;  // .. + 3
+const int kUnitSpecResolveSlot = 14;
 
 // photon_gbuffer.frag (passes/caustic): the light's back faces of the specular objects and the
 // shadow maps (light visibility of the photon's first surface); trace.glsl's units above.

@@ -165,6 +165,22 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.specularVplStride = n;
          },
          [](const BenchConfig& c) { return std::to_string(c.options.specularVplStride); }},
+        {"specular_resolution",
+         "resolution of the lighting at the reflected/refracted hits: full (every specular "
+         "pixel) or half (one pixel per 2x2 block, upsampled by hit geometry)",
+         [](const CameraIntrinsics&, bool) {
+             return std::vector<std::string>{RendererOptions{}.specularHalfResolution ? "half"
+                                                                                      : "full"};
+         },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "full" && v != "half")
+                 throw Error(
+                     fmt::format("bench: knob specular_resolution: '{}' is not full or half", v));
+             c.options.specularHalfResolution = v == "half";
+         },
+         [](const BenchConfig& c) {
+             return std::string(c.options.specularHalfResolution ? "half" : "full");
+         }},
         {"virtual",
          "on: composite the virtual objects; off: the composite is the footage unchanged (a "
          "sanity point: it must score as the footage-only row, and any configuration that does "

@@ -191,12 +191,14 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=2 "
-              "refraction_steps=16 specular_vpl_stride=4 virtual=on "
-              "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
-              "caustic_gather=on caustic_radius=1 "
-              "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
-              "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 moving_objects=off "
-              "env_source=static env_resolution=512 env_lights=0");
+              "refraction_steps=16 specular_vpl_stride=4 specular_resolution=" +
+                  std::string(RendererOptions{}.specularHalfResolution ? "half" : "full") +
+                  " virtual=on "
+                  "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
+                  "caustic_gather=on caustic_radius=1 "
+                  "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
+                  "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 moving_objects=off "
+                  "env_source=static env_resolution=512 env_lights=0");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";
@@ -357,6 +359,9 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_EQ(defaults.at("specular_vpl_stride"),
               std::to_string(RendererOptions{}.specularVplStride));
     EXPECT_THROW(benchGrid(cam, true, {{"specular_vpl_stride", {"8"}}}), Error);
+    EXPECT_EQ(defaults.at("specular_resolution"),
+              RendererOptions{}.specularHalfResolution ? "half" : "full");
+    EXPECT_THROW(benchGrid(cam, true, {{"specular_resolution", {"quarter"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"refraction_steps", {"1"}}}), Error);
 }
 

@@ -4,10 +4,19 @@
 
 namespace mirage::render {
 
+namespace {
+// Scenes without a translucent object never take direct.frag's translucency branch.
+std::string translucencyDefines(const GpuScene& scene) {
+    return scene.hasTranslucent() ? std::string() : "#define MIRAGE_NO_TRANSLUCENCY 1\n";
+}
+}  // namespace
+
 DirectLightPass::DirectLightPass(const GpuScene& scene)
-    : program_(fullscreenProgram("direct", "passes/direct/direct.frag", scene.lightingDefines())),
-      programNoGlass_(fullscreenProgram("direct (no glass shadows)", "passes/direct/direct.frag",
-                                        scene.lightingDefines(false))) {}
+    : program_(fullscreenProgram("direct", "passes/direct/direct.frag",
+                                 scene.lightingDefines() + translucencyDefines(scene))),
+      programNoGlass_(
+          fullscreenProgram("direct (no glass shadows)", "passes/direct/direct.frag",
+                            scene.lightingDefines(false) + translucencyDefines(scene))) {}
 
 void DirectLightPass::setup(PassBuilder& b) const {
     b.read(Resource::GBufferPosition);

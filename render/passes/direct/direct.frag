@@ -20,7 +20,8 @@ layout(binding = kUnitDirectGlassReal) uniform sampler2DArray glassReal;
 #endif
 // The translucency pass's radiance leaving each surface voxel of the translucent objects
 // (before the exit F_t): per object its S vec4 for L_rv, then its S for L_r (translucency.glsl).
-// Read only when translucentOn.
+// Read only when translucentOn. Scenes without a translucent object compile without this code
+// (MIRAGE_NO_TRANSLUCENCY): llvmpipe runs an untaken branch's buffer reads for every pixel.
 layout(std430, binding = kBindingTranslucentRadiance) readonly buffer TranslucentRadianceBlock {
     vec4 translucentL[];
 };
@@ -50,6 +51,7 @@ void main() {
     // camera (VnmShading::scattered), instead of the surface BRDF: L_rv from all lights, L_r from
     // real lights with the real-only shadow maps (and nothing on a virtual object, as for any
     // virtual pixel). An object beyond the ones with a map has no voxel: shaded as a surface.
+#ifndef MIRAGE_NO_TRANSLUCENCY  // the variant for scenes without translucent objects
     int object, voxel;
     if (translucentOn == 1 && Em.a < -0.5 && translucentVoxelAt(p, object, voxel)) {
         TranslucentObjectGpu obj = translucentObjects[object];
@@ -63,6 +65,7 @@ void main() {
         outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
         return;
     }
+#endif
     for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, p, wi, E);

@@ -1,5 +1,7 @@
 #include "render/passes/specular/SpecularLightPass.h"
 
+#include <array>
+
 #include "render/FrameGraph.h"
 #include "render/passes/caustic/PhotonGridPass.h"
 
@@ -26,16 +28,29 @@ SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
 }
 
 SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOptions& options)
-    : plain_(makeVariant("specular light", scene.lightingDefines())) {
-    if (PhotonGridPass::sceneCanGather(scene, options))
+    : plain_(makeVariant("specular light", scene.lightingDefines())),
+      sceneCanGather_(PhotonGridPass::sceneCanGather(scene, options)) {
+    if (sceneCanGather_)
         gather_ = makeVariant("specular light (caustic gather)",
                               scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
+    if (options.specularHalfResolution) {
+        const std::string half = scene.lightingDefines() + "#define MIRAGE_SPECULAR_HALF 1\n";
+        halfPlain_ = makeVariant("specular light (half resolution)", half);
+        if (sceneCanGather_)
+            halfGather_ = makeVariant("specular light (half resolution, caustic gather)",
+                                      half + "#define MIRAGE_CAUSTIC_GATHER 1\n");
+        resolve_ =
+            fullscreenProgram("specular light upsample", "passes/specular/specular_resolve.frag");
+        halfMaskProgram_ = fullscreenProgram("specular half-resolution mask",
+                                             "passes/specular/specular_half_mask.frag");
+    }
 }
 
 void SpecularLightPass::setup(PassBuilder& b) const {
     for (Resource r : kHitBuffers) b.read(r);
     b.read(Resource::GBufferPosition);
-    b.read(Resource::SpecularMask);  // depth attachment: shade specular pixels only
+    b.read(Resource::GBufferEmissive);  // the specular slot (half-resolution upsample)
+    b.read(Resource::SpecularMask);     // depth attachment: shade specular pixels only
     b.read(Resource::EnvironmentMap);
     b.read(Resource::EnvironmentLight);
     for (Resource r :
@@ -55,7 +70,8 @@ PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
                       (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
                       (vpls ? " + VPLs" : "") +
                       (PhotonGridPass::gatherDecision(ctx).run ? " + caustic photons" : "") +
-                      " at the reflected/refracted hits"};
+                      " at the reflected/refracted hits" +
+                      (ctx.options.specularHalfResolution ? ", half resolution" : "")};
 }
 
 void SpecularLightPass::resize(const FrameContext& ctx) {
@@ -74,6 +90,71 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(3, env_);
     fbo_.finalize(4);
     attachedMask_ = 0;  // execute() attaches the specular mask
+    if (!ctx.options.specularHalfResolution) return;
+    halfWidth_ = (w + 1) / 2;
+    halfHeight_ = (h + 1) / 2;
+    const int hw = halfWidth_, hh = halfHeight_;
+    halfReflRv_ = gl::Texture::create2D("half L_rv at the reflected hit", hw, hh, GL_RGBA16F);
+    halfReflR_ = gl::Texture::create2D("half L_r at the reflected hit", hw, hh, GL_RGBA16F);
+    halfRefrRv_ = gl::Texture::create2D("half L_rv at the refracted hit", hw, hh, GL_RGBA16F);
+    halfRefrR_ = gl::Texture::create2D("half L_r at the refracted hit", hw, hh, GL_RGBA16F);
+    for (gl::Texture* t : {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_})
+        t->setFilter(GL_NEAREST, GL_NEAREST);
+    halfMask_ = gl::Texture::create2D("half specular pixel mask", hw, hh, GL_DEPTH_COMPONENT32F);
+    halfMaskFbo_ = gl::Framebuffer("half specular pixel mask fbo");
+    halfMaskFbo_.attachDepth(halfMask_);
+    halfMaskFbo_.finalize(0);
+    halfFbo_ = gl::Framebuffer("half specular light fbo");
+    halfFbo_.attachColor(0, halfReflRv_);
+    halfFbo_.attachColor(1, halfReflR_);
+    halfFbo_.attachColor(2, halfRefrRv_);
+    halfFbo_.attachColor(3, halfRefrR_);
+    halfFbo_.attachDepth(halfMask_);
+    halfFbo_.finalize(4);
+}
+
+void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& res,
+                                            const Variant& v) {
+    // The scissor rectangle in half pixels, rounded outwards.
+    const glm::ivec4& s = ctx.specularScissor;
+    const glm::ivec4 halfRect{s.x / 2, s.y / 2, (s.x + s.z + 1) / 2 - s.x / 2,
+                              (s.y + s.w + 1) / 2 - s.y / 2};
+    halfMaskFbo_.bind();
+    ctx.beginFullscreen(halfMaskProgram_, halfWidth_, halfHeight_);
+    glDepthMask(GL_TRUE);
+    glClearBufferfv(GL_DEPTH, 0, std::array<float, 1>{1.0f}.data());
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    ctx.drawFullscreenTriangleIn(halfRect, 0);
+    halfFbo_.bind();
+    ctx.beginFullscreen(v.program, halfWidth_, halfHeight_);
+    setUniforms(ctx, res, v);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_FALSE);
+    ctx.drawFullscreenTriangleIn(halfRect, 4);
+    // The upsample, on the canvas's specular pixels.
+    fbo_.bind();
+    ctx.beginFullscreen(resolve_, ctx.canvasWidth(), ctx.canvasHeight());
+    const gl::Texture* half[4] = {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_};
+    for (int i = 0; i < 4; ++i)
+        glBindTextureUnit(GLuint(kUnitSpecResolveHalfFirst + i), half[i]->id());
+    glBindTextureUnit(kUnitSpecResolveSlot, res.texture(Resource::GBufferEmissive).id());
+    glUniform1i(resolve_.uniformLocation("geometryTest"),
+                ctx.options.specularUpsampleGeometry ? 1 : 0);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_FALSE);
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+}
+
+void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
+                                    const Variant& v) const {
+    if (v.cellSize >= 0) glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
+    const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
+                      res.has(Resource::ImperfectShadowMaps);
+    glUniform1i(v.useVpls, vpls ? 1 : 0);
+    glUniform1i(v.vplStride, ctx.options.specularVplStride);
 }
 
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
@@ -83,13 +164,10 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
         fbo_.finalize(4);
         attachedMask_ = mask.id();
     }
-    fbo_.bind();
     // The gather variant only in frames with a photon grid: llvmpipe pays for a branch's buffer
     // reads even when no pixel takes it.
-    const bool gather = gather_.program.id() != 0 && res.has(Resource::PhotonGrid) &&
-                        res.has(Resource::PhotonRecords);
-    const Variant& v = gather ? gather_ : plain_;
-    ctx.beginFullscreen(v.program, ctx.canvasWidth(), ctx.canvasHeight());
+    const bool gather =
+        sceneCanGather_ && res.has(Resource::PhotonGrid) && res.has(Resource::PhotonRecords);
     for (int i = 0; i < 10; ++i)
         glBindTextureUnit(GLuint(kUnitSpecLightReflFirst + i), res.texture(kHitBuffers[i]).id());
     glBindTextureUnit(kUnitSpecLightShadowAll,
@@ -122,16 +200,21 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
                          res.buffer(Resource::PhotonGrid).id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons,
                          res.buffer(Resource::PhotonRecords).id());
-        glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
     }
-    glUniform1i(v.useVpls, vpls ? 1 : 0);
-    glUniform1i(v.vplStride, ctx.options.specularVplStride);
-    // Only specular pixels pass the early depth test against the mask (the triangle lies at
-    // depth 0.5); the rest stay 0 (not a specular pixel).
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_FALSE);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+    if (ctx.options.specularHalfResolution && halfPlain_.program.id() != 0) {
+        shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_);
+    } else {
+        const Variant& v = gather ? gather_ : plain_;
+        fbo_.bind();
+        ctx.beginFullscreen(v.program, ctx.canvasWidth(), ctx.canvasHeight());
+        setUniforms(ctx, res, v);
+        // Only specular pixels pass the early depth test against the mask (the triangle lies at
+        // depth 0.5); the rest stay 0 (not a specular pixel).
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+    }
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);

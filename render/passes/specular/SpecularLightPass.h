@@ -24,11 +24,21 @@ private:
         GLint useVpls = -1, vplStride = -1, cellSize = -1;
     };
     static Variant makeVariant(const char* label, const std::string& defines);
+    void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
+    void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v);
     Variant plain_, gather_;  // gather_: only for scenes that can have caustics
     gl::Texture rv_, r_, rRefl_, env_;
     gl::Framebuffer fbo_;
     GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
     int width_ = 0, height_ = 0;
+    // RendererOptions::specularHalfResolution: the half-resolution variants (built on first use),
+    // the upsample, the half-size specular-pixel mask and hit radiance.
+    bool sceneCanGather_ = false;
+    Variant halfPlain_, halfGather_;
+    gl::Program resolve_, halfMaskProgram_;
+    gl::Texture halfReflRv_, halfReflR_, halfRefrRv_, halfRefrR_, halfMask_;
+    gl::Framebuffer halfFbo_, halfMaskFbo_;
+    int halfWidth_ = 0, halfHeight_ = 0;
 };
 
 }  // namespace mirage::render

@@ -27,6 +27,12 @@ vec3 schlickColour(vec3 f0, float cosTheta) {
     return f0 + (1.0 - f0) * (c2 * c2 * c);
 }
 
+// Half-resolution specular lighting (specular_light.frag MIRAGE_SPECULAR_HALF,
+// specular_resolve.frag): hit radiance is stored divided by (albedo + this floor) and multiplied
+// back by the full-resolution hit's, so texture detail at the hits stays sharp; the floor keeps
+// black hits finite.
+const float kSpecularDemodulationFloor = 0.05;
+
 // Environment radiance (linear, intensity applied) in world direction l from the
 // equirectangular map: u = 0.5 + (atan2(l.x, -l.z) - rotation) / 2pi, v = acos(l.y) / pi
 // (GpuScene::environmentMap, the reference renderer's convention).

@@ -15,6 +15,12 @@
 // instead (Sec. 4.1.3); L'_rv and L'_r stay untouched there. Linear radiance throughout.
 // Variant MIRAGE_CAUSTIC_GATHER (frames with a world-space photon grid): each hit also gathers
 // the caustic photons around it (caustic.glsl gatherCaustic), routed as the camera's caustic.
+// Variant MIRAGE_SPECULAR_HALF (RendererOptions::specularHalfResolution): drawn at half the
+// canvas size per axis; half pixel q shades ONE specular canvas pixel of its 2x2 block (the first
+// in row order: its representative) and writes each hit's radiance unweighted, without emission
+// and divided by (albedo + kSpecularDemodulationFloor), so that specular_resolve.frag can
+// upsample it by hit geometry and put back the full-resolution Fresnel weight, albedo, emission
+// and environment. The VPL interleaving tiles then cover 2x2 half pixels (4x4 canvas pixels).
 in vec2 uv;
 layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
 layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
@@ -39,11 +45,20 @@ layout(binding = kUnitSpecLightPosition) uniform sampler2D gPosition;  // primar
 layout(binding = kUnitEnvironmentMap) uniform sampler2D envMap;
 uniform int useVpls;    // 1 when VPLs (and their ISMs) exist this frame
 uniform int vplStride;  // interleaving: pixel p sums VPLs g, g + stride, ... (g from p), x stride
+#ifdef MIRAGE_SPECULAR_HALF
+// Hit radiance of the block's representative (rgb, see above). outReflRv.a = 1 + the
+// representative's index in the 2x2 block (x + 2 y), 0 where the block has no specular pixel.
+layout(location = 0) out vec4 outReflRv;  // reflected hit, L_rv
+layout(location = 1) out vec4 outReflR;   // reflected hit, L_r
+layout(location = 2) out vec4 outRefrRv;  // refracted hit, L_rv
+layout(location = 3) out vec4 outRefrR;   // refracted hit, L_r
+#else
 layout(location = 0) out vec4 outRv;     // L'_rv
 layout(location = 1) out vec4 outR;      // L'_r
 layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r (for Eq. 9, see
                                          // composite.frag)
 layout(location = 3) out vec4 outEnv;    // L_env; a = 1 on specular pixels
+#endif
 
 float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
     int tile = ismTileSize, perRow = ismTilesPerRow;
@@ -106,6 +121,69 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
     if (xReal) r += emissive;
 }
 
+#ifdef MIRAGE_SPECULAR_HALF
+void main() {
+    // The representative: the first specular canvas pixel of this half pixel's 2x2 block.
+    ivec2 block = 2 * ivec2(gl_FragCoord.xy), size = textureSize(reflEmissive, 0);
+    int rep = -1;
+    for (int i = 3; i >= 0; --i) {
+        ivec2 c = block + ivec2(i & 1, i >> 1);
+        if (all(lessThan(c, size)) && texelFetch(reflEmissive, c, 0).a >= 0.5) rep = i;
+    }
+    ivec2 px = block + ivec2(max(rep, 0) & 1, max(rep, 0) >> 1);
+#ifdef MIRAGE_CAUSTIC_GATHER
+    // Footprints from the neighbouring half pixels' representatives (2 canvas pixels apart: the
+    // kernel must cover the half-resolution sample spacing).
+    vec3 pSpec = texelFetch(gPosition, px, 0).xyz;
+    float toCamera = distance(cameraPos.xyz, pSpec);
+    float footprint[2];
+    for (int k = 0; k < 2; ++k) {
+        vec3 h = (k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0)).xyz;
+        vec3 nh = (k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0)).xyz;
+        float cosHit = abs(dot(nh, normalize(pSpec - h + vec3(0.0, 0.0, 1e-9))));
+        footprint[k] = gatherFootprint(dFdx(h), dFdy(h), toCamera + distance(pSpec, h), cosHit);
+    }
+#endif
+    outReflRv = vec4(0.0);
+    outReflR = vec4(0.0);
+    outRefrRv = vec4(0.0);
+    outRefrR = vec4(0.0);
+    if (rep < 0) return;  // no specular pixel in the block
+    vec3 hitRv[2], hitR[2];
+    for (int k = 0; k < 2; ++k) {
+        hitRv[k] = vec3(0.0);
+        hitR[k] = vec3(0.0);
+        vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
+        vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
+        int origin = int(P.w + 0.5);
+        if (all(lessThanEqual(w, vec3(0.0))) || origin == ORIGIN_NONE) continue;
+        vec4 N = k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0);
+        vec4 A = k == 0 ? texelFetch(reflAlbedo, px, 0) : texelFetch(refrAlbedo, px, 0);
+        vec3 v = normalize(texelFetch(gPosition, px, 0).xyz - P.xyz);
+        if (!allFinite(v)) v = N.xyz;
+        int st = max(vplStride, 1), side = st >= 16 ? 4 : (st >= 4 ? 2 : 1);
+        ivec2 q = ivec2(gl_FragCoord.xy);
+        int firstVpl = (q.x % side + side * (q.y % side)) % st;
+        vec3 hrv, hr;
+        shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, vec3(0.0), firstVpl,
+                 hrv, hr);
+#ifdef MIRAGE_CAUSTIC_GATHER
+        vec3 eRv, eR, crv, cr;
+        gatherCaustic(P.xyz, N.xyz, footprint[k], eRv, eR);
+        causticRadiance(eRv, eR, A.rgb, A.a, origin == ORIGIN_REAL, crv, cr);
+        hrv += crv;
+        hr += cr;
+#endif
+        vec3 demodulate = 1.0 / (A.rgb + kSpecularDemodulationFloor);
+        hitRv[k] = allFinite(hrv) ? hrv * demodulate : vec3(0.0);
+        hitR[k] = allFinite(hr) ? hr * demodulate : vec3(0.0);
+    }
+    outReflRv = vec4(hitRv[0], float(1 + rep));
+    outReflR = vec4(hitR[0], 1.0);
+    outRefrRv = vec4(hitRv[1], 1.0);
+    outRefrR = vec4(hitR[1], 1.0);
+}
+#else
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
 #ifdef MIRAGE_CAUSTIC_GATHER
@@ -164,3 +242,4 @@ void main() {
     outRRefl = vec4(allFinite(rRefl) ? rRefl : vec3(0.0), 1.0);
     outEnv = vec4(allFinite(env) ? env : vec3(0.0), 1.0);
 }
+#endif
