@@ -56,6 +56,52 @@ double imageSharpness(const cv::Mat& grey) {
     return weakest / range;
 }
 
+cv::Rect texturedRegion(const cv::Mat& grey) {
+    constexpr int block = 8;
+    const int bw = grey.cols / block, bh = grey.rows / block;
+    if (grey.empty() || grey.type() != CV_8UC1 || bw < 1 || bh < 1) return {};
+    // Per block: the intensity range over every second pixel of every second row (a tag's
+    // border cell is at least 2 px wide wherever libapriltag can find the tag).
+    std::vector<uint8_t> lo(size_t(bw * bh), 255), hi(size_t(bw * bh), 0);
+    for (int y = 0; y < bh * block; y += 2) {
+        const uint8_t* row = grey.ptr<uint8_t>(y);
+        uint8_t* l = lo.data() + size_t((y / block) * bw);
+        uint8_t* h = hi.data() + size_t((y / block) * bw);
+        for (int bx = 0; bx < bw; ++bx) {
+            const uint8_t* p = row + bx * block;
+            uint8_t a = std::min(std::min(p[0], p[2]), std::min(p[4], p[6]));
+            uint8_t b = std::max(std::max(p[0], p[2]), std::max(p[4], p[6]));
+            l[bx] = std::min(l[bx], a);
+            h[bx] = std::max(h[bx], b);
+        }
+    }
+    std::array<int, 256> hist{};
+    for (size_t i = 0; i < lo.size(); ++i) ++hist[size_t(hi[i] - lo[i])];
+    // 99th percentile of the block ranges: the tags' black-on-white contrast (robust to a few
+    // specular blocks), whatever the exposure.
+    int p99 = 255;
+    for (int acc = 0, r = 255; r >= 0; --r) {
+        acc += hist[size_t(r)];
+        if (100 * acc >= int(lo.size())) {
+            p99 = r;
+            break;
+        }
+    }
+    const int threshold = std::max(12, p99 / 2);
+    int x0 = bw, y0 = bh, x1 = -1, y1 = -1;
+    for (int by = 0; by < bh; ++by)
+        for (int bx = 0; bx < bw; ++bx) {
+            const size_t i = size_t(by * bw + bx);
+            if (hi[i] - lo[i] < threshold) continue;
+            x0 = std::min(x0, bx);
+            y0 = std::min(y0, by);
+            x1 = std::max(x1, bx);
+            y1 = std::max(y1, by);
+        }
+    if (x1 < 0) return {};
+    return cv::Rect(x0 * block, y0 * block, (x1 - x0 + 1) * block, (y1 - y0 + 1) * block);
+}
+
 double tagEdgeWidthPx(const cv::Mat& grey, const std::array<glm::dvec2, 4>& corners) {
     double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
     for (const auto& c : corners) {
@@ -163,7 +209,8 @@ std::optional<cv::Rect> Tracker::boardRegion(const Pose& T_world_camera, cv::Siz
     return cv::Rect(bx0, by0, bx1 - bx0, by1 - by0);
 }
 
-bool Tracker::coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior, TrackedFrame& f) {
+bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region,
+                           const std::optional<Pose>& prior, TrackedFrame& f) {
     f.coarseTried = true;
     if (!coarseDetector_) {
         DetectorOptions o = options_.detector;
@@ -174,7 +221,7 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior
         coarseCellsAtBorder_ = TagFamily(o.family).widthAtBorder();
     }
     auto t0 = std::chrono::steady_clock::now();
-    std::vector<TagDetection> coarse = coarseDetector_->detect(grey);
+    std::vector<TagDetection> coarse = coarseDetector_->detect(grey, region);
     f.coarseTags = int(coarse.size());
     // Only tags whose corners were refined at full resolution are used (libapriltag's corners
     // on the decimated image are off by up to half a pixel); the finder tries the others.
@@ -285,9 +332,23 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
             if (r && r->area() > 0 && r->area() < 0.7 * full.area()) f.searchRegion = *r;
         }
         if (f.searchRegion == full) framesSinceFullSearch_ = 0;
+        if (options_.textureRegion && !prior) {
+            // No pose to say where the board is: where the image has the tags' contrast.
+            const cv::Rect r = texturedRegion(grey);
+            const double m = options_.textureMarginPx;
+            const cv::Rect grown = cv::Rect(cv::Point(std::max(0, int(r.x - m)) / 8 * 8,
+                                                      std::max(0, int(r.y - m)) / 8 * 8),
+                                            cv::Point(int(r.br().x + m), int(r.br().y + m))) &
+                                   full;
+            if (r.area() > 0 && grown.area() <= options_.textureMaxFraction * full.area()) {
+                f.searchRegion = grown;
+                f.textureRegionUsed = true;
+            }
+        }
 
-        if (!(options_.coarseToFine && grey.cols >= options_.coarseMinWidth &&
-              f.searchRegion == full && coarseToFine(grey, ambiguityPrior, f))) {
+        const bool coarseRegion = f.searchRegion == full || f.textureRegionUsed;
+        if (!(options_.coarseToFine && grey.cols >= options_.coarseMinWidth && coarseRegion &&
+              coarseToFine(grey, f.searchRegion, ambiguityPrior, f))) {
             t0 = std::chrono::steady_clock::now();
             f.detections = detector_.detect(grey, f.searchRegion);
             f.detectMs += msSince(t0);
@@ -298,6 +359,13 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         }
         bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
         if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
+            const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
+            retry = !now || (*now & f.searchRegion) != *now;
+        }
+        if (f.textureRegionUsed && f.estimate.pose) {
+            // The textured region holds the whole board under the frame's pose (ok or not):
+            // searching the rest of the image cannot add a tag of that board. Else the region
+            // may have cut off tags: search the whole image.
             const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
             retry = !now || (*now & f.searchRegion) != *now;
         }

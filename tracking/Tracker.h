@@ -81,6 +81,16 @@ struct TrackerOptions {
     // usable tags in too few frames to pay for itself (docs/tracking.md: equal time, measured).
     bool coarseToFine = true;
     int coarseMinWidth = 1000;
+    // Textured-region search of frames without a recent ok pose (docs/tracking.md, "Single
+    // frames"): libapriltag searches only the image box of the blocks that hold strong contrast
+    // (texturedRegion: the printed tags' black-on-white edges), grown by textureMarginPx, when
+    // that box covers at most textureMaxFraction of the image (a cluttered background spreads the
+    // contrast over the image: then the full image is searched, as without it). The frame is
+    // searched again on the full image when the region gave no pose or the board under that pose
+    // reaches outside the region (tags the region may have cut off).
+    bool textureRegion = true;
+    double textureMaxFraction = 0.5;
+    double textureMarginPx = 24.0;
     float coarseDecimate = 4.0f;
     double coarseSearchPx = 4.0;
     int coarsePoseTags = 4;
@@ -109,6 +119,8 @@ struct TrackedFrame {
     bool coarseTried = false;
     int coarseTags = 0;
     bool coarseUsed = false;
+    // Textured-region search: the frame's search began in texturedRegion's box (searchRegion).
+    bool textureRegionUsed = false;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -116,6 +128,12 @@ struct TrackedFrame {
 // (motion blur along one direction lowers that one only), divided by the 1..99 % intensity
 // range; about 1 / (edge width in pixels). 0 for an image without contrast.
 double imageSharpness(const cv::Mat& grey);
+
+// Image box (pixels) of the 8x8-pixel blocks of an 8-bit grey image whose intensity range
+// (brightest minus darkest of every second pixel of every second row) is at least half the
+// 99th percentile of the blocks' ranges and at least 12 levels: where printed black-on-white
+// tags are, on a plain background. Empty when no block qualifies.
+cv::Rect texturedRegion(const cv::Mat& grey);
 
 // Edge width around a tag (pixels): 1 / imageSharpness of the image box of its corners grown by
 // 2 px; about 2 px for a sharp image, the blur length for a motion blur longer than that.
@@ -153,9 +171,11 @@ private:
 
     TrackerOptions options_;
     Detector detector_;
-    // Coarse-to-fine search: the frame's tags from libapriltag on the decimated image, then all
-    // board tags found from their pose; false (f unchanged but the coarse fields) to fall back.
-    bool coarseToFine(const cv::Mat& grey, const std::optional<Pose>& prior, TrackedFrame& f);
+    // Coarse-to-fine search: the frame's tags from libapriltag on the decimated image (inside
+    // `region`), then all board tags found from their pose; false (f unchanged but the coarse
+    // fields) to fall back.
+    bool coarseToFine(const cv::Mat& grey, const cv::Rect& region, const std::optional<Pose>& prior,
+                      TrackedFrame& f);
 
     // Fills TagDetection::edgeWidthPx of the board tags: the edge width (blur) around the
     // largest one, for the estimator's corner-noise model (~0.02-0.05 ms).

@@ -30,6 +30,7 @@ struct TrackArgs {
     double fps = 30.0;
     bool noFilter = false;
     bool noTagTracking = false;
+    bool noTextureRegion = false;
     bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
@@ -92,6 +93,7 @@ void run(const TrackArgs& a) {
     tracking::TrackerOptions opt = a.options;
     opt.filterEnabled = !a.noFilter;
     opt.tagTracking = !a.noTagTracking;
+    opt.textureRegion = !a.noTextureRegion;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -266,6 +268,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_flag("--no-tag-tracking", a->noTagTracking,
                   "Search every frame with libapriltag (region of interest) instead of finding "
                   "the tags where the predicted pose puts them (docs/tracking.md, Tracking mode)");
+    cmd->add_flag("--no-texture-region", a->noTextureRegion,
+                  "Without a recent pose, search the whole image instead of first the region "
+                  "with the tags' contrast (docs/tracking.md, Single frames)");
     cmd->callback([a] { run(*a); });
 });
 

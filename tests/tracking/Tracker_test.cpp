@@ -89,6 +89,8 @@ TEST(Tracker, RegionOfInterestFollowsTheBoardAndFallsBackToTheFullImage) {
     TrackerOptions roiOptions;
     roiOptions.tagTracking =
         false;  // libapriltag in the region (the tracking mode: TagTracking_test)
+    // The first frame searches the full image (no textured region: TexturedRegion_test).
+    roiOptions.textureRegion = false;
     Tracker withRoi(board, cam, roiOptions);
     // Both search the full image with libapriltag at decimate 2 (the coarse-to-fine search of
     // full frames: CoarseToFine_test).
@@ -97,6 +99,7 @@ TEST(Tracker, RegionOfInterestFollowsTheBoardAndFallsBackToTheFullImage) {
     noRoiOptions.tagTracking = false;
     noRoiOptions.coarseToFine = false;
     noRoiOptions.roiEnabled = false;
+    noRoiOptions.textureRegion = false;
     Tracker noRoi(board, cam, noRoiOptions);
     const cv::Rect full(0, 0, cam.width, cam.height);
 

@@ -170,29 +170,33 @@ BENCHMARK(BM_MirageTrack)
 // mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
 // apart). Args: mode 1 = coarse-to-fine (libapriltag at `coarse` decimation, the other board tags
 // found from that pose at full resolution and verified; the default with coarse 4 from 1000 px
-// width), 0 =
-// libapriltag's search at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker).
+// width), 0 = libapriltag's search at decimate 2 only (= BM_Mirage/decimate:2 inside the
+// Tracker); texture 1 = the search starts in the textured region (default), 0 = full image.
 void BM_MirageSingle(benchmark::State& state) {
     const BoardFrames& f = frames(int(state.range(0)));
     TrackerOptions opt;
     opt.coarseToFine = state.range(1) == 1;
     opt.coarseMinWidth = 0;  // measured at 640x480 too (off there by default)
     opt.coarseDecimate = float(state.range(2));
+    opt.textureRegion = state.range(3) == 1;
     opt.filterEnabled = false;
     Tracker tracker(f.board, f.camera, opt);
     TrackingAccuracy acc;
     double t = 0;
-    int coarseUsed = 0;
+    int coarseUsed = 0, regionUsed = 0;
     for (size_t v = 0; v < f.images.size(); ++v) {
         const TrackedFrame r = tracker.process(f.images[v], t += 10.0);
         acc.addFrame(f, v, foundTags(r.detections), okPose(r.estimate));
         coarseUsed += r.coarseUsed;
+        regionUsed += r.textureRegionUsed && !r.fullFrameRetry;
     }
     size_t i = 0;
     for (auto _ : state)
         benchmark::DoNotOptimize(tracker.process(f.images[i++ % f.images.size()], t += 10.0));
     report(state, acc);
     state.counters["coarse_used"] = coarseUsed;
+    // Frames whose search stayed inside the textured region (no full-image retry).
+    state.counters["region_used"] = regionUsed;
 }
 
 // ---- OpenCV ArUco ----------------------------------------------------------------------------
@@ -243,13 +247,15 @@ BENCHMARK(BM_Mirage)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_MirageSingle)
-    ->ArgNames({"width", "mode", "coarse"})
-    ->Args({640, 0, 0})
-    ->Args({640, 1, 3})
-    ->Args({640, 1, 4})
-    ->Args({1280, 0, 0})
-    ->Args({1280, 1, 3})
-    ->Args({1280, 1, 4})
+    ->ArgNames({"width", "mode", "coarse", "texture"})
+    ->Args({640, 0, 0, 1})
+    ->Args({640, 0, 0, 0})
+    ->Args({640, 1, 4, 1})
+    ->Args({640, 1, 4, 0})
+    ->Args({1280, 1, 4, 1})
+    ->Args({1280, 1, 4, 0})
+    ->Args({1280, 0, 0, 1})
+    ->Args({1280, 0, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Aruco)
