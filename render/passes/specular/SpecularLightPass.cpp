@@ -13,6 +13,8 @@ constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::Re
                                       Resource::RefractionNormal,   Resource::RefractionAlbedo,
                                       Resource::RefractionEmissive, Resource::RefractionWeight};
 static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
+// L'_rv, L'_r, reflection share, L_env, then the four history buffers.
+constexpr int kAttachments = 8;
 }  // namespace
 
 SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
@@ -22,8 +24,16 @@ SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
     v.useVpls = v.program.uniformLocation("useVpls");
     v.vplStride = v.program.uniformLocation("vplStride");
     v.cellSize = v.program.uniformLocation("photonCellSize");
+    v.historyWeight = v.program.uniformLocation("historyWeight");
     return v;
 }
+
+namespace {
+// The history's share this frame: RendererOptions::temporalBlend where L' is smoothed.
+float specularBlend(const FrameContext& ctx) {
+    return ctx.options.specularTemporal ? ctx.options.temporalBlend : 0.0f;
+}
+}  // namespace
 
 SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOptions& options)
     : plain_(makeVariant("specular light", scene.lightingDefines())) {
@@ -47,6 +57,10 @@ void SpecularLightPass::setup(PassBuilder& b) const {
     b.write(Resource::SpecularR, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::SpecularRReflection, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::Lenv, GL_RGBA16F, SizeRule::Canvas);
+    // This frame's smoothed L', read back by the next frame as temporal history.
+    b.write(Resource::SpecularHistoryRv, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::SpecularHistoryR, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::SpecularHistoryRReflection, GL_RGBA32F, SizeRule::Canvas, true);
 }
 
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
@@ -55,7 +69,8 @@ PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
                       (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
                       (vpls ? " + VPLs" : "") +
                       (PhotonGridPass::gatherDecision(ctx).run ? " + caustic photons" : "") +
-                      " at the reflected/refracted hits"};
+                      " at the reflected/refracted hits, " +
+                      history_.note(ctx, specularBlend(ctx))};
 }
 
 void SpecularLightPass::resize(const FrameContext& ctx) {
@@ -67,23 +82,40 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     r_ = gl::Texture::create2D("L'_r", w, h, GL_RGBA16F);
     rRefl_ = gl::Texture::create2D("L'_r reflection share", w, h, GL_RGBA16F);
     env_ = gl::Texture::create2D("L_env", w, h, GL_RGBA16F);
-    fbo_ = gl::Framebuffer("specular light fbo");
-    fbo_.attachColor(0, rv_);
-    fbo_.attachColor(1, r_);
-    fbo_.attachColor(2, rRefl_);
-    fbo_.attachColor(3, env_);
-    fbo_.finalize(4);
-    attachedMask_ = 0;  // execute() attaches the specular mask
+    for (int i = 0; i < 2; ++i) {
+        // 32-bit: world positions and distances the history test compares.
+        historyRv_[i] = gl::Texture::create2D("L'_rv (history)", w, h, GL_RGBA32F);
+        historyR_[i] = gl::Texture::create2D("L'_r (history)", w, h, GL_RGBA32F);
+        historyRRefl_[i] =
+            gl::Texture::create2D("L'_r reflection share (history)", w, h, GL_RGBA32F);
+        historyHits_[i] = gl::Texture::create2D("specular hits (history)", w, h, GL_RGBA32F);
+        // Linear: the history is read at reprojected, fractional positions.
+        for (gl::Texture* t : {&historyRv_[i], &historyR_[i], &historyRRefl_[i], &historyHits_[i]})
+            t->setFilter(GL_LINEAR, GL_LINEAR);
+        fbo_[i] = gl::Framebuffer("specular light fbo");
+        fbo_[i].attachColor(0, rv_);
+        fbo_[i].attachColor(1, r_);
+        fbo_[i].attachColor(2, rRefl_);
+        fbo_[i].attachColor(3, env_);
+        fbo_[i].attachColor(4, historyRv_[i]);
+        fbo_[i].attachColor(5, historyR_[i]);
+        fbo_[i].attachColor(6, historyRRefl_[i]);
+        fbo_[i].attachColor(7, historyHits_[i]);
+        fbo_[i].finalize(kAttachments);
+        attachedMask_[i] = 0;  // execute() attaches the specular mask
+    }
+    history_.drop();  // new buffers hold no history
 }
 
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
+    const int write = history_.writeSlot(), read = history_.readSlot();
     const gl::Texture& mask = res.texture(Resource::SpecularMask);
-    if (mask.id() != attachedMask_) {  // specgbuf reallocates it only on a resize
-        fbo_.attachDepth(mask);
-        fbo_.finalize(4);
-        attachedMask_ = mask.id();
+    if (mask.id() != attachedMask_[write]) {  // specgbuf reallocates it only on a resize
+        fbo_[write].attachDepth(mask);
+        fbo_[write].finalize(kAttachments);
+        attachedMask_[write] = mask.id();
     }
-    fbo_.bind();
+    fbo_[write].bind();
     // The gather variant only in frames with a photon grid: llvmpipe pays for a branch's buffer
     // reads even when no pixel takes it.
     const bool gather = gather_.program.id() != 0 && res.has(Resource::PhotonGrid) &&
@@ -126,12 +158,19 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     }
     glUniform1i(v.useVpls, vpls ? 1 : 0);
     glUniform1i(v.vplStride, ctx.options.specularVplStride);
+    const float blend = specularBlend(ctx);
+    glUniform1f(v.historyWeight, history_.usable(ctx, blend) ? blend : 0.0f);
+    glBindTextureUnit(kUnitSpecLightHistoryRv, historyRv_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryR, historyR_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryRRefl, historyRRefl_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryHits, historyHits_[read].id());
     // Only specular pixels pass the early depth test against the mask (the triangle lies at
     // depth 0.5); the rest stay 0 (not a specular pixel).
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+    // Every attachment cleared: a history texel outside the specular pixels holds distance 0.
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, kAttachments);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
@@ -139,6 +178,10 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(Resource::SpecularR, r_);
     res.publish(Resource::SpecularRReflection, rRefl_);
     res.publish(Resource::Lenv, env_);
+    history_.written(ctx);
+    res.publish(Resource::SpecularHistoryRv, historyRv_[write]);
+    res.publish(Resource::SpecularHistoryR, historyR_[write]);
+    res.publish(Resource::SpecularHistoryRReflection, historyRRefl_[write]);
 }
 
 }  // namespace mirage::render
