@@ -23,6 +23,9 @@ struct EffectSwitch {
 
 inline constexpr EffectSwitch kEffectSwitches[] = {
     {"caustics", "caustics", &render::RendererOptions::caustics},
+    {"caustic_temporal", "caustic smoothing", &render::RendererOptions::causticTemporal},
+    {"specular_temporal", "mirror/glass light smoothing",
+     &render::RendererOptions::specularTemporal},
     {"glass_shadows", "shadows through glass", &render::RendererOptions::glassShadows},
     {"refl_refr_vpls", "VPLs through mirror/glass",
      &render::RendererOptions::reflectedRefractedVpls},

@@ -33,6 +33,9 @@ void RendererOptions::validate() const {
              std::to_string(impostorResolution));
     if (!(shadowBias >= 0.0f && shadowBias <= 1.0f))
         fail("shadowBias must be in [0, 1] metres, got " + std::to_string(shadowBias));
+    if (!(temporalBlend >= 0.0f && temporalBlend <= 0.98f))
+        fail("temporalBlend must be in [0, 0.98] (the history's weight), got " +
+             std::to_string(temporalBlend));
     if (causticMapSize < 16 || causticMapSize > 2048 || causticMapSize % 8 != 0)
         fail("causticMapSize must be a multiple of 8 in 16..2048 texels, got " +
              std::to_string(causticMapSize));

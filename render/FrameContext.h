@@ -27,17 +27,21 @@ enum class RoughRefractionMethod {
 const char* roughRefractionMethodName(RoughRefractionMethod m);  // "filter", "lean", "gsr"
 
 struct RendererOptions {
-    int vplCount = 256;                  // total VPLs per frame, split over the lights with RSMs
-    int shadowMapSize = 512;             // texels per side of each shadow / RSM layer
-    int ismTileSize = 64;                // texels per side of one VPL's imperfect shadow map
-    int ismPointsPerVpl = 1024;          // surface points splatted into each VPL's ISM
-    int interleave = 4;                  // K: each pixel gathers vplCount / K^2 VPLs
-    int indirectScale = 2;               // VPL gather at 1/scale resolution per axis (1 or 2); the
-                                         // geometry-aware filter upsamples it to full resolution
-    float vplDistanceClamp = 0.1f;       // metres: VPL distance below this is clamped (no spikes)
-    float shadowBias = 0.001f;           // metres: constant depth bias of the shadow-map test
-                                         // (lighting.glsl adds 1.5 texels' footprint / cos)
-    float temporalBlend = 0.8f;          // history weight for the VPL lighting (0 = off)
+    int vplCount = 256;             // total VPLs per frame, split over the lights with RSMs
+    int shadowMapSize = 512;        // texels per side of each shadow / RSM layer
+    int ismTileSize = 64;           // texels per side of one VPL's imperfect shadow map
+    int ismPointsPerVpl = 1024;     // surface points splatted into each VPL's ISM
+    int interleave = 4;             // K: each pixel gathers vplCount / K^2 VPLs
+    int indirectScale = 2;          // VPL gather at 1/scale resolution per axis (1 or 2); the
+                                    // geometry-aware filter upsamples it to full resolution
+    float vplDistanceClamp = 0.1f;  // metres: VPL distance below this is clamped (no spikes)
+    float shadowBias = 0.001f;      // metres: constant depth bias of the shadow-map test
+                                    // (lighting.glsl adds 1.5 texels' footprint / cos)
+    // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
+    // and where switched on below the caustic buffer and the specular-hit light L'. Each frame
+    // keeps (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend)
+    // frames. 0 .. 0.98.
+    float temporalBlend = 0.8f;
     float exposure = 1.0f;               // rendered linear radiance -> camera linear units
     float alphaMax = 8.0f;               // cap of alpha = CI / L_r
     float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
@@ -69,6 +73,18 @@ struct RendererOptions {
     // cells are twice it: the gather's cost grows with it). false: those hits get no caustic.
     bool causticGather = true;
     float causticGatherRadius = 0.01f;
+    // Temporal smoothing of the caustic buffer (Knecht 2013 end of Sec. 4.2; render/passes/caustic
+    // caustic_resolve.frag): this frame's caustic irradiance blended with last frame's,
+    // reprojected by the receiver's world position and rejected where the surface there is at
+    // another distance, with the GI filter's reset rules (render/TemporalHistory.h). A tracked
+    // camera jitters every frame, which moves the photon footprints over the pixels: without it
+    // the caustic shimmers. false: every frame's caustic stands alone.
+    bool causticTemporal = true;
+    // The same for the light of the reflected / refracted hits, L'_rv and L'_r (gathered caustic
+    // included; render/passes/specular specular_light.frag), reprojected by the mirror / glass
+    // surface's position and rejected also where either ray's hit distance changed (a
+    // reflection's hit moves differently from the mirror under camera motion).
+    bool specularTemporal = true;
     // Fuzzy reflections of rough metals (render/passes/fuzzy, docs/specular.md): the image-space
     // filter (Kulikova and Dmitriev, Eqs. 1-5) over the mirror-ray buffers. fuzzyConeDeg is the
     // cone bound Theta (degrees) that limits each pixel's kernel (Eq. 4); fuzzyTaps the taps per
@@ -223,7 +239,11 @@ public:
     GpuFrame frame{};  // uploaded to the FrameBlock UBO before the passes run
     GpuLightBlock lightBlock{};
     int frameIndex = 0;
+    // The frame's part of the temporal history rule (render/TemporalHistory.h): false in the
+    // first frame, after a cut / seek / tracking loss (FrameInput::resetHistory) and after
+    // objects moved (Renderer::updateTransforms); historyResetReason says which.
     bool historyValid = false;
+    std::string historyResetReason;
     EnvironmentInput environment;
     // What the camera-independent passes' output depends on besides the static scene: the light
     // matrices and parameters and the frame plan (Renderer sets it before every frame; equal keys

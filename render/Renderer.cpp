@@ -386,7 +386,12 @@ void Renderer::planFrame(const FrameInput& input) {
                         : s.environmentOrigin() == Origin::Real ? kOriginReal
                                                                 : kOriginVirtual;
     // Moved objects leave their history where they stood: start afresh (as after a cut).
-    c.historyValid = !input.resetHistory && !objectsMoved_ && lastRanFilter_ && c.frameIndex > 0;
+    // Each pass that keeps a history adds its own part: it ran in the previous frame.
+    c.historyValid = !input.resetHistory && !objectsMoved_ && c.frameIndex > 0;
+    c.historyResetReason = c.frameIndex == 0    ? "first frame"
+                           : input.resetHistory ? "cut, seek or tracking loss"
+                           : objectsMoved_      ? "objects moved"
+                                                : "";
     f.envOrigin = envFlag;
     f.historyValid = c.historyValid ? 1 : 0;
     f.ismTileSize = options_.ismTileSize;
@@ -447,7 +452,6 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     // Camera-independent passes (shadow maps, VPLs, ISMs, photons) are redone when objects moved.
     c.staticKey = staticPlanKey(c) + fmt::format("|g{}", scene_->generation());
     const FrameReport& report = graph_.execute(c, c.staticKey);
-    lastRanFilter_ = report.ran("gifilter");
     objectsMoved_ = false;
     ++c.frameIndex;
     return report;

@@ -131,7 +131,6 @@ private:
     uint64_t envLightsGeneration_ = UINT64_MAX;  // the environment generation they were found in
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
-    bool lastRanFilter_ = false;
     bool objectsMoved_ = false;  // updateTransforms moved something since the last render()
 };
 

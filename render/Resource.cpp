@@ -61,6 +61,9 @@ const char* resourceName(Resource r) {
         "SpecularR",
         "SpecularRReflection",
         "Lenv",
+        "SpecularHistoryRv",
+        "SpecularHistoryR",
+        "SpecularHistoryRReflection",
         "FuzzySpecularRv",
         "FuzzySpecularR",
         "FuzzySpecularRReflection",
@@ -81,6 +84,8 @@ const char* resourceName(Resource r) {
         "PhotonRecords",
         "CausticRv",
         "CausticR",
+        "CausticHistoryRv",
+        "CausticHistoryR",
         "Composite",
         "CompositeSrgb",
     };

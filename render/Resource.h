@@ -82,6 +82,14 @@ enum class Resource {
     SpecularR,            // L'_r (Eq. 4)
     SpecularRReflection,  // the reflection's share of L'_r
     Lenv,                 // L_env: environment seen where a ray leaves the modelled scene
+    // SpecularRv, SpecularR, SpecularRReflection after temporal smoothing, kept by the specular
+    // light pass as the next frame's history (persistent, RGBA32F). SpecularHistoryRv.a = the
+    // specular surface's camera distance (m, 0: none); SpecularHistoryR.a and
+    // SpecularHistoryRReflection.a = y and z of the refracted ray's hit (world, m), whose x and
+    // the reflected ray's hit the pass keeps beside them (specular_light.frag).
+    SpecularHistoryRv,
+    SpecularHistoryR,
+    SpecularHistoryRReflection,
     // Fuzzy reflections of rough metals (render/passes/fuzzy): the four above filtered over each
     // rough pixel's reflection cone, and the filtered video term of the reflection (rgb camera
     // units: eta1 CI_r(p_refl) or the rendered real share; a = 1 on a rough-metal pixel).
@@ -118,8 +126,13 @@ enum class Resource {
     // indices); PhotonRecords: GpuPhoton per photon, sorted by cell.
     PhotonGrid,
     PhotonRecords,
-    CausticRv,      // caustic radiance reflected by the receiver towards the camera (Eq. 12)
-    CausticR,       // the same for L_r: light, specular object and receiver real (Eqs. 13-14)
+    CausticRv,  // caustic radiance reflected by the receiver towards the camera (Eq. 12)
+    CausticR,   // the same for L_r: light, specular object and receiver real (Eqs. 13-14)
+    // The caustic irradiance (rgb W/m^2, before the receiver's albedo) for L_rv / L_r after
+    // temporal smoothing, a = camera distance (m) of the receiver (0: none); kept by the
+    // caustic pass as the next frame's temporal history (persistent, canvas size).
+    CausticHistoryRv,
+    CausticHistoryR,
     Composite,      // the output (camera image size): linear RGBA32F, a = coverage
     CompositeSrgb,  // the same, sRGB8
     Count

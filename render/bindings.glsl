@@ -112,6 +112,10 @@ const int kUnitSpecLightPosition = 14;
 const int kUnitEnvironmentMap = 15;
 const int kUnitSpecLightGlassAll = 24;  // above the impostor units
 const int kUnitSpecLightGlassReal = 25;
+const int kUnitSpecLightHistoryRv = 26;    // last frame's smoothed L'_rv, L'_r and reflection
+const int kUnitSpecLightHistoryR = 27;     // share (temporal history)
+const int kUnitSpecLightHistoryRRefl = 28;
+const int kUnitSpecLightHistoryHits = 29;  // the hits the history was lit at
 // specular_resolve.frag (the half-resolution upsample): GBuf_refl / GBuf_refr at the units above,
 // the half-resolution hit radiance (reflected L_rv, L_r, refracted L_rv, L_r) and the primary
 // G-buffer's emissive (a = specular slot + 1).
@@ -147,6 +151,8 @@ const int kUnitResolveAccum = 0;
 const int kUnitResolvePosition = 1;
 const int kUnitResolveAlbedo = 2;
 const int kUnitResolveEmissive = 3;
+const int kUnitResolveHistoryRv = 4;  // last frame's caustic irradiance (temporal history)
+const int kUnitResolveHistoryR = 5;
 
 // composite.frag
 const int kUnitCompositeCamera = 0;

@@ -66,7 +66,7 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
     int interleave;  // K: the interleaved-sampling tile size
     int frameIndex;
     int envOrigin;       // environment light: kOriginNone (off), kOriginReal, kOriginVirtual
-    int historyValid;    // 1 if the GI filter's temporal history may be used
+    int historyValid;    // 1 if the frame keeps temporal history (FrameContext::historyValid)
     int ismTileSize;     // texels per side of one VPL's imperfect shadow map tile
     int ismTilesPerRow;  // tiles per row of the ISM atlas
     float vplDistanceClamp;  // metres: VPL distance below this is clamped

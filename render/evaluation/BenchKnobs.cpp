@@ -255,6 +255,35 @@ const std::vector<BenchKnob>& benchKnobs() {
          [](const BenchConfig& c) {
              return fmt::format("{:g}", 100.0f * c.options.causticGatherRadius);
          }},
+        {"caustic_temporal",
+         "on: the caustic buffer smoothed over frames (reprojected history, the GI filter's "
+         "reset rules); off: every frame's caustic stands alone",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.causticTemporal = parseOnOff("caustic_temporal", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.causticTemporal); }},
+        {"specular_temporal",
+         "on: the light of the reflected / refracted hits (L'_rv, L'_r) smoothed over frames, "
+         "history rejected where a hit moved; off: every frame's stands alone",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.specularTemporal = parseOnOff("specular_temporal", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.specularTemporal); }},
+        {"pose_jitter",
+         "tracking-like noise on every frame's pose: mm of translation (1 sigma per axis) and "
+         "a tenth of that in degrees of rotation (0..10; 0: the exact ground-truth pose)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+         [](BenchConfig& c, const std::string& v) {
+             char* end = nullptr;
+             const double q = std::strtod(v.c_str(), &end);
+             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.0 && q <= 10.0))
+                 throw Error(fmt::format(
+                     "bench: knob pose_jitter: '{}' is not a number of mm in [0, 10]", v));
+             c.poseJitterMm = q;
+         },
+         [](const BenchConfig& c) { return fmt::format("{:g}", c.poseJitterMm); }},
         // Fuzzy reflections of rough metals (docs/specular.md): one default value each.
         {"fuzzy",
          "on: the fuzzy-reflection filter over rough metals' mirror reflections; off: rough "

@@ -13,6 +13,7 @@
 #include "core/image/ImageIO.h"
 #include "core/scene/ScenePlacement.h"
 #include "render/Renderer.h"
+#include "render/evaluation/PoseJitter.h"
 
 namespace mirage::render {
 namespace {
@@ -180,8 +181,12 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
                 renderer.updateTransforms(away);
                 renderer.updateTransforms(scene);
             }
-            const FrameReport& report =
-                renderer.render({f.T_world_camera, f.footage, /*resetHistory=*/i == 0});
+            const Pose pose =
+                config.poseJitterMm > 0.0
+                    ? jitteredPose(f.T_world_camera, config.poseJitterMm, 0.1 * config.poseJitterMm,
+                                   uint64_t(rep) * 100003u + i)
+                    : f.T_world_camera;
+            const FrameReport& report = renderer.render({pose, f.footage, /*resetHistory=*/i == 0});
             const cv::Mat composite = renderer.compositeSrgb();
             const double wallMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)

@@ -39,6 +39,11 @@ struct BenchConfig {
     // for a move (shadow maps, VPLs, ISMs, caustics and impostors redone, history dropped) while
     // its image stays comparable with the session's ground truth.
     bool movingObjects = false;
+    // Tracking-like noise on every frame's ground-truth pose (knob pose_jitter=MM): MM mm of
+    // translation and MM / 10 degrees of rotation, 1 sigma (PoseJitter.h), a new draw per frame
+    // and repeat. The ground truth stays at the exact pose, so the noise costs error in itself;
+    // what it shows is what shimmers (temporal smoothing on / off).
+    double poseJitterMm = 0.0;
     std::string label() const;  // "vpls=256 indirect_scale=2 ..."
 };
 

@@ -8,8 +8,14 @@ namespace mirage::render {
 
 CausticPass::CausticPass()
     : splat_(computeProgram("caustic splat", "passes/caustic/caustic_splat.comp")),
-      resolve_(fullscreenProgram("caustic resolve", "passes/caustic/caustic_resolve.frag")),
-      fbo_("caustic fbo") {}
+      resolve_(fullscreenProgram("caustic resolve", "passes/caustic/caustic_resolve.frag")) {}
+
+namespace {
+// The history's share this frame: RendererOptions::temporalBlend where caustics are smoothed.
+float causticBlend(const FrameContext& ctx) {
+    return ctx.options.causticTemporal ? ctx.options.temporalBlend : 0.0f;
+}
+}  // namespace
 
 void CausticPass::setup(PassBuilder& b) const {
     for (Resource r : {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonHitRefr,
@@ -18,12 +24,16 @@ void CausticPass::setup(PassBuilder& b) const {
         b.read(r);
     b.write(Resource::CausticRv, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::CausticR, GL_RGBA16F, SizeRule::Canvas);
+    // This frame's smoothed irradiance, read back by the next frame as temporal history.
+    b.write(Resource::CausticHistoryRv, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::CausticHistoryR, GL_RGBA32F, SizeRule::Canvas, true);
 }
 
 PassDecision CausticPass::decide(const FrameContext& ctx) const {
     if (ctx.plan.causticLayers == 0) return {false, ctx.plan.causticReason};
     return {true, "photon quads of " + std::to_string(ctx.plan.causticLayers) +
-                      " light(s) splatted (compute, atomics)"};
+                      " light(s) splatted (compute, atomics), " +
+                      history_.note(ctx, causticBlend(ctx))};
 }
 
 void CausticPass::resize(const FrameContext& ctx) {
@@ -35,10 +45,22 @@ void CausticPass::resize(const FrameContext& ctx) {
     accum_.setFilter(GL_NEAREST, GL_NEAREST);
     rv_ = gl::Texture::create2D("caustic L_rv", w, h, GL_RGBA16F);
     r_ = gl::Texture::create2D("caustic L_r", w, h, GL_RGBA16F);
-    fbo_ = gl::Framebuffer("caustic fbo");
-    fbo_.attachColor(0, rv_);
-    fbo_.attachColor(1, r_);
-    fbo_.finalize(2);
+    for (int i = 0; i < 2; ++i) {
+        // 32-bit: alpha holds the camera distance the history test compares (temporal.glsl).
+        historyRv_[i] =
+            gl::Texture::create2D("caustic irradiance L_rv (history)", w, h, GL_RGBA32F);
+        historyR_[i] = gl::Texture::create2D("caustic irradiance L_r (history)", w, h, GL_RGBA32F);
+        // Linear: the history is read at reprojected, fractional positions.
+        historyRv_[i].setFilter(GL_LINEAR, GL_LINEAR);
+        historyR_[i].setFilter(GL_LINEAR, GL_LINEAR);
+        fbo_[i] = gl::Framebuffer("caustic fbo");
+        fbo_[i].attachColor(0, rv_);
+        fbo_[i].attachColor(1, r_);
+        fbo_[i].attachColor(2, historyRv_[i]);
+        fbo_[i].attachColor(3, historyR_[i]);
+        fbo_[i].finalize(4);
+    }
+    history_.drop();  // new buffers hold no history
 }
 
 void CausticPass::execute(FrameContext& ctx, PassResources& res) {
@@ -65,14 +87,23 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
     glDispatchCompute(GLuint((s + 7) / 8), GLuint((s + 7) / 8), GLuint(2 * ctx.plan.causticLayers));
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 
-    fbo_.bind();
+    const int write = history_.writeSlot(), read = history_.readSlot();
+    fbo_[write].bind();
     ctx.beginFullscreen(resolve_, width_, height_);
     glBindTextureUnit(kUnitResolveAccum, accum_.id());
     glBindTextureUnit(kUnitResolvePosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitResolveAlbedo, res.texture(Resource::GBufferAlbedo).id());
     glBindTextureUnit(kUnitResolveEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitResolveHistoryRv, historyRv_[read].id());
+    glBindTextureUnit(kUnitResolveHistoryR, historyR_[read].id());
     glUniform1f(resolve_.uniformLocation("invFixedScale"), 1.0f / fixedScale);
+    const float blend = causticBlend(ctx);
+    glUniform1f(resolve_.uniformLocation("historyWeight"),
+                history_.usable(ctx, blend) ? blend : 0.0f);
     ctx.drawFullscreenTriangle();
+    history_.written(ctx);
+    res.publish(Resource::CausticHistoryRv, historyRv_[write]);
+    res.publish(Resource::CausticHistoryR, historyR_[write]);
     res.publish(Resource::CausticRv, rv_);
     res.publish(Resource::CausticR, r_);
 }

@@ -3,8 +3,11 @@
 // photons of the photon G-buffers splatted as quads in camera space by a compute shader (integer
 // atomics into a fixed-point irradiance buffer, depth-rejected against the G-buffer), then
 // resolved into the caustic radiance the receivers reflect, routed into L_rv and L_r by Eqs.
-// 12-14. The composite adds CausticRv / CausticR to the GI solutions.
+// 12-14. The composite adds CausticRv / CausticR to the GI solutions. The irradiance is
+// smoothed over time before the routing (RendererOptions::causticTemporal): two canvas-size
+// buffers ping-pong as this frame's result and the next frame's history.
 #include "render/RenderPass.h"
+#include "render/TemporalHistory.h"
 
 namespace mirage::render {
 
@@ -20,7 +23,11 @@ public:
 private:
     gl::Program splat_, resolve_;
     gl::Texture accum_, rv_, r_;
-    gl::Framebuffer fbo_;
+    // Smoothed irradiance for L_rv / L_r, a = camera distance (m); [history_.writeSlot()] is
+    // written this frame and read as history by the next.
+    gl::Texture historyRv_[2], historyR_[2];
+    gl::Framebuffer fbo_[2];
+    TemporalHistory history_;
     int width_ = 0, height_ = 0;
 };
 

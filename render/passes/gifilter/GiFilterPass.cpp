@@ -28,11 +28,9 @@ void GiFilterPass::setup(PassBuilder& b) const {
 }
 
 PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
-    return {true,
-            std::string("geometry-aware ") + std::to_string(ctx.options.interleave) + "x" +
-                std::to_string(ctx.options.interleave) +
-                (ctx.historyValid && ctx.options.temporalBlend > 0 ? ", temporal history used"
-                                                                   : ", temporal history reset")};
+    return {true, std::string("geometry-aware ") + std::to_string(ctx.options.interleave) + "x" +
+                      std::to_string(ctx.options.interleave) + ", " +
+                      history_.note(ctx, ctx.options.temporalBlend)};
 }
 
 void GiFilterPass::resize(const FrameContext& ctx) {
@@ -42,7 +40,7 @@ void GiFilterPass::resize(const FrameContext& ctx) {
         lowRv_[0].height() == (h + s - 1) / s)
         return;
     for (int i = 0; i < 2; ++i) {
-        // 32-bit: alpha holds the camera distance the history test compares to within 0.5 %.
+        // 32-bit: alpha holds the camera distance the history test compares (temporal.glsl).
         lowRv_[i] = gl::Texture::create2D("indirect L_rv filtered", (w + s - 1) / s,
                                           (h + s - 1) / s, GL_RGBA32F);
         lowR_[i] = gl::Texture::create2D("indirect L_r filtered", (w + s - 1) / s, (h + s - 1) / s,
@@ -55,6 +53,7 @@ void GiFilterPass::resize(const FrameContext& ctx) {
         lowFbo_[i].attachColor(1, lowR_[i]);
         lowFbo_[i].finalize(2);
     }
+    history_.drop();  // new buffers hold no history
     rv_ = gl::Texture::create2D("L_rv", w, h, GL_RGBA16F);
     r_ = gl::Texture::create2D("L_r", w, h, GL_RGBA16F);
     fbo_ = gl::Framebuffer("gi upsample fbo");
@@ -64,10 +63,12 @@ void GiFilterPass::resize(const FrameContext& ctx) {
 }
 
 void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
-    const int write = current_, read = 1 - current_;
+    const int write = history_.writeSlot(), read = history_.readSlot();
     lowFbo_[write].bind();
     ctx.beginFullscreen(filter_, lowRv_[write].width(), lowRv_[write].height());
     glUniform1i(filter_.uniformLocation("scale"), ctx.options.indirectScale);
+    glUniform1f(filter_.uniformLocation("historyWeight"),
+                history_.usable(ctx, ctx.options.temporalBlend) ? ctx.options.temporalBlend : 0.0f);
     const GLuint position = res.texture(Resource::GBufferPosition).id();
     const GLuint normal = res.texture(Resource::GBufferNormal).id();
     glBindTextureUnit(kUnitFilterPosition, position);
@@ -88,7 +89,7 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitUpsampleDirectRv, res.texture(Resource::DirectRv).id());
     glBindTextureUnit(kUnitUpsampleDirectR, res.texture(Resource::DirectR).id());
     ctx.drawFullscreenTriangle();
-    current_ = read;
+    history_.written(ctx);
     res.publish(Resource::GiHistoryRv, lowRv_[write]);
     res.publish(Resource::GiHistoryR, lowR_[write]);
     res.publish(Resource::LRv, rv_);

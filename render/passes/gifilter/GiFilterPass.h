@@ -4,6 +4,7 @@
 // its output is the next frame's history, so two gather-size buffers ping-pong), then joint
 // bilateral upsampling and the sum with direct light at full resolution (upsample.frag).
 #include "render/RenderPass.h"
+#include "render/TemporalHistory.h"
 
 namespace mirage::render {
 
@@ -21,12 +22,12 @@ private:
     gl::Program filter_;    // K x K geometry-aware filter + temporal, gather resolution
     gl::Program upsample_;  // joint bilateral upsampling + sum with direct light
     // Filtered indirect light at gather resolution, rgb + camera distance (m) in a; [current_]
-    // is written this frame and read as history by the next.
+    // is written this frame and read as history by the next (history_ says which).
     gl::Texture lowRv_[2], lowR_[2];
     gl::Framebuffer lowFbo_[2];
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;
-    int current_ = 0;
+    TemporalHistory history_;
 };
 
 }  // namespace mirage::render

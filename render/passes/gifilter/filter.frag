@@ -1,5 +1,6 @@
 #version 450 core
 #include "common.glsl"
+#include "temporal.glsl"
 // Geometry-aware filter of the interleaved indirect light, at gather resolution: a K x K window
 // around gather pixel c holds one pixel of every VPL group; neighbours count only if their
 // position and normal match c's (weights: cos^16 of the normal difference, distance from c's
@@ -21,6 +22,7 @@ layout(binding = kUnitFilterIndirectR) uniform sampler2D indirectR;
 layout(binding = kUnitFilterHistoryRv) uniform sampler2D historyRv;  // gather res: rgb filtered, a = camera dist.
 layout(binding = kUnitFilterHistoryR) uniform sampler2D historyR;
 uniform int scale;  // gather pixel q was shaded at G-buffer pixel q * scale
+uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
 layout(location = 0) out vec4 outRv;  // rgb filtered + smoothed; a = camera distance (m)
 layout(location = 1) out vec4 outR;   // (the history of the next frame)
 
@@ -62,23 +64,16 @@ void main() {
         }
     vec3 iRv = wsum > 1e-6 ? sumRv / wsum : vec3(0.0);
     vec3 iR = wsum > 1e-6 ? sumR / wsum : vec3(0.0);
-    if (historyValid == 1 && temporalBlend > 0.0) {
-        vec4 prev = prevViewProj * vec4(P.xyz, 1.0);
-        if (prev.w > 1e-6) {
-            vec2 puv = prev.xy / prev.w * 0.5 + 0.5;
-            if (all(greaterThanEqual(puv, vec2(0.0))) && all(lessThanEqual(puv, vec2(1.0)))) {
-                // Canvas position -> gather texel (gather pixel q sits at canvas pixel q*scale).
-                vec2 hp = (puv * vec2(size) - 0.5) / float(scale) + 0.5;
-                vec2 huv = hp / vec2(textureSize(historyRv, 0));
-                vec4 hRv = texture(historyRv, huv);
-                vec4 hR = texture(historyR, huv);
-                float expected = length(P.xyz - prevCameraPos.xyz);
-                if (abs(hRv.a - expected) < 0.02 * expected + 0.005 && allFinite(hRv.rgb) &&
-                    allFinite(hR.rgb)) {
-                    iRv = mix(iRv, hRv.rgb, temporalBlend);
-                    iR = mix(iR, hR.rgb, temporalBlend);
-                }
-            }
+    vec2 puv;
+    if (historyWeight > 0.0 && reprojectToPreviousFrame(P.xyz, puv)) {
+        // Canvas position -> gather texel (gather pixel q sits at canvas pixel q*scale).
+        vec2 hp = (puv * vec2(size) - 0.5) / float(scale) + 0.5;
+        vec2 huv = hp / vec2(textureSize(historyRv, 0));
+        vec4 hRv = texture(historyRv, huv);
+        vec4 hR = texture(historyR, huv);
+        if (historyIsSameSurface(hRv.a, P.xyz) && allFinite(hRv.rgb) && allFinite(hR.rgb)) {
+            iRv = mix(iRv, hRv.rgb, historyWeight);
+            iR = mix(iR, hR.rgb, historyWeight);
         }
     }
     outRv = vec4(iRv, camDist);

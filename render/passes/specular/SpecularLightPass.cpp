@@ -15,6 +15,8 @@ constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::Re
                                       Resource::RefractionNormal,   Resource::RefractionAlbedo,
                                       Resource::RefractionEmissive, Resource::RefractionWeight};
 static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
+// L'_rv, L'_r, reflection share, L_env, then the four history buffers.
+constexpr int kAttachments = 8;
 }  // namespace
 
 SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
@@ -24,8 +26,20 @@ SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
     v.useVpls = v.program.uniformLocation("useVpls");
     v.vplStride = v.program.uniformLocation("vplStride");
     v.cellSize = v.program.uniformLocation("photonCellSize");
+    v.historyWeight = v.program.uniformLocation("historyWeight");
     return v;
 }
+
+namespace {
+// The history's share this frame: RendererOptions::temporalBlend where L' is smoothed. The
+// half-resolution variant has no history: its hits are shaded per 2x2 block and upsampled, and
+// the history test needs each pixel's own hits.
+float specularBlend(const FrameContext& ctx) {
+    return ctx.options.specularTemporal && !ctx.options.specularHalfResolution
+               ? ctx.options.temporalBlend
+               : 0.0f;
+}
+}  // namespace
 
 SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOptions& options)
     : plain_(makeVariant("specular light", scene.lightingDefines())),
@@ -62,6 +76,10 @@ void SpecularLightPass::setup(PassBuilder& b) const {
     b.write(Resource::SpecularR, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::SpecularRReflection, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::Lenv, GL_RGBA16F, SizeRule::Canvas);
+    // This frame's smoothed L', read back by the next frame as temporal history.
+    b.write(Resource::SpecularHistoryRv, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::SpecularHistoryR, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::SpecularHistoryRReflection, GL_RGBA32F, SizeRule::Canvas, true);
 }
 
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
@@ -71,7 +89,8 @@ PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
                       (vpls ? " + VPLs" : "") +
                       (PhotonGridPass::gatherDecision(ctx).run ? " + caustic photons" : "") +
                       " at the reflected/refracted hits" +
-                      (ctx.options.specularHalfResolution ? ", half resolution" : "")};
+                      (ctx.options.specularHalfResolution ? ", half resolution" : "") + ", " +
+                      history_.note(ctx, specularBlend(ctx))};
 }
 
 void SpecularLightPass::resize(const FrameContext& ctx) {
@@ -83,13 +102,29 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     r_ = gl::Texture::create2D("L'_r", w, h, GL_RGBA16F);
     rRefl_ = gl::Texture::create2D("L'_r reflection share", w, h, GL_RGBA16F);
     env_ = gl::Texture::create2D("L_env", w, h, GL_RGBA16F);
-    fbo_ = gl::Framebuffer("specular light fbo");
-    fbo_.attachColor(0, rv_);
-    fbo_.attachColor(1, r_);
-    fbo_.attachColor(2, rRefl_);
-    fbo_.attachColor(3, env_);
-    fbo_.finalize(4);
-    attachedMask_ = 0;  // execute() attaches the specular mask
+    for (int i = 0; i < 2; ++i) {
+        // 32-bit: world positions and distances the history test compares.
+        historyRv_[i] = gl::Texture::create2D("L'_rv (history)", w, h, GL_RGBA32F);
+        historyR_[i] = gl::Texture::create2D("L'_r (history)", w, h, GL_RGBA32F);
+        historyRRefl_[i] =
+            gl::Texture::create2D("L'_r reflection share (history)", w, h, GL_RGBA32F);
+        historyHits_[i] = gl::Texture::create2D("specular hits (history)", w, h, GL_RGBA32F);
+        // Linear: the history is read at reprojected, fractional positions.
+        for (gl::Texture* t : {&historyRv_[i], &historyR_[i], &historyRRefl_[i], &historyHits_[i]})
+            t->setFilter(GL_LINEAR, GL_LINEAR);
+        fbo_[i] = gl::Framebuffer("specular light fbo");
+        fbo_[i].attachColor(0, rv_);
+        fbo_[i].attachColor(1, r_);
+        fbo_[i].attachColor(2, rRefl_);
+        fbo_[i].attachColor(3, env_);
+        fbo_[i].attachColor(4, historyRv_[i]);
+        fbo_[i].attachColor(5, historyR_[i]);
+        fbo_[i].attachColor(6, historyRRefl_[i]);
+        fbo_[i].attachColor(7, historyHits_[i]);
+        fbo_[i].finalize(kAttachments);
+        attachedMask_[i] = 0;  // execute() attaches the specular mask
+    }
+    history_.drop();  // new buffers hold no history
     if (!ctx.options.specularHalfResolution) return;
     halfWidth_ = (w + 1) / 2;
     halfHeight_ = (h + 1) / 2;
@@ -113,8 +148,8 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     halfFbo_.finalize(4);
 }
 
-void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& res,
-                                            const Variant& v) {
+void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v,
+                                            const gl::Framebuffer& out) {
     // The scissor rectangle in half pixels, rounded outwards.
     const glm::ivec4& s = ctx.specularScissor;
     const glm::ivec4 halfRect{s.x / 2, s.y / 2, (s.x + s.z + 1) / 2 - s.x / 2,
@@ -133,8 +168,10 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
     ctx.drawFullscreenTriangleIn(halfRect, 4);
-    // The upsample, on the canvas's specular pixels.
-    fbo_.bind();
+    // The upsample, on the canvas's specular pixels. It writes L'_rv, L'_r, the reflection's
+    // share and L_env; the history attachments are cleared and stay unused (no history at half
+    // resolution: specularBlend).
+    out.bind();
     ctx.beginFullscreen(resolve_, ctx.canvasWidth(), ctx.canvasHeight());
     const gl::Texture* half[4] = {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_};
     for (int i = 0; i < 4; ++i)
@@ -145,7 +182,7 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+    ctx.drawFullscreenTriangleIn(ctx.specularScissor, kAttachments);
 }
 
 void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
@@ -155,14 +192,19 @@ void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources
                       res.has(Resource::ImperfectShadowMaps);
     glUniform1i(v.useVpls, vpls ? 1 : 0);
     glUniform1i(v.vplStride, ctx.options.specularVplStride);
+    if (v.historyWeight >= 0) {
+        const float blend = specularBlend(ctx);
+        glUniform1f(v.historyWeight, history_.usable(ctx, blend) ? blend : 0.0f);
+    }
 }
 
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
+    const int write = history_.writeSlot(), read = history_.readSlot();
     const gl::Texture& mask = res.texture(Resource::SpecularMask);
-    if (mask.id() != attachedMask_) {  // specgbuf reallocates it only on a resize
-        fbo_.attachDepth(mask);
-        fbo_.finalize(4);
-        attachedMask_ = mask.id();
+    if (mask.id() != attachedMask_[write]) {  // specgbuf reallocates it only on a resize
+        fbo_[write].attachDepth(mask);
+        fbo_[write].finalize(kAttachments);
+        attachedMask_[write] = mask.id();
     }
     // The gather variant only in frames with a photon grid: llvmpipe pays for a branch's buffer
     // reads even when no pixel takes it.
@@ -201,11 +243,15 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons,
                          res.buffer(Resource::PhotonRecords).id());
     }
+    glBindTextureUnit(kUnitSpecLightHistoryRv, historyRv_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryR, historyR_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryRRefl, historyRRefl_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryHits, historyHits_[read].id());
     if (ctx.options.specularHalfResolution && halfPlain_.program.id() != 0) {
-        shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_);
+        shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, fbo_[write]);
     } else {
         const Variant& v = gather ? gather_ : plain_;
-        fbo_.bind();
+        fbo_[write].bind();
         ctx.beginFullscreen(v.program, ctx.canvasWidth(), ctx.canvasHeight());
         setUniforms(ctx, res, v);
         // Only specular pixels pass the early depth test against the mask (the triangle lies at
@@ -213,7 +259,8 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_GREATER);
         glDepthMask(GL_FALSE);
-        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 4);
+        // Every attachment cleared: a history texel outside the specular pixels holds distance 0.
+        ctx.drawFullscreenTriangleIn(ctx.specularScissor, kAttachments);
     }
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
@@ -222,6 +269,10 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(Resource::SpecularR, r_);
     res.publish(Resource::SpecularRReflection, rRefl_);
     res.publish(Resource::Lenv, env_);
+    history_.written(ctx);
+    res.publish(Resource::SpecularHistoryRv, historyRv_[write]);
+    res.publish(Resource::SpecularHistoryR, historyR_[write]);
+    res.publish(Resource::SpecularHistoryRReflection, historyRRefl_[write]);
 }
 
 }  // namespace mirage::render

@@ -4,8 +4,13 @@
 // (imperfect shadow maps), Fresnel-weighted and routed real / virtual; rays that hit nothing
 // modelled look up the environment map into L_env (specular_light.frag). In frames with a
 // world-space photon grid (PhotonGridPass) the hits also gather the caustic photons around them
-// (a shader variant: without a grid the frame pays nothing for it).
+// (a shader variant: without a grid the frame pays nothing for it). L'_rv, L'_r and the
+// reflection's share are smoothed over time (RendererOptions::specularTemporal): four
+// canvas-size buffers ping-pong as this frame's result and the next frame's history (not in the
+// half-resolution variant, RendererOptions::specularHalfResolution: its hits are shaded per 2x2
+// block, and the history test needs each pixel's own hits).
 #include "render/RenderPass.h"
+#include "render/TemporalHistory.h"
 
 namespace mirage::render {
 
@@ -21,15 +26,21 @@ public:
 private:
     struct Variant {
         gl::Program program;
-        GLint useVpls = -1, vplStride = -1, cellSize = -1;
+        GLint useVpls = -1, vplStride = -1, cellSize = -1, historyWeight = -1;
     };
     static Variant makeVariant(const char* label, const std::string& defines);
     void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
-    void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v);
+    void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v,
+                             const gl::Framebuffer& out);
     Variant plain_, gather_;  // gather_: only for scenes that can have caustics
     gl::Texture rv_, r_, rRefl_, env_;
-    gl::Framebuffer fbo_;
-    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
+    // Smoothed L'_rv, L'_r, reflection share and the hits they were lit at (Resource.h; the
+    // hits' texture is read by this pass alone, so it is not a frame-graph resource);
+    // [history_.writeSlot()] is written this frame and read as history by the next.
+    gl::Texture historyRv_[2], historyR_[2], historyRRefl_[2], historyHits_[2];
+    gl::Framebuffer fbo_[2];
+    GLuint attachedMask_[2] = {0, 0};  // the SpecularMask texture attached as fbo_[i]'s depth
+    TemporalHistory history_;
     int width_ = 0, height_ = 0;
     // RendererOptions::specularHalfResolution: the half-resolution variants (built on first use),
     // the upsample, the half-size specular-pixel mask and hit radiance.

@@ -1,5 +1,6 @@
 #version 450 core
 #include "common.glsl"
+#include "temporal.glsl"
 #include "lighting.glsl"
 #include "passes/specular/specular.glsl"
 #include "passes/caustic/caustic.glsl"
@@ -21,6 +22,12 @@
 // and divided by (albedo + kSpecularDemodulationFloor), so that specular_resolve.frag can
 // upsample it by hit geometry and put back the full-resolution Fresnel weight, albedo, emission
 // and environment. The VPL interleaving tiles then cover 2x2 half pixels (4x4 canvas pixels).
+// Then L'_rv, L'_r and the reflection's share are smoothed over time (Knecht 2013 end of Sec.
+// 4.2): last frame's values, reprojected by the specular surface's world position, are blended
+// in where the pixel is the same surface (temporal.glsl) AND both of its rays hit where they hit
+// then (a reflection moves over the mirror differently from the mirror itself: under camera
+// motion the hits move and the history is rejected rather than smeared; under tracking noise
+// they stay within a few millimetres and it is used).
 in vec2 uv;
 layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
 layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
@@ -53,11 +60,33 @@ layout(location = 1) out vec4 outReflR;   // reflected hit, L_r
 layout(location = 2) out vec4 outRefrRv;  // refracted hit, L_rv
 layout(location = 3) out vec4 outRefrR;   // refracted hit, L_r
 #else
+uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
+// Last frame's smoothed L'_rv (a = the specular surface's camera distance, m; 0: no specular
+// pixel), L'_r and the reflection's share of L'_r, and the hits they were lit at: the reflected
+// ray's in historyHits.xyz, the refracted ray's in (historyHits.w, historyR.a, historyRRefl.a)
+// (world, m; kNoHit where a ray hit nothing).
+layout(binding = kUnitSpecLightHistoryRv) uniform sampler2D historyRv;
+layout(binding = kUnitSpecLightHistoryR) uniform sampler2D historyR;
+layout(binding = kUnitSpecLightHistoryRRefl) uniform sampler2D historyRRefl;
+layout(binding = kUnitSpecLightHistoryHits) uniform sampler2D historyHits;
 layout(location = 0) out vec4 outRv;     // L'_rv
 layout(location = 1) out vec4 outR;      // L'_r
 layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r (for Eq. 9, see
                                          // composite.frag)
 layout(location = 3) out vec4 outEnv;    // L_env; a = 1 on specular pixels
+layout(location = 4) out vec4 outHistoryRv;  // the next frame's history (as historyRv, ...)
+layout(location = 5) out vec4 outHistoryR;
+layout(location = 6) out vec4 outHistoryRRefl;
+layout(location = 7) out vec4 outHistoryHits;
+
+const float kNoHit = 1e6;  // the hit of a ray that hit nothing modelled (or was not traced)
+
+// A history hit (world, m) is this frame's hit: both rays hit nothing, or both hit within
+// 0.5 % of the path from the camera + 2 mm of each other (a few pixels' footprint at the hit;
+// tracking noise moves a hit by about a millimetre, a moving camera by centimetres).
+bool sameHit(vec3 stored, vec3 current, float pathLength) {
+    return distance(stored, current) < 0.005 * pathLength + 0.002;
+}
 #endif
 
 float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
@@ -203,13 +232,20 @@ void main() {
     outR = vec4(0.0);
     outRRefl = vec4(0.0);
     outEnv = vec4(0.0);
+    outHistoryRv = vec4(0.0);
+    outHistoryR = vec4(0.0);
+    outHistoryRRefl = vec4(0.0);
+    outHistoryHits = vec4(0.0);
     if (texelFetch(reflEmissive, px, 0).a < 0.5) return;  // not a specular pixel
     vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
+    vec3 surface = texelFetch(gPosition, px, 0).xyz;
+    vec3 hit[2] = vec3[2](vec3(kNoHit), vec3(kNoHit));  // per ray (world, m)
     for (int k = 0; k < 2; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;
         int origin = int(P.w + 0.5);
+        if (origin != ORIGIN_NONE) hit[k] = P.xyz;
         if (origin == ORIGIN_NONE) {
             if (dot(P.xyz, P.xyz) > 0.25) env += w * environmentRadiance(envMap, P.xyz);
             continue;
@@ -237,9 +273,33 @@ void main() {
         r += w * hr;
         if (k == 0) rRefl = w * hr;
     }
-    outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
-    outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
-    outRRefl = vec4(allFinite(rRefl) ? rRefl : vec3(0.0), 1.0);
+    rv = allFinite(rv) ? rv : vec3(0.0);
+    r = allFinite(r) ? r : vec3(0.0);
+    rRefl = allFinite(rRefl) ? rRefl : vec3(0.0);
+    vec2 puv;
+    if (historyWeight > 0.0 && reprojectToPreviousFrame(surface, puv)) {
+        vec4 hRv = texture(historyRv, puv);
+        vec4 hR = texture(historyR, puv);
+        vec4 hRRefl = texture(historyRRefl, puv);
+        vec4 hHits = texture(historyHits, puv);
+        float toSurface = distance(surface, cameraPos.xyz);
+        if (historyIsSameSurface(hRv.a, surface) &&
+            sameHit(hHits.xyz, hit[0], toSurface + distance(surface, hit[0])) &&
+            sameHit(vec3(hHits.w, hR.a, hRRefl.a), hit[1],
+                    toSurface + distance(surface, hit[1])) &&
+            allFinite(hRv.rgb) && allFinite(hR.rgb) && allFinite(hRRefl.rgb)) {
+            rv = mix(rv, max(hRv.rgb, vec3(0.0)), historyWeight);
+            r = mix(r, max(hR.rgb, vec3(0.0)), historyWeight);
+            rRefl = mix(rRefl, max(hRRefl.rgb, vec3(0.0)), historyWeight);
+        }
+    }
+    outHistoryRv = vec4(rv, distance(surface, cameraPos.xyz));
+    outHistoryR = vec4(r, hit[1].y);
+    outHistoryRRefl = vec4(rRefl, hit[1].z);
+    outHistoryHits = vec4(hit[0], hit[1].x);
+    outRv = vec4(rv, 1.0);
+    outR = vec4(r, 1.0);
+    outRRefl = vec4(rRefl, 1.0);
     outEnv = vec4(allFinite(env) ? env : vec3(0.0), 1.0);
 }
 #endif
