@@ -1,6 +1,6 @@
 // Temporal history, per texel (after common.glsl): the reprojection of a world point with last
 // frame's camera and the test that a history texel is the same surface, shared by every pass
-// that smooths over frames (gifilter, caustic; render/TemporalHistory.h holds the per-frame
+// that smooths over frames (gifilter, caustic, speclight; render/TemporalHistory.h holds the per-frame
 // rule). A history texel stores, beside its value, the camera distance (m) of the surface it was
 // computed for.
 

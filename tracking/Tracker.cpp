@@ -56,8 +56,11 @@ double imageSharpness(const cv::Mat& grey) {
     return weakest / range;
 }
 
+// Side (px) of the blocks texturedRegion judges; the region is a union of whole blocks.
+constexpr int kTextureBlockPx = 8;
+
 cv::Rect texturedRegion(const cv::Mat& grey) {
-    constexpr int block = 8;
+    constexpr int block = kTextureBlockPx;
     const int bw = grey.cols / block, bh = grey.rows / block;
     if (grey.empty() || grey.type() != CV_8UC1 || bw < 1 || bh < 1) return {};
     // Per block: the intensity range over every second pixel of every second row (a tag's
@@ -336,10 +339,11 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
             // No pose to say where the board is: where the image has the tags' contrast.
             const cv::Rect r = texturedRegion(grey);
             const double m = options_.textureMarginPx;
-            const cv::Rect grown = cv::Rect(cv::Point(std::max(0, int(r.x - m)) / 8 * 8,
-                                                      std::max(0, int(r.y - m)) / 8 * 8),
-                                            cv::Point(int(r.br().x + m), int(r.br().y + m))) &
-                                   full;
+            const cv::Rect grown =
+                cv::Rect(cv::Point(std::max(0, int(r.x - m)) / kTextureBlockPx * kTextureBlockPx,
+                                   std::max(0, int(r.y - m)) / kTextureBlockPx * kTextureBlockPx),
+                         cv::Point(int(r.br().x + m), int(r.br().y + m))) &
+                full;
             if (r.area() > 0 && grown.area() <= options_.textureMaxFraction * full.area()) {
                 f.searchRegion = grown;
                 f.textureRegionUsed = true;
