@@ -45,6 +45,9 @@ void RendererOptions::validate() const {
     if (!(causticGatherRadius >= 0.001f && causticGatherRadius <= 0.5f))
         fail("causticGatherRadius must be in [0.001, 0.5] (metres), got " +
              std::to_string(causticGatherRadius));
+    if (causticGatherCap < 0 || causticGatherCap > (1 << 20))
+        fail("causticGatherCap must be 0 (all photons) or 1..1048576 photons per bucket, got " +
+             std::to_string(causticGatherCap));
     if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
         fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
     if (!(fuzzyConeDeg > 0.0f && fuzzyConeDeg <= 60.0f))

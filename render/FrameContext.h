@@ -73,6 +73,13 @@ struct RendererOptions {
     // cells are twice it: the gather's cost grows with it). false: those hits get no caustic.
     bool causticGather = true;
     float causticGatherRadius = 0.01f;
+    // Photons the gather reads per grid bucket (0: all). A focused caustic puts tens of thousands
+    // of photons into one cell, and every hit near it would read them all (a glass sphere alone
+    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read with a
+    // stride (every s-th photon from a per-pixel offset) and what is read is weighted
+    // by count / read, so the estimate keeps its expectation and gains noise only where photons
+    // are dense.
+    int causticGatherCap = 256;
     // Temporal smoothing of the caustic buffer (Knecht 2013 end of Sec. 4.2; render/passes/caustic
     // caustic_resolve.frag): this frame's caustic irradiance blended with last frame's,
     // reprojected by the receiver's world position and rejected where the surface there is at

@@ -255,6 +255,21 @@ const std::vector<BenchKnob>& benchKnobs() {
          [](const BenchConfig& c) {
              return fmt::format("{:g}", 100.0f * c.options.causticGatherRadius);
          }},
+        {"caustic_gather_cap",
+         "photons the caustic gather reads per grid bucket, 0 = all (fuller buckets are read with "
+         "a stride and weighted by count / read)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+         [](BenchConfig& c, const std::string& v) {
+             char* end = nullptr;
+             const long q = std::strtol(v.c_str(), &end, 10);
+             if (v.empty() || end != v.c_str() + v.size() || q < 0 || q > (1 << 20))
+                 throw Error(
+                     fmt::format("bench: knob caustic_gather_cap: '{}' is not a photon "
+                                 "count in 0..1048576 (0: all)",
+                                 v));
+             c.options.causticGatherCap = int(q);
+         },
+         [](const BenchConfig& c) { return std::to_string(c.options.causticGatherCap); }},
         {"caustic_temporal",
          "on: the caustic buffer smoothed over frames (reprojected history, the GI filter's "
          "reset rules); off: every frame's caustic stands alone",

@@ -84,6 +84,7 @@ vec3 unpackNormalOct(int bits) {
 layout(std430, binding = kBindingPhotonGrid) readonly buffer PhotonGridCells { uint photonGrid[]; };
 layout(std430, binding = kBindingPhotons) readonly buffer PhotonRecords { GpuPhoton photons[]; };
 uniform float photonCellSize;  // m: 2 x RendererOptions::causticGatherRadius
+uniform uint photonGatherCap;  // photons read per bucket, 0: all (RendererOptions::causticGatherCap)
 
 // A gather point's footprint (m): the spacing of the neighbouring pixels' hits on its surface,
 // from the screen-space derivatives dx, dy of the hit position. Across a silhouette (another
@@ -131,7 +132,25 @@ void gatherCaustic(vec3 x, vec3 n, float footprint, out vec3 eRv, out vec3 eR) {
                 visited[nVisited++] = b;
                 uint first = photonGrid[kPhotonGridCells + b];
                 uint last = photonGrid[kPhotonGridCells + b + 1];
-                for (uint i = first; i < last; ++i) {
+                // A bucket fuller than the cap is read with a stride from an offset that varies
+                // by pixel and bucket (not by frame: a frame depends on its inputs only, so a
+                // frame after a history reset equals a fresh renderer's); what is read stands
+                // for the whole bucket (weight count / read). Photons sit in a bucket in photon-map order, so a stride samples the
+                // whole map's footprint rather than one corner of it.
+                uint count = last - first, stride = 1u;
+                if (count == 0u) continue;
+                if (photonGatherCap > 0u && count > photonGatherCap)
+                    stride = (count + photonGatherCap - 1u) / photonGatherCap;
+                uint start = first;
+                if (stride > 1u) {
+                    uvec2 p = uvec2(gl_FragCoord.xy);
+                    uint seed = (p.x * 73856093u) ^ (p.y * 19349663u) ^ uint(b);
+                    seed = (seed ^ (seed >> 16)) * 0x45d9f3bu;
+                    start += (seed ^ (seed >> 16)) % stride;
+                }
+                float share = float(count) / float((last - start + stride - 1u) / stride);
+                vec3 bucketRv = vec3(0.0), bucketR = vec3(0.0);
+                for (uint i = start; i < last; i += stride) {
                     vec3 d = x - photons[i].position;
                     float r = min(max(photons[i].radius, 1.5 * footprint), reach);
                     float d2 = dot(d, d), r2 = r * r;
@@ -139,9 +158,11 @@ void gatherCaustic(vec3 x, vec3 n, float footprint, out vec3 eRv, out vec3 eR) {
                     vec3 np = unpackNormalOct(photons[i].normal);
                     if (dot(np, n) < 0.5 || abs(dot(d, np)) > 0.5 * r) continue;
                     float w = 2.0 / (PI * r2) * (1.0 - d2 / r2);
-                    eRv += photons[i].powerRv * w;
-                    eR += photons[i].powerR * w;
+                    bucketRv += photons[i].powerRv * w;
+                    bucketR += photons[i].powerR * w;
                 }
+                eRv += share * bucketRv;
+                eR += share * bucketR;
             }
 }
 #endif

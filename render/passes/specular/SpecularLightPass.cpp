@@ -26,6 +26,7 @@ SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
     v.useVpls = v.program.uniformLocation("useVpls");
     v.vplStride = v.program.uniformLocation("vplStride");
     v.cellSize = v.program.uniformLocation("photonCellSize");
+    v.gatherCap = v.program.uniformLocation("photonGatherCap");
     v.historyWeight = v.program.uniformLocation("historyWeight");
     return v;
 }
@@ -188,6 +189,7 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
 void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
                                     const Variant& v) const {
     if (v.cellSize >= 0) glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
+    if (v.gatherCap >= 0) glUniform1ui(v.gatherCap, GLuint(ctx.options.causticGatherCap));
     const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
                       res.has(Resource::ImperfectShadowMaps);
     glUniform1i(v.useVpls, vpls ? 1 : 0);

@@ -26,7 +26,7 @@ public:
 private:
     struct Variant {
         gl::Program program;
-        GLint useVpls = -1, vplStride = -1, cellSize = -1, historyWeight = -1;
+        GLint useVpls = -1, vplStride = -1, cellSize = -1, gatherCap = -1, historyWeight = -1;
     };
     static Variant makeVariant(const char* label, const std::string& defines);
     void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
