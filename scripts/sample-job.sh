@@ -8,7 +8,7 @@ set -euo pipefail
 mirage="$1"; data="$2"; out="$3"
 mkdir -p "$out"
 session="$data/sessions/sample"
-scene="$data/scenes/tabletop/tabletop.gltf"
+scene="$data/scenes/tabletop/tabletop_backlit.gltf"
 
 "$mirage" track "$session" -o "$out/poses.csv"
 "$mirage" replay "$session" --scene "$scene" -o "$out/replay.mkv"
