@@ -21,6 +21,7 @@ import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.dont_write_bytecode = True  # no __pycache__ beside the scene files
 sys.path.insert(0, HERE)
 from make_tabletop import look_at_rotation  # noqa: E402  (the same light orientation rule)
 
