@@ -202,8 +202,18 @@ TEST(BadInput, TrackPrintsTheSessionReadersWarnings) {
     EXPECT_TRUE(has(r, "frames.csv")) << "the missing frames.csv is not mentioned: " << r.output;
 }
 
-// The summary's count of ok poses off the ground truth (> 2 degrees or > 2 % of the distance).
+// The summary's count of ok poses (-1: no summary).
+int okFrames(const CommandResult& r) {
+    const std::string key = "states: ok ";
+    const size_t at = r.output.find(key);
+    if (at == std::string::npos) return -1;
+    return std::stoi(r.output.substr(at + key.size()));
+}
+
+// The summary's count of ok poses off the ground truth (> 2 degrees or > 2 % of the distance);
+// 0 when no frame is ok (the summary then has no ground-truth lines), -1 when it is missing.
 int wrongButOk(const CommandResult& r) {
+    if (okFrames(r) == 0) return 0;
     const std::string key = "wrong-but-ok frames (> 2 deg or > 2 %): ";
     const size_t at = r.output.find(key);
     if (at == std::string::npos) return -1;
@@ -213,8 +223,12 @@ int wrongButOk(const CommandResult& r) {
 TEST(BadInput, DamagedSampleGivesNoWrongOkPose) {
     // The sample session with 200 XOR-ed bytes (three seeds) and with 4 KiB of random bytes in
     // the middle of main.mkv. FFmpeg's decoder concealed the damage and tracking reported
-    // confident wrong poses; now damaged frames are lost with their reason.
-    const std::string original = readFileBytes(sample() / "main.mkv");
+    // confident wrong poses; now damaged frames are lost with their reason. The sample's video
+    // carries a CRC-32 per cluster, which would find every damaged frame; without it (as from
+    // other recorders) only the JPEG checks can, and a few frames damaged only in coefficient
+    // value bits are delivered and tracked.
+    const std::string original =
+        withoutMatroskaClusterChecksums(readFileBytes(sample() / "main.mkv"));
     for (int trial = 0; trial < 4; ++trial) {
         const fs::path s = copySample("bad_damaged_sample_" + std::to_string(trial));
         std::string bytes = original;
@@ -230,6 +244,9 @@ TEST(BadInput, DamagedSampleGivesNoWrongOkPose) {
             runMirage({"track", s.string(), "-o", (s.parent_path() / "poses.csv").string()});
         ASSERT_EQ(r.exitCode, 0) << r.output;
         EXPECT_EQ(wrongButOk(r), 0) << "trial " << trial << "\n" << r.output;
+        if (trial == 3) {
+            EXPECT_GE(okFrames(r), 30) << r.output;
+        }
         EXPECT_EQ(r.output.find("(0 unreadable"), std::string::npos) << r.output;
     }
 }

@@ -31,6 +31,10 @@ namespace fs = std::filesystem;
 fs::path sampleSession() {
     return dataDir() / "sessions" / "sample";
 }
+// The scene the sample session was synthesised from: its real spot light lights the footage.
+std::string sampleScene() {
+    return (dataDir() / "scenes" / "tabletop" / "tabletop_backlit.gltf").string();
+}
 std::string diffuseScene() {
     return (dataDir() / "scenes" / "tabletop" / "tabletop_diffuse.gltf").string();
 }
@@ -201,7 +205,7 @@ TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
 // The footage as recorded (main.mkv, JPEG) against the frames the stand-in delivered.
 TEST(LiveRecording, ReplayOfTheRecordingReproducesTheLiveComposite) {
     const fs::path dir = outputDir("live_record");
-    const std::string scene = (dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
+    const std::string scene = sampleScene();
     const fs::path rec = dir / "rec";
     // 2 frames/s: the sample's 36 frames last 18 s, so 3 frames get processed even on a loaded
     // machine (at 6 frames/s the stand-in ended after 2 frames under a load average of 10).
@@ -469,7 +473,7 @@ TEST(LivePlacement, ReplayAppliesTheSamePlacement) {
 // refused before any work, with the names known.
 TEST(LiveHeadless, EffectsSwitchedOffLeaveTheFrameGraph) {
     const fs::path dir = outputDir("live_effects_off");
-    const std::string scene = (dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
+    const std::string scene = sampleScene();
     auto live = runMirage({"live", "--camera", sampleSession().string(), "--scene", scene,
                            "--headless", "--camera-fps", "2", "--frames", "1", "--off",
                            "caustics,glass_shadows", "-o", (dir / "live_off").string()});

@@ -23,6 +23,11 @@ std::string scene() {
     return (test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf").string();
 }
 
+// The scene the sample session was synthesised from (its real spot light lights the footage).
+std::string sampleScene() {
+    return (test::dataDir() / "scenes" / "tabletop" / "tabletop_backlit.gltf").string();
+}
+
 std::string bytesOf(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     EXPECT_TRUE(in) << p;
@@ -222,7 +227,7 @@ TEST(ShardedRuns, ReplayBlocksWithWarmupJoinSeamlessly) {
     const fs::path dir = test::outputDir("shards_replay");
     fs::remove_all(dir);
     const std::string session = (test::dataDir() / "sessions" / "sample").string();
-    const std::vector<std::string> base = {"replay",   session, "--scene",       scene(),
+    const std::vector<std::string> base = {"replay",   session, "--scene",       sampleScene(),
                                            "--frames", "10",    "--ground-truth"};
     auto args = base;
     args.insert(args.end(), {"-o", (dir / "whole").string()});

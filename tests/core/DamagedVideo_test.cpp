@@ -4,6 +4,7 @@
 // must be reported lost with a reason, and every frame whose bytes are intact must be delivered.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <random>
 
@@ -53,10 +54,16 @@ struct Original {
 
 const Original& original() {
     static const Original o = [] {
+        // Without the checksums: the JPEG checks alone must find the damage, as in other
+        // recorders' files (ChecksummedRecordingGivesRightFramesOrLostOnes tests the checksums).
+        const fs::path video = test::outputDir("damaged_video_original") / "main.mkv";
+        std::ofstream(video, std::ios::binary)
+            << test::withoutMatroskaClusterChecksums(readFileBytes(sampleVideo()));
         Original r;
-        r.bytes = readFileBytes(sampleVideo());
-        r.scan = scanMatroska(sampleVideo());
-        r.decoded = readAllFrames(sampleVideo());
+        r.bytes = readFileBytes(video);
+        r.scan = scanMatroska(video);
+        r.decoded = readAllFrames(video);
+        EXPECT_EQ(r.bytes.size(), fs::file_size(sampleVideo()));
         return r;
     }();
     return o;
@@ -165,6 +172,8 @@ TEST(DamagedVideo, TwoHundredByteFlipsGiveRightFramesOrLostOnes) {
         // Most damage desynchronises the entropy decoder and is caught; what is left are
         // changed coefficient values (measured: 3 to 6 frames per seed).
         EXPECT_LT(r.valueDamage, r.lost) << "seed " << seed;
+        std::printf("200 flips, seed %u: %d delivered, %d lost, %d damaged in value bits only\n",
+                    seed, r.delivered, r.lost, r.valueDamage);
     }
 }
 

@@ -61,6 +61,29 @@ double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q) {
     return v[k];
 }
 
+std::string withoutMatroskaClusterChecksums(std::string bytes) {
+    const auto vint = [&](size_t at, size_t& length) -> uint64_t {
+        const auto first = uint8_t(bytes[at]);
+        length = 1;
+        while (length <= 8 && !(first & (0x80 >> (length - 1)))) ++length;
+        uint64_t v = first & (0xFF >> length);
+        for (size_t k = 1; k < length; ++k) v = (v << 8) | uint8_t(bytes[at + k]);
+        return v;
+    };
+    const std::string clusterId("\x1F\x43\xB6\x75", 4), crc("\xBF\x84", 2);
+    for (size_t at = bytes.find(clusterId); at != std::string::npos;
+         at = bytes.find(clusterId, at + 4)) {
+        if (at + 13 > bytes.size()) break;  // the ID, the longest size, a child's ID and size
+        size_t sizeLength = 0;
+        const uint64_t size = vint(at + 4, sizeLength);
+        const size_t data = at + 4 + sizeLength;
+        if (bytes.compare(data, 2, crc) != 0 || data + size > bytes.size() || size < 6) continue;
+        bytes.erase(data, 6);
+        bytes.insert(data + size - 6, std::string("\xEC\x84\0\0\0\0", 6));
+    }
+    return bytes;
+}
+
 CommandResult runMirage(const std::vector<std::string>& args) {
     std::string cmd = std::string("'") + MIRAGE_BINARY + "'";
     for (const auto& a : args) {

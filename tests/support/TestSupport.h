@@ -43,6 +43,12 @@ CsvTable readCsvTable(const std::filesystem::path& path);
 std::vector<cv::Mat> sessionFrames(const std::filesystem::path& session,
                                    const std::string& camera = "main");
 
+// A Matroska file's bytes with every cluster's leading CRC-32 element (ID 0xBF, size 4) moved
+// out of the way: the cluster's other children move up by its 6 bytes and an EBML Void of the
+// same 6 bytes ends the cluster, so every size and the file's length stay. mirage's recordings
+// carry the checksum, other recorders' files do not: there only the JPEG checks can find damage.
+std::string withoutMatroskaClusterChecksums(std::string bytes);
+
 struct CommandResult {
     int exitCode = -1;
     std::string output;  // stdout and stderr together
