@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <apriltag/apriltag.h>
@@ -39,6 +40,11 @@ bool sampleLinear(const cv::Mat& grey, double x, double y, double& v) {
     return true;
 }
 
+// Whether sampleLinear can sample at p (its 2x2 neighbourhood lies in the image).
+bool insideForBilinear(const cv::Mat& grey, const glm::dvec2& p) {
+    return p.x >= 0 && p.y >= 0 && p.x < grey.cols - 1 && p.y < grey.rows - 1;
+}
+
 }  // namespace
 
 // Sub-pixel edge refinement (see DetectorOptions::refineCorners). Leaves the corners unchanged if
@@ -69,32 +75,58 @@ bool Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder,
         const int nSamples = std::clamp(int(len / 2), 6, 40);
         std::vector<glm::dvec2> pts;
         std::vector<double> weights;
-        std::vector<double> profile(static_cast<size_t>(nProfile), 0.0);
+        // Samples of a profile are taken lazily (NaN = not sampled yet): the levels at both ends,
+        // then the segments in order of their distance from the initial edge until no segment
+        // can hold a crossing closer than the one found. The result is the crossing closest to
+        // the profile centre, as if every sample had been taken (large tags have profiles of up
+        // to 33 samples, of which ~4-8 are needed).
+        std::vector<double> profile(static_cast<size_t>(nProfile));
+        const double tLast = -range + (nProfile - 1) * step;
+        // Segment holding t = 0 (the initial edge), clamped to the profile.
+        const int centreSeg = std::clamp(int(std::floor(range / step)), 0, nProfile - 2);
         for (int s = 0; s < nSamples; ++s) {
             const double f = 0.15 + 0.7 * (s + 0.5) / nSamples;
             const glm::dvec2 base = a + f * (b - a);
-            bool ok = true;
-            for (int i = 0; i < nProfile && ok; ++i) {
-                const glm::dvec2 p = base + normal * (-range + i * step);
-                ok = sampleLinear(grey, p.x, p.y, profile[size_t(i)]);
-            }
-            if (!ok) continue;
-            const double dark = 0.5 * (profile[0] + profile[1]);
-            const double bright =
-                0.5 * (profile[size_t(nProfile - 1)] + profile[size_t(nProfile - 2)]);
+            // The bilinear sampling domain is convex: both ends inside = every sample inside.
+            const glm::dvec2 pFirst = base - normal * range, pLast = base + normal * tLast;
+            if (!insideForBilinear(grey, pFirst) || !insideForBilinear(grey, pLast)) continue;
+            std::fill(profile.begin(), profile.end(), std::numeric_limits<double>::quiet_NaN());
+            auto at = [&](int i) {
+                double& v = profile[size_t(i)];
+                if (std::isnan(v)) {
+                    const glm::dvec2 p = base + normal * (-range + i * step);
+                    sampleLinear(grey, p.x, p.y, v);
+                }
+                return v;
+            };
+            const double dark = 0.5 * (at(0) + at(1));
+            const double bright = 0.5 * (at(nProfile - 1) + at(nProfile - 2));
             const double contrast = bright - dark;
             if (contrast < 0.03) continue;
             const double mid = 0.5 * (dark + bright);
             // Crossing of the mid level closest to the initial edge (profile centre).
             double best = 1e9, bestT = 0;
-            for (int i = 0; i + 1 < nProfile; ++i) {
-                const double v0 = profile[size_t(i)], v1 = profile[size_t(i + 1)];
-                if ((v0 - mid) * (v1 - mid) > 0 || v0 == v1) continue;
+            auto trySegment = [&](int i) {
+                const double v0 = at(i), v1 = at(i + 1);
+                if ((v0 - mid) * (v1 - mid) > 0 || v0 == v1) return;
                 const double tc = -range + step * (i + (mid - v0) / (v1 - v0));
                 if (std::abs(tc) < std::abs(best)) {
                     best = tc;
                     bestT = tc;
                 }
+            };
+            trySegment(centreSeg);
+            // Distance from t = 0 to the nearest point of the segments left and right of those
+            // tried so far.
+            int left = centreSeg - 1, right = centreSeg + 1;
+            while (left >= 0 || right + 1 < nProfile) {
+                const double dl = left >= 0 ? std::abs(-range + (left + 1) * step) : 1e18;
+                const double dr = right + 1 < nProfile ? std::abs(-range + right * step) : 1e18;
+                if (std::min(dl, dr) > std::abs(best)) break;
+                if (dl <= dr)
+                    trySegment(left--);
+                else
+                    trySegment(right++);
             }
             if (best > 1e8) continue;
             pts.push_back(base + normal * bestT);

@@ -156,7 +156,21 @@ Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
       tagFinder_(board, camera, options.prediction),
       estimator_(std::move(board), std::move(camera), options.pose),
       filter_(options.filter),
-      oneEuro_(options.oneEuro) {}
+      oneEuro_(options.oneEuro) {
+    coarseCellsAtBorder_ = TagFamily(options_.detector.family).widthAtBorder();
+    double diameter = 0, largest = 0;
+    const auto& tags = estimator_.board().tags;
+    for (size_t i = 0; i < tags.size(); ++i) {
+        largest = std::max(largest, tags[i].size);
+        const auto ci = tags[i].cornersInWorld();
+        for (size_t j = i; j < tags.size(); ++j) {
+            const auto cj = tags[j].cornersInWorld();
+            for (const auto& a : ci)
+                for (const auto& b : cj) diameter = std::max(diameter, glm::length(a - b));
+        }
+    }
+    largestTagOverDiameter_ = diameter > 0 ? largest / diameter : 0;
+}
 
 Pose Tracker::predictPose(double t) const {
     Pose p = *lastOk_;
@@ -212,27 +226,44 @@ std::optional<cv::Rect> Tracker::boardRegion(const Pose& T_world_camera, cv::Siz
     return cv::Rect(bx0, by0, bx1 - bx0, by1 - by0);
 }
 
-bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region,
+// Corner move (pixels) of the coarse tags' first refinement pass beyond which a second pass runs.
+constexpr double kCoarseSecondPassMovePx = 0.25;
+
+bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float decimate,
                            const std::optional<Pose>& prior, TrackedFrame& f) {
     f.coarseTried = true;
-    if (!coarseDetector_) {
+    Detector* coarseDetector = nullptr;
+    for (auto& [d, det] : coarseDetectors_)
+        if (d == decimate) coarseDetector = det.get();
+    if (!coarseDetector) {
         DetectorOptions o = options_.detector;
-        o.decimate = options_.coarseDecimate;
+        o.decimate = decimate;
         // Small tags are the ordinary search's job (the fallback).
         o.fullResolutionRetry = false;
-        coarseDetector_ = std::make_unique<Detector>(o);
-        coarseCellsAtBorder_ = TagFamily(o.family).widthAtBorder();
+        // Refined by coarseToFine, in one or two passes.
+        o.refineCorners = false;
+        coarseDetectors_.emplace_back(decimate, std::make_unique<Detector>(o));
+        coarseDetector = coarseDetectors_.back().second.get();
     }
     auto t0 = std::chrono::steady_clock::now();
-    std::vector<TagDetection> coarse = coarseDetector_->detect(grey, region);
+    std::vector<TagDetection> coarse = coarseDetector->detect(grey, region);
     f.coarseTags = int(coarse.size());
-    // Only tags whose corners were refined at full resolution are used (libapriltag's corners
-    // on the decimated image are off by up to half a pixel); the finder tries the others.
-    // A second pass of the refinement from the refined corners: the first one started from
-    // libapriltag's decimated corners, up to ~1 px off, whose sample lines along the edges are
-    // skewed (measured: up to 0.47 px corner error left on a 31 px tag, 0.2 px after this pass).
+    // Only tags whose corners mirage's refinement can measure at full resolution are used
+    // (libapriltag's corners on the decimated image are off by up to ~1 px); the finder tries the
+    // others. A second pass of the refinement when the first moved a corner by more than
+    // kCoarseSecondPassMovePx: a pass that starts from corners ~1 px off has its profiles along
+    // the edges skewed (measured: up to 0.47 px corner error left on a 31 px tag, 0.2 px after
+    // the second pass); after a small move a second pass changes little and costs as much
+    // (~0.4 ms for the 24 large tags of a near 640x480 view).
     std::erase_if(coarse, [&](TagDetection& d) {
-        return !d.refined || !Detector::refineCorners(grey, coarseCellsAtBorder_, d.corners);
+        const std::array<glm::dvec2, 4> before = d.corners;
+        if (!Detector::refineCorners(grey, coarseCellsAtBorder_, d.corners)) return true;
+        d.refined = true;
+        double moved = 0;
+        for (size_t k = 0; k < 4; ++k)
+            moved = std::max(moved, glm::length(d.corners[k] - before[k]));
+        return moved > kCoarseSecondPassMovePx &&
+               !Detector::refineCorners(grey, coarseCellsAtBorder_, d.corners);
     });
     f.detectMs += msSince(t0);
     if (coarse.empty()) return false;
@@ -335,15 +366,17 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
             if (r && r->area() > 0 && r->area() < 0.7 * full.area()) f.searchRegion = *r;
         }
         if (f.searchRegion == full) framesSinceFullSearch_ = 0;
+        // No pose to say where the board is: where the image has the tags' contrast.
+        const cv::Rect r = !prior && (options_.textureRegion || options_.coarseFirst)
+                               ? texturedRegion(grey)
+                               : cv::Rect();
+        const double m = options_.textureMarginPx;
+        const cv::Rect grown =
+            cv::Rect(cv::Point(std::max(0, int(r.x - m)) / kTextureBlockPx * kTextureBlockPx,
+                               std::max(0, int(r.y - m)) / kTextureBlockPx * kTextureBlockPx),
+                     cv::Point(int(r.br().x + m), int(r.br().y + m))) &
+            full;
         if (options_.textureRegion && !prior) {
-            // No pose to say where the board is: where the image has the tags' contrast.
-            const cv::Rect r = texturedRegion(grey);
-            const double m = options_.textureMarginPx;
-            const cv::Rect grown =
-                cv::Rect(cv::Point(std::max(0, int(r.x - m)) / kTextureBlockPx * kTextureBlockPx,
-                                   std::max(0, int(r.y - m)) / kTextureBlockPx * kTextureBlockPx),
-                         cv::Point(int(r.br().x + m), int(r.br().y + m))) &
-                full;
             if (r.area() > 0 && grown.area() <= options_.textureMaxFraction * full.area()) {
                 f.searchRegion = grown;
                 f.textureRegionUsed = true;
@@ -351,8 +384,27 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         }
 
         const bool coarseRegion = f.searchRegion == full || f.textureRegionUsed;
-        if (!(options_.coarseToFine && grey.cols >= options_.coarseMinWidth && coarseRegion &&
-              coarseToFine(grey, f.searchRegion, ambiguityPrior, f))) {
+        float coarseDecimate = options_.coarseToFine && grey.cols >= options_.coarseMinWidth
+                                   ? options_.coarseDecimate
+                                   : 0.0f;
+        if (options_.coarseFirst && r.area() > 0) {
+            // The tags' size from the textured region picks the decimation (or none).
+            f.coarseFirstSidePx =
+                largestTagOverDiameter_ * std::hypot(double(r.width), double(r.height));
+            coarseDecimate = 0;
+            for (float d : options_.coarseFirstDecimations)
+                if (d > coarseDecimate && f.coarseFirstSidePx >= d * options_.coarseFirstMinSidePx)
+                    coarseDecimate = d;
+            f.coarseFirstDecimate = coarseDecimate;
+        }
+        // The coarse search reads only the textured region also when it is too large for the
+        // ordinary search (a near board): a confirmed coarse pose has every board tag predicted
+        // in the whole image searched by the finder, and an unconfirmed one falls back to the
+        // ordinary search of f.searchRegion.
+        cv::Rect coarseSearch = f.searchRegion;
+        if (options_.coarseFirst && options_.textureRegion && r.area() > 0) coarseSearch = grown;
+        if (!(coarseDecimate > 1.0f && coarseRegion &&
+              coarseToFine(grey, coarseSearch, coarseDecimate, ambiguityPrior, f))) {
             t0 = std::chrono::steady_clock::now();
             f.detections = detector_.detect(grey, f.searchRegion);
             f.detectMs += msSince(t0);

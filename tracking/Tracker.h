@@ -94,6 +94,17 @@ struct TrackerOptions {
     float coarseDecimate = 4.0f;
     double coarseSearchPx = 4.0;
     int coarsePoseTags = 4;
+    // Coarse-first single frames (docs/tracking.md, "Single frames: coarse-first search"): in a
+    // frame without a recent ok pose, the textured region's size says how large the board's
+    // tags are in the image (the largest tag's side, estimated as the board's largest tag over
+    // its diameter times the region's diagonal; an overestimate under foreshortening). The
+    // coarse-to-fine search then runs at any image width, at the largest decimation of
+    // coarseFirstDecimations that leaves the estimated side at least coarseFirstMinSidePx on the
+    // decimated image; when none does (small, distant tags) the ordinary search runs directly.
+    // It replaces coarseMinWidth / coarseDecimate in such frames; false = those as before.
+    bool coarseFirst = true;
+    std::vector<float> coarseFirstDecimations{4.0f, 3.0f};
+    double coarseFirstMinSidePx = 15.0;
 };
 
 struct TrackedFrame {
@@ -119,6 +130,10 @@ struct TrackedFrame {
     bool coarseTried = false;
     int coarseTags = 0;
     bool coarseUsed = false;
+    // Coarse-first search: the largest tag's side estimated from the textured region (pixels;
+    // 0 when not estimated) and the decimation it chose (0: none, the ordinary search).
+    double coarseFirstSidePx = 0;
+    float coarseFirstDecimate = 0;
     // Textured-region search: the frame's search began in texturedRegion's box (searchRegion).
     bool textureRegionUsed = false;
 };
@@ -174,16 +189,20 @@ private:
     // Coarse-to-fine search: the frame's tags from libapriltag on the decimated image (inside
     // `region`), then all board tags found from their pose; false (f unchanged but the coarse
     // fields) to fall back.
-    bool coarseToFine(const cv::Mat& grey, const cv::Rect& region, const std::optional<Pose>& prior,
-                      TrackedFrame& f);
+    bool coarseToFine(const cv::Mat& grey, const cv::Rect& region, float decimate,
+                      const std::optional<Pose>& prior, TrackedFrame& f);
 
     // Fills TagDetection::edgeWidthPx of the board tags: the edge width (blur) around the
     // largest one, for the estimator's corner-noise model (~0.02-0.05 ms).
     void measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const;
 
     PredictedTagFinder tagFinder_;
-    std::unique_ptr<Detector> coarseDetector_;  // created at the first full search
+    // Coarse detectors by decimation, created when first needed.
+    std::vector<std::pair<float, std::unique_ptr<Detector>>> coarseDetectors_;
     int coarseCellsAtBorder_ = 8;
+    // The board's largest tag side over its diameter (the largest distance between two tag
+    // corners): the largest tag's image side per pixel of the board's image extent.
+    double largestTagOverDiameter_ = 0;
     PoseEstimator estimator_;
     PoseFilter filter_;
     OneEuroPoseFilter oneEuro_;

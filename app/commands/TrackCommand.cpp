@@ -31,6 +31,7 @@ struct TrackArgs {
     bool noFilter = false;
     bool noTagTracking = false;
     bool noTextureRegion = false;
+    bool noCoarseFirst = false;
     bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
@@ -94,6 +95,7 @@ void run(const TrackArgs& a) {
     opt.filterEnabled = !a.noFilter;
     opt.tagTracking = !a.noTagTracking;
     opt.textureRegion = !a.noTextureRegion;
+    opt.coarseFirst = !a.noCoarseFirst;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -271,6 +273,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_flag("--no-texture-region", a->noTextureRegion,
                   "Without a recent pose, search the whole image instead of first the region "
                   "with the tags' contrast (docs/tracking.md, Single frames)");
+    cmd->add_flag("--no-coarse-first", a->noCoarseFirst,
+                  "Without a recent pose, do not pick a coarse-to-fine decimation from the "
+                  "size of the textured region (docs/tracking.md, Single frames: coarse-first)");
     cmd->callback([a] { run(*a); });
 });
 

@@ -18,11 +18,12 @@ const Scene& scene() {
     return testing::boardViewScene();
 }
 
-// One unrelated frame through a fresh Tracker (no previous pose), coarse-to-fine on or off.
+// One unrelated frame through a fresh Tracker (no previous pose), coarse-to-fine at the fixed
+// decimation on or off (the coarse-first choice of the decimation, CoarseFirst_test.cpp, off).
 TrackedFrame single(const cv::Mat& img, bool coarseToFine, int coarsePoseTags = 4) {
     const Scene& s = scene();
     TrackerOptions o;
-
+    o.coarseFirst = false;
     o.coarseToFine = coarseToFine;
     o.filterEnabled = false;
     o.coarsePoseTags = coarsePoseTags;
@@ -126,19 +127,22 @@ TEST(CoarseToFine, OneTagCoarsePoseIsSettledOrFallsBack) {
     EXPECT_GT(used, 0);
 }
 
-// The defaults: off at 640x480 (coarseMinWidth 1000), on at 1280x720 with the same pose as the
-// decimate-2 search.
+// The fixed-decimation defaults (coarse-first off, as in frames where the textured region is not
+// measured: the periodic full search of the video): off at 640x480 (coarseMinWidth 1000), on at
+// 1280x720 with the same pose as the decimate-2 search.
 TEST(CoarseToFine, DefaultOnlyFrom1000PxWidth) {
     const Scene& s = scene();
     const Pose T = testing::lookAt({-0.12, 0.39, 0.17}, {0, 0, 0}, {0, 0, -1}, 0.3);
-    Tracker small(s.board, s.cam);
+    TrackerOptions fixed;
+    fixed.coarseFirst = false;
+    Tracker small(s.board, s.cam, fixed);
     const TrackedFrame a = small.process(s.render(T), 0.0);
     EXPECT_EQ(a.estimate.state, TrackingState::Ok);
     EXPECT_FALSE(a.coarseTried);
     const CameraIntrinsics hd = testing::pinholeCamera(1280, 720, 1000);
     const cv::Mat img = renderSyntheticBoardView(s.board, s.tex, hd, T);
-    Tracker withDefaults(s.board, hd);
-    TrackerOptions off;
+    Tracker withDefaults(s.board, hd, fixed);
+    TrackerOptions off = fixed;
     off.coarseToFine = false;
     Tracker without(s.board, hd, off);
     const TrackedFrame c = withDefaults.process(img, 0.0), o = without.process(img, 0.0);

@@ -18,7 +18,14 @@ TEST(Tracker, StaticCameraJitterBeforeAndAfterFiltering) {
     const auto cam = testing::pinholeCamera();
     const Pose T = testing::lookAt({0.12, 0.42, 0.25}, {0, 0, 0});
     const cv::Mat clean = renderSyntheticBoardView(board, tex, cam, T);
-    Tracker tracker(board, cam);
+    // The first frame from libapriltag's search, as when the figures of docs/tracking.md were
+    // measured: the spread over frames 10-39 still holds part of the filter's settling from the
+    // first frame's pose (gain ~0.1: 0.9^10 = 35 % of its offset), so a first pose 0.001 deg
+    // different moves the rotation ratio (with the coarse-first search 2.6x instead of 3.1x, its
+    // first pose being the closer one to the truth: 0.0043 vs 0.0054 deg).
+    TrackerOptions firstBySearch;
+    firstBySearch.coarseFirst = false;
+    Tracker tracker(board, cam, firstBySearch);
     cv::RNG rng(11);
     std::vector<glm::dvec3> rawT, filtT;
     std::vector<glm::dquat> rawR, filtR;

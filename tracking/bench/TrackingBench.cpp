@@ -127,6 +127,7 @@ void BM_MirageTrack(benchmark::State& state) {
     // frames is measured on single frames, BM_MirageSingle); mode 2 uses it for the periodic full
     // search, as by default.
     opt.coarseToFine = state.range(1) >= 2;
+    opt.coarseFirst = state.range(1) >= 2;
     Tracker tracker(f.board, f.camera, opt);
     TrackingAccuracy acc;
     const double dt = 1.0 / 30.0;
@@ -168,15 +169,18 @@ BENCHMARK(BM_MirageTrack)
     ->UseRealTime();
 
 // mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
-// apart). Args: mode 1 = coarse-to-fine (libapriltag at `coarse` decimation, the other board tags
-// found from that pose at full resolution and verified; the default with coarse 4 from 1000 px
-// width), 0 = libapriltag's search at decimate 2 only (= BM_Mirage/decimate:2 inside the
-// Tracker); texture 1 = the search starts in the textured region (default), 0 = full image.
+// apart). Args: mode 2 = coarse-first (the default: the coarse-to-fine search at the decimation
+// the textured region's size picks, 4, 3 or none), 1 = coarse-to-fine at the fixed `coarse`
+// decimation (libapriltag at that decimation, the other board tags found from that pose at full
+// resolution and verified; the previous default from 1000 px width), 0 = libapriltag's search
+// at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker); texture 1 = the search starts
+// in the textured region (default), 0 = full image.
 void BM_MirageSingle(benchmark::State& state) {
     const BoardFrames& f = frames(int(state.range(0)));
     TrackerOptions opt;
+    opt.coarseFirst = state.range(1) == 2;
     opt.coarseToFine = state.range(1) == 1;
-    opt.coarseMinWidth = 0;  // measured at 640x480 too (off there by default)
+    opt.coarseMinWidth = 0;  // mode 1 measured at 640x480 too
     opt.coarseDecimate = float(state.range(2));
     opt.textureRegion = state.range(3) == 1;
     opt.filterEnabled = false;
@@ -248,14 +252,15 @@ BENCHMARK(BM_Mirage)
     ->UseRealTime();
 BENCHMARK(BM_MirageSingle)
     ->ArgNames({"width", "mode", "coarse", "texture"})
+    ->Args({640, 2, 0, 1})
     ->Args({640, 0, 0, 1})
     ->Args({640, 0, 0, 0})
     ->Args({640, 1, 4, 1})
-    ->Args({640, 1, 4, 0})
+    ->Args({640, 1, 3, 1})
+    ->Args({1280, 2, 0, 1})
     ->Args({1280, 1, 4, 1})
     ->Args({1280, 1, 4, 0})
     ->Args({1280, 0, 0, 1})
-    ->Args({1280, 0, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Aruco)

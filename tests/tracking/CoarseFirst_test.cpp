@@ -1,0 +1,171 @@
+// The Tracker's coarse-first search of frames without a recent pose (TrackerOptions::
+// coarseFirst): the textured region's size estimates the tags' size, which picks the decimation
+// of the coarse-to-fine search (4, 3, or none: the ordinary search). Whatever it picks, a frame
+// whose coarse pose is not confirmed falls back to the ordinary search.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <functional>
+
+#include <opencv2/imgproc.hpp>
+
+#include "testscenes/TrackingViews.h"
+#include "tracking/Tracker.h"
+
+namespace mirage::tracking {
+namespace {
+
+using Scene = testing::BoardViewScene;
+const Scene& scene() {
+    return testing::boardViewScene();
+}
+
+glm::dvec3 orbit(double dist, double elevDeg, double azDeg) {
+    const double el = glm::radians(elevDeg), az = glm::radians(azDeg);
+    return dist *
+           glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+}
+
+// One unrelated frame through a fresh Tracker (no previous pose): the defaults (coarse-first
+// on), or with the coarse-first search off (libapriltag's ordinary search in the textured region).
+TrackedFrame single(const cv::Mat& img, bool coarseFirst, const Board* board = nullptr,
+                    double minSidePx = TrackerOptions{}.coarseFirstMinSidePx) {
+    TrackerOptions o;
+    o.coarseFirst = coarseFirst;
+    o.coarseFirstMinSidePx = minSidePx;
+    o.filterEnabled = false;
+    Tracker tracker(board ? *board : scene().board, scene().cam, o);
+    return tracker.process(img, 0.0);
+}
+
+double rotationDeg(const Pose& a, const Pose& b) {
+    return glm::degrees(rotationAngleBetween(a.rotation, b.rotation));
+}
+
+// Near, middle and far views: the decimation follows the tags' size, and the pose is the
+// ordinary search's.
+TEST(CoarseFirst, DecimationFollowsTheTagSize) {
+    struct View {
+        const char* name;
+        Pose T;
+        float decimate;  // expected choice
+    };
+    const std::vector<View> views = {
+        {"0.3 m", testing::lookAt(orbit(0.3, 75, 10), {0, 0, 0}), 4.0f},
+        {"0.5 m", testing::lookAt(orbit(0.5, 60, -20), {0.01, 0, 0}), 3.0f},
+        {"0.8 m", testing::lookAt(orbit(0.8, 50, 15), {0, 0, 0}), 0.0f},
+    };
+    for (const View& v : views) {
+        const cv::Mat img = scene().render(v.T);
+        const TrackedFrame c = single(img, true), o = single(img, false);
+        std::printf("%s: estimated side %.1f px, decimate %.0f, coarse used %d, %zu vs %zu tags\n",
+                    v.name, c.coarseFirstSidePx, double(c.coarseFirstDecimate), int(c.coarseUsed),
+                    c.estimate.tagsUsed.size(), o.estimate.tagsUsed.size());
+        EXPECT_EQ(c.coarseFirstDecimate, v.decimate) << v.name;
+        EXPECT_EQ(c.coarseTried, v.decimate > 0) << v.name;
+        ASSERT_EQ(c.estimate.state, TrackingState::Ok) << v.name << ": " << c.estimate.reason;
+        ASSERT_EQ(o.estimate.state, TrackingState::Ok) << v.name << ": " << o.estimate.reason;
+        if (v.decimate > 0) {
+            EXPECT_TRUE(c.coarseUsed) << v.name;
+            EXPECT_GE(c.estimate.tagsUsed.size(), o.estimate.tagsUsed.size()) << v.name;
+        }
+        EXPECT_LT(rotationDeg(*c.estimate.pose, *o.estimate.pose), 0.02) << v.name;
+        EXPECT_LT(glm::length(c.estimate.pose->translation - o.estimate.pose->translation), 2e-4)
+            << v.name;
+        EXPECT_LT(rotationDeg(*c.estimate.pose, v.T), 0.1) << v.name;
+    }
+}
+
+// The hard views (as in HardCases and TexturedRegion): the coarse-first search gives the state
+// of the ordinary search; where ok, its pose (within 0.05 deg / 0.3 mm) and within 0.5 deg / 1 %
+// of the truth. A coarse pose that is not confirmed never becomes the frame's.
+TEST(CoarseFirst, SameStateAsTheOrdinarySearchOnHardViews) {
+    struct View {
+        const char* name;
+        Pose T;
+        std::function<void(cv::Mat&)> modify;
+    };
+    const std::vector<View> views = {
+        {"steep 70 deg", testing::lookAt(orbit(0.45, 20, 10), {0, 0, 0}, {0, 1, 0}), {}},
+        {"steep 78 deg", testing::lookAt(orbit(0.35, 12, 0), {0, 0, 0}, {0, 1, 0}), {}},
+        {"motion blur 9 px", testing::lookAt(orbit(0.45, 60, 15), {0, 0, 0}),
+         [](cv::Mat& img) {
+             cv::Mat k = cv::Mat::zeros(1, 9, CV_32F) + 1.0f / 9;
+             cv::filter2D(img, img, -1, k);
+         }},
+        {"occluded half", testing::lookAt(orbit(0.4, 65, -10), {0, 0, 0}),
+         [](cv::Mat& img) {
+             cv::rectangle(img, {0, 0}, {img.cols / 2, img.rows}, cv::Scalar(60), cv::FILLED);
+         }},
+        {"exposure x0.2", testing::lookAt(orbit(0.4, 60, 5), {0, 0, 0}),
+         [](cv::Mat& img) { img.convertTo(img, -1, 0.2, 0); }},
+        {"board cut by the image edge", testing::lookAt(orbit(0.35, 70, 0), {0.12, 0, 0.05}), {}},
+        {"distant 1.1 m", testing::lookAt(orbit(1.1, 80, 0), {0, 0, 0}), {}},
+    };
+    int coarseUsed = 0;
+    for (const View& v : views) {
+        cv::Mat img = scene().render(v.T);
+        if (v.modify) v.modify(img);
+        const TrackedFrame c = single(img, true), o = single(img, false);
+        std::printf("%s: %s (decimate %.0f, coarse tags %d, used %d), ordinary search %s\n", v.name,
+                    trackingStateName(c.estimate.state), double(c.coarseFirstDecimate),
+                    c.coarseTags, int(c.coarseUsed), trackingStateName(o.estimate.state));
+        coarseUsed += c.coarseUsed;
+        ASSERT_EQ(c.estimate.state, o.estimate.state) << v.name << ": " << c.estimate.reason;
+        ASSERT_EQ(c.estimate.pose.has_value(), o.estimate.pose.has_value()) << v.name;
+        if (c.estimate.state != TrackingState::Ok) continue;
+        EXPECT_LT(rotationDeg(*c.estimate.pose, *o.estimate.pose), 0.05) << v.name;
+        EXPECT_LT(glm::length(c.estimate.pose->translation - o.estimate.pose->translation), 3e-4)
+            << v.name;
+        EXPECT_LT(rotationDeg(*c.estimate.pose, v.T), 0.5) << v.name;
+        EXPECT_LT(glm::length(c.estimate.pose->translation - v.T.translation),
+                  0.01 * glm::length(v.T.translation))
+            << v.name;
+    }
+    // At least one of these views takes the coarse path (the board cut by the image edge), not
+    // only the fallback.
+    EXPECT_GE(coarseUsed, 1);
+}
+
+// Must fail: the coarse path forced on a view whose tags are too small for it (every decimation
+// allowed whatever the estimated size) finds nothing usable and falls back: the frame gets
+// exactly the ordinary search's pose. And a wrong board file (wrong gap: the tags do not fit one
+// pose; every tag turned by 90 degrees) gives no ok pose through the coarse path, while the
+// right board on the same frame does (the comparison can pass).
+TEST(CoarseFirst, ForcedOnSmallTagsFallsBackAndAWrongBoardGivesNoPose) {
+    const cv::Mat far = scene().render(testing::lookAt(orbit(0.8, 45, -10), {0, 0, 0}));
+    const TrackedFrame forced = single(far, true, nullptr, 0.0), o = single(far, false);
+    std::printf("forced: decimate %.0f, coarse tags %d, used %d; %s\n",
+                double(forced.coarseFirstDecimate), forced.coarseTags, int(forced.coarseUsed),
+                trackingStateName(forced.estimate.state));
+    EXPECT_EQ(forced.coarseFirstDecimate, 4.0f);
+    EXPECT_TRUE(forced.coarseTried);
+    EXPECT_FALSE(forced.coarseUsed);
+    ASSERT_EQ(forced.estimate.state, o.estimate.state) << forced.estimate.reason;
+    ASSERT_TRUE(forced.estimate.pose && o.estimate.pose);
+    EXPECT_EQ(forced.estimate.tagsUsed, o.estimate.tagsUsed);
+    EXPECT_EQ(rotationDeg(*forced.estimate.pose, *o.estimate.pose), 0.0);
+
+    const cv::Mat near = scene().render(testing::lookAt(orbit(0.35, 70, 10), {0, 0, 0}));
+    BoardLayout wrongGap;
+    wrongGap.gap = 0.012;
+    Board turned = scene().board;
+    const Pose turn = Pose::fromRotationTranslation(glm::dmat3(0, 1, 0, -1, 0, 0, 0, 0, 1), {});
+    for (auto& t : turned.tags) t.T_world_tag = t.T_world_tag * turn;
+    for (const Board& board : {wrongGap.makeBoard(), turned}) {
+        const TrackedFrame c = single(near, true, &board);
+        std::printf("wrong board: %s (%s), decimate %.0f, coarse tags %d\n",
+                    trackingStateName(c.estimate.state), c.estimate.reason.c_str(),
+                    double(c.coarseFirstDecimate), c.coarseTags);
+        EXPECT_TRUE(c.coarseTried);
+        EXPECT_GT(c.coarseTags, 0);
+        EXPECT_FALSE(c.coarseUsed);
+        EXPECT_NE(c.estimate.state, TrackingState::Ok) << c.estimate.reason;
+    }
+    const TrackedFrame right = single(near, true);
+    EXPECT_EQ(right.estimate.state, TrackingState::Ok) << right.estimate.reason;
+    EXPECT_TRUE(right.coarseUsed);
+}
+
+}  // namespace
+}  // namespace mirage::tracking

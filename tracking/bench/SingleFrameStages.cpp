@@ -1,0 +1,130 @@
+// Where a single frame's time goes (docs/tracking.md, "Single frames: coarse-first search"): the
+// benchmark's 16 unrelated views, each through a Tracker with no previous pose, `reps` times.
+// Per view: the tracker's CPU time per frame (this thread's CPU clock, so that other jobs on
+// the machine inflate it less than wall time), the path it took (coarse decimation, coarse pose
+// used, textured region), and the CPU time of mirage's own stages on that frame's tags (corner
+// refinement of every tag once, the pose estimate). Then libapriltag's own stage timer
+// (apriltag_detector_t::tp, wall time) of a decimate-2 search of each view's textured region: the
+// ordinary search the coarse-first path replaces.
+//
+//   tracking_single_stages [--width 640|1280] [--reps N] [--no-coarse-first]
+#include <apriltag/apriltag.h>
+#include <apriltag/common/timeprofile.h>
+
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <map>
+#include <string>
+
+#include "tracking/ArucoComparison.h"
+#include "tracking/TagFamily.h"
+#include "tracking/Tracker.h"
+
+namespace {
+
+// This thread's CPU time in milliseconds.
+double cpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace mirage::tracking;
+    int width = 640, reps = 20;
+    bool coarseFirst = true;
+    for (int i = 1; i < argc; ++i) {
+        if (!std::strcmp(argv[i], "--width") && i + 1 < argc)
+            width = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc)
+            reps = std::max(1, std::atoi(argv[++i]));
+        else if (!std::strcmp(argv[i], "--no-coarse-first"))
+            coarseFirst = false;
+        else {
+            std::fprintf(stderr, "usage: %s [--width 640|1280] [--reps N] [--no-coarse-first]\n",
+                         argv[0]);
+            return 2;
+        }
+    }
+    const BoardFrames f = singleBoardViews(width);
+    TrackerOptions opt;
+    opt.filterEnabled = false;
+    opt.coarseFirst = coarseFirst;
+    Tracker tracker(f.board, f.camera, opt);
+    PoseEstimator estimator(f.board, f.camera);
+    const TagFamily family("tag36h11");
+
+    apriltag_detector_t* td = apriltag_detector_create();
+    apriltag_family_t* raw = family.raw();
+    apriltag_detector_add_family_bits(td, raw, 1);
+    td->quad_decimate = 2.0f;
+    td->nthreads = 1;
+    std::map<std::string, double> stageMs;  // per view, summed over views
+
+    double t = 0, sumFrame = 0, sumRefine = 0, sumPose = 0, sumApril = 0;
+    std::printf("view | frame ms | path | tags | state | refine ms | pose ms | apriltag d2 ms\n");
+    for (size_t v = 0; v < f.images.size(); ++v) {
+        const cv::Mat& grey = f.images[v];
+        TrackedFrame r;
+        double c0 = cpuMs();
+        for (int i = 0; i < reps; ++i) r = tracker.process(grey, t += 10.0);
+        const double frameMs = (cpuMs() - c0) / reps;
+
+        c0 = cpuMs();
+        for (int i = 0; i < reps; ++i)
+            for (TagDetection d : r.detections)
+                Detector::refineCorners(grey, family.widthAtBorder(), d.corners);
+        const double refineMs = (cpuMs() - c0) / reps;
+        c0 = cpuMs();
+        for (int i = 0; i < reps; ++i) estimator.estimate(r.detections);
+        const double poseMs = (cpuMs() - c0) / reps;
+
+        // libapriltag's decimate-2 search of the textured region (grown as the tracker grows it).
+        const cv::Rect tex = texturedRegion(grey);
+        const int m = int(opt.textureMarginPx);
+        const cv::Rect region =
+            (tex.area() > 0 ? cv::Rect(tex.x - m, tex.y - m, tex.width + 2 * m, tex.height + 2 * m)
+                            : cv::Rect(0, 0, grey.cols, grey.rows)) &
+            cv::Rect(0, 0, grey.cols, grey.rows);
+        image_u8_t im{region.width, region.height, int(grey.step[0]),
+                      const_cast<uint8_t*>(grey.ptr<uint8_t>(region.y)) + region.x};
+        c0 = cpuMs();
+        for (int i = 0; i < reps; ++i) {
+            zarray_t* dets = apriltag_detector_detect(td, &im);
+            int64_t last = td->tp->utime;
+            for (int k = 0; k < zarray_size(td->tp->stamps); ++k) {
+                timeprofile_entry e{};
+                zarray_get(td->tp->stamps, k, &e);
+                stageMs[e.name] += double(e.utime - last) / 1000.0 / reps;
+                last = e.utime;
+            }
+            apriltag_detections_destroy(dets);
+        }
+        const double aprilMs = (cpuMs() - c0) / reps;
+
+        char path[64];
+        if (r.coarseTried)
+            std::snprintf(path, sizeof path, "coarse d%.0f %s", double(r.coarseFirstDecimate),
+                          r.coarseUsed ? "used" : "fell back");
+        else
+            std::snprintf(path, sizeof path, "search%s", r.fullFrameRetry ? " + full retry" : "");
+        std::printf("%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f\n", v, frameMs, path,
+                    r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
+                    trackingStateName(r.estimate.state), refineMs, poseMs, aprilMs);
+        sumFrame += frameMs;
+        sumRefine += refineMs;
+        sumPose += poseMs;
+        sumApril += aprilMs;
+    }
+    const double n = double(f.images.size());
+    std::printf("mean | %.2f | | | | %.3f | %.3f | %.2f\n", sumFrame / n, sumRefine / n,
+                sumPose / n, sumApril / n);
+    std::printf("libapriltag stages of the decimate-2 search (wall ms per view, mean):\n");
+    for (const auto& [name, ms] : stageMs)
+        if (ms / n >= 0.005) std::printf("  %-26s %.3f\n", name.c_str(), ms / n);
+    apriltag_detector_destroy(td);
+    return 0;
+}
