@@ -438,7 +438,8 @@ SuiteSpec defaultSuite() {
           {"glass_shadows", {"on", "off"}},
           {"refl_refr_vpls", {"on", "off"}},
           {"caustic_gather", {"on", "off"}},
-          {"caustic_radius", {"0.5", "1", "2", "4"}}},
+          {"caustic_radius", {"0.5", "1", "2", "4"}},
+          {"caustic_gather_cap", {"0", "64", "256", "1024"}}},
          {}},
     };
     const fs::path dir = s.scene.parent_path();
