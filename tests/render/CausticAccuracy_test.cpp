@@ -37,14 +37,7 @@ struct CausticReference {
 
 using test::linearLuminance;
 
-test::SpecularScene sphereView(const test::CausticScene& s) {
-    test::SpecularScene v;
-    v.cam = s.cam;
-    v.pose = s.pose;
-    v.sphereCentre = s.sphereCentre;
-    v.sphereRadius = s.sphereRadius;
-    return v;
-}
+using test::sphereView;
 
 CausticReference causticReference(const test::CausticScene& s, int spp = 32) {
     const test::CausticReferenceRender ref = test::renderCausticReference(s, spp, 9);

@@ -186,17 +186,24 @@ TEST(CausticGather, CausticSeenInMirrorMatchesReferenceAndGatherOffFails) {
     EXPECT_GT(noPhoton, 100);
 }
 
-// A caustic focused to a few pixels (the table at the ball lens's focus), seen in the mirror:
-// finite, and no firefly (the gathered caustic's 3x3-smoothed peak at most 2x the reference's,
-// plus 2 % of the brightest directly lit surface).
-TEST(CausticGather, FocusedCausticInMirrorHasNoFirefly) {
-    gl::Context context = gl::Context::headless();
+// The sphere raised so that the table lies at the ball lens's focus, its caustic focused to a few
+// pixels, seen in the mirror at 96x72.
+test::CausticScene focusedCausticInMirror() {
     test::CausticSceneOptions o;
     o.mirror = true;
     o.sphereCentre = glm::vec3(0.0f, 0.13f, 0.0f);
     o.lightPos = glm::vec3(0.5f, 0.996f, 0.0f);
     test::CausticScene s = test::makeCausticScene(o);
     test::mirrorView(s, 96, 72, 132.0);
+    return s;
+}
+
+// A caustic focused to a few pixels (the table at the ball lens's focus), seen in the mirror:
+// finite, and no firefly (the gathered caustic's 3x3-smoothed peak at most 2x the reference's,
+// plus 2 % of the brightest directly lit surface).
+TEST(CausticGather, FocusedCausticInMirrorHasNoFirefly) {
+    gl::Context context = gl::Context::headless();
+    const test::CausticScene s = focusedCausticInMirror();
     const Reference ref = reference(s, 12);
     const Realtime on = realtime(s, ref.footage, true), off = realtime(s, ref.footage, false);
     save("gather_mirror_focused", ref, on, off);
@@ -223,12 +230,7 @@ TEST(CausticGather, FocusedCausticInMirrorHasNoFirefly) {
 // reading all by far more than the floor.
 TEST(CausticGather, CappedBucketsKeepTheFocusedCausticAndACapOfOneFails) {
     gl::Context context = gl::Context::headless();
-    test::CausticSceneOptions o;
-    o.mirror = true;
-    o.sphereCentre = glm::vec3(0.0f, 0.13f, 0.0f);
-    o.lightPos = glm::vec3(0.5f, 0.996f, 0.0f);
-    test::CausticScene s = test::makeCausticScene(o);
-    test::mirrorView(s, 96, 72, 132.0);
+    const test::CausticScene s = focusedCausticInMirror();
     const Reference ref = reference(s, 12);
     RendererOptions all, capped, one;
     all.causticGatherCap = 0;

@@ -25,14 +25,7 @@ namespace {
 
 using test::linearLuminance;
 
-test::SpecularScene sphereView(const test::CausticScene& s) {
-    test::SpecularScene v;
-    v.cam = s.cam;
-    v.pose = s.pose;
-    v.sphereCentre = s.sphereCentre;
-    v.sphereRadius = s.sphereRadius;
-    return v;
-}
+using test::sphereView;
 
 // The caustic scene (CausticTestScenes.h: a virtual glass sphere, r = 0.1 m, IOR 1.5, 7.5 cm
 // above a real table, a real spot 1 m away at 60 degrees elevation on the +X side; its caustic

@@ -20,11 +20,7 @@ const Scene& scene() {
     return testing::boardViewScene();
 }
 
-glm::dvec3 orbit(double dist, double elevDeg, double azDeg) {
-    const double el = glm::radians(elevDeg), az = glm::radians(azDeg);
-    return dist *
-           glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
-}
+using testing::orbit;
 
 // One unrelated frame through a fresh Tracker (no previous pose): the defaults (coarse-first
 // on), or with the coarse-first search off (libapriltag's ordinary search in the textured region).

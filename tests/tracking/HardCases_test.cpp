@@ -65,11 +65,7 @@ void expectNoConfidentWrongAnswer(const Outcome& o, const std::string& what) {
     }
 }
 
-glm::dvec3 orbit(double dist, double elevDeg, double azDeg) {
-    const double el = glm::radians(elevDeg), az = glm::radians(azDeg);
-    return dist *
-           glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
-}
+using testing::orbit;
 
 TEST(HardCases, SteepAngleSeventyDegreesAndMore) {
     for (double elev : {20.0, 15.0, 10.0}) {  // 70, 75, 80 degrees from frontal

@@ -19,11 +19,7 @@ const Scene& scene() {
     return testing::boardViewScene();
 }
 
-glm::dvec3 orbit(double dist, double elevDeg, double azDeg) {
-    const double el = glm::radians(elevDeg), az = glm::radians(azDeg);
-    return dist *
-           glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
-}
+using testing::orbit;
 
 // One unrelated frame through a fresh Tracker (no previous pose), the textured region on or off.
 TrackedFrame single(const cv::Mat& img, bool textureRegion, const Board* board = nullptr) {

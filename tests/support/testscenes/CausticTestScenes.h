@@ -146,4 +146,14 @@ inline cv::Mat straightShadowMask(const CausticScene& s, double inner = 0.9) {
     return m;
 }
 
+// The caustic scene's camera and glass sphere as a specular test view (the sphere's pixel mask).
+inline SpecularScene sphereView(const CausticScene& s) {
+    SpecularScene v;
+    v.cam = s.cam;
+    v.pose = s.pose;
+    v.sphereCentre = s.sphereCentre;
+    v.sphereRadius = s.sphereRadius;
+    return v;
+}
+
 }  // namespace mirage::test

@@ -18,6 +18,14 @@ inline Pose lookAt(const glm::dvec3& eye, const glm::dvec3& target,
     return test::lookAt(eye, target, up, rollRad);
 }
 
+// A camera position on a sphere of `dist` metres around the board's centre (the page's origin):
+// elevation above the page and azimuth from +Z towards +X, in degrees.
+inline glm::dvec3 orbit(double dist, double elevDeg, double azDeg) {
+    const double el = glm::radians(elevDeg), az = glm::radians(azDeg);
+    return dist *
+           glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+}
+
 inline CameraIntrinsics pinholeCamera(int w = 640, int h = 480, double f = 600) {
     CameraIntrinsics c;
     c.width = w;
