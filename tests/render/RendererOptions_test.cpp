@@ -52,6 +52,11 @@ TEST(RendererOptions, OtherRangesNameTheOption) {
         o.causticGatherRadius = bad;
         EXPECT_NE(refusal(o).find("causticGatherRadius"), std::string::npos) << bad;
     }
+    for (int bad : {-1, (1 << 20) + 1}) {
+        o = {};
+        o.causticGatherCap = bad;
+        EXPECT_NE(refusal(o).find("causticGatherCap"), std::string::npos) << bad;
+    }
 }
 
 }  // namespace

@@ -135,8 +135,9 @@ void gatherCaustic(vec3 x, vec3 n, float footprint, out vec3 eRv, out vec3 eR) {
                 // A bucket fuller than the cap is read with a stride from an offset that varies
                 // by pixel and bucket (not by frame: a frame depends on its inputs only, so a
                 // frame after a history reset equals a fresh renderer's); what is read stands
-                // for the whole bucket (weight count / read). Photons sit in a bucket in photon-map order, so a stride samples the
-                // whole map's footprint rather than one corner of it.
+                // for the whole bucket (weight count / read). The scatter fills a bucket roughly
+                // in photon-map order, so a stride samples the bucket's whole footprint of the
+                // map rather than one corner of it.
                 uint count = last - first, stride = 1u;
                 if (count == 0u) continue;
                 if (photonGatherCap > 0u && count > photonGatherCap)
