@@ -134,7 +134,7 @@ const std::vector<BenchKnob>& benchKnobs() {
              return std::string(c.options.impostorCubeMapBaseline ? "cubemap" : "impostors");
          }},
         {"impostor_resolution", "texels per side of each impostor and cube-map face",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
          [](BenchConfig& c, const std::string& v) {
              c.options.impostorResolution = parseInt("impostor_resolution", v, 16, 2048);
          },
@@ -258,7 +258,7 @@ const std::vector<BenchKnob>& benchKnobs() {
         {"caustic_gather_cap",
          "photons the caustic gather reads per grid bucket, 0 = all (fuller buckets are read with "
          "a stride and weighted by count / read)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
          [](BenchConfig& c, const std::string& v) {
              char* end = nullptr;
              const long q = std::strtol(v.c_str(), &end, 10);
