@@ -16,8 +16,8 @@ void RendererOptions::validate() const {
         fail("vnmResolution must be 2..512, got " + std::to_string(vnmResolution));
     if (interleave < 1 || interleave > 8)
         fail("interleave must be 1..8, got " + std::to_string(interleave));
-    if (indirectScale != 1 && indirectScale != 2)
-        fail("indirectScale must be 1 or 2, got " + std::to_string(indirectScale));
+    if (indirectScale < 0 || indirectScale > 4)
+        fail("indirectScale must be 0 (automatic) or 1..4, got " + std::to_string(indirectScale));
     if (shadowMapSize < 16 || shadowMapSize > 4096)
         fail("shadowMapSize must be 16..4096, got " + std::to_string(shadowMapSize));
     if (ismTileSize < 8 || ismTileSize > 256)

@@ -3,6 +3,7 @@
 // the per-frame plan (which lights cast shadows, which need a real-only shadow map, whether
 // VPLs are needed) and the uniform buffers. The frame's textures are handed from pass to pass by
 // the frame graph (render/FrameGraph.h), not through this context.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -27,13 +28,15 @@ enum class RoughRefractionMethod {
 const char* roughRefractionMethodName(RoughRefractionMethod m);  // "filter", "lean", "gsr"
 
 struct RendererOptions {
-    int vplCount = 256;             // total VPLs per frame, split over the lights with RSMs
-    int shadowMapSize = 512;        // texels per side of each shadow / RSM layer
-    int ismTileSize = 64;           // texels per side of one VPL's imperfect shadow map
-    int ismPointsPerVpl = 1024;     // surface points splatted into each VPL's ISM
-    int interleave = 4;             // K: each pixel gathers vplCount / K^2 VPLs
-    int indirectScale = 2;          // VPL gather at 1/scale resolution per axis (1 or 2); the
-                                    // geometry-aware filter upsamples it to full resolution
+    int vplCount = 256;          // total VPLs per frame, split over the lights with RSMs
+    int shadowMapSize = 512;     // texels per side of each shadow / RSM layer
+    int ismTileSize = 64;        // texels per side of one VPL's imperfect shadow map
+    int ismPointsPerVpl = 1024;  // surface points splatted into each VPL's ISM
+    int interleave = 4;          // K: each pixel gathers vplCount / K^2 VPLs
+    // VPL gather at 1/scale resolution per axis, 1..4, upsampled by the geometry-aware filter; 0:
+    // automatic, gatherScale(): a gather pixel every ~1/160 of the canvas width whatever the
+    // resolution, so that the indirect light keeps its detail relative to the image.
+    int indirectScale = 0;
     float vplDistanceClamp = 0.1f;  // metres: VPL distance below this is clamped (no spikes)
     float shadowBias = 0.001f;      // metres: constant depth bias of the shadow-map test
                                     // (lighting.glsl adds 1.5 texels' footprint / cos)
@@ -111,9 +114,10 @@ struct RendererOptions {
     int gsrSubdivisions = 4;
     int roughMipLevels = 8;
     // 1, 4 or 16: each hit sums every stride-th VPL (x stride), interleaved over 2x2 / 4x4
-    // pixels. 16 costs a third of 4's speclight time and the tabletop bench cannot tell them
-    // apart, but the 4x4 pattern costs 0.07 SSIM over a small glass sphere (docs/specular.md).
-    int specularVplStride = 4;
+    // pixels. 16 costs about half of 4's speclight time and the tabletop bench cannot tell them
+    // apart (docs/specular.md, "Cost"); the 4x4 pattern costs some SSIM over a small glass
+    // sphere, where the VPL light seen through the glass is a large share.
+    int specularVplStride = 16;
     // Specular lighting (speclight) at half the canvas resolution per axis: each 2x2 block's
     // first specular pixel is shaded (lights, VPLs, caustic photons at its hits) and the canvas
     // pixels take the hit radiance from the four half pixels around them, weighted by how well
@@ -171,6 +175,11 @@ struct RendererOptions {
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.
     void validate() const;
+    // The gather scale for a canvas this wide: indirectScale, or when 0 width / 160 in 1..4
+    // (4 at 640x480, 2 at 320x240, 1 at 160x120).
+    int gatherScale(int canvasWidth) const {
+        return indirectScale > 0 ? indirectScale : std::clamp(canvasWidth / 160, 1, 4);
+    }
 };
 
 // Tiles per row of the imperfect shadow map atlas (one square tile per VPL).
@@ -273,6 +282,7 @@ public:
     const gl::Texture& noGlassTexture() const { return noGlass_; }
 
     int canvasWidth() const { return projection.canvasWidth; }
+    int gatherScale() const { return options.gatherScale(canvasWidth()); }
     int canvasHeight() const { return projection.canvasHeight; }
     void bindFrameBlocks() const;
     // Full-screen pass set-up: viewport width x height, depth test and blending off, `program`

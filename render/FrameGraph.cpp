@@ -25,7 +25,7 @@ bool expectedSize(SizeRule s, const FrameContext& c, int& w, int& h, int& layers
             return true;
         case SizeRule::Gather:
         case SizeRule::GatherTiles: {
-            const int sc = o.indirectScale, k = std::max(1, o.interleave);
+            const int sc = c.gatherScale(), k = std::max(1, o.interleave);
             w = (c.canvasWidth() + sc - 1) / sc, h = (c.canvasHeight() + sc - 1) / sc;
             if (s == SizeRule::GatherTiles) w = (w + k - 1) / k * k, h = (h + k - 1) / k * k;
             return true;

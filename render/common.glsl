@@ -52,4 +52,30 @@ vec3 shIrradiance(vec3 n) {
 
 bool allFinite(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
 
+// Octahedral encoding of a unit vector into 2 x 16-bit snorm (Cigolle et al. 2014).
+int packNormalOct(vec3 n) {
+    n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-20);
+    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0,
+                                                          n.y >= 0.0 ? 1.0 : -1.0);
+    return int(packSnorm2x16(e));
+}
+vec3 unpackNormalOct(int bits) {
+    vec2 e = unpackSnorm2x16(uint(bits));
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    float t = max(-n.z, 0.0);
+    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
+    return normalize(n);
+}
+
+// The VPL gather runs at 1/scale resolution per axis (RendererOptions::indirectScale): gather
+// pixel q shades the canvas pixel q * scale + (scale - 1) / 2, the middle of its scale x scale
+// block (rounded down), so that the samples are spread evenly and the upsampling's bilinear
+// weights see them where they are. Clamped to the canvas (the gather buffer rounds up).
+ivec2 gatherCanvasPixel(ivec2 q, int scale, ivec2 canvasSize) {
+    return min(q * scale + (scale - 1) / 2, canvasSize - 1);
+}
+// Canvas pixel position c (pixel centres at integers) in gather pixel coordinates (gather pixel
+// centres at integers): the inverse of gatherCanvasPixel.
+vec2 canvasToGather(vec2 c, int scale) { return (c - float((scale - 1) / 2)) / float(scale); }
+
 #endif

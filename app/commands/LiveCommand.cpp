@@ -102,13 +102,14 @@ struct LiveArgs {
 
 constexpr int kHudWidth = 330;  // pixels, right of the view
 
-// Quality presets of the HUD: VPLs, gather scale (1 = full resolution), impostor resolution.
+// Quality presets of the HUD: VPLs, gather scale (0 = automatic by the canvas width, 1 = full
+// resolution), impostor resolution.
 struct QualityPreset {
     const char* name;
     int vpls, indirectScale, impostorResolution;
 };
 constexpr QualityPreset kPresets[] = {
-    {"low", 64, 2, 128}, {"medium", 256, 2, 256}, {"high", 1024, 1, 512}};
+    {"low", 64, 0, 128}, {"medium", 256, 0, 256}, {"high", 1024, 1, 512}};
 
 // What the HUD can show instead of the composite (canvas-size linear buffers, tone-mapped by
 // clamping to [0, 1] and sRGB encoding).

@@ -93,14 +93,20 @@ const std::vector<BenchKnob>& benchKnobs() {
              c.options.vplCount = parseInt("vpls", v, 0, 16384);
          },
          [](const BenchConfig& c) { return std::to_string(c.options.vplCount); }},
-        {"indirect_scale", "VPL gather at 1/N resolution per axis (1 or 2)",
+        {"indirect_scale",
+         "VPL gather at 1/N resolution per axis (1..4), or auto: width / 160 in 1..4 (4 at "
+         "640x480)",
          [](const CameraIntrinsics&, bool quick) {
-             return quick ? std::vector<std::string>{"2"} : std::vector<std::string>{"2", "1"};
+             return quick ? std::vector<std::string>{"auto"}
+                          : std::vector<std::string>{"auto", "2", "1"};
          },
          [](BenchConfig& c, const std::string& v) {
-             c.options.indirectScale = parseInt("indirect_scale", v, 1, 2);
+             c.options.indirectScale = v == "auto" ? 0 : parseInt("indirect_scale", v, 1, 4);
          },
-         [](const BenchConfig& c) { return std::to_string(c.options.indirectScale); }},
+         [](const BenchConfig& c) {
+             return c.options.indirectScale == 0 ? std::string("auto")
+                                                 : std::to_string(c.options.indirectScale);
+         }},
         {"static_reuse",
          "on: reuse the camera-independent passes (shadow, vpl, ism) while the plan is "
          "unchanged; off: re-run them every frame",
@@ -156,7 +162,9 @@ const std::vector<BenchKnob>& benchKnobs() {
         {"specular_vpl_stride",
          "VPL interleaving at the reflected/refracted hits: each hit sums every N-th VPL (x N) "
          "over an N-pixel tile: 1 (all), 4 (2x2) or 16 (4x4)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
+         [](const CameraIntrinsics&, bool) {
+             return std::vector<std::string>{std::to_string(RendererOptions{}.specularVplStride)};
+         },
          [](BenchConfig& c, const std::string& v) {
              const int n = parseInt("specular_vpl_stride", v, 1, 16);
              if (n != 1 && n != 4 && n != 16)

@@ -189,9 +189,9 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     const std::vector<BenchConfig> grid = benchGrid(camera, true, {{"vpls", {"256"}}});
     ASSERT_EQ(grid.size(), 1u);
     EXPECT_EQ(grid[0].label(),
-              "resolution=160x120 vpls=256 indirect_scale=2 static_reuse=on sync_passes=on "
+              "resolution=160x120 vpls=256 indirect_scale=auto static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=2 "
-              "refraction_steps=16 specular_vpl_stride=4 specular_resolution=" +
+              "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
                   std::string(RendererOptions{}.specularHalfResolution ? "half" : "full") +
                   " virtual=on "
                   "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
@@ -312,14 +312,14 @@ TEST(RealtimeBench, HardCasesStayFiniteThroughGroundTruthAndBench) {
 TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     CameraIntrinsics cam = test::smallCamera(1024, 768);
     const auto full = benchGrid(cam, false, {});
-    EXPECT_EQ(full.size(), 3u * 3u * 2u);  // 1024x768, 640x480, 320x240 x 64/256/1024 x 1/2
+    EXPECT_EQ(full.size(), 3u * 3u * 3u);  // 1024x768, 640x480, 320x240 x 64/256/1024 x auto/2/1
     for (const auto& c : full) EXPECT_TRUE(c.options.syncPasses);
     const auto quick = benchGrid(cam, true, {});
     ASSERT_EQ(quick.size(), 2u);
     EXPECT_EQ(quick[0].width, 640);
     EXPECT_THROW(benchGrid(cam, true, {{"nonsense", {"1"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"vpls", {"many"}}}), Error);
-    EXPECT_THROW(benchGrid(cam, true, {{"indirect_scale", {"3"}}}), Error);
+    EXPECT_THROW(benchGrid(cam, true, {{"indirect_scale", {"5"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"sync_passes", {"maybe"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"static_reuse", {"yes"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"resolution", {"2048x1536"}}}), Error);  // upsampling

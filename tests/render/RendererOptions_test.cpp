@@ -41,9 +41,11 @@ TEST(RendererOptions, OtherRangesNameTheOption) {
     RendererOptions o;
     o.vplCount = -1;
     EXPECT_NE(refusal(o).find("vplCount"), std::string::npos);
-    o = {};
-    o.indirectScale = 3;
-    EXPECT_NE(refusal(o).find("indirectScale"), std::string::npos);
+    for (int bad : {-1, 5}) {
+        o = {};
+        o.indirectScale = bad;
+        EXPECT_NE(refusal(o).find("indirectScale"), std::string::npos) << bad;
+    }
     o = {};
     o.backProjectionEpsilon = std::numeric_limits<float>::quiet_NaN();
     EXPECT_NE(refusal(o).find("backProjectionEpsilon"), std::string::npos);
@@ -57,6 +59,22 @@ TEST(RendererOptions, OtherRangesNameTheOption) {
         o.causticGatherCap = bad;
         EXPECT_NE(refusal(o).find("causticGatherCap"), std::string::npos) << bad;
     }
+}
+
+// The automatic gather scale keeps a gather pixel every ~1/160 of the canvas width: the indirect
+// light's detail relative to the image does not depend on the resolution. An explicit scale wins.
+TEST(RendererOptions, AutomaticGatherScaleFollowsTheCanvasWidth) {
+    RendererOptions o;
+    ASSERT_EQ(o.indirectScale, 0);
+    EXPECT_EQ(o.gatherScale(160), 1);
+    EXPECT_EQ(o.gatherScale(100), 1);  // never below 1
+    EXPECT_EQ(o.gatherScale(320), 2);
+    EXPECT_EQ(o.gatherScale(480), 3);
+    EXPECT_EQ(o.gatherScale(640), 4);
+    EXPECT_EQ(o.gatherScale(1920), 4);  // at most 4
+    o.indirectScale = 2;
+    EXPECT_EQ(o.gatherScale(640), 2);
+    EXPECT_EQ(o.gatherScale(160), 2);
 }
 
 }  // namespace

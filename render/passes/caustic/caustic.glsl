@@ -62,21 +62,6 @@ int photonBucket(ivec3 cell) {
 }
 int photonBucketAt(vec3 x, float cellSize) { return photonBucket(ivec3(floor(x / cellSize))); }
 
-// Octahedral encoding of a unit vector into 2 x 16-bit snorm (Cigolle et al. 2014).
-int packNormalOct(vec3 n) {
-    n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-20);
-    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0,
-                                                          n.y >= 0.0 ? 1.0 : -1.0);
-    return int(packSnorm2x16(e));
-}
-vec3 unpackNormalOct(int bits) {
-    vec2 e = unpackSnorm2x16(uint(bits));
-    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-    float t = max(-n.z, 0.0);
-    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
-    return normalize(n);
-}
-
 #ifdef MIRAGE_CAUSTIC_GATHER
 // The photon gather (specular_light.frag's variant for frames with a photon grid): the caustic
 // irradiance at a reflected / refracted ray's hit, which the camera-space caustic buffer cannot

@@ -34,24 +34,29 @@ PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
 }
 
 void GiFilterPass::resize(const FrameContext& ctx) {
-    const int w = ctx.canvasWidth(), h = ctx.canvasHeight(), s = ctx.options.indirectScale;
+    const int w = ctx.canvasWidth(), h = ctx.canvasHeight(), s = ctx.gatherScale();
     // Runs before every frame: reallocating would also throw the temporal history away.
-    if (rv_.width() == w && rv_.height() == h && lowRv_[0].width() == (w + s - 1) / s &&
-        lowRv_[0].height() == (h + s - 1) / s)
+    const int lowW = (w + s - 1) / s, lowH = (h + s - 1) / s;
+    if (rv_.width() == w && rv_.height() == h && lowRv_[0].width() == lowW &&
+        lowRv_[0].height() == lowH)
         return;
+    gatherPosition_ = gl::Texture::create2D("indirect upsample position", lowW, lowH, GL_RGBA32F);
+    gatherLight_ = gl::Texture::create2D("indirect upsample light", lowW, lowH, GL_RGBA32UI);
+    gatherPosition_.setFilter(GL_NEAREST, GL_NEAREST);
+    gatherLight_.setFilter(GL_NEAREST, GL_NEAREST);
     for (int i = 0; i < 2; ++i) {
         // 32-bit: alpha holds the camera distance the history test compares (temporal.glsl).
-        lowRv_[i] = gl::Texture::create2D("indirect L_rv filtered", (w + s - 1) / s,
-                                          (h + s - 1) / s, GL_RGBA32F);
-        lowR_[i] = gl::Texture::create2D("indirect L_r filtered", (w + s - 1) / s, (h + s - 1) / s,
-                                         GL_RGBA32F);
+        lowRv_[i] = gl::Texture::create2D("indirect L_rv filtered", lowW, lowH, GL_RGBA32F);
+        lowR_[i] = gl::Texture::create2D("indirect L_r filtered", lowW, lowH, GL_RGBA32F);
         // Linear: the history is read at reprojected, fractional positions.
         lowRv_[i].setFilter(GL_LINEAR, GL_LINEAR);
         lowR_[i].setFilter(GL_LINEAR, GL_LINEAR);
         lowFbo_[i] = gl::Framebuffer("gi filter fbo");
         lowFbo_[i].attachColor(0, lowRv_[i]);
         lowFbo_[i].attachColor(1, lowR_[i]);
-        lowFbo_[i].finalize(2);
+        lowFbo_[i].attachColor(2, gatherPosition_);
+        lowFbo_[i].attachColor(3, gatherLight_);
+        lowFbo_[i].finalize(4);
     }
     history_.drop();  // new buffers hold no history
     rv_ = gl::Texture::create2D("L_rv", w, h, GL_RGBA16F);
@@ -66,7 +71,7 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     const int write = history_.writeSlot(), read = history_.readSlot();
     lowFbo_[write].bind();
     ctx.beginFullscreen(filter_, lowRv_[write].width(), lowRv_[write].height());
-    glUniform1i(filter_.uniformLocation("scale"), ctx.options.indirectScale);
+    glUniform1i(filter_.uniformLocation("scale"), ctx.gatherScale());
     glUniform1f(filter_.uniformLocation("historyWeight"),
                 history_.usable(ctx, ctx.options.temporalBlend) ? ctx.options.temporalBlend : 0.0f);
     const GLuint position = res.texture(Resource::GBufferPosition).id();
@@ -81,11 +86,11 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
 
     fbo_.bind();
     ctx.beginFullscreen(upsample_, ctx.canvasWidth(), ctx.canvasHeight());
-    glUniform1i(upsample_.uniformLocation("scale"), ctx.options.indirectScale);
+    glUniform1i(upsample_.uniformLocation("scale"), ctx.gatherScale());
     glBindTextureUnit(kUnitUpsamplePosition, position);
     glBindTextureUnit(kUnitUpsampleNormal, normal);
-    glBindTextureUnit(kUnitUpsampleIndirectRv, lowRv_[write].id());
-    glBindTextureUnit(kUnitUpsampleIndirectR, lowR_[write].id());
+    glBindTextureUnit(kUnitUpsampleGatherPosition, gatherPosition_.id());
+    glBindTextureUnit(kUnitUpsampleGatherLight, gatherLight_.id());
     glBindTextureUnit(kUnitUpsampleDirectRv, res.texture(Resource::DirectRv).id());
     glBindTextureUnit(kUnitUpsampleDirectR, res.texture(Resource::DirectR).id());
     ctx.drawFullscreenTriangle();

@@ -21,10 +21,14 @@ layout(binding = kUnitFilterIndirectRv) uniform sampler2D indirectRv;  // deinte
 layout(binding = kUnitFilterIndirectR) uniform sampler2D indirectR;
 layout(binding = kUnitFilterHistoryRv) uniform sampler2D historyRv;  // gather res: rgb filtered, a = camera dist.
 layout(binding = kUnitFilterHistoryR) uniform sampler2D historyR;
-uniform int scale;  // gather pixel q was shaded at G-buffer pixel q * scale
+uniform int scale;  // gather pixel q was shaded at G-buffer pixel gatherCanvasPixel(q, scale)
 uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
 layout(location = 0) out vec4 outRv;  // rgb filtered + smoothed; a = camera distance (m)
 layout(location = 1) out vec4 outR;   // (the history of the next frame)
+// The same light packed for upsample.frag, which reads 4 gather pixels per canvas pixel: two
+// texel reads per gather pixel instead of four (its G-buffer position and normal, L_rv, L_r).
+layout(location = 2) out vec4 outUpsamplePosition;  // xyz world (m) shaded; w = 1 (0: no surface)
+layout(location = 3) out uvec4 outUpsampleLight;    // L_rv, L_r as 6 halves; w: normal (oct)
 
 float geometryWeight(vec3 p, vec3 n, float camDist, vec3 q, vec3 nq) {
     float planeDist = abs(dot(q - p, n)) / max(0.01 * camDist, 1e-4);
@@ -39,11 +43,14 @@ float geometryWeight(vec3 p, vec3 n, float camDist, vec3 q, vec3 nq) {
 void main() {
     ivec2 c = ivec2(gl_FragCoord.xy);
     ivec2 size = textureSize(gPosition, 0);
-    vec4 P = texelFetch(gPosition, min(c * scale, size - 1), 0);
+    ivec2 cg = gatherCanvasPixel(c, scale, size);
+    vec4 P = texelFetch(gPosition, cg, 0);
     outRv = vec4(0.0);
     outR = vec4(0.0);
+    outUpsamplePosition = vec4(0.0);
+    outUpsampleLight = uvec4(0u);
     if (int(P.w + 0.5) == ORIGIN_NONE) return;
-    vec3 n = texelFetch(gNormal, min(c * scale, size - 1), 0).xyz;
+    vec3 n = texelFetch(gNormal, cg, 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
     const int K = MIRAGE_INTERLEAVE;
     ivec2 lowSize = textureSize(indirectRv, 0);
@@ -53,7 +60,7 @@ void main() {
     for (int dy = -K / 2; dy < K - K / 2; ++dy)
         for (int dx = -K / 2; dx < K - K / 2; ++dx) {
             ivec2 q = clamp(c + ivec2(dx, dy), ivec2(0), lowSize - 1);
-            ivec2 qg = min(q * scale, size - 1);
+            ivec2 qg = gatherCanvasPixel(q, scale, size);
             vec4 Q = texelFetch(gPosition, qg, 0);
             if (int(Q.w + 0.5) == ORIGIN_NONE) continue;
             float w = geometryWeight(P.xyz, n, camDist, Q.xyz, texelFetch(gNormal, qg, 0).xyz);
@@ -66,9 +73,9 @@ void main() {
     vec3 iR = wsum > 1e-6 ? sumR / wsum : vec3(0.0);
     vec2 puv;
     if (historyWeight > 0.0 && reprojectToPreviousFrame(P.xyz, puv)) {
-        // Canvas position -> gather texel (gather pixel q sits at canvas pixel q*scale).
-        vec2 hp = (puv * vec2(size) - 0.5) / float(scale) + 0.5;
-        vec2 huv = hp / vec2(textureSize(historyRv, 0));
+        // Canvas position -> gather texture coordinate.
+        vec2 hp = canvasToGather(puv * vec2(size) - 0.5, scale);
+        vec2 huv = (hp + 0.5) / vec2(textureSize(historyRv, 0));
         vec4 hRv = texture(historyRv, huv);
         vec4 hR = texture(historyR, huv);
         if (historyIsSameSurface(hRv.a, P.xyz) && allFinite(hRv.rgb) && allFinite(hR.rgb)) {
@@ -78,4 +85,7 @@ void main() {
     }
     outRv = vec4(iRv, camDist);
     outR = vec4(iR, camDist);
+    outUpsamplePosition = vec4(P.xyz, 1.0);
+    outUpsampleLight = uvec4(packHalf2x16(iRv.rg), packHalf2x16(vec2(iRv.b, iR.r)),
+                             packHalf2x16(iR.gb), uint(packNormalOct(n)));
 }

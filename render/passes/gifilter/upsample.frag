@@ -3,12 +3,14 @@
 // Joint bilateral upsampling of the filtered, temporally smoothed indirect light (filter.frag,
 // gather resolution) to full resolution: the 2 x 2 gather pixels around p, weighted bilinearly
 // and by geometry (position / normal match with p), and the sum with direct light: the GI
-// solutions L_rv and L_r (linear).
+// solutions L_rv and L_r (linear). Each gather pixel's position, normal and light come packed
+// by filter.frag in two texels (llvmpipe pays per texel read, and this pass reads 4 gather
+// pixels for each of the canvas's).
 in vec2 uv;
 layout(binding = kUnitUpsamplePosition) uniform sampler2D gPosition;
 layout(binding = kUnitUpsampleNormal) uniform sampler2D gNormal;
-layout(binding = kUnitUpsampleIndirectRv) uniform sampler2D indirectRv;  // filtered, gather resolution
-layout(binding = kUnitUpsampleIndirectR) uniform sampler2D indirectR;
+layout(binding = kUnitUpsampleGatherPosition) uniform sampler2D gatherPosition;  // xyz; w = 0: none
+layout(binding = kUnitUpsampleGatherLight) uniform usampler2D gatherLight;  // L_rv, L_r, normal
 layout(binding = kUnitUpsampleDirectRv) uniform sampler2D directRv;
 layout(binding = kUnitUpsampleDirectR) uniform sampler2D directR;
 uniform int scale;  // the indirect buffers are at 1/scale resolution (joint bilateral upsampling)
@@ -27,8 +29,8 @@ void main() {
     }
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
-    ivec2 lowSize = textureSize(indirectRv, 0);
-    vec2 f = (vec2(px) + 0.5) / float(scale) - 0.5;  // p in gather pixel coordinates
+    ivec2 lowSize = textureSize(gatherPosition, 0);
+    vec2 f = canvasToGather(vec2(px), scale);  // p in gather pixel coordinates
     ivec2 c0 = ivec2(floor(f));
     vec2 fr = f - vec2(c0);
     vec3 sumRv = vec3(0.0), sumR = vec3(0.0);
@@ -36,10 +38,10 @@ void main() {
     for (int k = 0; k < 4; ++k) {
         ivec2 o = ivec2(k & 1, k >> 1);
         ivec2 q = clamp(c0 + o, ivec2(0), lowSize - 1);
-        ivec2 qg = min(q * scale, size - 1);
-        vec4 Q = texelFetch(gPosition, qg, 0);
-        if (int(Q.w + 0.5) == ORIGIN_NONE) continue;
-        vec3 nq = texelFetch(gNormal, qg, 0).xyz;
+        vec4 Q = texelFetch(gatherPosition, q, 0);
+        if (Q.w < 0.5) continue;  // no surface there
+        uvec4 L = texelFetch(gatherLight, q, 0);
+        vec3 nq = unpackNormalOct(int(L.w));
         float planeDist = abs(dot(Q.xyz - P.xyz, n)) / max(0.01 * camDist, 1e-4);
         float cs = max(dot(n, nq), 0.0);
         cs *= cs;
@@ -49,8 +51,9 @@ void main() {
         float geom = cs / (1.0 + planeDist * planeDist * 4.0);
         float bil = (o.x == 1 ? fr.x : 1.0 - fr.x) * (o.y == 1 ? fr.y : 1.0 - fr.y);
         float w = geom * (bil + 1e-3);  // a rejected bilinear tap leaves the others in charge
-        sumRv += w * texelFetch(indirectRv, q, 0).rgb;
-        sumR += w * texelFetch(indirectR, q, 0).rgb;
+        vec2 l0 = unpackHalf2x16(L.x), l1 = unpackHalf2x16(L.y), l2 = unpackHalf2x16(L.z);
+        sumRv += w * vec3(l0, l1.x);
+        sumR += w * vec3(l1.y, l2);
         wsum += w;
     }
     vec3 iRv = wsum > 1e-6 ? sumRv / wsum : vec3(0.0);

@@ -24,13 +24,13 @@ PassDecision IndirectLightPass::decide(const FrameContext& ctx) const {
     const int k = std::max(1, ctx.options.interleave);
     return {true, "interleaved " + std::to_string(k) + "x" + std::to_string(k) + ": " +
                       std::to_string((ctx.options.vplCount + k * k - 1) / (k * k)) +
-                      " VPLs per pixel"};
+                      " VPLs per pixel, at 1/" + std::to_string(ctx.gatherScale()) + " resolution"};
 }
 
 void IndirectLightPass::resize(const FrameContext& ctx) {
     // Gather resolution: canvas / indirectScale, rounded up to a multiple of K so that the
     // deinterleaved layout (K x K tiles, tile g holding the pixels of VPL group g) is exact.
-    const int s = ctx.options.indirectScale, k = std::max(1, ctx.options.interleave);
+    const int s = ctx.gatherScale(), k = std::max(1, ctx.options.interleave);
     const int lowW = (ctx.canvasWidth() + s - 1) / s, lowH = (ctx.canvasHeight() + s - 1) / s;
     const int w = (lowW + k - 1) / k * k, h = (lowH + k - 1) / k * k;
     if (w == rv_.width() && h == rv_.height()) return;
@@ -47,7 +47,7 @@ void IndirectLightPass::resize(const FrameContext& ctx) {
 void IndirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, rv_.width(), rv_.height());  // each tile sets its viewport
-    glUniform1i(program_.uniformLocation("scale"), ctx.options.indirectScale);
+    glUniform1i(program_.uniformLocation("scale"), ctx.gatherScale());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
     glBindTextureUnit(kUnitIndirectPosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitIndirectNormal, res.texture(Resource::GBufferNormal).id());

@@ -14,7 +14,7 @@ layout(binding = kUnitIndirectNormal) uniform sampler2D gNormal;
 layout(binding = kUnitIndirectAlbedo) uniform sampler2D gAlbedo;
 layout(binding = kUnitIndirectIsmAll) uniform usampler2D ismAll;
 layout(binding = kUnitIndirectIsmReal) uniform usampler2D ismReal;
-uniform int scale;  // gather pixel q shades G-buffer pixel q * scale
+uniform int scale;  // gather pixel q shades G-buffer pixel gatherCanvasPixel(q, scale)
 uniform ivec2 group;       // (x mod K, y mod K) of this draw's pixels
 uniform ivec2 tileOrigin;  // where this group's tile starts in the target
 layout(location = 0) out vec4 outRv;
@@ -31,7 +31,7 @@ float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
 void main() {
     int K = max(interleave, 1);
     ivec2 q = (ivec2(gl_FragCoord.xy) - tileOrigin) * K + group;  // interleaved gather pixel
-    ivec2 g = min(q * scale, textureSize(gPosition, 0) - 1);
+    ivec2 g = gatherCanvasPixel(q, scale, textureSize(gPosition, 0));
     vec4 P = texelFetch(gPosition, g, 0);
     int origin = int(P.w + 0.5);
     outRv = vec4(0.0);
