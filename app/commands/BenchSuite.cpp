@@ -409,7 +409,7 @@ SuiteSpec defaultSuite() {
          "the yellow box alone: shadows and indirect light (the glass sphere and mirror left out)",
          {"glass_sphere", "mirror"},
          {{"vpls", {"64", "128", "256", "512", "1024"}},
-          {"indirect_scale", {"1", "2"}},
+          {"indirect_scale", {"auto", "2", "1"}},
           {"static_reuse", {"on", "off"}}},
          {}},
         {"mirror",
@@ -427,7 +427,8 @@ SuiteSpec defaultSuite() {
          {},
          {{"vpls", {"64", "256", "1024"}},
           {"impostor_resolution", {"128", "256"}},
-          {"specular_trace", {"impostors", "cubemap"}}},
+          {"specular_trace", {"impostors", "cubemap"}},
+          {"specular_vpl_stride", {"4", "16"}}},
          {}},
         {"caustics",
          "light through the glass sphere: its caustic, its tinted shadow and the VPLs it "
