@@ -115,9 +115,9 @@ struct RendererOptions {
     int roughMipLevels = 8;
     // 1, 4 or 16: each hit sums every stride-th VPL (x stride), interleaved over 2x2 / 4x4
     // pixels. 16 costs about half of 4's speclight time and the tabletop bench cannot tell them
-    // apart (docs/specular.md, "Cost"); the 4x4 pattern costs some SSIM over a small glass
-    // sphere, where the VPL light seen through the glass is a large share.
-    int specularVplStride = 16;
+    // apart, but its 4x4 pattern costs 0.05-0.07 SSIM over a small glass sphere, below the
+    // specular tests' floors (docs/specular.md, "Cost").
+    int specularVplStride = 4;
     // Specular lighting (speclight) at half the canvas resolution per axis: each 2x2 block's
     // first specular pixel is shaded (lights, VPLs, caustic photons at its hits) and the canvas
     // pixels take the hit radiance from the four half pixels around them, weighted by how well
