@@ -114,10 +114,10 @@ struct RendererOptions {
     int gsrSubdivisions = 4;
     int roughMipLevels = 8;
     // 1, 4 or 16: each hit sums every stride-th VPL (x stride), interleaved over 2x2 / 4x4
-    // pixels. 16 costs about half of 4's speclight time and the tabletop bench cannot tell them
-    // apart, but its 4x4 pattern costs 0.05-0.07 SSIM over a small glass sphere, below the
-    // specular tests' floors (docs/specular.md, "Cost").
-    int specularVplStride = 4;
+    // pixels; each hit's VPL irradiance is then averaged over its 2x2 quad (specular_light.frag),
+    // so a quad sums 4 subsets. 16 costs about half of 4's speclight time; the quad average keeps
+    // its pattern weak enough for the specular tests' SSIM floors (docs/specular.md, "Cost").
+    int specularVplStride = 16;
     // Specular lighting (speclight) at half the canvas resolution per axis: each 2x2 block's
     // first specular pixel is shaded (lights, VPLs, caustic photons at its hits) and the canvas
     // pixels take the hit radiance from the four half pixels around them, weighted by how well

@@ -191,7 +191,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     EXPECT_EQ(grid[0].label(),
               "resolution=160x120 vpls=256 indirect_scale=auto static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=2 "
-              "refraction_steps=16 specular_vpl_stride=4 specular_resolution=" +
+              "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
                   std::string(RendererOptions{}.specularHalfResolution ? "half" : "full") +
                   " virtual=on "
                   "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "

@@ -81,6 +81,37 @@ layout(location = 7) out vec4 outHistoryHits;
 
 const float kNoHit = 1e6;  // the hit of a ray that hit nothing modelled (or was not traced)
 
+// The value of x at the other pixel of this pixel's 2x2 quad in x / y (fine derivatives are the
+// exact differences within a quad; llvmpipe shades whole quads).
+vec4 quadSwapX(vec4 x) { return x + ((int(gl_FragCoord.x) & 1) == 0 ? 1.0 : -1.0) * dFdxFine(x); }
+vec4 quadSwapY(vec4 x) { return x + ((int(gl_FragCoord.y) & 1) == 0 ? 1.0 : -1.0) * dFdyFine(x); }
+
+// The VPL irradiance of one ray's hit averaged over the pixel's 2x2 quad: a quad holds four VPL
+// subsets (the interleaving tile is 2x2 or 4x4), so the average sums 4x the VPLs of one pixel and
+// the tile's pattern is a quarter as strong. A neighbour counts where it has a hit of this ray
+// (valid = 1) near this pixel's: within 1 % of the path from the camera + 3 mm, weight falling
+// off with the distance, so the light of one surface does not leak onto another across an edge.
+// Call in uniform control flow (derivatives). irr.w / irrR.w: valid (0 or 1).
+void quadAverage(inout vec4 irrRv, inout vec4 irrR, vec3 hit, float pathLength) {
+    vec4 h = vec4(hit, 0.0);
+    vec4 sumRv = irrRv * irrRv.w, sumR = irrR * irrRv.w;
+    float wsum = irrRv.w;
+    for (int j = 0; j < 3; ++j) {
+        vec4 nRv = j == 0 ? quadSwapX(irrRv) : j == 1 ? quadSwapY(irrRv) : quadSwapX(quadSwapY(irrRv));
+        vec4 nR = j == 0 ? quadSwapX(irrR) : j == 1 ? quadSwapY(irrR) : quadSwapX(quadSwapY(irrR));
+        vec4 nh = j == 0 ? quadSwapX(h) : j == 1 ? quadSwapY(h) : quadSwapX(quadSwapY(h));
+        float t = distance(nh.xyz, hit) / (0.01 * pathLength + 0.003);
+        float w = nRv.w > 0.5 ? 1.0 / (1.0 + t * t) : 0.0;
+        sumRv += w * nRv;
+        sumR += w * nR;
+        wsum += w;
+    }
+    if (irrRv.w > 0.5 && wsum > 0.0) {
+        irrRv = vec4(sumRv.rgb / wsum, 1.0);
+        irrR = vec4(sumR.rgb / wsum, 1.0);
+    }
+}
+
 // A history hit (world, m) is this frame's hit: both rays hit nothing, or both hit within
 // 0.5 % of the path from the camera + 2 mm of each other (a few pixels' footprint at the hit;
 // tracking noise moves a hit by about a millimetre, a moving camera by centimetres).
@@ -96,11 +127,17 @@ float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
     return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
 }
 
-// Outgoing radiance of hit point x towards the specular surface (unit v), both GI solutions.
+// Outgoing radiance of hit point x towards the specular surface (unit v), both GI solutions:
+// lights, environment and emission in rv / r; the irradiance (W/m^2) from the interleaved VPL
+// subset (x stride) in vplRv / vplR, which the caller turns into radiance (x albedo (1 -
+// metallic) / pi), after averaging it over the quad in the full-resolution variant.
 void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, float roughness,
-              vec3 emissive, int firstVpl, out vec3 rv, out vec3 r) {
+              vec3 emissive, int firstVpl, out vec3 rv, out vec3 r, out vec3 vplRv,
+              out vec3 vplR) {
     rv = vec3(0.0);
     r = vec3(0.0);
+    vplRv = vec3(0.0);
+    vplR = vec3(0.0);
     for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, x, wi, E);
@@ -122,7 +159,6 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
         if (envOrigin == ORIGIN_REAL && xReal) r += env;
     }
     if (useVpls == 1) {
-        vec3 diffuse = albedo * (1.0 - metallic) / PI;
         float clamp2 = vplDistanceClamp * vplDistanceClamp;
         int stride = max(vplStride, 1);
         vec3 vrv = vec3(0.0), vr = vec3(0.0);
@@ -136,15 +172,15 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
             vec3 w = d / dist;
             float cosQ = dot(V.normal, w), cosP = dot(n, -w);
             if (cosQ <= 0.0 || cosP <= 0.0) continue;
-            vec3 c = diffuse * V.flux / PI * cosQ * cosP / max(dist2, clamp2);
+            vec3 c = V.flux / PI * cosQ * cosP / max(dist2, clamp2);
             float bias = 0.02 + 0.03 * dist;
             vec2 puv = paraboloidUv(V, w);
             if (dist - bias <= ismDistance(ismAll, i, puv)) vrv += c;
             if (V.isReal != 0 && xReal && dist - bias <= ismDistance(ismReal, i, puv))
                 vr += c;
         }
-        rv += vrv * float(stride);
-        r += vr * float(stride);
+        vplRv = vrv * float(stride);
+        vplR = vr * float(stride);
     }
     rv += emissive;
     if (xReal) r += emissive;
@@ -193,9 +229,11 @@ void main() {
         int st = max(vplStride, 1), side = st >= 16 ? 4 : (st >= 4 ? 2 : 1);
         ivec2 q = ivec2(gl_FragCoord.xy);
         int firstVpl = (q.x % side + side * (q.y % side)) % st;
-        vec3 hrv, hr;
+        vec3 hrv, hr, vrv, vr;
         shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, vec3(0.0), firstVpl,
-                 hrv, hr);
+                 hrv, hr, vrv, vr);
+        hrv += A.rgb * (1.0 - A.a) / PI * vrv;
+        hr += A.rgb * (1.0 - A.a) / PI * vr;
 #ifdef MIRAGE_CAUSTIC_GATHER
         vec3 eRv, eR, crv, cr;
         gatherCaustic(P.xyz, N.xyz, footprint[k], eRv, eR);
@@ -236,11 +274,16 @@ void main() {
     outHistoryR = vec4(0.0);
     outHistoryRRefl = vec4(0.0);
     outHistoryHits = vec4(0.0);
-    if (texelFetch(reflEmissive, px, 0).a < 0.5) return;  // not a specular pixel
+    // No early return before the quad average below: its derivatives need every lane's values.
+    bool specularPixel = texelFetch(reflEmissive, px, 0).a >= 0.5;
     vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
     vec3 surface = texelFetch(gPosition, px, 0).xyz;
     vec3 hit[2] = vec3[2](vec3(kNoHit), vec3(kNoHit));  // per ray (world, m)
-    for (int k = 0; k < 2; ++k) {
+    // Per ray: the VPL irradiance at its hit (w: 1 if the ray has one), and what turns it into
+    // this pixel's radiance (Fresnel weight x albedo (1 - metallic) / pi).
+    vec4 vplRv[2] = vec4[2](vec4(0.0), vec4(0.0)), vplR[2] = vec4[2](vec4(0.0), vec4(0.0));
+    vec3 vplToRadiance[2] = vec3[2](vec3(0.0), vec3(0.0));
+    for (int k = 0; k < 2 && specularPixel; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;
@@ -257,11 +300,16 @@ void main() {
         // on the same object; its glossy highlights are approximate).
         vec3 v = normalize(texelFetch(gPosition, px, 0).xyz - P.xyz);
         if (!allFinite(v)) v = N.xyz;
-        vec3 hrv, hr;
+        vec3 hrv, hr, irrRv, irrR;
         // Interleaved VPL subsets: a 2x2 (stride 4) or 4x4 (16) pixel tile covers every VPL.
         int st = max(vplStride, 1), side = st >= 16 ? 4 : (st >= 4 ? 2 : 1);
         int firstVpl = (px.x % side + side * (px.y % side)) % st;
-        shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, e, firstVpl, hrv, hr);
+        shadeHit(P.xyz, origin == ORIGIN_REAL, N.xyz, v, A.rgb, A.a, N.w, e, firstVpl, hrv, hr,
+                 irrRv, irrR);
+        bool finiteIrr = allFinite(irrRv) && allFinite(irrR);
+        vplRv[k] = vec4(finiteIrr ? irrRv : vec3(0.0), 1.0);
+        vplR[k] = vec4(finiteIrr ? irrR : vec3(0.0), 1.0);
+        vplToRadiance[k] = w * A.rgb * (1.0 - A.a) / PI;
 #ifdef MIRAGE_CAUSTIC_GATHER
         vec3 eRv, eR, crv, cr;
         gatherCaustic(P.xyz, N.xyz, footprint[k], eRv, eR);
@@ -273,6 +321,15 @@ void main() {
         r += w * hr;
         if (k == 0) rRefl = w * hr;
     }
+    float toSurface = distance(surface, cameraPos.xyz);
+    for (int k = 0; k < 2; ++k) {
+        if (vplStride > 1)  // uniform: the quad's lanes all take it
+            quadAverage(vplRv[k], vplR[k], hit[k], toSurface + distance(surface, hit[k]));
+        rv += vplToRadiance[k] * vplRv[k].rgb;
+        r += vplToRadiance[k] * vplR[k].rgb;
+        if (k == 0) rRefl += vplToRadiance[k] * vplR[k].rgb;
+    }
+    if (!specularPixel) return;
     rv = allFinite(rv) ? rv : vec3(0.0);
     r = allFinite(r) ? r : vec3(0.0);
     rRefl = allFinite(rRefl) ? rRefl : vec3(0.0);
@@ -282,7 +339,6 @@ void main() {
         vec4 hR = texture(historyR, puv);
         vec4 hRRefl = texture(historyRRefl, puv);
         vec4 hHits = texture(historyHits, puv);
-        float toSurface = distance(surface, cameraPos.xyz);
         if (historyIsSameSurface(hRv.a, surface) &&
             sameHit(hHits.xyz, hit[0], toSurface + distance(surface, hit[0])) &&
             sameHit(vec3(hHits.w, hR.a, hRRefl.a), hit[1],
