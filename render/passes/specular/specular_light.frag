@@ -89,11 +89,12 @@ vec4 quadSwapY(vec4 x) { return x + ((int(gl_FragCoord.y) & 1) == 0 ? 1.0 : -1.0
 // The VPL irradiance of one ray's hit averaged over the pixel's 2x2 quad: a quad holds four VPL
 // subsets (the interleaving tile is 2x2 or 4x4), so the average sums 4x the VPLs of one pixel and
 // the tile's pattern is a quarter as strong. A neighbour counts where it has a hit of this ray
-// (valid = 1) near this pixel's: within 1 % of the path from the camera + 3 mm, weight falling
-// off with the distance, so the light of one surface does not leak onto another across an edge.
+// (valid = 1) of the same origin (real / virtual: a virtual hit's L_r must stay without real
+// light) near this pixel's: within 1 % of the path from the camera + 3 mm, weight falling off
+// with the distance, so the light of one surface does not leak onto another across an edge.
 // Call in uniform control flow (derivatives). irr.w / irrR.w: valid (0 or 1).
-void quadAverage(inout vec4 irrRv, inout vec4 irrR, vec3 hit, float pathLength) {
-    vec4 h = vec4(hit, 0.0);
+void quadAverage(inout vec4 irrRv, inout vec4 irrR, vec3 hit, int origin, float pathLength) {
+    vec4 h = vec4(hit, float(origin));
     vec4 sumRv = irrRv * irrRv.w, sumR = irrR * irrRv.w;
     float wsum = irrRv.w;
     for (int j = 0; j < 3; ++j) {
@@ -101,7 +102,7 @@ void quadAverage(inout vec4 irrRv, inout vec4 irrR, vec3 hit, float pathLength) 
         vec4 nR = j == 0 ? quadSwapX(irrR) : j == 1 ? quadSwapY(irrR) : quadSwapX(quadSwapY(irrR));
         vec4 nh = j == 0 ? quadSwapX(h) : j == 1 ? quadSwapY(h) : quadSwapX(quadSwapY(h));
         float t = distance(nh.xyz, hit) / (0.01 * pathLength + 0.003);
-        float w = nRv.w > 0.5 ? 1.0 / (1.0 + t * t) : 0.0;
+        float w = nRv.w > 0.5 && abs(nh.w - float(origin)) < 0.5 ? 1.0 / (1.0 + t * t) : 0.0;
         sumRv += w * nRv;
         sumR += w * nR;
         wsum += w;
@@ -283,6 +284,7 @@ void main() {
     // this pixel's radiance (Fresnel weight x albedo (1 - metallic) / pi).
     vec4 vplRv[2] = vec4[2](vec4(0.0), vec4(0.0)), vplR[2] = vec4[2](vec4(0.0), vec4(0.0));
     vec3 vplToRadiance[2] = vec3[2](vec3(0.0), vec3(0.0));
+    int hitOrigin[2] = int[2](ORIGIN_NONE, ORIGIN_NONE);
     for (int k = 0; k < 2 && specularPixel; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
@@ -310,6 +312,7 @@ void main() {
         vplRv[k] = vec4(finiteIrr ? irrRv : vec3(0.0), 1.0);
         vplR[k] = vec4(finiteIrr ? irrR : vec3(0.0), 1.0);
         vplToRadiance[k] = w * A.rgb * (1.0 - A.a) / PI;
+        hitOrigin[k] = origin;
 #ifdef MIRAGE_CAUSTIC_GATHER
         vec3 eRv, eR, crv, cr;
         gatherCaustic(P.xyz, N.xyz, footprint[k], eRv, eR);
@@ -324,7 +327,8 @@ void main() {
     float toSurface = distance(surface, cameraPos.xyz);
     for (int k = 0; k < 2; ++k) {
         if (vplStride > 1)  // uniform: the quad's lanes all take it
-            quadAverage(vplRv[k], vplR[k], hit[k], toSurface + distance(surface, hit[k]));
+            quadAverage(vplRv[k], vplR[k], hit[k], hitOrigin[k],
+                        toSurface + distance(surface, hit[k]));
         rv += vplToRadiance[k] * vplRv[k].rgb;
         r += vplToRadiance[k] * vplR[k].rgb;
         if (k == 0) rRefl += vplToRadiance[k] * vplR[k].rgb;
