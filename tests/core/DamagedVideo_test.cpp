@@ -56,7 +56,7 @@ const Original& original() {
     static const Original o = [] {
         // Without the checksums: the JPEG checks alone must find the damage, as in other
         // recorders' files (ChecksummedRecordingGivesRightFramesOrLostOnes tests the checksums).
-        const fs::path video = test::outputDir("damaged_video_original") / "main.mkv";
+        const fs::path video = test::outputDirForThisTest("damaged_video_original") / "main.mkv";
         std::ofstream(video, std::ios::binary)
             << test::withoutMatroskaClusterChecksums(readFileBytes(sampleVideo()));
         Original r;

@@ -33,7 +33,7 @@ void writeBytes(const fs::path& p, const std::string& bytes) {
 }
 
 std::string written(const char* ext) {
-    const fs::path p = test::outputDir("linear_header") / (std::string("small") + ext);
+    const fs::path p = test::outputDirForThisTest("linear_header") / (std::string("small") + ext);
     writeLinearRgb(p, smallImage());
     return readBytes(p);
 }
@@ -146,7 +146,7 @@ TEST(LinearImageHeader, HdrResolutionIsChecked) {
 TEST(LinearImageHeader, ReaderRefusesDamagedHeaderBeforeDecoding) {
     std::string exr = written(".exr");
     putU32(exr, exrValue(exr, "dataWindow", "box2i") + 8, 1u << 30);
-    const fs::path p = test::outputDir("linear_header") / "damaged.exr";
+    const fs::path p = test::outputDirForThisTest("linear_header") / "damaged.exr";
     writeBytes(p, exr);
     try {
         readLinearRgb(p);

@@ -66,9 +66,7 @@ Scene tableScene(const fs::path& envFile) {
 // pixels do not clip). The main camera's footage is not used here (tiny, 1 spp).
 fs::path rotatingSession() {
     static const fs::path dir = [] {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        const fs::path d = test::outputDir(std::string("env_light_placement_") +
-                                           info->test_suite_name() + "." + info->name());
+        const fs::path d = test::outputDirForThisTest("env_light_placement");
         const fs::path env = d / "sun_and_sky.pfm";
         writeLinearRgb(env, test::equirectFromRadiance(sunAndSky, 256, 128));
         raytrace::SyntheticSessionOptions o;

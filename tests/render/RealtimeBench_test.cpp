@@ -90,9 +90,7 @@ raytrace::SyntheticSessionOptions tinySessionOptions() {
 // of a test that is still reading its session — a flaky failure seen under load.)
 const fs::path& tinySession() {
     static const fs::path dir = [] {
-        const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-        const fs::path d = mirage::test::outputDir(
-            "bench_session_" + std::string(test->test_suite_name()) + "." + test->name());
+        const fs::path d = mirage::test::outputDirForThisTest("bench_session");
         raytrace::writeSyntheticSession(benchScene(true), d, tinySessionOptions());
         return d;
     }();

@@ -32,6 +32,12 @@ std::filesystem::path outputDir(const std::string& name) {
     return p;
 }
 
+std::filesystem::path outputDirForThisTest(const std::string& prefix) {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    if (!info) return outputDir(prefix);
+    return outputDir(prefix + "_" + info->test_suite_name() + "." + info->name());
+}
+
 double meanLuminance(const cv::Mat& linearRgb, const cv::Mat& mask) {
     const cv::Scalar m = cv::mean(linearRgb, mask);
     return 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2];

@@ -13,6 +13,10 @@ std::filesystem::path dataDir();      // the project's data/ (MIRAGE_DATA_DIR)
 std::filesystem::path testDataDir();  // tests/data/
 // A fresh (emptied) folder under the build's test output directory.
 std::filesystem::path outputDir(const std::string& name);
+// outputDir(prefix + "_" + the running test's suite.name). ctest runs each test in its own
+// process, in parallel: a folder shared by several tests (a lazily made fixture, say) would be
+// emptied by one while another still reads it, so such fixtures use this instead.
+std::filesystem::path outputDirForThisTest(const std::string& prefix);
 
 // PSNR (dB) and mean SSIM of two images of equal size and type, over all pixels or where
 // mask != 0 (CV_8U): core/image/ImageCompare.h's, the figures the benchmark reports too.
