@@ -81,17 +81,20 @@ vec3 impFaceUp(int f) {
     return f == 2 ? vec3(0, 0, 1) : f == 3 ? vec3(0, 0, -1) : vec3(0, -1, 0);
 }
 
-// Texel of a cube (6 layers from `firstLayer`) in world direction d (need not be unit).
+// Texel of a cube (6 layers from `firstLayer`) in world direction d (need not be unit). Each
+// face's right and up axes are the world axes lookAt(forward, impFaceUp) gives it, written out:
+// the same texel as projecting on S = normalize(cross(F, up)), U = cross(S, F), without the
+// per-sample normalize and cross products (the enclosing search calls this ~20 times a ray).
 ivec3 impCubeTexel(vec3 d, int firstLayer) {
     vec3 a = abs(d);
-    int f = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1)
-          : a.y >= a.z               ? (d.y >= 0.0 ? 2 : 3)
-                                     : (d.z >= 0.0 ? 4 : 5);
-    vec3 F = impFaceForward(f);
-    vec3 S = normalize(cross(F, impFaceUp(f)));
-    vec3 U = cross(S, F);
-    float z = max(dot(d, F), 1e-20);
-    vec2 ndc = clamp(vec2(dot(d, S), dot(d, U)) / z, -1.0, 1.0);
+    bool xMajor = a.x >= a.y && a.x >= a.z, yMajor = !xMajor && a.y >= a.z;
+    // (right, up, forward) coordinates of d on its face.
+    vec3 m = xMajor   ? (d.x >= 0.0 ? vec3(-d.z, -d.y, d.x) : vec3(d.z, -d.y, -d.x))
+           : yMajor   ? (d.y >= 0.0 ? vec3(d.x, d.z, d.y) : vec3(d.x, -d.z, -d.y))
+                      : (d.z >= 0.0 ? vec3(d.x, -d.y, d.z) : vec3(-d.x, -d.y, -d.z));
+    int f = xMajor ? (d.x >= 0.0 ? 0 : 1) : yMajor ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
+    float z = max(m.z, 1e-20);
+    vec2 ndc = clamp(m.xy / z, -1.0, 1.0);
     int res = int(impHeader.cubeResolution);
     ivec2 px = clamp(ivec2((ndc * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
     return ivec3(px, firstLayer + f);
@@ -156,15 +159,17 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
     if (!found) return false;
     // Refinement: Newton steps on the tangent plane stored at the current texel (exact for
     // planar walls), kept inside the bracket [ta, tb]; regula falsi when the plane step leaves it.
+    // The stored point and normal at t: each step's are the ones the previous step read at its
+    // tm (= this t), carried over instead of looked up again.
     float t = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : tb;
+    ivec3 cur_tex = impCubeTexel(o + t * d - c, obj.enclosingCubeLayer);
+    vec4 q = texelFetch(impCubePosition, cur_tex, 0);
+    vec3 qn = texelFetch(impCubeNormal, cur_tex, 0).xyz;
     for (int s = 0; s < impHeader.refinementSteps; ++s) {
-        ivec3 cur_tex = impCubeTexel(o + t * d - c, obj.enclosingCubeLayer);
-        vec4 q = texelFetch(impCubePosition, cur_tex, 0);
-        vec3 n = texelFetch(impCubeNormal, cur_tex, 0).xyz;
-        float dn = dot(d, n);
+        float dn = dot(d, qn);
         float tm = ha > -IMP_EMPTY ? ta + (tb - ta) * ha / (ha - hb) : 0.5 * (ta + tb);
         if (q.w > 0.5 && abs(dn) > 1e-4) {
-            float tp = dot(q.xyz - o, n) / dn;
+            float tp = dot(q.xyz - o, qn) / dn;
             if (tp >= ta && tp <= tb) tm = tp;
         }
         if (abs(tm - t) < 1e-7 * max(tm, 1.0) && s > 0) break;  // converged
@@ -185,17 +190,18 @@ bool impTraceEnclosing(GpuImpostorObject obj, vec3 o, vec3 d, inout float tBest,
             tb_tex = tm_tex;
         }
         t = tm;
+        cur_tex = tm_tex;
+        q = qm;
+        qn = nm;
     }
     if (!(t > 0.0) || t >= tBest) return false;
-    ivec3 final_tex;
+    ivec3 final_tex = cur_tex;  // q, qn: the stored point and normal there
     vec3 x = o + t * d;
-    if (impEnclosingH(c, obj.enclosingCubeLayer, x, final_tex) < -IMP_EMPTY) return false;
+    if (q.w < 0.5) return false;  // an empty texel
     // A distance cube stores one surface per direction from c: a ray that passes over an edge
     // (a wall's top) lands "behind" it in a direction where the wall is. Accept only points on
     // the stored surface: within two texel footprints of the texel's point and one footprint of
     // its tangent plane.
-    vec4 q = texelFetch(impCubePosition, final_tex, 0);
-    vec3 qn = texelFetch(impCubeNormal, final_tex, 0).xyz;
     float footprint = length(x - c) * 2.0 / impHeader.cubeResolution + 1e-3;
     if (length(x - q.xyz) > 2.0 * footprint) return false;
     if (dot(qn, qn) > 1e-12 && abs(dot(x - q.xyz, normalize(qn))) > footprint) return false;
@@ -274,10 +280,12 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
     if (ha < -IMP_EMPTY && hb > thickness) return false;
     // Refinement: Newton steps on the tangent plane of the height field at the current estimate
     // (stored normal, bilinear depth), kept inside the bracket [ta, tb]; regula falsi otherwise.
+    // Each step's depth at t is the depth the previous step sampled at its tm (= this t): kept
+    // in dq, one bilinear lookup per step.
     float t = ha > -IMP_EMPTY && hb - ha > 0.0 ? ta + (tb - ta) * ha / (ha - hb) : tb;
+    float dq = impDepthAt(I, ro.xy + t * rd.xy);
     for (int s = 0; s < impHeader.refinementSteps; ++s) {
         vec2 qc = ro.xy + t * rd.xy;
-        float dq = impDepthAt(I, qc);
         vec3 n = texelFetch(impNormal, impTexel(I, qc), 0).xyz;
         vec3 nl = vec3(dot(n, I.axisU), dot(n, I.axisV), dot(n, I.axisW));
         float dn = dot(rd, nl);
@@ -286,7 +294,8 @@ bool impTraceOne(GpuImpostor I, vec3 o, vec3 d, inout float tBest, out ivec3 tex
             float tp = dot(vec3(qc, dq) - ro, nl) / dn;
             if (tp >= ta && tp <= tb) tm = tp;
         }
-        float hm = ro.z + tm * rd.z - impDepthAt(I, ro.xy + tm * rd.xy);
+        dq = impDepthAt(I, ro.xy + tm * rd.xy);
+        float hm = ro.z + tm * rd.z - dq;
         if (hm < 0.0) {
             ta = tm;
             ha = hm;

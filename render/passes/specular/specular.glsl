@@ -48,12 +48,14 @@ vec3 environmentRadiance(sampler2D envMap, vec3 l) {
 
 // Canvas-style pixel of world point x in a view (world -> clip `vp`, `size` texels): (0,0) = the
 // centre of the first texel; false behind the eye. The camera's view is projectToCanvas below.
-bool projectToView(mat4 vp, vec2 size, vec3 x, out vec2 px) {
-    vec4 c = vp * vec4(x, 1.0);
+bool clipToView(vec4 c, vec2 size, out vec2 px) {
     px = vec2(-1e4);
     if (c.w <= 1e-6) return false;
     px = (c.xy / c.w * 0.5 + 0.5) * size - 0.5;
     return true;
+}
+bool projectToView(mat4 vp, vec2 size, vec3 x, out vec2 px) {
+    return clipToView(vp * vec4(x, 1.0), size, px);
 }
 
 // Reflection weight of a smooth surface with material m at cos(theta) = cosV (Fresnel of `ior`
@@ -108,12 +110,15 @@ bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, 
     // passes the stored back face's (same object).
     float maxLen = 2.0 * sd.radius + 1e-3;
     int steps = clamp(marchSteps, 2, 128);
+    // Clip coordinates are linear along the ray: vp (p + t T1) = clipP + t clipT1, one
+    // multiply-add per sample instead of a matrix product.
+    vec4 clipP = vp * vec4(p, 1.0), clipT1 = vp * vec4(T1, 0.0);
     float prevT = 0.0, hitT = -1.0;
     for (int i = 1; i <= steps; ++i) {
         float t = maxLen * float(i) / float(steps);
         vec3 q = p + T1 * t;
         vec2 cp;
-        if (!projectToView(vp, size, q, cp)) break;
+        if (!clipToView(clipP + t * clipT1, size, cp)) break;
         ivec2 qi = ivec2(floor(cp + 0.5));
         if (any(lessThan(qi, ivec2(0))) || any(greaterThanEqual(qi, ivec2(size)))) break;
         vec4 B = texelFetch(backPosition, qi, 0);
@@ -131,7 +136,7 @@ bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, 
             float mid = 0.5 * (lo + hi);
             vec3 q = p + T1 * mid;
             vec2 cp;
-            projectToView(vp, size, q, cp);
+            clipToView(clipP + mid * clipT1, size, cp);
             ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(size) - 1);
             vec4 B = texelFetch(backPosition, qi, 0);
             bool past = int(B.w + 0.5) - 1 != slot || length(q - eye) >= length(B.xyz - eye);
