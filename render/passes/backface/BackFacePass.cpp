@@ -9,15 +9,12 @@ BackFacePass::BackFacePass()
                              "passes/backface/backface.frag")) {
     locModel_ = program_.uniformLocation("model");
     locNormal_ = program_.uniformLocation("normalMatrix");
-    locMode_ = program_.uniformLocation("mode");
     locSlot_ = program_.uniformLocation("specularSlot");
 }
 
 void BackFacePass::setup(PassBuilder& b) const {
-    b.read(Resource::GBufferPosition);  // is RealSurfaces when the scene has no virtual geometry
     b.write(Resource::BackFacePosition, GL_RGBA32F, SizeRule::Canvas);
     b.write(Resource::BackFaceNormal, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::RealSurfaces, GL_RGBA32F, SizeRule::Canvas);
 }
 
 PassDecision BackFacePass::decide(const FrameContext& ctx) const {
@@ -28,11 +25,9 @@ PassDecision BackFacePass::decide(const FrameContext& ctx) const {
     if (r.z <= 0 || r.w <= 0) return {false, "no mirror or glass object in view"};
     const double share = 100.0 * double(r.z) * double(r.w) /
                          (double(ctx.canvasWidth()) * double(ctx.canvasHeight()));
-    return {true,
-            std::to_string(n) + " specular draw(s) within " + std::to_string(r.z) + "x" +
-                std::to_string(r.w) + " canvas pixels (" + std::to_string(int(share + 0.5)) +
-                " %)" +
-                (ctx.scene.hasVirtual() ? " + real-surface depth (virtual objects present)" : "")};
+    return {true, std::to_string(n) + " specular draw(s) within " + std::to_string(r.z) + "x" +
+                      std::to_string(r.w) + " canvas pixels (" + std::to_string(int(share + 0.5)) +
+                      " %)"};
 }
 
 void BackFacePass::resize(const FrameContext& ctx) {
@@ -43,19 +38,12 @@ void BackFacePass::resize(const FrameContext& ctx) {
     position_ = gl::Texture::create2D("backface position", w, h, GL_RGBA32F);
     normal_ = gl::Texture::create2D("backface normal", w, h, GL_RGBA16F);
     depth_ = gl::Texture::create2D("backface depth", w, h, GL_DEPTH_COMPONENT32F);
-    realPosition_ = gl::Texture::create2D("real surface position", w, h, GL_RGBA32F);
-    realDepth_ = gl::Texture::create2D("real surface depth", w, h, GL_DEPTH_COMPONENT32F);
-    for (gl::Texture* t : {&position_, &normal_, &realPosition_})
-        t->setFilter(GL_NEAREST, GL_NEAREST);
+    for (gl::Texture* t : {&position_, &normal_}) t->setFilter(GL_NEAREST, GL_NEAREST);
     fbo_ = gl::Framebuffer("backface fbo");
     fbo_.attachColor(0, position_);
     fbo_.attachColor(1, normal_);
     fbo_.attachDepth(depth_);
     fbo_.finalize(2);
-    realFbo_ = gl::Framebuffer("real surface fbo");
-    realFbo_.attachColor(0, realPosition_);
-    realFbo_.attachDepth(realDepth_);
-    realFbo_.finalize(1);
 }
 
 void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
@@ -79,23 +67,10 @@ void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
     glClearBufferfv(GL_COLOR, 0, zero);
     glClearBufferfv(GL_COLOR, 1, zero);
     glClearBufferfv(GL_DEPTH, 0, &one);
-    glUniform1i(locMode_, 0);
     const std::vector<int>& spec = ctx.scene.specularDraws();
     for (size_t s = 0; s < spec.size(); ++s) draw(ctx.scene.draws()[size_t(spec[s])], int(s));
     res.publish(Resource::BackFacePosition, position_);
     res.publish(Resource::BackFaceNormal, normal_);
-
-    if (ctx.scene.hasVirtual()) {
-        realFbo_.bind();
-        glClearBufferfv(GL_COLOR, 0, zero);
-        glClearBufferfv(GL_DEPTH, 0, &one);
-        glUniform1i(locMode_, 1);
-        for (const DrawItem& d : ctx.scene.draws())
-            if (d.origin == Origin::Real) draw(d, -1);
-        res.publish(Resource::RealSurfaces, realPosition_);
-    } else {
-        res.publish(Resource::RealSurfaces, res.texture(Resource::GBufferPosition));
-    }
     glDisable(GL_DEPTH_TEST);
 }
 

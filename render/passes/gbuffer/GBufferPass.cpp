@@ -15,11 +15,24 @@ void GBufferPass::setup(PassBuilder& b) const {
     b.write(Resource::GBufferNormal, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::GBufferAlbedo, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::GBufferEmissive, GL_RGBA16F, SizeRule::Canvas);
+    b.write(Resource::RealSurfaces, GL_RGBA32F, SizeRule::Canvas);
+}
+
+bool GBufferPass::separateRealSurfaces(const FrameContext& ctx) {
+    // Its readers (the specular passes, the composite's specular variant) run only behind the
+    // back-face pass, which runs only with a mirror or glass object in view.
+    const glm::ivec4& r = ctx.specularScissor;
+    if (ctx.scene.specularDraws().empty() || r.z <= 0 || r.w <= 0) return false;
+    for (const DrawItem& d : ctx.scene.draws())
+        if (d.origin == Origin::Virtual) return true;
+    return false;
 }
 
 PassDecision GBufferPass::decide(const FrameContext& ctx) const {
     if (ctx.scene.draws().empty()) return {false, "the scene has no geometry"};
-    return {true, std::to_string(ctx.scene.draws().size()) + " draws"};
+    return {true,
+            std::to_string(ctx.scene.draws().size()) + " draws" +
+                (separateRealSurfaces(ctx) ? ", real first (nearest real surfaces kept)" : "")};
 }
 
 void GBufferPass::resize(const FrameContext& ctx) {
@@ -30,7 +43,8 @@ void GBufferPass::resize(const FrameContext& ctx) {
     albedo_ = gl::Texture::create2D("gbuffer albedo", w, h, GL_RGBA16F);
     emissive_ = gl::Texture::create2D("gbuffer emissive", w, h, GL_RGBA16F);
     depth_ = gl::Texture::create2D("gbuffer depth", w, h, GL_DEPTH_COMPONENT32F);
-    for (gl::Texture* t : {&position_, &normal_, &albedo_, &emissive_})
+    realSurfaces_ = gl::Texture::create2D("real surface position", w, h, GL_RGBA32F);
+    for (gl::Texture* t : {&position_, &normal_, &albedo_, &emissive_, &realSurfaces_})
         t->setFilter(GL_NEAREST, GL_NEAREST);
     fbo_ = gl::Framebuffer("gbuffer fbo");
     fbo_.attachColor(0, position_);
@@ -55,15 +69,31 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
     ctx.scene.bindGeometry();
+    const std::vector<DrawItem>& draws = ctx.scene.draws();
     const std::vector<int>& specular = ctx.scene.specularDraws();
-    size_t nextSpecular = 0;  // specularDraws() is in draw order
-    for (size_t di = 0; di < ctx.scene.draws().size(); ++di) {
-        const DrawItem& d = ctx.scene.draws()[di];
-        int slot = -1;
-        if (nextSpecular < specular.size() && specular[nextSpecular] == int(di))
-            slot = int(nextSpecular++);
-        glUniform1i(locSpecularSlot_, slot);
-        draw_.draw(ctx.scene, d);
+    specularSlot_.assign(draws.size(), -1);
+    for (size_t s = 0; s < specular.size(); ++s) specularSlot_[size_t(specular[s])] = int(s);
+    auto drawAll = [&](bool real, bool virt) {
+        for (size_t di = 0; di < draws.size(); ++di) {
+            const DrawItem& d = draws[di];
+            if (!(d.origin == Origin::Real ? real : virt)) continue;
+            glUniform1i(locSpecularSlot_, specularSlot_[di]);
+            draw_.draw(ctx.scene, d);
+        }
+    };
+    if (separateRealSurfaces(ctx)) {
+        // After the real draws the position target holds the nearest real surface everywhere
+        // (the depth test among them is the same as without the virtual ones). Ties at equal
+        // depth between a real and a virtual surface go to the real one.
+        drawAll(true, false);
+        glCopyImageSubData(position_.id(), GL_TEXTURE_2D, 0, 0, 0, 0, realSurfaces_.id(),
+                           GL_TEXTURE_2D, 0, 0, 0, 0, ctx.canvasWidth(), ctx.canvasHeight(), 1);
+        drawAll(false, true);
+        res.publish(Resource::RealSurfaces, realSurfaces_);
+    } else {
+        drawAll(true, true);
+        // Every surface is real, or no pass reads RealSurfaces this frame.
+        res.publish(Resource::RealSurfaces, position_);
     }
     glDisable(GL_DEPTH_TEST);
     res.publish(Resource::GBufferPosition, position_);

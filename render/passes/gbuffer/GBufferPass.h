@@ -1,6 +1,17 @@
 #pragma once
 // Primary G-buffer (GBuf_p of Knecht 2013 Sec. 5.1) from the tracked camera, rendered
 // undistorted onto the canvas of CameraProjection with the calibrated fx, fy.
+//
+// It also gives RealSurfaces: the nearest REAL surface per pixel (world position + origin), which
+// the back-projection of the video into reflections and refractions validates against (Knecht
+// 2013 Sec. 4.1.3; the video shows real surfaces only, virtual objects in front do not hide them).
+// When virtual draws are present and a mirror or glass object is in view (the only frames whose
+// passes read it), the real draws are rasterised first, the position target is copied into
+// RealSurfaces, and the virtual draws follow: one raster of the scene instead of a second raster
+// of every real draw (on llvmpipe the copy costs a fraction of that raster). Otherwise the
+// position target itself is published as RealSurfaces.
+#include <vector>
+
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -17,11 +28,15 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
+    // True when this frame needs RealSurfaces apart from the G-buffer position (see above).
+    static bool separateRealSurfaces(const FrameContext& ctx);
+
     gl::Program program_;
-    gl::Texture position_, normal_, albedo_, emissive_, depth_;
+    gl::Texture position_, normal_, albedo_, emissive_, depth_, realSurfaces_;
     gl::Framebuffer fbo_;
     MaterialDraw draw_{program_};  // after program_
     GLint locSpecularSlot_ = -1;
+    std::vector<int> specularSlot_;  // per draw: its index in specularDraws(), -1 = not specular
 };
 
 }  // namespace mirage::render
