@@ -245,6 +245,7 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
         coarseDetectors_.emplace_back(decimate, std::make_unique<Detector>(o));
         coarseDetector = coarseDetectors_.back().second.get();
     }
+    f.coarseWindow = region & cv::Rect(0, 0, grey.cols, grey.rows);
     auto t0 = std::chrono::steady_clock::now();
     std::vector<TagDetection> coarse = coarseDetector->detect(grey, region);
     f.coarseTags = int(coarse.size());
@@ -402,8 +403,24 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
         // in the whole image searched by the finder, and an unconfirmed one falls back to the
         // ordinary search of f.searchRegion.
         cv::Rect coarseSearch = f.searchRegion;
-        if (options_.coarseFirst && options_.textureRegion && r.area() > 0) coarseSearch = grown;
-        if (!(coarseDecimate > 1.0f && coarseRegion &&
+        if (options_.coarseFirst && options_.textureRegion && r.area() > 0) {
+            coarseSearch = grown;
+            if (options_.coarseWindowFraction > 0 && options_.coarseWindowFraction < 1) {
+                // The window about the region's centre, origin aligned like the region's.
+                const double hw = 0.5 * options_.coarseWindowFraction * r.width + m;
+                const double hh = 0.5 * options_.coarseWindowFraction * r.height + m;
+                const double cx = r.x + 0.5 * r.width, cy = r.y + 0.5 * r.height;
+                coarseSearch =
+                    cv::Rect(
+                        cv::Point(std::max(0, int(cx - hw)) / kTextureBlockPx * kTextureBlockPx,
+                                  std::max(0, int(cy - hh)) / kTextureBlockPx * kTextureBlockPx),
+                        cv::Point(int(cx + hw), int(cy + hh))) &
+                    full;
+            }
+        }
+        // Decimation 1 is a coarse stage too (coarseFirstDecimations): libapriltag at full
+        // resolution in the window.
+        if (!(coarseDecimate >= 1.0f && coarseRegion &&
               coarseToFine(grey, coarseSearch, coarseDecimate, ambiguityPrior, f))) {
             t0 = std::chrono::steady_clock::now();
             f.detections = detector_.detect(grey, f.searchRegion);

@@ -102,9 +102,17 @@ struct TrackerOptions {
     // coarseFirstDecimations that leaves the estimated side at least coarseFirstMinSidePx on the
     // decimated image; when none does (small, distant tags) the ordinary search runs directly.
     // It replaces coarseMinWidth / coarseDecimate in such frames; false = those as before.
+    // A decimation of 1 in the list (libapriltag at full resolution in the window below, for
+    // small, distant tags; docs/tracking.md) finds more tags there than the ordinary search; it
+    // is not in the default: its poses leave the covariance check of the Monte-Carlo views.
     bool coarseFirst = true;
     std::vector<float> coarseFirstDecimations{4.0f, 3.0f};
     double coarseFirstMinSidePx = 15.0;
+    // The coarse-first search reads only a window about the textured region's centre, this
+    // fraction of the region's width and height, grown by textureMarginPx (libapriltag's cost
+    // follows the tag edges it reads; the coarse pose needs only a few tags, one large tag may
+    // settle it, and the finder looks for the others). 1 (or more) = the whole grown region.
+    double coarseWindowFraction = 0.5;
 };
 
 struct TrackedFrame {
@@ -131,9 +139,12 @@ struct TrackedFrame {
     int coarseTags = 0;
     bool coarseUsed = false;
     // Coarse-first search: the largest tag's side estimated from the textured region (pixels;
-    // 0 when not estimated) and the decimation it chose (0: none, the ordinary search).
+    // 0 when not estimated) and the decimation it chose (0: none, the ordinary search; 1: full
+    // resolution in the coarse window).
     double coarseFirstSidePx = 0;
     float coarseFirstDecimate = 0;
+    // The image box libapriltag's coarse search read (pixels; empty when not tried).
+    cv::Rect coarseWindow;
     // Textured-region search: the frame's search began in texturedRegion's box (searchRegion).
     bool textureRegionUsed = false;
 };

@@ -170,15 +170,19 @@ BENCHMARK(BM_MirageTrack)
 
 // mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
 // apart). Args: mode 2 = coarse-first (the default: the coarse-to-fine search at the decimation
-// the textured region's size picks, 4, 3 or none), 1 = coarse-to-fine at the fixed `coarse`
-// decimation (libapriltag at that decimation, the other board tags found from that pose at full
-// resolution and verified; the previous default from 1000 px width), 0 = libapriltag's search
-// at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker); texture 1 = the search starts
-// in the textured region (default), 0 = full image.
+// the textured region's size picks, 4, 3 or none, in a window about the region's centre), 3 =
+// coarse-first as before the window (the whole grown region), 4 = the default with decimation 1
+// for the small tags (libapriltag at full resolution in the window), 1 = coarse-to-fine at the
+// fixed `coarse` decimation (libapriltag at that decimation, the other board tags found from that
+// pose at full resolution and verified; the previous default from 1000 px width), 0 = libapriltag's
+// search at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker); texture 1 = the search
+// starts in the textured region (default), 0 = full image.
 void BM_MirageSingle(benchmark::State& state) {
     const BoardFrames& f = frames(int(state.range(0)));
     TrackerOptions opt;
-    opt.coarseFirst = state.range(1) == 2;
+    opt.coarseFirst = state.range(1) >= 2;
+    if (state.range(1) == 3) opt.coarseWindowFraction = 1.0;
+    if (state.range(1) == 4) opt.coarseFirstDecimations = {4.0f, 3.0f, 1.0f};
     opt.coarseToFine = state.range(1) == 1;
     opt.coarseMinWidth = 0;  // mode 1 measured at 640x480 too
     opt.coarseDecimate = float(state.range(2));
@@ -253,11 +257,15 @@ BENCHMARK(BM_Mirage)
 BENCHMARK(BM_MirageSingle)
     ->ArgNames({"width", "mode", "coarse", "texture"})
     ->Args({640, 2, 0, 1})
+    ->Args({640, 3, 0, 1})
+    ->Args({640, 4, 0, 1})
     ->Args({640, 0, 0, 1})
     ->Args({640, 0, 0, 0})
     ->Args({640, 1, 4, 1})
     ->Args({640, 1, 3, 1})
     ->Args({1280, 2, 0, 1})
+    ->Args({1280, 3, 0, 1})
+    ->Args({1280, 4, 0, 1})
     ->Args({1280, 1, 4, 1})
     ->Args({1280, 1, 4, 0})
     ->Args({1280, 0, 0, 1})
