@@ -136,4 +136,59 @@ void FrameContext::drawFullscreenTriangleIn(const glm::ivec4& rect, int attachme
     glDisable(GL_SCISSOR_TEST);
 }
 
+void FrameContext::clearForRects(const std::vector<glm::ivec4>& rects, DrawnRects& drawn, int first,
+                                 int count, bool clearDepth) const {
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    const float one = 1.0f;
+    auto inside = [](const glm::ivec4& a, const glm::ivec4& b) {  // a within b
+        return a.x >= b.x && a.y >= b.y && a.x + a.z <= b.x + b.z && a.y + a.w <= b.y + b.w;
+    };
+    glEnable(GL_SCISSOR_TEST);
+    auto clearIn = [&](const glm::ivec4& r) {
+        if (r.z <= 0 || r.w <= 0) return;
+        glScissor(r.x, r.y, r.z, r.w);
+        for (int i = first; i < first + count; ++i) glClearBufferfv(GL_COLOR, i, zero);
+        if (clearDepth) glClearBufferfv(GL_DEPTH, 0, &one);
+    };
+    for (const glm::ivec4& r : drawn.rects) clearIn(r);
+    for (const glm::ivec4& r : rects)
+        if (std::none_of(drawn.rects.begin(), drawn.rects.end(),
+                         [&](const glm::ivec4& d) { return inside(r, d); }))
+            clearIn(r);
+    glDisable(GL_SCISSOR_TEST);
+    drawn.rects = rects;
+}
+
+void FrameContext::drawFullscreenTriangleIn(const std::vector<glm::ivec4>& rects) const {
+    glEnable(GL_SCISSOR_TEST);
+    for (const glm::ivec4& rect : rects) {
+        if (rect.z <= 0 || rect.w <= 0) continue;
+        glScissor(rect.x, rect.y, rect.z, rect.w);
+        drawFullscreenTriangle();
+    }
+    glDisable(GL_SCISSOR_TEST);
+}
+
+std::vector<glm::ivec4> mergeOverlappingRects(std::vector<glm::ivec4> rects) {
+    std::erase_if(rects, [](const glm::ivec4& r) { return r.z <= 0 || r.w <= 0; });
+    // Merging two can make the union overlap a third that neither did: repeat until no pair
+    // overlaps (n is the number of specular objects in view, a handful).
+    for (bool merged = true; merged;) {
+        merged = false;
+        for (size_t i = 0; i < rects.size() && !merged; ++i)
+            for (size_t j = i + 1; j < rects.size() && !merged; ++j) {
+                const glm::ivec4 a = rects[i], b = rects[j];
+                const bool overlap =
+                    a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w && b.y < a.y + a.w;
+                if (!overlap) continue;
+                const int x0 = std::min(a.x, b.x), y0 = std::min(a.y, b.y);
+                const int x1 = std::max(a.x + a.z, b.x + b.z), y1 = std::max(a.y + a.w, b.y + b.w);
+                rects[i] = {x0, y0, x1 - x0, y1 - y0};
+                rects.erase(rects.begin() + std::ptrdiff_t(j));
+                merged = true;
+            }
+    }
+    return rects;
+}
+
 }  // namespace mirage::render

@@ -27,6 +27,17 @@ enum class RoughRefractionMethod {
 };
 const char* roughRefractionMethodName(RoughRefractionMethod m);  // "filter", "lean", "gsr"
 
+// The rectangles (GL window x, y, width, height) that draws into a set of textures last covered.
+// Clearing those and the next draw's rectangles before that draw keeps the textures at their
+// clear value outside the new rectangles, as a full clear would, at the cost of those pixels
+// only (full-screen clears of the specular passes' float targets cost llvmpipe several ms a
+// frame). A new texture's contents are undefined: markAll() after allocating one.
+struct DrawnRects {
+    DrawnRects() { markAll(); }
+    void markAll() { rects.assign(1, glm::ivec4(0, 0, 1 << 24, 1 << 24)); }
+    std::vector<glm::ivec4> rects;
+};
+
 struct RendererOptions {
     int vplCount = 256;          // total VPLs per frame, split over the lights with RSMs
     int shadowMapSize = 512;     // texels per side of each shadow / RSM layer
@@ -128,6 +139,9 @@ struct RendererOptions {
     // Tests only: false drops the upsample's geometry test (plain bilinear weights; halos at
     // depth steps in the reflections).
     bool specularUpsampleGeometry = true;
+    // Tests only: false draws the specular passes over the one rectangle around every specular
+    // object (FrameContext::specularScissor) instead of each object's own (the same images).
+    bool specularRectsPerObject = true;
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
     // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
     bool reuseStaticPasses = true;
@@ -272,6 +286,12 @@ public:
     // this frame (width 0: none in view). The specular passes shade only these: on llvmpipe a
     // fragment costs its whole shader even where it exits at once.
     glm::ivec4 specularScissor{0, 0, 0, 0};
+    // The same per specular object, rectangles that overlap merged into their bounding one:
+    // together they hold every specular pixel, and where a mirror and a glass object lie apart
+    // on screen far fewer pixels than specularScissor (the draws over them pay per pixel
+    // covered, masked or not). refractiveRects: the glass objects' only, all the refraction
+    // search needs (a mirror's pixel refracts nothing). Both empty when none is in view.
+    std::vector<glm::ivec4> specularRects, refractiveRects;
 
     gl::Buffer frameUbo, lightUbo;
     gl::VertexArray emptyVao;  // for full-screen triangles
@@ -294,9 +314,21 @@ public:
     // full-screen triangle only inside `rect` (GL window x, y, width, height; nothing if empty):
     // for passes whose shader writes 0 outside the pixels that rect holds.
     void drawFullscreenTriangleIn(const glm::ivec4& rect, int attachments) const;
+    // Clears colour attachments first .. first + count - 1 of the bound framebuffer to 0 and,
+    // with clearDepth, its depth attachment to 1 (depth writes must be on) inside drawn.rects
+    // and `rects`; then drawn.rects = rects (see DrawnRects).
+    void clearForRects(const std::vector<glm::ivec4>& rects, DrawnRects& drawn, int first,
+                       int count, bool clearDepth = false) const;
+    // The full-screen triangle in each of `rects` (which must not overlap: see
+    // mergeOverlappingRects); clears nothing.
+    void drawFullscreenTriangleIn(const std::vector<glm::ivec4>& rects) const;
 
 private:
     gl::Texture black_, farShadow_, noGlass_;
 };
+
+// `rects` (GL window x, y, width, height) with every overlapping pair replaced by its bounding
+// rectangle until none overlaps, empty ones dropped: the same pixels covered or more, each once.
+std::vector<glm::ivec4> mergeOverlappingRects(std::vector<glm::ivec4> rects);
 
 }  // namespace mirage::render

@@ -71,34 +71,55 @@ bool tangentSlopes(double ca, double cz, double r, double& lo, double& hi) {
 }
 
 // The canvas pixels (GL window rectangle x, y, width, height; GL row 0 = image row 0, see
-// CameraProjection::projectionMatrix) that can show a specular object this frame: the exact
-// projection of every specular draw's bounding sphere, 2 px margin. The whole canvas when a sphere
-// reaches the camera plane; width 0 when no specular draw is in the frustum. Conservative: every
-// fragment of a draw lies inside its bounding sphere.
-glm::ivec4 specularScissor(const GpuScene& s, const glm::mat4& view, const glm::mat4& viewProj,
-                           const CameraProjection& p) {
+// CameraProjection::projectionMatrix) that can show one draw: the exact projection of its
+// bounding sphere, 2 px margin. The whole canvas when the sphere reaches the camera plane; width
+// 0 when it is outside the frustum. Conservative: every fragment of a draw lies inside its
+// bounding sphere.
+glm::ivec4 sphereRect(const BoundingSphere& b, const glm::mat4& view, const glm::mat4& viewProj,
+                      const CameraProjection& p) {
     const int width = p.canvasWidth, height = p.canvasHeight;
-    glm::dvec2 lo(1e30), hi(-1e30);
-    bool any = false;
-    for (int i : s.specularDraws()) {
-        const BoundingSphere& b = s.draws()[size_t(i)].bounds;
-        if (!inFrustum(viewProj, b)) continue;
-        any = true;
-        const glm::dvec3 c(view * glm::vec4(b.center, 1.0f));  // camera frame (OpenCV axes)
-        const double r = double(b.radius) * 1.001 + 1e-5;      // float rounding of the bounds
-        double x0, x1, y0, y1;
-        if (!tangentSlopes(c.x, c.z, r, x0, x1) || !tangentSlopes(c.y, c.z, r, y0, y1))
-            return {0, 0, width, height};
-        // Window position of slope m: fx m + cx + 0.5 (pixel centres at +0.5).
-        lo = glm::min(lo, glm::dvec2(p.camera.fx * x0 + p.canvasCx, p.camera.fy * y0 + p.canvasCy));
-        hi = glm::max(hi, glm::dvec2(p.camera.fx * x1 + p.canvasCx, p.camera.fy * y1 + p.canvasCy));
-    }
-    if (!any) return {0, 0, 0, 0};
-    const int x0 = std::clamp(int(std::floor(lo.x)) - 2, 0, width);
-    const int y0 = std::clamp(int(std::floor(lo.y)) - 2, 0, height);
-    const int x1 = std::clamp(int(std::ceil(hi.x)) + 3, 0, width);
-    const int y1 = std::clamp(int(std::ceil(hi.y)) + 3, 0, height);
+    if (!inFrustum(viewProj, b)) return {0, 0, 0, 0};
+    const glm::dvec3 c(view * glm::vec4(b.center, 1.0f));  // camera frame (OpenCV axes)
+    const double r = double(b.radius) * 1.001 + 1e-5;      // float rounding of the bounds
+    double sx0, sx1, sy0, sy1;
+    if (!tangentSlopes(c.x, c.z, r, sx0, sx1) || !tangentSlopes(c.y, c.z, r, sy0, sy1))
+        return {0, 0, width, height};
+    // Window position of slope m: fx m + cx + 0.5 (pixel centres at +0.5).
+    const int x0 = std::clamp(int(std::floor(p.camera.fx * sx0 + p.canvasCx)) - 2, 0, width);
+    const int y0 = std::clamp(int(std::floor(p.camera.fy * sy0 + p.canvasCy)) - 2, 0, height);
+    const int x1 = std::clamp(int(std::ceil(p.camera.fx * sx1 + p.canvasCx)) + 3, 0, width);
+    const int y1 = std::clamp(int(std::ceil(p.camera.fy * sy1 + p.canvasCy)) + 3, 0, height);
     return {x0, y0, x1 - x0, y1 - y0};
+}
+
+// FrameContext's specularScissor (the bounding rectangle of every specular draw's), its
+// specularRects and refractiveRects (the glass draws').
+void specularRectangles(const GpuScene& s, const glm::mat4& view, const glm::mat4& viewProj,
+                        const CameraProjection& p, FrameContext& c) {
+    std::vector<glm::ivec4> all, glass;
+    for (int i : s.specularDraws()) {
+        const DrawItem& d = s.draws()[size_t(i)];
+        const glm::ivec4 r = sphereRect(d.bounds, view, viewProj, p);
+        if (r.z <= 0 || r.w <= 0) continue;
+        all.push_back(r);
+        if (d.transmissive) glass.push_back(r);
+    }
+    c.specularScissor = {0, 0, 0, 0};
+    if (!all.empty()) {
+        glm::ivec2 lo(all.front().x, all.front().y), hi = lo;
+        for (const glm::ivec4& r : all) {
+            lo = glm::min(lo, glm::ivec2(r.x, r.y));
+            hi = glm::max(hi, glm::ivec2(r.x + r.z, r.y + r.w));
+        }
+        c.specularScissor = {lo.x, lo.y, hi.x - lo.x, hi.y - lo.y};
+    }
+    if (!c.options.specularRectsPerObject) {
+        const bool any = !all.empty(), anyGlass = !glass.empty();
+        all.assign(any ? 1 : 0, c.specularScissor);
+        glass.assign(anyGlass ? 1 : 0, c.specularScissor);
+    }
+    c.specularRects = mergeOverlappingRects(std::move(all));
+    c.refractiveRects = mergeOverlappingRects(std::move(glass));
 }
 
 // The smallest sphere holding both.
@@ -369,7 +390,7 @@ void Renderer::planFrame(const FrameInput& input) {
     f.viewMatrix = view;
     f.projMatrix = proj;
     f.viewProj = viewProj;
-    c.specularScissor = specularScissor(s, view, viewProj, projection_);
+    specularRectangles(s, view, viewProj, projection_, c);
     f.prevViewProj = prevViewProj_;
     f.cameraPos = glm::vec4(camPos, 1.0f);
     f.prevCameraPos = glm::vec4(prevCameraPos_, 1.0f);

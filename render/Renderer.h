@@ -103,6 +103,9 @@ public:
 
     const CameraProjection& projection() const { return projection_; }
     const FramePlan& plan() const { return ctx_->plan; }
+    // This frame's canvas rectangles of the specular / glass objects (FrameContext).
+    const std::vector<glm::ivec4>& specularRects() const { return ctx_->specularRects; }
+    const std::vector<glm::ivec4>& refractiveRects() const { return ctx_->refractiveRects; }
     const GpuScene& gpuScene() const { return *scene_; }
     const RendererOptions& options() const { return options_; }
     const FrameReport& lastReport() const { return graph_.lastReport(); }

@@ -44,6 +44,7 @@ void BackFacePass::resize(const FrameContext& ctx) {
     fbo_.attachColor(1, normal_);
     fbo_.attachDepth(depth_);
     fbo_.finalize(2);
+    drawn_.markAll();
 }
 
 void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
@@ -55,7 +56,6 @@ void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
     ctx.scene.bindGeometry();
-    const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
     auto draw = [&](const DrawItem& d, int slot) {
         glUniformMatrix4fv(locModel_, 1, GL_FALSE, &d.model[0][0]);
         glUniformMatrix4fv(locNormal_, 1, GL_FALSE, &d.normalMatrix[0][0]);
@@ -64,9 +64,9 @@ void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
     };
 
     fbo_.bind();
-    glClearBufferfv(GL_COLOR, 0, zero);
-    glClearBufferfv(GL_COLOR, 1, zero);
-    glClearBufferfv(GL_DEPTH, 0, &one);
+    // Every specular draw's fragments lie in its rectangle (FrameContext::specularRects).
+    glDepthMask(GL_TRUE);
+    ctx.clearForRects(ctx.specularRects, drawn_, 0, 2, true);
     const std::vector<int>& spec = ctx.scene.specularDraws();
     for (size_t s = 0; s < spec.size(); ++s) draw(ctx.scene.draws()[size_t(spec[s])], int(s));
     res.publish(Resource::BackFacePosition, position_);

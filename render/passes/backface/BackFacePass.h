@@ -21,6 +21,7 @@ private:
     gl::Program program_;
     gl::Texture position_, normal_, depth_;
     gl::Framebuffer fbo_;
+    DrawnRects drawn_;
     GLint locModel_ = -1, locNormal_ = -1, locSlot_ = -1;
     int width_ = 0, height_ = 0;
 };

@@ -89,6 +89,7 @@ void CompositePass::resize(const FrameContext& ctx) {
     maskFbo_ = gl::Framebuffer("composite specular mask fbo");
     maskFbo_.attachDepth(mask_);
     maskFbo_.finalize(0);
+    maskDrawn_.markAll();
 }
 
 glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const {
@@ -171,20 +172,22 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
             glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
     ctx.drawFullscreenTriangle();
-    const glm::ivec4 rect =
-        specular && ctx.options.showVirtual ? cameraRect(ctx, ctx.specularScissor) : glm::ivec4(0);
-    if (rect.z > 0 && rect.w > 0) {
-        // The mask of the camera pixels that see a specular pixel (inside the rectangle; 1
+    // The camera pixels of each specular object's canvas rectangle (the lens map can make two
+    // overlap: merged again).
+    std::vector<glm::ivec4> rects;
+    if (specular && ctx.options.showVirtual)
+        for (const glm::ivec4& r : ctx.specularRects) rects.push_back(cameraRect(ctx, r));
+    rects = mergeOverlappingRects(std::move(rects));
+    if (!rects.empty()) {
+        // The mask of the camera pixels that see a specular pixel (inside the rectangles; 1
         // outside), then the full variant on those only (early depth test).
         maskFbo_.bind();
         maskProgram_.use();
         glDepthMask(GL_TRUE);  // also lets the clear write
-        glClearBufferfv(GL_DEPTH, 0, std::array<float, 1>{1.0f}.data());
+        ctx.clearForRects(rects, maskDrawn_, 0, 0, true);
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_ALWAYS);
-        glEnable(GL_SCISSOR_TEST);
-        glScissor(rect.x, rect.y, rect.z, rect.w);
-        ctx.drawFullscreenTriangle();
+        ctx.drawFullscreenTriangleIn(rects);
         fbo_.bind();
         glDepthFunc(GL_GREATER);  // the triangle lies at depth 0.5
         glDepthMask(GL_FALSE);
@@ -200,8 +203,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                 res.textureOr(rough ? kRoughBuffers[i] : kFuzzyBuffers[i], ctx.blackTexture())
                     .id());
         glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
-        ctx.drawFullscreenTriangle();
-        glDisable(GL_SCISSOR_TEST);
+        ctx.drawFullscreenTriangleIn(rects);  // over the diffuse variant's output
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_LESS);
         glDisable(GL_DEPTH_TEST);

@@ -38,6 +38,7 @@ private:
     gl::Program maskProgram_;
     gl::Texture mask_;
     gl::Framebuffer maskFbo_;
+    DrawnRects maskDrawn_;
 };
 
 }  // namespace mirage::render

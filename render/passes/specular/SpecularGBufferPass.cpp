@@ -25,6 +25,7 @@ void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h,
     b.fbo.attachColor(4, b.weight);
     b.fbo.attachDepth(mask);
     b.fbo.finalize(5);
+    b.drawn.markAll();
 }
 
 void publish(PassResources& res, const SpecularHitBuffer& b, Resource position, Resource normal,
@@ -81,6 +82,7 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
     maskFbo_ = gl::Framebuffer("specular pixel mask fbo");
     maskFbo_.attachDepth(mask_);
     maskFbo_.finalize(0);
+    maskDrawn_.markAll();
     allocate(refl_, "GBuf_refl", w, h, mask_);
     allocate(refr_, "GBuf_refr", w, h, mask_);
 }
@@ -95,16 +97,17 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
     glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
     ImpostorPass::bindForTracing(res);  // kUnitImpostor*, kBindingImpostorRecords / Objects
-    // The specular-pixel depth mask: outside the scissor it stays cleared (1, not specular).
+    // The specular-pixel depth mask: outside the rectangles it stays cleared (1, not specular).
     maskFbo_.bind();
     ctx.beginFullscreen(maskProgram_, ctx.canvasWidth(), ctx.canvasHeight());
     glDepthMask(GL_TRUE);  // also lets the clear write
-    glClearBufferfv(GL_DEPTH, 0, std::array<float, 1>{1.0f}.data());
+    ctx.clearForRects(ctx.specularRects, maskDrawn_, 0, 0, true);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_ALWAYS);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 0);
+    ctx.drawFullscreenTriangleIn(ctx.specularRects);
     for (int mode = 0; mode < 2; ++mode) {
-        (mode == 0 ? refl_ : refr_).fbo.bind();
+        SpecularHitBuffer& hits = mode == 0 ? refl_ : refr_;
+        hits.fbo.bind();
         const gl::Program& program = programs_[mode];
         ctx.beginFullscreen(program, ctx.canvasWidth(), ctx.canvasHeight());
         if (mode == 1)
@@ -113,7 +116,10 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_GREATER);
         glDepthMask(GL_FALSE);
-        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);  // 0 elsewhere: no specular pixel
+        // 0 elsewhere: no specular pixel, or (refraction) none that refracts.
+        const std::vector<glm::ivec4>& rects = mode == 0 ? ctx.specularRects : ctx.refractiveRects;
+        ctx.clearForRects(rects, hits.drawn, 0, 5);
+        ctx.drawFullscreenTriangleIn(rects);
     }
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);

@@ -13,6 +13,7 @@ namespace mirage::render {
 struct SpecularHitBuffer {
     gl::Texture position, normal, albedo, emissive, weight;
     gl::Framebuffer fbo;
+    DrawnRects drawn;  // of all five
 };
 
 class SpecularGBufferPass final : public RenderPass {
@@ -29,6 +30,7 @@ private:
     gl::Program maskProgram_;  // specular_mask.frag: depth 0 on specular pixels, 1 elsewhere
     gl::Texture mask_;         // that depth mask, attached to both hit buffers' framebuffers
     gl::Framebuffer maskFbo_;
+    DrawnRects maskDrawn_;
     SpecularHitBuffer refl_, refr_;
     int width_ = 0, height_ = 0;
 };

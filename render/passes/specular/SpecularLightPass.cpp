@@ -125,6 +125,8 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
         fbo_[i].finalize(kAttachments);
         attachedMask_[i] = 0;  // execute() attaches the specular mask
     }
+    drawn_.markAll();
+    for (DrawnRects& d : historyDrawn_) d.markAll();
     history_.drop();  // new buffers hold no history
     if (!ctx.options.specularHalfResolution) return;
     halfWidth_ = (w + 1) / 2;
@@ -140,6 +142,8 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     halfMaskFbo_ = gl::Framebuffer("half specular pixel mask fbo");
     halfMaskFbo_.attachDepth(halfMask_);
     halfMaskFbo_.finalize(0);
+    halfMaskDrawn_.markAll();
+    halfDrawn_.markAll();
     halfFbo_ = gl::Framebuffer("half specular light fbo");
     halfFbo_.attachColor(0, halfReflRv_);
     halfFbo_.attachColor(1, halfReflR_);
@@ -149,30 +153,39 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     halfFbo_.finalize(4);
 }
 
+void SpecularLightPass::clearAndDraw(const FrameContext& ctx, int write) {
+    ctx.clearForRects(ctx.specularRects, drawn_, 0, 4);
+    ctx.clearForRects(ctx.specularRects, historyDrawn_[write], 4, 4);
+    ctx.drawFullscreenTriangleIn(ctx.specularRects);
+}
+
 void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v,
-                                            const gl::Framebuffer& out) {
-    // The scissor rectangle in half pixels, rounded outwards.
-    const glm::ivec4& s = ctx.specularScissor;
-    const glm::ivec4 halfRect{s.x / 2, s.y / 2, (s.x + s.z + 1) / 2 - s.x / 2,
-                              (s.y + s.w + 1) / 2 - s.y / 2};
+                                            int write) {
+    // The specular objects' rectangles in half pixels, rounded outwards.
+    std::vector<glm::ivec4> halfRects;
+    for (const glm::ivec4& s : ctx.specularRects)
+        halfRects.push_back(
+            {s.x / 2, s.y / 2, (s.x + s.z + 1) / 2 - s.x / 2, (s.y + s.w + 1) / 2 - s.y / 2});
+    halfRects = mergeOverlappingRects(std::move(halfRects));
     halfMaskFbo_.bind();
     ctx.beginFullscreen(halfMaskProgram_, halfWidth_, halfHeight_);
     glDepthMask(GL_TRUE);
-    glClearBufferfv(GL_DEPTH, 0, std::array<float, 1>{1.0f}.data());
+    ctx.clearForRects(halfRects, halfMaskDrawn_, 0, 0, true);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_ALWAYS);
-    ctx.drawFullscreenTriangleIn(halfRect, 0);
+    ctx.drawFullscreenTriangleIn(halfRects);
     halfFbo_.bind();
     ctx.beginFullscreen(v.program, halfWidth_, halfHeight_);
     setUniforms(ctx, res, v);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
-    ctx.drawFullscreenTriangleIn(halfRect, 4);
+    ctx.clearForRects(halfRects, halfDrawn_, 0, 4);
+    ctx.drawFullscreenTriangleIn(halfRects);
     // The upsample, on the canvas's specular pixels. It writes L'_rv, L'_r, the reflection's
     // share and L_env; the history attachments are cleared and stay unused (no history at half
     // resolution: specularBlend).
-    out.bind();
+    fbo_[write].bind();
     ctx.beginFullscreen(resolve_, ctx.canvasWidth(), ctx.canvasHeight());
     const gl::Texture* half[4] = {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_};
     for (int i = 0; i < 4; ++i)
@@ -183,7 +196,7 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, kAttachments);
+    clearAndDraw(ctx, write);
 }
 
 void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
@@ -250,7 +263,7 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecLightHistoryRRefl, historyRRefl_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryHits, historyHits_[read].id());
     if (ctx.options.specularHalfResolution && halfPlain_.program.id() != 0) {
-        shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, fbo_[write]);
+        shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, write);
     } else {
         const Variant& v = gather ? gather_ : plain_;
         fbo_[write].bind();
@@ -262,7 +275,7 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
         glDepthFunc(GL_GREATER);
         glDepthMask(GL_FALSE);
         // Every attachment cleared: a history texel outside the specular pixels holds distance 0.
-        ctx.drawFullscreenTriangleIn(ctx.specularScissor, kAttachments);
+        clearAndDraw(ctx, write);
     }
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);

@@ -30,8 +30,10 @@ private:
     };
     static Variant makeVariant(const char* label, const std::string& defines);
     void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
-    void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v,
-                             const gl::Framebuffer& out);
+    void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v, int write);
+    // Clears fbo_[write] (bound) where the last draws into its textures and this one's cover,
+    // then draws the full-screen triangle in the specular rectangles.
+    void clearAndDraw(const FrameContext& ctx, int write);
     Variant plain_, gather_;  // gather_: only for scenes that can have caustics
     gl::Texture rv_, r_, rRefl_, env_;
     // Smoothed L'_rv, L'_r, reflection share and the hits they were lit at (Resource.h; the
@@ -39,6 +41,8 @@ private:
     // [history_.writeSlot()] is written this frame and read as history by the next.
     gl::Texture historyRv_[2], historyR_[2], historyRRefl_[2], historyHits_[2];
     gl::Framebuffer fbo_[2];
+    // What draws covered in rv_ .. env_ (attachments 0-3 of both fbo_) and in each history set.
+    DrawnRects drawn_, historyDrawn_[2];
     GLuint attachedMask_[2] = {0, 0};  // the SpecularMask texture attached as fbo_[i]'s depth
     TemporalHistory history_;
     int width_ = 0, height_ = 0;
@@ -49,6 +53,7 @@ private:
     gl::Program resolve_, halfMaskProgram_;
     gl::Texture halfReflRv_, halfReflR_, halfRefrRv_, halfRefrR_, halfMask_;
     gl::Framebuffer halfFbo_, halfMaskFbo_;
+    DrawnRects halfDrawn_, halfMaskDrawn_;
     int halfWidth_ = 0, halfHeight_ = 0;
 };
 

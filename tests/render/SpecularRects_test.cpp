@@ -1,0 +1,179 @@
+// The specular passes draw over each specular object's own canvas rectangle (and the refraction
+// search over the glass objects' only) instead of one rectangle around all of them: the images
+// must not change, and on the tabletop (a mirror and a glass sphere apart on screen) the
+// rectangles must cover clearly fewer pixels than the one around both.
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <memory>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/gl/Context.h"
+#include "core/scene/Scene.h"
+#include "render/FrameContext.h"
+#include "render/Renderer.h"
+#include "tests/support/TestSupport.h"
+#include "testscenes/RenderTestScenes.h"
+
+namespace mirage::render {
+namespace {
+
+long long area(const std::vector<glm::ivec4>& rects) {
+    long long a = 0;
+    for (const glm::ivec4& r : rects) a += (long long)r.z * r.w;
+    return a;
+}
+
+bool overlap(const glm::ivec4& a, const glm::ivec4& b) {
+    return a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w && b.y < a.y + a.w;
+}
+
+bool covers(const std::vector<glm::ivec4>& rects, int x, int y) {
+    for (const glm::ivec4& r : rects)
+        if (x >= r.x && x < r.x + r.z && y >= r.y && y < r.y + r.w) return true;
+    return false;
+}
+
+TEST(SpecularRects, OverlappingRectanglesAreMergedAndTheRestKept) {
+    // Two apart, one touching the first's right edge (not overlapping), one empty.
+    const std::vector<glm::ivec4> apart = {
+        {0, 0, 10, 10}, {50, 50, 10, 10}, {10, 0, 5, 5}, {3, 3, 0, 7}};
+    const auto kept = mergeOverlappingRects(apart);
+    ASSERT_EQ(kept.size(), 3u);
+    EXPECT_EQ(area(kept), 100 + 100 + 25);
+    // A chain: a overlaps b, and only their union overlaps c.
+    const std::vector<glm::ivec4> chain = {{0, 0, 10, 10}, {8, 0, 10, 4}, {16, 6, 6, 6}};
+    const auto merged = mergeOverlappingRects(chain);
+    ASSERT_EQ(merged.size(), 1u);
+    EXPECT_EQ(merged[0], glm::ivec4(0, 0, 22, 12));
+    // Whatever the input, the output covers every input pixel and no two outputs overlap.
+    std::vector<glm::ivec4> many;
+    for (int i = 0; i < 12; ++i) many.push_back({(i * 37) % 90, (i * 53) % 70, 8 + i, 12 - i / 2});
+    const auto out = mergeOverlappingRects(many);
+    for (size_t i = 0; i < out.size(); ++i)
+        for (size_t j = i + 1; j < out.size(); ++j) EXPECT_FALSE(overlap(out[i], out[j]));
+    for (const glm::ivec4& r : many)
+        for (int y = r.y; y < r.y + r.w; ++y)
+            for (int x = r.x; x < r.x + r.z; ++x) ASSERT_TRUE(covers(out, x, y)) << x << "," << y;
+}
+
+class SpecularRectsRender : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        context_ = std::make_unique<gl::Context>(gl::Context::headless());
+    }
+    static void TearDownTestSuite() { context_.reset(); }
+    static std::unique_ptr<gl::Context> context_;
+};
+std::unique_ptr<gl::Context> SpecularRectsRender::context_;
+
+struct Frame {
+    cv::Mat composite, reflection, refraction, specularRv;
+    std::vector<glm::ivec4> rects, glassRects;
+};
+
+const CameraIntrinsics kCamera = test::smallCamera(160, 120, 130.0);
+// The tabletop's mirror on the left, the glass sphere in front of the board: apart on screen.
+const Pose kPose = test::lookAtPose({0.05, 0.40, 0.60}, {-0.05, 0.02, 0.0});
+// Another view: both objects elsewhere on screen.
+const Pose kOtherPose = test::lookAtPose({-0.25, 0.35, 0.55}, {0.05, 0.0, -0.05});
+
+RendererOptions options(bool perObject) {
+    RendererOptions o;
+    o.vplCount = 64;
+    o.temporalBlend = 0.0f;
+    o.specularRectsPerObject = perObject;
+    return o;
+}
+
+void renderFrame(Renderer& r, const Pose& pose) {
+    const cv::Mat footage(kCamera.height, kCamera.width, CV_8UC3, cv::Scalar(90, 110, 130));
+    r.render({pose, footage, true});
+}
+
+Frame readFrame(const Renderer& r) {
+    Frame f;
+    f.composite = r.compositeLinear();
+    f.reflection = r.readBuffer(Resource::ReflectionGBuffer);
+    f.refraction = r.readBuffer(Resource::RefractionGBuffer);
+    f.specularRv = r.readBuffer(Resource::SpecularRv);
+    f.rects = r.specularRects();
+    f.glassRects = r.refractiveRects();
+    return f;
+}
+
+Frame render(const Scene& scene, bool perObject) {
+    Renderer r(scene, kCamera, options(perObject));
+    renderFrame(r, kPose);
+    return readFrame(r);
+}
+
+double maxAbsDiff(const cv::Mat& a, const cv::Mat& b) {
+    return cv::norm(a, b, cv::NORM_INF);
+}
+
+TEST_F(SpecularRectsRender, PerObjectRectanglesChangeNoPixelAndCoverFewer) {
+    const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf");
+    const Frame perObject = render(scene, true);
+    const Frame one = render(scene, false);
+    ASSERT_EQ(one.rects.size(), 1u);
+    for (const glm::ivec4& r : perObject.rects)
+        std::cout << "specular rect " << r.x << "," << r.y << " " << r.z << "x" << r.w << "\n";
+    for (const glm::ivec4& r : perObject.glassRects)
+        std::cout << "glass rect " << r.x << "," << r.y << " " << r.z << "x" << r.w << "\n";
+    std::cout << "pixels: per object " << area(perObject.rects) << " (glass "
+              << area(perObject.glassRects) << "), one rectangle " << area(one.rects) << "\n";
+    // The scene must exercise the split: two objects apart, the glass one alone refracting.
+    EXPECT_EQ(perObject.rects.size(), 2u);
+    EXPECT_EQ(perObject.glassRects.size(), 1u);
+    EXPECT_LT(area(perObject.rects), area(one.rects) * 3 / 4);
+    EXPECT_LT(area(perObject.glassRects), area(perObject.rects) * 3 / 4);
+
+    EXPECT_LT(maxAbsDiff(perObject.composite, one.composite), 1e-5);
+    EXPECT_LT(maxAbsDiff(perObject.reflection, one.reflection), 1e-5);
+    EXPECT_LT(maxAbsDiff(perObject.refraction, one.refraction), 1e-5);
+    EXPECT_LT(maxAbsDiff(perObject.specularRv, one.specularRv), 1e-5);
+
+    // The comparison sees a change confined to the glass pixels: a glass sphere of index 1.45
+    // instead of 1.5 changes the refraction buffer and the composite.
+    Scene lowerIor = scene;
+    bool changed = false;
+    for (Material& m : lowerIor.materials)
+        if (m.isTransmissive() && !m.isMirror()) m.ior -= 0.05f, changed = true;
+    ASSERT_TRUE(changed);
+    const Frame other = render(lowerIor, true);
+    EXPECT_GT(maxAbsDiff(other.refraction, one.refraction), 1e-3);
+    EXPECT_GT(maxAbsDiff(other.composite, one.composite), 1e-3);
+}
+
+// The passes clear only the pixels the last frame's rectangles and this frame's cover: a frame
+// after one seen from elsewhere must hold exactly what a first frame from its own view holds,
+// zeros outside its rectangles included.
+TEST_F(SpecularRectsRender, NoPixelOfTheFrameBeforeIsLeftOutsideTheRectangles) {
+    const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf");
+    Renderer moved(scene, kCamera, options(true));
+    renderFrame(moved, kOtherPose);
+    const Frame before = readFrame(moved);
+    renderFrame(moved, kPose);
+    const Frame after = readFrame(moved);
+    const Frame fresh = render(scene, true);
+    // The earlier frame's objects lie where this frame's rectangles do not reach.
+    long long outside = 0;
+    for (const glm::ivec4& r : before.rects)
+        for (int y = r.y; y < r.y + r.w; ++y)
+            for (int x = r.x; x < r.x + r.z; ++x) outside += covers(after.rects, x, y) ? 0 : 1;
+    std::cout << outside << " pixels of the earlier frame's rectangles lie outside this one's\n";
+    ASSERT_GT(outside, 1000);
+    // And its buffers differ from this frame's there: a pass that cleared only the new
+    // rectangles would leave them.
+    ASSERT_GT(maxAbsDiff(before.reflection, fresh.reflection), 1e-2);
+    EXPECT_LT(maxAbsDiff(after.composite, fresh.composite), 1e-5);
+    EXPECT_LT(maxAbsDiff(after.reflection, fresh.reflection), 1e-5);
+    EXPECT_LT(maxAbsDiff(after.refraction, fresh.refraction), 1e-5);
+    EXPECT_LT(maxAbsDiff(after.specularRv, fresh.specularRv), 1e-5);
+}
+
+}  // namespace
+}  // namespace mirage::render
