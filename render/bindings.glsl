@@ -89,8 +89,7 @@ const int kUnitFilterHistoryRv = 4;
 const int kUnitFilterHistoryR = 5;
 const int kUnitUpsamplePosition = 0;
 const int kUnitUpsampleNormal = 1;
-const int kUnitUpsampleGatherPosition = 2;  // filter.frag's packed gather pixels
-const int kUnitUpsampleGatherLight = 3;
+const int kUnitUpsampleGatherLight = 3;  // filter.frag's packed gather pixels
 const int kUnitUpsampleDirectRv = 4;
 const int kUnitUpsampleDirectR = 5;
 

@@ -53,19 +53,22 @@ vec3 shIrradiance(vec3 n) {
 bool allFinite(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
 
 // Octahedral encoding of a unit vector into 2 x 16-bit snorm (Cigolle et al. 2014).
-int packNormalOct(vec3 n) {
+vec2 octEncode(vec3 n) {
     n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-20);
-    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0,
-                                                          n.y >= 0.0 ? 1.0 : -1.0);
-    return int(packSnorm2x16(e));
+    return n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0,
+                                                     n.y >= 0.0 ? 1.0 : -1.0);
 }
-vec3 unpackNormalOct(int bits) {
-    vec2 e = unpackSnorm2x16(uint(bits));
+vec3 octDecode(vec2 e) {
     vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
     float t = max(-n.z, 0.0);
     n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
     return normalize(n);
 }
+int packNormalOct(vec3 n) { return int(packSnorm2x16(octEncode(n))); }
+vec3 unpackNormalOct(int bits) { return octDecode(unpackSnorm2x16(uint(bits))); }
+// 16 bits (two 8-bit snorms, the low half of the result): about 1 degree at worst.
+uint packNormalOct8(vec3 n) { return packSnorm4x8(vec4(octEncode(n), 0.0, 0.0)) & 0xFFFFu; }
+vec3 unpackNormalOct8(uint bits) { return octDecode(unpackSnorm4x8(bits & 0xFFFFu).xy); }
 
 // The VPL gather runs at 1/scale resolution per axis (RendererOptions::indirectScale): gather
 // pixel q shades the canvas pixel q * scale + (scale - 1) / 2, the middle of its scale x scale

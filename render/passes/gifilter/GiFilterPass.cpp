@@ -6,6 +6,21 @@
 #include "render/FrameGraph.h"
 
 namespace mirage::render {
+namespace {
+
+// R^T K^-1 on the canvas: the world direction, at camera-frame depth 1, of canvas pixel (x, y)
+// with pixel centres at integers (x / z = (x - cx) / fx, as the projection matrix maps it).
+glm::mat3 rayFromCanvasPixel(const FrameContext& ctx) {
+    const CameraProjection& p = ctx.projection;
+    glm::mat3 kInv(1.0f);  // column-major: [column][row]
+    kInv[0][0] = float(1.0 / p.camera.fx);
+    kInv[1][1] = float(1.0 / p.camera.fy);
+    kInv[2][0] = float(-p.canvasCx / p.camera.fx);
+    kInv[2][1] = float(-p.canvasCy / p.camera.fy);
+    return glm::transpose(glm::mat3(ctx.frame.viewMatrix)) * kInv;
+}
+
+}  // namespace
 
 GiFilterPass::GiFilterPass(int interleave)
     : filter_(fullscreenProgram(
@@ -40,9 +55,7 @@ void GiFilterPass::resize(const FrameContext& ctx) {
     if (rv_.width() == w && rv_.height() == h && lowRv_[0].width() == lowW &&
         lowRv_[0].height() == lowH)
         return;
-    gatherPosition_ = gl::Texture::create2D("indirect upsample position", lowW, lowH, GL_RGBA32F);
     gatherLight_ = gl::Texture::create2D("indirect upsample light", lowW, lowH, GL_RGBA32UI);
-    gatherPosition_.setFilter(GL_NEAREST, GL_NEAREST);
     gatherLight_.setFilter(GL_NEAREST, GL_NEAREST);
     for (int i = 0; i < 2; ++i) {
         // 32-bit: alpha holds the camera distance the history test compares (temporal.glsl).
@@ -54,9 +67,8 @@ void GiFilterPass::resize(const FrameContext& ctx) {
         lowFbo_[i] = gl::Framebuffer("gi filter fbo");
         lowFbo_[i].attachColor(0, lowRv_[i]);
         lowFbo_[i].attachColor(1, lowR_[i]);
-        lowFbo_[i].attachColor(2, gatherPosition_);
-        lowFbo_[i].attachColor(3, gatherLight_);
-        lowFbo_[i].finalize(4);
+        lowFbo_[i].attachColor(2, gatherLight_);
+        lowFbo_[i].finalize(3);
     }
     history_.drop();  // new buffers hold no history
     rv_ = gl::Texture::create2D("L_rv", w, h, GL_RGBA16F);
@@ -89,7 +101,8 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1i(upsample_.uniformLocation("scale"), ctx.gatherScale());
     glBindTextureUnit(kUnitUpsamplePosition, position);
     glBindTextureUnit(kUnitUpsampleNormal, normal);
-    glBindTextureUnit(kUnitUpsampleGatherPosition, gatherPosition_.id());
+    glUniformMatrix3fv(upsample_.uniformLocation("rayFromPixel"), 1, GL_FALSE,
+                       &rayFromCanvasPixel(ctx)[0][0]);
     glBindTextureUnit(kUnitUpsampleGatherLight, gatherLight_.id());
     glBindTextureUnit(kUnitUpsampleDirectRv, res.texture(Resource::DirectRv).id());
     glBindTextureUnit(kUnitUpsampleDirectR, res.texture(Resource::DirectR).id());

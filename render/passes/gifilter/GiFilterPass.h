@@ -24,8 +24,8 @@ private:
     // Filtered indirect light at gather resolution, rgb + camera distance (m) in a; [current_]
     // is written this frame and read as history by the next (history_ says which).
     gl::Texture lowRv_[2], lowR_[2];
-    // The filtered light packed for the upsample (filter.frag): position, and L_rv, L_r, normal.
-    gl::Texture gatherPosition_, gatherLight_;
+    // The filtered light packed for the upsample (filter.frag): L_rv, L_r, depth, normal.
+    gl::Texture gatherLight_;
     gl::Framebuffer lowFbo_[2];
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;

@@ -3,17 +3,19 @@
 // Joint bilateral upsampling of the filtered, temporally smoothed indirect light (filter.frag,
 // gather resolution) to full resolution: the 2 x 2 gather pixels around p, weighted bilinearly
 // and by geometry (position / normal match with p), and the sum with direct light: the GI
-// solutions L_rv and L_r (linear). Each gather pixel's position, normal and light come packed
-// by filter.frag in two texels (llvmpipe pays per texel read, and this pass reads 4 gather
-// pixels for each of the canvas's).
+// solutions L_rv and L_r (linear). Each gather pixel's depth, normal and light come packed by
+// filter.frag in one texel (llvmpipe pays per texel read, and this pass reads 4 gather pixels
+// for each of the canvas's); its point is rebuilt on its canvas pixel's ray.
 in vec2 uv;
 layout(binding = kUnitUpsamplePosition) uniform sampler2D gPosition;
 layout(binding = kUnitUpsampleNormal) uniform sampler2D gNormal;
-layout(binding = kUnitUpsampleGatherPosition) uniform sampler2D gatherPosition;  // xyz; w = 0: none
-layout(binding = kUnitUpsampleGatherLight) uniform usampler2D gatherLight;  // L_rv, L_r, normal
+layout(binding = kUnitUpsampleGatherLight) uniform usampler2D gatherLight;  // L_rv, L_r, depth, normal
 layout(binding = kUnitUpsampleDirectRv) uniform sampler2D directRv;
 layout(binding = kUnitUpsampleDirectR) uniform sampler2D directR;
 uniform int scale;  // the indirect buffers are at 1/scale resolution (joint bilateral upsampling)
+// World direction of canvas pixel (x, y)'s ray, scaled to camera-frame depth 1:
+// rayFromPixel * vec3(x, y, 1) (R^T K^-1 on the canvas, pixel centres at integers).
+uniform mat3 rayFromPixel;
 layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;
 
@@ -29,7 +31,7 @@ void main() {
     }
     vec3 n = texelFetch(gNormal, px, 0).xyz;
     float camDist = length(P.xyz - cameraPos.xyz);
-    ivec2 lowSize = textureSize(gatherPosition, 0);
+    ivec2 lowSize = textureSize(gatherLight, 0);
     vec2 f = canvasToGather(vec2(px), scale);  // p in gather pixel coordinates
     ivec2 c0 = ivec2(floor(f));
     vec2 fr = f - vec2(c0);
@@ -38,11 +40,12 @@ void main() {
     for (int k = 0; k < 4; ++k) {
         ivec2 o = ivec2(k & 1, k >> 1);
         ivec2 q = clamp(c0 + o, ivec2(0), lowSize - 1);
-        vec4 Q = texelFetch(gatherPosition, q, 0);
-        if (Q.w < 0.5) continue;  // no surface there
         uvec4 L = texelFetch(gatherLight, q, 0);
-        vec3 nq = unpackNormalOct(int(L.w));
-        float planeDist = abs(dot(Q.xyz - P.xyz, n)) / max(0.01 * camDist, 1e-4);
+        float zq = unpackHalf2x16(L.w).x;
+        if (zq <= 0.0) continue;  // no surface there
+        vec3 nq = unpackNormalOct8(L.w >> 16);
+        vec3 Q = cameraPos.xyz + zq * (rayFromPixel * vec3(gatherCanvasPixel(q, scale, size), 1.0));
+        float planeDist = abs(dot(Q - P.xyz, n)) / max(0.01 * camDist, 1e-4);
         float cs = max(dot(n, nq), 0.0);
         cs *= cs;
         cs *= cs;
