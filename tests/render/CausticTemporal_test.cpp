@@ -17,27 +17,19 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/ScenePlacement.h"
 #include "render/Renderer.h"
 #include "render/evaluation/PoseJitter.h"
 #include "tests/render/CausticReference.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
 
 namespace mirage::render {
 namespace {
 
-class CausticTemporal : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> CausticTemporal::context_;
+class CausticTemporal : public test::HeadlessGlSuite {};
 
 // Tracking noise of a camera standing still: 0.5 mm and 0.05 degrees (1 sigma), frame k's draw.
 Pose jittered(const Pose& pose, int frame) {

@@ -14,7 +14,6 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera/CalibrationFile.h"
-#include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "core/session/SessionReadOptions.h"
@@ -22,6 +21,7 @@
 #include "render/Renderer.h"
 #include "render/SessionEnvironment.h"
 #include "render/raytrace/SyntheticSession.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/EnvironmentViews.h"
 #include "testscenes/LookAt.h"
@@ -89,15 +89,7 @@ fs::path rotatingSession() {
     return dir;
 }
 
-class EnvironmentLightPlacement : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> EnvironmentLightPlacement::context_;
+class EnvironmentLightPlacement : public test::HeadlessGlSuite {};
 
 double azimuthDeg(double x, double minusZ) {
     return glm::degrees(std::atan2(x, minusZ));

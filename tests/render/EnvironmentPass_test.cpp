@@ -12,10 +12,10 @@
 
 #include "core/Error.h"
 #include "core/camera/EquirectProjection.h"
-#include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
 #include "render/raytrace/SyntheticFootage.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/EnvironmentViews.h"
 #include "testscenes/RenderTestScenes.h"
@@ -29,15 +29,7 @@ using test::addMaterial;
 using test::lookAtPose;
 using test::smallCamera;
 
-class EnvironmentPassTest : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> EnvironmentPassTest::context_;
+class EnvironmentPassTest : public test::HeadlessGlSuite {};
 
 // The environment camera of `mirage synth`: looking straight up (camera +Z = world +Y, +X = world
 // +X, image down = world -Z).

@@ -13,10 +13,10 @@
 #include <opencv2/core.hpp>
 
 #include "core/Error.h"
-#include "core/gl/Context.h"
 #include "core/scene/ScenePlacement.h"
 #include "render/GpuScene.h"
 #include "render/Renderer.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
 #include "testscenes/TranslucentTestScenes.h"
@@ -24,15 +24,7 @@
 namespace mirage::render {
 namespace {
 
-class MovingObjects : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> MovingObjects::context_;
+class MovingObjects : public test::HeadlessGlSuite {};
 
 // The tabletop (glass sphere, mirror, yellow box on a real table under a real spot light) seen by
 // its main camera, small.

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "core/gl/Context.h"
 #include "render/Renderer.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
@@ -69,14 +69,8 @@ AlignmentStats measureAlignment(const cv::Mat& coverage, const CameraIntrinsics&
     return st;
 }
 
-class RealtimeLens : public ::testing::Test {
+class RealtimeLens : public test::HeadlessGlSuite {
 protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-
     Scene proxyScene() {
         Scene s;
         int m = addMaterial(s, glm::vec3(0.6f));
@@ -97,7 +91,6 @@ protected:
     }
     Pose pose = lookAtPose({0.4, 1.1, 1.3}, {0.05, 0.0, 0.0});
 };
-std::unique_ptr<gl::Context> RealtimeLens::context_;
 
 TEST_F(RealtimeLens, RealProxyLandsOnItsImageWithinOnePixel) {
     const CameraIntrinsics cam = distortedCamera();

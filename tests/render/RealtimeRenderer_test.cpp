@@ -10,9 +10,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
-#include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
 
@@ -26,15 +26,7 @@ using test::addMaterial;
 using test::lookAtPose;
 using test::smallCamera;
 
-class RealtimeRenderer : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> RealtimeRenderer::context_;
+class RealtimeRenderer : public test::HeadlessGlSuite {};
 
 // Independent CPU evaluation of the shading model (Lambert + GGX/Smith-Schlick/Schlick, glTF
 // metallic-roughness) for the closed-form checks.

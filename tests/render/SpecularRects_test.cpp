@@ -10,10 +10,10 @@
 
 #include <opencv2/core.hpp>
 
-#include "core/gl/Context.h"
 #include "core/scene/Scene.h"
 #include "render/FrameContext.h"
 #include "render/Renderer.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
 
@@ -59,15 +59,7 @@ TEST(SpecularRects, OverlappingRectanglesAreMergedAndTheRestKept) {
             for (int x = r.x; x < r.x + r.z; ++x) ASSERT_TRUE(covers(out, x, y)) << x << "," << y;
 }
 
-class SpecularRectsRender : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> SpecularRectsRender::context_;
+class SpecularRectsRender : public test::HeadlessGlSuite {};
 
 struct Frame {
     cv::Mat composite, reflection, refraction, specularRv;

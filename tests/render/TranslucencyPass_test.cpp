@@ -12,12 +12,12 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "core/gl/Context.h"
 #include "core/image/ImageCompare.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
 #include "render/raytrace/SyntheticFootage.h"
 #include "render/translucency/VoxelNumberMap.h"
+#include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/TranslucentTestScenes.h"
 
@@ -29,15 +29,7 @@ namespace fs = std::filesystem;
 
 constexpr int kResolution = 16;  // voxels along the cube's side (as the CPU accuracy tests)
 
-class TranslucencyPass : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        context_ = std::make_unique<gl::Context>(gl::Context::headless());
-    }
-    static void TearDownTestSuite() { context_.reset(); }
-    static std::unique_ptr<gl::Context> context_;
-};
-std::unique_ptr<gl::Context> TranslucencyPass::context_;
+class TranslucencyPass : public test::HeadlessGlSuite {};
 
 raytrace::RenderCamera testCamera() {
     return lookAtCamera(32, 32, 70.0, {0.9, 0.55, 1.3}, {0, 0, 0});
