@@ -167,5 +167,31 @@ TEST_F(SpecularRectsRender, NoPixelOfTheFrameBeforeIsLeftOutsideTheRectangles) {
     EXPECT_LT(maxAbsDiff(after.specularRv, fresh.specularRv), 1e-5);
 }
 
+// The edges of the rectangles: a camera inside an object's bounding sphere (here inside the
+// glass sphere itself) sees it over the whole canvas, and objects out of view give none and no
+// specular pass.
+TEST_F(SpecularRectsRender, CameraInsideABoundingSphereTakesTheWholeCanvasAndNoneInViewTakesNone) {
+    const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf");
+    Renderer inside(scene, kCamera, options(true));
+    // The glass sphere's centre (tabletop.gltf), looking along +x over the table.
+    renderFrame(inside, test::lookAtPose({0.02, 0.045, 0.16}, {0.5, 0.045, 0.16}));
+    const glm::ivec4 whole(0, 0, kCamera.width, kCamera.height);
+    ASSERT_EQ(inside.specularRects().size(), 1u);
+    EXPECT_EQ(inside.specularRects()[0], whole);
+    ASSERT_EQ(inside.refractiveRects().size(), 1u);
+    EXPECT_EQ(inside.refractiveRects()[0], whole);
+    EXPECT_TRUE(cv::checkRange(inside.compositeLinear()));
+
+    Renderer away(scene, kCamera, options(true));
+    // From above the table's far edge, looking away from the objects and up.
+    const cv::Mat footage(kCamera.height, kCamera.width, CV_8UC3, cv::Scalar(90, 110, 130));
+    const FrameReport& report =
+        away.render({test::lookAtPose({0.0, 0.3, -0.6}, {0.0, 0.8, -2.0}), footage, true});
+    EXPECT_TRUE(away.specularRects().empty());
+    EXPECT_TRUE(away.refractiveRects().empty());
+    EXPECT_FALSE(report.ran("specgbuf"));
+    EXPECT_TRUE(cv::checkRange(away.compositeLinear()));
+}
+
 }  // namespace
 }  // namespace mirage::render
