@@ -126,16 +126,6 @@ void FrameContext::drawFullscreenTriangle() const {
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-void FrameContext::drawFullscreenTriangleIn(const glm::ivec4& rect, int attachments) const {
-    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    for (int i = 0; i < attachments; ++i) glClearBufferfv(GL_COLOR, i, zero);
-    if (rect.z <= 0 || rect.w <= 0) return;
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(rect.x, rect.y, rect.z, rect.w);
-    drawFullscreenTriangle();
-    glDisable(GL_SCISSOR_TEST);
-}
-
 void FrameContext::clearForRects(const std::vector<glm::ivec4>& rects, DrawnRects& drawn, int first,
                                  int count, bool clearDepth) const {
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};

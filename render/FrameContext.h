@@ -310,10 +310,6 @@ public:
     void beginFullscreen(const gl::Program& program, int width, int height) const;
     // The full-screen triangle of fullscreen.vert (no vertex data: emptyVao).
     void drawFullscreenTriangle() const;
-    // Clears colour attachments 0..attachments-1 of the bound framebuffer to 0, then draws the
-    // full-screen triangle only inside `rect` (GL window x, y, width, height; nothing if empty):
-    // for passes whose shader writes 0 outside the pixels that rect holds.
-    void drawFullscreenTriangleIn(const glm::ivec4& rect, int attachments) const;
     // Clears colour attachments first .. first + count - 1 of the bound framebuffer to 0 and,
     // with clearDepth, its depth attachment to 1 (depth writes must be on) inside drawn.rects
     // and `rects`; then drawn.rects = rects (see DrawnRects).

@@ -167,6 +167,26 @@ TEST_F(SpecularRectsRender, NoPixelOfTheFrameBeforeIsLeftOutsideTheRectangles) {
     EXPECT_LT(maxAbsDiff(after.specularRv, fresh.specularRv), 1e-5);
 }
 
+// The same for the rough passes (the fuzzy filter and the rough-glass prefilter clear only what
+// their last draw and this one cover): frosted glass and brushed metal, two views.
+TEST_F(SpecularRectsRender, RoughPassesLeaveNoPixelOfTheFrameBefore) {
+    const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop_rough.gltf");
+    const Pose other = test::lookAtPose({0.45, 0.30, 0.10}, {-0.10, 0.02, -0.05});
+    Renderer moved(scene, kCamera, options(true));
+    renderFrame(moved, other);
+    const cv::Mat before = moved.readBuffer(Resource::FuzzySpecularRv);
+    const cv::Mat beforeRough = moved.readBuffer(Resource::RoughSpecularRv);
+    renderFrame(moved, kPose);
+    Renderer fresh(scene, kCamera, options(true));
+    renderFrame(fresh, kPose);
+    ASSERT_GT(maxAbsDiff(before, fresh.readBuffer(Resource::FuzzySpecularRv)), 1e-2);
+    ASSERT_GT(maxAbsDiff(beforeRough, fresh.readBuffer(Resource::RoughSpecularRv)), 1e-2);
+    for (Resource r : {Resource::FuzzySpecularRv, Resource::FuzzyReflectionVideo,
+                       Resource::RoughSpecularRv, Resource::RoughVideo})
+        EXPECT_LT(maxAbsDiff(moved.readBuffer(r), fresh.readBuffer(r)), 1e-5) << resourceName(r);
+    EXPECT_LT(maxAbsDiff(moved.compositeLinear(), fresh.compositeLinear()), 1e-5);
+}
+
 // The edges of the rectangles: a camera inside an object's bounding sphere (here inside the
 // glass sphere itself) sees it over the whole canvas, and objects out of view give none and no
 // specular pass.

@@ -84,6 +84,7 @@ void FuzzyReflectionPass::resize(const FrameContext& ctx) {
     attachAll(rowsFbo_, rows_);
     outFbo_ = gl::Framebuffer("fuzzy fbo");
     attachAll(outFbo_, out_);
+    for (DrawnRects* d : {&videoDrawn_, &rowsDrawn_, &outDrawn_}) d->markAll();
     const std::vector<glm::vec2> table = ctx.projection.canvasToCameraTable();
     canvasToCamera_ = gl::Texture::create2D("fuzzy canvas to camera", w, h, GL_RG32F);
     canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
@@ -114,7 +115,10 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
     const int filterGlass = ctx.options.roughRefraction == RoughRefractionMethod::Filter ? 1 : 0;
     glUniform1i(locGlassResolve_, filterGlass);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 1);
+    // The filters read neighbours anywhere in the rectangle around every specular object.
+    const std::vector<glm::ivec4> rect{ctx.specularScissor};
+    ctx.clearForRects(rect, videoDrawn_, 0, 1);
+    ctx.drawFullscreenTriangleIn(rect);
 
     // 2. Rows, then columns of the rows' result. The canvas has the camera's focal lengths
     // (pixels per radian near the axis: Eq. 5's image size / view angle).
@@ -132,7 +136,8 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locFocal_, focalPx);
         glUniform1i(locTaps_, ctx.options.fuzzyTaps);
         glUniform1i(locGlassFilter_, filterGlass);
-        ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);
+        ctx.clearForRects(rect, pass == 0 ? rowsDrawn_ : outDrawn_, 0, 5);
+        ctx.drawFullscreenTriangleIn(rect);
     }
     for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);
 }

@@ -30,6 +30,7 @@ private:
     gl::Texture video_, rows_[5], out_[5];
     gl::Texture canvasToCamera_;  // CameraProjection::canvasToCameraTable, RG32F
     gl::Framebuffer videoFbo_, rowsFbo_, outFbo_;
+    DrawnRects videoDrawn_, rowsDrawn_, outDrawn_;  // what the draws into each last covered
     GLint locGlassResolve_ = -1, locGlassFilter_ = -1;
     GLint locEpsilon_ = -1, locStep_ = -1, locCone_ = -1, locFocal_ = -1, locTaps_ = -1;
     int width_ = 0, height_ = 0;

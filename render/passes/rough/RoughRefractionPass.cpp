@@ -95,6 +95,8 @@ void RoughRefractionPass::resize(const FrameContext& ctx) {
         outFbo_.attachColor(i, out_[i]);
     }
     outFbo_.finalize(5);
+    chainsDrawn_.markAll();
+    outDrawn_.markAll();
     const std::vector<glm::vec2> table = ctx.projection.canvasToCameraTable();
     canvasToCamera_ = gl::Texture::create2D("rough canvas to camera", w, h, GL_RG32F);
     canvasToCamera_.setFilter(GL_LINEAR, GL_LINEAR);
@@ -126,7 +128,9 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     chainsFbo_.bind();
     ctx.beginFullscreen(prefilter_, w, h);
     glUniform1f(locPrefilterEpsilon_, ctx.options.backProjectionEpsilon);
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, kChains);
+    const std::vector<glm::ivec4> rect{ctx.specularScissor};
+    ctx.clearForRects(rect, chainsDrawn_, 0, kChains);
+    ctx.drawFullscreenTriangleIn(rect);
     for (gl::Texture& t : chains_) glGenerateTextureMipmap(t.id());
 
     // 2. The lobes per rough-glass pixel.
@@ -146,7 +150,8 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     const CameraIntrinsics& K = ctx.projection.camera;
     glUniform1f(locFocal_, float(0.5 * (K.fx + K.fy)));
     glUniform1f(locMaxLevel_, float(levels_ - 1));
-    ctx.drawFullscreenTriangleIn(ctx.specularScissor, 5);
+    ctx.clearForRects(rect, outDrawn_, 0, 5);
+    ctx.drawFullscreenTriangleIn(rect);
     for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);
 }
 

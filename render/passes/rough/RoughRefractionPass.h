@@ -33,6 +33,7 @@ private:
     gl::Texture chains_[kChains], out_[5];
     gl::Texture canvasToCamera_;  // CameraProjection::canvasToCameraTable, RG32F
     gl::Framebuffer chainsFbo_, outFbo_;
+    DrawnRects chainsDrawn_, outDrawn_;  // what the draws into each last covered (level 0)
     GLint locPrefilterEpsilon_ = -1, locMethod_ = -1, locSubdivisions_ = -1, locFocal_ = -1,
           locMaxLevel_ = -1;
     int width_ = 0, height_ = 0, levels_ = 0;
