@@ -647,6 +647,12 @@ bool GpuScene::hasTransmissive() const {
     return false;
 }
 
+bool GpuScene::hasBaseColorTextures() const {
+    for (const DrawItem& d : draws_)
+        if (d.baseColorTexture >= 0) return true;
+    return false;
+}
+
 bool GpuScene::hasMetallicRoughnessTextures() const {
     for (const DrawItem& d : draws_)
         if (d.metallicRoughnessTexture >= 0) return true;

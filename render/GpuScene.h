@@ -111,7 +111,8 @@ public:
     std::string lightingDefines(bool withGlass = true) const;
     bool hasTransmissive() const;
     bool hasTranslucent() const;
-    // Some draw has a metallic-roughness texture (else the G-buffer skips that texture read).
+    // Some draw has a base-colour / metallic-roughness texture (else the G-buffer skips the read).
+    bool hasBaseColorTextures() const;
     bool hasMetallicRoughnessTextures() const;
     // The medium of GPU material index `material` (DrawItem::material); null unless translucent.
     const GpuMedium* medium(int material) const;

@@ -159,7 +159,8 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.importTexture(Resource::EnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene,
                     "environment camera frame");
     g.addPass(std::make_unique<EnvironmentPass>());
-    g.addPass(std::make_unique<GBufferPass>(scene_->hasMetallicRoughnessTextures()));
+    g.addPass(std::make_unique<GBufferPass>(GBufferPass::MaterialMaps{
+        scene_->hasBaseColorTextures(), scene_->hasMetallicRoughnessTextures()}));
     g.addPass(std::make_unique<ShadowPass>());
     g.addPass(std::make_unique<ImpostorPass>());
     g.addPass(std::make_unique<PhotonGBufferPass>(*scene_));  // before vpl: VPLs follow photons

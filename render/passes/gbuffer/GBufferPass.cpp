@@ -1,12 +1,16 @@
 #include "render/passes/gbuffer/GBufferPass.h"
 
+#include <string>
+
 #include "render/FrameGraph.h"
 namespace mirage::render {
 
-GBufferPass::GBufferPass(bool metallicRoughnessMaps)
+GBufferPass::GBufferPass(MaterialMaps maps)
     : program_(rasterProgram(
           "gbuffer", "passes/gbuffer/gbuffer.vert", "passes/gbuffer/gbuffer.frag",
-          metallicRoughnessMaps ? "#define MIRAGE_METALLIC_ROUGHNESS_MAPS 1\n" : "")) {
+          std::string("#define MIRAGE_GBUFFER_MATERIAL 1\n") +
+              (maps.baseColor ? "#define MIRAGE_BASE_COLOR_MAPS 1\n" : "") +
+              (maps.metallicRoughness ? "#define MIRAGE_METALLIC_ROUGHNESS_MAPS 1\n" : ""))) {
     locSpecularSlot_ = program_.uniformLocation("specularSlot");
 }
 

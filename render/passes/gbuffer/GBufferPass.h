@@ -18,9 +18,14 @@ namespace mirage::render {
 
 class GBufferPass final : public RenderPass {
 public:
-    // metallicRoughnessMaps false: the shader skips the metallic-roughness texture read (a scene
-    // without such textures; llvmpipe pays for every texture read).
-    explicit GBufferPass(bool metallicRoughnessMaps = true);
+    // Which material textures the scene's draws have: the shader reads only those (llvmpipe pays
+    // for every texture read, of a white stand-in as much as of a real texture).
+    struct MaterialMaps {
+        bool baseColor = true;
+        bool metallicRoughness = true;
+    };
+    GBufferPass() : GBufferPass(MaterialMaps{}) {}
+    explicit GBufferPass(MaterialMaps maps);
     const char* name() const override { return "gbuffer"; }
     void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;

@@ -9,10 +9,26 @@ uniform mat4 normalMatrix;  // inverse transpose of model
 out vec3 worldPos;
 out vec3 worldNormal;
 out vec2 uv;
+#ifdef MIRAGE_GBUFFER_MATERIAL
+// The draw's material, read once per vertex and handed on flat: llvmpipe reads a storage buffer
+// per fragment lane even at a uniform index, which cost the G-buffer pass about a fifth of its
+// time when gbuffer.frag read it per pixel.
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
+uniform int materialIndex;
+flat out vec4 materialBaseMetallic;     // rgb linear base colour, a = metallic
+flat out vec4 materialEmissiveRough;    // rgb linear emitted radiance, a = roughness
+flat out int materialTranslucent;       // 1: a participating medium
+#endif
 void main() {
     vec4 wp = model * vec4(inPosition, 1.0);
     worldPos = wp.xyz;
     worldNormal = mat3(normalMatrix) * inNormal;
     uv = inUv;
     gl_Position = viewProj * wp;
+#ifdef MIRAGE_GBUFFER_MATERIAL
+    GpuMaterial m = materials[materialIndex];
+    materialBaseMetallic = vec4(m.baseColor.rgb, m.metallic);
+    materialEmissiveRough = vec4(m.emissive, m.roughness);
+    materialTranslucent = m.translucent;
+#endif
 }
