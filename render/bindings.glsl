@@ -13,8 +13,6 @@ const int kBindingVpls = 2;           // GpuVpl[] (std430)
 const int kBindingMaterials = 3;      // GpuMaterial[]
 const int kBindingIsmPoints = 4;      // GpuSurfacePoint[] (ism.comp)
 const int kBindingSpecularDraws = 5;  // GpuSpecularDraw[]
-const int kBindingImpostorRecords = 6;  // GpuImpostor[] (trace.glsl)
-const int kBindingImpostorObjects = 7;  // header + GpuImpostorObject[] (trace.glsl)
 const int kBindingEnvironment = 8;      // EnvironmentBlock (std140; environment_sh.comp writes it)
 // Translucent objects (render/passes/translucency, direct.frag), std430.
 const int kBindingTranslucentVoxels = 9;       // per surface voxel: 2 vec4 (see translucency.comp)
@@ -25,6 +23,8 @@ const int kBindingTranslucentGrid = 13;        // header + voxel number per grid
 // The world-space photon grid (passes/caustic photon_grid.comp; specular_light.frag), std430.
 const int kBindingPhotonGrid = 14;  // uint per hash cell: count (scratch), then the first photon
 const int kBindingPhotons = 15;     // GpuPhoton[], sorted by cell
+// Uniform block over the first 32 bytes of the impostor objects buffer (trace.glsl).
+const int kBindingImpostorHeader = 16;  // GpuImpostorHeader (std140 = its std430 layout)
 const int kBindingQueryRays = 4;        // query.comp (offline impostor queries, outside frames)
 const int kBindingQueryHits = 5;
 
@@ -79,6 +79,7 @@ const int kUnitIndirectNormal = 1;
 const int kUnitIndirectAlbedo = 2;
 const int kUnitIndirectIsmAll = 3;
 const int kUnitIndirectIsmReal = 4;
+const int kUnitIndirectVpls = 5;  // the VPL buffer as RGBA32F texels (common.glsl vplAt)
 
 // gifilter: filter.frag (gather resolution) and upsample.frag (canvas)
 const int kUnitFilterPosition = 0;
@@ -115,6 +116,7 @@ const int kUnitSpecLightHistoryRv = 26;    // last frame's smoothed L'_rv, L'_r 
 const int kUnitSpecLightHistoryR = 27;     // share (temporal history)
 const int kUnitSpecLightHistoryRRefl = 28;
 const int kUnitSpecLightHistoryHits = 29;  // the hits the history was lit at
+const int kUnitSpecLightVpls = 30;         // the VPL buffer as RGBA32F texels (common.glsl vplAt)
 // specular_resolve.frag (the half-resolution upsample): GBuf_refl / GBuf_refr at the units above,
 // the half-resolution hit radiance (reflected L_rv, L_r, refracted L_rv, L_r) and the primary
 // G-buffer's emissive (a = specular slot + 1).
@@ -222,5 +224,7 @@ const int kUnitImpostorDepth = 20;         // sampler2DArray, RG32F
 const int kUnitImpostorNormal = 21;        // sampler2DArray, RGBA16F
 const int kUnitImpostorAlbedo = 22;        // sampler2DArray, RGBA8
 const int kUnitImpostorEmissive = 23;      // sampler2DArray, RGBA16F
+const int kUnitImpostorRecords = 24;       // samplerBuffer, RGBA32F: GpuImpostor[] (5 texels each)
+const int kUnitImpostorObjects = 25;       // samplerBuffer, RGBA32F: header, GpuImpostorObject[]
 
 #endif

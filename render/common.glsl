@@ -16,6 +16,24 @@
 #define ORIGIN_VIRTUAL kOriginVirtual
 #define PI 3.14159265358979
 
+// VPL i of the VPL buffer read through a buffer texture of RGBA32F texels, four per GpuVpl (its
+// std430 layout: position | isReal, normal | valid, flux | pad, tangent | pad). llvmpipe reads a
+// storage buffer lane by lane at a per-pixel index; a texel fetch is one gather.
+GpuVpl vplAt(samplerBuffer texels, int i) {
+    vec4 a = texelFetch(texels, 4 * i), b = texelFetch(texels, 4 * i + 1);
+    vec4 c = texelFetch(texels, 4 * i + 2), d = texelFetch(texels, 4 * i + 3);
+    GpuVpl V;
+    V.position = a.xyz;
+    V.isReal = floatBitsToInt(a.w);
+    V.normal = b.xyz;
+    V.valid = floatBitsToInt(b.w);
+    V.flux = c.xyz;
+    V.pad0 = 0.0;
+    V.tangent = d.xyz;
+    V.pad1 = 0.0;
+    return V;
+}
+
 // Paraboloid coordinates (unit disc) of unit direction w around a VPL's normal (z axis).
 vec2 paraboloidUv(GpuVpl V, vec3 w) {
     vec3 b = cross(V.normal, V.tangent);

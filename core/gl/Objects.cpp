@@ -98,6 +98,23 @@ Texture Texture::create3D(std::string_view lbl, int w, int h, int d, GLenum fmt)
     return allocate(GL_TEXTURE_3D, lbl, w, h, d, fmt, 1, GL_LINEAR);
 }
 
+Texture Texture::createBufferView(std::string_view lbl) {
+    Texture t;
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &id);
+    ++texturesCreated;
+    t.h_ = Handle<detail::deleteTexture>(id);
+    t.target_ = GL_TEXTURE_BUFFER;
+    label(GL_TEXTURE, id, lbl);
+    return t;
+}
+
+void Texture::attachBuffer(const Buffer& buffer, GLenum fmt) {
+    MR_CHECK(target_ == GL_TEXTURE_BUFFER, "attachBuffer on a texture that is not a buffer view");
+    glTextureBuffer(id(), fmt, buffer.id());
+    format_ = fmt;
+}
+
 Texture Texture::createCube(std::string_view lbl, int size, GLenum fmt, int levels) {
     return allocate(GL_TEXTURE_CUBE_MAP, lbl, size, size, 6, fmt, levels, GL_LINEAR);
 }

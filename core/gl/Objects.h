@@ -79,6 +79,12 @@ public:
     // 3D texture (width x height x depth, depth reported as layers()), trilinear, clamp to edge.
     static Texture create3D(std::string_view label, int width, int height, int depth,
                             GLenum internalFormat);
+    // A buffer texture (GL_TEXTURE_BUFFER): no storage of its own; attachBuffer points it at a
+    // buffer's bytes, which shaders read with texelFetch(samplerBuffer, i).
+    static Texture createBufferView(std::string_view label);
+    // Points a buffer texture at `buffer`, read as texels of `internalFormat` (e.g. GL_RGBA32F).
+    // Cheap: call it whenever the buffer may have been reallocated.
+    void attachBuffer(const Buffer& buffer, GLenum internalFormat);
     // Textures created so far by this process (all the factories): lets a test check that a
     // per-frame loop allocates nothing once it runs (a renderer that did cost page faults on
     // every target and lost its temporal history).

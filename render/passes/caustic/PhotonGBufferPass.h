@@ -6,6 +6,7 @@
 // and its receiver hit traced through the impostors. Camera-independent: reused while the scene,
 // lights and plan stay.
 #include "render/RenderPass.h"
+#include "render/passes/impostor/ImpostorPass.h"
 
 namespace mirage::render {
 
@@ -20,6 +21,7 @@ public:
     bool cameraIndependent() const override { return true; }
 
 private:
+    ImpostorPass::TableViews impostorTables_;  // trace.glsl's tables, bound every frame
     gl::Program backProgram_, photonProgram_;
     gl::Texture backPosition_, backNormal_, depth_;
     gl::Texture reflHit_, reflPower_, refrHit_, refrPower_, reflSurface_, refrSurface_;

@@ -110,13 +110,26 @@ void ImpostorPass::declareTracing(PassBuilder& b) {
     b.read(Resource::ImpostorObjects);
 }
 
-void ImpostorPass::bindForTracing(const PassResources& res) {
+namespace {
+// trace.glsl's tables: records and objects as RGBA32F buffer textures, the header (the objects
+// buffer's first bytes) as a uniform block.
+void bindTables(const gl::Buffer& records, const gl::Buffer& objects,
+                ImpostorPass::TableViews& views) {
+    static_assert(sizeof(GpuImpostor) % 16 == 0 && sizeof(GpuImpostorObject) % 16 == 0 &&
+                  sizeof(GpuImpostorHeader) == 32);
+    views.records.attachBuffer(records, GL_RGBA32F);
+    views.objects.attachBuffer(objects, GL_RGBA32F);
+    glBindTextureUnit(kUnitImpostorRecords, views.records.id());
+    glBindTextureUnit(kUnitImpostorObjects, views.objects.id());
+    glBindBufferRange(GL_UNIFORM_BUFFER, kBindingImpostorHeader, objects.id(), 0,
+                      sizeof(GpuImpostorHeader));
+}
+}  // namespace
+
+void ImpostorPass::bindForTracing(const PassResources& res, TableViews& views) {
     for (unsigned i = 0; i < 8; ++i)
         glBindTextureUnit(kUnitImpostorCubePosition + i, res.texture(kTracingTextures[i]).id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords,
-                     res.buffer(Resource::ImpostorRecords).id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects,
-                     res.buffer(Resource::ImpostorObjects).id());
+    bindTables(res.buffer(Resource::ImpostorRecords), res.buffer(Resource::ImpostorObjects), views);
 }
 
 PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
@@ -512,8 +525,7 @@ void ImpostorPass::bindOwnForTracing() const {
                                    &depth_,        &normal_,     &albedo_,     &emissive_};
     for (unsigned i = 0; i < 8; ++i)
         glBindTextureUnit(kUnitImpostorCubePosition + i, units[i]->id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorRecords, records_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingImpostorObjects, objects_.id());
+    bindTables(records_, objects_, ownViews_);
 }
 
 std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& rays) const {

@@ -66,11 +66,18 @@ public:
     void resize(const FrameContext&) override {}
     void execute(FrameContext& ctx, PassResources& res) override;
 
+    // The record and object tables as the buffer textures trace.glsl reads them through. Each
+    // tracing pass owns a set: a buffer texture only points at a buffer, and bindForTracing
+    // points it again every frame (the impostors are rebuilt when the scene changes).
+    struct TableViews {
+        gl::Texture records = gl::Texture::createBufferView("impostor records (texels)");
+        gl::Texture objects = gl::Texture::createBufferView("impostor objects (texels)");
+    };
     // For a pass that traces the surroundings with trace.glsl: declares the impostor resources
-    // as its reads, and binds them by name (texture units kUnitImpostor* and storage bindings
-    // kBindingImpostorRecords / kBindingImpostorObjects, render/bindings.glsl).
+    // as its reads, and binds them by name (texture units kUnitImpostor* and the uniform block
+    // kBindingImpostorHeader, render/bindings.glsl).
     static void declareTracing(PassBuilder& b);
-    static void bindForTracing(const PassResources& res);
+    static void bindForTracing(const PassResources& res, TableViews& views);
 
     // Builds the impostors if the scene (by address) or the resolution changed (returns true
     // then), and sets the per-frame mode (refinement steps, baseline). Throws mirage::Error on
@@ -118,6 +125,7 @@ private:
     gl::Texture depth_, normal_, albedo_, emissive_;
     gl::Texture captureDepthBuffer_;
     gl::Buffer records_, objects_;
+    mutable TableViews ownViews_;             // bindOwnForTracing's (the offline queries)
     std::vector<unsigned char> objectBytes_;  // header + objects, re-uploaded with the mode
     gl::Framebuffer captureFbo_;
     const GpuScene* builtScene_ = nullptr;

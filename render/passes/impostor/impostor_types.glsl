@@ -1,16 +1,17 @@
 // The impostor tables' layout, written once: valid GLSL (included by trace.glsl) and valid C++
 // (ImpostorTypes.h includes it in namespace mirage::render after render/GpuTypes.h, with vec3 =
 // glm::vec3 etc., and checks the offsets). std430 storage buffers; every field named. World
-// frame = glTF (metres, +Y up).
+// frame = glTF (metres, +Y up). trace.glsl reads the buffers as RGBA32F texels (impostorAt,
+// impostorObjectAt) and the header as a uniform block: keep every struct a multiple of 16 bytes.
 #ifndef MIRAGE_IMPOSTOR_TYPES_GLSL
 #define MIRAGE_IMPOSTOR_TYPES_GLSL
 
 const int kImpostorBillboard = 0;  // GpuImpostor::kind: a box on the far side of the object
 const int kImpostorPlane = 1;      // a planar item (halfW = 0)
 
-// One impostor of a surrounding draw item for one specular object (binding
-// kBindingImpostorRecords). Its box is centre + [-1,1] * half extent along the three axes;
-// axisW points away from the specular object (billboards) or is the plane normal (planes).
+// One impostor of a surrounding draw item for one specular object (the records buffer). Its box
+// is centre + [-1,1] * half extent along the three axes; axisW points away from the specular
+// object (billboards) or is the plane normal (planes).
 struct GpuImpostor {
     vec3 centre;    // world centre of the box
     int layer;      // layer in the impostor arrays (depth, normal, albedo, emissive)
@@ -26,7 +27,7 @@ struct GpuImpostor {
     int pad1;
 };
 
-// Per specular object (binding kBindingImpostorObjects, after the GpuImpostorHeader).
+// Per specular object (the objects buffer, kUnitImpostorObjects, after the GpuImpostorHeader).
 struct GpuImpostorObject {
     vec3 centre;             // bounding-sphere centre (world, m) = the cube maps' centre
     float radius;            // bounding-sphere radius (m)
@@ -40,7 +41,7 @@ struct GpuImpostorObject {
     float pad2;
 };
 
-// Head of the kBindingImpostorObjects buffer.
+// Head of the objects buffer (uniform block kBindingImpostorHeader).
 struct GpuImpostorHeader {
     int cubeMapBaseline;       // 1: trace the plain cube-map baseline instead of impostors
     int refinementSteps;       // binary-search steps after the linear search

@@ -5,8 +5,8 @@
 //
 // specularSlot indexes GpuScene::specularDraws(); the object's own geometry is not in its
 // impostors. rayOrigin / rayDir are world (metres), rayDir unit. Built by ImpostorPass, bound by
-// ImpostorPass::bindForTracing(). Uses ONLY the texture units kUnitImpostor* (16..23) and the
-// storage-buffer bindings kBindingImpostorRecords / kBindingImpostorObjects (render/bindings.glsl).
+// ImpostorPass::bindForTracing(). Uses ONLY the texture units kUnitImpostor* (16..25) and the
+// uniform-block binding kBindingImpostorHeader (render/bindings.glsl).
 //
 // Two methods, chosen by RendererOptions::impostorCubeMapBaseline
 // (GpuImpostorHeader::cubeMapBaseline):
@@ -36,11 +36,52 @@ layout(binding = kUnitImpostorEmissive) uniform sampler2DArray impEmissive;  // 
 
 #include "impostor_types.glsl"
 
-layout(std430, binding = kBindingImpostorRecords) readonly buffer ImpostorRecords { GpuImpostor impostors[]; };
-layout(std430, binding = kBindingImpostorObjects) readonly buffer ImpostorObjects {
-    GpuImpostorHeader impHeader;
-    GpuImpostorObject impObjects[];
-};
+// The tables, as llvmpipe reads them fastest: it reads a storage buffer lane by lane (even at an
+// index every lane shares), a uniform block at a shared address once, and a buffer texture with
+// one gather per texel. So the header is a uniform block over the objects buffer's first 32
+// bytes, and records and objects are read as RGBA32F texels of their std430 layout (a
+// GpuImpostor is 5 texels, a GpuImpostorObject 3 after the header's 2).
+layout(std140, binding = kBindingImpostorHeader) uniform ImpostorHeader { GpuImpostorHeader impHeader; };
+layout(binding = kUnitImpostorRecords) uniform samplerBuffer impRecordTexels;
+layout(binding = kUnitImpostorObjects) uniform samplerBuffer impObjectTexels;
+
+GpuImpostor impostorAt(int i) {
+    vec4 a = texelFetch(impRecordTexels, 5 * i), b = texelFetch(impRecordTexels, 5 * i + 1);
+    vec4 c = texelFetch(impRecordTexels, 5 * i + 2), d = texelFetch(impRecordTexels, 5 * i + 3);
+    ivec4 e = floatBitsToInt(texelFetch(impRecordTexels, 5 * i + 4));
+    GpuImpostor I;
+    I.centre = a.xyz;
+    I.layer = floatBitsToInt(a.w);
+    I.axisU = b.xyz;
+    I.halfU = b.w;
+    I.axisV = c.xyz;
+    I.halfV = c.w;
+    I.axisW = d.xyz;
+    I.halfW = d.w;
+    I.kind = e.x;
+    I.drawIndex = e.y;
+    I.pad0 = 0;
+    I.pad1 = 0;
+    return I;
+}
+
+GpuImpostorObject impostorObjectAt(int slot) {
+    vec4 a = texelFetch(impObjectTexels, 2 + 3 * slot);
+    ivec4 b = floatBitsToInt(texelFetch(impObjectTexels, 2 + 3 * slot + 1));
+    vec4 c = texelFetch(impObjectTexels, 2 + 3 * slot + 2);
+    GpuImpostorObject O;
+    O.centre = a.xyz;
+    O.radius = a.w;
+    O.firstImpostor = b.x;
+    O.impostorCount = b.y;
+    O.baselineCubeLayer = b.z;
+    O.enclosingCubeLayer = b.w;
+    O.enclosingReach = c.x;
+    O.pad0 = 0.0;
+    O.pad1 = 0.0;
+    O.pad2 = 0.0;
+    return O;
+}
 
 struct SurroundingHit {
     bool hit;        // false: the ray leaves the modelled scene (the consumer uses L_env)
@@ -319,7 +360,7 @@ SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir) 
     if (specularSlot < 0 || specularSlot >= impHeader.objectCount) return h;
     if (!allFinite(rayOrigin) || !allFinite(rayDir) || dot(rayDir, rayDir) < 1e-12) return h;
     vec3 d = normalize(rayDir);
-    GpuImpostorObject obj = impObjects[specularSlot];
+    GpuImpostorObject obj = impostorObjectAt(specularSlot);
     if (impHeader.cubeMapBaseline == 1) return impTraceCube(obj, rayOrigin, d);
 
     float tBest = 1e30;
@@ -332,7 +373,7 @@ SurroundingHit traceSurroundings(int specularSlot, vec3 rayOrigin, vec3 rayDir) 
     }
     for (int k = 0; k < obj.impostorCount; ++k) {
         int idx = obj.firstImpostor + k;
-        if (impTraceOne(impostors[idx], rayOrigin, d, tBest, tx)) {
+        if (impTraceOne(impostorAt(idx), rayOrigin, d, tBest, tx)) {
             best = idx;
             bestTexel = tx;
         }

@@ -48,7 +48,8 @@ void IndirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     ctx.beginFullscreen(program_, rv_.width(), rv_.height());  // each tile sets its viewport
     glUniform1i(program_.uniformLocation("scale"), ctx.gatherScale());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
+    vplTexels_.attachBuffer(res.buffer(Resource::Vpls), GL_RGBA32F);
+    glBindTextureUnit(kUnitIndirectVpls, vplTexels_.id());
     glBindTextureUnit(kUnitIndirectPosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitIndirectNormal, res.texture(Resource::GBufferNormal).id());
     glBindTextureUnit(kUnitIndirectAlbedo, res.texture(Resource::GBufferAlbedo).id());

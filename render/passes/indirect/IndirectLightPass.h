@@ -17,6 +17,7 @@ private:
     gl::Program program_;
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;
+    gl::Texture vplTexels_ = gl::Texture::createBufferView("VPL texels (indirect)");
 };
 
 }  // namespace mirage::render

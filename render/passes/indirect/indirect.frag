@@ -8,7 +8,7 @@
 // shadow maps. Routing (DESIGN.md): a VPL at q lights p in L_rv always; in L_r only if the light,
 // q and p are all real, with visibility against real points only. Diffuse receivers.
 in vec2 uv;
-layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = kUnitIndirectVpls) uniform samplerBuffer vplTexels;  // GpuVpl[] (vplAt)
 layout(binding = kUnitIndirectPosition) uniform sampler2D gPosition;
 layout(binding = kUnitIndirectNormal) uniform sampler2D gNormal;
 layout(binding = kUnitIndirectAlbedo) uniform sampler2D gAlbedo;
@@ -46,7 +46,7 @@ void main() {
     float clamp2 = vplDistanceClamp * vplDistanceClamp;
     vec3 rv = vec3(0.0), r = vec3(0.0);
     for (int i = first; i < vplCount; i += K * K) {
-        GpuVpl V = vpls[i];
+        GpuVpl V = vplAt(vplTexels, i);
         if (V.valid == 0) continue;
         vec3 d = p - V.position;
         float dist2 = dot(d, d);

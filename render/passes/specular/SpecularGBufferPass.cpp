@@ -96,7 +96,7 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecGbufEmissive, res.texture(Resource::GBufferEmissive).id());
     glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
     glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
-    ImpostorPass::bindForTracing(res);  // kUnitImpostor*, kBindingImpostorRecords / Objects
+    ImpostorPass::bindForTracing(res, impostorTables_);  // kUnitImpostor*, the header block
     // The specular-pixel depth mask: outside the rectangles it stays cleared (1, not specular).
     maskFbo_.bind();
     ctx.beginFullscreen(maskProgram_, ctx.canvasWidth(), ctx.canvasHeight());

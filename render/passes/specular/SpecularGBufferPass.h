@@ -5,6 +5,7 @@
 // (specular_gbuffer.frag says how; docs/specular.md). Hits come from traceSurroundings (the
 // impostor helper's reflected-scene impostors, render/passes/impostor/trace.glsl).
 #include "render/RenderPass.h"
+#include "render/passes/impostor/ImpostorPass.h"
 
 namespace mirage::render {
 
@@ -26,6 +27,7 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
+    ImpostorPass::TableViews impostorTables_;  // trace.glsl's tables, bound every frame
     gl::Program programs_[2];  // [0] reflection, [1] refraction (MIRAGE_SPECULAR_MODE)
     gl::Program maskProgram_;  // specular_mask.frag: depth 0 on specular pixels, 1 elsewhere
     gl::Texture mask_;         // that depth mask, attached to both hit buffers' framebuffers

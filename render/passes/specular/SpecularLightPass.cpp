@@ -238,13 +238,15 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
                       res.has(Resource::ImperfectShadowMaps);
     if (vpls) {
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
+        vplTexels_.attachBuffer(res.buffer(Resource::Vpls), GL_RGBA32F);
+        glBindTextureUnit(kUnitSpecLightVpls, vplTexels_.id());
         glBindTextureUnit(kUnitSpecLightIsmAll, res.texture(Resource::ImperfectShadowMaps).id());
         glBindTextureUnit(kUnitSpecLightIsmReal,
                           res.textureOr(Resource::ImperfectShadowMapsReal,
                                         res.texture(Resource::ImperfectShadowMaps))
                               .id());
     } else {
+        glBindTextureUnit(kUnitSpecLightVpls, 0);
         glBindTextureUnit(kUnitSpecLightIsmAll, 0);
         glBindTextureUnit(kUnitSpecLightIsmReal, 0);
     }

@@ -44,6 +44,7 @@ private:
     // What draws covered in rv_ .. env_ (attachments 0-3 of both fbo_) and in each history set.
     DrawnRects drawn_, historyDrawn_[2];
     GLuint attachedMask_[2] = {0, 0};  // the SpecularMask texture attached as fbo_[i]'s depth
+    gl::Texture vplTexels_ = gl::Texture::createBufferView("VPL texels (specular light)");
     TemporalHistory history_;
     int width_ = 0, height_ = 0;
     // RendererOptions::specularHalfResolution: the half-resolution variants (built on first use),

@@ -29,7 +29,7 @@
 // motion the hits move and the history is rejected rather than smeared; under tracking noise
 // they stay within a few millimetres and it is used).
 in vec2 uv;
-layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };
+layout(binding = kUnitSpecLightVpls) uniform samplerBuffer vplTexels;  // GpuVpl[] (vplAt)
 layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
 layout(binding = kUnitSpecLightReflFirst + 1) uniform sampler2D reflNormal;
 layout(binding = kUnitSpecLightReflFirst + 2) uniform sampler2D reflAlbedo;
@@ -164,7 +164,7 @@ void shadeHit(vec3 x, bool xReal, vec3 n, vec3 v, vec3 albedo, float metallic, f
         int stride = max(vplStride, 1);
         vec3 vrv = vec3(0.0), vr = vec3(0.0);
         for (int i = firstVpl; i < vplCount; i += stride) {
-            GpuVpl V = vpls[i];
+            GpuVpl V = vplAt(vplTexels, i);
             if (V.valid == 0) continue;
             vec3 d = x - V.position;
             float dist2 = dot(d, d);
