@@ -159,6 +159,23 @@ void FrameContext::drawFullscreenTriangleIn(const std::vector<glm::ivec4>& rects
     glDisable(GL_SCISSOR_TEST);
 }
 
+void FrameContext::drawFullscreenTriangleOutsideSpecular(int first, int count) const {
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    glEnable(GL_SCISSOR_TEST);
+    for (const glm::ivec4& r : specularRects) {
+        if (r.z <= 0 || r.w <= 0) continue;
+        glScissor(r.x, r.y, r.z, r.w);
+        for (int i = first; i < first + count; ++i) glClearBufferfv(GL_COLOR, i, zero);
+    }
+    glDisable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);  // the triangle lies at depth 0.5: passes where the mask is 1
+    glDepthMask(GL_FALSE);
+    drawFullscreenTriangle();
+    glDepthMask(GL_TRUE);
+    glDisable(GL_DEPTH_TEST);
+}
+
 std::vector<glm::ivec4> mergeOverlappingRects(std::vector<glm::ivec4> rects) {
     std::erase_if(rects, [](const glm::ivec4& r) { return r.z <= 0 || r.w <= 0; });
     // Merging two can make the union overlap a third that neither did: repeat until no pair

@@ -142,6 +142,11 @@ struct RendererOptions {
     // Tests only: false draws the specular passes over the one rectangle around every specular
     // object (FrameContext::specularScissor) instead of each object's own (the same images).
     bool specularRectsPerObject = true;
+    // false (the default): `direct`, the GI upsample and the composite's diffuse variant skip the
+    // pixels that show a mirror or glass object (their light comes from the specular passes;
+    // FrameContext::drawFullscreenTriangleOutsideSpecular). true: they shade them too (tests
+    // compare the two).
+    bool diffuseOnSpecularPixels = false;
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
     // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
     bool reuseStaticPasses = true;
@@ -318,6 +323,13 @@ public:
     // The full-screen triangle in each of `rects` (which must not overlap: see
     // mergeOverlappingRects); clears nothing.
     void drawFullscreenTriangleIn(const std::vector<glm::ivec4>& rects) const;
+    // The full-screen triangle on every canvas pixel that does not show a mirror or glass object
+    // (the composite takes those pixels' light from the specular passes): the bound framebuffer
+    // has the frame's SpecularMask as its depth attachment (0 on specular pixels, 1 elsewhere),
+    // and the triangle at depth 0.5 passes GL_LESS only where it is 1, so llvmpipe's early depth
+    // test skips the blocks of specular pixels before the shader runs. Colour attachments
+    // first .. first + count - 1 are cleared to 0 inside specularRects first (what is not drawn).
+    void drawFullscreenTriangleOutsideSpecular(int first, int count) const;
 
 private:
     gl::Texture black_, farShadow_, noGlass_;

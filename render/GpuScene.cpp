@@ -610,6 +610,15 @@ void GpuScene::bindMaterialTextures(const DrawItem& d, GLuint unit) const {
     glBindTextureUnit(kUnitMetallicRoughnessMap, hasMr ? textures_[size_t(mr)].id() : white_.id());
 }
 
+void GpuScene::bindTableTexels(SceneTableViews& views, GLuint materialUnit,
+                               GLuint specularDrawUnit) const {
+    static_assert(sizeof(GpuMaterial) == 80 && sizeof(GpuSpecularDraw) == 32);
+    views.materials.attachBuffer(materials_, GL_RGBA32F);
+    views.specularDraws.attachBuffer(specularBuffer_, GL_RGBA32F);
+    glBindTextureUnit(materialUnit, views.materials.id());
+    glBindTextureUnit(specularDrawUnit, views.specularDraws.id());
+}
+
 void GpuScene::drawItem(const DrawItem& d) const {
     glDrawElementsBaseVertex(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(size_t(d.firstIndex) * 4), d.baseVertex);

@@ -84,6 +84,14 @@ struct SceneLight {
     Origin origin = Origin::Virtual;
 };
 
+// The material and specular-draw tables as buffer textures of RGBA32F texels (their std430
+// layout): llvmpipe reads a storage buffer lane by lane, a buffer texture with one gather per
+// texel. A pass that reads the tables per pixel owns a set (a view only points at the buffers).
+struct SceneTableViews {
+    gl::Texture materials = gl::Texture::createBufferView("materials (texels)");
+    gl::Texture specularDraws = gl::Texture::createBufferView("specular draws (texels)");
+};
+
 class GpuScene {
 public:
     // Uploads everything; `surfacePoints` is the size of the ISM point pool. The environment map
@@ -162,6 +170,10 @@ public:
     const gl::Buffer& surfacePointBuffer() const { return points_; }
     // GpuSpecularDraw per specular slot (a single zero entry when there is none).
     const gl::Buffer& specularDrawBuffer() const { return specularBuffer_; }
+    // Points `views` at the material and specular-draw tables and binds them to the two units,
+    // for shaders that read them per pixel (common.glsl materialAt / specularDrawAt).
+    void bindTableTexels(SceneTableViews& views, GLuint materialUnit,
+                         GLuint specularDrawUnit) const;
     // The environment as an equirectangular linear RGBA16F texture (intensity applied; 1x1 black
     // without an environment). Direction l (world) -> u = 0.5 + atan2(l.x, -l.z) / 2pi after
     // undoing environmentRotation() about +Y, v = acos(l.y) / pi from the top row.

@@ -38,6 +38,9 @@ const int kUnitShadowGlassLayer = 8;
 // shadow_glass.frag: the density grid of the translucent draw being rendered.
 const int kUnitShadowDensity = 9;
 
+// specular_mask.frag (passes/gbuffer): the G-buffer's emissive target (its specular slot).
+const int kUnitMaskEmissive = 0;
+
 // direct.frag
 const int kUnitDirectPosition = 0;
 const int kUnitDirectNormal = 1;
@@ -100,6 +103,8 @@ const int kUnitSpecGbufNormal = 1;
 const int kUnitSpecGbufEmissive = 2;
 const int kUnitSpecGbufBackPosition = 3;
 const int kUnitSpecGbufBackNormal = 4;
+const int kUnitSpecGbufMaterials = 5;      // samplerBuffer: GpuMaterial[] (common.glsl materialAt)
+const int kUnitSpecGbufSpecularDraws = 6;  // samplerBuffer: GpuSpecularDraw[] (specularDrawAt)
 
 // specular_light.frag: GBuf_refl then GBuf_refr (position, normal, albedo, emissive, weight)
 const int kUnitSpecLightReflFirst = 0;  // .. + 4
@@ -129,6 +134,8 @@ const int kUnitPhotonBackPosition = 0;
 const int kUnitPhotonBackNormal = 1;
 const int kUnitPhotonShadowAll = 2;
 const int kUnitPhotonShadowReal = 3;
+const int kUnitPhotonMaterials = 4;      // samplerBuffer: GpuMaterial[] (common.glsl materialAt)
+const int kUnitPhotonSpecularDraws = 5;  // samplerBuffer: GpuSpecularDraw[] (specularDrawAt)
 
 // caustic_splat.comp: the photon G-buffers and the primary G-buffer; the fixed-point
 // accumulation image (6 layers: L_rv rgb, L_r rgb irradiance).

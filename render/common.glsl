@@ -34,6 +34,41 @@ GpuVpl vplAt(samplerBuffer texels, int i) {
     return V;
 }
 
+// Material i and specular draw i from their tables read as buffer textures of RGBA32F texels
+// (GpuScene::bindTableTexels; the std430 layouts of gpu_types.glsl, 5 and 2 texels each).
+GpuMaterial materialAt(samplerBuffer texels, int i) {
+    vec4 a = texelFetch(texels, 5 * i), b = texelFetch(texels, 5 * i + 1);
+    vec4 c = texelFetch(texels, 5 * i + 2), d = texelFetch(texels, 5 * i + 3);
+    vec4 e = texelFetch(texels, 5 * i + 4);
+    GpuMaterial m;
+    m.baseColor = a;
+    m.emissive = b.xyz;
+    m.roughness = b.w;
+    m.metallic = c.x;
+    m.transmission = c.y;
+    m.ior = c.z;
+    m.attenuationDistance = c.w;
+    m.attenuationColor = d.xyz;
+    m.mirror = floatBitsToInt(d.w);
+    m.thickness = e.x;
+    m.specular = floatBitsToInt(e.y);
+    m.translucent = floatBitsToInt(e.z);
+    m.pad2 = 0.0;
+    return m;
+}
+GpuSpecularDraw specularDrawAt(samplerBuffer texels, int i) {
+    vec4 a = texelFetch(texels, 2 * i);
+    ivec4 b = floatBitsToInt(texelFetch(texels, 2 * i + 1));
+    GpuSpecularDraw d;
+    d.centre = a.xyz;
+    d.radius = a.w;
+    d.material = b.x;
+    d.origin = b.y;
+    d.drawIndex = b.z;
+    d.rough = b.w;
+    return d;
+}
+
 // Paraboloid coordinates (unit disc) of unit direction w around a VPL's normal (z axis).
 vec2 paraboloidUv(GpuVpl V, vec3 w) {
     vec3 b = cross(V.normal, V.tangent);

@@ -64,9 +64,7 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glDisable(GL_CULL_FACE);
     glDisable(GL_BLEND);
     scene.bindGeometry();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, scene.materialBuffer().id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
-                     scene.specularDrawBuffer().id());
+    scene.bindTableTexels(sceneTables_, kUnitPhotonMaterials, kUnitPhotonSpecularDraws);
     ImpostorPass::bindForTracing(res, impostorTables_);  // kUnitImpostor*, the header block
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f}, one = 1.0f;
     for (size_t li = 0; li < ctx.plan.lights.size(); ++li) {

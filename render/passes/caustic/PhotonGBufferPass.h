@@ -22,6 +22,7 @@ public:
 
 private:
     ImpostorPass::TableViews impostorTables_;  // trace.glsl's tables, bound every frame
+    SceneTableViews sceneTables_;              // materials and specular draws, likewise
     gl::Program backProgram_, photonProgram_;
     gl::Texture backPosition_, backNormal_, depth_;
     gl::Texture reflHit_, reflPower_, refrHit_, refrPower_, reflSurface_, refrSurface_;

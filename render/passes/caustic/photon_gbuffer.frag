@@ -15,8 +15,8 @@
 // Light inside the object (the nearest surface seen from the light faces away from it): one
 // refraction on the way out (TIR: one internal reflection), absorption over the distance from
 // the light; no reflected photon.
-layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
-layout(std430, binding = kBindingSpecularDraws) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
+layout(binding = kUnitPhotonMaterials) uniform samplerBuffer materialTexels;  // GpuMaterial[]
+layout(binding = kUnitPhotonSpecularDraws) uniform samplerBuffer specularDrawTexels;  // GpuSpecularDraw[]
 layout(binding = kUnitPhotonBackPosition) uniform sampler2D backPosition;  // xyz, w = slot + 1
 layout(binding = kUnitPhotonBackNormal) uniform sampler2D backNormal;      // outward
 layout(binding = kUnitPhotonShadowAll) uniform sampler2DArray shadowAll;
@@ -74,8 +74,8 @@ void main() {
     bool inside = dot(nOut, d) > 0.0;  // the light is inside the object
     vec3 n = inside ? -nOut : nOut;    // faces the light
     int slot = specularSlot;
-    GpuSpecularDraw sd = specularDraws[slot];
-    GpuMaterial m = materials[sd.material];
+    GpuSpecularDraw sd = specularDrawAt(specularDrawTexels, slot);
+    GpuMaterial m = materialAt(materialTexels, sd.material);
     float cosL = clamp(dot(n, -d), 1e-4, 1.0);
 
     // Pixel counting: the texel's solid angle in the fitted frustum (square, tanHalf).

@@ -121,14 +121,36 @@ glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& 
 }
 
 void CompositePass::execute(FrameContext& ctx, PassResources& res) {
-    fbo_.bind();
-    glEnable(GL_FRAMEBUFFER_SRGB);
     const bool specular = res.has(Resource::SpecularRv) && res.has(Resource::RealSurfaces) &&
                           res.has(Resource::ReflectionGBuffer);
-    // The diffuse variant everywhere, then the full one (Eqs. 6-11) over the camera pixels that
-    // can show a mirror or glass object: on llvmpipe a pixel costs the whole shader's code.
-    // Without a caustic pass the variant that never reads the caustic buffers: reading the black
-    // stand-in costs as much as a real buffer on llvmpipe, even behind a uniform branch.
+    // The camera pixels of each specular object's canvas rectangle (the lens map can make two
+    // overlap: merged again).
+    std::vector<glm::ivec4> rects;
+    if (specular && ctx.options.showVirtual)
+        for (const glm::ivec4& r : ctx.specularRects) rects.push_back(cameraRect(ctx, r));
+    rects = mergeOverlappingRects(std::move(rects));
+    if (!rects.empty()) {
+        // The mask of the camera pixels that see a specular pixel (inside the rectangles; 1
+        // outside): the full variant runs on those only and the diffuse variant on the rest
+        // (early depth test; on llvmpipe a pixel costs the whole shader's code).
+        maskFbo_.bind();
+        maskProgram_.use();
+        glViewport(0, 0, ctx.projection.camera.width, ctx.projection.camera.height);
+        glBindTextureUnit(kUnitCompositeRemap, remap_.id());
+        glBindTextureUnit(kUnitCompositeEmissive, res.texture(Resource::GBufferEmissive).id());
+        glDepthMask(GL_TRUE);  // also lets the clear write
+        ctx.clearForRects(rects, maskDrawn_, 0, 0, true);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_ALWAYS);
+        ctx.drawFullscreenTriangleIn(rects);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_DEPTH_TEST);
+    }
+    fbo_.bind();
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    // The diffuse variant on every pixel the full one (Eqs. 6-11) does not draw. Without a
+    // caustic pass the variant that never reads the caustic buffers: reading the black stand-in
+    // costs as much as a real buffer on llvmpipe, even behind a uniform branch.
     const int withCaustics = res.has(Resource::CausticRv) ? 1 : 0;
     if (withCaustics) {
         ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width,
@@ -171,25 +193,15 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
             glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
-    ctx.drawFullscreenTriangle();
-    // The camera pixels of each specular object's canvas rectangle (the lens map can make two
-    // overlap: merged again).
-    std::vector<glm::ivec4> rects;
-    if (specular && ctx.options.showVirtual)
-        for (const glm::ivec4& r : ctx.specularRects) rects.push_back(cameraRect(ctx, r));
-    rects = mergeOverlappingRects(std::move(rects));
-    if (!rects.empty()) {
-        // The mask of the camera pixels that see a specular pixel (inside the rectangles; 1
-        // outside), then the full variant on those only (early depth test).
-        maskFbo_.bind();
-        maskProgram_.use();
-        glDepthMask(GL_TRUE);  // also lets the clear write
-        ctx.clearForRects(rects, maskDrawn_, 0, 0, true);
+    if (!rects.empty() && !ctx.options.diffuseOnSpecularPixels) {
         glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_ALWAYS);
-        ctx.drawFullscreenTriangleIn(rects);
-        fbo_.bind();
-        glDepthFunc(GL_GREATER);  // the triangle lies at depth 0.5
+        glDepthFunc(GL_LESS);  // the triangle lies at depth 0.5: where the mask is 1
+        glDepthMask(GL_FALSE);
+    }
+    ctx.drawFullscreenTriangle();
+    if (!rects.empty()) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);  // where the mask is 0
         glDepthMask(GL_FALSE);
         program_.use();
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
@@ -203,7 +215,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                 res.textureOr(rough ? kRoughBuffers[i] : kFuzzyBuffers[i], ctx.blackTexture())
                     .id());
         glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
-        ctx.drawFullscreenTriangleIn(rects);  // over the diffuse variant's output
+        ctx.drawFullscreenTriangleIn(rects);  // the pixels the diffuse variant left
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_LESS);
         glDisable(GL_DEPTH_TEST);

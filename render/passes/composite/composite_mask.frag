@@ -2,9 +2,9 @@
 #include "common.glsl"
 // Depth mask of the camera pixels the full composite variant must shade: depth 0 where the canvas
 // pixel a camera pixel sees (the lens remap) shows a mirror or glass object (gEmissive.a =
-// specular slot + 1), 1 elsewhere. The full variant is then drawn at depth 0.5 with GL_GREATER:
-// llvmpipe's early depth test skips every SIMD block without such a pixel, which keeps the
-// diffuse variant's result (the full variant computes the same there).
+// specular slot + 1), 1 elsewhere. The diffuse variant is then drawn at depth 0.5 with GL_LESS
+// and the full variant with GL_GREATER: llvmpipe's early depth test skips every SIMD block whose
+// pixels all fail before the shader runs, so each pixel runs one variant.
 layout(binding = kUnitCompositeRemap) uniform sampler2D remap;      // camera size: canvas pixel
 layout(binding = kUnitCompositeEmissive) uniform sampler2D gEmissive;  // canvas, a = slot + 1
 void main() {

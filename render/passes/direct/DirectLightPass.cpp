@@ -30,6 +30,7 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.readOptional(Resource::ShadowGlassReal);
     b.readOptional(Resource::TranslucentGrid);  // none: no translucent object (or its pass off)
     b.readOptional(Resource::TranslucentRadiance);
+    b.readOptional(Resource::SpecularMask);  // none: no mirror or glass object in view
     b.write(Resource::DirectRv, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::DirectR, GL_RGBA16F, SizeRule::Canvas);
 }
@@ -47,9 +48,19 @@ void DirectLightPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(0, rv_);
     fbo_.attachColor(1, r_);
     fbo_.finalize(2);
+    attachedMask_ = 0;
 }
 
 void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
+    const gl::Texture* mask =
+        res.has(Resource::SpecularMask) && !ctx.options.diffuseOnSpecularPixels
+            ? &res.texture(Resource::SpecularMask)
+            : nullptr;
+    if (mask && mask->id() != attachedMask_) {  // reallocated only on a resize
+        fbo_.attachDepth(*mask);
+        fbo_.finalize(2);
+        attachedMask_ = mask->id();
+    }
     fbo_.bind();
     // Frames in which no light goes through glass use the variant without the glass lookups:
     // llvmpipe pays for a branch's texture reads even when no pixel takes it.
@@ -78,7 +89,11 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
                          res.buffer(Resource::TranslucentRadiance).id());
     }
     glUniform1i(program.uniformLocation("translucentOn"), translucent ? 1 : 0);
-    ctx.drawFullscreenTriangle();
+    // Mirror and glass pixels take their light from the specular passes: not shaded here.
+    if (mask)
+        ctx.drawFullscreenTriangleOutsideSpecular(0, 2);
+    else
+        ctx.drawFullscreenTriangle();
     res.publish(Resource::DirectRv, rv_);
     res.publish(Resource::DirectR, r_);
 }

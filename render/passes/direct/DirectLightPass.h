@@ -17,6 +17,7 @@ private:
     gl::Program program_, programNoGlass_;  // with / without MIRAGE_GLASS_SHADOWS
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;
+    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
 };
 
 }  // namespace mirage::render

@@ -10,7 +10,8 @@ GBufferPass::GBufferPass(MaterialMaps maps)
           "gbuffer", "passes/gbuffer/gbuffer.vert", "passes/gbuffer/gbuffer.frag",
           std::string("#define MIRAGE_GBUFFER_MATERIAL 1\n") +
               (maps.baseColor ? "#define MIRAGE_BASE_COLOR_MAPS 1\n" : "") +
-              (maps.metallicRoughness ? "#define MIRAGE_METALLIC_ROUGHNESS_MAPS 1\n" : ""))) {
+              (maps.metallicRoughness ? "#define MIRAGE_METALLIC_ROUGHNESS_MAPS 1\n" : ""))),
+      maskProgram_(fullscreenProgram("specular pixel mask", "passes/gbuffer/specular_mask.frag")) {
     locSpecularSlot_ = program_.uniformLocation("specularSlot");
 }
 
@@ -20,13 +21,19 @@ void GBufferPass::setup(PassBuilder& b) const {
     b.write(Resource::GBufferAlbedo, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::GBufferEmissive, GL_RGBA16F, SizeRule::Canvas);
     b.write(Resource::RealSurfaces, GL_RGBA32F, SizeRule::Canvas);
+    b.write(Resource::SpecularMask, GL_DEPTH_COMPONENT32F, SizeRule::Canvas);
+}
+
+bool GBufferPass::specularInView(const FrameContext& ctx) {
+    // As the back-face pass decides, behind which every specular pass runs.
+    const glm::ivec4& r = ctx.specularScissor;
+    return !ctx.scene.specularDraws().empty() && r.z > 0 && r.w > 0;
 }
 
 bool GBufferPass::separateRealSurfaces(const FrameContext& ctx) {
     // Its readers (the specular passes, the composite's specular variant) run only behind the
     // back-face pass, which runs only with a mirror or glass object in view.
-    const glm::ivec4& r = ctx.specularScissor;
-    if (ctx.scene.specularDraws().empty() || r.z <= 0 || r.w <= 0) return false;
+    if (!specularInView(ctx)) return false;
     for (const DrawItem& d : ctx.scene.draws())
         if (d.origin == Origin::Virtual) return true;
     return false;
@@ -36,7 +43,8 @@ PassDecision GBufferPass::decide(const FrameContext& ctx) const {
     if (ctx.scene.draws().empty()) return {false, "the scene has no geometry"};
     return {true,
             std::to_string(ctx.scene.draws().size()) + " draws" +
-                (separateRealSurfaces(ctx) ? ", real first (nearest real surfaces kept)" : "")};
+                (separateRealSurfaces(ctx) ? ", real first (nearest real surfaces kept)" : "") +
+                (specularInView(ctx) ? ", specular pixel mask" : "")};
 }
 
 void GBufferPass::resize(const FrameContext& ctx) {
@@ -57,6 +65,11 @@ void GBufferPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(3, emissive_);
     fbo_.attachDepth(depth_);
     fbo_.finalize(4);
+    mask_ = gl::Texture::create2D("specular pixel mask", w, h, GL_DEPTH_COMPONENT32F);
+    maskFbo_ = gl::Framebuffer("specular pixel mask fbo");
+    maskFbo_.attachDepth(mask_);
+    maskFbo_.finalize(0);
+    maskDrawn_.markAll();
 }
 
 void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
@@ -98,6 +111,19 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
         drawAll(true, true);
         // Every surface is real, or no pass reads RealSurfaces this frame.
         res.publish(Resource::RealSurfaces, position_);
+    }
+    if (specularInView(ctx)) {
+        // The mask over the specular rectangles; outside them it stays cleared (1).
+        maskFbo_.bind();
+        ctx.beginFullscreen(maskProgram_, ctx.canvasWidth(), ctx.canvasHeight());
+        glBindTextureUnit(kUnitMaskEmissive, emissive_.id());
+        glDepthMask(GL_TRUE);  // also lets the clear write
+        ctx.clearForRects(ctx.specularRects, maskDrawn_, 0, 0, true);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_ALWAYS);
+        ctx.drawFullscreenTriangleIn(ctx.specularRects);
+        glDepthFunc(GL_LESS);
+        res.publish(Resource::SpecularMask, mask_);
     }
     glDisable(GL_DEPTH_TEST);
     res.publish(Resource::GBufferPosition, position_);

@@ -10,6 +10,11 @@
 // RealSurfaces, and the virtual draws follow: one raster of the scene instead of a second raster
 // of every real draw (on llvmpipe the copy costs a fraction of that raster). Otherwise the
 // position target itself is published as RealSurfaces.
+//
+// With a mirror or glass object in view it also gives SpecularMask, a canvas depth buffer: 0 on
+// the pixels that show one, 1 elsewhere (specular_mask.frag), drawn over the specular objects'
+// rectangles only. The specular passes shade only those pixels, the diffuse lighting passes all
+// the others (FrameContext::drawFullscreenTriangleOutsideSpecular).
 #include <vector>
 
 #include "render/RenderPass.h"
@@ -33,12 +38,16 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
+    // A mirror or glass object is in view: the frame's specular passes run.
+    static bool specularInView(const FrameContext& ctx);
     // True when this frame needs RealSurfaces apart from the G-buffer position (see above).
     static bool separateRealSurfaces(const FrameContext& ctx);
 
     gl::Program program_;
-    gl::Texture position_, normal_, albedo_, emissive_, depth_, realSurfaces_;
-    gl::Framebuffer fbo_;
+    gl::Program maskProgram_;  // specular_mask.frag
+    gl::Texture position_, normal_, albedo_, emissive_, depth_, realSurfaces_, mask_;
+    gl::Framebuffer fbo_, maskFbo_;
+    DrawnRects maskDrawn_;         // what the last mask draw covered (cleared to 1 before the next)
     MaterialDraw draw_{program_};  // after program_
     GLint locSpecularSlot_ = -1;
     std::vector<int> specularSlot_;  // per draw: its index in specularDraws(), -1 = not specular

@@ -35,6 +35,7 @@ void GiFilterPass::setup(PassBuilder& b) const {
     b.read(Resource::IndirectR);
     b.read(Resource::DirectRv);
     b.read(Resource::DirectR);
+    b.readOptional(Resource::SpecularMask);  // none: no mirror or glass object in view
     // This frame's filtered indirect light, read back by the next frame as temporal history.
     b.write(Resource::GiHistoryRv, GL_RGBA32F, SizeRule::Gather, true);
     b.write(Resource::GiHistoryR, GL_RGBA32F, SizeRule::Gather, true);
@@ -77,6 +78,7 @@ void GiFilterPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(0, rv_);
     fbo_.attachColor(1, r_);
     fbo_.finalize(2);
+    attachedMask_ = 0;
 }
 
 void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
@@ -96,6 +98,15 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitFilterHistoryR, lowR_[read].id());
     ctx.drawFullscreenTriangle();
 
+    const gl::Texture* mask =
+        res.has(Resource::SpecularMask) && !ctx.options.diffuseOnSpecularPixels
+            ? &res.texture(Resource::SpecularMask)
+            : nullptr;
+    if (mask && mask->id() != attachedMask_) {  // reallocated only on a resize
+        fbo_.attachDepth(*mask);
+        fbo_.finalize(2);
+        attachedMask_ = mask->id();
+    }
     fbo_.bind();
     ctx.beginFullscreen(upsample_, ctx.canvasWidth(), ctx.canvasHeight());
     glUniform1i(upsample_.uniformLocation("scale"), ctx.gatherScale());
@@ -106,7 +117,11 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitUpsampleGatherLight, gatherLight_.id());
     glBindTextureUnit(kUnitUpsampleDirectRv, res.texture(Resource::DirectRv).id());
     glBindTextureUnit(kUnitUpsampleDirectR, res.texture(Resource::DirectR).id());
-    ctx.drawFullscreenTriangle();
+    // Mirror and glass pixels take their light from the specular passes: not upsampled here.
+    if (mask)
+        ctx.drawFullscreenTriangleOutsideSpecular(0, 2);
+    else
+        ctx.drawFullscreenTriangle();
     history_.written(ctx);
     res.publish(Resource::GiHistoryRv, lowRv_[write]);
     res.publish(Resource::GiHistoryR, lowR_[write]);

@@ -29,6 +29,7 @@ private:
     gl::Framebuffer lowFbo_[2];
     gl::Texture rv_, r_;
     gl::Framebuffer fbo_;
+    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
     TemporalHistory history_;
 };
 

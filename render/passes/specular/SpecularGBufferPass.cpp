@@ -8,8 +8,7 @@
 namespace mirage::render {
 namespace {
 
-void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h,
-              const gl::Texture& mask) {
+void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h) {
     b.position = gl::Texture::create2D(what + " position", w, h, GL_RGBA32F);
     b.normal = gl::Texture::create2D(what + " normal", w, h, GL_RGBA16F);
     b.albedo = gl::Texture::create2D(what + " albedo", w, h, GL_RGBA16F);
@@ -23,8 +22,7 @@ void allocate(SpecularHitBuffer& b, const std::string& what, int w, int h,
     b.fbo.attachColor(2, b.albedo);
     b.fbo.attachColor(3, b.emissive);
     b.fbo.attachColor(4, b.weight);
-    b.fbo.attachDepth(mask);
-    b.fbo.finalize(5);
+    b.fbo.finalize(5);  // execute() attaches the specular mask
     b.drawn.markAll();
 }
 
@@ -51,19 +49,16 @@ SpecularGBufferPass::SpecularGBufferPass()
                                   "#define MIRAGE_SPECULAR_MODE 0"),
                 fullscreenProgram("specular gbuffer (refraction)",
                                   "passes/specular/specular_gbuffer.frag",
-                                  "#define MIRAGE_SPECULAR_MODE 1")},
-      maskProgram_(fullscreenProgram("specular pixel mask", "passes/specular/specular_mask.frag")) {
-}
+                                  "#define MIRAGE_SPECULAR_MODE 1")} {}
 
 void SpecularGBufferPass::setup(PassBuilder& b) const {
     for (Resource r :
          {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
-          Resource::BackFacePosition, Resource::BackFaceNormal})
+          Resource::BackFacePosition, Resource::BackFaceNormal, Resource::SpecularMask})
         b.read(r);
     ImpostorPass::declareTracing(b);
     declare(b, Resource::ReflectionGBuffer, Resource::ReflectionNormal, Resource::ReflectionAlbedo,
             Resource::ReflectionEmissive, Resource::ReflectionWeight);
-    b.write(Resource::SpecularMask, GL_DEPTH_COMPONENT32F, SizeRule::Canvas);
     declare(b, Resource::RefractionGBuffer, Resource::RefractionNormal, Resource::RefractionAlbedo,
             Resource::RefractionEmissive, Resource::RefractionWeight);
 }
@@ -78,33 +73,29 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
     if (w == width_ && h == height_) return;
     width_ = w;
     height_ = h;
-    mask_ = gl::Texture::create2D("specular pixel mask", w, h, GL_DEPTH_COMPONENT32F);
-    maskFbo_ = gl::Framebuffer("specular pixel mask fbo");
-    maskFbo_.attachDepth(mask_);
-    maskFbo_.finalize(0);
-    maskDrawn_.markAll();
-    allocate(refl_, "GBuf_refl", w, h, mask_);
-    allocate(refr_, "GBuf_refr", w, h, mask_);
+    allocate(refl_, "GBuf_refl", w, h);
+    allocate(refr_, "GBuf_refr", w, h);
+    attachedMask_ = 0;
 }
 
 void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
-                     ctx.scene.specularDrawBuffer().id());
+    ctx.scene.bindTableTexels(sceneTables_, kUnitSpecGbufMaterials, kUnitSpecGbufSpecularDraws);
     glBindTextureUnit(kUnitSpecGbufPosition, res.texture(Resource::GBufferPosition).id());
     glBindTextureUnit(kUnitSpecGbufNormal, res.texture(Resource::GBufferNormal).id());
     glBindTextureUnit(kUnitSpecGbufEmissive, res.texture(Resource::GBufferEmissive).id());
     glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
     glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
     ImpostorPass::bindForTracing(res, impostorTables_);  // kUnitImpostor*, the header block
-    // The specular-pixel depth mask: outside the rectangles it stays cleared (1, not specular).
-    maskFbo_.bind();
-    ctx.beginFullscreen(maskProgram_, ctx.canvasWidth(), ctx.canvasHeight());
-    glDepthMask(GL_TRUE);  // also lets the clear write
-    ctx.clearForRects(ctx.specularRects, maskDrawn_, 0, 0, true);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_ALWAYS);
-    ctx.drawFullscreenTriangleIn(ctx.specularRects);
+    // The G-buffer pass's specular-pixel mask as both hit buffers' depth (it reallocates it only
+    // on a resize).
+    const gl::Texture& mask = res.texture(Resource::SpecularMask);
+    if (mask.id() != attachedMask_) {
+        for (SpecularHitBuffer* hits : {&refl_, &refr_}) {
+            hits->fbo.attachDepth(mask);
+            hits->fbo.finalize(5);
+        }
+        attachedMask_ = mask.id();
+    }
     for (int mode = 0; mode < 2; ++mode) {
         SpecularHitBuffer& hits = mode == 0 ? refl_ : refr_;
         hits.fbo.bind();
@@ -126,7 +117,6 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glDisable(GL_DEPTH_TEST);
     publish(res, refl_, Resource::ReflectionGBuffer, Resource::ReflectionNormal,
             Resource::ReflectionAlbedo, Resource::ReflectionEmissive, Resource::ReflectionWeight);
-    res.publish(Resource::SpecularMask, mask_);
     publish(res, refr_, Resource::RefractionGBuffer, Resource::RefractionNormal,
             Resource::RefractionAlbedo, Resource::RefractionEmissive, Resource::RefractionWeight);
 }

@@ -28,11 +28,9 @@ public:
 
 private:
     ImpostorPass::TableViews impostorTables_;  // trace.glsl's tables, bound every frame
+    SceneTableViews sceneTables_;              // materials and specular draws, likewise
     gl::Program programs_[2];  // [0] reflection, [1] refraction (MIRAGE_SPECULAR_MODE)
-    gl::Program maskProgram_;  // specular_mask.frag: depth 0 on specular pixels, 1 elsewhere
-    gl::Texture mask_;         // that depth mask, attached to both hit buffers' framebuffers
-    gl::Framebuffer maskFbo_;
-    DrawnRects maskDrawn_;
+    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as both hit buffers' depth
     SpecularHitBuffer refl_, refr_;
     int width_ = 0, height_ = 0;
 };

@@ -26,8 +26,8 @@
 // with d = |P2 - p| the distance travelled inside (KHR_materials_volume).
 // Weight of the reflected radiance: Fresnel F1 (dielectric) or Schlick(baseColour) (mirror).
 in vec2 uv;
-layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
-layout(std430, binding = kBindingSpecularDraws) readonly buffer SpecularDraws { GpuSpecularDraw specularDraws[]; };
+layout(binding = kUnitSpecGbufMaterials) uniform samplerBuffer materialTexels;  // GpuMaterial[]
+layout(binding = kUnitSpecGbufSpecularDraws) uniform samplerBuffer specularDrawTexels;  // GpuSpecularDraw[]
 layout(binding = kUnitSpecGbufPosition) uniform sampler2D gPosition;
 layout(binding = kUnitSpecGbufNormal) uniform sampler2D gNormal;
 layout(binding = kUnitSpecGbufEmissive) uniform sampler2D gEmissive;  // a = specular slot + 1
@@ -80,8 +80,8 @@ void main() {
     if (vl < 1e-6 || !allFinite(n)) return;
     v /= vl;
     vec3 d = -v;
-    GpuSpecularDraw sd = specularDraws[slot];
-    GpuMaterial m = materials[sd.material];
+    GpuSpecularDraw sd = specularDrawAt(specularDrawTexels, slot);
+    GpuMaterial m = materialAt(materialTexels, sd.material);
     float cosV = clamp(dot(n, v), 1e-4, 1.0);  // grazing: clamped, never 0
     bool mirror = m.mirror != 0;
     float transWeight = mirror ? 0.0 : clamp(m.transmission, 0.0, 1.0) *
