@@ -142,11 +142,16 @@ struct RendererOptions {
     // Tests only: false draws the specular passes over the one rectangle around every specular
     // object (FrameContext::specularScissor) instead of each object's own (the same images).
     bool specularRectsPerObject = true;
-    // false (the default): `direct`, the GI upsample and the composite's diffuse variant skip the
-    // pixels that show a mirror or glass object (their light comes from the specular passes;
+    // false (the default): `direct` (with the GI upsample) and the composite's diffuse variant skip
+    // the pixels that show a mirror or glass object (their light comes from the specular passes;
     // FrameContext::drawFullscreenTriangleOutsideSpecular). true: they shade them too (tests
     // compare the two).
     bool diffuseOnSpecularPixels = false;
+    // true: in frames with VPL light the direct-light pass also writes the direct light alone
+    // (DirectRv / DirectR; two more canvas targets), besides the GI solutions LRv / LR it sums
+    // with the upsampled indirect light. false (the default): DirectRv / DirectR exist only in
+    // frames without VPL light, where they are LRv / LR.
+    bool keepDirectLight = false;
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
     // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
     bool reuseStaticPasses = true;

@@ -167,9 +167,9 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<VplPass>());
     g.addPass(std::make_unique<IsmPass>());
     g.addPass(std::make_unique<TranslucencyPass>(scene, *scene_, options_));
-    g.addPass(std::make_unique<DirectLightPass>(*scene_));
     g.addPass(std::make_unique<IndirectLightPass>());
     g.addPass(std::make_unique<GiFilterPass>(options_.interleave));
+    g.addPass(std::make_unique<DirectLightPass>(*scene_));  // + the upsampled indirect light
     g.addPass(std::make_unique<CausticPass>());
     g.addPass(std::make_unique<BackFacePass>());
     g.addPass(std::make_unique<SpecularGBufferPass>());

@@ -31,6 +31,7 @@ const char* resourceName(Resource r) {
         "IndirectR",
         "GiHistoryRv",
         "GiHistoryR",
+        "GatherLight",
         "LRv",
         "LR",
         "ImpostorCubePosition",

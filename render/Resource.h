@@ -48,6 +48,8 @@ enum class Resource {
     IndirectR,
     GiHistoryRv,  // filtered indirect light at gather resolution, a = camera distance (m); kept
     GiHistoryR,   // by gifilter as the next frame's temporal history (persistent)
+    GatherLight,  // the filtered indirect light packed per gather pixel for the upsample: L_rv,
+                  // L_r as halves, camera-frame depth as a half, 8-bit oct normal (RGBA32UI)
     LRv,          // the two GI solutions: direct + filtered, upsampled indirect (canvas size)
     LR,
     // Reflected-scene impostors of the specular objects' surroundings (persistent: built once

@@ -50,6 +50,7 @@ const int kUnitDirectShadowAll = 4;
 const int kUnitDirectShadowReal = 5;
 const int kUnitDirectGlassAll = 6;  // ShadowGlass / ShadowGlassReal (glass in the shadow maps)
 const int kUnitDirectGlassReal = 7;
+const int kUnitDirectGatherLight = 8;  // filter.frag's packed gather pixels (gi_upsample.glsl)
 
 // translucency.comp: the shadow atlases
 const int kUnitTranslucencyShadowAll = 0;
@@ -84,18 +85,13 @@ const int kUnitIndirectIsmAll = 3;
 const int kUnitIndirectIsmReal = 4;
 const int kUnitIndirectVpls = 5;  // the VPL buffer as RGBA32F texels (common.glsl vplAt)
 
-// gifilter: filter.frag (gather resolution) and upsample.frag (canvas)
+// gifilter: filter.frag (gather resolution)
 const int kUnitFilterPosition = 0;
 const int kUnitFilterNormal = 1;
 const int kUnitFilterIndirectRv = 2;
 const int kUnitFilterIndirectR = 3;
 const int kUnitFilterHistoryRv = 4;
 const int kUnitFilterHistoryR = 5;
-const int kUnitUpsamplePosition = 0;
-const int kUnitUpsampleNormal = 1;
-const int kUnitUpsampleGatherLight = 3;  // filter.frag's packed gather pixels
-const int kUnitUpsampleDirectRv = 4;
-const int kUnitUpsampleDirectR = 5;
 
 // specular_gbuffer.frag
 const int kUnitSpecGbufPosition = 0;

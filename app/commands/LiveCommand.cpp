@@ -561,6 +561,9 @@ void runLive(const LiveArgs& a) {
         ropt.impostorResolution = kPresets[preset].impostorResolution;
         ropt.exposure = a.exposure;
         ropt.environmentLights = environmentLights;
+        // The HUD's direct-light views need the direct light apart in frames with VPLs (two
+        // more canvas targets); a headless run shows no view and does not pay for them.
+        ropt.keepDirectLight = !a.headless;
         return std::make_unique<render::Renderer>(placedScene(placement), calib.intrinsics, ropt);
     };
     std::unique_ptr<render::Renderer> renderer = makeRenderer();

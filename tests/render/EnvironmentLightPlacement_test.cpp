@@ -119,6 +119,7 @@ std::vector<FrameMeasure> replayTopDown(const fs::path& sessionDir, int environm
     EXPECT_TRUE(env.has_value()) << why;
     if (!env) return {};
     RendererOptions o;
+    o.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
     o.environmentLights = environmentLights;
     o.environmentMapWidth = 128;
     o.vplCount = 16;

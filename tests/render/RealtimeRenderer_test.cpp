@@ -19,6 +19,14 @@
 namespace mirage::render {
 namespace {
 
+// Options that keep the direct light apart (DirectRv / DirectR) in frames with VPL light, where
+// the direct-light pass otherwise writes only its sum with the indirect light (LRv / LR).
+RendererOptions directLightKept() {
+    RendererOptions o;
+    o.keepDirectLight = true;
+    return o;
+}
+
 using test::addBox;
 using test::addFloor;
 using test::addLight;
@@ -236,6 +244,7 @@ TEST_F(RealtimeRenderer, VirtualShadowOnlyInLrv) {
     addLight(s.scene, Light::Type::Spot, glm::vec3(s.lightPos), glm::vec3(axis), 8.0f, Origin::Real,
              1.0f, 0.9f);
     RendererOptions opt;
+    opt.keepDirectLight = true;  // DirectRv apart from LRv (this scene has VPLs)
     opt.vplCount = 64;
     Renderer r(s.scene, s.cam, opt);
     // Footage: the real world alone, as the camera would see it (L_r, sRGB-encoded).
@@ -354,7 +363,7 @@ TEST_F(RealtimeRenderer, BrightLightAndNearPlaneStayFinite) {
     // A virtual box whose front part is behind the camera: it crosses the near plane.
     addBox(scene, "near box", {-0.3f, 0.7f, 1.6f}, {0.3f, 1.3f, 2.4f}, white, Origin::Virtual);
     const CameraIntrinsics cam = smallCamera();
-    Renderer r(scene, cam);
+    Renderer r(scene, cam, directLightKept());
     cv::Mat footage(cam.height, cam.width, CV_8UC3, cv::Scalar(200, 200, 200));
     const FrameReport& rep = r.render({pose, footage, false});
     ASSERT_TRUE(rep.ran("vpl")) << rep.summary();
@@ -464,7 +473,7 @@ TEST_F(RealtimeRenderer, VirtualColourBleedsOntoRealFloor) {
              Origin::Real, 1.0f, 0.9f);
     const CameraIntrinsics cam = smallCamera();
     const Pose pose = lookAtPose({-0.5, 1.6, 2.2}, {0.1, 0.0, 0.0});
-    Renderer r(scene, cam);
+    Renderer r(scene, cam, directLightKept());
     r.render({pose, {}, false});
     cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
     // For inspection (linear EXR; PNG is sRGB-encoded).
@@ -539,7 +548,7 @@ TEST_F(RealtimeRenderer, VirtualOccluderBlocksBouncedLightOnlyInLrv) {
              Origin::Real, 0.25f, 0.2f);
     const CameraIntrinsics cam = smallCamera();
     const Pose pose = lookAtPose({0.9, 0.12, 0.2}, {-0.6, 0.05, 0.0});
-    Renderer r(scene, cam);
+    Renderer r(scene, cam, directLightKept());
     const FrameReport& rep = r.render({pose, {}, false});
     ASSERT_TRUE(rep.ran("ism")) << rep.summary();
     cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);

@@ -80,6 +80,7 @@ RendererOptions options(bool perObject) {
     o.vplCount = 64;
     o.temporalBlend = 0.0f;
     o.specularRectsPerObject = perObject;
+    o.keepDirectLight = true;  // DirectRv apart from LRv (the tabletop has VPL light)
     return o;
 }
 

@@ -44,6 +44,7 @@ struct Realtime {
 Realtime renderRealtime(const Scene& scene, bool translucency = true) {
     const raytrace::RenderCamera cam = testCamera();
     RendererOptions opt;
+    opt.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
     opt.vnmResolution = kResolution;
     opt.translucency = translucency;
     Renderer r(scene, cam.intrinsics, opt);
@@ -189,6 +190,7 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     const Scene scene = translucentTestScene({}, dir);
     const raytrace::RenderCamera cam = testCamera();
     RendererOptions opt;
+    opt.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
     opt.vnmResolution = 8;
     Renderer r(scene, cam.intrinsics, opt);
     auto objectMean = [&](const cv::Mat& rv) {
@@ -291,6 +293,7 @@ TEST_F(TranslucencyPass, TwoObjectsEachHaveTheirOwnMap) {
     const Scene scene = cubesScene(cubes, 0.3f, dir);
     const raytrace::RenderCamera cam = lookAtCamera(48, 32, 45.0, {0.2, 0.5, 1.4}, {0, 0, 0});
     RendererOptions opt;
+    opt.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
     opt.vnmResolution = 8;
     Renderer r(scene, cam.intrinsics, opt);
     const FrameReport& rep = r.render({cam.T_world_camera, cv::Mat(), true});

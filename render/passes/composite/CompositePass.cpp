@@ -38,9 +38,10 @@ CompositePass::CompositePass()
 
 void CompositePass::setup(PassBuilder& b) const {
     b.read(Resource::CameraImage);
-    // The two GI solutions, or direct light alone when no VPL light was filtered into them.
-    for (Resource r : {Resource::LRv, Resource::LR, Resource::CausticRv, Resource::CausticR,
-                       Resource::DirectRv, Resource::DirectR, Resource::GBufferPosition})
+    // The two GI solutions (direct light alone when no VPL light was filtered into them).
+    b.read(Resource::LRv);
+    b.read(Resource::LR);
+    for (Resource r : {Resource::CausticRv, Resource::CausticR, Resource::GBufferPosition})
         b.readOptional(r);
     // Mirror / glass pixels (Eqs. 6-11): only when the specular passes ran.
     for (Resource r : {Resource::GBufferEmissive, Resource::ReflectionGBuffer,
@@ -162,12 +163,9 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                             ctx.projection.camera.height);
         glUniform1i(locShowVirtualNoCaustics_, ctx.options.showVirtual ? 1 : 0);
     }
-    auto tex = [&](Resource a, Resource b) {
-        return res.textureOr(a, res.textureOr(b, ctx.blackTexture())).id();
-    };
     glBindTextureUnit(kUnitCompositeCamera, res.texture(Resource::CameraImage).id());
-    glBindTextureUnit(kUnitCompositeLRv, tex(Resource::LRv, Resource::DirectRv));
-    glBindTextureUnit(kUnitCompositeLR, tex(Resource::LR, Resource::DirectR));
+    glBindTextureUnit(kUnitCompositeLRv, res.texture(Resource::LRv).id());
+    glBindTextureUnit(kUnitCompositeLR, res.texture(Resource::LR).id());
     glBindTextureUnit(kUnitCompositeCausticRv,
                       res.textureOr(Resource::CausticRv, ctx.blackTexture()).id());
     glBindTextureUnit(kUnitCompositeCausticR,

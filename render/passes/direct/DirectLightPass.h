@@ -1,5 +1,13 @@
 #pragma once
-// Direct + environment + emitted light for every G-buffer pixel, into DirectRv / DirectR.
+// Direct + environment + emitted light for every G-buffer pixel, and the GI solutions LRv / LR:
+// in frames with VPL light, the filtered indirect light (gifilter's GatherLight) is upsampled
+// to the pixel and added in the same pass (gi_upsample.glsl); otherwise LRv / LR are the direct
+// light alone and are published as DirectRv / DirectR too. With
+// RendererOptions::keepDirectLight the direct light alone is also written to DirectRv /
+// DirectR in VPL frames (two more targets; tests and buffer views).
+#include <map>
+#include <tuple>
+
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -14,10 +22,16 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    gl::Program program_, programNoGlass_;  // with / without MIRAGE_GLASS_SHADOWS
-    gl::Texture rv_, r_;
-    gl::Framebuffer fbo_;
-    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
+    // The shader variant for (glass shadows, indirect light added, direct light kept apart),
+    // compiled on first use: llvmpipe pays for a branch's texture reads even when no pixel takes
+    // it, so each combination is its own program.
+    gl::Program& program(bool glass, bool indirect, bool keepDirect);
+
+    std::string sceneDefines_, sceneDefinesNoGlass_;
+    std::map<std::tuple<bool, bool, bool>, gl::Program> programs_;
+    gl::Texture rv_, r_, directRv_, directR_;
+    gl::Framebuffer fbo_, keepFbo_;                   // LRv, LR; and + DirectRv, DirectR
+    GLuint attachedMask_ = 0, keepAttachedMask_ = 0;  // SpecularMask attached as their depth
 };
 
 }  // namespace mirage::render

@@ -26,25 +26,28 @@ layout(std430, binding = kBindingTranslucentRadiance) readonly buffer Translucen
     vec4 translucentL[];
 };
 uniform int translucentOn;  // 1: the translucency pass ran this frame
+// Variant MIRAGE_WITH_INDIRECT (frames with VPL light): the outputs are the GI solutions, direct
+// plus the filtered indirect light upsampled to the pixel (gi_upsample.glsl); MIRAGE_KEEP_DIRECT
+// also writes the direct light alone (RendererOptions::keepDirectLight).
+#ifdef MIRAGE_WITH_INDIRECT
+#include "passes/gifilter/gi_upsample.glsl"
+#endif
 layout(location = 0) out vec4 outRv;  // linear radiance
 layout(location = 1) out vec4 outR;
+#ifdef MIRAGE_KEEP_DIRECT
+layout(location = 2) out vec4 outDirectRv;
+layout(location = 3) out vec4 outDirectR;
+#endif
 
-void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 P = texelFetch(gPosition, px, 0);
-    int origin = int(P.w + 0.5);
-    if (origin == ORIGIN_NONE) {
-        outRv = vec4(0.0);
-        outR = vec4(0.0);
-        return;
-    }
-    bool pReal = origin == ORIGIN_REAL;
+// Direct, environment and emitted light at the G-buffer pixel px (surface point P.xyz, origin
+// real or virtual), both GI solutions.
+void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r) {
     vec3 p = P.xyz;
-    vec4 N = texelFetch(gNormal, px, 0);
     vec3 n = N.xyz;
     vec4 A = texelFetch(gAlbedo, px, 0);
     vec3 v = normalize(cameraPos.xyz - p);
-    vec3 rv = vec3(0.0), r = vec3(0.0);
+    rv = vec3(0.0);
+    r = vec3(0.0);
     vec4 Em = texelFetch(gEmissive, px, 0);
     // A translucent pixel (gEmissive.a = -1) takes the light scattered through its object (the
     // one whose map has the nearest surface voxel) to that surface voxel, times F_t towards the
@@ -61,8 +64,6 @@ void main() {
         if (pReal) r = Ft * translucentL[base + obj.gridDims.w + voxel].rgb;
         rv += Em.rgb;
         if (pReal) r += Em.rgb;
-        outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
-        outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
         return;
     }
 #endif
@@ -89,6 +90,26 @@ void main() {
     vec3 e = Em.rgb;
     rv += e;
     if (pReal) r += e;
-    outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
-    outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 P = texelFetch(gPosition, px, 0);
+    int origin = int(P.w + 0.5);
+    vec3 rv = vec3(0.0), r = vec3(0.0), iRv = vec3(0.0), iR = vec3(0.0);
+    if (origin != ORIGIN_NONE) {
+        vec4 N = texelFetch(gNormal, px, 0);
+        directLight(px, P, N, origin == ORIGIN_REAL, rv, r);
+        rv = allFinite(rv) ? rv : vec3(0.0);
+        r = allFinite(r) ? r : vec3(0.0);
+#ifdef MIRAGE_WITH_INDIRECT
+        upsampleIndirect(px, textureSize(gPosition, 0), P.xyz, N.xyz, iRv, iR);
+#endif
+    }
+    outRv = vec4(rv + iRv, 1.0);
+    outR = vec4(r + iR, 1.0);
+#ifdef MIRAGE_KEEP_DIRECT
+    outDirectRv = vec4(rv, 1.0);
+    outDirectR = vec4(r, 1.0);
+#endif
 }

@@ -1,8 +1,9 @@
 #pragma once
-// Geometry-aware + temporal filter of the VPL light, summed with direct light into LRv / LR:
-// the K x K filter, de-interleaving and temporal smoothing at gather resolution (filter.frag;
-// its output is the next frame's history, so two gather-size buffers ping-pong), then joint
-// bilateral upsampling and the sum with direct light at full resolution (upsample.frag).
+// Geometry-aware + temporal filter of the VPL light: the K x K filter, de-interleaving and
+// temporal smoothing at gather resolution (filter.frag; its output is the next frame's history,
+// so two gather-size buffers ping-pong), and the same light packed per gather pixel
+// (GatherLight) for the joint bilateral upsampling, which the direct-light pass does while it
+// sums direct and indirect light into LRv / LR (gi_upsample.glsl): one canvas-size pass fewer.
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"
 
@@ -19,17 +20,13 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    gl::Program filter_;    // K x K geometry-aware filter + temporal, gather resolution
-    gl::Program upsample_;  // joint bilateral upsampling + sum with direct light
+    gl::Program filter_;  // K x K geometry-aware filter + temporal, gather resolution
     // Filtered indirect light at gather resolution, rgb + camera distance (m) in a; [current_]
     // is written this frame and read as history by the next (history_ says which).
     gl::Texture lowRv_[2], lowR_[2];
     // The filtered light packed for the upsample (filter.frag): L_rv, L_r, depth, normal.
     gl::Texture gatherLight_;
     gl::Framebuffer lowFbo_[2];
-    gl::Texture rv_, r_;
-    gl::Framebuffer fbo_;
-    GLuint attachedMask_ = 0;  // the SpecularMask texture attached as fbo_'s depth
     TemporalHistory history_;
 };
 

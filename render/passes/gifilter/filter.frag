@@ -25,11 +25,11 @@ uniform int scale;  // gather pixel q was shaded at G-buffer pixel gatherCanvasP
 uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
 layout(location = 0) out vec4 outRv;  // rgb filtered + smoothed; a = camera distance (m)
 layout(location = 1) out vec4 outR;   // (the history of the next frame)
-// The same light packed for upsample.frag, which reads 4 gather pixels per canvas pixel: one
-// texel per gather pixel instead of four (its G-buffer position and normal, L_rv, L_r). The
-// position is the camera-frame depth along the gather pixel's ray (upsample.frag rebuilds the
-// point): half precision is 0.05 % of it, far below the 1 % of the camera distance the
-// upsample's plane test tolerates.
+// The same light packed for the upsample (gi_upsample.glsl, in direct.frag), which reads 4
+// gather pixels per canvas pixel: one texel per gather pixel instead of four (its G-buffer
+// position and normal, L_rv, L_r). The position is the camera-frame depth along the gather
+// pixel's ray (the upsample rebuilds the point): half precision is 0.05 % of it, far below the
+// 1 % of the camera distance the upsample's plane test tolerates.
 layout(location = 2) out uvec4 outUpsampleLight;  // L_rv, L_r as 6 halves; w: see packGather
 
 // Camera-frame depth z (m, half; 0: no surface) in the low 16 bits, the normal (8-bit oct) in
