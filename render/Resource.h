@@ -42,7 +42,8 @@ enum class Resource {
     // vec4 for L_r.
     TranslucentGrid,
     TranslucentRadiance,
-    DirectRv,  // direct + environment + emission (canvas size)
+    DirectRv,  // direct + environment + emission (canvas size): LRv itself in frames without VPL
+               // light, else written apart only with RendererOptions::keepDirectLight
     DirectR,
     IndirectRv,  // interleaved VPL gather, deinterleaved and unfiltered (gather size)
     IndirectR,

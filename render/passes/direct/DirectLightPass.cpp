@@ -68,7 +68,8 @@ void DirectLightPass::setup(PassBuilder& b) const {
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
-                      (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "")};
+                      (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
+                      (ctx.plan.needVpls ? " + the upsampled indirect light" : "")};
 }
 
 void DirectLightPass::resize(const FrameContext& ctx) {
