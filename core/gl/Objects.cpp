@@ -61,13 +61,22 @@ std::uint64_t Texture::createdCount() {
     return texturesCreated.load();
 }
 
+namespace {
+// A new texture name of `target`, counted and labelled (every factory below starts here).
+GLuint createTextureName(GLenum target, std::string_view lbl) {
+    GLuint id = 0;
+    glCreateTextures(target, 1, &id);
+    ++texturesCreated;
+    label(GL_TEXTURE, id, lbl);
+    return id;
+}
+}  // namespace
+
 Texture Texture::allocate(GLenum target, std::string_view lbl, int w, int h, int layers, GLenum fmt,
                           int levels, GLenum minFilter) {
     MR_CHECK(w > 0 && h > 0 && layers > 0, "texture size must be positive");
     Texture t;
-    GLuint id = 0;
-    glCreateTextures(target, 1, &id);
-    ++texturesCreated;
+    const GLuint id = createTextureName(target, lbl);
     t.h_ = Handle<detail::deleteTexture>(id);
     t.width_ = w;
     t.height_ = h;
@@ -78,7 +87,6 @@ Texture Texture::allocate(GLenum target, std::string_view lbl, int w, int h, int
         glTextureStorage3D(id, levels, fmt, w, h, layers);
     else  // 2D, or a cube map (6 faces from one 2D storage call)
         glTextureStorage2D(id, levels, fmt, w, h);
-    label(GL_TEXTURE, id, lbl);
     t.setFilter(minFilter, GL_LINEAR);
     t.setWrap(GL_CLAMP_TO_EDGE);
     return t;
@@ -100,12 +108,8 @@ Texture Texture::create3D(std::string_view lbl, int w, int h, int d, GLenum fmt)
 
 Texture Texture::createBufferView(std::string_view lbl) {
     Texture t;
-    GLuint id = 0;
-    glCreateTextures(GL_TEXTURE_BUFFER, 1, &id);
-    ++texturesCreated;
-    t.h_ = Handle<detail::deleteTexture>(id);
+    t.h_ = Handle<detail::deleteTexture>(createTextureName(GL_TEXTURE_BUFFER, lbl));
     t.target_ = GL_TEXTURE_BUFFER;
-    label(GL_TEXTURE, id, lbl);
     return t;
 }
 

@@ -30,7 +30,7 @@ uniform int translucentOn;  // 1: the translucency pass ran this frame
 // plus the filtered indirect light upsampled to the pixel (gi_upsample.glsl); MIRAGE_KEEP_DIRECT
 // also writes the direct light alone (RendererOptions::keepDirectLight).
 #ifdef MIRAGE_WITH_INDIRECT
-#include "passes/gifilter/gi_upsample.glsl"
+#include "passes/direct/gi_upsample.glsl"
 #endif
 layout(location = 0) out vec4 outRv;  // linear radiance
 layout(location = 1) out vec4 outR;

@@ -3,7 +3,7 @@
 // temporal smoothing at gather resolution (filter.frag; its output is the next frame's history,
 // so two gather-size buffers ping-pong), and the same light packed per gather pixel
 // (GatherLight) for the joint bilateral upsampling, which the direct-light pass does while it
-// sums direct and indirect light into LRv / LR (gi_upsample.glsl): one canvas-size pass fewer.
+// sums direct and indirect light into LRv / LR (passes/direct/gi_upsample.glsl): one canvas-size pass fewer.
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"
 

@@ -25,7 +25,7 @@ uniform int scale;  // gather pixel q was shaded at G-buffer pixel gatherCanvasP
 uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
 layout(location = 0) out vec4 outRv;  // rgb filtered + smoothed; a = camera distance (m)
 layout(location = 1) out vec4 outR;   // (the history of the next frame)
-// The same light packed for the upsample (gi_upsample.glsl, in direct.frag), which reads 4
+// The same light packed for the upsample (passes/direct/gi_upsample.glsl), which reads 4
 // gather pixels per canvas pixel: one texel per gather pixel instead of four (its G-buffer
 // position and normal, L_rv, L_r). The position is the camera-frame depth along the gather
 // pixel's ray (the upsample rebuilds the point): half precision is 0.05 % of it, far below the
