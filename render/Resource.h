@@ -79,20 +79,17 @@ enum class Resource {
     RefractionAlbedo,
     RefractionEmissive,
     RefractionWeight,
-    SpecularMask,         // depth 0 on specular pixels, 1 elsewhere: the passes that shade only
-                          // those test against it (early depth test skips the rest)
-    SpecularRv,           // L'_rv (Eq. 3), Fresnel-weighted
-    SpecularR,            // L'_r (Eq. 4)
-    SpecularRReflection,  // the reflection's share of L'_r
-    Lenv,                 // L_env: environment seen where a ray leaves the modelled scene
-    // SpecularRv, SpecularR, SpecularRReflection after temporal smoothing, kept by the specular
-    // light pass as the next frame's history (persistent, RGBA32F). SpecularHistoryRv.a = the
-    // specular surface's camera distance (m, 0: none); SpecularHistoryR.a and
-    // SpecularHistoryRReflection.a = y and z of the refracted ray's hit (world, m), whose x and
-    // the reflected ray's hit the pass keeps beside them (specular_light.frag).
-    SpecularHistoryRv,
-    SpecularHistoryR,
-    SpecularHistoryRReflection,
+    SpecularMask,  // depth 0 on specular pixels, 1 elsewhere: the passes that shade only
+                   // those test against it (early depth test skips the rest)
+    // L'_rv (Eq. 3, Fresnel-weighted), L'_r (Eq. 4) and the reflection's share of L'_r, after
+    // temporal smoothing; the specular light pass keeps them as the next frame's history
+    // (persistent, RGBA32F). SpecularRv.a = the specular surface's camera distance (m, 0: none);
+    // SpecularR.a and SpecularRReflection.a = y and z of the refracted ray's hit (world, m),
+    // whose x and the reflected ray's hit the pass keeps beside them (specular_light.frag).
+    SpecularRv,
+    SpecularR,
+    SpecularRReflection,
+    Lenv,  // L_env: environment seen where a ray leaves the modelled scene
     // Fuzzy reflections of rough metals (render/passes/fuzzy): the four above filtered over each
     // rough pixel's reflection cone, and the filtered video term of the reflection (rgb camera
     // units: eta1 CI_r(p_refl) or the rendered real share; a = 1 on a rough-metal pixel).

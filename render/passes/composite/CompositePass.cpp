@@ -1,6 +1,7 @@
 #include "render/passes/composite/CompositePass.h"
 
 #include <array>
+#include <cmath>
 
 #include "render/FrameGraph.h"
 
@@ -17,16 +18,20 @@ constexpr Resource kRoughBuffers[5] = {Resource::RoughSpecularRv, Resource::Roug
 static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
 }  // namespace
 
-CompositePass::CompositePass()
-    : program_(fullscreenProgram("composite", "passes/composite/composite.frag")),
-      programDiffuse_(fullscreenProgram("composite (diffuse only)",
-                                        "passes/composite/composite.frag",
-                                        "#define MIRAGE_DIFFUSE_ONLY 1")),
-      programDiffuseNoCaustics_(fullscreenProgram(
-          "composite (diffuse only, no caustics)", "passes/composite/composite.frag",
-          "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_NO_CAUSTICS 1")),
-      maskProgram_(
-          fullscreenProgram("composite specular mask", "passes/composite/composite_mask.frag")) {
+void CompositePass::buildPrograms(bool identityRemap) {
+    // Without lens distortion on a canvas of the camera's size the remap is the identity: the
+    // variant reads each buffer at its own pixel instead of looking the position up and
+    // filtering (on llvmpipe a bilinear read costs four, and the table read one more).
+    const std::string identity = identityRemap ? "#define MIRAGE_IDENTITY_REMAP 1\n" : "";
+    program_ = fullscreenProgram("composite", "passes/composite/composite.frag", identity);
+    programDiffuse_ =
+        fullscreenProgram("composite (diffuse only)", "passes/composite/composite.frag",
+                          identity + "#define MIRAGE_DIFFUSE_ONLY 1\n");
+    programDiffuseNoCaustics_ = fullscreenProgram(
+        "composite (diffuse only, no caustics)", "passes/composite/composite.frag",
+        identity + "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_NO_CAUSTICS 1\n");
+    maskProgram_ = fullscreenProgram("composite specular mask",
+                                     "passes/composite/composite_mask.frag", identity);
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
     locShowVirtualDiffuse_ = programDiffuse_.uniformLocation("showVirtual");
     locShowVirtual_ = program_.uniformLocation("showVirtual");
@@ -34,6 +39,22 @@ CompositePass::CompositePass()
     locShowVirtualNoCaustics_ = programDiffuseNoCaustics_.uniformLocation("showVirtual");
     locWithCaustics_ = program_.uniformLocation("withCaustics");
     locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
+    identityRemap_ = identityRemap;
+    programsBuilt_ = true;
+}
+
+bool CompositePass::isIdentityRemap(const CameraProjection& p) {
+    const int w = p.camera.width, h = p.camera.height;
+    if (p.canvasWidth != w || p.canvasHeight != h || p.remap.size() != size_t(w) * size_t(h))
+        return false;
+    // Within a thousandth of a pixel: the bilinear weights the general variant would use are 0
+    // and 1 to that precision.
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const glm::vec2 q = p.remap[size_t(y) * size_t(w) + size_t(x)];
+            if (std::abs(q.x - float(x)) > 1e-3f || std::abs(q.y - float(y)) > 1e-3f) return false;
+        }
+    return true;
 }
 
 void CompositePass::setup(PassBuilder& b) const {
@@ -65,9 +86,11 @@ void CompositePass::resize(const FrameContext& ctx) {
     const int w = p.camera.width, h = p.camera.height;
     // Runs before every frame; the camera (and so the remap tables) is fixed for the renderer's
     // life, so only a size change rebuilds them.
-    if (linear_.width() == w && linear_.height() == h && canvasToCamera_.width() == p.canvasWidth &&
-        canvasToCamera_.height() == p.canvasHeight)
+    if (programsBuilt_ && linear_.width() == w && linear_.height() == h &&
+        canvasToCamera_.width() == p.canvasWidth && canvasToCamera_.height() == p.canvasHeight)
         return;
+    const bool identity = isIdentityRemap(p);
+    if (!programsBuilt_ || identity != identityRemap_) buildPrograms(identity);
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
     srgb_ = gl::Texture::create2D("composite srgb", w, h, GL_SRGB8_ALPHA8);
     remap_ = gl::Texture::create2D("lens remap", w, h, GL_RG32F);

@@ -7,7 +7,10 @@ namespace mirage::render {
 
 class CompositePass final : public RenderPass {
 public:
-    CompositePass();
+    CompositePass() = default;  // the programs are built by resize(), for the camera
+    // True when every camera pixel sees the canvas pixel of its own coordinates: no lens
+    // distortion and a canvas of the camera's size (the composite's identity-remap variant).
+    static bool isIdentityRemap(const CameraProjection& p);
     const char* name() const override { return "composite"; }
     void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
@@ -18,12 +21,15 @@ private:
     // The camera pixels (GL window rect) whose canvas position lies in canvasRect (canvas GL
     // window rect): where the composite can meet a specular pixel. Empty for an empty rect.
     glm::ivec4 cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const;
+    // The variants below, with MIRAGE_IDENTITY_REMAP when `identityRemap`.
+    void buildPrograms(bool identityRemap);
 
     // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
     // compositing code would cost every frame even behind a uniform that turns it off.
     gl::Program program_;                   // with Eqs. 6-11 for mirror / glass pixels
     gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
     gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
+    bool programsBuilt_ = false, identityRemap_ = false;
     gl::Texture linear_, srgb_, remap_;
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.

@@ -9,7 +9,8 @@
 // Guard where L_r is near 0 (a black surface, or light only the virtual light reaches): alpha
 // fades to 1 below alphaFadeLr (the model's own radiometry is used) and is capped at alphaMax,
 // and the result is clamped to >= 0 and finite. Lens distortion: the L buffers were rendered
-// undistorted on the canvas; `remap` gives each camera pixel's canvas position.
+// undistorted on the canvas; `remap` gives each camera pixel's canvas position (variant
+// MIRAGE_IDENTITY_REMAP: no distortion and a canvas of the camera's size, position = pixel).
 //
 // Pixels showing a mirror or glass object (the G-buffer's specular slot) are composited by
 // Knecht 2013 Eqs. 6-11 instead (docs/specular.md):
@@ -124,18 +125,23 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec3 ci = texelFetch(cameraImage, px, 0).rgb;
+#ifdef MIRAGE_IDENTITY_REMAP  // no lens distortion, canvas = camera image: each pixel its own
+    vec2 canvasPx = vec2(px);
+#define MIRAGE_CANVAS_AT(tex) texelFetch(tex, cpi, 0)
+#else
     vec2 canvasPx = texelFetch(remap, px, 0).xy;
+#define MIRAGE_CANVAS_AT(tex) texture(tex, (canvasPx + 0.5) * canvas.zw)
+#endif
     vec3 result = ci;
     float coverage = 0.0;
     if (canvasPx.x > -1000.0 && showVirtual != 0) {
-        vec2 cuv = (canvasPx + 0.5) * canvas.zw;
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
-        vec3 rv = texture(lRv, cuv).rgb, r = texture(lR, cuv).rgb;
+        vec3 rv = MIRAGE_CANVAS_AT(lRv).rgb, r = MIRAGE_CANVAS_AT(lR).rgb;
 #ifndef MIRAGE_NO_CAUSTICS  // the variant for frames without a caustic pass never reads them
         if (withCaustics != 0) {
-            rv += texture(causticRv, cuv).rgb;
-            r += texture(causticR, cuv).rgb;
+            rv += MIRAGE_CANVAS_AT(causticRv).rgb;
+            r += MIRAGE_CANVAS_AT(causticR).rgb;
         }
 #endif
         rv = max(rv, vec3(0.0)) * exposure;

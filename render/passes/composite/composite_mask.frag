@@ -8,7 +8,11 @@
 layout(binding = kUnitCompositeRemap) uniform sampler2D remap;      // camera size: canvas pixel
 layout(binding = kUnitCompositeEmissive) uniform sampler2D gEmissive;  // canvas, a = slot + 1
 void main() {
+#ifdef MIRAGE_IDENTITY_REMAP  // as composite.frag's variant
+    vec2 canvasPx = gl_FragCoord.xy - 0.5;
+#else
     vec2 canvasPx = texelFetch(remap, ivec2(gl_FragCoord.xy), 0).xy;
+#endif
     bool specular = false;
     if (canvasPx.x > -1000.0) {
         ivec2 cpi = clamp(ivec2(floor(canvasPx + 0.5)), ivec2(0), textureSize(gEmissive, 0) - 1);

@@ -40,9 +40,9 @@ void FuzzyReflectionPass::setup(PassBuilder& b) const {
           Resource::RefractionWeight, Resource::RealSurfaces, Resource::CameraImage})
         b.read(r);
     for (Resource r : kInputs) b.read(r);
-    // The video term in float32, as the composite computes it for a sharp pixel: a kernel of one
-    // pixel then reproduces the mirror path exactly (the L' buffers pass through RGBA16F exactly).
-    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA16F, SizeRule::Canvas);
+    // In float32, as the L' buffers come and as the composite computes the video term for a
+    // sharp pixel: a kernel of one pixel then reproduces the mirror path exactly.
+    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA32F, SizeRule::Canvas);
     b.write(Resource::FuzzyReflectionVideo, GL_RGBA32F, SizeRule::Canvas);
 }
 
@@ -73,9 +73,8 @@ void FuzzyReflectionPass::resize(const FrameContext& ctx) {
     video_ = gl::Texture::create2D("fuzzy video term", w, h, GL_RGBA32F);
     static const char* names[5] = {"L'_rv", "L'_r", "L'_r reflection share", "L_env", "video"};
     for (int i = 0; i < 5; ++i) {
-        const GLenum format = i == 4 ? GL_RGBA32F : GL_RGBA16F;
-        rows_[i] = gl::Texture::create2D(std::string("fuzzy rows ") + names[i], w, h, format);
-        out_[i] = gl::Texture::create2D(std::string("fuzzy ") + names[i], w, h, format);
+        rows_[i] = gl::Texture::create2D(std::string("fuzzy rows ") + names[i], w, h, GL_RGBA32F);
+        out_[i] = gl::Texture::create2D(std::string("fuzzy ") + names[i], w, h, GL_RGBA32F);
     }
     videoFbo_ = gl::Framebuffer("fuzzy video fbo");
     videoFbo_.attachColor(0, video_);

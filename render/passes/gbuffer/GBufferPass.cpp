@@ -63,8 +63,10 @@ void GBufferPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(1, normal_);
     fbo_.attachColor(2, albedo_);
     fbo_.attachColor(3, emissive_);
+    // The fifth target, RealSurfaces, is written by the real draws only (colour mask).
+    fbo_.attachColor(4, realSurfaces_);
     fbo_.attachDepth(depth_);
-    fbo_.finalize(4);
+    fbo_.finalize(5);
     mask_ = gl::Texture::create2D("specular pixel mask", w, h, GL_DEPTH_COMPONENT32F);
     maskFbo_ = gl::Framebuffer("specular pixel mask fbo");
     maskFbo_.attachDepth(mask_);
@@ -75,8 +77,9 @@ void GBufferPass::resize(const FrameContext& ctx) {
 void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_.bind();
     glViewport(0, 0, ctx.canvasWidth(), ctx.canvasHeight());
+    const bool separate = separateRealSurfaces(ctx);
     const float zero[4] = {0, 0, 0, 0};
-    for (int i = 0; i < 4; ++i) glClearBufferfv(GL_COLOR, i, zero);
+    for (int i = 0; i < (separate ? 5 : 4); ++i) glClearBufferfv(GL_COLOR, i, zero);
     const float one = 1.0f;
     glClearBufferfv(GL_DEPTH, 0, &one);
     glEnable(GL_DEPTH_TEST);
@@ -98,17 +101,20 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
             draw_.draw(ctx.scene, d);
         }
     };
-    if (separateRealSurfaces(ctx)) {
-        // After the real draws the position target holds the nearest real surface everywhere
-        // (the depth test among them is the same as without the virtual ones). Ties at equal
-        // depth between a real and a virtual surface go to the real one.
+    if (separate) {
+        // The real draws write RealSurfaces beside the position: once they are done it holds
+        // the nearest real surface everywhere (the depth test among them is the same as without
+        // the virtual ones), and the virtual draws leave it alone. Ties at equal depth between a
+        // real and a virtual surface go to the real one.
         drawAll(true, false);
-        glCopyImageSubData(position_.id(), GL_TEXTURE_2D, 0, 0, 0, 0, realSurfaces_.id(),
-                           GL_TEXTURE_2D, 0, 0, 0, 0, ctx.canvasWidth(), ctx.canvasHeight(), 1);
+        glColorMaski(4, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         drawAll(false, true);
+        glColorMaski(4, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         res.publish(Resource::RealSurfaces, realSurfaces_);
     } else {
+        glColorMaski(4, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         drawAll(true, true);
+        glColorMaski(4, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         // Every surface is real, or no pass reads RealSurfaces this frame.
         res.publish(Resource::RealSurfaces, position_);
     }

@@ -6,10 +6,11 @@
 // the back-projection of the video into reflections and refractions validates against (Knecht
 // 2013 Sec. 4.1.3; the video shows real surfaces only, virtual objects in front do not hide them).
 // When virtual draws are present and a mirror or glass object is in view (the only frames whose
-// passes read it), the real draws are rasterised first, the position target is copied into
-// RealSurfaces, and the virtual draws follow: one raster of the scene instead of a second raster
-// of every real draw (on llvmpipe the copy costs a fraction of that raster). Otherwise the
-// position target itself is published as RealSurfaces.
+// passes read it), the real draws are rasterised first, writing their position into RealSurfaces
+// too (a fifth target), and the virtual draws follow with that target masked off: one raster of
+// the scene instead of a second raster of every real draw, and no copy of the position target
+// between the two halves (on llvmpipe a copy waits for the rasteriser). Otherwise the position
+// target itself is published as RealSurfaces.
 //
 // With a mirror or glass object in view it also gives SpecularMask, a canvas depth buffer: 0 on
 // the pixels that show one, 1 elsewhere (specular_mask.frag), drawn over the specular objects'

@@ -21,12 +21,15 @@ layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the c
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
 layout(location = 3) out vec4 gEmissive;  // rgb linear emitted radiance, a = specular slot + 1
                                           // (0: not a mirror / glass pixel; -1: translucent)
+layout(location = 4) out vec4 gRealSurface;  // = gPosition; GBufferPass masks it off for the
+                                             // virtual draws (RealSurfaces)
 void main() {
     vec3 n = normalize(worldNormal);
     if (!allFinite(n)) n = vec3(0.0, 1.0, 0.0);
     // Shade the side the camera sees (proxies are often single quads seen from either side).
     if (dot(n, cameraPos.xyz - worldPos) < 0.0) n = -n;
     gPosition = vec4(worldPos, float(origin));
+    gRealSurface = gPosition;
     // glTF: the factors times the texture's G (roughness) and B (metallic), per pixel, so a
     // rough-glass object can be frosted in parts (render/passes/rough reads gNormal.w). Scenes
     // without such textures compile without the reads (a white texture costs as much to read).

@@ -44,9 +44,9 @@ void RoughRefractionPass::setup(PassBuilder& b) const {
         b.read(r);
     for (Resource r : kSharp) b.read(r);
     for (Resource r : kFuzzy) b.readOptional(r);  // rough metals filtered in the same frame
-    // The video term in float32 as the fuzzy pass's: the limit of a one-texel lobe reproduces
-    // the smooth path exactly.
-    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA16F, SizeRule::Canvas);
+    // In float32 as the L' buffers come and as the fuzzy pass's: the limit of a one-texel lobe
+    // reproduces the smooth path exactly.
+    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA32F, SizeRule::Canvas);
     b.write(Resource::RoughVideo, GL_RGBA32F, SizeRule::Canvas);
 }
 
@@ -77,11 +77,10 @@ void RoughRefractionPass::resize(const FrameContext& ctx) {
                                               "prefiltered L_env", "prefiltered video term"};
     chainsFbo_ = gl::Framebuffer("rough chains fbo");
     for (int i = 0; i < kChains; ++i) {
-        // The moments in float32 (the covariance is a difference of them), and the video term
-        // as the composite's.
-        const GLenum format = i < 3 || i == kChains - 1 ? GL_RGBA32F : GL_RGBA16F;
+        // In float32: the moments (the covariance is a difference of them), the L' buffers as
+        // they come (the one-texel limit is exact) and the video term as the composite's.
         chains_[i] =
-            gl::Texture::create2D(std::string("rough ") + chainNames[i], w, h, format, levels);
+            gl::Texture::create2D(std::string("rough ") + chainNames[i], w, h, GL_RGBA32F, levels);
         chains_[i].setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);
         chains_[i].setWrap(GL_CLAMP_TO_EDGE);
         chainsFbo_.attachColor(i, chains_[i]);
@@ -90,8 +89,7 @@ void RoughRefractionPass::resize(const FrameContext& ctx) {
     static const char* names[5] = {"L'_rv", "L'_r", "L'_r reflection share", "L_env", "video"};
     outFbo_ = gl::Framebuffer("rough refraction fbo");
     for (int i = 0; i < 5; ++i) {
-        out_[i] = gl::Texture::create2D(std::string("rough ") + names[i], w, h,
-                                        i == 4 ? GL_RGBA32F : GL_RGBA16F);
+        out_[i] = gl::Texture::create2D(std::string("rough ") + names[i], w, h, GL_RGBA32F);
         outFbo_.attachColor(i, out_[i]);
     }
     outFbo_.finalize(5);

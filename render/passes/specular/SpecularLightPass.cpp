@@ -15,8 +15,8 @@ constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::Re
                                       Resource::RefractionNormal,   Resource::RefractionAlbedo,
                                       Resource::RefractionEmissive, Resource::RefractionWeight};
 static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
-// L'_rv, L'_r, reflection share, L_env, then the four history buffers.
-constexpr int kAttachments = 8;
+// L'_rv, L'_r, reflection share (each also the next frame's history), L_env, the hits.
+constexpr int kAttachments = 5;
 }  // namespace
 
 SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
@@ -73,14 +73,12 @@ void SpecularLightPass::setup(PassBuilder& b) const {
           Resource::ShadowGlassReal, Resource::Vpls, Resource::ImperfectShadowMaps,
           Resource::ImperfectShadowMapsReal, Resource::PhotonGrid, Resource::PhotonRecords})
         b.readOptional(r);
-    b.write(Resource::SpecularRv, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::SpecularR, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::SpecularRReflection, GL_RGBA16F, SizeRule::Canvas);
+    // This frame's smoothed L', read back by the next frame as temporal history (32-bit: the
+    // alpha channels hold the world positions and distances the history test compares).
+    b.write(Resource::SpecularRv, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::SpecularR, GL_RGBA32F, SizeRule::Canvas, true);
+    b.write(Resource::SpecularRReflection, GL_RGBA32F, SizeRule::Canvas, true);
     b.write(Resource::Lenv, GL_RGBA16F, SizeRule::Canvas);
-    // This frame's smoothed L', read back by the next frame as temporal history.
-    b.write(Resource::SpecularHistoryRv, GL_RGBA32F, SizeRule::Canvas, true);
-    b.write(Resource::SpecularHistoryR, GL_RGBA32F, SizeRule::Canvas, true);
-    b.write(Resource::SpecularHistoryRReflection, GL_RGBA32F, SizeRule::Canvas, true);
 }
 
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
@@ -99,34 +97,26 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
     if (w == width_ && h == height_) return;
     width_ = w;
     height_ = h;
-    rv_ = gl::Texture::create2D("L'_rv", w, h, GL_RGBA16F);
-    r_ = gl::Texture::create2D("L'_r", w, h, GL_RGBA16F);
-    rRefl_ = gl::Texture::create2D("L'_r reflection share", w, h, GL_RGBA16F);
-    env_ = gl::Texture::create2D("L_env", w, h, GL_RGBA16F);
     for (int i = 0; i < 2; ++i) {
         // 32-bit: world positions and distances the history test compares.
-        historyRv_[i] = gl::Texture::create2D("L'_rv (history)", w, h, GL_RGBA32F);
-        historyR_[i] = gl::Texture::create2D("L'_r (history)", w, h, GL_RGBA32F);
-        historyRRefl_[i] =
-            gl::Texture::create2D("L'_r reflection share (history)", w, h, GL_RGBA32F);
-        historyHits_[i] = gl::Texture::create2D("specular hits (history)", w, h, GL_RGBA32F);
+        rv_[i] = gl::Texture::create2D("L'_rv", w, h, GL_RGBA32F);
+        r_[i] = gl::Texture::create2D("L'_r", w, h, GL_RGBA32F);
+        rRefl_[i] = gl::Texture::create2D("L'_r reflection share", w, h, GL_RGBA32F);
+        env_[i] = gl::Texture::create2D("L_env", w, h, GL_RGBA16F);
+        hits_[i] = gl::Texture::create2D("specular hits", w, h, GL_RGBA32F);
         // Linear: the history is read at reprojected, fractional positions.
-        for (gl::Texture* t : {&historyRv_[i], &historyR_[i], &historyRRefl_[i], &historyHits_[i]})
+        for (gl::Texture* t : {&rv_[i], &r_[i], &rRefl_[i], &hits_[i]})
             t->setFilter(GL_LINEAR, GL_LINEAR);
         fbo_[i] = gl::Framebuffer("specular light fbo");
-        fbo_[i].attachColor(0, rv_);
-        fbo_[i].attachColor(1, r_);
-        fbo_[i].attachColor(2, rRefl_);
-        fbo_[i].attachColor(3, env_);
-        fbo_[i].attachColor(4, historyRv_[i]);
-        fbo_[i].attachColor(5, historyR_[i]);
-        fbo_[i].attachColor(6, historyRRefl_[i]);
-        fbo_[i].attachColor(7, historyHits_[i]);
+        fbo_[i].attachColor(0, rv_[i]);
+        fbo_[i].attachColor(1, r_[i]);
+        fbo_[i].attachColor(2, rRefl_[i]);
+        fbo_[i].attachColor(3, env_[i]);
+        fbo_[i].attachColor(4, hits_[i]);
         fbo_[i].finalize(kAttachments);
         attachedMask_[i] = 0;  // execute() attaches the specular mask
+        drawn_[i].markAll();
     }
-    drawn_.markAll();
-    for (DrawnRects& d : historyDrawn_) d.markAll();
     history_.drop();  // new buffers hold no history
     if (!ctx.options.specularHalfResolution) return;
     halfWidth_ = (w + 1) / 2;
@@ -154,8 +144,7 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
 }
 
 void SpecularLightPass::clearAndDraw(const FrameContext& ctx, int write) {
-    ctx.clearForRects(ctx.specularRects, drawn_, 0, 4);
-    ctx.clearForRects(ctx.specularRects, historyDrawn_[write], 4, 4);
+    ctx.clearForRects(ctx.specularRects, drawn_[write], 0, kAttachments);
     ctx.drawFullscreenTriangleIn(ctx.specularRects);
 }
 
@@ -183,8 +172,7 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     ctx.clearForRects(halfRects, halfDrawn_, 0, 4);
     ctx.drawFullscreenTriangleIn(halfRects);
     // The upsample, on the canvas's specular pixels. It writes L'_rv, L'_r, the reflection's
-    // share and L_env; the history attachments are cleared and stay unused (no history at half
-    // resolution: specularBlend).
+    // share and L_env, and 0 hits (no history at half resolution: specularBlend).
     fbo_[write].bind();
     ctx.beginFullscreen(resolve_, ctx.canvasWidth(), ctx.canvasHeight());
     const gl::Texture* half[4] = {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_};
@@ -260,10 +248,10 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons,
                          res.buffer(Resource::PhotonRecords).id());
     }
-    glBindTextureUnit(kUnitSpecLightHistoryRv, historyRv_[read].id());
-    glBindTextureUnit(kUnitSpecLightHistoryR, historyR_[read].id());
-    glBindTextureUnit(kUnitSpecLightHistoryRRefl, historyRRefl_[read].id());
-    glBindTextureUnit(kUnitSpecLightHistoryHits, historyHits_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryRv, rv_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryR, r_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryRRefl, rRefl_[read].id());
+    glBindTextureUnit(kUnitSpecLightHistoryHits, hits_[read].id());
     if (ctx.options.specularHalfResolution && halfPlain_.program.id() != 0) {
         shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, write);
     } else {
@@ -282,14 +270,11 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
-    res.publish(Resource::SpecularRv, rv_);
-    res.publish(Resource::SpecularR, r_);
-    res.publish(Resource::SpecularRReflection, rRefl_);
-    res.publish(Resource::Lenv, env_);
+    res.publish(Resource::SpecularRv, rv_[write]);
+    res.publish(Resource::SpecularR, r_[write]);
+    res.publish(Resource::SpecularRReflection, rRefl_[write]);
+    res.publish(Resource::Lenv, env_[write]);
     history_.written(ctx);
-    res.publish(Resource::SpecularHistoryRv, historyRv_[write]);
-    res.publish(Resource::SpecularHistoryR, historyR_[write]);
-    res.publish(Resource::SpecularHistoryRReflection, historyRRefl_[write]);
 }
 
 }  // namespace mirage::render

@@ -5,8 +5,8 @@
 // modelled look up the environment map into L_env (specular_light.frag). In frames with a
 // world-space photon grid (PhotonGridPass) the hits also gather the caustic photons around them
 // (a shader variant: without a grid the frame pays nothing for it). L'_rv, L'_r and the
-// reflection's share are smoothed over time (RendererOptions::specularTemporal): four
-// canvas-size buffers ping-pong as this frame's result and the next frame's history (not in the
+// reflection's share are smoothed over time (RendererOptions::specularTemporal): they and the
+// hits they were lit at ping-pong, this frame's result being the next frame's history (not in the
 // half-resolution variant, RendererOptions::specularHalfResolution: its hits are shaded per 2x2
 // block, and the history test needs each pixel's own hits).
 #include "render/RenderPass.h"
@@ -35,14 +35,12 @@ private:
     // then draws the full-screen triangle in the specular rectangles.
     void clearAndDraw(const FrameContext& ctx, int write);
     Variant plain_, gather_;  // gather_: only for scenes that can have caustics
-    gl::Texture rv_, r_, rRefl_, env_;
-    // Smoothed L'_rv, L'_r, reflection share and the hits they were lit at (Resource.h; the
-    // hits' texture is read by this pass alone, so it is not a frame-graph resource);
-    // [history_.writeSlot()] is written this frame and read as history by the next.
-    gl::Texture historyRv_[2], historyR_[2], historyRRefl_[2], historyHits_[2];
+    // Smoothed L'_rv, L'_r, reflection share (Resource.h), L_env and the hits they were lit at
+    // (read by this pass alone, so not a frame-graph resource), fbo_[i]'s attachments 0-4:
+    // [history_.writeSlot()] is written and published this frame and read as history by the next.
+    gl::Texture rv_[2], r_[2], rRefl_[2], env_[2], hits_[2];
     gl::Framebuffer fbo_[2];
-    // What draws covered in rv_ .. env_ (attachments 0-3 of both fbo_) and in each history set.
-    DrawnRects drawn_, historyDrawn_[2];
+    DrawnRects drawn_[2];              // what draws covered in each fbo_'s attachments
     GLuint attachedMask_[2] = {0, 0};  // the SpecularMask texture attached as fbo_[i]'s depth
     gl::Texture vplTexels_ = gl::Texture::createBufferView("VPL texels (specular light)");
     TemporalHistory history_;

@@ -189,7 +189,8 @@ bool projectToCanvas(vec3 x, out vec2 canvasPx) {
 // x there. Valid when x is in front of the camera, inside the canvas and the camera image, and
 // the nearest REAL surface at that pixel (realSurfaces: xyz world, w = origin) has the same camera
 // distance within depthEpsilon * distance + 5 mm. canvasToCamera: canvas -> camera-image pixel
-// (lens distortion); cameraImage: sRGB8 texture, so `colour` is linear camera units.
+// (lens distortion; not read under MIRAGE_IDENTITY_REMAP, where the canvas is the camera image);
+// cameraImage: sRGB8 texture, so `colour` is linear camera units.
 bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampler2D cameraImage,
                  float depthEpsilon, out vec3 colour) {
     colour = vec3(0.0);
@@ -201,7 +202,11 @@ bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampl
     if (int(S.w + 0.5) != ORIGIN_REAL) return false;
     float dx = length(x - cameraPos.xyz), ds = length(S.xyz - cameraPos.xyz);
     if (abs(dx - ds) > depthEpsilon * dx + 0.005) return false;
+#ifdef MIRAGE_IDENTITY_REMAP  // the composite's variant without lens distortion
+    vec2 camPx = cp;
+#else
     vec2 camPx = texture(canvasToCamera, (cp + 0.5) * canvas.zw).xy;
+#endif
     ivec2 size = textureSize(cameraImage, 0);
     if (camPx.x < -0.5 || camPx.y < -0.5 || camPx.x > float(size.x) - 0.5 ||
         camPx.y > float(size.y) - 0.5)

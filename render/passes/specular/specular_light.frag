@@ -69,15 +69,14 @@ layout(binding = kUnitSpecLightHistoryRv) uniform sampler2D historyRv;
 layout(binding = kUnitSpecLightHistoryR) uniform sampler2D historyR;
 layout(binding = kUnitSpecLightHistoryRRefl) uniform sampler2D historyRRefl;
 layout(binding = kUnitSpecLightHistoryHits) uniform sampler2D historyHits;
+// This frame's smoothed values are the next frame's history: each output is both (the alpha
+// channels carry what the history test compares, as above).
 layout(location = 0) out vec4 outRv;     // L'_rv
 layout(location = 1) out vec4 outR;      // L'_r
 layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r (for Eq. 9, see
                                          // composite.frag)
 layout(location = 3) out vec4 outEnv;    // L_env; a = 1 on specular pixels
-layout(location = 4) out vec4 outHistoryRv;  // the next frame's history (as historyRv, ...)
-layout(location = 5) out vec4 outHistoryR;
-layout(location = 6) out vec4 outHistoryRRefl;
-layout(location = 7) out vec4 outHistoryHits;
+layout(location = 4) out vec4 outHits;   // the hits, as historyHits
 
 const float kNoHit = 1e6;  // the hit of a ray that hit nothing modelled (or was not traced)
 
@@ -271,10 +270,7 @@ void main() {
     outR = vec4(0.0);
     outRRefl = vec4(0.0);
     outEnv = vec4(0.0);
-    outHistoryRv = vec4(0.0);
-    outHistoryR = vec4(0.0);
-    outHistoryRRefl = vec4(0.0);
-    outHistoryHits = vec4(0.0);
+    outHits = vec4(0.0);
     // No early return before the quad average below: its derivatives need every lane's values.
     bool specularPixel = texelFetch(reflEmissive, px, 0).a >= 0.5;
     vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
@@ -353,13 +349,10 @@ void main() {
             rRefl = mix(rRefl, max(hRRefl.rgb, vec3(0.0)), historyWeight);
         }
     }
-    outHistoryRv = vec4(rv, distance(surface, cameraPos.xyz));
-    outHistoryR = vec4(r, hit[1].y);
-    outHistoryRRefl = vec4(rRefl, hit[1].z);
-    outHistoryHits = vec4(hit[0], hit[1].x);
-    outRv = vec4(rv, 1.0);
-    outR = vec4(r, 1.0);
-    outRRefl = vec4(rRefl, 1.0);
+    outRv = vec4(rv, distance(surface, cameraPos.xyz));
+    outR = vec4(r, hit[1].y);
+    outRRefl = vec4(rRefl, hit[1].z);
+    outHits = vec4(hit[0], hit[1].x);
     outEnv = vec4(allFinite(env) ? env : vec3(0.0), 1.0);
 }
 #endif

@@ -38,6 +38,7 @@ layout(location = 0) out vec4 outRv;     // L'_rv
 layout(location = 1) out vec4 outR;      // L'_r
 layout(location = 2) out vec4 outRRefl;  // the reflection's share of L'_r
 layout(location = 3) out vec4 outEnv;    // L_env; a = 1 on specular pixels
+layout(location = 4) out vec4 outHits;   // the full variant's history hits: unused here (0)
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -45,6 +46,7 @@ void main() {
     outR = vec4(0.0);
     outRRefl = vec4(0.0);
     outEnv = vec4(0.0);
+    outHits = vec4(0.0);
     if (texelFetch(reflEmissive, px, 0).a < 0.5) return;  // not a specular pixel
     float slot = texelFetch(gEmissive, px, 0).a;
     // The four half pixels around this pixel's centre, their bilinear weights and representatives
