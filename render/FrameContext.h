@@ -147,6 +147,10 @@ struct RendererOptions {
     // FrameContext::drawFullscreenTriangleOutsideSpecular). true: they shade them too (tests
     // compare the two).
     bool diffuseOnSpecularPixels = false;
+    // Where the lens remap is the identity (no distortion, a canvas of the camera's size) the
+    // composite reads each canvas buffer at its own pixel (CompositePass::isIdentityRemap).
+    // false: it reads through the remap table there too (tests compare the two).
+    bool compositeIdentityRemap = true;
     // true: in frames with VPL light the direct-light pass also writes the direct light alone
     // (DirectRv / DirectR; two more canvas targets), besides the GI solutions LRv / LR it sums
     // with the upsampled indirect light. false (the default): DirectRv / DirectR exist only in

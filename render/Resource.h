@@ -51,8 +51,8 @@ enum class Resource {
     GiHistoryR,   // by gifilter as the next frame's temporal history (persistent)
     GatherLight,  // the filtered indirect light packed per gather pixel for the upsample: L_rv,
                   // L_r as halves, camera-frame depth as a half, 8-bit oct normal (RGBA32UI)
-    LRv,          // the two GI solutions: direct + filtered, upsampled indirect (canvas size)
-    LR,
+    LRv,          // the two GI solutions: direct + filtered, upsampled indirect (canvas size);
+    LR,           // LRv.a = the pixel's origin (ORIGIN_*; 0 on the specular pixels it skips)
     // Reflected-scene impostors of the specular objects' surroundings (persistent: built once
     // per scene; render/passes/impostor/trace.glsl reads them).
     ImpostorCubePosition,  // G-buffer cube maps, 12 layers per specular object

@@ -7,8 +7,11 @@
 #include <cstdio>
 #include <memory>
 
+#include "core/scene/Scene.h"
 #include "render/Renderer.h"
+#include "render/passes/composite/CompositePass.h"
 #include "tests/support/HeadlessGlSuite.h"
+#include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
@@ -128,6 +131,46 @@ TEST_F(RealtimeLens, AlignmentCheckFailsWhenDistortionIsIgnored) {
     const AlignmentStats st = measureAlignment(r.coverage(), cam, pose, 1.2f);
     EXPECT_GT(st.maxError, 2.0);
     std::printf("distortion ignored: max edge error %.2f px\n", st.maxError);
+}
+
+// Without distortion, on a canvas of the camera's size, the lens remap is the identity and the
+// composite reads each canvas buffer at its own pixel; any distortion that moves a pixel by more
+// than a thousandth keeps the table.
+TEST_F(RealtimeLens, IdentityRemapOnlyWithoutDistortion) {
+    CameraIntrinsics pinhole = distortedCamera();
+    pinhole.distortion.clear();
+    EXPECT_TRUE(CompositePass::isIdentityRemap(CameraProjection::make(pinhole)));
+    EXPECT_FALSE(CompositePass::isIdentityRemap(CameraProjection::make(distortedCamera())));
+    CameraIntrinsics slight = pinhole;
+    slight.distortion = {-0.01, 0.0, 0.0, 0.0, 0.0};  // ~0.1 px at the corners
+    EXPECT_FALSE(CompositePass::isIdentityRemap(CameraProjection::make(slight)));
+}
+
+// The identity-remap variant composites every pixel as the general one (through the table),
+// mirror and glass pixels (the video back-projected into them) included; the comparison sees a
+// remap one pixel off.
+TEST_F(RealtimeLens, IdentityRemapVariantComposesAsTheTable) {
+    const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf");
+    const CameraIntrinsics cam = test::smallCamera(160, 120, 130.0);
+    const Pose view = lookAtPose({0.05, 0.40, 0.60}, {-0.05, 0.02, 0.0});
+    cv::Mat footage(cam.height, cam.width, CV_8UC3);
+    cv::randu(footage, 0, 255);
+    auto composite = [&](const CameraIntrinsics& c, bool identity) {
+        RendererOptions o;
+        o.vplCount = 64;
+        o.compositeIdentityRemap = identity;
+        Renderer r(scene, c, o);
+        r.render({view, footage, true});
+        EXPECT_GT(r.specularRects().size(), 0u);
+        return r.compositeLinear();
+    };
+    const cv::Mat fast = composite(cam, true), table = composite(cam, false);
+    const double diff = cv::norm(fast, table, cv::NORM_INF);
+    std::printf("identity remap against the table: max difference %.2g\n", diff);
+    EXPECT_LT(diff, 1e-4);
+    CameraIntrinsics shifted = cam;
+    shifted.cx += 1.0;
+    EXPECT_GT(cv::norm(fast, composite(shifted, false), cv::NORM_INF), 1e-2);
 }
 
 }  // namespace

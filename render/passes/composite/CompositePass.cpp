@@ -89,7 +89,7 @@ void CompositePass::resize(const FrameContext& ctx) {
     if (programsBuilt_ && linear_.width() == w && linear_.height() == h &&
         canvasToCamera_.width() == p.canvasWidth && canvasToCamera_.height() == p.canvasHeight)
         return;
-    const bool identity = isIdentityRemap(p);
+    const bool identity = ctx.options.compositeIdentityRemap && isIdentityRemap(p);
     if (!programsBuilt_ || identity != identityRemap_) buildPrograms(identity);
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
     srgb_ = gl::Texture::create2D("composite srgb", w, h, GL_SRGB8_ALPHA8);

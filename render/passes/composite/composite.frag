@@ -136,8 +136,16 @@ void main() {
     float coverage = 0.0;
     if (canvasPx.x > -1000.0 && showVirtual != 0) {
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
+#if defined(MIRAGE_IDENTITY_REMAP) && defined(MIRAGE_DIFFUSE_ONLY)
+        // direct.frag writes the pixel's origin into LRv.a (it skips only the specular pixels,
+        // which this variant never draws): one read fewer.
+        vec4 lrv = texelFetch(lRv, cpi, 0);
+        int origin = int(lrv.a + 0.5);
+        vec3 rv = lrv.rgb, r = texelFetch(lR, cpi, 0).rgb;
+#else
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
         vec3 rv = MIRAGE_CANVAS_AT(lRv).rgb, r = MIRAGE_CANVAS_AT(lR).rgb;
+#endif
 #ifndef MIRAGE_NO_CAUSTICS  // the variant for frames without a caustic pass never reads them
         if (withCaustics != 0) {
             rv += MIRAGE_CANVAS_AT(causticRv).rgb;

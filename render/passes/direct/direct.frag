@@ -32,7 +32,7 @@ uniform int translucentOn;  // 1: the translucency pass ran this frame
 #ifdef MIRAGE_WITH_INDIRECT
 #include "passes/direct/gi_upsample.glsl"
 #endif
-layout(location = 0) out vec4 outRv;  // linear radiance
+layout(location = 0) out vec4 outRv;  // linear radiance; a = the pixel's origin (ORIGIN_*)
 layout(location = 1) out vec4 outR;
 #ifdef MIRAGE_KEEP_DIRECT
 layout(location = 2) out vec4 outDirectRv;
@@ -106,7 +106,7 @@ void main() {
         upsampleIndirect(px, textureSize(gPosition, 0), P.xyz, N.xyz, iRv, iR);
 #endif
     }
-    outRv = vec4(rv + iRv, 1.0);
+    outRv = vec4(rv + iRv, float(origin));  // a: the origin, for the composite's diffuse variant
     outR = vec4(r + iR, 1.0);
 #ifdef MIRAGE_KEEP_DIRECT
     outDirectRv = vec4(rv, 1.0);
