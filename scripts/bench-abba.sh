@@ -25,8 +25,9 @@ done
 [ -d "$session" ] || { echo "bench-abba: session $session is not a directory" >&2; exit 2; }
 mkdir -p "$out"
 
-run() {  # which round
+run() {  # which round [bench args...]
     local which=$1 round=$2 bin knobs
+    shift 2
     if [ "$which" = a ]; then bin=$A knobs=${A_KNOBS:-}; else bin=$B knobs=${B_KNOBS:-}; fi
     echo "round $round $which: load $(cut -d' ' -f1-3 /proc/loadavg)"
     # shellcheck disable=SC2086  # the knob strings are word lists

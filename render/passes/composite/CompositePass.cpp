@@ -85,12 +85,14 @@ void CompositePass::resize(const FrameContext& ctx) {
     const CameraProjection& p = ctx.projection;
     const int w = p.camera.width, h = p.camera.height;
     // Runs before every frame; the camera (and so the remap tables) is fixed for the renderer's
-    // life, so only a size change rebuilds them.
-    if (programsBuilt_ && linear_.width() == w && linear_.height() == h &&
-        canvasToCamera_.width() == p.canvasWidth && canvasToCamera_.height() == p.canvasHeight)
-        return;
-    const bool identity = ctx.options.compositeIdentityRemap && isIdentityRemap(p);
+    // life, so only a size change rebuilds them (the programs also follow the option).
+    const bool sameSize = linear_.width() == w && linear_.height() == h &&
+                          canvasToCamera_.width() == p.canvasWidth &&
+                          canvasToCamera_.height() == p.canvasHeight;
+    if (!sameSize) remapIsIdentity_ = isIdentityRemap(p);
+    const bool identity = ctx.options.compositeIdentityRemap && remapIsIdentity_;
     if (!programsBuilt_ || identity != identityRemap_) buildPrograms(identity);
+    if (sameSize) return;
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
     srgb_ = gl::Texture::create2D("composite srgb", w, h, GL_SRGB8_ALPHA8);
     remap_ = gl::Texture::create2D("lens remap", w, h, GL_RG32F);

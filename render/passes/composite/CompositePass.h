@@ -29,7 +29,8 @@ private:
     gl::Program program_;                   // with Eqs. 6-11 for mirror / glass pixels
     gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
     gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
-    bool programsBuilt_ = false, identityRemap_ = false;
+    bool programsBuilt_ = false, identityRemap_ = false;  // the variants built, and which
+    bool remapIsIdentity_ = false;  // isIdentityRemap of the camera the tables were built for
     gl::Texture linear_, srgb_, remap_;
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
