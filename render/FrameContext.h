@@ -160,9 +160,10 @@ struct RendererOptions {
     // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
     bool reuseStaticPasses = true;
     bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
-    // glFinish around every pass so each timer query holds only its pass's work. llvmpipe defers
-    // rasterisation until a later sync (a compute dispatch that reads the result, a readback), so
-    // without this a pass's time can show up in the next pass's query. For benchmarks.
+    // glFinish around every pass, each timed by the wall clock between the two (PassReport::gpuMs).
+    // llvmpipe defers rasterisation until a later sync (a compute dispatch that reads the result,
+    // a readback), so without this a pass's time can show up in the next pass's timer query, and
+    // its queries miss compute dispatches. For benchmarks.
     bool syncPasses = false;
     // false: the composite is the footage unchanged, as if no virtual object existed (the live
     // view's "hide" key; the bench's `virtual=off` sanity point, which must score as the footage).

@@ -1,6 +1,7 @@
 #include "render/FrameGraph.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -249,6 +250,12 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
     plan(ctx, run);
     report_.totalGpuMs = 0.0;
     const RendererOptions& o = ctx.options;
+    using Clock = std::chrono::steady_clock;
+    const auto msSince = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    const Clock::time_point frameStart = Clock::now();
+    syncedMs_.assign(nodes_.size(), 0.0);
     for (size_t i = 0; i < nodes_.size(); ++i) {
         Node& node = nodes_[i];
         RenderPass& p = *node.pass;
@@ -273,19 +280,36 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
         p.resize(ctx);  // no-op unless the plan's sizes changed (shadow layers, VPL count)
         published_[i].clear();
         PassResources view(*this, i, ctx);
-        if (o.syncPasses) glFinish();
-        timers_[i].begin();
-        p.execute(ctx, view);
-        if (o.syncPasses) glFinish();
-        timers_[i].end();
+        if (o.syncPasses) {
+            // The pass alone between two glFinish: its time is the wall time between them. On
+            // llvmpipe that is what the pass costs, and GL_TIME_ELAPSED is not: it reads ~0 for
+            // compute dispatches and has returned a timestamp (7e7 "ms") after them.
+            glFinish();
+            const Clock::time_point start = Clock::now();
+            p.execute(ctx, view);
+            glFinish();
+            syncedMs_[i] = msSince(start);
+        } else {
+            timers_[i].begin();
+            p.execute(ctx, view);
+            timers_[i].end();
+        }
         rep.ran = true;
         staticOutputValid_[i] = p.cameraIndependent();
         outputHeld_[i] = true;
     }
     for (size_t i = 0; i < nodes_.size(); ++i) {
         if (!report_.passes[i].ran) continue;
-        report_.passes[i].gpuMs = timers_[i].elapsedMs();
-        report_.totalGpuMs += report_.passes[i].gpuMs;
+        double ms = syncedMs_[i];
+        if (!o.syncPasses) {
+            // GPU time of the pass's commands, overlapping its neighbours'. No pass can take
+            // longer than the frame so far (the result is in): a value beyond that is a broken
+            // query result, reported as 0 rather than as a figure.
+            ms = timers_[i].elapsedMs();
+            if (!(ms >= 0.0 && ms <= msSince(frameStart) + 1.0)) ms = 0.0;
+        }
+        report_.passes[i].gpuMs = ms;
+        report_.totalGpuMs += ms;
     }
     return report_;
 }

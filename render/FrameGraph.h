@@ -29,7 +29,10 @@ struct PassReport {
     bool ran = false;
     bool reused = false;  // not run: the output of an earlier frame was reused (still valid)
     std::string reason;
-    double gpuMs = 0.0;  // GL_TIME_ELAPSED of the pass (0 when skipped)
+    // The pass's time (0 when skipped), ms: with RendererOptions::syncPasses the wall time from
+    // a glFinish before it to one after it (its whole cost on a software rasteriser, compute
+    // dispatches included); otherwise its GL_TIME_ELAPSED, overlapping the other passes' work.
+    double gpuMs = 0.0;
 };
 
 struct FrameReport {
@@ -109,6 +112,7 @@ private:
     std::array<int, kResourceCount> writer_{};  // pass index per resource, -1 none
     bool compiled_ = false;
     std::vector<gl::TimerQuery> timers_;
+    std::vector<double> syncedMs_;  // per pass, this frame: wall ms between its two glFinish
     // This frame's resources, and what each pass published when it last ran (replayed when a
     // camera-independent pass reuses its output).
     std::array<Slot, kResourceCount> current_{};

@@ -4,7 +4,7 @@
 // (render/FrameGraph.h; one folder per pass in render/passes/), built once here: the renderer
 // plans each frame from the scene (which lights cast shadows, which need real-only visibility,
 // whether VPLs are needed, whether a specular object is in view), the graph runs only the passes
-// the frame needs, times each with a GL timer query and reports which ran and why
+// the frame needs, times each (PassReport::gpuMs) and reports which ran and why
 // (`mirage info --passes SCENE` prints it, docs/realtime-renderer.md draws it). Needs a current
 // GL 4.5 context (core/gl/Context.h).
 #include <memory>

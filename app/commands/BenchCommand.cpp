@@ -2,8 +2,9 @@
 // "Ground truth, and how every effect is judged"; docs/bench.md). Runs the renderer over the
 // frames of a synthetic session (made with `mirage synth --ground-truth-composite`) at the
 // ground-truth poses, for a grid of knobs (render/evaluation/RealtimeBench.h), and writes:
-//   OUTDIR/bench.csv         one row per configuration: median GPU ms per pass and in total (GL
-//                            timer queries, syncPasses), median wall ms, PSNR/SSIM over the whole
+//   OUTDIR/bench.csv         one row per configuration: median GPU ms per pass and in total (with
+//                            syncPasses the wall time of each pass between two glFinish; else GL
+//                            timer queries), median wall ms, PSNR/SSIM over the whole
 //                            frame and over the influenced pixels (pooled over frames)
 //   OUTDIR/bench_frames.csv  the same per configuration and frame
 //   OUTDIR/bench.md          a markdown table of bench.csv with the command, date and load average
@@ -238,8 +239,10 @@ void runBench(const BenchArgs& a) {
         "- machine: {} CPU ({} cores), GL renderer {} ({}), started {}, load average (1/5/15 min) "
         "{} "
         "before, {} after\n"
-        "- times: medians over frames (x{} repeats) of GPU ms per pass from GL timer queries with "
-        "`syncPasses`; wall ms = render() + composite readback on the CPU\n"
+        "- times: medians over frames (x{} repeats) of ms per pass: with `syncPasses` the wall "
+        "time "
+        "between a glFinish before and after each pass, else GL timer queries; wall ms = render() "
+        "+ composite readback on the CPU\n"
         "- errors: 8-bit sRGB composite vs the ground-truth composite, pooled over frames; "
         "\"infl.\" = pixels the virtual objects influence ({} pixel(s) in all at the session's "
         "size)\n",

@@ -60,7 +60,8 @@ void writeBenchCsv(const std::string& path, const std::vector<BenchResult>& resu
     std::ofstream out = openOut(path);
     const auto knobs = knobNames(results);
     const auto passes = passNames(results);
-    out << "# mirage bench: medians over frames of GPU ms per pass (GL timer queries, syncPasses);"
+    out << "# mirage bench: medians over frames of ms per pass (syncPasses: wall time between the "
+           "glFinish before and after each pass; otherwise GL timer queries);"
            " errors pooled over frames, 8-bit sRGB vs the ground-truth composite\n";
     out << "config,baseline";
     for (const auto& k : knobs) out << "," << k;

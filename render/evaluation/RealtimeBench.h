@@ -3,7 +3,7 @@
 // of a synthetic session at the ground-truth poses, for a grid of knobs, each configuration judged
 // against the reference renderer's ground-truth composite (GroundTruthComposite.h) by PSNR/SSIM
 // over the whole frame and over the pixels the virtual objects influence, and timed per pass with
-// GL timer queries (RendererOptions::syncPasses, so every pass's query holds only its own work).
+// RendererOptions::syncPasses (each pass alone between two glFinish, timed by the wall clock).
 //
 // Knobs are a list (benchKnobs()), not loops: a new knob (impostor resolution, refinement steps,
 // caustic map size, ...) is one entry there, and the grid, CSV and table pick it up.

@@ -4,6 +4,10 @@
 // publish checks (format, size rule), and per-frame culling with its reasons.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <iostream>
+#include <thread>
+
 #include <functional>
 #include <memory>
 #include <string>
@@ -61,6 +65,7 @@ struct TestPassSpec {
     std::vector<Resource> lookUp{};        // looked up in execute() (declared or not)
     std::vector<Resource> publishExtra{};  // published in execute() without a declaration
     GLenum publishFormat = GL_RGBA16F;     // format of the published textures
+    int cpuMs = 0;                         // execute() sleeps this long
 };
 
 class TestPass final : public RenderPass {
@@ -85,6 +90,7 @@ public:
     }
     void execute(FrameContext&, PassResources& res) override {
         ++runs;
+        if (s_.cpuMs > 0) std::this_thread::sleep_for(std::chrono::milliseconds(s_.cpuMs));
         for (Resource r : s_.lookUp) (void)res.texture(r);
         for (Resource r : s_.writes) res.publish(r, r == Resource::Composite ? camera_ : canvas_);
         for (Resource r : s_.publishExtra) res.publish(r, canvas_);
@@ -275,6 +281,27 @@ TEST_F(FrameGraphTest, CullsFromTheOutputsAndSaysWhy) {
               (std::vector<std::string>{"off", "dependent", "unread", "used", "last"}));
     EXPECT_NE(g.describe().find("reads  Vpls"), std::string::npos) << g.describe();
     EXPECT_NE(g.dot().find("p0 -> p1 [label=\"Vpls\"]"), std::string::npos) << g.dot();
+}
+
+// With syncPasses a pass's time is the wall time between a glFinish before and after it: all it
+// costs on llvmpipe, also work GL_TIME_ELAPSED does not see (compute dispatches there; here the
+// pass sleeps on the CPU, which the GPU timer does not see either: the unsynchronised report
+// shows the difference).
+TEST_F(FrameGraphTest, SynchronisedPassTimeIsTheWholePass) {
+    FrameGraph g;
+    add(g, {.name = "slow", .writes = {Resource::Composite}, .cpuMs = 40});
+    g.markOutput(Resource::Composite);
+    g.compile();
+    options_.syncPasses = true;
+    const double synced = g.execute(*ctx_, "").passes[0].gpuMs;
+    options_.syncPasses = false;
+    const double timed = g.execute(*ctx_, "").passes[0].gpuMs;
+    std::cout << "a pass sleeping 40 ms: " << synced << " ms synchronised, " << timed
+              << " ms by GL_TIME_ELAPSED\n";
+    EXPECT_GE(synced, 39.0);
+    EXPECT_LT(synced, 2000.0);
+    EXPECT_GE(timed, 0.0);
+    EXPECT_LT(timed, 20.0);
 }
 
 // The renderer's own graph: every pass in the report, in the graph's order.
