@@ -98,10 +98,13 @@ Board Board::parse(const std::string& text, const std::string& source) {
     if (j.contains("format") && j["format"] != "mirage-board")
         c.fail("format", "must be \"mirage-board\"");
     Board b;
-    if (j.contains("family")) {
-        if (!j["family"].is_string()) c.fail("family", "must be a string such as \"tag36h11\"");
-        b.family = j["family"].get<std::string>();
-    }
+    // Required: a board printed with another family than assumed finds no tags, or wrong ones.
+    if (!j.contains("family"))
+        c.fail("family",
+               "missing: name the tag family the board was printed with, e.g. "
+               "\"tag36h11\" (mirage board writes it)");
+    if (!j["family"].is_string()) c.fail("family", "must be a string such as \"tag36h11\"");
+    b.family = j["family"].get<std::string>();
     int codeCount = 0;
     try {
         codeCount = TagFamily(b.family).codeCount();

@@ -85,7 +85,12 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
     }
     std::snprintf(b, sizeof b, ",%.3f,%.3f,", f.detectMs, f.poseMs);
     csv_ << b;
-    if (ok && groundTruth) {
+    // Ground truth comes range-checked from frames.csv (core/session/FramesCsv.h); a value that
+    // still overflows the error figures is not compared rather than printed as inf or NaN.
+    const bool comparable =
+        groundTruth && std::isfinite(glm::length(groundTruth->translation)) &&
+        std::isfinite(glm::length(e.pose ? e.pose->translation : glm::dvec3(0)));
+    if (ok && comparable) {
         const double rotErr =
             glm::degrees(rotationAngleBetween(e.pose->rotation, groundTruth->rotation));
         const double posErr = glm::length(e.pose->translation - groundTruth->translation);

@@ -44,6 +44,7 @@ public:
     // Human-readable summary (several lines).
     std::string summary() const;
     int frames() const { return frames_; }
+    int unreadable() const { return unreadable_; }  // frames reported lost for their input
     int okFrames() const { return stateCount_[0]; }
     // ok frames whose pose is off by more than 2 degrees or 2 % of the distance (needs truth).
     int wrongButOk() const { return wrongOk_; }

@@ -69,6 +69,7 @@ void runEnvRadiometry(const EnvRadiometryArgs& a) {
     std::map<int, PoseRow> poses;
     if (!a.poses.empty()) {
         poses = readPosesCsv(a.poses);
+        checkPoseFrames(poses, session, a.poses);
     } else {
         bool anyGroundTruth = false;
         for (const FrameRecord& r : session.frames)

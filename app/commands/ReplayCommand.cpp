@@ -216,6 +216,7 @@ void runReplay(const ReplayArgs& a) {
     std::unique_ptr<tracking::Tracker> tracker;
     if (useTracked) {
         poses = readPosesCsv(a.poses);
+        checkPoseFrames(poses, session, a.poses);
     } else if (!a.groundTruth && !session.board.empty() &&
                std::filesystem::exists(session.path(session.board))) {
         tracker = std::make_unique<tracking::Tracker>(

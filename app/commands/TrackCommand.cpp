@@ -15,6 +15,7 @@
 #include "core/camera/CalibrationFile.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
+#include "core/session/SessionReadOptions.h"
 #include "tracking/Board.h"
 #include "tracking/EnvironmentMap.h"
 #include "tracking/Tracker.h"
@@ -43,54 +44,121 @@ glm::dvec3 boardCentre(const tracking::Board& b) {
     return c / double(b.tags.size());
 }
 
-void run(const TrackArgs& a) {
-    const bool fromSession = !a.session.empty();
-    if (fromSession == !a.video.empty())
-        throw Error(
-            "mirage track: give either SESSION or --video V --calib CAM.yaml --board B.json");
+// What `track` reads: the frames, the calibration and board files, and for a session its
+// metadata and what reading it found wrong.
+struct TrackInputs {
+    bool fromSession = false;
     Session session;
     SessionReadReport readReport;
     std::unique_ptr<FrameSource> frames;
     std::filesystem::path calibPath, boardPath;
-    if (fromSession) {
-        session = readSession(a.session, &readReport);
-        for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
-        const SessionCamera* cam = session.camera(a.camera);
-        if (!cam) throw FileError(a.session, "session has no camera '" + a.camera + "'");
-        if (!a.calib.empty())
-            calibPath = a.calib;
-        else if (cam->calibration.empty())
-            throw FileError(a.session,
-                            "camera '" + a.camera + "' has no calibration file; pass --calib");
-        else
-            calibPath = session.path(cam->calibration);
-        boardPath = a.board.empty() ? session.path(session.board) : std::filesystem::path(a.board);
-        frames = openCameraFrames(session, a.camera);
-    } else {
+    std::vector<std::string> missingVideos;  // session cameras whose video is not there
+};
+
+TrackInputs openInputs(const TrackArgs& a) {
+    TrackInputs in;
+    in.fromSession = !a.session.empty();
+    if (in.fromSession == !a.video.empty())
+        throw Error(
+            "mirage track: give either SESSION or --video V --calib CAM.yaml --board B.json");
+    if (!in.fromSession) {
         if (a.calib.empty() || a.board.empty())
             throw Error("mirage track --video needs --calib CAM.yaml and --board BOARD.json");
-        calibPath = a.calib;
-        boardPath = a.board;
-        frames = openFrames(a.video);
+        in.calibPath = a.calib;
+        in.boardPath = a.board;
+        in.frames = openFrames(a.video);
+        return in;
     }
-    // Outputs are checked before any work (never an input; written under a temporary name and
-    // renamed when done), see core/OutputFile.h.
-    OutputRule rule{
-        fromSession ? sessionInputs(session) : std::vector<std::filesystem::path>{a.video}, a.force,
-        "mirage track"};
-    rule.inputs.push_back(calibPath);
-    rule.inputs.push_back(boardPath);
-    OutputFile posesOut(a.output, OutputOrigin::Named, rule);
-    std::optional<OutputFile> envmapOut, validOut;
-    if (!a.envmap.empty()) {
-        auto validPath = std::filesystem::path(a.envmap);
-        validPath.replace_filename(validPath.stem().string() + "_valid.png");
-        envmapOut.emplace(a.envmap, OutputOrigin::Named, rule);
-        validOut.emplace(validPath, OutputOrigin::Derived, rule);
-    }
+    // The environment camera is needed only for --envmap: without it, the main camera's rows
+    // are kept where the environment video is missing or short.
+    SessionReadOptions options;
+    options.environmentOptional = a.envmap.empty();
+    in.session = readSession(a.session, &in.readReport, options);
+    for (const auto& w : in.readReport.warnings) spdlog::warn("session: {}", w);
+    for (const SessionCamera& c : in.session.cameras)
+        if (!std::filesystem::exists(in.session.path(c.video)))
+            in.missingVideos.push_back("camera '" + c.name + "': " + c.video + " is missing");
+    const SessionCamera* cam = in.session.camera(a.camera);
+    if (!cam) throw FileError(a.session, "session has no camera '" + a.camera + "'");
+    if (!a.calib.empty())
+        in.calibPath = a.calib;
+    else if (cam->calibration.empty())
+        throw FileError(a.session,
+                        "camera '" + a.camera + "' has no calibration file; pass --calib");
+    else
+        in.calibPath = in.session.path(cam->calibration);
+    in.boardPath =
+        a.board.empty() ? in.session.path(in.session.board) : std::filesystem::path(a.board);
+    if (in.session.frames.empty())
+        throw FileError(
+            a.session,
+            "no frame to track: " + std::to_string(in.readReport.framesListed) +
+                " frames listed, none readable in every camera it needs" +
+                (in.readReport.warnings.empty() ? std::string()
+                                                : " (" + in.readReport.warnings.front() + ")"));
+    in.frames = openCameraFrames(in.session, a.camera);
+    return in;
+}
 
-    const CameraCalibration calib = loadCalibration(calibPath);
-    const tracking::Board board = tracking::Board::load(boardPath);
+// The optional environment map from the session's fish-eye camera, posed by its extrinsic: fixed
+// in the world, or relative to the main camera (T_world_env = T_world_main * T_main_env, only in
+// frames where the main camera is tracked ok).
+struct EnvironmentInput {
+    std::unique_ptr<FrameSource> frames;
+    CameraCalibration calib;
+    std::optional<tracking::EnvironmentMap> map;
+    int updates = 0;
+
+    void update(const tracking::TrackedFrame& f) {
+        cv::Mat env;
+        if (!frames->read(env) || env.empty()) return;
+        std::optional<Pose> T_world_env;
+        if (calib.extrinsicParent == "world")
+            T_world_env = *calib.T_parent_camera;
+        else if (f.estimate.state == tracking::TrackingState::Ok)
+            T_world_env = *f.estimate.pose * *calib.T_parent_camera;
+        if (T_world_env) {
+            map->update(env, calib.intrinsics, *T_world_env);
+            ++updates;
+        }
+    }
+};
+
+std::unique_ptr<EnvironmentInput> openEnvironment(const TrackArgs& a, const TrackInputs& in) {
+    if (a.envmap.empty()) return nullptr;
+    if (!in.fromSession)
+        throw Error("mirage track --envmap needs a session with a fish-eye camera");
+    const Session& session = in.session;
+    std::string name = a.envCamera;
+    if (name.empty())
+        for (const auto& c : session.cameras)
+            if (c.role == "environment") name = c.name;
+    const SessionCamera* ec = session.camera(name);
+    if (!ec)
+        throw FileError(a.session, "no environment camera (role \"environment\" or --env-camera)");
+    if (ec->calibration.empty())
+        throw FileError(a.session, "environment camera '" + name + "' has no calibration file");
+    auto env = std::make_unique<EnvironmentInput>();
+    env->calib = loadCalibration(session.path(ec->calibration));
+    if (!env->calib.T_parent_camera)
+        throw FileError(
+            session.path(ec->calibration).string(),
+            "T_parent_camera missing: the fish-eye's pose (parent main or world) is needed");
+    env->frames = openCameraFrames(session, name);
+    env->map.emplace(a.envmapWidth);
+    // Beyond the calibration data's reach the fish-eye model is extrapolated: not sampled.
+    if (env->calib.reachDeg > 0) {
+        env->map->setReachDeg(env->calib.reachDeg);
+        spdlog::warn(
+            "{}: the calibration reaches {:.1f} deg off-axis; environment-map directions "
+            "beyond it are not sampled (left unseen in the validity map). Calibrate with "
+            "boards nearer the rim to widen it.",
+            session.path(ec->calibration).string(), env->calib.reachDeg);
+    }
+    return env;
+}
+
+tracking::TrackerOptions trackerOptions(const TrackArgs& a) {
     tracking::TrackerOptions opt = a.options;
     opt.filterEnabled = !a.noFilter;
     opt.tagTracking = !a.noTagTracking;
@@ -101,61 +169,30 @@ void run(const TrackArgs& a) {
     else if (a.filter != "predictive")
         throw Error("mirage track --filter: expected predictive or one-euro, got '" + a.filter +
                     "'");
-    tracking::Tracker tracker(board, calib.intrinsics, opt);
-    tracking::TrackingReport report(posesOut.temp(), boardCentre(board));
-    if (fromSession) report.addUnreadable(readReport.framesListed - readReport.framesReadable);
+    return opt;
+}
 
-    // Optional environment map from the session's fish-eye camera, posed by its extrinsic: fixed in
-    // the world, or relative to the main camera (T_world_env = T_world_main * T_main_env, only in
-    // frames where the main camera is tracked ok).
-    std::unique_ptr<FrameSource> envFrames;
-    std::optional<CameraCalibration> envCalib;
-    std::optional<tracking::EnvironmentMap> envMap;
-    int envUpdates = 0;
-    if (!a.envmap.empty()) {
-        if (!fromSession)
-            throw Error("mirage track --envmap needs a session with a fish-eye camera");
-        std::string name = a.envCamera;
-        if (name.empty())
-            for (const auto& c : session.cameras)
-                if (c.role == "environment") name = c.name;
-        const SessionCamera* ec = session.camera(name);
-        if (!ec)
-            throw FileError(a.session,
-                            "no environment camera (role \"environment\" or --env-camera)");
-        if (ec->calibration.empty())
-            throw FileError(a.session, "environment camera '" + name + "' has no calibration file");
-        envCalib = loadCalibration(session.path(ec->calibration));
-        if (!envCalib->T_parent_camera)
-            throw FileError(
-                session.path(ec->calibration).string(),
-                "T_parent_camera missing: the fish-eye's pose (parent main or world) is needed");
-        envFrames = openCameraFrames(session, name);
-        envMap.emplace(a.envmapWidth);
-        // Beyond the calibration data's reach the fish-eye model is extrapolated: not sampled.
-        if (envCalib->reachDeg > 0) {
-            envMap->setReachDeg(envCalib->reachDeg);
-            spdlog::warn(
-                "{}: the calibration reaches {:.1f} deg off-axis; environment-map directions "
-                "beyond it are not sampled (left unseen in the validity map). Calibrate with "
-                "boards nearer the rim to widen it.",
-                session.path(ec->calibration).string(), envCalib->reachDeg);
-        }
-    }
+struct TrackLoopCounts {
+    int framesRead = 0;  // frames the source delivered (lost ones included)
+    int repeats = 0;     // frames that repeat the previous one exactly
+};
 
-    installStopSignals();
-    int repeats = 0;
-    int i = 0;
-    for (; !stopRequested(); ++i) {
+// Tracks every frame of `in.frames` into `report` (and `env`, if given) until the end or a stop
+// signal. A frame of another size than the calibration's is an error before anything is written.
+TrackLoopCounts trackFrames(const TrackArgs& a, TrackInputs& in, const CameraCalibration& calib,
+                            tracking::Tracker& tracker, tracking::TrackingReport& report,
+                            EnvironmentInput* env) {
+    TrackLoopCounts n;
+    for (int& i = n.framesRead; !stopRequested(); ++i) {
         cv::Mat bgr;
         const auto t0 = std::chrono::steady_clock::now();
         bool got = false;
         try {
-            got = frames->read(bgr);
+            got = in.frames->read(bgr);
         } catch (const Error& e) {
             // A frame that cannot be decoded ends what this source can deliver.
             spdlog::warn("frame {}: {}; stopping here", i, e.what());
-            const int total = frames->frameCount();
+            const int total = in.frames->frameCount();
             report.addUnreadable(total > i ? total - i : 1);
             break;
         }
@@ -163,71 +200,118 @@ void run(const TrackArgs& a) {
         const double decodeMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                 .count();
-        const double t = frames->lastTimestamp().value_or(i / a.fps);
+        const double t = in.frames->lastTimestamp().value_or(i / a.fps);
         std::optional<Pose> gt;
         int frameIndex = i;
-        if (fromSession && size_t(i) < session.frames.size()) {
-            gt = session.frames[size_t(i)].groundTruth;
-            frameIndex = session.frames[size_t(i)].index;
+        if (in.fromSession && size_t(i) < in.session.frames.size()) {
+            gt = in.session.frames[size_t(i)].groundTruth;
+            frameIndex = in.session.frames[size_t(i)].index;
         }
-        tracking::TrackedFrame f;
-        const std::string problem = frames->lastProblem();
+        const std::string problem = in.frames->lastProblem();
         if (bgr.empty()) {
             // Lost with its reason (damaged bytes): never tracked from a concealed image.
-            f = tracker.markLost(t, problem.empty() ? "frame not decodable" : problem);
+            const tracking::TrackedFrame f =
+                tracker.markLost(t, problem.empty() ? "frame not decodable" : problem);
             report.addUnreadableFrame(frameIndex, f);
             spdlog::warn("{}", f.estimate.reason);
             continue;
         }
         if (!problem.empty()) {
-            ++repeats;
+            ++n.repeats;
             spdlog::warn("{}", problem);
         }
-        if (bgr.cols != calib.intrinsics.width || bgr.rows != calib.intrinsics.height) {
-            f = tracker.markLost(t, "frame size " + std::to_string(bgr.cols) + "x" +
-                                        std::to_string(bgr.rows) + " differs from the calibration");
-        } else {
-            f = tracker.process(bgr, t);
-        }
+        if (bgr.cols != calib.intrinsics.width || bgr.rows != calib.intrinsics.height)
+            throw FileError(in.calibPath.string(),
+                            "is for " + std::to_string(calib.intrinsics.width) + "x" +
+                                std::to_string(calib.intrinsics.height) +
+                                " images, but the frames are " + std::to_string(bgr.cols) + "x" +
+                                std::to_string(bgr.rows) +
+                                "; pass the calibration of this camera at this resolution");
+        const tracking::TrackedFrame f = tracker.process(bgr, t);
         report.add(frameIndex, f, gt, decodeMs);
-        if (envFrames) {
-            cv::Mat env;
-            if (envFrames->read(env) && !env.empty()) {
-                std::optional<Pose> T_world_env;
-                if (envCalib->extrinsicParent == "world")
-                    T_world_env = *envCalib->T_parent_camera;
-                else if (f.estimate.state == tracking::TrackingState::Ok)
-                    T_world_env = *f.estimate.pose * *envCalib->T_parent_camera;
-                if (T_world_env) {
-                    envMap->update(env, envCalib->intrinsics, *T_world_env);
-                    ++envUpdates;
-                }
-            }
-        }
+        if (env) env->update(f);
     }
+    return n;
+}
+
+// The exit status says whether the job was done: 0 when every frame was read and some tracked;
+// 2 when poses were written but part of the input could not be read (the counts say how much);
+// an error (exit 1) when no frame has a pose.
+void reportOutcome(const TrackArgs& a, const TrackInputs& in,
+                   const tracking::TrackingReport& report, const TrackLoopCounts& n) {
+    if (n.repeats > 0)
+        spdlog::warn("{} frame(s) repeat the previous frame exactly (frozen or duplicated)",
+                     n.repeats);
+    spdlog::info("wrote {}\n{}", a.output, report.summary());
+    if (stopRequested()) {
+        spdlog::warn("track: interrupted after {} frames; {} holds them", n.framesRead, a.output);
+        commandExitCode() = 128 + stopSignal();
+        return;
+    }
+    // Frames the input lists but could not deliver: lost to damage, or dropped by the session
+    // reader (missing from a video, bad rows).
+    const int unreadable = report.unreadable();
+    const int total = report.frames() + unreadable;
+    const std::string counts =
+        std::to_string(report.okFrames()) + " of " + std::to_string(total) + " frames tracked";
+    if (report.okFrames() == 0)
+        throw Error("track: nothing tracked (" + counts + ", " + std::to_string(unreadable) +
+                    " unreadable); " + a.output + " lists each frame's reason");
+    if (unreadable > 0 || !in.missingVideos.empty()) {
+        std::string why = std::to_string(unreadable) + " frame(s) of the input could not be read";
+        for (const std::string& m : in.missingVideos) why += "; " + m;
+        spdlog::warn("track: {}; {} (see the warnings above); exit status 2", counts, why);
+        commandExitCode() = 2;
+        return;
+    }
+    spdlog::info("track: {}", counts);
+}
+
+void run(const TrackArgs& a) {
+    TrackInputs in = openInputs(a);
+    // Outputs are checked before any work (never an input; written under a temporary name and
+    // renamed when done), see core/OutputFile.h.
+    OutputRule rule{
+        in.fromSession ? sessionInputs(in.session) : std::vector<std::filesystem::path>{a.video},
+        a.force, "mirage track"};
+    rule.inputs.push_back(in.calibPath);
+    rule.inputs.push_back(in.boardPath);
+    OutputFile posesOut(a.output, OutputOrigin::Named, rule);
+    std::optional<OutputFile> envmapOut, validOut;
+    if (!a.envmap.empty()) {
+        auto validPath = std::filesystem::path(a.envmap);
+        validPath.replace_filename(validPath.stem().string() + "_valid.png");
+        envmapOut.emplace(a.envmap, OutputOrigin::Named, rule);
+        validOut.emplace(validPath, OutputOrigin::Derived, rule);
+    }
+
+    const CameraCalibration calib = loadCalibration(in.calibPath);
+    const tracking::Board board = tracking::Board::load(in.boardPath);
+    tracking::Tracker tracker(board, calib.intrinsics, trackerOptions(a));
+    tracking::TrackingReport report(posesOut.temp(), boardCentre(board));
+    if (in.fromSession)
+        report.addUnreadable(in.readReport.framesListed - in.readReport.framesReadable);
+    const std::unique_ptr<EnvironmentInput> env = openEnvironment(a, in);
+
+    installStopSignals();
+    const TrackLoopCounts n = trackFrames(a, in, calib, tracker, report, env.get());
     restoreStopSignals();
-    if (envMap) {
-        writeLinearRgb(envmapOut->temp(), envMap->radiance());
+    if (n.framesRead == 0 && !stopRequested())
+        throw Error("track: no frame could be read from " + (in.fromSession ? a.session : a.video));
+    if (env) {
+        writeLinearRgb(envmapOut->temp(), env->map->radiance());
         cv::Mat valid;
-        cv::cvtColor(envMap->validity(), valid, cv::COLOR_GRAY2BGR);
+        cv::cvtColor(env->map->validity(), valid, cv::COLOR_GRAY2BGR);
         writeBgr8(validOut->temp(), valid);
         envmapOut->commit();
         validOut->commit();
         spdlog::info("environment map {} ({} frames, {:.1f} % of directions seen; validity {})",
-                     a.envmap, envUpdates, 100 * envMap->validFraction(),
+                     a.envmap, env->updates, 100 * env->map->validFraction(),
                      validOut->path().string());
     }
     report.close();
     posesOut.commit();
-    if (repeats > 0)
-        spdlog::warn("{} frame(s) repeat the previous frame exactly (frozen or duplicated)",
-                     repeats);
-    if (report.frames() == 0 && i == 0) spdlog::warn("no frame could be read");
-    spdlog::info("wrote {}\n{}", a.output, report.summary());
-    if (stopRequested()) {
-        spdlog::warn("track: interrupted after {} frames; {} holds them", i, a.output);
-        commandExitCode() = 128 + stopSignal();
-    }
+    reportOutcome(a, in, report, n);
 }
 
 const CommandRegistrar reg("track", [](CLI::App& parent) {

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/Error.h"
+#include "core/Log.h"
 #include "core/Timestamp.h"
 #include "core/session/AtomicFile.h"
 
@@ -97,12 +98,9 @@ struct Reader {
     }
 };
 
-}  // namespace
-
-CameraCalibration loadCalibration(const std::filesystem::path& path) {
+// The file's text as an OpenCV FileStorage.
+cv::FileStorage openCalibrationYaml(const std::filesystem::path& path) {
     const std::string file = path.string();
-    if (!std::filesystem::is_regular_file(path))
-        throw FileError(file, "calibration file not found (run `mirage calibrate` to make one)");
     // Reading through memory keeps FileStorage from guessing the format from the extension
     // (ROS camera_info files are often *.yml or *.yaml without the %YAML directive).
     std::string text = readFileBytes(path);
@@ -120,14 +118,12 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
                                   e.what() + ")");
     }
     if (!fs.isOpened()) throw FileError(file, "not a valid OpenCV YAML file");
-    Reader r{file, fs.root()};
-    if (!r.root.isMap())
-        throw FileError(file, "expected a YAML map of calibration keys at the top");
+    return fs;
+}
 
-    CameraCalibration c;
-    CameraIntrinsics& in = c.intrinsics;
+// Image size and camera matrix.
+void readSizeAndCameraMatrix(const Reader& r, CameraIntrinsics& in) {
     std::string key;
-
     cv::FileNode n = r.find(kWidthKeys, key);
     if (n.empty()) r.fail("image_width", "missing (the calibrated image size is required)");
     in.width = r.integer(n, key);
@@ -156,7 +152,12 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
         r.fail(key, "not an upper-triangular camera matrix with K[2][2] = 1");
     if (std::abs(k.at<double>(0, 1)) > 1e-9 * in.fx)
         r.fail(key, "non-zero skew K[0][1] is not supported by mirage's camera models");
+}
 
+// Distortion model and coefficients.
+void readDistortion(const Reader& r, CameraIntrinsics& in) {
+    std::string key;
+    cv::FileNode n;
     // Model: mirage's distortion_model key, else the tutorial's fisheye_model flag, else pinhole.
     in.model = DistortionModel::BrownConrady;
     if (cv::FileNode m = r.root["distortion_model"]; !m.empty()) {
@@ -194,7 +195,10 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
                             " is non-zero: mirage supports k1,k2,p1,p2,k3 only (recalibrate "
                             "without the rational / thin-prism / tilted models)");
     if (in.distortion.size() > supported) in.distortion.resize(supported);
+}
 
+// Residuals, view count, reach and reliability: what the calibration says about itself.
+void readQuality(const Reader& r, CameraCalibration& c) {
     if (cv::FileNode e = r.root["avg_reprojection_error"]; !e.empty())
         c.avgReprojectionError = r.number(e, "avg_reprojection_error");
     if (cv::FileNode e = r.root["per_view_reprojection_errors"]; !e.empty()) {
@@ -227,7 +231,10 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
         if (!e.isString()) r.fail("unreliable_reason", "expected a string");
         c.unreliableReason = e.string();
     }
+}
 
+// The optional extrinsic: T_parent_camera with its parent.
+void readExtrinsic(const Reader& r, CameraCalibration& c) {
     cv::FileNode t = r.root["T_parent_camera"];
     cv::FileNode parent = r.root["extrinsic_parent"];
     if (!t.empty()) {
@@ -261,8 +268,30 @@ CameraCalibration loadCalibration(const std::filesystem::path& path) {
     } else if (!parent.empty()) {
         r.fail("T_parent_camera", "missing although extrinsic_parent is set");
     }
+}
 
-    if (!in.isValid()) throw FileError(file, "intrinsics are not finite/positive");
+}  // namespace
+
+CameraCalibration loadCalibration(const std::filesystem::path& path) {
+    const std::string file = path.string();
+    if (!std::filesystem::is_regular_file(path))
+        throw FileError(file, "calibration file not found (run `mirage calibrate` to make one)");
+    cv::FileStorage fs = openCalibrationYaml(path);
+    Reader r{file, fs.root()};
+    if (!r.root.isMap())
+        throw FileError(file, "expected a YAML map of calibration keys at the top");
+    CameraCalibration c;
+    readSizeAndCameraMatrix(r, c.intrinsics);
+    readDistortion(r, c.intrinsics);
+    readQuality(r, c);
+    readExtrinsic(r, c);
+    if (!c.intrinsics.isValid()) throw FileError(file, "intrinsics are not finite/positive");
+    // Used all the same (the numbers may still serve), but never silently.
+    if (!c.reliable)
+        spdlog::warn(
+            "{}: the calibration is marked unreliable (reliable: 0){}; results that "
+            "depend on it may be off. Recalibrate (docs/calibration.md)",
+            file, c.unreliableReason.empty() ? "" : ": " + c.unreliableReason);
     return c;
 }
 

@@ -118,6 +118,19 @@ cv::Mat readLinearRgb(const std::filesystem::path& path) {
     if (img.depth() == CV_32F || img.depth() == CV_16F || img.depth() == CV_64F) {
         img.convertTo(img, CV_32F);
         cv::cvtColor(img, img, cv::COLOR_BGR2RGB);
+        // Radiance is finite: one NaN or infinity spreads through every sum that touches it
+        // (an environment map's integral, a merged shard).
+        for (int y = 0; y < img.rows; ++y) {
+            const auto* row = img.ptr<cv::Vec3f>(y);
+            for (int x = 0; x < img.cols; ++x)
+                for (int c = 0; c < 3; ++c)
+                    if (!std::isfinite(row[x][c]))
+                        throw FileError(path.string(),
+                                        "pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                                            ") channel " + "RGB"[c] + " is " +
+                                            (std::isnan(row[x][c]) ? "NaN" : "infinite") +
+                                            "; linear images must hold finite values");
+        }
         return img;
     }
     if (img.depth() == CV_16U) {  // 16-bit PNG: sRGB-encoded like 8-bit

@@ -18,7 +18,8 @@ float linearToSrgb(float linear);
 cv::Mat linearRgbToSrgbBgr8(const cv::Mat& linearRgb, float exposure = 1.0f);
 cv::Mat srgbBgr8ToLinearRgb(const cv::Mat& bgr8);
 
-// Reads any supported file as linear RGB float. Throws FileError if missing or unreadable.
+// Reads any supported file as linear RGB float. Throws FileError if missing or unreadable, or if
+// a float image holds NaN or infinity (naming the first such pixel).
 cv::Mat readLinearRgb(const std::filesystem::path& path);
 // Writes a linear RGB float image; format by extension (.exr, .pfm, .hdr linear; .png, .jpg
 // tone-mapped by exposure + sRGB). Written to a temporary name and renamed, so a reader never

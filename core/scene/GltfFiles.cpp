@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include "core/ContainedPath.h"
 #include "core/scene/GltfScreening.h"
 
 namespace mirage::gltf {
@@ -60,7 +61,10 @@ bool writeWholeFile(std::string* err, const std::string&, const std::vector<unsi
 bool resolvedAgainst(const std::string& path, const std::string& baseDir) {
     if (baseDir.empty()) return false;
     const std::string prefix = baseDir.back() == '/' ? baseDir : baseDir + "/";
-    return path.size() > prefix.size() && path.compare(0, prefix.size(), prefix) == 0;
+    // The URI part after the prefix must itself stay inside the folder once normalised
+    // ("base/../../etc/passwd" starts with the prefix too).
+    return path.size() > prefix.size() && path.compare(0, prefix.size(), prefix) == 0 &&
+           containedReferenceProblem(path.substr(prefix.size())).empty();
 }
 
 tinygltf::FsCallbacks fileCallbacks(const std::string* baseDir) {

@@ -11,11 +11,13 @@
 #include <tiny_gltf.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "core/ContainedPath.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/scene/GltfAccessors.h"
 #include "core/scene/GltfFiles.h"
 #include "core/scene/GltfImages.h"
+#include "core/scene/GltfSchema.h"
 #include "core/scene/GltfScreening.h"
 
 namespace mirage::gltf {
@@ -84,6 +86,7 @@ private:
         if (gltf::jsonNestingDepth(bytes.data() + json.start, json.size) > gltf::kMaxJsonDepth)
             fail("JSON nesting deeper than " + std::to_string(gltf::kMaxJsonDepth) +
                  " levels; this is not a glTF file mirage can load (check extras/extensions)");
+        gltf::checkGltfSchema(bytes.data() + json.start, json.size, file_);
 
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(&gltf::loadImageCallback, nullptr);
@@ -504,7 +507,7 @@ private:
         if (baseDir_.empty())
             fail(what + " refers to file " + quote(uri) +
                  ", but the scene was loaded from memory without a folder");
-        const fs::path path = baseDir_ / fs::path(uri);
+        const fs::path path = resolveContained(baseDir_, uri, file_, what + " file");
         std::error_code ec;
         if (!fs::is_regular_file(path, ec))
             fail(what + " file " + quote(uri) + " was not found (looked in " + baseDir_.string() +
@@ -1013,7 +1016,7 @@ private:
 
     fs::path existingFile(const std::string& relative, const std::string& what) const {
         if (relative.empty()) fail(what + " is empty");
-        fs::path p = fs::path(relative).is_absolute() ? fs::path(relative) : baseDir_ / relative;
+        fs::path p = resolveContained(baseDir_, relative, file_, what);
         std::error_code ec;
         p = fs::absolute(p, ec).lexically_normal();
         if (ec || !fs::is_regular_file(p, ec))

@@ -1,6 +1,6 @@
-// Frame sources: video files (FFmpeg through OpenCV; mirage's MJPEG Matroska recordings through
-// MatroskaFrames), image folders, a session camera's frames in frames.csv order, and lists of
-// image files, folders and videos (calibration inputs).
+// Frame sources: video files (MJPEG in Matroska or AVI through the strict readers of
+// StrictVideoFrames.h; other videos through FFmpeg), image folders, a session camera's frames in
+// frames.csv order, and lists of image files, folders and videos (calibration inputs).
 #include "core/session/FrameSource.h"
 
 #include <algorithm>
@@ -15,9 +15,9 @@
 #include "core/Error.h"
 #include "core/image/StrictJpeg.h"
 #include "core/session/FrameInventory.h"
-#include "core/session/MatroskaFrames.h"
 #include "core/session/MatroskaScanner.h"
 #include "core/session/Session.h"
+#include "core/session/StrictVideoFrames.h"
 
 namespace mirage {
 
@@ -70,21 +70,12 @@ cv::Mat readImageFile(const std::filesystem::path& p) {
     return img;
 }
 
-// mirage's own recordings (Matroska MJPEG) are read by MatroskaFrames: exact frames or a
-// reason why each is lost. Other videos go through FFmpeg.
-std::unique_ptr<MatroskaFrames> openMatroskaMjpeg(const std::filesystem::path& path) {
-    if (!isMatroska(path)) return nullptr;
-    auto m = std::make_unique<MatroskaFrames>(path);
-    if (!m->supported()) return nullptr;
-    return m;
-}
-
 class VideoFileFrames final : public FrameSource {
 public:
     explicit VideoFileFrames(const std::filesystem::path& path)
-        : mkv_(openMatroskaMjpeg(path)), fileName_(path.filename().string()) {
-        if (mkv_) {
-            count_ = mkv_->count();
+        : strict_(openStrictVideo(path)), fileName_(path.filename().string()) {
+        if (strict_) {
+            count_ = strict_->count();
             return;
         }
         cap_ = openVideo(path);
@@ -99,9 +90,9 @@ public:
         }
     }
     bool read(cv::Mat& bgr) override {
-        if (mkv_) {
+        if (strict_) {
             if (position_ >= count_) return false;
-            MatroskaFrames::Frame f = mkv_->frame(position_++);
+            StrictVideoFrames::Frame f = strict_->frame(position_++);
             bgr = f.bgr;
             problem_ = f.problem;
             last_ = f.seconds;
@@ -124,7 +115,7 @@ public:
     }
 
 private:
-    std::unique_ptr<MatroskaFrames> mkv_;
+    std::unique_ptr<StrictVideoFrames> strict_;  // MJPEG in Matroska or AVI; else FFmpeg
     std::string fileName_;
     cv::VideoCapture cap_;
     int count_ = -1, limit_ = -1, position_ = 0;
@@ -170,16 +161,16 @@ public:
         if (std::filesystem::is_directory(path)) {
             images_ = listImageFrames(path, nullptr);
         } else {
-            mkv_ = openMatroskaMjpeg(path);
-            if (!mkv_) cap_ = openVideo(path);
+            strict_ = openStrictVideo(path);
+            if (!strict_) cap_ = openVideo(path);
         }
     }
     bool read(cv::Mat& bgr) override {
         if (row_ >= rows_.size()) return false;
         const int want = rows_[row_].index;
         problem_.clear();
-        if (mkv_) {
-            MatroskaFrames::Frame f = mkv_->frame(want);
+        if (strict_) {
+            StrictVideoFrames::Frame f = strict_->frame(want);
             bgr = f.bgr;
             problem_ = f.problem;
         } else if (cap_.isOpened()) {
@@ -213,7 +204,7 @@ private:
     std::vector<FrameRecord> rows_;
     int cameraIndex_;
     std::string fileName_, lastName_;
-    std::unique_ptr<MatroskaFrames> mkv_;
+    std::unique_ptr<StrictVideoFrames> strict_;
     std::string problem_;
     cv::VideoCapture cap_;
     std::map<int, std::filesystem::path> images_;
@@ -369,6 +360,12 @@ FrameInventory inventoryFrames(const std::filesystem::path& path) {
         return inv;
     }
     if (!std::filesystem::exists(path)) throw FileError(path.string(), "video file is missing");
+    if (const auto strict = openStrictVideo(path); strict && !isMatroska(path)) {
+        inv.videoFrames = strict->count();
+        if (!strict->containerProblem().empty())
+            inv.problems.push_back(path.filename().string() + ": " + strict->containerProblem());
+        return inv;
+    }
     if (isMatroska(path)) {
         const MatroskaScan scan = scanMatroska(path);
         // Frames lost inside damaged bytes keep their numbers: the rows after them still match.

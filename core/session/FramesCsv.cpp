@@ -7,6 +7,7 @@
 
 #include "core/Error.h"
 #include "core/session/AtomicFile.h"
+#include "core/session/PosesCsv.h"
 
 namespace mirage {
 
@@ -161,6 +162,12 @@ std::vector<FrameRecord> readFramesCsv(const std::filesystem::path& path, double
                         ok = false;
                     }
                 }
+                for (size_t i = 0; i < 3 && ok; ++i)
+                    if (std::abs(g[i]) > kMaxPoseMetres) {
+                        bad(li, std::string(kGtColumns[i]) + " " + f[size_t(gtCols[i])] +
+                                    " m is beyond +-100 km (translations are metres)");
+                        ok = false;
+                    }
                 if (!ok) continue;
                 const double norm =
                     std::sqrt(g[3] * g[3] + g[4] * g[4] + g[5] * g[5] + g[6] * g[6]);
@@ -177,6 +184,15 @@ std::vector<FrameRecord> readFramesCsv(const std::filesystem::path& path, double
                 r.groundTruth = p;
             }
         }
+        // A camera clock never runs backwards: such a row is a damaged or spliced file.
+        for (size_t c = 0; c < timeCols.size() && ok && !rows.empty(); ++c)
+            if (timeCols[c] >= 0 && r.timestamps[c] < rows.back().timestamps[c]) {
+                bad(li, "t_" + cameraNames[c] + " " + f[size_t(timeCols[c])] +
+                            " goes back in time (frame " + std::to_string(rows.back().index) +
+                            " was at " + std::to_string(rows.back().timestamps[c]) + " s)");
+                ok = false;
+            }
+        if (!ok) continue;
         rows.push_back(std::move(r));
     }
     if (badRows > kMaxRowWarnings)

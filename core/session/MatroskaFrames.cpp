@@ -1,13 +1,17 @@
 #include "core/session/MatroskaFrames.h"
 
 #include "core/Error.h"
-#include "core/image/StrictJpeg.h"
 
 namespace mirage {
 
 MatroskaFrames::MatroskaFrames(const std::filesystem::path& path)
     : path_(path), scan_(scanMatroska(path)), in_(path, std::ios::binary) {
     if (!in_) throw FileError(path.string(), "cannot open video for reading");
+    jpeg_.setTrackSize(scan_.width, scan_.height);
+}
+
+std::string MatroskaFrames::containerProblem() const {
+    return scan_.problem;
 }
 
 bool MatroskaFrames::supported() const {
@@ -77,26 +81,9 @@ MatroskaFrames::Frame MatroskaFrames::frame(int position) {
                     " lost: the checksum of its cluster does not match (damaged bytes)";
         return f;
     }
-    std::string why;
-    f.bgr = decodeJpegStrict(bytes_.data(), bytes_.size(), &why);
-    if (f.bgr.empty()) {
-        f.problem = "frame " + std::to_string(position) + " lost: " + why;
-    } else if (scan_.width > 0 && (f.bgr.cols != scan_.width || f.bgr.rows != scan_.height)) {
-        f.problem = "frame " + std::to_string(position) + " lost: its JPEG is " +
-                    std::to_string(f.bgr.cols) + "x" + std::to_string(f.bgr.rows) +
-                    " but the video track is " + std::to_string(scan_.width) + "x" +
-                    std::to_string(scan_.height);
-        f.bgr.release();
-    } else if (previousPosition_ >= 0 && bytes_ == previousBytes_) {
-        // A camera with sensor noise never repeats a frame to the byte: a duplicated block or a
-        // frozen camera. The image is right but says nothing new.
-        f.problem = "frame " + std::to_string(position) + " repeats frame " +
-                    std::to_string(previousPosition_) + " exactly (a frozen or duplicated frame)";
-    }
-    if (!f.bgr.empty()) {
-        previousBytes_.swap(bytes_);
-        previousPosition_ = position;
-    }
+    const double seconds = f.seconds;
+    f = jpeg_.decode(position, bytes_);
+    f.seconds = seconds;
     return f;
 }
 

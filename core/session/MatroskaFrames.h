@@ -15,27 +15,24 @@
 #include <opencv2/core.hpp>
 
 #include "core/session/MatroskaScanner.h"
+#include "core/session/StrictVideoFrames.h"
 
 namespace mirage {
 
-class MatroskaFrames {
+class MatroskaFrames final : public StrictVideoFrames {
 public:
     // Scans the file; throws FileError if it is not Matroska (see scanMatroska).
     explicit MatroskaFrames(const std::filesystem::path& path);
 
     // True if this reader decodes the video: V_MJPEG, blocks without lacing (else FFmpeg must).
-    bool supported() const;
+    bool supported() const override;
     const MatroskaScan& scan() const { return scan_; }
     // Frame numbers 0 .. count()-1 (lost frames included).
-    int count() const;
-
-    struct Frame {
-        cv::Mat bgr;          // empty if lost
-        double seconds = 0;   // block time
-        std::string problem;  // why it is lost; or, with an image, a remark (exact repeat)
-    };
-    // Frame `position`; positions must be asked for in increasing order.
-    Frame frame(int position);
+    int count() const override;
+    // Frame `position` (seconds: its block time); positions must be asked for in increasing
+    // order.
+    Frame frame(int position) override;
+    std::string containerProblem() const override;
 
 private:
     bool clusterChecksumMatches(const MatroskaBlock& b);
@@ -44,8 +41,8 @@ private:
     MatroskaScan scan_;
     std::ifstream in_;
     size_t next_ = 0;  // index into scan_.blocks
-    std::vector<uint8_t> bytes_, previousBytes_;
-    int previousPosition_ = -1;
+    std::vector<uint8_t> bytes_;
+    StrictJpegFrames jpeg_;
 };
 
 }  // namespace mirage

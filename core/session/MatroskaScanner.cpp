@@ -211,263 +211,300 @@ MatroskaScan scanMatroska(const std::filesystem::path& path) {
     return scanMatroska(in, fileSize, path.string());
 }
 
-MatroskaScan scanMatroska(std::istream& in, uint64_t fileSize, const std::string& name) {
-    const std::filesystem::path path(name);  // for messages only
-    MatroskaScan r;
-    if (fileSize == 0) {
-        r.problem = "the file is empty (recording stopped before the first frame)";
-        r.truncated = true;
-        return r;
+namespace {
+
+// One pass over a Matroska file: the header, then the Segment's elements in order, resynchronising
+// at the next Cluster after damaged bytes.
+class MatroskaWalker {
+public:
+    MatroskaWalker(std::istream& in, uint64_t fileSize, const std::string& name)
+        : c_(in, fileSize), fileSize_(fileSize), path_(name) {}
+
+    MatroskaScan scan() {
+        if (fileSize_ == 0) {
+            r_.problem = "the file is empty (recording stopped before the first frame)";
+            r_.truncated = true;
+            return r_;
+        }
+        const auto segment = readHeader();
+        if (!segment || segment->id != kSegment) {
+            r_.problem = "no Segment after the EBML header";
+            r_.truncated = !segment.has_value();
+            return r_;
+        }
+        segEnd_ = std::min(segment->end(fileSize_), fileSize_);
+        // A Segment of known size that runs past the end: the file was cut (checked at the end,
+        // so that the complete clusters before the cut are still counted).
+        const bool segmentCut = segment->size != kUnknown && segment->end(fileSize_) > fileSize_;
+        p_ = segment->dataStart;
+        while (p_ < segEnd_ && step()) {
+        }
+        assignPositions(r_);
+        describeGaps();
+        r_.truncated = r_.truncated || segmentCut;
+        if (r_.truncated && r_.problem.empty())
+            r_.problem = "the file ends in the middle of an element (cut short, e.g. by a crash)";
+        return r_;
     }
-    Cursor c(in, fileSize);
 
-    const auto ebml = c.header(0);
-    if (!ebml || ebml->id != kEbml || ebml->size == kUnknown)
-        throw FileError(path.string(), "not a Matroska file (no EBML header)");
-    std::string docType;
-    for (uint64_t p = ebml->dataStart; p < ebml->end(fileSize);) {
-        const auto e = c.header(p);
-        if (!e || e->size == kUnknown) break;
-        if (e->id == kDocType) docType = c.readString(*e);
-        p = e->end(fileSize);
+private:
+    // The EBML header (DocType matroska or webm), and the element after it.
+    std::optional<Element> readHeader() {
+        const auto ebml = c_.header(0);
+        if (!ebml || ebml->id != kEbml || ebml->size == kUnknown)
+            throw FileError(path_.string(), "not a Matroska file (no EBML header)");
+        std::string docType;
+        for (uint64_t p = ebml->dataStart; p < ebml->end(fileSize_);) {
+            const auto e = c_.header(p);
+            if (!e || e->size == kUnknown) break;
+            if (e->id == kDocType) docType = c_.readString(*e);
+            p = e->end(fileSize_);
+        }
+        if (docType != "matroska" && docType != "webm")
+            throw FileError(path_.string(), "not a Matroska file (DocType '" + docType + "')");
+        return c_.header(ebml->end(fileSize_));
     }
-    if (docType != "matroska" && docType != "webm")
-        throw FileError(path.string(), "not a Matroska file (DocType '" + docType + "')");
 
-    const auto segment = c.header(ebml->end(fileSize));
-    if (!segment || segment->id != kSegment) {
-        r.problem = "no Segment after the EBML header";
-        r.truncated = !segment.has_value();
-        return r;
+    static std::string hexId(uint32_t id) {
+        char idHex[16];
+        std::snprintf(idHex, sizeof idHex, "0x%X", unsigned(id));
+        return idHex;
     }
-    const uint64_t segEnd = std::min(segment->end(fileSize), fileSize);
-    // A Segment of known size that runs past the end: the file was cut (checked at the end, so
-    // that the complete clusters before the cut are still counted).
-    const bool segmentCut = segment->size != kUnknown && segment->end(fileSize) > fileSize;
 
-    uint64_t videoTrack = 0;  // 0 = not known yet: count every block
-    std::set<uint64_t> knownTracks;
-    uint64_t p = segment->dataStart;
-    uint64_t timestampScaleNs = 1'000'000;
-    uint64_t clusterTicks = 0;
-    bool afterGap = false;  // the next block follows damaged bytes
-    // Damage: skip to the next Cluster whose header and first child parse, and record the gap.
-    // Returns false if no cluster follows (the damage runs to the end of the file).
-    auto resync = [&](uint64_t damagedAt, const std::string& what) {
-        const auto next = nextCluster(c, damagedAt + 1, segEnd);
-        MatroskaGap g;
-        g.begin = damagedAt;
-        g.end = next.value_or(fileSize);
-        g.what = what;
-        r.gaps.push_back(g);
-        afterGap = true;
-        if (!next) return false;
-        p = *next;
-        return true;
-    };
-    auto addBlock = [&](const Element& b, uint64_t track, uint64_t headerBytes, int16_t relTicks,
-                        uint8_t flags) {
-        MatroskaBlock blk;
-        blk.offset = b.dataStart + headerBytes;
-        blk.size = b.size > headerBytes ? b.size - headerBytes : 0;
-        blk.laced = (flags & 0x06) != 0;
-        const int64_t ticks = int64_t(clusterTicks) + relTicks;
-        blk.seconds = double(ticks) * double(timestampScaleNs) * 1e-9;
-        blk.afterGap = afterGap;
-        afterGap = false;
-        (void)track;
-        r.blocks.push_back(blk);
-    };
-
-    while (p < segEnd) {
-        const auto e = c.header(p);
+    // One Segment-level element at p_; false when the walk ends.
+    bool step() {
+        const auto e = c_.header(p_);
         if (!e) {
             // Too few bytes left for a header: the file was cut. Otherwise the bytes are damaged.
-            if (fileSize - p < 12 || !resync(p, "unreadable element header")) {
-                if (fileSize - p < 12) r.truncated = true;
+            if (fileSize_ - p_ < 12) {
+                r_.truncated = true;
+                return false;
+            }
+            return resync(p_, "unreadable element header");
+        }
+        if (!isTopLevel(e->id) && e->id != 0xEC /*Void*/ && e->id != 0xBF /*CRC-32*/)
+            return resync(p_, "unknown element " + hexId(e->id) + " at segment level");
+        if (e->id == 0x1549A966 /*Info*/ && e->size != kUnknown) readInfo(*e);
+        if (e->id == kTracks) readTracks(*e);
+        if (e->id == kCluster) return walkCluster(*e);
+        if (e->size == kUnknown) {
+            r_.problem =
+                "element " + hexId(e->id) + " of unknown size at byte " + std::to_string(p_);
+            return false;
+        }
+        if (e->end(segEnd_) > fileSize_) {
+            if (nextCluster(c_, p_ + 1, segEnd_))
+                return resync(p_, "element size runs past the end of the file");
+            r_.truncated = true;
+            return false;
+        }
+        p_ = e->end(segEnd_);
+        return true;
+    }
+
+    // Damage: skip to the next Cluster whose header and first child parse, and record the gap.
+    // Returns false if no cluster follows (the damage runs to the end of the file).
+    bool resync(uint64_t damagedAt, const std::string& what) {
+        const auto next = nextCluster(c_, damagedAt + 1, segEnd_);
+        MatroskaGap g;
+        g.begin = damagedAt;
+        g.end = next.value_or(fileSize_);
+        g.what = what;
+        r_.gaps.push_back(g);
+        afterGap_ = true;
+        if (!next) return false;
+        p_ = *next;
+        return true;
+    }
+
+    void readInfo(const Element& e) {
+        for (uint64_t q = e.dataStart; q < std::min(e.end(segEnd_), segEnd_);) {
+            const auto f = c_.header(q);
+            if (!f || f->size == kUnknown) break;
+            if (f->id == 0x2AD7B1 /*TimestampScale*/) {
+                const uint64_t v = c_.readUint(*f);
+                if (v > 0 && v <= 1'000'000'000) timestampScaleNs_ = v;
+            }
+            q = f->end(segEnd_);
+        }
+    }
+
+    void readTracks(const Element& e) {
+        for (uint64_t q = e.dataStart; q < std::min(e.end(segEnd_), segEnd_);) {
+            const auto t = c_.header(q);
+            if (!t || t->size == kUnknown) break;
+            if (t->id == kTrackEntry) readTrackEntry(*t);
+            q = t->end(segEnd_);
+        }
+    }
+
+    // The first video track is the one whose frames are listed.
+    void readTrackEntry(const Element& t) {
+        uint64_t number = 0, type = 0;
+        std::string codec;
+        int w = 0, h = 0;
+        for (uint64_t s = t.dataStart; s < t.end(segEnd_);) {
+            const auto f = c_.header(s);
+            if (!f || f->size == kUnknown) break;
+            if (f->id == kTrackNumber) number = c_.readUint(*f);
+            if (f->id == kTrackType) type = c_.readUint(*f);
+            if (f->id == kCodecId) codec = c_.readString(*f);
+            if (f->id == kVideo) {
+                for (uint64_t v = f->dataStart; v < f->end(segEnd_);) {
+                    const auto g = c_.header(v);
+                    if (!g || g->size == kUnknown) break;
+                    if (g->id == kPixelWidth) w = int(c_.readUint(*g));
+                    if (g->id == kPixelHeight) h = int(c_.readUint(*g));
+                    v = g->end(segEnd_);
+                }
+            }
+            s = f->end(segEnd_);
+        }
+        if (number != 0) knownTracks_.insert(number);
+        if (type == 1 && videoTrack_ == 0) {
+            videoTrack_ = number;
+            r_.codecId = codec;
+            r_.width = w;
+            r_.height = h;
+        }
+    }
+
+    // A Cluster's children until its end, or for an unknown size until the next top-level
+    // element; false when the walk ends.
+    bool walkCluster(const Element& e) {
+        const uint64_t clusterEnd = e.end(segEnd_);
+        uint64_t q = e.dataStart;
+        bool damaged = false;
+        std::optional<uint32_t> clusterCrc;
+        std::pair<uint64_t, uint64_t> crcRange{0, 0};
+        const size_t firstBlock = r_.blocks.size();
+        while (q < std::min(clusterEnd, segEnd_)) {
+            const auto b = c_.header(q);
+            if (!b) {
+                if (fileSize_ - q < 12)
+                    r_.truncated = true;
+                else
+                    damaged = true;
                 break;
             }
-            continue;
+            if (e.size == kUnknown && isTopLevel(b->id)) break;
+            if (!isClusterChild(b->id) || b->size == kUnknown) {
+                damaged = true;
+                break;
+            }
+            if (b->end(segEnd_) > fileSize_) {
+                // Runs past the end: cut short, unless a cluster follows (a damaged size).
+                if (nextCluster(c_, q + 1, segEnd_))
+                    damaged = true;
+                else
+                    r_.truncated = true;
+                break;
+            }
+            if (e.size != kUnknown && b->end(segEnd_) > clusterEnd) {
+                damaged = true;
+                break;
+            }
+            if (b->id == kClusterTimestamp) clusterTicks_ = c_.readUint(*b);
+            // A CRC-32 first in a cluster of known size covers the rest of the cluster.
+            if (b->id == 0xBF && q == e.dataStart && b->size == 4 && e.size != kUnknown) {
+                uint8_t v[4];
+                if (c_.read(b->dataStart, v, 4)) {
+                    clusterCrc = uint32_t(v[0]) | uint32_t(v[1]) << 8 | uint32_t(v[2]) << 16 |
+                                 uint32_t(v[3]) << 24;
+                    crcRange = {b->end(segEnd_), clusterEnd};
+                }
+            }
+            clusterChild(*b);
+            q = b->end(segEnd_);
         }
-        if (!isTopLevel(e->id) && e->id != 0xEC /*Void*/ && e->id != 0xBF /*CRC-32*/) {
-            char idHex[16];
-            std::snprintf(idHex, sizeof idHex, "0x%X", unsigned(e->id));
-            if (!resync(p, std::string("unknown element ") + idHex + " at segment level")) break;
-            continue;
-        }
-        if (e->id == 0x1549A966 /*Info*/ && e->size != kUnknown) {
-            for (uint64_t q = e->dataStart; q < std::min(e->end(segEnd), segEnd);) {
-                const auto f = c.header(q);
+        if (clusterCrc)
+            for (size_t k = firstBlock; k < r_.blocks.size(); ++k) {
+                r_.blocks[k].hasCrc = true;
+                r_.blocks[k].crc = *clusterCrc;
+                r_.blocks[k].crcBegin = crcRange.first;
+                r_.blocks[k].crcEnd = crcRange.second;
+            }
+        if (damaged) return resync(q, "damaged cluster");
+        // A cluster of known size that runs past the end of the file was cut, even when the cut
+        // falls between two of its children.
+        if (e.size != kUnknown && clusterEnd > fileSize_) r_.truncated = true;
+        if (r_.truncated) return false;
+        p_ = e.size == kUnknown ? q : clusterEnd;
+        return true;
+    }
+
+    // A SimpleBlock, or a BlockGroup's Block, of the video track becomes a frame.
+    void clusterChild(const Element& b) {
+        const Element* blockElement = nullptr;
+        std::optional<Element> inner;
+        if (b.id == kSimpleBlock) blockElement = &b;
+        if (b.id == kBlockGroup) {
+            for (uint64_t s = b.dataStart; s < b.end(segEnd_);) {
+                const auto f = c_.header(s);
                 if (!f || f->size == kUnknown) break;
-                if (f->id == 0x2AD7B1 /*TimestampScale*/) {
-                    const uint64_t v = c.readUint(*f);
-                    if (v > 0 && v <= 1'000'000'000) timestampScaleNs = v;
-                }
-                q = f->end(segEnd);
+                if (f->id == kBlock) inner = f;
+                s = f->end(segEnd_);
             }
+            if (inner) blockElement = &*inner;
         }
-        if (e->id == kTracks) {
-            for (uint64_t q = e->dataStart; q < std::min(e->end(segEnd), segEnd);) {
-                const auto t = c.header(q);
-                if (!t || t->size == kUnknown) break;
-                if (t->id == kTrackEntry) {
-                    uint64_t number = 0, type = 0;
-                    std::string codec;
-                    int w = 0, h = 0;
-                    for (uint64_t s = t->dataStart; s < t->end(segEnd);) {
-                        const auto f = c.header(s);
-                        if (!f || f->size == kUnknown) break;
-                        if (f->id == kTrackNumber) number = c.readUint(*f);
-                        if (f->id == kTrackType) type = c.readUint(*f);
-                        if (f->id == kCodecId) codec = c.readString(*f);
-                        if (f->id == kVideo) {
-                            for (uint64_t v = f->dataStart; v < f->end(segEnd);) {
-                                const auto g = c.header(v);
-                                if (!g || g->size == kUnknown) break;
-                                if (g->id == kPixelWidth) w = int(c.readUint(*g));
-                                if (g->id == kPixelHeight) h = int(c.readUint(*g));
-                                v = g->end(segEnd);
-                            }
-                        }
-                        s = f->end(segEnd);
-                    }
-                    if (number != 0) knownTracks.insert(number);
-                    if (type == 1 && videoTrack == 0) {
-                        videoTrack = number;
-                        r.codecId = codec;
-                        r.width = w;
-                        r.height = h;
-                    }
-                }
-                q = t->end(segEnd);
-            }
+        if (!blockElement) return;
+        const BlockHead h = c_.blockHead(*blockElement);
+        if (h.track != 0 && (videoTrack_ == 0 || h.track == videoTrack_)) {
+            ++r_.completeFrames;
+            addBlock(*blockElement, h);
+        } else if (videoTrack_ != 0 && !knownTracks_.count(h.track)) {
+            // A block of no track: its track number was damaged. It still takes its place in
+            // the video (a lost frame), so later frames keep theirs.
+            ++r_.completeFrames;
+            addBlock(*blockElement, h);
+            r_.blocks.back().damaged = "its track number is damaged";
         }
-        if (e->id == kCluster) {
-            // Children until the cluster's end, or for an unknown size until the next
-            // top-level element.
-            const uint64_t clusterEnd = e->end(segEnd);
-            uint64_t q = e->dataStart;
-            bool damaged = false;
-            std::optional<uint32_t> clusterCrc;
-            std::pair<uint64_t, uint64_t> crcRange{0, 0};
-            const size_t firstBlock = r.blocks.size();
-            while (q < std::min(clusterEnd, segEnd)) {
-                const auto b = c.header(q);
-                if (!b) {
-                    if (fileSize - q < 12) {
-                        r.truncated = true;
-                    } else {
-                        damaged = true;
-                    }
-                    break;
-                }
-                if (e->size == kUnknown && isTopLevel(b->id)) break;
-                if (!isClusterChild(b->id) || b->size == kUnknown) {
-                    damaged = true;
-                    break;
-                }
-                if (b->end(segEnd) > fileSize) {
-                    // Runs past the end: cut short, unless a cluster follows (a damaged size).
-                    if (nextCluster(c, q + 1, segEnd)) {
-                        damaged = true;
-                    } else {
-                        r.truncated = true;
-                    }
-                    break;
-                }
-                if (e->size != kUnknown && b->end(segEnd) > clusterEnd) {
-                    damaged = true;
-                    break;
-                }
-                if (b->id == kClusterTimestamp) clusterTicks = c.readUint(*b);
-                // A CRC-32 first in a cluster of known size covers the rest of the cluster.
-                if (b->id == 0xBF && q == e->dataStart && b->size == 4 && e->size != kUnknown) {
-                    uint8_t v[4];
-                    if (c.read(b->dataStart, v, 4)) {
-                        clusterCrc = uint32_t(v[0]) | uint32_t(v[1]) << 8 | uint32_t(v[2]) << 16 |
-                                     uint32_t(v[3]) << 24;
-                        crcRange = {b->end(segEnd), clusterEnd};
-                    }
-                }
-                const Element* blockElement = nullptr;
-                std::optional<Element> inner;
-                if (b->id == kSimpleBlock) blockElement = &*b;
-                if (b->id == kBlockGroup) {
-                    for (uint64_t s = b->dataStart; s < b->end(segEnd);) {
-                        const auto f = c.header(s);
-                        if (!f || f->size == kUnknown) break;
-                        if (f->id == kBlock) inner = f;
-                        s = f->end(segEnd);
-                    }
-                    if (inner) blockElement = &*inner;
-                }
-                if (blockElement) {
-                    const BlockHead h = c.blockHead(*blockElement);
-                    if (h.track != 0 && (videoTrack == 0 || h.track == videoTrack)) {
-                        ++r.completeFrames;
-                        addBlock(*blockElement, h.track, h.headerBytes, h.relTicks, h.flags);
-                    } else if (videoTrack != 0 && !knownTracks.count(h.track)) {
-                        // A block of no track: its track number was damaged. It still takes
-                        // its place in the video (a lost frame), so later frames keep theirs.
-                        ++r.completeFrames;
-                        addBlock(*blockElement, h.track, h.headerBytes, h.relTicks, h.flags);
-                        r.blocks.back().damaged = "its track number is damaged";
-                    }
-                }
-                q = b->end(segEnd);
-            }
-            if (clusterCrc)
-                for (size_t k = firstBlock; k < r.blocks.size(); ++k) {
-                    r.blocks[k].hasCrc = true;
-                    r.blocks[k].crc = *clusterCrc;
-                    r.blocks[k].crcBegin = crcRange.first;
-                    r.blocks[k].crcEnd = crcRange.second;
-                }
-            if (damaged) {
-                if (!resync(q, "damaged cluster")) break;
-                continue;
-            }
-            // A cluster of known size that runs past the end of the file was cut, even when
-            // the cut falls between two of its children.
-            if (e->size != kUnknown && clusterEnd > fileSize) r.truncated = true;
-            if (r.truncated) break;
-            p = e->size == kUnknown ? q : clusterEnd;
-            continue;
-        }
-        if (e->size == kUnknown) {
-            char idHex[16];
-            std::snprintf(idHex, sizeof idHex, "0x%X", unsigned(e->id));
-            r.problem =
-                std::string("element ") + idHex + " of unknown size at byte " + std::to_string(p);
-            break;
-        }
-        if (e->end(segEnd) > fileSize) {
-            if (nextCluster(c, p + 1, segEnd)) {
-                if (!resync(p, "element size runs past the end of the file")) break;
-                continue;
-            }
-            r.truncated = true;
-            break;
-        }
-        p = e->end(segEnd);
     }
-    assignPositions(r);
-    for (const MatroskaGap& g : r.gaps) {
-        std::string lost = "no frame lost";
-        if (g.lastLost >= g.firstLost)
-            lost = g.firstLost == g.lastLost ? "frame " + std::to_string(g.firstLost) + " lost"
-                                             : "frames " + std::to_string(g.firstLost) + "-" +
-                                                   std::to_string(g.lastLost) + " lost";
-        else if (g.end >= fileSize)
-            lost = "the frames after frame " + std::to_string(g.firstLost - 1) + " lost";
-        r.problem += std::string(r.problem.empty() ? "" : "; ") + "bytes " +
-                     std::to_string(g.begin) + "-" + std::to_string(g.end) + " damaged (" + g.what +
-                     ")" + (g.end < fileSize ? ", resumed at the next cluster" : "") + ": " + lost;
+
+    void addBlock(const Element& b, const BlockHead& h) {
+        MatroskaBlock blk;
+        blk.offset = b.dataStart + h.headerBytes;
+        blk.size = b.size > h.headerBytes ? b.size - h.headerBytes : 0;
+        blk.laced = (h.flags & 0x06) != 0;
+        const int64_t ticks = int64_t(clusterTicks_) + h.relTicks;
+        blk.seconds = double(ticks) * double(timestampScaleNs_) * 1e-9;
+        blk.afterGap = afterGap_;
+        afterGap_ = false;
+        r_.blocks.push_back(blk);
     }
-    r.truncated = r.truncated || segmentCut;
-    if (r.truncated && r.problem.empty())
-        r.problem = "the file ends in the middle of an element (cut short, e.g. by a crash)";
-    return r;
+
+    void describeGaps() {
+        for (const MatroskaGap& g : r_.gaps) {
+            std::string lost = "no frame lost";
+            if (g.lastLost >= g.firstLost)
+                lost = g.firstLost == g.lastLost ? "frame " + std::to_string(g.firstLost) + " lost"
+                                                 : "frames " + std::to_string(g.firstLost) + "-" +
+                                                       std::to_string(g.lastLost) + " lost";
+            else if (g.end >= fileSize_)
+                lost = "the frames after frame " + std::to_string(g.firstLost - 1) + " lost";
+            r_.problem += std::string(r_.problem.empty() ? "" : "; ") + "bytes " +
+                          std::to_string(g.begin) + "-" + std::to_string(g.end) + " damaged (" +
+                          g.what + ")" +
+                          (g.end < fileSize_ ? ", resumed at the next cluster" : "") + ": " + lost;
+        }
+    }
+
+    Cursor c_;
+    uint64_t fileSize_;
+    std::filesystem::path path_;  // for messages only
+    MatroskaScan r_;
+    uint64_t segEnd_ = 0, p_ = 0;
+    uint64_t videoTrack_ = 0;  // 0 = not known yet: count every block
+    std::set<uint64_t> knownTracks_;
+    uint64_t timestampScaleNs_ = 1'000'000;
+    uint64_t clusterTicks_ = 0;
+    bool afterGap_ = false;  // the next block follows damaged bytes
+};
+
+}  // namespace
+
+MatroskaScan scanMatroska(std::istream& in, uint64_t fileSize, const std::string& name) {
+    return MatroskaWalker(in, fileSize, name).scan();
 }
 
 }  // namespace mirage

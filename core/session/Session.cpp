@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/ContainedPath.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/camera/CalibrationFile.h"
@@ -76,42 +77,29 @@ struct JsonReader {
     }
 };
 
-// A relative path inside the session folder (no absolute paths, no "..").
-void checkRelative(const JsonReader& r, const std::string& field, const std::string& p) {
-    const std::filesystem::path path(p);
-    if (path.is_absolute()) r.fail(field, "must be relative to the session folder: '" + p + "'");
-    for (const auto& part : path)
-        if (part == "..") r.fail(field, "must stay inside the session folder: '" + p + "'");
+// A file the session names: inside the session folder (core/ContainedPath.h). Empty names are
+// for optional files the session leaves out.
+void checkContained(const JsonReader& r, const std::string& field, const std::string& p) {
+    if (p.empty()) return;
+    const std::string problem = containedReferenceProblem(p);
+    if (!problem.empty())
+        r.fail(field, "'" + p + "' " + problem + "; name a file inside the session folder");
 }
 
-}  // namespace
-
-Session readSession(const std::filesystem::path& dir, SessionReadReport* reportOut) {
-    return readSession(dir, reportOut, SessionReadOptions{});
-}
-
-Session readSession(const std::filesystem::path& dir, SessionReadReport* reportOut,
-                    const SessionReadOptions& options) {
-    SessionReadReport report;
-    if (!std::filesystem::is_directory(dir))
-        throw FileError(dir.string(), "not a folder (a session is a folder with session.json)");
-    const auto jsonPath = dir / "session.json";
-    if (!std::filesystem::is_regular_file(jsonPath))
-        throw FileError(jsonPath.string(), "missing: the folder is not a mirage session");
-    const JsonReader r{jsonPath.string()};
-
-    json j;
+json parseSessionJson(const std::filesystem::path& jsonPath) {
     try {
-        j = json::parse(readFileBytes(jsonPath));
+        json j = json::parse(readFileBytes(jsonPath));
+        if (!j.is_object()) throw FileError(jsonPath.string(), "expected a JSON object at the top");
+        return j;
     } catch (const json::exception& e) {
         // parse_error, and out_of_range for a number that overflows a double ("1e999", found
         // by session_fuzz).
         throw FileError(jsonPath.string(), std::string("not valid JSON: ") + e.what());
     }
-    if (!j.is_object()) throw FileError(jsonPath.string(), "expected a JSON object at the top");
+}
 
-    Session s;
-    s.dir = dir;
+// format, version and fps.
+void readFormat(const JsonReader& r, const json& j, Session& s, SessionReadReport& report) {
     s.format = r.string(j, "format", "format", true);
     if (s.format != kSessionFormat)
         r.fail("format", "is '" + s.format + "', expected '" + kSessionFormat + "'");
@@ -122,7 +110,6 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     if (s.version > kSessionVersion)
         r.fail("version", std::to_string(s.version) + " is newer than this mirage reads (" +
                               std::to_string(kSessionVersion) + "); update mirage");
-
     if (j.contains("fps")) {
         if (!j["fps"].is_number() || !(j["fps"].get<double>() > 0) ||
             !std::isfinite(j["fps"].get<double>()))
@@ -131,7 +118,10 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
     } else {
         report.warnings.push_back("session.json: no 'fps'; assuming 30");
     }
+}
 
+// cameras[]: the first is the main camera, exactly one is.
+void readCameras(const JsonReader& r, const json& j, Session& s) {
     if (!j.contains("cameras") || !j["cameras"].is_array() || j["cameras"].empty())
         r.fail("cameras", "expected a non-empty list of cameras");
     for (size_t i = 0; i < j["cameras"].size(); ++i) {
@@ -144,28 +134,39 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
             r.fail(f + ".name", "must be a non-empty word (it names a frames.csv column)");
         if (s.cameraIndex(c.name) >= 0) r.fail(f + ".name", "duplicate camera '" + c.name + "'");
         c.video = r.string(cj, "video", f + ".video", true);
-        checkRelative(r, f + ".video", c.video);
+        if (c.video.empty()) r.fail(f + ".video", "is empty; name the camera's video or folder");
+        checkContained(r, f + ".video", c.video);
         c.calibration = r.string(cj, "calibration", f + ".calibration", false);
-        checkRelative(r, f + ".calibration", c.calibration);
+        checkContained(r, f + ".calibration", c.calibration);
         c.role = r.string(cj, "role", f + ".role", false, i == 0 ? "main" : "environment");
         if (c.role != "main" && c.role != "environment")
             r.fail(f + ".role", "must be 'main' or 'environment', got '" + c.role + "'");
+        if (i > 0 && c.role == "main")
+            r.fail(f + ".role",
+                   "is 'main', but cameras[0] is the main camera and a session has one; mark "
+                   "this one 'environment' or list it first");
         s.cameras.push_back(c);
     }
     if (s.cameras[0].role != "main")
         r.fail("cameras[0].role", "the first camera must be the main camera");
+}
 
+// board, scene, frames, created.
+void readNamedFiles(const JsonReader& r, const json& j, Session& s) {
     s.board = r.string(j, "board", "board", false);
-    checkRelative(r, "board", s.board);
+    checkContained(r, "board", s.board);
     s.scene = r.string(j, "scene", "scene", false);
     s.framesFile = r.string(j, "frames", "frames", false, "frames.csv");
-    checkRelative(r, "frames", s.framesFile);
+    if (s.framesFile.empty()) r.fail("frames", "is empty; name the frame list (frames.csv)");
+    checkContained(r, "frames", s.framesFile);
     if (j.contains("created") && j["created"].is_object()) {
         s.createdBy = r.string(j["created"], "by", "created.by", false);
         s.createdAt = r.string(j["created"], "at", "created.at", false);
     }
+}
 
-    // Files named by session.json: missing ones are warnings, the footage may still be usable.
+// Files named by session.json: missing or bad ones are warnings, the footage may still be usable.
+void checkNamedFiles(const Session& s, SessionReadReport& report) {
     if (!s.board.empty() && !std::filesystem::exists(s.path(s.board)))
         report.warnings.push_back("board file " + s.board + " is missing");
     for (const auto& c : s.cameras) {
@@ -176,8 +177,10 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
             report.warnings.push_back("camera '" + c.name + "' calibration: " + e.what());
         }
     }
+}
 
-    // What each camera's video actually holds.
+// What each camera's video actually holds.
+std::vector<FrameInventory> inventoryCameras(const Session& s, SessionReadReport& report) {
     std::vector<FrameInventory> inventories;
     for (const auto& c : s.cameras) {
         try {
@@ -189,16 +192,19 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
             inventories.push_back(FrameInventory{});  // no frames
         }
     }
+    return inventories;
+}
 
+// frames.csv's rows; without a usable one, one row per frame of the main camera, times from
+// the frame rate.
+std::vector<FrameRecord> readFrameRows(const Session& s, const FrameInventory& main,
+                                       SessionReadReport& report) {
     std::vector<std::string> names;
     for (const auto& c : s.cameras) names.push_back(c.name);
-    std::vector<FrameRecord> rows;
     const auto csvPath = s.path(s.framesFile);
-    bool haveFrameList = false;
     if (std::filesystem::is_regular_file(csvPath)) {
         try {
-            rows = readFramesCsv(csvPath, s.fps, names, report.warnings);
-            haveFrameList = true;
+            return readFramesCsv(csvPath, s.fps, names, report.warnings);
         } catch (const FileError& e) {
             report.warnings.push_back(std::string(e.what()) +
                                       "; frames taken from the main video alone");
@@ -207,25 +213,26 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
         report.warnings.push_back(s.framesFile +
                                   " is missing; frames taken from the main video alone");
     }
-    if (!haveFrameList) {
-        // No frame list: one row per frame of the main camera, times from the frame rate.
-        const FrameInventory& main = inventories[0];
-        std::vector<int> indices;
-        if (main.isFolder)
-            for (const auto& [i, p] : main.images) indices.push_back(i);
-        else
-            for (int i = 0; i < main.videoFrames; ++i) indices.push_back(i);
-        for (int i : indices) {
-            FrameRecord fr;
-            fr.index = i;
-            fr.timestamps.assign(s.cameras.size(), i / s.fps);
-            rows.push_back(fr);
-        }
+    std::vector<int> indices;
+    if (main.isFolder)
+        for (const auto& [i, p] : main.images) indices.push_back(i);
+    else
+        for (int i = 0; i < main.videoFrames; ++i) indices.push_back(i);
+    std::vector<FrameRecord> rows;
+    for (int i : indices) {
+        FrameRecord fr;
+        fr.index = i;
+        fr.timestamps.assign(s.cameras.size(), i / s.fps);
+        rows.push_back(fr);
     }
-    report.framesListed = int(rows.size());
+    return rows;
+}
 
-    // Keep the rows whose images every camera has (every camera but the environment cameras,
-    // when the reader can do without them).
+// Keeps the rows whose images every camera has (every camera but the environment cameras, when
+// the reader can do without them); says which are dropped.
+void keepReadableRows(Session& s, std::vector<FrameRecord> rows,
+                      const std::vector<FrameInventory>& inventories,
+                      const SessionReadOptions& options, SessionReadReport& report) {
     auto required = [&](size_t ci) {
         return !(options.environmentOptional && ci > 0 && s.cameras[ci].role == "environment");
     };
@@ -253,6 +260,35 @@ Session readSession(const std::filesystem::path& dir, SessionReadReport* reportO
             all = all && (!required(ci) || inventories[ci].has(row.index));
         if (all) s.frames.push_back(std::move(row));
     }
+}
+
+}  // namespace
+
+Session readSession(const std::filesystem::path& dir, SessionReadReport* reportOut) {
+    return readSession(dir, reportOut, SessionReadOptions{});
+}
+
+Session readSession(const std::filesystem::path& dir, SessionReadReport* reportOut,
+                    const SessionReadOptions& options) {
+    SessionReadReport report;
+    if (!std::filesystem::is_directory(dir))
+        throw FileError(dir.string(), "not a folder (a session is a folder with session.json)");
+    const auto jsonPath = dir / "session.json";
+    if (!std::filesystem::is_regular_file(jsonPath))
+        throw FileError(jsonPath.string(), "missing: the folder is not a mirage session");
+    const JsonReader r{jsonPath.string()};
+    const json j = parseSessionJson(jsonPath);
+
+    Session s;
+    s.dir = dir;
+    readFormat(r, j, s, report);
+    readCameras(r, j, s);
+    readNamedFiles(r, j, s);
+    checkNamedFiles(s, report);
+    const std::vector<FrameInventory> inventories = inventoryCameras(s, report);
+    std::vector<FrameRecord> rows = readFrameRows(s, inventories[0], report);
+    report.framesListed = int(rows.size());
+    keepReadableRows(s, std::move(rows), inventories, options, report);
     report.framesReadable = int(s.frames.size());
 
     // A caller that asks for the report shows it its own way; otherwise nothing is lost.

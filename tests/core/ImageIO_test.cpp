@@ -1,5 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include <limits>
+
+#include <fstream>
+
 #include "core/Error.h"
 #include "core/image/ImageIO.h"
 #include "tests/support/TestSupport.h"
@@ -44,6 +50,26 @@ TEST(ImageIO, NanBecomesBlackInPng) {
     cv::Mat bgr = linearRgbToSrgbBgr8(img);
     EXPECT_EQ(bgr.at<cv::Vec3b>(0, 0)[2], 0);    // R was NaN
     EXPECT_EQ(bgr.at<cv::Vec3b>(0, 0)[0], 255);  // B was 2.0, clamped
+}
+
+TEST(ImageIO, NonFiniteLinearPixelsAreRefusedNamingThePixel) {
+    // A NaN in a static environment map spread through its integral into every lit pixel; now
+    // the file is refused where it is read.
+    const auto dir = test::outputDir("imageio_nan");
+    for (const float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+        std::string pfm = "PF\n2 1\n-1.0\n";
+        const float values[6] = {0.5f, 0.5f, 0.5f, 0.25f, bad, 0.25f};  // pixel (1, 0), G
+        pfm.append(reinterpret_cast<const char*>(values), sizeof values);
+        std::ofstream(dir / "env.pfm", std::ios::binary | std::ios::trunc) << pfm;
+        try {
+            readLinearRgb(dir / "env.pfm");
+            ADD_FAILURE() << "a non-finite pixel was accepted";
+        } catch (const FileError& e) {
+            const std::string m = e.what();
+            EXPECT_NE(m.find("env.pfm"), std::string::npos) << m;
+            EXPECT_NE(m.find("pixel (1, 0) channel G"), std::string::npos) << m;
+        }
+    }
 }
 
 TEST(ImageIO, MissingAndUnknownFilesGiveFileErrors) {

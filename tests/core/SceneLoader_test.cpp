@@ -11,6 +11,7 @@
 
 #include "core/Error.h"
 #include "core/scene/Scene.h"
+#include "core/session/AtomicFile.h"
 #include "tests/support/TestSupport.h"
 
 namespace mirage {
@@ -664,16 +665,99 @@ TEST(SceneLoader, TextureUriResolvesAgainstTheGltfFolderOnly) {
     EXPECT_NE(message.find(fs::absolute(gltfDir).lexically_normal().string()), std::string::npos)
         << message;
 
+    // A URI that leaves the glTF's folder is refused, even when the file exists.
     writeScene("../elsewhere/tex.png");
-    const Scene up = loadScene(gltfDir / "tri.gltf");
-    ASSERT_EQ(up.textures.size(), 1u);
-    EXPECT_EQ(up.textures[0].width, 4);
+    message.clear();
+    try {
+        loadScene(gltfDir / "tri.gltf");
+    } catch (const FileError& e) {
+        message = e.what();
+    }
+    EXPECT_NE(message.find("images[0].uri: the URI '../elsewhere/tex.png' leaves the folder"),
+              std::string::npos)
+        << message;
 
     fs::copy_file(elsewhere / "tex.png", gltfDir / "tex.png", fs::copy_options::overwrite_existing);
     writeScene("tex.png");
     const Scene beside = loadScene(gltfDir / "tri.gltf");
     ASSERT_EQ(beside.textures.size(), 1u);
     EXPECT_EQ(beside.textures[0].pixels[0], 255);  // red, RGBA
+}
+
+// Every loader resolves the files a scene names inside the scene's folder: a buffer or image URI
+// that climbs out ("../../../etc/passwd"), is absolute or has a scheme is an error naming it,
+// before any of it is read. Before, "../../../secret.bin" was read as the mesh's buffer.
+TEST(SceneLoader, UrisOutsideTheSceneFolderAreRefused) {
+    const fs::path root = test::outputDir("scene_uri_escape");
+    const fs::path sceneDir = root / "a" / "b" / "c";
+    fs::create_directories(sceneDir);
+    std::ofstream(root / "secret.bin", std::ios::binary) << std::string(42, '\0');
+    const std::string text = readFileBytes(scenesDir() / "bad" / "missing_buffer.gltf");
+    const std::string absolute = fs::absolute(root / "secret.bin").string();
+    for (const std::string& uri :
+         {std::string("../../../secret.bin"), std::string("../../../etc/passwd"), absolute,
+          std::string("sub/../../../../secret.bin"), std::string("%2e%2e/%2e%2e/%2e%2e/secret.bin"),
+          std::string("file:///etc/passwd")}) {
+        SCOPED_TRACE(uri);
+        std::string json = text;
+        json.replace(json.find("missing.bin"), 11, uri);
+        std::ofstream(sceneDir / "scene.gltf", std::ios::trunc) << json;
+        try {
+            loadScene(sceneDir / "scene.gltf");
+            ADD_FAILURE() << "loaded a buffer from outside the scene folder";
+        } catch (const FileError& e) {
+            const std::string m = e.what();
+            EXPECT_NE(m.find("buffers[0].uri"), std::string::npos) << m;
+            EXPECT_NE(m.find("'" + uri + "'"), std::string::npos) << m;
+        }
+    }
+    // Inside the folder, also through a normalised path, the same bytes load.
+    fs::create_directories(sceneDir / "sub");
+    fs::copy_file(root / "secret.bin", sceneDir / "mesh.bin", fs::copy_options::overwrite_existing);
+    std::string json = text;
+    json.replace(json.find("missing.bin"), 11, "sub/../mesh.bin");
+    std::ofstream(sceneDir / "scene.gltf", std::ios::trunc) << json;
+    try {
+        loadScene(sceneDir / "scene.gltf");
+    } catch (const FileError& e) {
+        // The buffer was found; the all-zero triangle may still be refused for what it holds.
+        EXPECT_EQ(std::string(e.what()).find("uri"), std::string::npos) << e.what();
+    }
+}
+
+// tinygltf skips a property of the wrong type without a word; every such field is an error
+// naming its JSON path.
+TEST(SceneLoader, FieldsOfTheWrongTypeAreErrorsWithTheirPath) {
+    const fs::path dir = test::outputDir("scene_wrong_types");
+    const std::string good = readFileBytes(scenesDir() / "bad" / "missing_buffer.gltf");
+    struct Case {
+        std::string from, to, path;
+    };
+    const std::vector<Case> cases = {
+        {"\"mesh\": 0", "\"mesh\": 0, \"translation\": [\"a\", 0, 0]", "nodes[0].translation[0]"},
+        {"\"mesh\": 0", "\"mesh\": 0, \"translation\": [0, 0]", "nodes[0].translation"},
+        {"\"mesh\": 0", "\"mesh\": 0, \"scale\": \"big\"", "nodes[0].scale"},
+        {"\"mesh\": 0", "\"mesh\": \"0\"", "nodes[0].mesh"},
+        {"\"mesh\": 0", "\"mesh\": 0, \"rotation\": [0, 0, 0, null]", "nodes[0].rotation[3]"},
+        {"\"count\": 3,\n   \"type\": \"VEC3\"", "\"count\": 3.5,\n   \"type\": \"VEC3\"",
+         "accessors[0].count"},
+        {"\"POSITION\": 0", "\"POSITION\": true", "meshes[0].primitives[0].attributes.POSITION"},
+        {"\"byteLength\": 42", "\"byteLength\": \"42\"", "buffers[0].byteLength"},
+        {"\"version\": \"2.0\"", "\"version\": 2.0", "asset.version"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.to);
+        std::string json = good;
+        ASSERT_NE(json.find(c.from), std::string::npos);
+        json.replace(json.find(c.from), c.from.size(), c.to);
+        std::ofstream(dir / "scene.gltf", std::ios::trunc) << json;
+        try {
+            loadScene(dir / "scene.gltf");
+            ADD_FAILURE() << "loaded";
+        } catch (const FileError& e) {
+            EXPECT_NE(std::string(e.what()).find(c.path + ":"), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(SceneLoader, MissingFile) {

@@ -561,6 +561,46 @@ TEST(SessionCorrupt, SessionJsonErrorsAreClear) {
     EXPECT_NE(readError(dir / "nonexistent").find("not a folder"), std::string::npos);
 }
 
+TEST(SessionCorrupt, TwoMainCamerasAndOutsideFilesAreRefused) {
+    const fs::path dir = test::outputDir("session_two_mains");
+    writeSession(dir, 2, false);
+    const std::string good = readFileBytes(dir / "session.json");
+    auto with = [&](const std::string& from, const std::string& to) {
+        std::string s = good;
+        s.replace(s.find(from), from.size(), to);
+        writeFileAtomically(dir / "session.json", s);
+        return readError(dir);
+    };
+    // Taken silently before: the second "main" camera was read as an environment camera.
+    std::string e = with("\"role\": \"environment\"", "\"role\": \"main\"");
+    EXPECT_NE(e.find("cameras[1].role"), std::string::npos) << e;
+    EXPECT_NE(e.find("a session has one"), std::string::npos) << e;
+    // Files named by the session stay inside it, after normalisation too.
+    for (const char* outside : {"/etc/passwd", "sub/../../x.mkv", "file:///etc/passwd"}) {
+        e = with("\"video\": \"env.mkv\"", std::string("\"video\": \"") + outside + "\"");
+        EXPECT_NE(e.find("cameras[1].video"), std::string::npos) << e;
+        EXPECT_NE(e.find(outside), std::string::npos) << e;
+    }
+    e = with("\"video\": \"env.mkv\"", "\"video\": \"\"");
+    EXPECT_NE(e.find("cameras[1].video"), std::string::npos) << e;
+}
+
+TEST(SessionCorrupt, TimestampsGoingBackwardsAreReportedAndSkipped) {
+    const fs::path dir = test::outputDir("session_time_backwards");
+    writeSession(dir, 6, false);
+    // Row 4 (frame 3) gets a main-camera time before frame 2's: a spliced or damaged file.
+    rewriteCsv(dir / "frames.csv", [](std::vector<std::string>& lines) {
+        std::string& row = lines[4];
+        const size_t comma = row.find(',');
+        row = row.substr(0, comma) + ",999.5" + row.substr(row.find(',', comma + 1));
+    });
+    SessionReadReport report;
+    const Session s = readSession(dir, &report);
+    EXPECT_EQ(s.frames.size(), 5u);
+    EXPECT_TRUE(contains(report, "frames.csv line 5: t_main 999.5 goes back in time"))
+        << allWarnings(report);
+}
+
 TEST(SessionCorrupt, RandomDamageNeverCrashes) {
     // Flipped bytes, cut files and garbage rows: readers report and keep going, never crash,
     // never loop, never claim more frames than were written.

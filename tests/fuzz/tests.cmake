@@ -92,6 +92,7 @@ mirage_loader_fuzz(board_fuzz BoardFuzz.cpp "mirage_tracking;mirage_core"
 mirage_loader_fuzz(session_fuzz SessionFuzz.cpp mirage_core ${_corpus}/session)
 mirage_loader_fuzz(poses_csv_fuzz PosesCsvFuzz.cpp mirage_core ${_corpus}/poses)
 mirage_loader_fuzz(matroska_fuzz MatroskaFuzz.cpp mirage_core ${_corpus}/matroska)
+mirage_loader_fuzz(avi_fuzz AviFuzz.cpp mirage_core ${_corpus}/avi)
 mirage_loader_fuzz(env_image_fuzz EnvImageFuzz.cpp mirage_core ${_corpus}/envimage
                    ${CMAKE_CURRENT_SOURCE_DIR}/data/scenes/good)
 mirage_loader_fuzz(density_grid_fuzz DensityGridFuzz.cpp mirage_core ${_corpus}/density

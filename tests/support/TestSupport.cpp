@@ -14,6 +14,8 @@
 
 #include "core/Csv.h"
 #include "core/image/ImageCompare.h"
+#include "core/session/AtomicFile.h"
+#include "core/session/MatroskaScanner.h"
 #include "core/session/Session.h"
 
 namespace mirage::test {
@@ -65,6 +67,81 @@ double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q) {
     size_t k = std::min(v.size() - 1, size_t(q * double(v.size() - 1) + 0.5));
     std::nth_element(v.begin(), v.begin() + long(k), v.end());
     return v[k];
+}
+
+namespace {
+
+void putLe32(std::string& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out += char((v >> (8 * i)) & 0xFF);
+}
+void putLe16(std::string& out, uint16_t v) {
+    out += char(v & 0xFF);
+    out += char(v >> 8);
+}
+// A chunk: FourCC, little-endian size, payload, a pad byte to an even size.
+std::string riffChunk(const char* id, const std::string& payload) {
+    std::string c(id, 4);
+    putLe32(c, uint32_t(payload.size()));
+    c += payload;
+    if (payload.size() % 2) c += '\0';
+    return c;
+}
+std::string riffList(const char* type, const std::string& children) {
+    return riffChunk("LIST", std::string(type, 4) + children);
+}
+
+}  // namespace
+
+std::string mjpegAviBytes(const std::vector<std::string>& jpegs, int width, int height, double fps,
+                          bool withIndex) {
+    const uint32_t rate = uint32_t(std::lround(fps * 1000)), scale = 1000;
+    size_t largest = 0;
+    for (const auto& j : jpegs) largest = std::max(largest, j.size());
+    std::string avih;
+    for (uint32_t v :
+         {uint32_t(1e6 / fps), 0u, 0u, 0x10u /*AVIF_HASINDEX*/, uint32_t(jpegs.size()), 0u, 1u,
+          uint32_t(largest), uint32_t(width), uint32_t(height), 0u, 0u, 0u, 0u})
+        putLe32(avih, v);
+    std::string strh = "vidsMJPG";
+    for (uint32_t v :
+         {0u, 0u, 0u, scale, rate, 0u, uint32_t(jpegs.size()), uint32_t(largest), ~0u, 0u})
+        putLe32(strh, v);
+    putLe16(strh, 0);
+    putLe16(strh, 0);
+    putLe16(strh, uint16_t(width));
+    putLe16(strh, uint16_t(height));
+    std::string strf;  // BITMAPINFOHEADER
+    putLe32(strf, 40);
+    putLe32(strf, uint32_t(width));
+    putLe32(strf, uint32_t(height));
+    putLe16(strf, 1);
+    putLe16(strf, 24);
+    strf += "MJPG";
+    putLe32(strf, uint32_t(width * height * 3));
+    for (int i = 0; i < 4; ++i) putLe32(strf, 0);
+    const std::string hdrl =
+        riffList("hdrl", riffChunk("avih", avih) +
+                             riffList("strl", riffChunk("strh", strh) + riffChunk("strf", strf)));
+    std::string movi = "movi", idx1;
+    for (const auto& j : jpegs) {
+        idx1 += "00dc";
+        putLe32(idx1, 0x10);                   // AVIIF_KEYFRAME
+        putLe32(idx1, uint32_t(movi.size()));  // from the 'movi' FourCC
+        putLe32(idx1, uint32_t(j.size()));
+        movi += riffChunk("00dc", j);
+    }
+    std::string body = "AVI " + hdrl + riffChunk("LIST", movi);
+    if (withIndex) body += riffChunk("idx1", idx1);
+    return riffChunk("RIFF", body);
+}
+
+std::vector<std::string> matroskaJpegs(const std::filesystem::path& mkv) {
+    const MatroskaScan scan = scanMatroska(mkv);
+    const std::string bytes = readFileBytes(mkv);
+    std::vector<std::string> jpegs;
+    for (const MatroskaBlock& b : scan.blocks)
+        jpegs.push_back(bytes.substr(size_t(b.offset), size_t(b.size)));
+    return jpegs;
 }
 
 std::string withoutMatroskaClusterChecksums(std::string bytes) {

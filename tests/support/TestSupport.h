@@ -53,6 +53,15 @@ std::vector<cv::Mat> sessionFrames(const std::filesystem::path& session,
 // carry the checksum, other recorders' files do not: there only the JPEG checks can find damage.
 std::string withoutMatroskaClusterChecksums(std::string bytes);
 
+// An AVI (RIFF) file holding `jpegs` as one MJPEG video stream, laid out as FFmpeg's AVI muxer
+// lays it out (hdrl with avih/strl/strh/strf, a movi list of '00dc' chunks, an idx1 index with
+// offsets relative to 'movi'), without the index if `withIndex` is false (a recording cut before
+// it was written). The JPEG bytes are copied unchanged.
+std::string mjpegAviBytes(const std::vector<std::string>& jpegs, int width, int height, double fps,
+                          bool withIndex = true);
+// The JPEG of every frame of a Matroska MJPEG file, in order (bytes as stored).
+std::vector<std::string> matroskaJpegs(const std::filesystem::path& mkv);
+
 struct CommandResult {
     int exitCode = -1;
     std::string output;  // stdout and stderr together

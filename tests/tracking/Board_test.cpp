@@ -99,17 +99,34 @@ TEST(Board, MalformedFilesNameTheField) {
     const std::string pose = R"("T_world_tag": {"t": [0,0,0], "q_wxyz": [1,0,0,0]})";
     expectFieldError("{", "JSON");
     expectFieldError(R"({"family": "tag36h11"})", "tags");
-    expectFieldError(R"({"tags": [{"id": 1, )" + pose + "}]}", "tags[0].size");
-    expectFieldError(R"({"tags": [{"id": 1, "size": -1, )" + pose + "}]}", "tags[0].size");
+    expectFieldError(R"({"family": "tag36h11", "tags": [{"id": 1, )" + pose + "}]}",
+                     "tags[0].size");
+    expectFieldError(R"({"family": "tag36h11", "tags": [{"id": 1, "size": -1, )" + pose + "}]}",
+                     "tags[0].size");
     expectFieldError(
-        R"({"tags": [{"id": 1, "size": 0.1, "T_world_tag": {"t": [0,0,0], "q_wxyz": [2,0,0,0]}}]})",
+        R"({"family": "tag36h11", "tags": [{"id": 1, "size": 0.1, "T_world_tag": {"t": [0,0,0], "q_wxyz": [2,0,0,0]}}]})",
         "q_wxyz");
-    expectFieldError(R"({"tags": [{"id": 1, "size": 0.1, )" + pose +
+    expectFieldError(R"({"family": "tag36h11", "tags": [{"id": 1, "size": 0.1, )" + pose +
                          "}, {\"id\": 1, \"size\": 0.1, " + pose + "}]}",
                      "tags[1].id");
     expectFieldError(R"({"family": "nope", "tags": []})", "family");
-    expectFieldError(R"({"tags": [{"id": 9999, "size": 0.1, )" + pose + "}]}", "tags[0].id");
+    expectFieldError(R"({"family": "tag36h11", "tags": [{"id": 9999, "size": 0.1, )" + pose + "}]}",
+                     "tags[0].id");
     EXPECT_THROW(Board::load("/nonexistent/board.json"), FileError);
+}
+
+TEST(Board, FileWithoutFamilyIsRefused) {
+    // Taking tag36h11 when the family is missing tracked a board printed with another family as
+    // no tags at all, or found codes of the wrong family: the family is required.
+    const std::string text =
+        R"({"tags": [{"id": 1, "size": 0.1, "T_world_tag": {"t": [0,0,0], "q_wxyz": [1,0,0,0]}}]})";
+    try {
+        Board::parse(text, "nofamily.json");
+        FAIL() << "a board without a family was accepted";
+    } catch (const FileError& e) {
+        EXPECT_NE(std::string(e.what()).find("nofamily.json"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'family'"), std::string::npos) << e.what();
+    }
 }
 
 TEST(BoardImage, RasterHasExactPhysicalScale) {
