@@ -103,7 +103,8 @@ TEST(TrackCommand, SyntheticSessionMeetsAccuracyWithAFrameOfNoise) {
     EXPECT_LT(rotMax, 0.3);
 }
 
-// A recording cut short (crash while writing): the frames lost are counted, the rest tracked.
+// A recording cut short (crash while writing): the frames lost are counted, the rest tracked, and
+// the exit status (2) says the input was not read in full.
 TEST(TrackCommand, TruncatedVideoCountsLostFramesAndContinues) {
     const auto dir = makeSession("truncated", 8, true);
     const auto video = dir / "main.mkv";
@@ -112,7 +113,7 @@ TEST(TrackCommand, TruncatedVideoCountsLostFramesAndContinues) {
     std::filesystem::resize_file(video, size * 6 / 10);
     const auto csv = dir.parent_path() / "poses.csv";
     const auto r = test::runMirage({"track", dir.string(), "-o", csv.string()});
-    ASSERT_EQ(r.exitCode, 0) << r.output;
+    ASSERT_EQ(r.exitCode, 2) << r.output;
     const auto rows = readCsv(csv);
     ASSERT_GE(rows.size(), 3u);  // header + some frames
     ASSERT_LT(rows.size(), 9u);  // not all 8 frames survived
@@ -213,7 +214,7 @@ TEST(TrackCommand, BadInputNamesTheFile) {
                               (out / "p.csv").string()});
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.output.find("none"), std::string::npos) << r.output;
-    std::ofstream(out / "bad.json") << "{\"tags\": [{\"id\": 1}]}";
+    std::ofstream(out / "bad.json") << "{\"family\": \"tag36h11\", \"tags\": [{\"id\": 1}]}";
     const auto dir = makeSession("badboard", 1);
     r = test::runMirage({"track", dir.string(), "--board", (out / "bad.json").string(), "-o",
                          (out / "p.csv").string()});
