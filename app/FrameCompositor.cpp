@@ -2,8 +2,6 @@
 
 #include <chrono>
 
-#include <opencv2/core/utility.hpp>
-
 #include "core/gl/Objects.h"
 
 namespace mirage::app {
@@ -14,42 +12,13 @@ double msSince(Clock::time_point t0) {
 }
 }  // namespace
 
-FrameCompositor::FrameCompositor(render::Renderer& renderer, tracking::Tracker* tracker)
-    : renderer_(renderer), tracker_(tracker) {}
+FrameCompositor::FrameCompositor(render::Renderer& renderer) : renderer_(renderer) {}
 
-CompositedFrame FrameCompositor::process(const cv::Mat& bgr, double t, const std::string& problem,
-                                         std::optional<PoseRow> given, bool renderVirtual) {
+CompositedFrame FrameCompositor::composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual) {
     CompositedFrame out;
-    PoseRow& pr = out.pose;
-    const auto t1 = Clock::now();
-    if (bgr.empty()) {
-        // Lost (damaged bytes): no image to composite into and no pose to trust; the row says
-        // why, the output skips the frame.
-        pr = {"lost", problem.empty() ? "frame not decodable" : problem, std::nullopt};
-        if (tracker_) tracker_->markLost(t, pr.reason);
-    } else if (given) {
-        pr = std::move(*given);
-    } else if (tracker_) {
-        tracking::TrackedFrame tf = tracker_->process(bgr, t);
-        pr.state = tracking::trackingStateName(tf.estimate.state);
-        pr.reason = tf.estimate.reason;
-        if (tf.estimate.state == tracking::TrackingState::Ok)
-            pr.pose = tf.filtered ? tf.filtered : tf.estimate.pose;
-    } else {
-        pr = {"lost", "no pose source", std::nullopt};
-    }
-    if (pr.state == "uncertain") {
-        pr.pose.reset();
-        if (lastGood_ && t >= lastGoodT_ && t - lastGoodT_ <= kHoldUncertainS) {
-            pr.pose = lastGood_;
-            pr.reason += cv::format("; held the last ok pose (t = %.3f s)", lastGoodT_);
-        }
-    } else if (pr.pose) {
-        lastGood_ = pr.pose;
-        lastGoodT_ = t;
-    }
-    out.trackingMs = msSince(t1);
-    if (pr.pose && renderVirtual) {
+    out.pose = std::move(pose);
+    const PoseRow& pr = out.pose;
+    if (pr.pose && renderVirtual && !bgr.empty()) {
         const render::FrameReport& rep =
             renderer_.render({*pr.pose, bgr, /*resetHistory=*/lastLost_});
         for (const auto& p : rep.passes) out.passMs[p.name] = p.gpuMs;
@@ -63,7 +32,7 @@ CompositedFrame FrameCompositor::process(const cv::Mat& bgr, double t, const std
     }
     // History is reset after every frame that was not rendered, so that a live session and the
     // replay of its recording (which sees exactly the rendered frames) agree.
-    lastLost_ = !(pr.pose && renderVirtual);
+    lastLost_ = !(out.report != nullptr);
     return out;
 }
 

@@ -1,22 +1,17 @@
 #pragma once
-// The per-frame work of every command that composites footage (mirage replay, mirage live): pose
-// (tracked, or given by the caller), the rule for uncertain poses, render, composite, readback.
-// One implementation, so that a live session and the replay of its recording make the same
-// decisions on the same frames and therefore the same images.
+// The render and composite stages of every loop that composites footage (mirage replay, mirage
+// live): the virtual objects rendered from the frame's decided pose (app/PoseStage.h),
+// composited into the frame, read back. One implementation, so that a live session and the
+// replay of its recording make the same images from the same frames and poses.
 #include <map>
-#include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
 
 #include "core/session/PosesCsv.h"
 #include "render/Renderer.h"
-#include "tracking/Tracker.h"
 
 namespace mirage::app {
-
-// How long an `uncertain` frame may be composited with the last ok pose (seconds).
-inline constexpr double kHoldUncertainS = 0.25;
 
 struct CompositedFrame {
     // State and reason of the frame, and the pose composited (T_world_camera, OpenCV axes);
@@ -33,18 +28,13 @@ struct CompositedFrame {
 
 class FrameCompositor {
 public:
-    // `tracker` may be null when every frame's pose is given by the caller.
-    FrameCompositor(render::Renderer& renderer, tracking::Tracker* tracker);
+    explicit FrameCompositor(render::Renderer& renderer);
 
-    // One frame: `bgr` 8-bit BGR sRGB (empty = lost, `problem` says why), `t` its time in
-    // seconds. `given`: the pose decided elsewhere (a poses file, the ground truth); nullopt:
-    // track the frame. An uncertain pose is never composited; for up to kHoldUncertainS after
-    // the last ok pose that pose is held (a short wobble of the tracking does not blink the
-    // virtual objects away), later the footage passes through as for a loss, and the temporal
-    // history is reset on the next frame with a pose. `renderVirtual` false: the footage passes
-    // through even with a pose (the pose is still reported).
-    CompositedFrame process(const cv::Mat& bgr, double t, const std::string& problem,
-                            std::optional<PoseRow> given, bool renderVirtual = true);
+    // One frame: `bgr` 8-bit BGR sRGB (empty = lost) with its decided pose. With a pose (and
+    // `renderVirtual`) the renderer renders and composites; without one, or with
+    // `renderVirtual` false, the footage passes through (the pose is still reported) and the
+    // temporal history is reset on the next rendered frame.
+    CompositedFrame composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual = true);
 
     // Blits the last composite into the current context's default framebuffer (w x h pixels,
     // flipped to the window's bottom-up rows).
@@ -52,10 +42,7 @@ public:
 
 private:
     render::Renderer& renderer_;
-    tracking::Tracker* tracker_;
     bool lastLost_ = true;
-    std::optional<Pose> lastGood_;  // the last composited ok (or given) pose, and its time
-    double lastGoodT_ = 0;
 };
 
 }  // namespace mirage::app

@@ -10,21 +10,6 @@
 #include "core/Error.h"
 #include "core/Log.h"
 
-namespace mirage::app {
-std::vector<CommandSpec>& commandRegistry() {
-    static std::vector<CommandSpec> r;
-    return r;
-}
-int& commandExitCode() {
-    static int code = 0;
-    return code;
-}
-std::vector<std::string>& commandLine() {
-    static std::vector<std::string> args;
-    return args;
-}
-}  // namespace mirage::app
-
 int main(int argc, char** argv) {
     using namespace mirage;
     app::commandLine().assign(argv, argv + argc);

@@ -428,13 +428,12 @@ double CalibrationResult::relativeFocalStd() const {
     return std::isfinite(r) ? r : kInf;
 }
 
-CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size imageSize,
-                            const CalibrationOptions& o) {
-    if (imageSize.width <= 0 || imageSize.height <= 0)
-        throw Error(fmt::format("calibration: invalid image size {}x{}", imageSize.width,
-                                imageSize.height));
-    CalibrationResult result;
-    result.parameterNames = parameterNames(o.model);
+namespace {
+
+// Screens every view (enough points inside the image): the usable ones' indices; the others
+// are marked rejected with the reason in `result`.
+std::vector<size_t> usableViews(const std::vector<CalibrationView>& views, cv::Size imageSize,
+                                CalibrationResult& result) {
     std::vector<size_t> active;
     for (size_t i = 0; i < views.size(); ++i) {
         ViewResult vr;
@@ -456,21 +455,26 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
             "calibration: none of the {} views is usable (each needs at least 4 board points "
             "inside the image); check that the board was detected",
             views.size()));
+    return active;
+}
 
-    // Working copies: outlier corners are dropped from these.
-    std::vector<CalibrationView> work(views.begin(), views.end());
-    std::vector<std::vector<DroppedCorner>> dropped(views.size());
-    auto current = [&] {
-        std::vector<const CalibrationView*> c;
-        for (size_t i : active) c.push_back(&work[i]);
-        return c;
-    };
+// The views in use, as the solver takes them.
+std::vector<const CalibrationView*> inUse(const std::vector<CalibrationView>& work,
+                                          const std::vector<size_t>& active) {
+    std::vector<const CalibrationView*> c;
+    for (size_t i : active) c.push_back(&work[i]);
+    return c;
+}
 
+// Solves, then drops the worst view while it is an outlier (its RMS above outlierFactor x the
+// median and outlierMinErrorPx), within the rejection budget; re-solved after each drop.
+Solution solveRejectingOutlierViews(const std::vector<CalibrationView>& work,
+                                    std::vector<size_t>& active, cv::Size imageSize,
+                                    const CalibrationOptions& o, CalibrationResult& result) {
     const size_t usable = active.size();
     const size_t maxRejected = size_t(std::floor(o.maxRejectedFraction * double(usable)));
-    Solution s;
     while (true) {
-        s = solve(current(), imageSize, o);
+        Solution s = solve(inUse(work, active), imageSize, o);
         const double med = median(s.viewRms);
         const auto worst =
             size_t(std::max_element(s.viewRms.begin(), s.viewRms.end()) - s.viewRms.begin());
@@ -478,7 +482,7 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
         const bool outlier = worstRms > o.outlierFactor * med && worstRms > o.outlierMinErrorPx;
         if (!outlier || usable - active.size() >= maxRejected ||
             int(active.size()) - 1 < std::max(o.minViews, 2))
-            break;
+            return s;
         auto& vr = result.views[active[worst]];
         vr.rejected = true;
         vr.rmsPx = worstRms;
@@ -486,9 +490,15 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
                                       worstRms, o.outlierFactor, med);
         active.erase(active.begin() + long(worst));
     }
+}
 
-    // Outlier corners, worst first in each view per round (a gross error inflates its
-    // neighbours' residuals through the fit), re-solved after each round.
+// Outlier corners, worst first in each view per round (a gross error inflates its neighbours'
+// residuals through the fit), re-solved after each round. Dropped corners leave `work` and are
+// listed in `dropped`.
+Solution dropOutlierCorners(Solution s, const std::vector<CalibrationView>& views,
+                            std::vector<CalibrationView>& work, const std::vector<size_t>& active,
+                            std::vector<std::vector<DroppedCorner>>& dropped,
+                            const CalibrationOptions& o) {
     for (int round = 0; round < 10; ++round) {
         bool any = false;
         for (size_t k = 0; k < active.size(); ++k) {
@@ -509,11 +519,15 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
             any = true;
         }
         if (!any) break;
-        s = refit(current(), s, o, {});
+        s = refit(inUse(work, active), s, o, {});
     }
+    return s;
+}
 
-    // Views weighted by their measured noise: one noisier than 1.5x the median view counts
-    // (median / noise)^2 as much per corner.
+// Views weighted by their measured noise: one noisier than 1.5x the median view counts
+// (median / noise)^2 as much per corner. Returns the per-view residual scales (1: unweighted).
+std::vector<double> weightByNoise(Solution& s, const std::vector<CalibrationView>& work,
+                                  const std::vector<size_t>& active, const CalibrationOptions& o) {
     std::vector<double> noise(active.size()), scales(active.size(), 1.0);
     for (size_t k = 0; k < active.size(); ++k)
         noise[k] = noiseOf(residualLengths(work[active[k]], s.intrinsics, s.rvecs[k], s.tvecs[k]));
@@ -525,8 +539,18 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
                 scales[k] = medianNoise / noise[k];
                 weighted = true;
             }
-    if (weighted) s = refit(current(), s, o, scales);
+    if (weighted) s = refit(inUse(work, active), s, o, scales);
+    return scales;
+}
 
+// The solution into the result: intrinsics, and per used view its fit, tilt and reach (the
+// corners' angles off the axis, from the fitted pose: exact, no inversion of the lens
+// polynomial, and their distance from the principal point).
+void describeViews(const Solution& s, const std::vector<CalibrationView>& work,
+                   const std::vector<size_t>& active,
+                   const std::vector<std::vector<DroppedCorner>>& dropped,
+                   const std::vector<double>& scales, const CalibrationOptions& o,
+                   CalibrationResult& result) {
     auto& c = result.calibration;
     c.intrinsics = s.intrinsics;
     c.avgReprojectionError = s.rms;
@@ -553,8 +577,6 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
         } else {
             boardTilt(vr.rvec, vr.tiltDeg, vr.tiltDirectionDeg);
         }
-        // Reach: the corners' angles off the axis (from the fitted pose: exact, no inversion of
-        // the lens polynomial) and their distance from the principal point.
         cv::Matx33d R;
         cv::Rodrigues(vr.rvec, R);
         for (size_t i = 0; i < v.boardPoints.size(); ++i) {
@@ -571,12 +593,16 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
     }
     c.reachDeg = reachDeg;
     c.reachRadiusPx = reachRadius;
+}
 
-    // Reliability: every reason is collected, so the user sees all that is wrong at once.
+// Reliability: every reason is collected, so the user sees all that is wrong at once.
+void judgeReliability(size_t usedViews, cv::Size imageSize, const CalibrationOptions& o,
+                      CalibrationResult& result) {
+    auto& c = result.calibration;
     std::vector<std::string> reasons;
-    if (int(active.size()) < o.minViews)
+    if (int(usedViews) < o.minViews)
         reasons.push_back(
-            fmt::format("only {} usable views (at least {} needed)", active.size(), o.minViews));
+            fmt::format("only {} usable views (at least {} needed)", usedViews, o.minViews));
     if (result.maxTiltDeg < o.minMaxTiltDeg)
         reasons.push_back(fmt::format(
             "all views are nearly fronto-parallel (largest tilt {:.1f} deg < {:.0f} deg): the "
@@ -599,8 +625,13 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
                         c.stdDeviations[2], c.stdDeviations[3], ppLimit));
     c.reliable = reasons.empty();
     for (size_t i = 0; i < reasons.size(); ++i) c.unreliableReason += (i ? "; " : "") + reasons[i];
+}
 
-    // Coverage warning: distortion far from every corner is extrapolated.
+// Coverage warnings: distortion far from every corner is extrapolated; for a fish-eye, whose
+// distortion is decided toward the rim, the rings off-axis (through the fitted lens) that the
+// image can hold but no used corner reached.
+void warnAboutCoverage(const std::vector<CalibrationView>& views, const std::vector<size_t>& active,
+                       cv::Size imageSize, CalibrationResult& result) {
     float minX = 1e9f, minY = 1e9f, maxX = -1e9f, maxY = -1e9f;
     for (size_t i : active)
         for (const auto& p : views[i].imagePoints) {
@@ -616,16 +647,36 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size 
             fmt::format("the corners span only {:.0f}% of the image: distortion near the edges is "
                         "extrapolated; move the board into the corners",
                         100 * covered));
-    // A fish-eye's distortion is decided toward the rim: name the rings off-axis (through the
-    // fitted lens) that the image can hold but no used corner reached.
-    if (c.intrinsics.model == DistortionModel::KannalaBrandt) {
+    const CameraIntrinsics& lens = result.calibration.intrinsics;
+    if (lens.model == DistortionModel::KannalaBrandt) {
         CoverageMap rings(imageSize);
-        rings.setAngularLens(c.intrinsics);
+        rings.setAngularLens(lens);
         for (size_t i : active) rings.add(views[i].imagePoints);
         for (const auto& missing : rings.missingRings())
             result.warnings.push_back(
                 missing + ": the model is extrapolated there; add views toward the rim");
     }
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const std::vector<CalibrationView>& views, cv::Size imageSize,
+                            const CalibrationOptions& o) {
+    if (imageSize.width <= 0 || imageSize.height <= 0)
+        throw Error(fmt::format("calibration: invalid image size {}x{}", imageSize.width,
+                                imageSize.height));
+    CalibrationResult result;
+    result.parameterNames = parameterNames(o.model);
+    std::vector<size_t> active = usableViews(views, imageSize, result);
+    // Working copies: outlier corners are dropped from these.
+    std::vector<CalibrationView> work(views.begin(), views.end());
+    std::vector<std::vector<DroppedCorner>> dropped(views.size());
+    Solution s = solveRejectingOutlierViews(work, active, imageSize, o, result);
+    s = dropOutlierCorners(std::move(s), views, work, active, dropped, o);
+    const std::vector<double> scales = weightByNoise(s, work, active, o);
+    describeViews(s, work, active, dropped, scales, o, result);
+    judgeReliability(active.size(), imageSize, o, result);
+    warnAboutCoverage(views, active, imageSize, result);
     return result;
 }
 

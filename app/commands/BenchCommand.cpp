@@ -109,6 +109,60 @@ void writeBenchImages(const fs::path& folder, const std::vector<render::BenchRes
     std::ofstream(folder / "labels.txt") << index;
 }
 
+// The benchmarked session with its ground-truth composite, the main camera's calibration and
+// the scene it was synthesised from; what to do when one is missing.
+struct BenchInputs {
+    Session session;
+    render::GroundTruthInfo gt;
+    CameraCalibration calib;
+    std::string scenePath;
+};
+BenchInputs readBenchInputs(const BenchArgs& a) {
+    BenchInputs in;
+    SessionReadReport readReport;
+    in.session = readSession(a.session, &readReport);
+    const Session& session = in.session;
+    for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
+    const std::optional<render::GroundTruthInfo> gt = render::readGroundTruthInfo(session.dir);
+    if (!gt)
+        throw FileError(fs::path(a.session) / render::kGroundTruthFile,
+                        "the session has no ground-truth composite; make it with `mirage synth "
+                        "SCENE -o SESSION --ground-truth-composite` (docs/bench.md)");
+    in.gt = *gt;
+    const SessionCamera* main = session.cameras.empty() ? nullptr : &session.cameras.front();
+    for (const auto& c : session.cameras)
+        if (c.role == "main") main = &c;
+    if (!main || main->calibration.empty())
+        throw FileError(a.session, "the main camera has no calibration file in session.json");
+    in.calib = loadCalibration(session.path(main->calibration));
+    in.scenePath = a.scene.empty() ? gt->scene : a.scene;
+    if (in.scenePath.empty() || !fs::exists(in.scenePath))
+        throw FileError(in.scenePath.empty()
+                            ? (fs::path(a.session) / render::kGroundTruthFile).string()
+                            : in.scenePath,
+                        "scene not found; pass --scene SCENE.gltf (the scene the session was "
+                        "synthesised from, with its virtual objects)");
+    return in;
+}
+
+// The session's environment camera, for configurations with env_source=camera (nullopt when
+// the grid has none); what is wrong with it otherwise.
+std::optional<render::SessionEnvironment> benchEnvironment(
+    const std::vector<render::BenchConfig>& grid, const Session& session, const BenchArgs& a) {
+    if (std::none_of(grid.begin(), grid.end(),
+                     [](const render::BenchConfig& c) { return c.environmentCamera; }))
+        return std::nullopt;
+    std::string why;
+    std::optional<render::SessionEnvironment> env =
+        render::SessionEnvironment::open(session, a.exposure, why);
+    if (!env)
+        throw FileError(
+            a.session,
+            "knob env_source=camera: " +
+                (why.empty() ? std::string("the session has no environment camera") : why));
+    return env;
+}
+
 void runBench(const BenchArgs& a) {
     if (a.listKnobs) {
         for (const auto& k : render::benchKnobs())
@@ -119,28 +173,11 @@ void runBench(const BenchArgs& a) {
     if (a.repeats < 1) throw Error("mirage bench: --repeat must be >= 1");
     const auto overrides = parseKnobs(a.knobs);
 
-    SessionReadReport readReport;
-    const Session session = readSession(a.session, &readReport);
-    for (const auto& w : readReport.warnings) spdlog::warn("session: {}", w);
-    const std::optional<render::GroundTruthInfo> gt = render::readGroundTruthInfo(session.dir);
-    if (!gt)
-        throw FileError(fs::path(a.session) / render::kGroundTruthFile,
-                        "the session has no ground-truth composite; make it with `mirage synth "
-                        "SCENE -o SESSION --ground-truth-composite` (docs/bench.md)");
-    const SessionCamera* main = session.cameras.empty() ? nullptr : &session.cameras.front();
-    for (const auto& c : session.cameras)
-        if (c.role == "main") main = &c;
-    if (!main || main->calibration.empty())
-        throw FileError(a.session, "the main camera has no calibration file in session.json");
-    const CameraCalibration calib = loadCalibration(session.path(main->calibration));
-
-    const std::string scenePath = a.scene.empty() ? gt->scene : a.scene;
-    if (scenePath.empty() || !fs::exists(scenePath))
-        throw FileError(scenePath.empty()
-                            ? (fs::path(a.session) / render::kGroundTruthFile).string()
-                            : scenePath,
-                        "scene not found; pass --scene SCENE.gltf (the scene the session was "
-                        "synthesised from, with its virtual objects)");
+    const BenchInputs inputs = readBenchInputs(a);
+    const Session& session = inputs.session;
+    const render::GroundTruthInfo* gt = &inputs.gt;
+    const CameraCalibration& calib = inputs.calib;
+    const std::string& scenePath = inputs.scenePath;
     // The outputs are checked before the benchmark runs (core/OutputFile.h).
     const fs::path out(a.output);
     OutputRule rule{sessionInputs(session), a.force, "mirage bench"};
@@ -181,17 +218,7 @@ void runBench(const BenchArgs& a) {
                         "ground-truth composite to judge against");
 
     // The session's environment camera, for configurations with env_source=camera.
-    std::optional<render::SessionEnvironment> env;
-    if (std::any_of(grid.begin(), grid.end(),
-                    [](const render::BenchConfig& c) { return c.environmentCamera; })) {
-        std::string why;
-        env = render::SessionEnvironment::open(session, a.exposure, why);
-        if (!env)
-            throw FileError(
-                a.session,
-                "knob env_source=camera: " +
-                    (why.empty() ? std::string("the session has no environment camera") : why));
-    }
+    std::optional<render::SessionEnvironment> env = benchEnvironment(grid, session, a);
 
     gl::ContextOptions copt;
     copt.width = calib.intrinsics.width;

@@ -543,6 +543,129 @@ SuiteSpec loadSuite(const fs::path& file) {
     return s;
 }
 
+// The summary table: per effect its default and cheapest setting, best error and the settings
+// that do not beat the footage alone.
+std::string summaryTable(const std::vector<EffectRun>& runs) {
+    std::string md;
+    md +=
+        "| effect | default ms | default PSNR (dB) | footage only (dB) | best PSNR (dB) | "
+        "cheapest ms (PSNR) | settings not beating the footage |\n|---|---|---|---|---|---|---|\n";
+    for (const EffectRun& r : runs) {
+        const BenchResult& d = r.results.front();
+        double best = -1e9;
+        std::string broken;
+        for (size_t i = 0; i < r.results.size(); ++i) {
+            if (std::isfinite(r.results[i].error.psnrInfluenced))
+                best = std::max(best, r.results[i].error.psnrInfluenced);
+            if (!beatsFootage(r.results[i], r.baseline))
+                broken += (broken.empty() ? "" : ", ") + r.pointLabels[i];
+        }
+        const BenchResult& c = r.results[r.cheapest];
+        md += fmt::format("| [{}](#{}) | {:.1f} | {} | {} | {} | {:.1f} ({}) | {} |\n",
+                          r.effect->name, r.effect->name, d.medianWallMs,
+                          fmtDb(d.error.psnrInfluenced), fmtDb(r.baseline.error.psnrInfluenced),
+                          fmtDb(best), c.medianWallMs, fmtDb(c.error.psnrInfluenced),
+                          broken.empty() ? "none" : broken);
+    }
+
+    return md;
+}
+
+// The stacked bars of every effect's default frame, pass by pass (results/passes.svg).
+std::string passBars(const std::vector<EffectRun>& runs, const fs::path& out) {
+    plot::StackedBarPlot bars;
+    bars.title = "Time per pass of the default frame";
+    bars.xLabel = "GPU ms per frame (median, passes synchronised)";
+    for (const EffectRun& r : runs) {
+        plot::Bar b{r.effect->name, {}};
+        const BenchResult& d = r.results.front();
+        for (const std::string& p : d.passOrder) {
+            auto it = d.medianPassMs.find(p);
+            if (it != d.medianPassMs.end() && it->second > 0) b.segments.push_back({p, it->second});
+        }
+        bars.bars.push_back(std::move(b));
+    }
+    writeText(out / "results" / "passes.svg", plot::svgStackedBars(bars));
+    return "\n![time per pass](results/passes.svg)\n";
+}
+
+// One effect's section: its speed-against-error plot, the table of its settings and the
+// first frame's side-by-side crops of the default and cheapest setting.
+std::string effectSection(const EffectRun& r, const fs::path& out) {
+    std::string md;
+    const std::string name = safeName(r.effect->name);
+    plot::ScatterPlot p;
+    p.title = r.effect->name + ": speed against error";
+    p.xLabel = "ms per frame (median wall)";
+    p.yLabel = "PSNR over influenced pixels (dB)";
+    for (size_t i = 0; i < r.results.size(); ++i)
+        p.points.push_back({r.results[i].medianWallMs, r.results[i].error.psnrInfluenced,
+                            r.pointLabels[i], i == 0, !beatsFootage(r.results[i], r.baseline)});
+    p.hasBaseline = std::isfinite(r.baseline.error.psnrInfluenced);
+    p.baselineY = r.baseline.error.psnrInfluenced;
+    p.baselineLabel = "footage only";
+    writeText(out / "results" / (name + "_time_error.svg"), plot::svgScatter(p));
+    md += fmt::format("\n## {}\n\n{}. Session `{}`.\n\n![{} speed against error]({})\n\n",
+                      r.effect->name, r.effect->title, fs::relative(r.session, out).string(),
+                      r.effect->name, "results/" + name + "_time_error.svg");
+    md +=
+        "| setting | ms per frame | PSNR infl. (dB) | SSIM infl. | PSNR frame (dB) | "
+        "Pareto |\n|---|---|---|---|---|---|\n";
+    const std::vector<size_t> front = plot::paretoFront(p.points);
+    for (size_t i = 0; i < r.results.size(); ++i) {
+        const auto& e = r.results[i].error;
+        md += fmt::format("| {}{} | {:.1f} | {} | {:.4f} | {} | {} |\n", r.pointLabels[i],
+                          beatsFootage(r.results[i], r.baseline) ? "" : " (not above footage)",
+                          r.results[i].medianWallMs, fmtDb(e.psnrInfluenced), e.ssimInfluenced,
+                          fmtDb(e.psnrFrame),
+                          std::find(front.begin(), front.end(), i) != front.end() ? "yes" : "");
+    }
+    md += fmt::format("| footage only | - | {} | {:.4f} | {} | |\n",
+                      fmtDb(r.baseline.error.psnrInfluenced), r.baseline.error.ssimInfluenced,
+                      fmtDb(r.baseline.error.psnrFrame));
+    md += "\nFirst frame, real-time | ground truth | difference x4:\n\n";
+    for (const auto& [which, idx] :
+         std::vector<std::pair<std::string, size_t>>{{"default", 0}, {"cheapest", r.cheapest}}) {
+        const cv::Mat crop = sideBySide(r.results[idx], r.frames.front().influence);
+        if (crop.empty()) continue;
+        const std::string file = fmt::format("results/images/{}_{}.png", name, which);
+        writeBgr8(out / file, crop);
+        md += fmt::format("- {} ({}): ![{} {}]({})\n", which, r.pointLabels[idx], r.effect->name,
+                          which, file);
+    }
+    return md;
+}
+
+// The scaling section: frame time against pixels, VPLs and triangles.
+std::string scalingSection(const EffectRun& first, const ScalingCurves& scaling,
+                           const fs::path& out) {
+    std::string md;
+    md += fmt::format(
+        "\n## Scaling\n\nThe default setting of `{}`, one quantity varied (times only: the "
+        "ground truth is not rendered again). Expected: linear in pixels and in VPLs, "
+        "sub-linear in triangles (most passes work per pixel or per VPL, only the G-buffer, "
+        "shadow and impostor passes per triangle).\n\n",
+        first.effect->name);
+    const auto line = [&](const std::string& file, const std::string& title, const std::string& x,
+                          plot::Series s, bool logX) {
+        if (s.points.empty()) return;
+        plot::LinePlot lp;
+        lp.title = title;
+        lp.xLabel = x;
+        lp.yLabel = "ms per frame";
+        lp.logX = logX;
+        lp.series = {std::move(s)};
+        writeText(out / "results" / file, plot::svgLines(lp));
+        md += fmt::format("![{}](results/{})\n", title, file);
+    };
+    line("scaling_pixels.svg", "Frame time against pixels", "megapixels", scaling.pixels, false);
+    line("scaling_vpls.svg", "Frame time against VPLs", "VPLs", scaling.vpls, false);
+    line("scaling_triangles.svg", "Frame time against triangles", "triangles (log)",
+         scaling.triangles, true);
+    md += "\n" + scaling.table;
+    return md;
+}
+
 void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& commandLine) {
     // Every scene is loaded (and every knob checked) before hours of synthesis.
     std::map<fs::path, Scene> loaded;
@@ -624,111 +747,10 @@ void runSuite(const SuiteSpec& spec, const fs::path& out, const std::string& com
         "- a point drawn red does not beat the footage-only baseline (the dashed line): it "
         "shows nothing of the virtual objects that the footage alone does not\n\n";
 
-    md +=
-        "| effect | default ms | default PSNR (dB) | footage only (dB) | best PSNR (dB) | "
-        "cheapest ms (PSNR) | settings not beating the footage |\n|---|---|---|---|---|---|---|\n";
-    for (const EffectRun& r : runs) {
-        const BenchResult& d = r.results.front();
-        double best = -1e9;
-        std::string broken;
-        for (size_t i = 0; i < r.results.size(); ++i) {
-            if (std::isfinite(r.results[i].error.psnrInfluenced))
-                best = std::max(best, r.results[i].error.psnrInfluenced);
-            if (!beatsFootage(r.results[i], r.baseline))
-                broken += (broken.empty() ? "" : ", ") + r.pointLabels[i];
-        }
-        const BenchResult& c = r.results[r.cheapest];
-        md += fmt::format("| [{}](#{}) | {:.1f} | {} | {} | {} | {:.1f} ({}) | {} |\n",
-                          r.effect->name, r.effect->name, d.medianWallMs,
-                          fmtDb(d.error.psnrInfluenced), fmtDb(r.baseline.error.psnrInfluenced),
-                          fmtDb(best), c.medianWallMs, fmtDb(c.error.psnrInfluenced),
-                          broken.empty() ? "none" : broken);
-    }
-
-    plot::StackedBarPlot bars;
-    bars.title = "Time per pass of the default frame";
-    bars.xLabel = "GPU ms per frame (median, passes synchronised)";
-    for (const EffectRun& r : runs) {
-        plot::Bar b{r.effect->name, {}};
-        const BenchResult& d = r.results.front();
-        for (const std::string& p : d.passOrder) {
-            auto it = d.medianPassMs.find(p);
-            if (it != d.medianPassMs.end() && it->second > 0) b.segments.push_back({p, it->second});
-        }
-        bars.bars.push_back(std::move(b));
-    }
-    writeText(out / "results" / "passes.svg", plot::svgStackedBars(bars));
-    md += "\n![time per pass](results/passes.svg)\n";
-
-    for (const EffectRun& r : runs) {
-        const std::string name = safeName(r.effect->name);
-        plot::ScatterPlot p;
-        p.title = r.effect->name + ": speed against error";
-        p.xLabel = "ms per frame (median wall)";
-        p.yLabel = "PSNR over influenced pixels (dB)";
-        for (size_t i = 0; i < r.results.size(); ++i)
-            p.points.push_back({r.results[i].medianWallMs, r.results[i].error.psnrInfluenced,
-                                r.pointLabels[i], i == 0, !beatsFootage(r.results[i], r.baseline)});
-        p.hasBaseline = std::isfinite(r.baseline.error.psnrInfluenced);
-        p.baselineY = r.baseline.error.psnrInfluenced;
-        p.baselineLabel = "footage only";
-        writeText(out / "results" / (name + "_time_error.svg"), plot::svgScatter(p));
-        md += fmt::format("\n## {}\n\n{}. Session `{}`.\n\n![{} speed against error]({})\n\n",
-                          r.effect->name, r.effect->title, fs::relative(r.session, out).string(),
-                          r.effect->name, "results/" + name + "_time_error.svg");
-        md +=
-            "| setting | ms per frame | PSNR infl. (dB) | SSIM infl. | PSNR frame (dB) | "
-            "Pareto |\n|---|---|---|---|---|---|\n";
-        const std::vector<size_t> front = plot::paretoFront(p.points);
-        for (size_t i = 0; i < r.results.size(); ++i) {
-            const auto& e = r.results[i].error;
-            md += fmt::format("| {}{} | {:.1f} | {} | {:.4f} | {} | {} |\n", r.pointLabels[i],
-                              beatsFootage(r.results[i], r.baseline) ? "" : " (not above footage)",
-                              r.results[i].medianWallMs, fmtDb(e.psnrInfluenced), e.ssimInfluenced,
-                              fmtDb(e.psnrFrame),
-                              std::find(front.begin(), front.end(), i) != front.end() ? "yes" : "");
-        }
-        md += fmt::format("| footage only | - | {} | {:.4f} | {} | |\n",
-                          fmtDb(r.baseline.error.psnrInfluenced), r.baseline.error.ssimInfluenced,
-                          fmtDb(r.baseline.error.psnrFrame));
-        md += "\nFirst frame, real-time | ground truth | difference x4:\n\n";
-        for (const auto& [which, idx] : std::vector<std::pair<std::string, size_t>>{
-                 {"default", 0}, {"cheapest", r.cheapest}}) {
-            const cv::Mat crop = sideBySide(r.results[idx], r.frames.front().influence);
-            if (crop.empty()) continue;
-            const std::string file = fmt::format("results/images/{}_{}.png", name, which);
-            writeBgr8(out / file, crop);
-            md += fmt::format("- {} ({}): ![{} {}]({})\n", which, r.pointLabels[idx],
-                              r.effect->name, which, file);
-        }
-    }
-
-    if (haveScaling) {
-        md += fmt::format(
-            "\n## Scaling\n\nThe default setting of `{}`, one quantity varied (times only: the "
-            "ground truth is not rendered again). Expected: linear in pixels and in VPLs, "
-            "sub-linear in triangles (most passes work per pixel or per VPL, only the G-buffer, "
-            "shadow and impostor passes per triangle).\n\n",
-            runs.front().effect->name);
-        const auto line = [&](const std::string& file, const std::string& title,
-                              const std::string& x, plot::Series s, bool logX) {
-            if (s.points.empty()) return;
-            plot::LinePlot lp;
-            lp.title = title;
-            lp.xLabel = x;
-            lp.yLabel = "ms per frame";
-            lp.logX = logX;
-            lp.series = {std::move(s)};
-            writeText(out / "results" / file, plot::svgLines(lp));
-            md += fmt::format("![{}](results/{})\n", title, file);
-        };
-        line("scaling_pixels.svg", "Frame time against pixels", "megapixels", scaling.pixels,
-             false);
-        line("scaling_vpls.svg", "Frame time against VPLs", "VPLs", scaling.vpls, false);
-        line("scaling_triangles.svg", "Frame time against triangles", "triangles (log)",
-             scaling.triangles, true);
-        md += "\n" + scaling.table;
-    }
+    md += summaryTable(runs);
+    md += passBars(runs, out);
+    for (const EffectRun& r : runs) md += effectSection(r, out);
+    if (haveScaling) md += scalingSection(runs.front(), scaling, out);
     if (!trackingRows.empty()) md += trackingSection(trackingRows, spec.repeats, out);
     writeText(out / "results.md", md);
     spdlog::info("suite: wrote {} (load average {} before, {} after)",

@@ -35,6 +35,49 @@ struct RenderArgs {
     bool force = false;
 };
 
+// --mode composite: L_r and L_rv rendered, composited into the camera image (the real-only
+// render when none is given); --save-buffers writes L_r, L_rv and the coverage beside OUT (or
+// hands them to the shard).
+cv::Mat renderComposite(const RenderArgs& a, const Scene& scene, raytrace::EmbreeDevice& device,
+                        const raytrace::RenderCamera& camera, const raytrace::RenderSettings& st,
+                        const raytrace::ProgressCallback& progress, TerminalProgress& bar,
+                        const cv::Mat& cameraImage, std::vector<OutputFile>& bufferFiles,
+                        bool split, std::vector<cv::Mat>& shardBuffers) {
+    raytrace::DifferentialImages images =
+        raytrace::renderDifferential(scene, device, camera, st, progress);
+    bar.finish();
+    cv::Mat ci;
+    if (a.cameraImage.empty()) {
+        // Synthetic footage: the camera sees exactly the real-only render.
+        ci = images.realOnly;
+    } else {
+        ci = cameraImage;
+        if (ci.size() != images.realOnly.size())
+            throw FileError(
+                a.cameraImage,
+                fmt::format("camera image is {}x{} but the render is {}x{}; pass "
+                            "--width/--height matching it",
+                            ci.cols, ci.rows, images.realOnly.cols, images.realOnly.rows));
+    }
+    const cv::Mat result = raytrace::compositeDifferential(ci, images);
+    if (a.saveBuffers) {
+        cv::Mat cov;
+        cv::merge(std::vector<cv::Mat>(3, images.virtualCoverage), cov);
+        if (split) {
+            shardBuffers = {images.realOnly, images.realAndVirtual, cov};
+        }
+        const cv::Mat* buffers[] = {&images.realOnly, &images.realAndVirtual, &cov};
+        for (size_t k = 0; k < bufferFiles.size(); ++k) {
+            writeLinearRgb(bufferFiles[k].temp(), *buffers[k], 1.0f);
+            bufferFiles[k].commit();
+            spdlog::info("wrote {}", bufferFiles[k].path().string());
+        }
+    }
+    spdlog::info("L_r: {} passes in {:.1f} s; L_rv: {} passes in {:.1f} s", images.realStats.passes,
+                 images.realStats.seconds, images.mixedStats.passes, images.mixedStats.seconds);
+    return result;
+}
+
 void run(const RenderArgs& a) {
     const std::filesystem::path out(a.output);
     std::string ext = out.extension().string();
@@ -123,39 +166,8 @@ void run(const RenderArgs& a) {
     cv::Mat result;
     std::vector<cv::Mat> shardBuffers;  // L_r, L_rv, coverage of a split composite (--save-buffers)
     if (a.mode == "composite") {
-        raytrace::DifferentialImages images =
-            raytrace::renderDifferential(scene, device, camera, st, progress);
-        bar.finish();
-        cv::Mat ci;
-        if (a.cameraImage.empty()) {
-            // Synthetic footage: the camera sees exactly the real-only render.
-            ci = images.realOnly;
-        } else {
-            ci = cameraImage;
-            if (ci.size() != images.realOnly.size())
-                throw FileError(
-                    a.cameraImage,
-                    fmt::format("camera image is {}x{} but the render is {}x{}; pass "
-                                "--width/--height matching it",
-                                ci.cols, ci.rows, images.realOnly.cols, images.realOnly.rows));
-        }
-        result = raytrace::compositeDifferential(ci, images);
-        if (a.saveBuffers) {
-            cv::Mat cov;
-            cv::merge(std::vector<cv::Mat>(3, images.virtualCoverage), cov);
-            if (split) {
-                shardBuffers = {images.realOnly, images.realAndVirtual, cov};
-            }
-            const cv::Mat* buffers[] = {&images.realOnly, &images.realAndVirtual, &cov};
-            for (size_t k = 0; k < bufferFiles.size(); ++k) {
-                writeLinearRgb(bufferFiles[k].temp(), *buffers[k], 1.0f);
-                bufferFiles[k].commit();
-                spdlog::info("wrote {}", bufferFiles[k].path().string());
-            }
-        }
-        spdlog::info("L_r: {} passes in {:.1f} s; L_rv: {} passes in {:.1f} s",
-                     images.realStats.passes, images.realStats.seconds, images.mixedStats.passes,
-                     images.mixedStats.seconds);
+        result = renderComposite(a, scene, device, camera, st, progress, bar, cameraImage,
+                                 bufferFiles, split, shardBuffers);
     } else {
         raytrace::RayTracingScene rt(
             scene, a.mode == "r" ? raytrace::SceneSubset::RealOnly : raytrace::SceneSubset::All,

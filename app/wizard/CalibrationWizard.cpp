@@ -8,6 +8,7 @@
 #include <imgui.h>
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -27,19 +28,6 @@
 
 namespace mirage::app {
 namespace {
-
-// The next frame of `source` that is not lost, and its name ("frame N" where the source names
-// none: a live camera). A lost frame (damaged bytes in a recording) is logged and skipped.
-bool nextFrame(FrameSource& source, cv::Mat& bgr, std::string& name, int& index) {
-    while (source.read(bgr)) {
-        const int i = index++;
-        name = source.lastName();
-        if (name.empty()) name = fmt::format("frame {}", i);
-        if (!bgr.empty()) return true;
-        spdlog::warn("{}: frame lost ({}), skipped", name, source.lastProblem());
-    }
-    return false;
-}
 
 // An RGBA8 texture showing an 8-bit BGR image (sRGB-encoded values shown as they are).
 class ImageTexture {
@@ -147,254 +135,331 @@ void saveCalibrationFile(const WizardOptions& o, const calib::CalibrationSession
     spdlog::info("{}", status);
 }
 
+// The wizard: its input, the calibration session deciding on every frame, and the window.
+class CalibrationWizard {
+public:
+    CalibrationWizard(const WizardOptions& options, WizardInput& input, cv::Mat first,
+                      std::string firstName, const calib::SessionOptions& sessionOptions);
+    int run();
+
+private:
+    void processFrame();  // the calibration session's decision on the current frame
+    void advance();       // the next frame, unless paused, at the end or about to screenshot
+    void drawCameraPanel();
+    void drawPreviewPanel();
+    void drawCoveragePanel();
+    void drawCalibrationPanel();
+    void drawParameters();
+    void drawViews();
+
+    const WizardOptions& o_;
+    WizardInput& input_;
+    calib::SessionOptions sessionOptions_;
+    calib::CalibrationSession session_;
+    cv::Mat current_;
+    std::string frameName_;
+    gl::Context ctx_;
+    ImGuiScope imgui_;
+    ImageTexture camTex_, undistTex_;
+    calib::Undistorter undistorter_;
+    calib::FrameReport rep_;
+    bool haveFrame_ = true, endOfInput_ = false, paused_ = false, showUndistorted_ = true;
+    int framesProcessed_ = 0, exitCode_ = 0, screenshotCountdown_ = -1;
+    std::string status_;
+};
+
+gl::Context wizardWindow() {
+    gl::ContextOptions co;
+    co.width = 1280;
+    co.height = 800;
+    co.title = "mirage calibrate";
+    return gl::Context::window(co);
+}
+
+CalibrationWizard::CalibrationWizard(const WizardOptions& options, WizardInput& input,
+                                     cv::Mat first, std::string firstName,
+                                     const calib::SessionOptions& sessionOptions)
+    : o_(options),
+      input_(input),
+      sessionOptions_(sessionOptions),
+      session_(calib::CalibrationTarget::parse(options.board), first.size(), sessionOptions),
+      current_(std::move(first)),
+      frameName_(std::move(firstName)),
+      ctx_(wizardWindow()),
+      imgui_(ctx_.glfwWindow()),
+      status_("source: " + input.description()) {}
+
+void CalibrationWizard::processFrame() {
+    if (!haveFrame_) return;
+    rep_ = session_.processFrame(current_, frameName_);
+    ++framesProcessed_;
+    camTex_.show(overlay(current_, session_, rep_));
+    if (session_.result() && showUndistorted_)
+        undistTex_.show(undistorter_.apply(current_, session_.result()->calibration.intrinsics, 0.5,
+                                           session_.result()->calibration.reachDeg));
+    haveFrame_ = false;
+}
+
+void CalibrationWizard::advance() {
+    const bool screenshotDue =
+        !o_.screenshot.empty() &&
+        ((o_.screenshotAfterFrames > 0 && framesProcessed_ >= o_.screenshotAfterFrames) ||
+         endOfInput_);
+    if (!paused_ && !endOfInput_ && !screenshotDue) {
+        if (input_.next(current_, frameName_)) {
+            haveFrame_ = true;
+        } else {
+            endOfInput_ = true;
+            status_ = "end of input: " + std::to_string(framesProcessed_) + " frames";
+        }
+    }
+    if (screenshotDue && screenshotCountdown_ < 0) screenshotCountdown_ = 2;  // let ImGui lay out
+}
+
+constexpr ImGuiWindowFlags kFixed =
+    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
+
+void CalibrationWizard::drawCameraPanel() {
+    ImGui::SetNextWindowPos({0, 0});
+    ImGui::SetNextWindowSize({660, 540});
+    ImGui::Begin("Camera", nullptr, kFixed);
+    if (!camTex_.empty()) {
+        const float scale = std::min(640.f / float(current_.cols), 480.f / float(current_.rows));
+        ImGui::Image(camTex_.id(), {float(current_.cols) * scale, float(current_.rows) * scale});
+    }
+    ImGui::Text("%s | %s | motion %.2f px | sharpness %.0f | tilt %.0f deg", frameName_.c_str(),
+                calib::captureDecisionName(rep_.decision), rep_.motionPx, rep_.sharpness,
+                rep_.tiltDeg);
+    ImGui::End();
+}
+
+void CalibrationWizard::drawPreviewPanel() {
+    ImGui::SetNextWindowPos({0, 540});
+    ImGui::SetNextWindowSize({330, 260});
+    ImGui::Begin("Undistorted preview", nullptr, kFixed);
+    ImGui::Checkbox("show", &showUndistorted_);
+    if (session_.result() && showUndistorted_ && !undistTex_.empty())
+        ImGui::Image(undistTex_.id(), {270, 270.f * float(current_.rows) / float(current_.cols)});
+    else
+        ImGui::TextWrapped("Appears after the first calibration (%d views).",
+                           sessionOptions_.calibration.minViews);
+    ImGui::End();
+}
+
+void CalibrationWizard::drawCoveragePanel() {
+    ImGui::SetNextWindowPos({330, 540});
+    ImGui::SetNextWindowSize({330, 260});
+    ImGui::Begin("Coverage and tilts", nullptr, kFixed);
+    drawCoverage(session_, {300, 130});
+    const auto& cov = session_.coverage();
+    if (cov.angular()) {
+        // Fish-eye: corners per ring of angle off-axis (the fraction is over rings x sectors).
+        ImGui::Text("off-axis bins covered: %.0f%%", 100 * cov.coveredFraction());
+        std::string rings;
+        for (int r = 0; r < cov.reachableRings(); ++r) {
+            const int lo = int(calib::CoverageMap::kRingStepDeg * r);
+            const int hi = int(calib::CoverageMap::kRingStepDeg * (r + 1));
+            rings +=
+                fmt::format("{}{}: {}", r ? ", " : "",
+                            r + 1 < calib::CoverageMap::kRingCount ? fmt::format("{}-{}", lo, hi)
+                                                                   : fmt::format("{}+", lo),
+                            cov.ringCount(r));
+        }
+        ImGui::TextWrapped("deg off-axis %s", rings.c_str());
+    } else {
+        ImGui::Text("cells covered: %.0f%%", 100 * cov.coveredFraction());
+    }
+    const auto& tilts = session_.tilts();
+    for (int b = 0; b < calib::TiltCoverage::BinCount; ++b) {
+        const auto bin = calib::TiltCoverage::Bin(b);
+        ImGui::TextColored(tilts.count(bin) ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(1, 0.5f, 0.4f, 1),
+                           "%-16s %d", calib::TiltCoverage::binName(bin), tilts.count(bin));
+        if (b % 2 == 0 && b + 1 < calib::TiltCoverage::BinCount) ImGui::SameLine(160);
+    }
+    ImGui::Text("largest tilt: %.0f deg", tilts.maxTiltDeg());
+    ImGui::End();
+}
+
+void CalibrationWizard::drawParameters() {
+    const auto& r = session_.result();
+    if (!r) {
+        if (!session_.calibrationError().empty())
+            ImGui::TextWrapped("calibration failed: %s", session_.calibrationError().c_str());
+        return;
+    }
+    const auto& c = r->calibration;
+    const auto& in = c.intrinsics;
+    ImGui::Text("RMS reprojection error: %.3f px   views used: %d", c.avgReprojectionError,
+                r->usedViewCount());
+    if (!c.reliable) {
+        ImGui::PushTextWrapPos(0);
+        ImGui::TextColored({1, 0.4f, 0.4f, 1}, "UNRELIABLE: %s", c.unreliableReason.c_str());
+        ImGui::PopTextWrapPos();
+    }
+    if (!ImGui::BeginTable("params", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) return;
+    ImGui::TableSetupColumn("parameter");
+    ImGui::TableSetupColumn("value");
+    ImGui::TableSetupColumn("std dev (1 sigma)");
+    ImGui::TableHeadersRow();
+    for (size_t i = 0; i < r->parameterNames.size(); ++i) {
+        const double v = i == 0   ? in.fx
+                         : i == 1 ? in.fy
+                         : i == 2 ? in.cx
+                         : i == 3 ? in.cy
+                                  : in.coeff(i - 4);
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        ImGui::TextUnformatted(r->parameterNames[i].c_str());
+        ImGui::TableNextColumn();
+        ImGui::Text("%.5f", v);
+        ImGui::TableNextColumn();
+        ImGui::Text("%.5f", i < c.stdDeviations.size() ? c.stdDeviations[i] : -1.0);
+    }
+    ImGui::EndTable();
+}
+
+void CalibrationWizard::drawViews() {
+    ImGui::Text("Views (RMS px, tilt deg):");
+    ImGui::BeginChild("views", {0, 0}, true);
+    std::optional<size_t> drop;
+    for (size_t i = 0; i < session_.views().size(); ++i) {
+        const auto& r = session_.result();
+        const bool rejected = r && r->views[i].rejected;
+        ImGui::PushID(int(i));
+        if (ImGui::SmallButton("drop")) drop = i;
+        ImGui::SameLine();
+        if (rejected)
+            ImGui::TextColored({1, 0.4f, 0.4f, 1}, "%-22s OUTLIER: %s",
+                               session_.views()[i].name.c_str(), r->views[i].rejectReason.c_str());
+        else if (r)
+            ImGui::Text("%-22s %.3f  %4.0f", session_.views()[i].name.c_str(), r->views[i].rmsPx,
+                        r->views[i].tiltDeg);
+        else
+            ImGui::Text("%-22s", session_.views()[i].name.c_str());
+        ImGui::PopID();
+    }
+    ImGui::EndChild();
+    if (drop) session_.dropView(*drop);
+}
+
+void CalibrationWizard::drawCalibrationPanel() {
+    ImGui::SetNextWindowPos({660, 0});
+    ImGui::SetNextWindowSize({620, 800});
+    ImGui::Begin("Calibration", nullptr, kFixed);
+    const bool done = session_.state() == calib::CalibrationSession::State::Done;
+    ImGui::TextColored(done ? ImVec4(0.4f, 1, 0.4f, 1) : ImVec4(1, 0.85f, 0.3f, 1), "%s",
+                       done ? "DONE" : "COLLECTING");
+    ImGui::SameLine();
+    ImGui::Text("| %s | %s model | %zu views", session_.target().description().c_str(),
+                o_.model == DistortionModel::KannalaBrandt ? "fisheye" : "pinhole",
+                session_.views().size());
+    ImGui::Separator();
+    ImGui::PushTextWrapPos(0);
+    ImGui::TextColored({0.6f, 0.85f, 1, 1}, "Next: %s", session_.advice().c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::Separator();
+    if (ImGui::Button(paused_ ? "Resume" : "Pause")) paused_ = !paused_;
+    ImGui::SameLine();
+    if (ImGui::Button("Capture now") && rep_.boardFound) session_.addView(rep_.view);
+    ImGui::SameLine();
+    ImGui::BeginDisabled(o_.output.empty() || !session_.result());
+    if (ImGui::Button("Save")) {
+        try {
+            saveCalibrationFile(o_, session_, status_, exitCode_);
+        } catch (const Error& e) {
+            status_ = e.what();
+        }
+    }
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    ImGui::TextWrapped("%s", o_.output.empty() ? "(-o not given)" : o_.output.c_str());
+    ImGui::TextWrapped("%s", status_.c_str());
+    ImGui::Separator();
+    drawParameters();
+    const auto unmet = session_.unmetTargets();
+    if (!unmet.empty()) {
+        ImGui::Text("Not done yet:");
+        for (const auto& u : unmet) ImGui::BulletText("%s", u.c_str());
+    }
+    ImGui::Separator();
+    drawViews();
+    ImGui::End();
+}
+
+int CalibrationWizard::run() {
+    while (!ctx_.shouldClose()) {
+        ctx_.pollEvents();
+        processFrame();
+        advance();
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        drawCameraPanel();
+        drawPreviewPanel();
+        drawCoveragePanel();
+        drawCalibrationPanel();
+        ImGui::Render();
+        int fw = 0, fh = 0;
+        glfwGetFramebufferSize(ctx_.glfwWindow(), &fw, &fh);
+        glViewport(0, 0, fw, fh);
+        glClearColor(0.1f, 0.1f, 0.12f, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (screenshotCountdown_ >= 0 && screenshotCountdown_-- == 0) {
+            saveWindowPng(o_.screenshot, ctx_.glfwWindow());
+            break;
+        }
+        ctx_.swapBuffers();
+    }
+    return exitCode_;
+}
+
 }  // namespace
 
-int runCalibrationWizard(const WizardOptions& o) {
-    if (o.board.empty())
-        throw Error("--board is required (a board file or chessboard:COLSxROWS:SQUARE_METRES)");
-    std::unique_ptr<FrameSource> source;
-    bool stillImages = false;
+WizardInput::WizardInput(const WizardOptions& o) {
     if (!o.inputs.empty()) {
         FrameListOptions so;
         so.allVideoFrames = true;  // stillness is measured between consecutive video frames
-        source = openFrameList(o.inputs, so);
-        stillImages = std::none_of(o.inputs.begin(), o.inputs.end(),
-                                   [](const std::string& i) { return isVideoFile(i); });
+        source_ = openFrameList(o.inputs, so);
+        stillImages_ = std::none_of(o.inputs.begin(), o.inputs.end(),
+                                    [](const std::string& i) { return isVideoFile(i); });
+        description_ = o.inputs.front();
     } else if (!o.cameraDevice.empty()) {
-        source = std::make_unique<V4l2Camera>(o.cameraDevice, CaptureRequest{});
+        source_ = std::make_unique<V4l2Camera>(o.cameraDevice, CaptureRequest{});
+        description_ = o.cameraDevice;
     } else {
         throw Error(
             "the wizard needs a source: INPUT... (images, a folder or a video) or "
             "--camera /dev/videoN; for headless use, --batch");
     }
-    auto target = calib::CalibrationTarget::parse(o.board);
-    cv::Mat current;
-    std::string frameName;
-    int frameIndex = 0;
-    if (!nextFrame(*source, current, frameName, frameIndex))
-        throw Error("the input holds no frames");
+}
 
+bool WizardInput::next(cv::Mat& bgr, std::string& name) {
+    while (source_->read(bgr)) {
+        const int i = index_++;
+        name = source_->lastName();
+        if (name.empty()) name = fmt::format("frame {}", i);
+        if (!bgr.empty()) return true;
+        spdlog::warn("{}: frame lost ({}), skipped", name, source_->lastProblem());
+    }
+    return false;
+}
+
+int runCalibrationWizard(const WizardOptions& o) {
+    if (o.board.empty())
+        throw Error("--board is required (a board file or chessboard:COLSxROWS:SQUARE_METRES)");
+    WizardInput input(o);
+    calib::CalibrationTarget::parse(o.board);  // a bad board is refused before the window opens
+    cv::Mat first;
+    std::string firstName;
+    if (!input.next(first, firstName)) throw Error("the input holds no frames");
     calib::SessionOptions so;
     so.calibration.model = o.model;
     so.calibration.fixK3 = o.fixK3;
     // Separate photos are each a deliberate, still capture: no stillness over frames needed.
-    if (stillImages) so.stillFrames = 0;
-    calib::CalibrationSession session(std::move(target), current.size(), so);
-
-    gl::ContextOptions co;
-    co.width = 1280;
-    co.height = 800;
-    co.title = "mirage calibrate";
-    auto ctx = gl::Context::window(co);
-    ImGuiScope imgui(ctx.glfwWindow());
-    ImageTexture camTex, undistTex;
-    calib::Undistorter undistorter;
-
-    calib::FrameReport rep;
-    bool haveFrame = true, endOfInput = false, paused = false, showUndistorted = true;
-    int framesProcessed = 0, exitCode = 0, screenshotCountdown = -1;
-    std::string status = "source: " + (o.inputs.empty() ? o.cameraDevice : o.inputs.front());
-    std::string lastCaptured;
-
-    while (!ctx.shouldClose()) {
-        ctx.pollEvents();
-        if (haveFrame) {
-            rep = session.processFrame(current, frameName);
-            ++framesProcessed;
-            if (rep.decision == calib::CaptureDecision::Captured) lastCaptured = frameName;
-            camTex.show(overlay(current, session, rep));
-            if (session.result() && showUndistorted)
-                undistTex.show(undistorter.apply(current, session.result()->calibration.intrinsics,
-                                                 0.5, session.result()->calibration.reachDeg));
-            haveFrame = false;
-        }
-        const bool screenshotDue =
-            !o.screenshot.empty() &&
-            ((o.screenshotAfterFrames > 0 && framesProcessed >= o.screenshotAfterFrames) ||
-             endOfInput);
-        if (!paused && !endOfInput && !screenshotDue) {
-            if (nextFrame(*source, current, frameName, frameIndex)) {
-                haveFrame = true;
-            } else {
-                endOfInput = true;
-                status = "end of input: " + std::to_string(framesProcessed) + " frames";
-            }
-        }
-        if (screenshotDue && screenshotCountdown < 0) screenshotCountdown = 2;  // let ImGui lay out
-
-        ImGui_ImplOpenGL3_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        const ImGuiWindowFlags fixed =
-            ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse;
-
-        ImGui::SetNextWindowPos({0, 0});
-        ImGui::SetNextWindowSize({660, 540});
-        ImGui::Begin("Camera", nullptr, fixed);
-        if (!camTex.empty()) {
-            const float scale = std::min(640.f / float(current.cols), 480.f / float(current.rows));
-            ImGui::Image(camTex.id(), {float(current.cols) * scale, float(current.rows) * scale});
-        }
-        ImGui::Text("%s | %s | motion %.2f px | sharpness %.0f | tilt %.0f deg", frameName.c_str(),
-                    calib::captureDecisionName(rep.decision), rep.motionPx, rep.sharpness,
-                    rep.tiltDeg);
-        ImGui::End();
-
-        ImGui::SetNextWindowPos({0, 540});
-        ImGui::SetNextWindowSize({330, 260});
-        ImGui::Begin("Undistorted preview", nullptr, fixed);
-        ImGui::Checkbox("show", &showUndistorted);
-        if (session.result() && showUndistorted && !undistTex.empty())
-            ImGui::Image(undistTex.id(), {270, 270.f * float(current.rows) / float(current.cols)});
-        else
-            ImGui::TextWrapped("Appears after the first calibration (%d views).",
-                               so.calibration.minViews);
-        ImGui::End();
-
-        ImGui::SetNextWindowPos({330, 540});
-        ImGui::SetNextWindowSize({330, 260});
-        ImGui::Begin("Coverage and tilts", nullptr, fixed);
-        drawCoverage(session, {300, 130});
-        if (session.coverage().angular()) {
-            // Fish-eye: corners per ring of angle off-axis (the fraction is over rings x sectors).
-            const auto& cov = session.coverage();
-            ImGui::Text("off-axis bins covered: %.0f%%", 100 * cov.coveredFraction());
-            std::string rings;
-            for (int r = 0; r < cov.reachableRings(); ++r) {
-                const int lo = int(calib::CoverageMap::kRingStepDeg * r);
-                const int hi = int(calib::CoverageMap::kRingStepDeg * (r + 1));
-                rings += fmt::format("{}{}: {}", r ? ", " : "",
-                                     r + 1 < calib::CoverageMap::kRingCount
-                                         ? fmt::format("{}-{}", lo, hi)
-                                         : fmt::format("{}+", lo),
-                                     cov.ringCount(r));
-            }
-            ImGui::TextWrapped("deg off-axis %s", rings.c_str());
-        } else {
-            ImGui::Text("cells covered: %.0f%%", 100 * session.coverage().coveredFraction());
-        }
-        const auto& tilts = session.tilts();
-        for (int b = 0; b < calib::TiltCoverage::BinCount; ++b) {
-            const auto bin = calib::TiltCoverage::Bin(b);
-            ImGui::TextColored(
-                tilts.count(bin) ? ImVec4(0.5f, 1, 0.5f, 1) : ImVec4(1, 0.5f, 0.4f, 1), "%-16s %d",
-                calib::TiltCoverage::binName(bin), tilts.count(bin));
-            if (b % 2 == 0 && b + 1 < calib::TiltCoverage::BinCount) ImGui::SameLine(160);
-        }
-        ImGui::Text("largest tilt: %.0f deg", tilts.maxTiltDeg());
-        ImGui::End();
-
-        ImGui::SetNextWindowPos({660, 0});
-        ImGui::SetNextWindowSize({620, 800});
-        ImGui::Begin("Calibration", nullptr, fixed);
-        const bool done = session.state() == calib::CalibrationSession::State::Done;
-        ImGui::TextColored(done ? ImVec4(0.4f, 1, 0.4f, 1) : ImVec4(1, 0.85f, 0.3f, 1), "%s",
-                           done ? "DONE" : "COLLECTING");
-        ImGui::SameLine();
-        ImGui::Text("| %s | %s model | %zu views", session.target().description().c_str(),
-                    o.model == DistortionModel::KannalaBrandt ? "fisheye" : "pinhole",
-                    session.views().size());
-        ImGui::Separator();
-        ImGui::PushTextWrapPos(0);
-        ImGui::TextColored({0.6f, 0.85f, 1, 1}, "Next: %s", session.advice().c_str());
-        ImGui::PopTextWrapPos();
-        ImGui::Separator();
-        if (ImGui::Button(paused ? "Resume" : "Pause")) paused = !paused;
-        ImGui::SameLine();
-        if (ImGui::Button("Capture now") && rep.boardFound) session.addView(rep.view);
-        ImGui::SameLine();
-        ImGui::BeginDisabled(o.output.empty() || !session.result());
-        if (ImGui::Button("Save")) {
-            try {
-                saveCalibrationFile(o, session, status, exitCode);
-            } catch (const Error& e) {
-                status = e.what();
-            }
-        }
-        ImGui::EndDisabled();
-        ImGui::SameLine();
-        ImGui::TextWrapped("%s", o.output.empty() ? "(-o not given)" : o.output.c_str());
-        ImGui::TextWrapped("%s", status.c_str());
-        ImGui::Separator();
-        if (const auto& r = session.result()) {
-            const auto& c = r->calibration;
-            const auto& in = c.intrinsics;
-            ImGui::Text("RMS reprojection error: %.3f px   views used: %d", c.avgReprojectionError,
-                        r->usedViewCount());
-            if (!c.reliable) {
-                ImGui::PushTextWrapPos(0);
-                ImGui::TextColored({1, 0.4f, 0.4f, 1}, "UNRELIABLE: %s",
-                                   c.unreliableReason.c_str());
-                ImGui::PopTextWrapPos();
-            }
-            if (ImGui::BeginTable("params", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg)) {
-                ImGui::TableSetupColumn("parameter");
-                ImGui::TableSetupColumn("value");
-                ImGui::TableSetupColumn("std dev (1 sigma)");
-                ImGui::TableHeadersRow();
-                for (size_t i = 0; i < r->parameterNames.size(); ++i) {
-                    const double v = i == 0   ? in.fx
-                                     : i == 1 ? in.fy
-                                     : i == 2 ? in.cx
-                                     : i == 3 ? in.cy
-                                              : in.coeff(i - 4);
-                    ImGui::TableNextRow();
-                    ImGui::TableNextColumn();
-                    ImGui::TextUnformatted(r->parameterNames[i].c_str());
-                    ImGui::TableNextColumn();
-                    ImGui::Text("%.5f", v);
-                    ImGui::TableNextColumn();
-                    ImGui::Text("%.5f", i < c.stdDeviations.size() ? c.stdDeviations[i] : -1.0);
-                }
-                ImGui::EndTable();
-            }
-        } else if (!session.calibrationError().empty()) {
-            ImGui::TextWrapped("calibration failed: %s", session.calibrationError().c_str());
-        }
-        const auto unmet = session.unmetTargets();
-        if (!unmet.empty()) {
-            ImGui::Text("Not done yet:");
-            for (const auto& u : unmet) ImGui::BulletText("%s", u.c_str());
-        }
-        ImGui::Separator();
-        ImGui::Text("Views (RMS px, tilt deg):");
-        ImGui::BeginChild("views", {0, 0}, true);
-        std::optional<size_t> drop;
-        for (size_t i = 0; i < session.views().size(); ++i) {
-            const auto& r = session.result();
-            const bool rejected = r && r->views[i].rejected;
-            ImGui::PushID(int(i));
-            if (ImGui::SmallButton("drop")) drop = i;
-            ImGui::SameLine();
-            if (rejected)
-                ImGui::TextColored({1, 0.4f, 0.4f, 1}, "%-22s OUTLIER: %s",
-                                   session.views()[i].name.c_str(),
-                                   r->views[i].rejectReason.c_str());
-            else if (r)
-                ImGui::Text("%-22s %.3f  %4.0f", session.views()[i].name.c_str(), r->views[i].rmsPx,
-                            r->views[i].tiltDeg);
-            else
-                ImGui::Text("%-22s", session.views()[i].name.c_str());
-            ImGui::PopID();
-        }
-        ImGui::EndChild();
-        if (drop) session.dropView(*drop);
-        ImGui::End();
-
-        ImGui::Render();
-        int fw = 0, fh = 0;
-        glfwGetFramebufferSize(ctx.glfwWindow(), &fw, &fh);
-        glViewport(0, 0, fw, fh);
-        glClearColor(0.1f, 0.1f, 0.12f, 1);
-        glClear(GL_COLOR_BUFFER_BIT);
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        if (screenshotCountdown >= 0 && screenshotCountdown-- == 0) {
-            saveWindowPng(o.screenshot, ctx.glfwWindow());
-            break;
-        }
-        ctx.swapBuffers();
-    }
-    return exitCode;
+    if (input.stillImages()) so.stillFrames = 0;
+    CalibrationWizard wizard(o, input, std::move(first), std::move(firstName), so);
+    return wizard.run();
 }
 
 }  // namespace mirage::app

@@ -1,0 +1,33 @@
+#pragma once
+// What `mirage live` is asked to do (its command-line options, docs/live.md).
+#include <string>
+#include <vector>
+
+#include "core/capture/CameraControls.h"
+
+namespace mirage::app {
+
+struct LiveOptions {
+    std::string camera, scene, calibration, board, output, record;
+    std::vector<std::string> effectsOff;  // bench knob names of effects switched off
+    double cameraFps = 0;                 // 0: the stand-in's own rate
+    int width = 640, height = 480;
+    int maxFrames = -1;
+    int vpls = 256;
+    float exposure = 1.0f;
+    int jpegQuality = 92;
+    bool headless = false;
+    bool force = false;
+    bool loop = false;  // a stand-in starts again at its end
+    bool listCameras = false;
+    std::string placement;          // default: <scene>.placement.json
+    ExposureSettings exposureLock;  // webcam: exposure / gain / white balance to hold
+    std::string screenshot;         // window: save a PNG after --screenshot-after frames, exit
+    int screenshotAfter = 10;
+    // The fish-eye environment camera (docs/environment.md): a webcam, a video or a session's
+    // environment camera, and its calibration (intrinsics, extrinsics, radiometry_to_main).
+    std::string envCamera, envCalibration;
+    bool estimateLights = false;  // place the environment camera's dominant lights
+};
+
+}  // namespace mirage::app

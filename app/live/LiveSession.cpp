@@ -1,0 +1,362 @@
+#include "app/live/LiveSession.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "app/BoardPlane.h"
+#include "app/EffectSwitches.h"
+#include "app/InputChecks.h"
+#include "core/Error.h"
+#include "core/Log.h"
+#include "core/OutputFile.h"
+#include "core/capture/CaptureFormat.h"
+#include "core/scene/ScenePlacement.h"
+#include "render/LightEstimation.h"
+
+namespace mirage::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+// The calibration and board of the session: as given, else found for the camera; what to do
+// when there is none.
+fs::path calibrationFor(const LiveOptions& a, const CameraInput& cam) {
+    const fs::path p = !a.calibration.empty() ? fs::path(a.calibration) : cam.calibration;
+    if (p.empty())
+        throw Error("mirage live: no calibration for " + cam.description +
+                    (cam.calibrationHint.empty() ? "" : ": " + cam.calibrationHint) +
+                    "; or pass --calibration CAM.yaml (the file `mirage calibrate` saved for "
+                    "this camera)");
+    return p;
+}
+fs::path boardFor(const LiveOptions& a, const CameraInput& cam) {
+    const fs::path p = !a.board.empty() ? fs::path(a.board) : cam.board;
+    if (p.empty())
+        throw Error("mirage live: no tag board for " + cam.description +
+                    (cam.boardHint.empty() ? "" : ": " + cam.boardHint) +
+                    "; or pass --board BOARD.json (the board file of the printed board, e.g. "
+                    "from `mirage board`)");
+    return p;
+}
+
+// Lights found in the environment camera's frames: as many as light estimation reports within
+// the renderer's light budget.
+int environmentLightCount(const LiveOptions& a, const Scene& scene) {
+    if (!a.estimateLights) return 0;
+    const int n = std::min(render::LightEstimationOptions{}.maxLights,
+                           render::kMaxLights - int(scene.lightInstances().size()));
+    if (n <= 0)
+        throw Error(fmt::format(
+            "mirage live --estimate-lights: scene {} already has {} lights, the real-time "
+            "renderer's limit; remove one",
+            a.scene, render::kMaxLights));
+    return n;
+}
+
+}  // namespace
+
+LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
+    if (a.scene.empty()) throw Error("mirage live: --scene SCENE is required");
+    // From here on SIGINT/SIGTERM only ask the loop to stop: every output and recording opened
+    // below is closed on the way out, never cut off by the default signal action.
+    installStopSignals();
+    camera_ = openCamera(a);
+    calibrationPath_ = calibrationFor(a, camera_);
+    boardPath_ = boardFor(a, camera_);
+    spdlog::info("live: calibration {}, board {}", calibrationPath_.string(), boardPath_.string());
+    calibration_ = loadCalibration(calibrationPath_);
+    checkLooksLikeGltf(a.scene);
+    scene_ = loadScene(a.scene);
+    if (!scene_.hasVirtual())
+        spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
+    const tracking::Board board = tracking::Board::load(boardPath_);
+    tracker_ = std::make_unique<tracking::Tracker>(board, calibration_.intrinsics);
+    // Where the virtual objects stand: the saved placement (moves within the board's plane).
+    placementFile_ = a.placement.empty() ? placementPath(a.scene) : fs::path(a.placement);
+    const ScenePlacement placement = loadPlacement(placementFile_).value_or(ScenePlacement{});
+    const PlacementPlane plane = boardPlane(board);
+    if (!placement.isIdentity())
+        spdlog::info(
+            "live: placement from {}: moved {:.3f}, {:.3f} m, turned {:.1f} deg, scale {:.3f}",
+            placementFile_.string(), placement.moveU, placement.moveV, placement.turnDeg,
+            placement.scale);
+    placement_ = std::make_unique<PlacementEditor>(placement);
+    if (!a.envCamera.empty()) {
+        environment_ = openEnvironmentCamera(a);
+        spdlog::info("live: environment camera {} (calibration {})", environment_->description,
+                     environment_->calibration.string());
+    } else if (!a.envCalibration.empty()) {
+        throw Error(
+            "mirage live: --env-calibration without --env-camera; name the environment "
+            "camera (a webcam, a video or a session) with --env-camera");
+    } else if (a.estimateLights) {
+        throw Error(
+            "mirage live: --estimate-lights finds the lights in the environment camera's "
+            "frames; name the environment camera with --env-camera");
+    }
+    LiveRenderSettings settings;
+    settings.environmentLights = environmentLightCount(a, scene_);
+
+    // Outputs, checked before any work (as replay's).
+    OutputRule rule{camera_.inputs, a.force, "mirage live"};
+    if (environment_)
+        rule.inputs.insert(rule.inputs.end(), environment_->inputs.begin(),
+                           environment_->inputs.end());
+    rule.inputs.push_back(a.scene);
+    rule.inputs.push_back(calibrationPath_);
+    rule.inputs.push_back(boardPath_);
+    outputs_ = std::make_unique<LiveOutputs>(a.output, rule);
+    if (!a.record.empty()) {
+        checkOutput(a.record, OutputOrigin::Named, rule, true);
+        LiveRecording::checkFolder(a.record);
+    }
+
+    const int width = calibration_.intrinsics.width, height = calibration_.intrinsics.height;
+    gl::ContextOptions copt;
+    copt.width = width + kHudWidth;  // the view, and the HUD beside it
+    copt.height = std::max(height, 560);
+    copt.title = "mirage live";
+    context_ = std::make_unique<gl::Context>(a.headless ? gl::Context::headless(copt)
+                                                        : gl::Context::window(copt));
+    switchEffectsOff(a.effectsOff, settings.effects);
+    settings.vpls = a.vpls;
+    settings.exposure = a.exposure;
+    settings.keepDirectLight = !a.headless;
+    controls_.preset = settings.preset;
+    controls_.effects = settings.effects;
+    render_ =
+        std::make_unique<LiveRenderStage>(scene_, plane, placement, calibration_.intrinsics,
+                                          settings, environment_ ? &environment_->setup : nullptr);
+    track_ = std::make_unique<PoseStage>(tracker_.get());
+    passes_ = render_->passNames();
+    outputs_->open(camera_.fps, a.jpegQuality, passes_);
+    LiveRecording::Options ro;
+    ro.fps = camera_.fps;
+    ro.jpegQuality = a.jpegQuality;
+    if (environment_) ro.environmentCalibration = environment_->calibration;
+    recorder_ = std::make_unique<LiveRecorder>(a.record, calibrationPath_, boardPath_, ro, a.scene);
+    if (!a.record.empty()) recorder_->start();
+    spdlog::info("live: {} -> {} ({}x{}); tracking on {}", camera_.description,
+                 a.headless ? "headless" : "window", width, height, boardPath_.string());
+    if (!a.headless)
+        window_ = std::make_unique<LiveWindow>(*context_, calibration_.intrinsics, plane);
+}
+
+LiveSession::~LiveSession() {
+    // Left by an error: the recording is closed (every frame in it stays playable); the -o
+    // outputs, not finished, leave nothing (their temporary files are removed).
+    if (capture_) capture_->stop();
+    try {
+        if (recorder_) recorder_->stop();
+    } catch (const Error& e) {
+        spdlog::warn("live: {}", e.what());
+    }
+    restoreStopSignals();
+}
+
+int LiveSession::run() {
+    capture_ = std::make_unique<LiveCapture>(camera_, environment_ ? &*environment_ : nullptr);
+    const auto tStart = Clock::now();
+    lastFrameAt_ = Clock::now();
+    while (!stopRequested() && (options_.maxFrames < 0 || processed_ < options_.maxFrames)) {
+        LiveFrame f;
+        bool got = false;
+        if (!controls_.paused) {
+            // The window redraws at most about every 15 ms while it waits for a frame (a frame
+            // that arrives ends the wait at once), so the HUD stays responsive without spinning.
+            got = capture_->next(f, options_.headless ? 0.1 : 0.015);
+            if (!got && capture_->ended()) break;
+        } else {
+            std::this_thread::sleep_for(std::chrono::milliseconds(15));
+        }
+        const bool lost = capture_->lost();
+        if (lost && !reportedLost_)
+            spdlog::warn("live: camera lost: {}; waiting for it to come back",
+                         capture_->lostReason());
+        if (!lost && reportedLost_) spdlog::info("live: camera back");
+        reportedLost_ = lost;
+        if (got) process(f);
+        if (window_ && !present()) break;
+    }
+    const std::string captureError = capture_->stop();
+    const double seconds = msSince(tStart) * 1e-3;
+    finish();
+    const LatestFrameCapture& c = capture_->main();
+    spdlog::info(
+        "live: {} frames in {:.1f} s ({:.1f} frames/s); camera delivered {}, dropped {} while "
+        "processing was busy (the driver dropped {}); median capture-to-display latency {:.0f} "
+        "ms; camera reconnected {} times",
+        processed_, seconds, processed_ / std::max(seconds, 1e-9), c.delivered(), c.dropped(),
+        c.deviceDropped(), median(latencies_), c.reconnections());
+    if (!captureError.empty()) throw Error("mirage live: " + captureError);
+    return stopRequested() ? 128 + stopSignal() : 0;
+}
+
+void LiveSession::finish() {
+    if (finished_) return;
+    finished_ = true;
+    if (capture_) capture_->stop();
+    if (outputs_) outputs_->finish();
+    if (recorder_) recorder_->stop();
+}
+
+void LiveSession::updateEnvironment(const LiveFrame& f) {
+    if (!capture_->hasEnvironment()) return;
+    if (f.newEnvironment) {
+        const std::string problem = render_->updateEnvironment(f.envBgr, f.envSeconds);
+        // Once per distinct problem: a wrong calibration fails every frame alike.
+        if (!problem.empty() && problem != envProblem_) {
+            envProblem_ = problem;
+            spdlog::warn("live: environment frames not used: {}", envProblem_);
+        }
+    }
+    envAgeMs_ = render_->hasEnvironmentFrame()
+                    ? (f.main.captureSeconds - render_->environmentSeconds()) * 1e3
+                    : std::numeric_limits<double>::quiet_NaN();
+}
+
+void LiveSession::process(LiveFrame& frame) {
+    const CapturedFrame& f = frame.main;
+    const int width = calibration_.intrinsics.width, height = calibration_.intrinsics.height;
+    if (!f.bgr.empty() && (f.bgr.cols != width || f.bgr.rows != height))
+        throw Error(fmt::format(
+            "mirage live: {} delivers {}x{} frames but the calibration {} is for {}x{}; use "
+            "the calibration of this camera at this size (or ask the camera for {}x{})",
+            camera_.description, f.bgr.cols, f.bgr.rows, calibrationPath_.string(), width, height,
+            width, height));
+    envAgeMs_ = std::numeric_limits<double>::quiet_NaN();
+    updateEnvironment(frame);
+    const auto t0 = Clock::now();
+    PoseRow pose = track_->decide(f.bgr, f.captureSeconds, f.problem, std::nullopt);
+    const double trackingMs = msSince(t0);
+    CompositedFrame cf = render_->composite(f.bgr, std::move(pose), !controls_.hideVirtual);
+    cf.trackingMs = trackingMs;
+    if (f.bgr.empty()) spdlog::warn("live: {}", cf.pose.reason);
+    if (!cf.image.empty()) {
+        outputs_->writeImage(processed_, cf.image, f.captureSeconds);
+        if (window_) {
+            viewProblem_.clear();
+            cv::Mat img = cf.image;
+            if (kBufferViews[controls_.view].resource && cf.report) {
+                try {
+                    img = render_->view(controls_.view);
+                } catch (const Error& e) {
+                    viewProblem_ = e.what();
+                }
+            }
+            window_->show(img);
+        }
+    }
+    // Written (headless) or uploaded for display: the end of the capture-to-display latency
+    // (the window's swap follows).
+    const double latencyMs = (steadySeconds() - f.captureSeconds) * 1e3;
+    latencies_.push_back(latencyMs);
+    lastLatencyMs_ = latencyMs;
+    recorder_->append(f.bgr, f.captureSeconds, cf.pose, frame.envBgr, frame.envSeconds);
+    outputs_->writeRow(processed_, f, envAgeMs_, cf, msSince(t0), latencyMs);
+    const double dt = msSince(lastFrameAt_) * 1e-3;
+    lastFrameAt_ = Clock::now();
+    if (processed_ > 0 && dt > 0) fpsEma_ = fpsEma_ == 0 ? 1 / dt : 0.8 * fpsEma_ + 0.2 / dt;
+    last_ = std::move(cf);
+    last_.image.release();
+    ++processed_;
+}
+
+std::string LiveSession::environmentText() const {
+    if (!environment_) return "";
+    return environment_->description +
+           (!render_->hasEnvironmentFrame() ? ", waiting for a frame"
+            : capture_->environmentEnded()  ? ", ended (its last frame lights)"
+            : std::isfinite(envAgeMs_)      ? cv::format(", frame %.0f ms older", envAgeMs_)
+                                            : "");
+}
+
+bool LiveSession::present() {
+    HudStatus s;
+    if (capture_->lost()) s.lostReason = capture_->lostReason();
+    s.fps = fpsEma_;
+    s.latencyMs = lastLatencyMs_;
+    s.dropped = static_cast<long long>(capture_->main().dropped());
+    s.driverDropped = static_cast<long long>(capture_->main().deviceDropped());
+    s.last = &last_;
+    s.exposureText = camera_.exposureText;
+    s.exposureWarnings = camera_.exposureWarnings;
+    s.environmentText = environmentText();
+    s.viewProblem = viewProblem_;
+    if (recorder_->recording())
+        s.recordingText =
+            cv::format("REC %s: %d frames", recorder_->dir().string().c_str(), recorder_->frames());
+    s.placement = placement_->placement();
+    s.placementPending = placement_->pending();
+    const HudRequests req = window_->draw(s, controls_);
+    if (req.placement) {
+        // The objects follow in the next frame: moved in place (shadows, indirect light,
+        // caustics and impostors redone in that frame), or, for a translucent object whose voxel
+        // number map lies in the world, by a new renderer once the keys rest.
+        const bool inPlace = render_->move(*req.placement);
+        placement_->change(*req.placement, inPlace, Clock::now());
+    }
+    bool closed = req.close;
+    if (!options_.screenshot.empty() && processed_ >= options_.screenshotAfter) {
+        window_->savePng(options_.screenshot);
+        closed = true;
+    }
+    if (req.screenshot) window_->savePng(timestampName("mirage-live-", ".png"));
+    window_->swap();
+    if (req.toggleRecord) {
+        try {
+            if (recorder_->recording())
+                recorder_->stop();
+            else
+                recorder_->start();
+        } catch (const Error& e) {
+            // A recording that cannot start (a folder in the way, a full disk) must not end the
+            // session: say why and go on.
+            spdlog::warn("live: {}", e.what());
+        }
+    }
+    LiveRenderSettings& settings = render_->settings();
+    bool rebuild = false;
+    if (placement_->settle(Clock::now(), window_->dragging())) {
+        rebuild = placement_->rebuildNeeded();
+        try {
+            savePlacement(placementFile_, placement_->placement());
+            spdlog::info("live: placement saved to {}", placementFile_.string());
+        } catch (const Error& e) {
+            spdlog::warn("live: placement not saved: {}", e.what());
+        }
+    }
+    if (req.rebuild) {
+        // A new renderer with the preset's options and the effects as switched; the temporal
+        // history starts again.
+        if (controls_.preset != settings.preset) {
+            settings.preset = controls_.preset;
+            settings.vpls = kQualityPresets[settings.preset].vpls;
+            spdlog::info("live: quality {}", kQualityPresets[settings.preset].name);
+        }
+        settings.effects = controls_.effects;
+        rebuild = true;
+    }
+    if (rebuild) {
+        render_->rebuild();
+        track_->restart();
+        last_.report = nullptr;
+    }
+    return !closed;
+}
+
+}  // namespace mirage::app
