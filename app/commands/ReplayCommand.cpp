@@ -43,6 +43,8 @@
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
 #include "app/OutputKind.h"
+#include "app/PathChecks.h"
+#include "app/ShardOptions.h"
 #include "app/commands/ShardMerge.h"
 #include "core/Csv.h"
 #include "core/Error.h"
@@ -477,7 +479,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", args->output, "OUT.mkv (MJPEG video) or a folder for PNG frames")
-        ->required();
+        ->required()
+        ->check(outputPath(OutputShape::FileOrFolder));
     cmd->add_option("--poses", args->poses,
                     "Camera poses CSV from `mirage track` (default: live tracking on the session's "
                     "board; the ground truth when it has no board file)")
@@ -499,7 +502,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
         ->check(wholeIn(0, 100000));
     cmd->add_option("--shard", args->shard,
                     "Replay part I of N (I/N, 0-based: the I-th of N contiguous blocks of the "
-                    "frames, each warmed up) into OUT.shards/; join with `mirage merge OUT`");
+                    "frames, each warmed up) into OUT.shards/; join with `mirage merge OUT`")
+        ->check(shardSpecCheck());
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_option("--static-env", args->staticEnv,
