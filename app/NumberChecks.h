@@ -1,7 +1,13 @@
 #pragma once
-// Range checks for numeric command-line options: CLI11's Range lets NaN through (every
-// comparison with NaN is false) and says nothing about infinity. Here a value must parse
-// completely as a finite number inside [lo, hi]; the message gives the range.
+// The one validator of numeric command-line options. CLI11's Range lets NaN through (every
+// comparison with NaN is false), says nothing about infinity, and its unsigned parsing takes
+// "-1" as 2^64 - 1. Here a value must parse completely as a finite number inside its range,
+// and the same range gives the help's text ("FLOAT:in (0, 179)") and the error message, so
+// the two cannot disagree. Ranges that a library checks too come from the library's
+// NumberRange constants (core/NumberRange.h), so the command line and the library agree as well.
+// Every numeric option of every command uses one of these; the CLI conformance test
+// (tests/app/CliConformance_test.cpp) fails on a numeric option without it.
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -9,24 +15,36 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "core/NumberRange.h"
+
 namespace mirage::app {
 
-inline CLI::Validator finiteIn(double lo, double hi, bool loOpen = false) {
-    const std::string range = fmt::format("{}{}, {}]", loOpen ? "(" : "[", lo, hi);
+// Name of the validators below, which the CLI conformance test looks for.
+inline constexpr const char* kNumberCheckName = "number-range";
+
+// Real numbers inside `range` (finite; "1e3" and "0.5" are fine).
+inline CLI::Validator finiteIn(const NumberRange& range) {
+    const std::string text = range.text();
     return CLI::Validator(
-        [lo, hi, loOpen, range](std::string& text) -> std::string {
-            const char* begin = text.c_str();
+        [range, text](std::string& value) -> std::string {
+            const char* begin = value.c_str();
             char* end = nullptr;
             const double v = std::strtod(begin, &end);
-            if (end == begin || *end != '\0' || !std::isfinite(v) || v < lo || v > hi ||
-                (loOpen && v == lo))
-                return "'" + text + "' is not a finite number in " + range;
+            if (end == begin || *end != '\0' || !range.contains(v))
+                return "'" + value + "' is not a finite number in " + text;
             return {};
         },
-        "in " + range);
+        "in " + text, kNumberCheckName);
 }
 
-// Whole numbers in [lo, hi] (also rejects "1.5" and values that overflow an int).
+inline CLI::Validator finiteIn(double lo, double hi, bool loOpen = false) {
+    return finiteIn(NumberRange{lo, hi, loOpen, false});
+}
+
+// Seeds are unsigned 64-bit, but "-1" must not wrap around to 2^64 - 1: seeds go to 2^63 - 1.
+inline constexpr long long kMaxSeed = 0x7fffffffffffffffLL;
+
+// Whole numbers in [lo, hi] (also rejects "1.5", "-0x10" and values that overflow).
 inline CLI::Validator wholeIn(long long lo, long long hi) {
     const std::string range = fmt::format("[{}, {}]", lo, hi);
     return CLI::Validator(
@@ -39,7 +57,7 @@ inline CLI::Validator wholeIn(long long lo, long long hi) {
                 return "'" + text + "' is not a whole number in " + range;
             return {};
         },
-        "in " + range);
+        "in " + range, kNumberCheckName);
 }
 
 }  // namespace mirage::app

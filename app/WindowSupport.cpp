@@ -40,8 +40,9 @@ void saveWindowPng(const std::filesystem::path& path, GLFWwindow* window) {
     cv::Mat bgr;
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
     cv::flip(bgr, bgr, 0);  // GL rows start at the bottom
-    createParentFolders(path);
-    writeBgr8(path, bgr);
+    OutputFile out(path, OutputOrigin::Named, OutputRule{{}, true, "screenshot"});
+    writeBgr8(out.temp(), bgr);
+    out.commit();
     spdlog::info("wrote screenshot {}", path.string());
 }
 

@@ -3,12 +3,46 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "app/Command.h"
 #include "core/Error.h"
 #include "core/Log.h"
+
+namespace {
+
+// `mirage --list-options`: every subcommand's options as CLI11 holds them, one per line,
+// tab-separated: command, name, kind (flag, positional, option), type with its validators'
+// descriptions ("FLOAT:in (0, 179)"), values per use, validator names. Hidden from the help;
+// the CLI conformance test (tests/app/CliConformance_test.cpp) walks this list.
+void listOptions(CLI::App& cli) {
+    for (CLI::App* sub : cli.get_subcommands({})) {
+        for (const CLI::Option* opt : sub->get_options()) {
+            if (opt->get_name() == "--help" || opt->get_name() == "-h,--help") continue;
+            const bool flag = opt->get_items_expected_max() == 0;
+            std::string validators;
+            for (int i = 0;; ++i) {
+                try {
+                    validators += (i ? "," : "") +
+                                  const_cast<CLI::Option*>(opt)->get_validator(i)->get_name();
+                } catch (const CLI::OptionNotFound&) {
+                    break;
+                }
+            }
+            std::printf("%s\t%s\t%s\t%s\t%d\t%s\n", sub->get_name().c_str(),
+                        opt->get_name(false, true).c_str(),
+                        flag                   ? "flag"
+                        : opt->nonpositional() ? "option"
+                                               : "positional",
+                        opt->get_type_name().c_str(), opt->get_items_expected_max(),
+                        validators.c_str());
+        }
+    }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     using namespace mirage;
@@ -29,6 +63,10 @@ int main(int argc, char** argv) {
               [](const auto& a, const auto& b) { return a.name < b.name; });
     for (auto& spec : registry) spec.setup(cli);
     cli.parse_complete_callback([&] { setLogLevel(logLevel); });
+    if (argc == 2 && std::string(argv[1]) == "--list-options") {
+        listOptions(cli);
+        return 0;
+    }
 
     try {
         cli.parse(argc, argv);

@@ -11,6 +11,7 @@
 
 #include "calibration/JointRefinement.h"
 #include "core/Error.h"
+#include "core/image/StrictJpeg.h"
 #include "core/session/FrameSource.h"
 
 namespace mirage::calib {
@@ -272,8 +273,10 @@ StereoExtrinsics extrinsicsFromPairedInputs(const CameraIntrinsics& main,
 
 WorldPose poseFromWorldBoard(const CameraIntrinsics& camera, const std::string& imagePath,
                              const CalibrationTarget& target) {
-    const cv::Mat img = cv::imread(imagePath, cv::IMREAD_COLOR);
-    if (img.empty()) throw FileError(imagePath, "cannot be read as an image");
+    // Strict decoding, the size screened from the header first (core/image/StrictJpeg.h).
+    std::string why;
+    const cv::Mat img = readImageStrict(imagePath, &why);
+    if (img.empty()) throw FileError(imagePath, "cannot be read as an image: " + why);
     if (img.cols != camera.width || img.rows != camera.height)
         throw FileError(imagePath, fmt::format("is {}x{} but the calibration is for {}x{}",
                                                img.cols, img.rows, camera.width, camera.height));

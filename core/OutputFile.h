@@ -8,7 +8,16 @@
 //    --force;
 //  - written to a temporary name beside the target and renamed over it only when the command
 //    finishes it, so a failure (bad input found late, disk full, a crash) never leaves a
-//    truncated file where the old one was.
+//    truncated file where the old one was;
+//  - only a regular file or a new path is ever replaced: a character or block device
+//    (`-o /dev/full`), a socket, or a folder where a file is expected is refused before any
+//    work; a FIFO, or the standard output given as /dev/stdout (/dev/fd/N, /proc/self/fd/N), is
+//    written through when the output is finished (the bytes are copied into it, it stays what
+//    it was), which is what `-o /dev/stdout | ...` means; a folder output must be a folder or a
+//    new path;
+//  - temporaries are removed when SIGINT, SIGTERM or SIGHUP stops the process (a command that
+//    polls stopRequested() finishes its own way instead), and a later run removes temporaries
+//    that a killed process (SIGKILL, a crash) left beside its output.
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -36,6 +45,23 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
 void checkOutput(const std::filesystem::path& out, OutputOrigin origin, const OutputRule& rule,
                  bool outIsFolder = false);
 
+// What is at an output path, as checkOutput() found it.
+enum class OutputTarget {
+    New,           // nothing yet
+    RegularFile,   // replaced by rename when the output is finished
+    Folder,        // only for folder outputs
+    WriteThrough,  // a FIFO or the standard output: the finished bytes are written into it
+};
+
+// Classifies `out`; throws mirage::Error naming the output and what to do for a device, a
+// socket, a folder where a file is expected (or a file or FIFO where a folder is).
+OutputTarget outputTarget(const std::filesystem::path& out, const std::string& command,
+                          bool outIsFolder = false);
+
+// True for the name of a temporary a writer keeps beside its output ("x.partial-123.png"):
+// folder listings of inputs skip them, so a command never reads its own unfinished output.
+bool isPartialOutputName(const std::filesystem::path& p);
+
 // Creates the parent folders of `out` (every command does, so `-o results/run1/x.png` works
 // the same everywhere); throws FileError if that fails.
 void createParentFolders(const std::filesystem::path& out);
@@ -56,13 +82,17 @@ public:
 
     const std::filesystem::path& path() const { return path_; }
     const std::filesystem::path& temp() const { return temp_; }
-    // fsync + rename. Throws FileError ("disk full?") if the data cannot be flushed.
+    // fsync + rename (or the copy into a FIFO / standard output). Throws FileError ("disk
+    // full?") if the data cannot be flushed.
     void commit();
     bool committed() const { return committed_; }
+    bool writesThrough() const { return writeThrough_; }
 
 private:
     std::filesystem::path path_, temp_;
     bool committed_ = false;
+    bool writeThrough_ = false;
+    int cleanupSlot_ = -1;  // the temporary's entry in the on-signal cleanup list
 };
 
 // A folder (or file) written under a temporary name beside its final path,
@@ -78,13 +108,15 @@ public:
 
     const std::filesystem::path& temp() const { return temp_; }
     const std::filesystem::path& finalPath() const { return final_; }
-    // Replaces whatever is at the final path (the caller checked it may) with the temporary.
+    // Replaces what is at the final path (the caller checked it may: a folder or a regular
+    // file, never a special file) with the temporary.
     // Throws FileError saying where the complete result was left if the rename fails.
     void commit();
 
 private:
     std::filesystem::path final_, temp_;
     bool committed_ = false;
+    int cleanupSlot_ = -1;
 };
 
 // Closes a stream that wrote an OutputFile's temp() and throws FileError naming `out` if any

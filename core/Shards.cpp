@@ -37,6 +37,38 @@ std::string joinItems(const std::vector<int>& items, size_t most = 12) {
     return s;
 }
 
+// The data rows of a CSV text (after the header line), each as (first field, FNV-1a hash).
+std::vector<std::pair<std::string, std::string>> csvRows(const std::string& text) {
+    std::vector<std::pair<std::string, std::string>> rows;
+    size_t start = text.find('\n');
+    while (start != std::string::npos && start + 1 < text.size()) {
+        const size_t end = text.find('\n', start + 1);
+        const std::string line =
+            text.substr(start + 1, end == std::string::npos ? std::string::npos : end - start - 1);
+        if (!line.empty())
+            rows.emplace_back(line.substr(0, line.find(',')), hex64(fingerprint64(line)));
+        start = end;
+    }
+    return rows;
+}
+
+std::string readAll(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw FileError(path.string(), "cannot open for reading");
+    return std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// "frame 12" for "main/000012.png" in a shard of frames; "" when the name holds no number.
+std::string itemOfFile(const std::string& path, const std::string& unit) {
+    const std::string stem = fs::path(path).stem().string();
+    size_t i = stem.size();
+    while (i > 0 && std::isdigit(static_cast<unsigned char>(stem[i - 1]))) --i;
+    if (i == stem.size()) return "";
+    const std::string one =
+        !unit.empty() && unit.back() == 's' ? unit.substr(0, unit.size() - 1) : unit;
+    return " (" + one + " " + std::to_string(std::stoll(stem.substr(i, 9))) + ")";
+}
+
 }  // namespace
 
 ShardSpec parseShardSpec(const std::string& text) {
@@ -52,7 +84,7 @@ ShardSpec parseShardSpec(const std::string& text) {
     return s;
 }
 
-ItemRange parseItemRange(const std::string& text) {
+ItemRange parseItemRange(const std::string& text, const std::string& option) {
     const size_t colon = text.find(':');
     ItemRange r;
     bool ok = colon != std::string::npos;
@@ -63,26 +95,28 @@ ItemRange parseItemRange(const std::string& text) {
         if (ok && r.end >= 0 && r.end <= r.begin) ok = false;
     }
     if (!ok)
-        throw Error("--frames '" + text +
+        throw Error(option + " '" + text +
                     "' must be A:B (items A to B-1, 0-based, A < B), A: (from A) or :B");
     return r;
 }
 
-std::vector<int> selectItems(int total, const ItemRange& range, const ShardSpec& shard) {
+std::vector<int> selectItems(int total, const ItemRange& range, const ShardSpec& shard,
+                             const std::string& option, const std::string& unit) {
     const int end = range.end < 0 ? total : range.end;
     if (range.begin >= total || end > total)
-        throw Error(fmt::format("--frames {}:{} reaches beyond the {} items of this run (0 to {})",
-                                range.begin, end, total, total - 1));
+        throw Error(fmt::format("{} {}:{} reaches beyond the {} {} of this run (0 to {})", option,
+                                range.begin, end, total, unit, total - 1));
     std::vector<int> items;
     for (int i = range.begin + shard.index; i < end; i += shard.count) items.push_back(i);
     return items;
 }
 
-std::vector<int> selectBlock(int total, const ItemRange& range, const ShardSpec& shard) {
+std::vector<int> selectBlock(int total, const ItemRange& range, const ShardSpec& shard,
+                             const std::string& option, const std::string& unit) {
     const int end = range.end < 0 ? total : range.end;
     if (range.begin >= total || end > total)
-        throw Error(fmt::format("--frames {}:{} reaches beyond the {} items of this run (0 to {})",
-                                range.begin, end, total, total - 1));
+        throw Error(fmt::format("{} {}:{} reaches beyond the {} {} of this run (0 to {})", option,
+                                range.begin, end, total, unit, total - 1));
     const int64_t n = end - range.begin;
     const int first = range.begin + int(n * shard.index / shard.count);
     const int last = range.begin + int(n * (shard.index + 1) / shard.count);
@@ -138,7 +172,94 @@ void writeShardManifest(const fs::path& dir, const ShardManifest& m) {
     if (created.empty()) created = utcTimestamp();
     j["created"] = created;
     j["payload"] = m.payload;
+    nlohmann::json files = nlohmann::json::array();
+    for (const ShardFile& f : listShardFiles(dir)) {
+        nlohmann::json e = {{"path", f.path}, {"bytes", f.bytes}, {"fnv1a64", f.hash}};
+        if (!f.rows.empty()) {
+            nlohmann::json rows = nlohmann::json::array();
+            for (const auto& [key, hash] : f.rows) rows.push_back({key, hash});
+            e["rows"] = std::move(rows);
+        }
+        files.push_back(std::move(e));
+    }
+    j["files"] = std::move(files);
     writeFileAtomically(dir / "shard.json", j.dump(1));
+}
+
+std::vector<ShardFile> listShardFiles(const fs::path& dir) {
+    std::vector<ShardFile> files;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        if (!e.is_regular_file()) continue;
+        const std::string rel = fs::relative(e.path(), dir).generic_string();
+        if (rel == "shard.json") continue;
+        const std::string bytes = readAll(e.path());
+        ShardFile f;
+        f.path = rel;
+        f.bytes = bytes.size();
+        f.hash = hex64(fingerprint64(bytes));
+        if (e.path().extension() == ".csv") f.rows = csvRows(bytes);
+        files.push_back(std::move(f));
+    }
+    std::sort(files.begin(), files.end(),
+              [](const ShardFile& a, const ShardFile& b) { return a.path < b.path; });
+    return files;
+}
+
+namespace {
+
+// Names the first difference between the rows a CSV had when the shard was written and now.
+std::string csvDifference(const ShardFile& was, const ShardFile& now, const std::string& unit) {
+    const std::string one =
+        !unit.empty() && unit.back() == 's' ? unit.substr(0, unit.size() - 1) : unit;
+    std::map<std::string, std::string> current(now.rows.begin(), now.rows.end());
+    for (const auto& [key, hash] : was.rows) {
+        const auto it = current.find(key);
+        if (it == current.end()) return "the row of " + one + " " + key + " was deleted";
+        if (it->second != hash) return "the row of " + one + " " + key + " was changed";
+        current.erase(it);
+    }
+    if (!current.empty())
+        return "it holds a row for " + one + " " + current.begin()->first +
+               " that the shard did not write";
+    return "its rows are as written but in another order or with other bytes between them";
+}
+
+}  // namespace
+
+void verifyShardFiles(const fs::path& dir, const ShardManifest& m) {
+    if (m.files.empty()) return;  // a version-1 shard: nothing recorded to check against
+    const std::vector<ShardFile> now = listShardFiles(dir);
+    std::map<std::string, const ShardFile*> byPath;
+    for (const ShardFile& f : now) byPath[f.path] = &f;
+    const std::string shardName = dir.filename().string();
+    for (const ShardFile& was : m.files) {
+        const auto it = byPath.find(was.path);
+        const std::string where = (dir / was.path).string();
+        if (it == byPath.end())
+            throw FileError(
+                where,
+                "shard " + shardName + ": missing" + itemOfFile(was.path, m.unit) +
+                    "; the shard is damaged, rerun it: " + rerunCommand(m.commandLine, m.shard));
+        const ShardFile& f = *it->second;
+        if (f.hash != was.hash) {
+            const std::string what =
+                !was.rows.empty() || !f.rows.empty()
+                    ? csvDifference(was, f, m.unit)
+                    : "changed since the shard wrote it" + itemOfFile(was.path, m.unit);
+            throw FileError(where, "shard " + shardName + ": " + what +
+                                       "; the shard is damaged, rerun it: " +
+                                       rerunCommand(m.commandLine, m.shard));
+        }
+        byPath.erase(it);
+    }
+    if (!byPath.empty()) {
+        const std::string extra = byPath.begin()->first;
+        throw FileError((dir / extra).string(),
+                        "shard " + shardName + ": holds a file the shard did not write" +
+                            itemOfFile(extra, m.unit) +
+                            " (copied in from another shard?); remove it or rerun the shard: " +
+                            rerunCommand(m.commandLine, m.shard));
+    }
 }
 
 ShardManifest readShardManifest(const fs::path& dir) {
@@ -180,6 +301,21 @@ ShardManifest readShardManifest(const fs::path& dir) {
         m.commandLine = field("command_line").get<std::vector<std::string>>();
         m.createdAt = field("created").get<std::string>();
         m.payload = field("payload");
+        if (j.contains("files"))
+            for (const auto& e : j["files"]) {
+                ShardFile f;
+                f.path = e.at("path").get<std::string>();
+                f.bytes = e.at("bytes").get<uint64_t>();
+                f.hash = e.at("fnv1a64").get<std::string>();
+                if (e.contains("rows"))
+                    for (const auto& r : e["rows"])
+                        f.rows.emplace_back(r.at(0).get<std::string>(), r.at(1).get<std::string>());
+                if (f.path.empty() || fs::path(f.path).is_absolute() ||
+                    f.path.find("..") != std::string::npos)
+                    throw FileError(file.string(), "field 'files' names '" + f.path +
+                                                       "', outside the shard folder");
+                m.files.push_back(std::move(f));
+            }
     } catch (const nlohmann::json::exception& e) {
         throw FileError(file.string(), std::string("a field has the wrong type: ") + e.what());
     }
@@ -228,6 +364,7 @@ ShardSet collectShards(const fs::path& output) {
     for (const fs::path& d : dirs) {
         set.shards.push_back(readShardManifest(d));
         set.folders.push_back(d);
+        verifyShardFiles(d, set.shards.back());
     }
     if (set.shards.empty())
         throw FileError(folder.string(),

@@ -147,6 +147,12 @@ glm::vec3 anyPerpendicular(const glm::vec3& d) {
 Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererOptions options)
     : options_(options) {
     options_.validate();
+    // Without a mesh nothing is drawn: the frame graph would cull every pass and the composite
+    // would be missing, which is the scene's problem, not the renderer's.
+    if (scene.meshInstances().empty())
+        throw FileError(scene.source.empty() ? "scene" : scene.source.string(),
+                        "the scene has no mesh in its node tree: nothing to render or composite "
+                        "(add the real surfaces' proxies and the virtual objects as meshes)");
     scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environmentLights);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);

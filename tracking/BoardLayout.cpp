@@ -14,9 +14,13 @@ Pose BoardLayout::tableSheetPose() {
 }
 
 Board BoardLayout::makeBoard() const {
-    if (rows < 1 || cols < 1) throw Error("board layout: rows and cols must be >= 1");
-    if (!(tagSize > 0) || !(gap >= 0) || !(margin >= 0))
-        throw Error("board layout: tag size must be > 0, gap and margin >= 0 (metres)");
+    if (rows < 1 || cols < 1 || rows > kBoardMaxTagsPerSide || cols > kBoardMaxTagsPerSide)
+        throw Error("board layout: rows and cols must be 1.." +
+                    std::to_string(kBoardMaxTagsPerSide));
+    if (!kBoardTagSizeM.contains(tagSize) || !kBoardGapM.contains(gap) ||
+        !kBoardMarginM.contains(margin))
+        throw Error("board layout: tag size must be in " + kBoardTagSizeM.text() + ", gap in " +
+                    kBoardGapM.text() + " and margin in " + kBoardMarginM.text() + " metres");
     const TagFamily fam(family);
     if (firstId < 0 || firstId + rows * cols > fam.codeCount())
         throw Error("board layout: ids " + std::to_string(firstId) + ".." +

@@ -12,10 +12,18 @@
 // and every tag's frame has +X = world +X, +Y = world +Z, +Z = world -Y (into the table).
 #include <string>
 
+#include "core/NumberRange.h"
 #include "core/math/Pose.h"
 #include "tracking/Board.h"
 
 namespace mirage::tracking {
+
+// What a printable board may measure (metres; a sheet beyond a metre or a grid beyond 100 x 100
+// tags is no longer a printout). makeBoard() and `mirage board`'s options check the same ranges.
+inline constexpr NumberRange kBoardTagSizeM{0, 1, true, false};
+inline constexpr NumberRange kBoardGapM{0, 1};
+inline constexpr NumberRange kBoardMarginM{0, 1};
+inline constexpr int kBoardMaxTagsPerSide = 100;
 
 struct BoardLayout {
     int rows = 4, cols = 6;
@@ -30,8 +38,9 @@ struct BoardLayout {
     static Pose tableSheetPose();
 
     // The board: tags with their world poses and the sheet (page size, scale bar, caption).
-    // Throws mirage::Error on a layout that cannot be printed: rows/cols < 1, sizes <= 0, ids
-    // beyond the family, or gap/margin narrower than the tags' quiet zone.
+    // Throws mirage::Error on a layout that cannot be printed: rows/cols outside
+    // [1, kBoardMaxTagsPerSide], sizes outside the ranges above (NaN, infinite), ids beyond the
+    // family, or gap/margin narrower than the tags' quiet zone.
     Board makeBoard() const;
 };
 

@@ -27,6 +27,8 @@
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/PathChecks.h"
+#include "app/ShardOptions.h"
 #include "app/commands/BenchSuite.h"
 #include "app/commands/MachineInfo.h"
 #include "app/commands/ShardMerge.h"
@@ -319,7 +321,8 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
         "grid of knobs, judged against the ground-truth composite");
     cmd->add_option("session", a->session,
                     "Synthetic session made with `mirage synth --ground-truth-composite`");
-    cmd->add_option("-o,--output", a->output, "Folder for bench.csv, bench_frames.csv, bench.md");
+    cmd->add_option("-o,--output", a->output, "Folder for bench.csv, bench_frames.csv, bench.md")
+        ->check(outputPath(OutputShape::Folder));
     cmd->add_option("--scene", a->scene,
                     "Scene with the virtual objects (default: the one ground_truth.json names)");
     cmd->add_flag("--quick", a->quick, "A small grid (one resolution, 64/256 VPLs, gather 1/2)");
@@ -341,7 +344,8 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
     cmd->add_option("--shard", a->shard,
                     "Run part I of N of the grid (I/N, 0-based: every N-th configuration from I) "
                     "into OUTDIR.shards/; join the parts with `mirage merge OUTDIR` "
-                    "(docs/scale.md)");
+                    "(docs/scale.md)")
+        ->check(shardSpecCheck());
     cmd->add_option("--suite", a->suite,
                     "Write the results page to OUTDIR/results.md: every effect's session "
                     "synthesised (or reused from OUTDIR/sessions), its knob sweeps, plots, crops "

@@ -13,6 +13,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
+#include "app/PathChecks.h"
 #include "app/wizard/CalibrationWizard.h"
 #include "calibration/BatchCalibration.h"
 #include "calibration/Extrinsics.h"
@@ -163,18 +165,32 @@ void writeSynthetic(const CalibrateArgs& a) {
     po.minDistance = model == DistortionModel::KannalaBrandt ? 0.18 : 0.3;
     po.maxDistance = model == DistortionModel::KannalaBrandt ? 0.35 : 0.55;
     po.marginPx = 12;
+    // Checked and staged like every folder output (core/OutputFile.h): written under a temporary
+    // name beside the folder and moved into place when complete; an existing set is replaced
+    // only with --force, a folder holding other files never.
+    const fs::path outDir(a.writeSynthetic);
+    checkOutput(outDir, OutputOrigin::Named, OutputRule{{}, a.force, "mirage calibrate"}, true);
+    std::error_code ec;
+    if (fs::is_directory(outDir, ec) && !fs::is_empty(outDir, ec) &&
+        !(a.force && fs::exists(outDir / "truth.yaml")))
+        throw FileError(a.writeSynthetic,
+                        fs::exists(outDir / "truth.yaml")
+                            ? "already holds a synthetic set; pass --force to replace it"
+                            : "exists and is not empty; choose a new folder");
     const auto poses = calib::sampleBoardPoses(cam, board, a.syntheticViews, po, rng);
-    fs::create_directories(a.writeSynthetic);
+    StagedPath staged(outDir);
+    const fs::path dir = staged.temp();
+    fs::create_directories(dir);
     const calib::ChessboardRenderer hiRes(cam, 3);
     for (size_t i = 0; i < poses.size(); ++i) {
         const cv::Mat img = hiRes.render(board, poses[i]);
-        const auto path = fs::path(a.writeSynthetic) / fmt::format("view_{:02}.png", i);
+        const auto path = dir / fmt::format("view_{:02}.png", i);
         if (!cv::imwrite(path.string(), img)) throw FileError(path.string(), "cannot write");
     }
     // A video of the board moving from pose to pose (motion-blurred while it moves), holding
     // still at each, with one pose first held out of focus: what the wizard's auto-capture sees.
     const calib::ChessboardRenderer renderer(cam, 2);
-    const auto videoPath = (fs::path(a.writeSynthetic) / "sequence.avi").string();
+    const auto videoPath = (dir / "sequence.avi").string();
     cv::VideoWriter video(videoPath, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 15.0,
                           cv::Size(cam.width, cam.height), false);
     if (!video.isOpened()) throw FileError(videoPath, "cannot open for writing (MJPG/AVI)");
@@ -203,7 +219,9 @@ void writeSynthetic(const CalibrateArgs& a) {
     }
     CameraCalibration truth;
     truth.intrinsics = cam;
-    saveCalibration(fs::path(a.writeSynthetic) / "truth.yaml", truth);
+    video.release();
+    saveCalibration(dir / "truth.yaml", truth);
+    staged.commit();
     spdlog::info("wrote {} views of chessboard:9x6:0.025, sequence.avi and truth.yaml into {}",
                  poses.size(), a.writeSynthetic);
 }
@@ -219,17 +237,22 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
                     "charuco:SQUARESXxSQUARESY:SQUARE_M:MARKER_M[:DICT] (squares)");
     cmd->add_option("-o,--output", a->output,
                     "Calibration file to write (OpenCV YAML); with --camera the default is the "
-                    "camera folder mirage live reads");
+                    "camera folder mirage live reads")
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--model", a->model, "pinhole (Brown-Conrady) or fisheye (Kannala-Brandt)")
         ->capture_default_str();
-    cmd->add_option("--ros", a->ros, "Also export a ROS camera_info YAML here");
+    cmd->add_option("--ros", a->ros, "Also export a ROS camera_info YAML here")
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--ros-name", a->rosName, "camera_name in the ROS export")
         ->capture_default_str();
-    cmd->add_option("--report", a->report, "Report file (default: OUTPUT.report.txt)");
-    cmd->add_flag("--force", a->force, "Replace an existing report beside the output");
+    cmd->add_option("--report", a->report, "Report file (default: OUTPUT.report.txt)")
+        ->check(outputPath(OutputShape::File));
+    cmd->add_flag("--force", a->force,
+                  "Replace an existing report beside the output (or an existing synthetic set)");
     cmd->add_flag("--fix-k3", a->fixK3, "Pinhole: keep k3 = 0 (narrow lenses)");
     cmd->add_option("--video-step", a->videoStep,
-                    "Videos: use every Nth frame (default: about 120 frames per video)");
+                    "Videos: use every Nth frame (default: about 120 frames per video)")
+        ->check(wholeIn(1, 100000000));
     cmd->add_option("--main-calib", a->mainCalib,
                     "Extrinsics: the main camera's calibration; with --main-input gives this "
                     "camera's pose relative to the main camera");
@@ -243,13 +266,18 @@ const CommandRegistrar reg("calibrate", [](CLI::App& parent) {
         "Wizard: live V4L2 camera device (e.g. /dev/video0); without -o the calibration is "
         "saved where mirage live looks for this camera (docs/live.md)");
     cmd->add_option("--screenshot", a->screenshot,
-                    "Wizard: save a PNG of the window after --screenshot-after frames, then exit");
+                    "Wizard: save a PNG of the window after --screenshot-after frames, then exit")
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--screenshot-after", a->screenshotAfterFrames,
-                    "Wizard: frames to process before the screenshot (default: all)");
+                    "Wizard: frames to process before the screenshot (default: all)")
+        ->check(wholeIn(1, 100000000));
     cmd->add_option("--write-synthetic", a->writeSynthetic,
-                    "Write rendered board views with known intrinsics (truth.yaml) to this folder");
-    cmd->add_option("--synthetic-views", a->syntheticViews, "Views for --write-synthetic")
-        ->capture_default_str();
+                    "Write rendered board views with known intrinsics (truth.yaml) to this folder")
+        ->check(outputPath(OutputShape::Folder));
+    cmd->add_option("--synthetic-views", a->syntheticViews,
+                    "Views for --write-synthetic (a calibration needs at least 3)")
+        ->capture_default_str()
+        ->check(wholeIn(3, 1000));
     cmd->callback([a] {
         if (!a->writeSynthetic.empty()) return writeSynthetic(*a);
         if (a->batch) {

@@ -6,12 +6,16 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include <epoxy/gl.h>
 
 #include "app/Command.h"
+#include "app/NumberChecks.h"
+#include "app/PathChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/gl/Context.h"
 #include "core/scene/Scene.h"
 #include "render/Renderer.h"
@@ -30,6 +34,11 @@ struct InfoArgs {
 void printPasses(const InfoArgs& a) {
     if (a.width < 16 || a.height < 16 || a.width > 8192 || a.height > 8192)
         throw Error("mirage info: --width/--height must be 16..8192 pixels");
+    // The DOT file is checked (and its temporary made) before the scene is rendered.
+    std::optional<OutputFile> dotOut;
+    if (!a.dot.empty())
+        dotOut.emplace(a.dot, OutputOrigin::Named,
+                       OutputRule{{a.passesScene}, true, "mirage info"});
     Scene scene = loadScene(a.passesScene);
     if (a.noLights) {
         for (Node& n : scene.nodes) n.light = -1;
@@ -45,10 +54,10 @@ void printPasses(const InfoArgs& a) {
               << ", camera '" << cameraName << "' at " << a.width << "x" << a.height << ":\n"
               << (a.markdown ? renderer.graph().markdown() : renderer.graph().describe());
     if (!a.dot.empty()) {
-        std::ofstream out(a.dot);
-        if (!out) throw FileError(a.dot, "cannot create the DOT file (does the folder exist?)");
+        std::ofstream out(dotOut->temp());
         out << renderer.graph().dot();
-        if (!out) throw FileError(a.dot, "could not write the DOT file");
+        closeChecked(out, a.dot);
+        dotOut->commit();
         spdlog::info("wrote {} (draw it with: dot -Tsvg {} -o graph.svg)", a.dot, a.dot);
     }
 }
@@ -63,13 +72,16 @@ const CommandRegistrar reg("info", [](CLI::App& parent) {
                     "(.gltf/.glb): passes, what each reads and writes, why each ran or not");
     cmd->add_option("--camera", a->camera,
                     "With --passes: the scene's camera node to view from (default: the first)");
-    cmd->add_option("--width", a->width, "With --passes: image width in pixels (default 640)");
-    cmd->add_option("--height", a->height, "With --passes: image height in pixels (default 480)");
+    cmd->add_option("--width", a->width, "With --passes: image width in pixels (default 640)")
+        ->check(wholeIn(16, 8192));
+    cmd->add_option("--height", a->height, "With --passes: image height in pixels (default 480)")
+        ->check(wholeIn(16, 8192));
     cmd->add_flag("--no-lights", a->noLights,
                   "With --passes: remove the scene's lights first (environment light only)");
     cmd->add_flag("--markdown", a->markdown,
                   "With --passes: print the graph as a markdown table (docs)");
-    cmd->add_option("--dot", a->dot, "With --passes: also write the graph as Graphviz DOT here");
+    cmd->add_option("--dot", a->dot, "With --passes: also write the graph as Graphviz DOT here")
+        ->check(outputPath(OutputShape::File));
     cmd->callback([a] {
         if (a->passesScene.empty() && (!a->dot.empty() || a->noLights || !a->camera.empty()))
             throw Error("mirage info: --camera, --dot and --no-lights need --passes SCENE");

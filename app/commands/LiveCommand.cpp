@@ -11,6 +11,7 @@
 #include "app/Command.h"
 #include "app/EffectSwitches.h"
 #include "app/NumberChecks.h"
+#include "app/PathChecks.h"
 #include "app/live/LiveInputs.h"
 #include "app/live/LiveSession.h"
 
@@ -68,7 +69,8 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
         ->check(wholeIn(-1, 100000000));
     cmd->add_option("-o,--output", args->output,
                     "Write the composites: OUT.mkv (MJPEG video) or a folder of PNG frames, with "
-                    "a per-frame CSV beside it");
+                    "a per-frame CSV beside it")
+        ->check(outputPath(OutputShape::FileOrFolder));
     cmd->add_option("--off", args->effectsOff,
                     "Start with these effects off (comma-separated, as `mirage bench` names "
                     "them; the HUD switches them): " +
@@ -77,14 +79,16 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
         ->check(effectSwitchName());
     cmd->add_option("--record", args->record,
                     "Record the session (the camera's frames and the live poses) into this new "
-                    "folder; replay it with `mirage replay`");
+                    "folder; replay it with `mirage replay`")
+        ->check(outputPath(OutputShape::Folder));
     cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
         ->check(wholeIn(0, 16384));
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--force", args->force, "Replace an existing CSV beside the output");
     cmd->add_option("--screenshot", args->screenshot,
-                    "Window: save a PNG of the window after --screenshot-after frames, then exit");
+                    "Window: save a PNG of the window after --screenshot-after frames, then exit")
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--screenshot-after", args->screenshotAfter,
                     "Window: frames to process before --screenshot")
         ->capture_default_str()

@@ -31,6 +31,12 @@ struct MergeArgs {
 void run(const MergeArgs& a) {
     fs::path out(a.output);
     if (!out.has_filename()) out = out.parent_path();
+    // OUT is replaced by a folder or file moved into place: a device, a socket or a FIFO cannot
+    // be (core/OutputFile.h), and is refused before the shards are read.
+    if (outputTarget(out, "mirage merge", fs::is_directory(out)) == OutputTarget::WriteThrough)
+        throw Error("mirage merge: '" + out.string() +
+                    "' is a FIFO or the standard output; the merge is written to the -o OUT the "
+                    "shards were run with, as a file or folder");
     const ShardSet set = collectShards(out);
     const ShardManifest& first = set.shards.front();
     if (fs::exists(out) && !a.force)

@@ -11,6 +11,8 @@
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/PathChecks.h"
+#include "app/ShardOptions.h"
 #include "app/commands/ShardMerge.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
@@ -94,7 +96,7 @@ void run(const RenderArgs& a) {
         throw Error("mirage render: --width/--height must be positive");
 
     const ShardSpec shard = a.shard.empty() ? ShardSpec{} : parseShardSpec(a.shard);
-    const ItemRange rowRange = a.rows.empty() ? ItemRange{} : parseItemRange(a.rows);
+    const ItemRange rowRange = a.rows.empty() ? ItemRange{} : parseItemRange(a.rows, "--rows");
     const bool split = !a.shard.empty() || !a.rows.empty();
     if (split && a.seconds > 0)
         throw Error(
@@ -136,7 +138,7 @@ void run(const RenderArgs& a) {
     raytrace::RenderCamera camera = raytrace::cameraFromNode(scene, a.camera, a.width, height);
 
     raytrace::RenderSettings st;
-    if (split) st.rows = selectItems(height, rowRange, shard);
+    if (split) st.rows = selectItems(height, rowRange, shard, "--rows", "image rows");
     if (split && st.rows.empty())
         throw Error(
             fmt::format("mirage render: shard {}/{} holds no row of the {} rows; use at "
@@ -212,7 +214,8 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
     cmd->add_option("--camera", a->camera, "Name of the glTF camera node to render")->required();
     cmd->add_option("-o,--output", a->output,
                     "Image: .exr/.pfm (linear RGB) or .png (tone-mapped sRGB)")
-        ->required();
+        ->required()
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--spp", a->spp, "Samples (passes) per pixel")
         ->capture_default_str()
         ->check(wholeIn(1, 1 << 30));
@@ -226,7 +229,8 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
                     "Image height (default: from the camera's aspect ratio, else 4:3)")
         ->check(wholeIn(0, 16384));
     cmd->add_option("--seed", a->seed, "Random seed (same seed = same image)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(0, kMaxSeed));
     cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
         ->capture_default_str()
         ->check(wholeIn(0, 4096));
@@ -245,10 +249,12 @@ const CommandRegistrar reg("render", [](CLI::App& parent) {
                   "Replace existing --save-buffers files beside the output (or an existing shard)");
     cmd->add_option("--shard", a->shard,
                     "Render part I of N (I/N, 0-based: every N-th image row from row I) into "
-                    "OUT.shards/; join the parts with `mirage merge OUT` (docs/scale.md)");
+                    "OUT.shards/; join the parts with `mirage merge OUT` (docs/scale.md)")
+        ->check(shardSpecCheck());
     cmd->add_option("--rows", a->rows,
                     "Render only image rows A to B-1 (A:B), as a shard; with --shard, the part "
-                    "of those rows");
+                    "of those rows")
+        ->check(itemRangeCheck("--rows"));
     cmd->add_flag("--save-buffers", a->saveBuffers,
                   "composite: also write OUT_Lr.exr, OUT_Lrv.exr, OUT_coverage.exr");
     cmd->add_option("--photons", a->photons, "Caustic photons per pass (0 = automatic)")

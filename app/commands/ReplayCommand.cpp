@@ -28,6 +28,8 @@
 #include "app/Command.h"
 #include "app/EffectSwitches.h"
 #include "app/NumberChecks.h"
+#include "app/PathChecks.h"
+#include "app/ShardOptions.h"
 #include "app/replay/ReplaySession.h"
 
 namespace mirage::app {
@@ -46,7 +48,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", args->output, "OUT.mkv (MJPEG video) or a folder for PNG frames")
-        ->required();
+        ->required()
+        ->check(outputPath(OutputShape::FileOrFolder));
     cmd->add_option("--poses", args->poses,
                     "Camera poses CSV from `mirage track` (default: live tracking on the session's "
                     "board; the ground truth when it has no board file)")
@@ -68,7 +71,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
         ->check(wholeIn(0, 100000));
     cmd->add_option("--shard", args->shard,
                     "Replay part I of N (I/N, 0-based: the I-th of N contiguous blocks of the "
-                    "frames, each warmed up) into OUT.shards/; join with `mirage merge OUT`");
+                    "frames, each warmed up) into OUT.shards/; join with `mirage merge OUT`")
+        ->check(shardSpecCheck());
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_option("--static-env", args->staticEnv,

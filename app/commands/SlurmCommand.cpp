@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "app/NumberChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/Shards.h"
 
 namespace mirage::app {
@@ -37,6 +39,39 @@ struct SlurmArgs {
     bool dryRun = false;
     std::vector<std::string> command;  // synth|render|bench and its arguments
 };
+
+// sbatch's --time formats (man sbatch): minutes, minutes:seconds, hours:minutes:seconds,
+// days-hours, days-hours:minutes, days-hours:minutes:seconds, with at least one minute or day;
+// checked here so that a typo fails now, not when the cluster reads the script.
+CLI::Validator slurmTime() {
+    return CLI::Validator(
+        [](std::string& v) -> std::string {
+            static const std::regex format(
+                R"((\d{1,7})|(\d{1,7}):(\d{1,2})|(\d{1,5}):(\d{1,2}):(\d{1,2})|)"
+                R"((\d{1,5})-(\d{1,2})|(\d{1,5})-(\d{1,2}):(\d{1,2})|)"
+                R"((\d{1,5})-(\d{1,2}):(\d{1,2}):(\d{1,2}))");
+            std::smatch m;
+            if (!std::regex_match(v, m, format) || v.find_first_not_of("0:-") == std::string::npos)
+                return "'" + v +
+                       "' is not a Slurm time limit: use M, M:S, H:M:S, D-H, D-H:M or D-H:M:S "
+                       "(e.g. 04:00:00), more than zero";
+            return {};
+        },
+        "TIME");
+}
+
+// Partition and account names go into the batch script's #SBATCH lines: plain names only.
+CLI::Validator slurmName() {
+    return CLI::Validator(
+        [](std::string& v) -> std::string {
+            if (v.empty() ||
+                v.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                    "0123456789_.,-") != std::string::npos)
+                return "'" + v + "' is not a Slurm name (letters, digits, _ . , - only)";
+            return {};
+        },
+        "NAME");
+}
 
 std::string quote(const std::string& s) {
     if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
@@ -148,6 +183,8 @@ void run(const SlurmArgs& a) {
     fs::path scripts = out;
     scripts += ".slurm";
     const fs::path logs = scripts / "logs";
+    outputTarget(scripts, "mirage slurm", /*outIsFolder=*/true);
+    outputTarget(out, "mirage slurm", fs::is_directory(out));
     fs::create_directories(logs);
 
     const int memoryMb = a.memoryMb > 0 ? a.memoryMb : estimateMemoryMb(a.command);
@@ -171,10 +208,14 @@ void run(const SlurmArgs& a) {
     merge += quote(mirage) + " merge " + quote(out.string()) + "\n";
 
     const fs::path taskScript = scripts / "shards.sbatch", mergeScript = scripts / "merge.sbatch";
-    std::ofstream(taskScript) << task;
-    std::ofstream(mergeScript) << merge;
-    if (!std::ofstream(taskScript, std::ios::app) || !std::ofstream(mergeScript, std::ios::app))
-        throw FileError(scripts.string(), "cannot write the batch scripts here");
+    // Regenerated on every run (core/OutputFile.h: never over a special file, whole or not at all).
+    for (const auto& [path, text] : {std::pair{taskScript, task}, std::pair{mergeScript, merge}}) {
+        OutputFile script(path, OutputOrigin::Derived, OutputRule{{}, true, "mirage slurm"});
+        std::ofstream o(script.temp());
+        o << text;
+        closeChecked(o, path);
+        script.commit();
+    }
     fs::permissions(taskScript, fs::perms::owner_exec, fs::perm_options::add);
     fs::permissions(mergeScript, fs::perms::owner_exec, fs::perm_options::add);
 
@@ -223,10 +264,13 @@ const CommandRegistrar reg("slurm", [](CLI::App& parent) {
         ->check(wholeIn(1, 4096));
     cmd->add_option("--mem", a->memoryMb, "Memory per task in MB (default: estimated)")
         ->check(wholeIn(1, 1 << 24));
-    cmd->add_option("--time", a->timeLimit, "Time limit per task (Slurm format, e.g. 04:00:00)")
-        ->capture_default_str();
-    cmd->add_option("--partition", a->partition, "Slurm partition");
-    cmd->add_option("--account", a->account, "Slurm account");
+    cmd->add_option("--time", a->timeLimit,
+                    "Time limit per task (Slurm format: M, M:S, H:M:S, D-H, D-H:M or D-H:M:S, "
+                    "e.g. 04:00:00)")
+        ->capture_default_str()
+        ->check(slurmTime());
+    cmd->add_option("--partition", a->partition, "Slurm partition")->check(slurmName());
+    cmd->add_option("--account", a->account, "Slurm account")->check(slurmName());
     cmd->add_option("--sbatch", a->sbatch, "The sbatch program")->capture_default_str();
     cmd->add_option("--mirage", a->mirage,
                     "The mirage binary the tasks run (default: this one; must be visible on "

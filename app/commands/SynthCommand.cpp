@@ -14,12 +14,15 @@
 #include "app/Command.h"
 #include "app/InputChecks.h"
 #include "app/NumberChecks.h"
+#include "app/PathChecks.h"
+#include "app/ShardOptions.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
 #include "core/Shards.h"
 #include "core/scene/Scene.h"
+#include "render/raytrace/SyntheticFootage.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tracking/Board.h"
 
@@ -125,7 +128,7 @@ void run(SynthArgs a) {
     const ShardSpec shard = a.shard.empty() ? ShardSpec{} : parseShardSpec(a.shard);
     const ItemRange range = a.frames.empty() ? ItemRange{} : parseItemRange(a.frames);
     const int total = raytrace::syntheticFrameCount(a.o);
-    const std::vector<int> selected = selectItems(total, range, shard);
+    const std::vector<int> selected = selectItems(total, range, shard, "--frames", "frames");
     if (!shard.whole() || int(selected.size()) != total) {
         writeShard(a, scene, shard, range, total, selected);
         return;
@@ -156,7 +159,9 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
     auto a = std::make_shared<SynthArgs>();
     cmd->add_option("scene", a->scene, "Scene (.gltf/.glb) with REAL nodes, a board plane, lights")
         ->required();
-    cmd->add_option("-o,--output", a->output, "Session folder to create")->required();
+    cmd->add_option("-o,--output", a->output, "Session folder to create")
+        ->required()
+        ->check(outputPath(OutputShape::Folder));
     cmd->add_option("--board", a->board,
                     "Board file the scene shows (default: board.json beside the scene)");
     cmd->add_option("--width", a->o.width, "Main camera width (pixels)")
@@ -167,7 +172,7 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
         ->check(wholeIn(1, 16384));
     cmd->add_option("--hfov", a->o.hfovDeg, "Main camera horizontal field of view (degrees)")
         ->capture_default_str()
-        ->check(finiteIn(0, 179, true));
+        ->check(finiteIn(raytrace::kPinholeHfovDeg));
     cmd->add_option("--fps", a->o.fps, "Frame rate")
         ->capture_default_str()
         ->check(finiteIn(0, 1000, true));
@@ -178,7 +183,8 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
         ->capture_default_str()
         ->check(wholeIn(1, 1 << 20));
     cmd->add_option("--seed", a->o.seed, "Random seed (render noise, sensor noise, shake)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(0, kMaxSeed));
     cmd->add_option("--threads", a->o.threads, "Worker threads (0 = all cores)")
         ->capture_default_str()
         ->check(wholeIn(0, 4096));
@@ -220,7 +226,7 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
         ->check(wholeIn(16, 8192));
     cmd->add_option("--env-fov", a->o.envFovDeg, "Fish-eye field of view (degrees)")
         ->capture_default_str()
-        ->check(finiteIn(0, 360, true));
+        ->check(finiteIn(raytrace::kFisheyeFovDeg));
     cmd->add_option("--env-exposure", a->o.envExposure,
                     "Environment camera's exposure (multiplies the linear radiance it films)")
         ->capture_default_str()
@@ -245,10 +251,12 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
         ->check(finiteIn(0, 1e6));
     cmd->add_option("--shard", a->shard,
                     "Render part I of N (I/N, 0-based: every N-th frame from frame I) into "
-                    "OUT.shards/; join the parts with `mirage merge OUT` (docs/scale.md)");
+                    "OUT.shards/; join the parts with `mirage merge OUT` (docs/scale.md)")
+        ->check(shardSpecCheck());
     cmd->add_option("--frames", a->frames,
                     "Render only frames A to B-1 (A:B), as a shard; with --shard, the part of "
-                    "that range");
+                    "that range")
+        ->check(itemRangeCheck("--frames"));
     cmd->add_flag("--force", a->force,
                   "Replace an existing session in the output folder (or an existing shard)");
     cmd->callback([a] { run(*a); });

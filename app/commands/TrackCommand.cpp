@@ -9,6 +9,7 @@
 
 #include "app/Command.h"
 #include "app/NumberChecks.h"
+#include "app/PathChecks.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
@@ -323,7 +324,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_option("--calib", a->calib, "OpenCV calibration YAML (overrides the session's)");
     cmd->add_option("--board", a->board, "Board file (overrides the session's)");
     cmd->add_option("--camera", a->camera, "Session camera to track")->capture_default_str();
-    cmd->add_option("-o,--output", a->output, "POSES.csv")->required();
+    cmd->add_option("-o,--output", a->output, "POSES.csv (or /dev/stdout, a FIFO: written through)")
+        ->required()
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--fps", a->fps, "Frame rate for sources without timestamps")
         ->capture_default_str()
         ->check(finiteIn(0, 1e6, true));
@@ -335,7 +338,8 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
         ->capture_default_str();
     cmd->add_option("--envmap", a->envmap,
                     "Also build an environment map from the session's fish-eye camera "
-                    "(.exr/.pfm/.hdr linear; validity mask beside it as <name>_valid.png)");
+                    "(.exr/.pfm/.hdr linear; validity mask beside it as <name>_valid.png)")
+        ->check(outputPath(OutputShape::File));
     cmd->add_option("--env-camera", a->envCamera,
                     "Session camera for --envmap (default: the "
                     "one with role environment)");

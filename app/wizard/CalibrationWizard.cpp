@@ -20,6 +20,7 @@
 #include "calibration/Undistorter.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/capture/V4l2Camera.h"
 #include "core/gl/Context.h"
@@ -128,7 +129,11 @@ void saveCalibrationFile(const WizardOptions& o, const calib::CalibrationSession
         return;
     }
     const auto cal = calib::calibrationForFile(*s.result());
-    saveCalibration(o.output, cal);
+    // Through core/OutputFile.h like every output: never over an input or a special file.
+    OutputFile out(o.output, OutputOrigin::Named,
+                   OutputRule{{o.inputs.begin(), o.inputs.end()}, true, "mirage calibrate"});
+    saveCalibration(out.temp(), cal);
+    out.commit();
     status = cal.reliable ? "saved " + o.output
                           : "saved " + o.output + " marked UNRELIABLE: " + cal.unreliableReason;
     exitCode = cal.reliable ? 0 : 2;

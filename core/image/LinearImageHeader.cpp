@@ -287,8 +287,55 @@ LinearImageHeader screenHdr(const std::filesystem::path& path, std::string_view 
 
 }  // namespace
 
+std::string encodedImageSizeProblem(std::string_view bytes) {
+    auto u8 = [&](size_t i) { return int64_t(static_cast<unsigned char>(bytes[i])); };
+    int64_t width = 0, height = 0;
+    const char* kind = "";
+    if (bytes.size() >= 24 && bytes.substr(0, 8) == std::string_view("\x89PNG\r\n\x1a\n", 8) &&
+        bytes.substr(12, 4) == "IHDR") {
+        width = (u8(16) << 24) | (u8(17) << 16) | (u8(18) << 8) | u8(19);
+        height = (u8(20) << 24) | (u8(21) << 16) | (u8(22) << 8) | u8(23);
+        kind = "PNG";
+    } else if (bytes.size() >= 4 && u8(0) == 0xFF && u8(1) == 0xD8) {
+        // Walk the marker segments to the first start-of-frame (SOF0..SOF15 but DHT, JPG, DAC).
+        size_t p = 2;
+        while (p + 4 <= bytes.size()) {
+            if (u8(p) != 0xFF) return "";
+            const int64_t marker = u8(p + 1);
+            if (marker == 0xFF) {
+                ++p;
+                continue;
+            }
+            if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {
+                p += 2;
+                continue;
+            }
+            const size_t length = size_t((u8(p + 2) << 8) | u8(p + 3));
+            if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
+                marker != 0xCC) {
+                if (p + 9 > bytes.size()) return "";
+                height = (u8(p + 5) << 8) | u8(p + 6);
+                width = (u8(p + 7) << 8) | u8(p + 8);
+                kind = "JPEG";
+                break;
+            }
+            p += 2 + length;
+        }
+    }
+    if (!*kind) return "";
+    if (width > kMaxLinearImageSide || height > kMaxLinearImageSide ||
+        width * height > kMaxEncodedImagePixels)
+        return std::string(kind) + " image of " + std::to_string(width) + " x " +
+               std::to_string(height) + " pixels: too large to read; at most " +
+               std::to_string(kMaxEncodedImagePixels) + " pixels (e.g. 8192 x 8192) and " +
+               std::to_string(kMaxLinearImageSide) + " per side are read (scale it down)";
+    return "";
+}
+
 LinearImageHeader screenLinearImageHeader(const std::filesystem::path& path,
                                           std::string_view bytes) {
+    if (const std::string problem = encodedImageSizeProblem(bytes); !problem.empty())
+        throw FileError(path.string(), problem);
     if (bytes.size() >= 4 && std::memcmp(bytes.data(), kExrMagic.data(), 4) == 0)
         return screenExr(path, bytes);
     if (bytes.size() >= 3 && bytes[0] == 'P' && (bytes[1] == 'F' || bytes[1] == 'f') &&

@@ -1,5 +1,7 @@
 #include "core/image/StrictJpeg.h"
 
+#include "core/image/LinearImageHeader.h"
+
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
@@ -93,6 +95,9 @@ cv::Mat readImageStrict(const std::filesystem::path& path, std::string* problem)
     if (!in) return fail("cannot open the file");
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     auto data = [&] { return reinterpret_cast<const uint8_t*>(bytes.data()); };
+    // The size from the header first: the decoders allocate whatever it asks for.
+    if (const std::string tooLarge = encodedImageSizeProblem(bytes); !tooLarge.empty())
+        return fail(tooLarge);
     if (bytes.size() >= 3 && std::memcmp(bytes.data(), "\xFF\xD8\xFF", 3) == 0)
         return decodeJpegStrict(data(), bytes.size(), problem);
     static const char kPngMagic[] = "\x89PNG\r\n\x1a\n";

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "core/Error.h"
+#include "core/OutputFile.h"
 #include "core/image/StrictJpeg.h"
 #include "core/session/FrameInventory.h"
 #include "core/session/MatroskaScanner.h"
@@ -324,8 +325,10 @@ std::map<int, std::filesystem::path> listImageFrames(const std::filesystem::path
     std::error_code ec;
     for (const auto& e : std::filesystem::directory_iterator(folder, ec))
         // Skip temporary files of atomic writes ("000012.png.tmp.png" has a .png extension
-        // but its stem does not end in a number).
-        if (e.is_regular_file() && isImageFile(e.path())) files.push_back(e.path());
+        // but its stem does not end in a number) and of outputs being written
+        // ("out.partial-123.png", core/OutputFile.h): never read a command's own partial output.
+        if (e.is_regular_file() && isImageFile(e.path()) && !isPartialOutputName(e.path()))
+            files.push_back(e.path());
     if (ec) throw FileError(folder.string(), "cannot list image folder: " + ec.message());
     std::sort(files.begin(), files.end());
     std::map<int, std::filesystem::path> byNumber;

@@ -82,10 +82,9 @@ Pose cameraPathPose(const CameraPathOptions& o, double t) {
 }
 
 CameraIntrinsics pinholeFromHorizontalFov(int width, int height, double hfovDeg) {
-    if (width <= 0 || height <= 0 || !(hfovDeg > 1 && hfovDeg < 179))
-        throw Error(
-            "pinhole camera: size must be positive and the horizontal field of view in (1, 179) "
-            "degrees");
+    if (width <= 0 || height <= 0 || !kPinholeHfovDeg.contains(hfovDeg))
+        throw Error("pinhole camera: size must be positive and the horizontal field of view in " +
+                    kPinholeHfovDeg.text() + " degrees");
     CameraIntrinsics k;
     k.width = width;
     k.height = height;
@@ -98,9 +97,9 @@ CameraIntrinsics pinholeFromHorizontalFov(int width, int height, double hfovDeg)
 }
 
 CameraIntrinsics equidistantFisheye(int size, double fovDeg) {
-    if (size <= 0 || !(fovDeg > 10 && fovDeg <= 200))
-        throw Error(
-            "fish-eye camera: size must be positive and the field of view in (10, 200] degrees");
+    if (size <= 0 || !kFisheyeFovDeg.contains(fovDeg))
+        throw Error("fish-eye camera: size must be positive and the field of view in " +
+                    kFisheyeFovDeg.text() + " degrees");
     CameraIntrinsics k;
     k.width = k.height = size;
     k.fx = k.fy = 0.5 * size / (0.5 * fovDeg * kDeg);

@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/NumberRange.h"
 #include "core/camera/CameraModel.h"
 #include "core/math/Pose.h"
 
@@ -33,6 +34,12 @@ struct CameraPathOptions {
 Pose cameraPathPose(const CameraPathOptions& o, double t);
 // "orbit", "shake" or "pan".
 std::string cameraPathSegment(const CameraPathOptions& o, double t);
+
+// Fields of view the synthetic cameras can be made with (degrees): a pinhole's projection
+// degenerates towards 180 degrees; the equidistant fish-eye is kept below 200 (its image circle
+// would fold back). `mirage synth` checks --hfov and --env-fov against the same ranges.
+inline constexpr NumberRange kPinholeHfovDeg{1, 179, true, true};
+inline constexpr NumberRange kFisheyeFovDeg{10, 200, true, false};
 
 // Undistorted pinhole with square pixels and the principal point at the image centre.
 CameraIntrinsics pinholeFromHorizontalFov(int width, int height, double hfovDeg);

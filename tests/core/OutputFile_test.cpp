@@ -1,7 +1,13 @@
 // Output safety (core/OutputFile.h): an output is never an input, an unnamed existing file is
 // never replaced without --force, and a failed write leaves the previous file as it was.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
+#include <thread>
 
 #include <fstream>
 
@@ -116,6 +122,109 @@ TEST(OutputFile, DiskFullIsReportedNotSwallowed) {
     for (int i = 0; i < 100000; ++i) s << "frame,t,state\n";  // more than the stream's buffer
     const std::string e = errorOf([&] { closeChecked(s, "/dev/full"); });
     EXPECT_NE(e.find("disk full"), std::string::npos) << e;
+}
+
+TEST(OutputFile, ADeviceOrSocketIsRefusedNeverReplaced) {
+    for (const char* dev : {"/dev/null", "/dev/full"}) {
+        const std::string e = errorOf([&] {
+            OutputFile f(dev, OutputOrigin::Named, OutputRule{{}, true, "test"});
+        });
+        EXPECT_NE(e.find("is a character device"), std::string::npos) << e;
+        EXPECT_TRUE(fs::is_character_file(dev));
+    }
+    const fs::path dir = test::outputDir("output_file_device");
+    writeText(dir / "file", "x");
+    // A file where a folder is meant, a FIFO where a folder is meant.
+    EXPECT_NE(errorOf([&] { outputTarget(dir / "file", "test", true); }).find("is a file"),
+              std::string::npos);
+    ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0644), 0);
+    EXPECT_NE(errorOf([&] { outputTarget(dir / "fifo", "test", true); }).find("FIFO"),
+              std::string::npos);
+    EXPECT_EQ(outputTarget(dir / "fifo", "test"), OutputTarget::WriteThrough);
+    EXPECT_EQ(outputTarget(dir / "new", "test"), OutputTarget::New);
+    EXPECT_EQ(outputTarget(dir / "file", "test"), OutputTarget::RegularFile);
+    EXPECT_EQ(outputTarget(dir, "test", true), OutputTarget::Folder);
+}
+
+TEST(OutputFile, AFifoIsWrittenThroughAndStaysAFifo) {
+    const fs::path dir = test::outputDir("output_file_fifo");
+    const fs::path fifo = dir / "out.csv";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+    std::string received;
+    std::thread reader([&] {
+        std::ifstream in(fifo, std::ios::binary);
+        received.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    });
+    {
+        OutputFile out(fifo, OutputOrigin::Named, OutputRule{{}, false, "test"});
+        EXPECT_TRUE(out.writesThrough());
+        EXPECT_NE(out.temp().parent_path(), dir) << "no temporary beside a FIFO";
+        writeText(out.temp(), "frame,t\n0,0\n");
+        out.commit();
+        EXPECT_FALSE(fs::exists(out.temp()));
+    }
+    reader.join();
+    EXPECT_EQ(received, "frame,t\n0,0\n");
+    EXPECT_TRUE(fs::is_fifo(fifo));
+}
+
+TEST(OutputFile, StandardOutputRedirectedToAFileIsAppendedNotReplaced) {
+    // /proc/self/fd/N reaches the file a shell redirected: renaming over the link would leave
+    // the file untouched and replace the link; the bytes must go into the file.
+    const fs::path dir = test::outputDir("output_file_fd");
+    writeText(dir / "redirected.csv", "before\n");
+    const int fd = ::open((dir / "redirected.csv").c_str(), O_WRONLY | O_APPEND);
+    ASSERT_GE(fd, 0);
+    const fs::path link = "/proc/self/fd/" + std::to_string(fd);
+    {
+        OutputFile out(link, OutputOrigin::Named, OutputRule{{}, false, "test"});
+        EXPECT_TRUE(out.writesThrough());
+        writeText(out.temp(), "after\n");
+        out.commit();
+    }
+    ::close(fd);
+    EXPECT_EQ(readFileBytes(dir / "redirected.csv"), "before\nafter\n");
+}
+
+TEST(OutputFile, ASignalRemovesTheTemporaries) {
+    const fs::path dir = test::outputDir("output_file_signal");
+    for (int sig : {SIGINT, SIGTERM}) {
+        const pid_t pid = ::fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            std::signal(sig, SIG_DFL);
+            OutputFile f(dir / "image.png", OutputOrigin::Named, OutputRule{});
+            writeText(f.temp(), "half an image");
+            StagedPath staged(dir / "session");
+            fs::create_directories(staged.temp() / "frames");
+            writeText(staged.temp() / "frames" / "000001.png", "x");
+            ::raise(sig);
+            ::_exit(0);  // not reached: the signal ends the process
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "status " << status;
+        for (const auto& e : fs::directory_iterator(dir))
+            ADD_FAILURE() << "left behind: " << e.path();
+    }
+}
+
+TEST(OutputFile, TemporariesOfADeadProcessAreRemovedByTheNextWriter) {
+    const fs::path dir = test::outputDir("output_file_stale");
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) ::_exit(0);
+    ::waitpid(pid, nullptr, 0);  // `pid` now names no process
+    const std::string stale = "image.partial-" + std::to_string(pid) + ".png";
+    writeText(dir / stale, "left by kill -9");
+    writeText(dir / "image.partial-1.png", "pid 1 runs: not ours to remove");
+    writeText(dir / "other.partial-" + std::to_string(pid) + ".png", "another output's");
+    OutputFile f(dir / "image.png", OutputOrigin::Named, OutputRule{});
+    EXPECT_FALSE(fs::exists(dir / stale));
+    EXPECT_TRUE(fs::exists(dir / "image.partial-1.png"));
+    EXPECT_TRUE(fs::exists(dir / ("other.partial-" + std::to_string(pid) + ".png")));
+    EXPECT_TRUE(isPartialOutputName(dir / stale));
+    EXPECT_FALSE(isPartialOutputName(dir / "image.png"));
 }
 
 }  // namespace

@@ -169,5 +169,59 @@ TEST(Shards, RerunCommandReplacesTheShardOnly) {
     EXPECT_NE(fingerprint64("a"), fingerprint64("b"));
 }
 
+// The manifest lists the shard's files: a deleted CSV row, a changed or swapped image, a missing
+// file or one the shard did not write is named with the shard and the frame.
+TEST(Shards, ManifestCatchesDamagedFiles) {
+    const fs::path out = test::outputDir("shards_files") / "out";
+    auto build = [&] {
+        fs::remove_all(shardsFolder(out));
+        for (int i : {0, 1}) {
+            const ShardManifest m = manifest(i, 2, 4);
+            const fs::path dir = shardFolder(out, m.shard);
+            fs::create_directories(dir / "main");
+            std::ofstream csv(dir / "frames.csv");
+            csv << "frame,t\n";
+            for (int item : m.items) {
+                csv << item << "," << item * 0.25 << "\n";
+                std::ofstream(dir / "main" / (std::to_string(100000 + item).substr(1) + ".png"))
+                    << "pixels of frame " << item;
+            }
+            csv.close();
+            writeShardManifest(dir, m);
+        }
+    };
+    auto errorOf = [&] {
+        try {
+            collectShards(out);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    build();
+    EXPECT_EQ(errorOf(), "");
+    // A deleted row.
+    std::ofstream(shardFolder(out, {1, 2}) / "frames.csv") << "frame,t\n3,0.75\n";
+    std::string e = errorOf();
+    EXPECT_NE(e.find("1-of-2"), std::string::npos) << e;
+    EXPECT_NE(e.find("row of frame 1 was deleted"), std::string::npos) << e;
+    // A frame swapped in from the other shard.
+    build();
+    fs::copy_file(shardFolder(out, {1, 2}) / "main" / "00001.png",
+                  shardFolder(out, {0, 2}) / "main" / "00000.png",
+                  fs::copy_options::overwrite_existing);
+    e = errorOf();
+    EXPECT_NE(e.find("0-of-2"), std::string::npos) << e;
+    EXPECT_NE(e.find("(frame 0)"), std::string::npos) << e;
+    // A missing file, and an extra one.
+    build();
+    fs::remove(shardFolder(out, {0, 2}) / "main" / "00002.png");
+    EXPECT_NE(errorOf().find("missing (frame 2)"), std::string::npos) << errorOf();
+    build();
+    fs::copy_file(shardFolder(out, {1, 2}) / "main" / "00003.png",
+                  shardFolder(out, {0, 2}) / "main" / "00003.png");
+    EXPECT_NE(errorOf().find("did not write (frame 3)"), std::string::npos) << errorOf();
+}
+
 }  // namespace
 }  // namespace mirage
