@@ -66,6 +66,8 @@
 #include "core/session/Session.h"
 #include "render/LightEstimation.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::app {
@@ -118,12 +120,12 @@ struct BufferView {
     std::optional<render::Resource> resource;  // nullopt: the composite
 };
 const BufferView kViews[] = {{"composite", std::nullopt},
-                             {"L_rv (real + virtual)", render::Resource::LRv},
-                             {"L_r (real only)", render::Resource::LR},
-                             {"direct L_rv", render::Resource::DirectRv},
-                             {"direct L_r", render::Resource::DirectR},
-                             {"G-buffer albedo", render::Resource::GBufferAlbedo},
-                             {"G-buffer normal", render::Resource::GBufferNormal}};
+                             {"L_rv (real + virtual)", render::kLRv},
+                             {"L_r (real only)", render::kLR},
+                             {"direct L_rv", render::kDirectRv},
+                             {"direct L_r", render::kDirectR},
+                             {"G-buffer albedo", render::kGBufferAlbedo},
+                             {"G-buffer normal", render::kGBufferNormal}};
 constexpr int kViewCount = int(sizeof kViews / sizeof kViews[0]);
 
 // A linear RGB float buffer (top row first) shown as sRGB 8-bit BGR.
