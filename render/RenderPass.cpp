@@ -1,5 +1,6 @@
 #include "render/RenderPass.h"
 
+#include "render/FrameGraph.h"
 #include "render/Shaders.h"
 
 namespace mirage::render {
@@ -25,20 +26,63 @@ gl::Program computeProgram(std::string_view label, std::string_view computePath,
         defines);
 }
 
-void PassBuilder::write(Resource r, GLenum format, SizeRule size, bool persistent) {
-    writes_.push_back({r, false, format, size, persistent});
+void TargetFramebuffer::bind(std::initializer_list<const gl::Texture*> colors) {
+    std::vector<GLuint> ids;
+    for (const gl::Texture* t : colors) ids.push_back(t->id());
+    if (ids != ids_) {
+        fbo_ = gl::Framebuffer(label_);
+        int i = 0;
+        for (const gl::Texture* t : colors) fbo_.attachColor(i++, *t);
+        fbo_.finalize(i);
+        ids_ = std::move(ids);
+    }
+    fbo_.bind();
 }
 
-void PassBuilder::writeBuffer(Resource r, SizeRule size, bool persistent) {
-    writes_.push_back({r, true, 0, size, persistent});
+int PassBuilder::newestVersion(Resource r) const {
+    int v = graph_ ? graph_->newestVersion(r) : -1;
+    for (const ResourceWrite& w : writes_)
+        if (w.id == r) v = w.modifies ? v + 1 : 0;
+    return v;
 }
 
-void PassBuilder::read(Resource r) {
-    reads_.push_back({r, false});
+TextureHandle PassBuilder::create(Resource r, TextureDesc desc) {
+    writes_.push_back({r, false, desc, false, 0});
+    return {r, graph_ ? 0 : -1};
 }
 
-void PassBuilder::readOptional(Resource r) {
-    reads_.push_back({r, true});
+void PassBuilder::createBuffer(Resource r, SizeRule size, bool persistent) {
+    writes_.push_back(
+        {r, true, {0, size, persistent ? Storage::Persistent : Storage::PassOwned}, false, 0});
+}
+
+TextureHandle PassBuilder::modify(Resource r, TextureDesc desc) {
+    const int v = newestVersion(r);
+    reads_.push_back({r, false, v});
+    writes_.push_back({r, false, desc, true, v + 1});
+    return {r, graph_ && v >= 0 ? v + 1 : -1};
+}
+
+TextureHandle PassBuilder::modifyOptional(Resource r, TextureDesc desc) {
+    const int v = newestVersion(r);
+    reads_.push_back({r, true, v});
+    writes_.push_back({r, false, desc, true, v + 1});
+    return {r, graph_ && v >= 0 ? v + 1 : -1};
+}
+
+TextureHandle PassBuilder::read(Resource r) {
+    reads_.push_back({r, false, -1});
+    return {r, newestVersion(r)};
+}
+
+TextureHandle PassBuilder::readOptional(Resource r) {
+    reads_.push_back({r, true, -1});
+    return {r, newestVersion(r)};
+}
+
+TextureHandle PassBuilder::read(TextureHandle h) {
+    reads_.push_back({h.resource, false, h.version});
+    return h;
 }
 
 }  // namespace mirage::render

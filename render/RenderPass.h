@@ -4,6 +4,7 @@
 // allocates its targets in resize(), and records GL work in execute() without allocating,
 // getting other passes' textures only by name from its PassResources view. Shaders live beside
 // the pass (render/passes/<pass>/) and are embedded at build time.
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,6 +27,21 @@ gl::Program rasterProgram(std::string_view label, std::string_view vertexPath,
 gl::Program computeProgram(std::string_view label, std::string_view computePath,
                            std::string_view defines = {});
 
+// A framebuffer over textures the graph allocates (Storage::Transient): made again only when the
+// graph hands the pass other textures than the last time (it keeps an assignment while the
+// frame's passes and sizes stay the same).
+class TargetFramebuffer {
+public:
+    explicit TargetFramebuffer(std::string label) : label_(std::move(label)) {}
+    // Binds the framebuffer with `colors` as colour attachments 0, 1, ...
+    void bind(std::initializer_list<const gl::Texture*> colors);
+
+private:
+    std::string label_;
+    std::vector<GLuint> ids_;
+    gl::Framebuffer fbo_;
+};
+
 struct PassDecision {
     bool run = true;
     std::string reason;  // e.g. "2 lights have casters in their cone" / "no virtual object lit"
@@ -35,32 +51,55 @@ struct PassDecision {
 struct ResourceWrite {
     Resource id;
     bool buffer = false;
-    GLenum format = 0;  // GL internal format (textures)
-    SizeRule size = SizeRule::Canvas;
-    bool persistent = false;  // kept across frames by its pass (history, impostors)
+    TextureDesc desc;       // textures: format, size rule, storage (buffers: format 0)
+    bool modifies = false;  // a new version of a resource an earlier pass created
+    int version = 0;        // set by the graph: 0 for a create, the previous version + 1
+    bool persistent() const { return desc.storage == Storage::Persistent; }
 };
 struct ResourceRead {
     Resource id;
     bool optional = false;
+    int version = -1;  // the version read: the newest at this pass (set by the graph), or the
+                       // version of the handle the pass named (checked to be the newest)
 };
 
-// Collects a pass's declarations (FrameGraph::addPass calls RenderPass::setup with it).
+class FrameGraph;
+
+// Collects a pass's declarations (FrameGraph::addPass calls RenderPass::setup with it) and
+// returns handles to the versions they name (after google/filament's FrameGraph::Builder).
 class PassBuilder {
 public:
-    // A texture the pass writes (allocates and publishes), with its GL internal format and size
-    // rule. persistent: the pass keeps it across frames (temporal history, impostors).
-    void write(Resource r, GLenum format, SizeRule size, bool persistent = false);
-    void writeBuffer(Resource r, SizeRule size, bool persistent = false);
-    // A resource the pass reads: required (the pass is skipped when no pass writes it this
-    // frame) or optional (the pass checks PassResources::has and falls back).
-    void read(Resource r);
-    void readOptional(Resource r);
+    // A builder that only records (its handles name no version): to inspect a pass's setup.
+    PassBuilder() = default;
+
+    // A texture the pass creates (version 0), with its descriptor: the graph allocates a
+    // Storage::Transient one (PassResources::target), the pass allocates and publishes the rest.
+    TextureHandle create(Resource r, TextureDesc desc);
+    // A buffer the pass creates and publishes. persistent: kept across frames by the pass.
+    void createBuffer(Resource r, SizeRule size, bool persistent = false);
+    // A new version of a texture an earlier pass created: the pass reads the newest version
+    // (required, or optional: when no earlier version exists this frame the pass makes the
+    // resource from scratch) and writes the next one, with its own descriptor (a filter cannot
+    // write in place, so a version may live in another texture). Readers declared after this
+    // pass read the new version; when this pass is skipped, they read the previous one.
+    TextureHandle modify(Resource r, TextureDesc desc);
+    TextureHandle modifyOptional(Resource r, TextureDesc desc);
+    // A resource the pass reads, at its newest version: required (the pass is skipped when no
+    // pass writes it this frame) or optional (the pass checks PassResources::has and falls back).
+    TextureHandle read(Resource r);
+    TextureHandle readOptional(Resource r);
+    // A read of the version `h` names: the graph refuses it (mirage::Error at addPass) unless it
+    // is still the newest version, i.e. no pass modified the resource since `h` was returned.
+    TextureHandle read(TextureHandle h);
 
     const std::vector<ResourceWrite>& writes() const { return writes_; }
     const std::vector<ResourceRead>& reads() const { return reads_; }
 
 private:
     friend class FrameGraph;
+    explicit PassBuilder(const FrameGraph* g) : graph_(g) {}
+    int newestVersion(Resource r) const;
+    const FrameGraph* graph_ = nullptr;
     std::vector<ResourceWrite> writes_;
     std::vector<ResourceRead> reads_;
 };

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
+#include "render/FrameImports.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
@@ -142,6 +143,129 @@ glm::vec3 anyPerpendicular(const glm::vec3& d) {
     return std::abs(d.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
 }
 
+// A spot light whose cone holds a mirror or glass object gets photon G-buffers (caustics on):
+// their layer, the frustum fitted to the objects' bounding sphere, and the plan's peak
+// irradiance.
+void planCaustics(const SceneLight& l, const GpuScene& s, bool causticsOn, LightPlan& lp,
+                  FramePlan& plan) {
+    BoundingSphere specBounds;
+    bool specularInCone = false;
+    for (int di : s.specularDraws()) {
+        const BoundingSphere& b = s.draws()[size_t(di)].bounds;
+        if (!inLightCone(l, b)) continue;
+        specBounds = specularInCone ? mergeSpheres(specBounds, b) : b;
+        specularInCone = true;
+    }
+    if (l.type == kLightSpot && specularInCone && causticsOn) {
+        lp.caustics = true;
+        lp.causticLayer = plan.causticLayers++;
+        const float d = glm::length(specBounds.center - l.position);
+        const float radius = std::max(specBounds.radius * 1.02f, 1e-4f);
+        const float peak = luminance(l.radiantIntensity);
+        if (d > radius) {
+            // Fitted to the objects: every texel falls on (or near) them.
+            const float half = std::asin(std::min(radius / d, 0.999f));
+            const glm::vec3 axis = (specBounds.center - l.position) / d;
+            lp.causticTanHalf = std::tan(half);
+            lp.causticViewProj =
+                glm::perspective(2.0f * half, 1.0f, std::max((d - radius) * 0.5f, 1e-3f),
+                                 d + radius * 1.5f) *
+                glm::lookAt(l.position, specBounds.center, anyPerpendicular(axis));
+            plan.causticIrradiance =
+                std::max(plan.causticIrradiance, peak / std::max(d * d, 1e-4f));
+        } else {
+            // The light inside the objects' bounds: the spot's own frustum.
+            const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
+            lp.causticTanHalf = std::tan(half);
+            lp.causticViewProj =
+                glm::perspective(2.0f * half, 1.0f, 1e-3f, 2.0f * radius + 1e-2f) *
+                glm::lookAt(l.position, l.position + l.direction, anyPerpendicular(l.direction));
+            plan.causticIrradiance =
+                std::max(plan.causticIrradiance, peak / std::max(radius * radius * 0.01f, 1e-4f));
+        }
+    }
+}
+
+// The light's shadow-map matrices (spot: its cone; point: six cube faces; directional: an
+// orthographic box around the scene's bounds B of radius R) into its GpuLight, and its layers.
+void shadowMatrices(const SceneLight& l, const BoundingSphere& B, float R, GpuLight& g,
+                    LightPlan& lp) {
+    g.position = l.position;
+    g.range = l.range;
+    g.direction = l.direction;
+    g.type = l.type;
+    const float scale = 1.0f / std::max(0.001f, l.cosInner - l.cosOuter);
+    g.cosOuter = l.cosOuter;
+    g.cosInner = l.cosInner;
+    g.coneScale = scale;
+    g.coneOffset = -l.cosOuter * scale;
+    g.radiantIntensity = l.radiantIntensity;
+    g.frustumSize = 1.0f;
+    const float farL = glm::length(B.center - l.position) + R + 0.1f;
+    const float nearL = std::clamp(farL * 1e-4f, 0.005f, 0.05f);
+    if (l.type == kLightSpot) {
+        const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
+        g.frustumSize = std::tan(half);
+        g.viewProj[0] =
+            glm::perspective(2.0f * half, 1.0f, nearL, farL) *
+            glm::lookAt(l.position, l.position + l.direction, anyPerpendicular(l.direction));
+        lp.layers = 1;
+    } else if (l.type == kLightPoint) {
+        const glm::vec3 dirs[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+        const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
+                                  {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+        g.frustumSize = 1.0f;
+        for (int f = 0; f < 6; ++f)
+            g.viewProj[f] = glm::perspective(glm::half_pi<float>(), 1.0f, nearL, farL) *
+                            glm::lookAt(l.position, l.position + dirs[f], ups[f]);
+        lp.layers = 6;
+    } else {
+        const glm::vec3 eye = B.center - l.direction * (2.0f * R + 1.0f);
+        g.position = eye;
+        g.range = 0.0f;
+        g.frustumSize = R;
+        g.viewProj[0] = glm::ortho(-R, R, -R, R, 0.0f, 4.0f * R + 2.0f) *
+                        glm::lookAt(eye, B.center, anyPerpendicular(l.direction));
+        lp.layers = 1;
+    }
+}
+
+// VPLs: needed when the virtual objects change the indirect light that can be seen; split over
+// the lights with shadow maps (each gets a reflective shadow map).
+void planVpls(const RendererOptions& o, bool anyCaster, bool anyReachesVirtual, bool virtualInView,
+              bool surfacePointsHaveVirtual, FramePlan& plan) {
+    if (o.vplCount <= 0) {
+        plan.vplReason = "VPL count is 0";
+    } else if (!anyCaster) {
+        plan.vplReason = "no light reaches any geometry";
+    } else if (!o.cullPasses) {
+        plan.needVpls = true;
+        plan.vplReason = "pass culling off";
+    } else if (anyReachesVirtual) {
+        plan.needVpls = true;
+        plan.vplReason = "a light reaches a virtual object";
+    } else if (virtualInView) {
+        plan.needVpls = true;
+        plan.vplReason = "a virtual object in view receives bounced light";
+    } else {
+        plan.vplReason = "no light reaches a virtual object and none is in view";
+    }
+    if (plan.needVpls) {
+        int withRsm = 0;
+        for (LightPlan& lp : plan.lights) withRsm += lp.castsShadow;
+        int first = 0, k = 0;
+        for (LightPlan& lp : plan.lights) {
+            if (!lp.castsShadow) continue;
+            lp.hasRsm = true;
+            lp.firstVpl = first;
+            lp.vplCount = ++k == withRsm ? o.vplCount - first : o.vplCount / withRsm;
+            first += lp.vplCount;
+        }
+        plan.needRealOnlyIsm = surfacePointsHaveVirtual;
+    }
+}
+
 }  // namespace
 
 Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererOptions options)
@@ -159,10 +283,9 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
 
     // The frame, in order. Passes know each other only through the resources they declare.
     FrameGraph& g = graph_;
-    g.importTexture(Resource::CameraImage, GL_SRGB8_ALPHA8, SizeRule::Camera, "camera frame");
-    g.importTexture(Resource::SceneEnvironmentMap, GL_RGBA16F, SizeRule::Scene,
-                    "scene environment");
-    g.importTexture(Resource::EnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene,
+    g.importTexture(kCameraImage, GL_SRGB8_ALPHA8, SizeRule::Camera, "camera frame");
+    g.importTexture(kSceneEnvironmentMap, GL_RGBA16F, SizeRule::Scene, "scene environment");
+    g.importTexture(kEnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene,
                     "environment camera frame");
     g.addPass(std::make_unique<EnvironmentPass>());
     g.addPass(std::make_unique<GBufferPass>(GBufferPass::MaterialMaps{
@@ -184,16 +307,16 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<FuzzyReflectionPass>());
     g.addPass(std::make_unique<RoughRefractionPass>());
     g.addPass(std::make_unique<CompositePass>());
-    g.markOutput(Resource::Composite);
-    g.markOutput(Resource::CompositeSrgb);
+    g.markOutput(kComposite);
+    g.markOutput(kCompositeSrgb);
     g.compile();
 
     cameraImage_ =
         gl::Texture::create2D("camera image", camera.width, camera.height, GL_SRGB8_ALPHA8);
     cameraImage_.setFilter(GL_NEAREST, GL_NEAREST);
     uploadCameraImage(cv::Mat());
-    g.setImport(Resource::CameraImage, cameraImage_);
-    g.setImport(Resource::SceneEnvironmentMap, scene_->environmentMap());
+    g.setImport(kCameraImage, cameraImage_);
+    g.setImport(kSceneEnvironmentMap, scene_->environmentMap());
     planFrame(FrameInput{});
     for (const FrameGraph::Node& n : g.nodes()) n.pass->resize(*ctx_);
 }
@@ -217,182 +340,13 @@ void Renderer::uploadCameraImage(const cv::Mat& bgr) {
     cameraImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
 }
 
-void Renderer::planFrame(const FrameInput& input) {
+// The frame's uniform blocks (GpuFrame, the lights) and its history rule.
+void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view,
+                                  const glm::mat4& proj) {
     FrameContext& c = *ctx_;
     const GpuScene& s = *scene_;
-    FramePlan plan;
-    const BoundingSphere& B = s.bounds();
-    const float R = std::max(B.radius, 0.01f);
-
-    // Camera.
-    c.T_world_camera = input.T_world_camera;
-    const glm::mat4 view(input.T_world_camera.inverse().matrix());
-    const glm::mat4 proj = projection_.projectionMatrix(options_.nearM, options_.farM);
     const glm::mat4 viewProj = proj * view;
     const glm::vec3 camPos(input.T_world_camera.translation);
-
-    bool virtualInView = false;
-    for (const DrawItem& d : s.draws())
-        if (d.origin == Origin::Virtual && inFrustum(viewProj, d.bounds)) virtualInView = true;
-
-    // Lights: matrices, caster tests, routing flags.
-    c.lightBlock = GpuLightBlock{};
-    int layer = 0;
-    bool anyReachesVirtual = false, anyCaster = false;
-    for (size_t i = 0; i < s.lights().size(); ++i) {
-        const SceneLight& l = s.lights()[i];
-        GpuLight& g = c.lightBlock.lights[i];
-        LightPlan lp;
-        bool real = false, virt = false, glassReal = false, glassVirtual = false,
-             translucentInCone = false;
-        for (const DrawItem& d : s.draws()) {
-            if (!inLightCone(l, d.bounds)) continue;
-            (d.origin == Origin::Real ? real : virt) = true;
-            if (d.transmissive) (d.origin == Origin::Real ? glassReal : glassVirtual) = true;
-            translucentInCone = translucentInCone || d.translucent;
-        }
-        lp.castsShadow = real || virt;
-        lp.reachesVirtual = virt;
-        lp.needsRealOnlyMap = lp.castsShadow && virt && real && l.origin == Origin::Real;
-        // Caustics: a spot light whose cone holds a mirror or glass object.
-        BoundingSphere specBounds;
-        bool specularInCone = false;
-        for (int di : s.specularDraws()) {
-            const BoundingSphere& b = s.draws()[size_t(di)].bounds;
-            if (!inLightCone(l, b)) continue;
-            specBounds = specularInCone ? mergeSpheres(specBounds, b) : b;
-            specularInCone = true;
-        }
-        if (l.type == kLightSpot && specularInCone && options_.caustics) {
-            lp.caustics = true;
-            lp.causticLayer = plan.causticLayers++;
-            const float d = glm::length(specBounds.center - l.position);
-            const float radius = std::max(specBounds.radius * 1.02f, 1e-4f);
-            const float peak = luminance(l.radiantIntensity);
-            if (d > radius) {
-                // Fitted to the objects: every texel falls on (or near) them.
-                const float half = std::asin(std::min(radius / d, 0.999f));
-                const glm::vec3 axis = (specBounds.center - l.position) / d;
-                lp.causticTanHalf = std::tan(half);
-                lp.causticViewProj =
-                    glm::perspective(2.0f * half, 1.0f, std::max((d - radius) * 0.5f, 1e-3f),
-                                     d + radius * 1.5f) *
-                    glm::lookAt(l.position, specBounds.center, anyPerpendicular(axis));
-                plan.causticIrradiance =
-                    std::max(plan.causticIrradiance, peak / std::max(d * d, 1e-4f));
-            } else {
-                // The light inside the objects' bounds: the spot's own frustum.
-                const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
-                lp.causticTanHalf = std::tan(half);
-                lp.causticViewProj =
-                    glm::perspective(2.0f * half, 1.0f, 1e-3f, 2.0f * radius + 1e-2f) *
-                    glm::lookAt(l.position, l.position + l.direction,
-                                anyPerpendicular(l.direction));
-                plan.causticIrradiance = std::max(plan.causticIrradiance,
-                                                  peak / std::max(radius * radius * 0.01f, 1e-4f));
-            }
-        }
-        lp.glassTransmits = options_.glassShadows && (glassReal || glassVirtual) && !lp.caustics;
-        lp.translucentTransmits = options_.translucentShadows && translucentInCone;
-        lp.needsRealOnlyGlass = lp.needsRealOnlyMap && lp.hasGlassLayer();
-        anyReachesVirtual = anyReachesVirtual || virt;
-        anyCaster = anyCaster || lp.castsShadow;
-
-        g.position = l.position;
-        g.range = l.range;
-        g.direction = l.direction;
-        g.type = l.type;
-        const float scale = 1.0f / std::max(0.001f, l.cosInner - l.cosOuter);
-        g.cosOuter = l.cosOuter;
-        g.cosInner = l.cosInner;
-        g.coneScale = scale;
-        g.coneOffset = -l.cosOuter * scale;
-        g.radiantIntensity = l.radiantIntensity;
-        g.frustumSize = 1.0f;
-        const float farL = glm::length(B.center - l.position) + R + 0.1f;
-        const float nearL = std::clamp(farL * 1e-4f, 0.005f, 0.05f);
-        if (l.type == kLightSpot) {
-            const float half = std::min(l.outerAngle * 1.02f + 0.01f, 1.48f);
-            g.frustumSize = std::tan(half);
-            g.viewProj[0] =
-                glm::perspective(2.0f * half, 1.0f, nearL, farL) *
-                glm::lookAt(l.position, l.position + l.direction, anyPerpendicular(l.direction));
-            lp.layers = 1;
-        } else if (l.type == kLightPoint) {
-            const glm::vec3 dirs[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                       {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-            const glm::vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
-                                      {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-            g.frustumSize = 1.0f;
-            for (int f = 0; f < 6; ++f)
-                g.viewProj[f] = glm::perspective(glm::half_pi<float>(), 1.0f, nearL, farL) *
-                                glm::lookAt(l.position, l.position + dirs[f], ups[f]);
-            lp.layers = 6;
-        } else {
-            const glm::vec3 eye = B.center - l.direction * (2.0f * R + 1.0f);
-            g.position = eye;
-            g.range = 0.0f;
-            g.frustumSize = R;
-            g.viewProj[0] = glm::ortho(-R, R, -R, R, 0.0f, 4.0f * R + 2.0f) *
-                            glm::lookAt(eye, B.center, anyPerpendicular(l.direction));
-            lp.layers = 1;
-        }
-        if (!lp.castsShadow) lp.layers = 0;
-        lp.firstLayer = layer;
-        layer += lp.layers;
-        g.firstShadowLayer = lp.firstLayer;
-        g.shadowLayers = lp.layers;
-        g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
-        g.isReal = l.origin == Origin::Real ? 1 : 0;
-        g.glassShadow = lp.hasGlassLayer() ? 1 : 0;
-        plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
-        plan.glassShadows = plan.glassShadows || lp.hasGlassLayer();
-        plan.needRealOnlyGlass = plan.needRealOnlyGlass || lp.needsRealOnlyGlass;
-        plan.lights.push_back(lp);
-    }
-    plan.shadowLayers = layer;
-    if (plan.causticLayers > 0) {
-        plan.causticReason = std::to_string(plan.causticLayers) +
-                             " spot light(s) with a mirror or glass object in the cone";
-    } else if (!options_.caustics) {
-        plan.causticReason = "caustics off";
-    } else {
-        plan.causticReason = "no spot light's cone holds a mirror or glass object";
-    }
-
-    // VPLs: needed when the virtual objects change the indirect light that can be seen.
-    if (options_.vplCount <= 0) {
-        plan.vplReason = "VPL count is 0";
-    } else if (!anyCaster) {
-        plan.vplReason = "no light reaches any geometry";
-    } else if (!options_.cullPasses) {
-        plan.needVpls = true;
-        plan.vplReason = "pass culling off";
-    } else if (anyReachesVirtual) {
-        plan.needVpls = true;
-        plan.vplReason = "a light reaches a virtual object";
-    } else if (virtualInView) {
-        plan.needVpls = true;
-        plan.vplReason = "a virtual object in view receives bounced light";
-    } else {
-        plan.vplReason = "no light reaches a virtual object and none is in view";
-    }
-    if (plan.needVpls) {
-        int withRsm = 0;
-        for (LightPlan& lp : plan.lights) withRsm += lp.castsShadow;
-        int first = 0, k = 0;
-        for (LightPlan& lp : plan.lights) {
-            if (!lp.castsShadow) continue;
-            lp.hasRsm = true;
-            lp.firstVpl = first;
-            lp.vplCount = ++k == withRsm ? options_.vplCount - first : options_.vplCount / withRsm;
-            first += lp.vplCount;
-        }
-        plan.needRealOnlyIsm = s.surfacePointsHaveVirtual();
-    }
-    c.plan = plan;
-
-    // Frame uniforms.
     GpuFrame& f = c.frame;
     f.viewMatrix = view;
     f.projMatrix = proj;
@@ -435,6 +389,80 @@ void Renderer::planFrame(const FrameInput& input) {
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
     prevViewProj_ = viewProj;
     prevCameraPos_ = camPos;
+}
+
+void Renderer::planFrame(const FrameInput& input) {
+    FrameContext& c = *ctx_;
+    const GpuScene& s = *scene_;
+    FramePlan plan;
+    const BoundingSphere& B = s.bounds();
+    const float R = std::max(B.radius, 0.01f);
+
+    // Camera.
+    c.T_world_camera = input.T_world_camera;
+    const glm::mat4 view(input.T_world_camera.inverse().matrix());
+    const glm::mat4 proj = projection_.projectionMatrix(options_.nearM, options_.farM);
+    const glm::mat4 viewProj = proj * view;
+
+    bool virtualInView = false;
+    for (const DrawItem& d : s.draws())
+        if (d.origin == Origin::Virtual && inFrustum(viewProj, d.bounds)) virtualInView = true;
+
+    // Lights: matrices, caster tests, routing flags.
+    c.lightBlock = GpuLightBlock{};
+    int layer = 0;
+    bool anyReachesVirtual = false, anyCaster = false;
+    for (size_t i = 0; i < s.lights().size(); ++i) {
+        const SceneLight& l = s.lights()[i];
+        GpuLight& g = c.lightBlock.lights[i];
+        LightPlan lp;
+        bool real = false, virt = false, glassReal = false, glassVirtual = false,
+             translucentInCone = false;
+        for (const DrawItem& d : s.draws()) {
+            if (!inLightCone(l, d.bounds)) continue;
+            (d.origin == Origin::Real ? real : virt) = true;
+            if (d.transmissive) (d.origin == Origin::Real ? glassReal : glassVirtual) = true;
+            translucentInCone = translucentInCone || d.translucent;
+        }
+        lp.castsShadow = real || virt;
+        lp.reachesVirtual = virt;
+        lp.needsRealOnlyMap = lp.castsShadow && virt && real && l.origin == Origin::Real;
+        planCaustics(l, s, options_.caustics, lp, plan);
+        lp.glassTransmits = options_.glassShadows && (glassReal || glassVirtual) && !lp.caustics;
+        lp.translucentTransmits = options_.translucentShadows && translucentInCone;
+        lp.needsRealOnlyGlass = lp.needsRealOnlyMap && lp.hasGlassLayer();
+        anyReachesVirtual = anyReachesVirtual || virt;
+        anyCaster = anyCaster || lp.castsShadow;
+
+        shadowMatrices(l, B, R, g, lp);
+        if (!lp.castsShadow) lp.layers = 0;
+        lp.firstLayer = layer;
+        layer += lp.layers;
+        g.firstShadowLayer = lp.firstLayer;
+        g.shadowLayers = lp.layers;
+        g.realOnlyMap = lp.needsRealOnlyMap ? 1 : 0;
+        g.isReal = l.origin == Origin::Real ? 1 : 0;
+        g.glassShadow = lp.hasGlassLayer() ? 1 : 0;
+        plan.needRealOnlyShadows = plan.needRealOnlyShadows || lp.needsRealOnlyMap;
+        plan.glassShadows = plan.glassShadows || lp.hasGlassLayer();
+        plan.needRealOnlyGlass = plan.needRealOnlyGlass || lp.needsRealOnlyGlass;
+        plan.lights.push_back(lp);
+    }
+    plan.shadowLayers = layer;
+    if (plan.causticLayers > 0) {
+        plan.causticReason = std::to_string(plan.causticLayers) +
+                             " spot light(s) with a mirror or glass object in the cone";
+    } else if (!options_.caustics) {
+        plan.causticReason = "caustics off";
+    } else {
+        plan.causticReason = "no spot light's cone holds a mirror or glass object";
+    }
+
+    planVpls(options_, anyCaster, anyReachesVirtual, virtualInView, s.surfacePointsHaveVirtual(),
+             plan);
+    c.plan = plan;
+
+    writeFrameUniforms(input, view, proj);
 }
 
 namespace {
@@ -502,7 +530,7 @@ void Renderer::setEnvironmentCamera(const EnvironmentCameraSetup& camera) {
     if (envImage_.width() != w || envImage_.height() != h) {
         envImage_ = gl::Texture::create2D("environment camera frame", w, h, GL_SRGB8_ALPHA8);
         envImage_.setFilter(GL_LINEAR, GL_LINEAR);
-        graph_.setImport(Resource::EnvironmentCamera, envImage_);
+        graph_.setImport(kEnvironmentCamera, envImage_);
     }
     EnvironmentInput& e = ctx_->environment;
     e.camera = camera.intrinsics;
@@ -595,11 +623,11 @@ std::vector<std::string> Renderer::passNames() const {
 }
 
 const gl::Texture& Renderer::compositeTexture() const {
-    return graph_.texture(Resource::CompositeSrgb);
+    return graph_.texture(kCompositeSrgb);
 }
 
 cv::Mat Renderer::compositeLinear() const {
-    const gl::Texture& t = graph_.texture(Resource::Composite);
+    const gl::Texture& t = graph_.texture(kComposite);
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     cv::Mat rgba(t.height(), t.width(), CV_32FC4, px.data()), rgb;
     cv::cvtColor(rgba, rgb, cv::COLOR_RGBA2RGB);
@@ -607,7 +635,7 @@ cv::Mat Renderer::compositeLinear() const {
 }
 
 cv::Mat Renderer::compositeSrgb() const {
-    const gl::Texture& t = graph_.texture(Resource::CompositeSrgb);
+    const gl::Texture& t = graph_.texture(kCompositeSrgb);
     auto px = t.read<unsigned char>(GL_RGBA, GL_UNSIGNED_BYTE, 4);
     cv::Mat rgba(t.height(), t.width(), CV_8UC4, px.data()), bgr;
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
@@ -615,7 +643,7 @@ cv::Mat Renderer::compositeSrgb() const {
 }
 
 cv::Mat Renderer::coverage() const {
-    const gl::Texture& t = graph_.texture(Resource::Composite);
+    const gl::Texture& t = graph_.texture(kComposite);
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     cv::Mat out(t.height(), t.width(), CV_8U);
     for (int y = 0; y < t.height(); ++y)
@@ -627,7 +655,7 @@ cv::Mat Renderer::coverage() const {
 }
 
 cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
-    const Resource r = realOnly ? Resource::ImperfectShadowMapsReal : Resource::ImperfectShadowMaps;
+    const Resource r = realOnly ? kImperfectShadowMapsReal : kImperfectShadowMaps;
     if (!graph_.has(r)) throw Error("no imperfect shadow map was rendered this frame");
     const gl::Texture& t = graph_.texture(r);
     auto bits = t.read<uint32_t>(GL_RED_INTEGER, GL_UNSIGNED_INT, 1);
@@ -637,22 +665,22 @@ cv::Mat Renderer::readIsmAtlas(bool realOnly) const {
 }
 
 std::vector<GpuVpl> Renderer::readVpls() const {
-    if (!graph_.has(Resource::Vpls)) throw Error("no VPLs were placed this frame");
-    const gl::Buffer& b = graph_.buffer(Resource::Vpls);
+    if (!graph_.has(kVpls)) throw Error("no VPLs were placed this frame");
+    const gl::Buffer& b = graph_.buffer(kVpls);
     std::vector<GpuVpl> v(b.size() / sizeof(GpuVpl));
     glGetNamedBufferSubData(b.id(), 0, GLsizeiptr(v.size() * sizeof(GpuVpl)), v.data());
     return v;
 }
 
 cv::Mat Renderer::readEnvironmentMap() const {
-    const gl::Texture& t = graph_.texture(Resource::EnvironmentMap);
+    const gl::Texture& t = graph_.texture(kEnvironmentMap);
     auto px = t.read<float>(GL_RGBA, GL_FLOAT, 4);
     return cv::Mat(t.height(), t.width(), CV_32FC4, px.data()).clone();
 }
 
 GpuEnvironment Renderer::readEnvironmentLight() const {
     GpuEnvironment g{};
-    glGetNamedBufferSubData(graph_.buffer(Resource::EnvironmentLight).id(), 0, sizeof(g), &g);
+    glGetNamedBufferSubData(graph_.buffer(kEnvironmentLight).id(), 0, sizeof(g), &g);
     return g;
 }
 

@@ -116,6 +116,7 @@ public:
 
 private:
     void planFrame(const FrameInput& input);
+    void writeFrameUniforms(const FrameInput& input, const glm::mat4& view, const glm::mat4& proj);
     void placeEnvironmentLights();
     void uploadCameraImage(const cv::Mat& bgr);
 

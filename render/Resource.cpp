@@ -2,95 +2,6 @@
 
 namespace mirage::render {
 
-const char* resourceName(Resource r) {
-    static const char* const names[kResourceCount] = {
-        "CameraImage",
-        "SceneEnvironmentMap",
-        "EnvironmentCamera",
-        "EnvironmentMap",
-        "EnvironmentLight",
-        "GBufferPosition",
-        "GBufferNormal",
-        "GBufferAlbedo",
-        "GBufferEmissive",
-        "ShadowMaps",
-        "ShadowMapsReal",
-        "ShadowGlass",
-        "ShadowGlassReal",
-        "RsmFlux",
-        "RsmNormal",
-        "RsmPosition",
-        "Vpls",
-        "ImperfectShadowMaps",
-        "ImperfectShadowMapsReal",
-        "TranslucentGrid",
-        "TranslucentRadiance",
-        "DirectRv",
-        "DirectR",
-        "IndirectRv",
-        "IndirectR",
-        "GiHistoryRv",
-        "GiHistoryR",
-        "GatherLight",
-        "LRv",
-        "LR",
-        "ImpostorCubePosition",
-        "ImpostorCubeNormal",
-        "ImpostorCubeAlbedo",
-        "ImpostorCubeEmissive",
-        "ImpostorDepth",
-        "ImpostorNormal",
-        "ImpostorAlbedo",
-        "ImpostorEmissive",
-        "ImpostorRecords",
-        "ImpostorObjects",
-        "BackFacePosition",
-        "BackFaceNormal",
-        "RealSurfaces",
-        "ReflectionGBuffer",
-        "ReflectionNormal",
-        "ReflectionAlbedo",
-        "ReflectionEmissive",
-        "ReflectionWeight",
-        "RefractionGBuffer",
-        "RefractionNormal",
-        "RefractionAlbedo",
-        "RefractionEmissive",
-        "RefractionWeight",
-        "SpecularMask",
-        "SpecularRv",
-        "SpecularR",
-        "SpecularRReflection",
-        "Lenv",
-        "FuzzySpecularRv",
-        "FuzzySpecularR",
-        "FuzzySpecularRReflection",
-        "FuzzyLenv",
-        "FuzzyReflectionVideo",
-        "RoughSpecularRv",
-        "RoughSpecularR",
-        "RoughSpecularRReflection",
-        "RoughLenv",
-        "RoughVideo",
-        "PhotonHitRefl",
-        "PhotonPowerRefl",
-        "PhotonHitRefr",
-        "PhotonPowerRefr",
-        "PhotonSurfaceRefl",
-        "PhotonSurfaceRefr",
-        "PhotonGrid",
-        "PhotonRecords",
-        "CausticRv",
-        "CausticR",
-        "CausticHistoryRv",
-        "CausticHistoryR",
-        "Composite",
-        "CompositeSrgb",
-    };
-    const int i = int(r);
-    return i >= 0 && i < kResourceCount ? names[i] : "?";
-}
-
 const char* sizeRuleName(SizeRule s) {
     switch (s) {
         case SizeRule::Canvas:
@@ -141,6 +52,24 @@ const char* formatName(GLenum format) {
             return "DEPTH32F";
     }
     return "other";
+}
+
+size_t bytesPerTexel(GLenum format) {
+    switch (format) {
+        case GL_RGBA32F:
+        case GL_RGBA32UI:
+            return 16;
+        case GL_RGBA16F:
+        case GL_RG32F:
+            return 8;
+        case GL_RGBA8:
+        case GL_SRGB8_ALPHA8:
+        case GL_R32F:
+        case GL_R32UI:
+        case GL_DEPTH_COMPONENT32F:
+            return 4;
+    }
+    return 0;
 }
 
 }  // namespace mirage::render

@@ -42,8 +42,8 @@
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
 #include "render/SessionEnvironment.h"
-#include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/RealtimeBench.h"
+#include "render/raytrace/GroundTruthComposite.h"
 
 namespace mirage::app {
 namespace {

@@ -25,8 +25,8 @@
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
 #include "render/SessionEnvironment.h"
-#include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/RealtimeBench.h"
+#include "render/raytrace/GroundTruthComposite.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tracking/ArucoComparison.h"
 

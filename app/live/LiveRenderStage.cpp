@@ -4,16 +4,18 @@
 #include <cmath>
 
 #include "core/Error.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
 
 namespace mirage::app {
 
 const BufferView kBufferViews[] = {{"composite", std::nullopt},
-                                   {"L_rv (real + virtual)", render::Resource::LRv},
-                                   {"L_r (real only)", render::Resource::LR},
-                                   {"direct L_rv", render::Resource::DirectRv},
-                                   {"direct L_r", render::Resource::DirectR},
-                                   {"G-buffer albedo", render::Resource::GBufferAlbedo},
-                                   {"G-buffer normal", render::Resource::GBufferNormal}};
+                                   {"L_rv (real + virtual)", render::kLRv},
+                                   {"L_r (real only)", render::kLR},
+                                   {"direct L_rv", render::kDirectRv},
+                                   {"direct L_r", render::kDirectR},
+                                   {"G-buffer albedo", render::kGBufferAlbedo},
+                                   {"G-buffer normal", render::kGBufferNormal}};
 const int kBufferViewCount = int(sizeof kBufferViews / sizeof kBufferViews[0]);
 
 cv::Mat toneMapForView(const cv::Mat& linearRgb) {

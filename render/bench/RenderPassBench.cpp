@@ -21,6 +21,7 @@
 #include "core/image/ImageIO.h"
 #include "render/EnvironmentLights.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "render/raytrace/SyntheticFootage.h"
@@ -100,8 +101,8 @@ void BM_Frame(benchmark::State& state) {
         const std::string tag =
             cv::format("%dx%d_%dvpl_spec%d", w, h, opt.vplCount, int(state.range(5)));
         writeBgr8(d / ("composite_" + tag + ".png"), r.compositeSrgb());
-        writeLinearRgb(d / ("Lrv_" + tag + ".png"), r.readBuffer(render::Resource::LRv));
-        writeLinearRgb(d / ("Lr_" + tag + ".png"), r.readBuffer(render::Resource::LR));
+        writeLinearRgb(d / ("Lrv_" + tag + ".png"), r.readBuffer(render::kLRv));
+        writeLinearRgb(d / ("Lr_" + tag + ".png"), r.readBuffer(render::kLR));
     }
     std::map<std::string, double> sums;
     for (auto _ : state) {

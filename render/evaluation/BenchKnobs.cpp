@@ -60,373 +60,441 @@ std::string BenchConfig::label() const {
     return s;
 }
 
+namespace {
+
+// The frame: resolution, VPLs, gather scale, pass reuse and timing.
+void frameKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.insert(
+        knobs.end(),
+        {
+            {"resolution",
+             "render (and judging) resolution WIDTHxHEIGHT, same aspect as the session",
+             [](const CameraIntrinsics& k, bool quick) {
+                 // The session's size, then the standard 4:3 sizes below it with its aspect ratio.
+                 std::vector<std::string> v{fmt::format("{}x{}", k.width, k.height)};
+                 const std::pair<int, int> standard[] = {{1024, 768}, {640, 480}, {320, 240}};
+                 for (auto [w, h] : standard)
+                     if (w * h < k.width * k.height && sameAspect(w, h, k.width, k.height))
+                         v.push_back(fmt::format("{}x{}", w, h));
+                 if (quick) {
+                     // The largest size up to 640x480 (the goal's resolution when the session has
+                     // it).
+                     for (const auto& s : v)
+                         if (parseResolution(s).first <= 640) return std::vector<std::string>{s};
+                     return std::vector<std::string>{v.back()};
+                 }
+                 return v;
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 std::tie(c.width, c.height) = parseResolution(v);
+             },
+             [](const BenchConfig& c) {
+                 return c.width > 0 ? fmt::format("{}x{}", c.width, c.height)
+                                    : std::string("session");
+             }},
+            {"vpls", "virtual point lights per frame (RendererOptions::vplCount)",
+             [](const CameraIntrinsics&, bool quick) {
+                 return quick ? std::vector<std::string>{"64", "256"}
+                              : std::vector<std::string>{"64", "256", "1024"};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.vplCount = parseInt("vpls", v, 0, 16384);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.vplCount); }},
+            {"indirect_scale",
+             "VPL gather at 1/N resolution per axis (1..4), or auto: width / 160 in 1..4 (4 at "
+             "640x480)",
+             [](const CameraIntrinsics&, bool quick) {
+                 return quick ? std::vector<std::string>{"auto"}
+                              : std::vector<std::string>{"auto", "2", "1"};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.indirectScale = v == "auto" ? 0 : parseInt("indirect_scale", v, 1, 4);
+             },
+             [](const BenchConfig& c) {
+                 return c.options.indirectScale == 0 ? std::string("auto")
+                                                     : std::to_string(c.options.indirectScale);
+             }},
+            {"static_reuse",
+             "on: reuse the camera-independent passes (shadow, vpl, ism) while the plan is "
+             "unchanged; off: re-run them every frame",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.reuseStaticPasses = parseOnOff("static_reuse", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.reuseStaticPasses); }},
+            {"sync_passes",
+             "on: glFinish around every pass so each pass's GPU ms is its own (llvmpipe defers "
+             "work); "
+             "off: as mirage replay runs, passes overlap and only the wall ms is meaningful",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.syncPasses = parseOnOff("sync_passes", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.syncPasses); }},
+        });
+}
+
+// Specular objects. One default value each, so the default grid does not grow; sweep them
+// with --knob (docs/bench.md). They change nothing in a scene without mirror or glass (the
+// impostor and specular passes do not run).
+void specularKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.insert(
+        knobs.end(),
+        {
+            {"specular_trace",
+             "what reflected/refracted rays are traced against: impostors (Popescu et al. 2006) or "
+             "cubemap (the plain G-buffer cube-map baseline)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"impostors"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 if (v != "impostors" && v != "cubemap")
+                     throw Error(fmt::format(
+                         "bench: knob specular_trace: '{}' is not impostors or cubemap", v));
+                 c.options.impostorCubeMapBaseline = v == "cubemap";
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.impostorCubeMapBaseline ? "cubemap" : "impostors");
+             }},
+            {"impostor_resolution", "texels per side of each impostor and cube-map face",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.impostorResolution = parseInt("impostor_resolution", v, 16, 2048);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.impostorResolution); }},
+            {"impostor_steps", "refinement steps of the impostor height-field search",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"2"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.impostorRefineSteps); }},
+            {"refraction_steps",
+             "march steps of the refracted ray through the back-face buffer (the exit point; also "
+             "the caustic photons')",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.refractionMarchSteps = parseInt("refraction_steps", v, 2, 128);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.refractionMarchSteps); }},
+            {"specular_vpl_stride",
+             "VPL interleaving at the reflected/refracted hits: each hit sums every N-th VPL (x N) "
+             "over an N-pixel tile: 1 (all), 4 (2x2) or 16 (4x4)",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{
+                     std::to_string(RendererOptions{}.specularVplStride)};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 const int n = parseInt("specular_vpl_stride", v, 1, 16);
+                 if (n != 1 && n != 4 && n != 16)
+                     throw Error(
+                         fmt::format("bench: knob specular_vpl_stride: '{}' is not 1, 4 or 16", v));
+                 c.options.specularVplStride = n;
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.specularVplStride); }},
+            {"specular_resolution",
+             "resolution of the lighting at the reflected/refracted hits: full (every specular "
+             "pixel) or half (one pixel per 2x2 block, upsampled by hit geometry)",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{RendererOptions{}.specularHalfResolution ? "half"
+                                                                                          : "full"};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 if (v != "full" && v != "half")
+                     throw Error(fmt::format(
+                         "bench: knob specular_resolution: '{}' is not full or half", v));
+                 c.options.specularHalfResolution = v == "half";
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.specularHalfResolution ? "half" : "full");
+             }},
+            {"virtual",
+             "on: composite the virtual objects; off: the composite is the footage unchanged (a "
+             "sanity point: it must score as the footage-only row, and any configuration that does "
+             "not beat that row is broken)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.showVirtual = parseOnOff("virtual", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.showVirtual); }},
+        });
+}
+
+// Caustics (docs/caustics.md): one default value each, as the specular knobs; and the pose
+// jitter the temporal buffers are judged under.
+void causticKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.insert(
+        knobs.end(),
+        {
+            {"caustics",
+             "on: photon G-buffers and the caustic splat for spot lights on mirror/glass",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.caustics = parseOnOff("caustics", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.caustics); }},
+            {"glass_shadows",
+             "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
+             "off: glass is opaque there",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.glassShadows = parseOnOff("glass_shadows", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.glassShadows); }},
+            {"refl_refr_vpls",
+             "on: a VPL on a mirror or glass follows the reflected / refracted photon to its "
+             "receiver (spot lights with caustics); off: it stays dark on the object",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.reflectedRefractedVpls = parseOnOff("refl_refr_vpls", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.reflectedRefractedVpls); }},
+            {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.causticMapSize = parseInt("caustic_map", v, 16, 2048);
+                 if (c.options.causticMapSize % 8 != 0)
+                     throw Error(
+                         fmt::format("bench: knob caustic_map: {} is not a multiple of 8", v));
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.causticMapSize); }},
+            {"caustic_quad", "photon quad radius in photon spacings on the receiver (0.25..8)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1.5"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 char* end = nullptr;
+                 const float q = std::strtof(v.c_str(), &end);
+                 if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.25f && q <= 8.0f))
+                     throw Error(fmt::format(
+                         "bench: knob caustic_quad: '{}' is not a number in [0.25, 8]", v));
+                 c.options.causticQuadScale = q;
+             },
+             [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
+            {"caustic_gather",
+             "on: the photons in a world-space grid, gathered at the reflected / refracted hits "
+             "(caustics seen in mirrors and through glass); off: those hits get no caustic",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.causticGather = parseOnOff("caustic_gather", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.causticGather); }},
+            {"caustic_radius",
+             "photon kernel radius cap of the caustic gather, in cm (0.1..50; grid cells are twice "
+             "that)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 char* end = nullptr;
+                 const float q = std::strtof(v.c_str(), &end);
+                 if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.1f && q <= 50.0f))
+                     throw Error(fmt::format(
+                         "bench: knob caustic_radius: '{}' is not a number of cm in [0.1, 50]", v));
+                 c.options.causticGatherRadius = 0.01f * q;
+             },
+             [](const BenchConfig& c) {
+                 return fmt::format("{:g}", 100.0f * c.options.causticGatherRadius);
+             }},
+            {"caustic_gather_cap",
+             "photons the caustic gather reads per grid bucket, 0 = all (fuller buckets are read "
+             "with "
+             "a stride and weighted by count / read)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 char* end = nullptr;
+                 const long q = std::strtol(v.c_str(), &end, 10);
+                 if (v.empty() || end != v.c_str() + v.size() || q < 0 || q > (1 << 20))
+                     throw Error(
+                         fmt::format("bench: knob caustic_gather_cap: '{}' is not a photon "
+                                     "count in 0..1048576 (0: all)",
+                                     v));
+                 c.options.causticGatherCap = int(q);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.causticGatherCap); }},
+            {"caustic_temporal",
+             "on: the caustic buffer smoothed over frames (reprojected history, the GI filter's "
+             "reset rules); off: every frame's caustic stands alone",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.causticTemporal = parseOnOff("caustic_temporal", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.causticTemporal); }},
+            {"specular_temporal",
+             "on: the light of the reflected / refracted hits (L'_rv, L'_r) smoothed over frames, "
+             "history rejected where a hit moved; off: every frame's stands alone",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.specularTemporal = parseOnOff("specular_temporal", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.specularTemporal); }},
+            {"pose_jitter",
+             "tracking-like noise on every frame's pose: mm of translation (1 sigma per axis) and "
+             "a tenth of that in degrees of rotation (0..10; 0: the exact ground-truth pose)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 char* end = nullptr;
+                 const double q = std::strtod(v.c_str(), &end);
+                 if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.0 && q <= 10.0))
+                     throw Error(fmt::format(
+                         "bench: knob pose_jitter: '{}' is not a number of mm in [0, 10]", v));
+                 c.poseJitterMm = q;
+             },
+             [](const BenchConfig& c) { return fmt::format("{:g}", c.poseJitterMm); }},
+        });
+}
+
+// Fuzzy reflections of rough metals and rough glass (docs/specular.md): one default value
+// each.
+void roughKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.insert(
+        knobs.end(),
+        {
+            {"fuzzy",
+             "on: the fuzzy-reflection filter over rough metals' mirror reflections; off: rough "
+             "metals reflect sharply (their roughness ignored)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.fuzzyReflections = parseOnOff("fuzzy", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.fuzzyReflections); }},
+            {"fuzzy_cone", "the fuzzy filter's cone bound Theta in degrees (0 < Theta <= 60)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"20"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 char* end = nullptr;
+                 const float q = std::strtof(v.c_str(), &end);
+                 if (v.empty() || end != v.c_str() + v.size() || !(q > 0.0f && q <= 60.0f))
+                     throw Error(
+                         fmt::format("bench: knob fuzzy_cone: '{}' is not a number in (0, 60]", v));
+                 c.options.fuzzyConeDeg = q;
+             },
+             [](const BenchConfig& c) { return fmt::format("{:g}", c.options.fuzzyConeDeg); }},
+            {"fuzzy_taps", "taps per side of each separable fuzzy-filter pass (1..64)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"12"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.fuzzyTaps = parseInt("fuzzy_taps", v, 1, 64);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.fuzzyTaps); }},
+            // Rough glass (docs/specular.md, "Rough refraction"): one default value each.
+            {"rough_method",
+             "how rough glass blurs what is seen through it: lean (LEAN-mapped back faces, one "
+             "lobe), gsr (Gaussian sum reduction, one lobe per hemisphere subdivision) or filter "
+             "(the fuzzy pass's image-space filter)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"lean"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 if (v == "lean")
+                     c.options.roughRefraction = RoughRefractionMethod::Lean;
+                 else if (v == "gsr")
+                     c.options.roughRefraction = RoughRefractionMethod::Gsr;
+                 else if (v == "filter")
+                     c.options.roughRefraction = RoughRefractionMethod::Filter;
+                 else
+                     throw Error(fmt::format(
+                         "bench: knob rough_method: '{}' is not one of lean, gsr, filter", v));
+             },
+             [](const BenchConfig& c) {
+                 return std::string(roughRefractionMethodName(c.options.roughRefraction));
+             }},
+            {"gsr_subdivisions", "hemisphere sectors of the Gaussian sum reduction (1..8)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.gsrSubdivisions = parseInt("gsr_subdivisions", v, 1, 8);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.gsrSubdivisions); }},
+            {"lean_mip_levels",
+             "mip levels of the rough-refraction chains (LEAN moments, camera image, rough-glass "
+             "radiance; 1..12): a wider lobe is cut at the last",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"8"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.roughMipLevels = parseInt("lean_mip_levels", v, 1, 12);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.roughMipLevels); }},
+        });
+}
+
+// Translucent objects (docs/translucency.md) and moving objects.
+void translucencyKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.insert(
+        knobs.end(),
+        {
+            {"translucent_shadows",
+             "on: a translucent object lets light through in the shadow maps (its optical "
+             "thickness along the light's ray, coloured by its medium); off: it is opaque there",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.translucentShadows = parseOnOff("translucent_shadows", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.translucentShadows); }},
+            {"vnm_resolution",
+             "voxels along a translucent object's longest side in its voxel number map (2..512; "
+             "the LUT grows with the 4th power)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.vnmResolution = parseInt("vnm_resolution", v, 2, 512);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.vnmResolution); }},
+            {"moving_objects",
+             "on: the virtual objects move before every frame (to 1 cm along +X and back), so "
+             "every frame redoes what depends on where they stand: shadows, VPLs, ISMs, caustics, "
+             "impostors (docs/live.md)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.movingObjects = parseOnOff("moving_objects", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.movingObjects); }},
+        });
+}
+
+// The environment (docs/environment.md). Defaults keep the static map, so the default grid
+// is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
+void environmentKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.insert(
+        knobs.end(),
+        {
+            {"env_source",
+             "static: the scene's environment map; camera: the session's environment camera, a new "
+             "frame every frame",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"static"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 if (v != "static" && v != "camera")
+                     throw Error(
+                         fmt::format("bench: knob env_source: '{}' is not static or camera", v));
+                 c.environmentCamera = v == "camera";
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.environmentCamera ? "camera" : "static");
+             }},
+            {"env_resolution",
+             "width of the environment map built from each environment-camera frame (height = "
+             "width "
+             "/ 2; with env_source=camera)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"512"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 const int w = parseInt("env_resolution", v, 16, 4096);
+                 if (w % 2 != 0)
+                     throw Error(fmt::format("bench: knob env_resolution: '{}' is not even", v));
+                 c.options.environmentMapWidth = w;
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.environmentMapWidth); }},
+            {"env_lights",
+             "lights found in each environment-camera frame placed as shadow-casting lights, taken "
+             "out of the environment light (0 = none; with env_source=camera)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.environmentLights = parseInt("env_lights", v, 0, kMaxLights);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.environmentLights); }},
+        });
+}
+
+}  // namespace
+
+// The knobs, one group per effect, in the grid's (and the report's) column order.
 const std::vector<BenchKnob>& benchKnobs() {
-    static const std::vector<BenchKnob> knobs = {
-        {"resolution", "render (and judging) resolution WIDTHxHEIGHT, same aspect as the session",
-         [](const CameraIntrinsics& k, bool quick) {
-             // The session's size, then the standard 4:3 sizes below it with its aspect ratio.
-             std::vector<std::string> v{fmt::format("{}x{}", k.width, k.height)};
-             const std::pair<int, int> standard[] = {{1024, 768}, {640, 480}, {320, 240}};
-             for (auto [w, h] : standard)
-                 if (w * h < k.width * k.height && sameAspect(w, h, k.width, k.height))
-                     v.push_back(fmt::format("{}x{}", w, h));
-             if (quick) {
-                 // The largest size up to 640x480 (the goal's resolution when the session has it).
-                 for (const auto& s : v)
-                     if (parseResolution(s).first <= 640) return std::vector<std::string>{s};
-                 return std::vector<std::string>{v.back()};
-             }
-             return v;
-         },
-         [](BenchConfig& c, const std::string& v) {
-             std::tie(c.width, c.height) = parseResolution(v);
-         },
-         [](const BenchConfig& c) {
-             return c.width > 0 ? fmt::format("{}x{}", c.width, c.height) : std::string("session");
-         }},
-        {"vpls", "virtual point lights per frame (RendererOptions::vplCount)",
-         [](const CameraIntrinsics&, bool quick) {
-             return quick ? std::vector<std::string>{"64", "256"}
-                          : std::vector<std::string>{"64", "256", "1024"};
-         },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.vplCount = parseInt("vpls", v, 0, 16384);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.vplCount); }},
-        {"indirect_scale",
-         "VPL gather at 1/N resolution per axis (1..4), or auto: width / 160 in 1..4 (4 at "
-         "640x480)",
-         [](const CameraIntrinsics&, bool quick) {
-             return quick ? std::vector<std::string>{"auto"}
-                          : std::vector<std::string>{"auto", "2", "1"};
-         },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.indirectScale = v == "auto" ? 0 : parseInt("indirect_scale", v, 1, 4);
-         },
-         [](const BenchConfig& c) {
-             return c.options.indirectScale == 0 ? std::string("auto")
-                                                 : std::to_string(c.options.indirectScale);
-         }},
-        {"static_reuse",
-         "on: reuse the camera-independent passes (shadow, vpl, ism) while the plan is "
-         "unchanged; off: re-run them every frame",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.reuseStaticPasses = parseOnOff("static_reuse", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.reuseStaticPasses); }},
-        {"sync_passes",
-         "on: glFinish around every pass so each pass's GPU ms is its own (llvmpipe defers work); "
-         "off: as mirage replay runs, passes overlap and only the wall ms is meaningful",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.syncPasses = parseOnOff("sync_passes", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.syncPasses); }},
-        // Specular objects. One default value each, so the default grid does not grow;
-        // sweep them with --knob (docs/bench.md). They change nothing in a scene without mirror
-        // or glass (the impostor and specular passes do not run).
-        {"specular_trace",
-         "what reflected/refracted rays are traced against: impostors (Popescu et al. 2006) or "
-         "cubemap (the plain G-buffer cube-map baseline)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"impostors"}; },
-         [](BenchConfig& c, const std::string& v) {
-             if (v != "impostors" && v != "cubemap")
-                 throw Error(fmt::format(
-                     "bench: knob specular_trace: '{}' is not impostors or cubemap", v));
-             c.options.impostorCubeMapBaseline = v == "cubemap";
-         },
-         [](const BenchConfig& c) {
-             return std::string(c.options.impostorCubeMapBaseline ? "cubemap" : "impostors");
-         }},
-        {"impostor_resolution", "texels per side of each impostor and cube-map face",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.impostorResolution = parseInt("impostor_resolution", v, 16, 2048);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.impostorResolution); }},
-        {"impostor_steps", "refinement steps of the impostor height-field search",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"2"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.impostorRefineSteps); }},
-        {"refraction_steps",
-         "march steps of the refracted ray through the back-face buffer (the exit point; also "
-         "the caustic photons')",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.refractionMarchSteps = parseInt("refraction_steps", v, 2, 128);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.refractionMarchSteps); }},
-        {"specular_vpl_stride",
-         "VPL interleaving at the reflected/refracted hits: each hit sums every N-th VPL (x N) "
-         "over an N-pixel tile: 1 (all), 4 (2x2) or 16 (4x4)",
-         [](const CameraIntrinsics&, bool) {
-             return std::vector<std::string>{std::to_string(RendererOptions{}.specularVplStride)};
-         },
-         [](BenchConfig& c, const std::string& v) {
-             const int n = parseInt("specular_vpl_stride", v, 1, 16);
-             if (n != 1 && n != 4 && n != 16)
-                 throw Error(
-                     fmt::format("bench: knob specular_vpl_stride: '{}' is not 1, 4 or 16", v));
-             c.options.specularVplStride = n;
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.specularVplStride); }},
-        {"specular_resolution",
-         "resolution of the lighting at the reflected/refracted hits: full (every specular "
-         "pixel) or half (one pixel per 2x2 block, upsampled by hit geometry)",
-         [](const CameraIntrinsics&, bool) {
-             return std::vector<std::string>{RendererOptions{}.specularHalfResolution ? "half"
-                                                                                      : "full"};
-         },
-         [](BenchConfig& c, const std::string& v) {
-             if (v != "full" && v != "half")
-                 throw Error(
-                     fmt::format("bench: knob specular_resolution: '{}' is not full or half", v));
-             c.options.specularHalfResolution = v == "half";
-         },
-         [](const BenchConfig& c) {
-             return std::string(c.options.specularHalfResolution ? "half" : "full");
-         }},
-        {"virtual",
-         "on: composite the virtual objects; off: the composite is the footage unchanged (a "
-         "sanity point: it must score as the footage-only row, and any configuration that does "
-         "not beat that row is broken)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.showVirtual = parseOnOff("virtual", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.showVirtual); }},
-        // Caustics (docs/caustics.md): one default value each, as the specular knobs.
-        {"caustics", "on: photon G-buffers and the caustic splat for spot lights on mirror/glass",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.caustics = parseOnOff("caustics", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.caustics); }},
-        {"glass_shadows",
-         "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
-         "off: glass is opaque there",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.glassShadows = parseOnOff("glass_shadows", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.glassShadows); }},
-        {"refl_refr_vpls",
-         "on: a VPL on a mirror or glass follows the reflected / refracted photon to its "
-         "receiver (spot lights with caustics); off: it stays dark on the object",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.reflectedRefractedVpls = parseOnOff("refl_refr_vpls", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.reflectedRefractedVpls); }},
-        {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.causticMapSize = parseInt("caustic_map", v, 16, 2048);
-             if (c.options.causticMapSize % 8 != 0)
-                 throw Error(fmt::format("bench: knob caustic_map: {} is not a multiple of 8", v));
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.causticMapSize); }},
-        {"caustic_quad", "photon quad radius in photon spacings on the receiver (0.25..8)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1.5"}; },
-         [](BenchConfig& c, const std::string& v) {
-             char* end = nullptr;
-             const float q = std::strtof(v.c_str(), &end);
-             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.25f && q <= 8.0f))
-                 throw Error(
-                     fmt::format("bench: knob caustic_quad: '{}' is not a number in [0.25, 8]", v));
-             c.options.causticQuadScale = q;
-         },
-         [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
-        {"caustic_gather",
-         "on: the photons in a world-space grid, gathered at the reflected / refracted hits "
-         "(caustics seen in mirrors and through glass); off: those hits get no caustic",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.causticGather = parseOnOff("caustic_gather", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.causticGather); }},
-        {"caustic_radius",
-         "photon kernel radius cap of the caustic gather, in cm (0.1..50; grid cells are twice "
-         "that)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1"}; },
-         [](BenchConfig& c, const std::string& v) {
-             char* end = nullptr;
-             const float q = std::strtof(v.c_str(), &end);
-             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.1f && q <= 50.0f))
-                 throw Error(fmt::format(
-                     "bench: knob caustic_radius: '{}' is not a number of cm in [0.1, 50]", v));
-             c.options.causticGatherRadius = 0.01f * q;
-         },
-         [](const BenchConfig& c) {
-             return fmt::format("{:g}", 100.0f * c.options.causticGatherRadius);
-         }},
-        {"caustic_gather_cap",
-         "photons the caustic gather reads per grid bucket, 0 = all (fuller buckets are read with "
-         "a stride and weighted by count / read)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
-         [](BenchConfig& c, const std::string& v) {
-             char* end = nullptr;
-             const long q = std::strtol(v.c_str(), &end, 10);
-             if (v.empty() || end != v.c_str() + v.size() || q < 0 || q > (1 << 20))
-                 throw Error(
-                     fmt::format("bench: knob caustic_gather_cap: '{}' is not a photon "
-                                 "count in 0..1048576 (0: all)",
-                                 v));
-             c.options.causticGatherCap = int(q);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.causticGatherCap); }},
-        {"caustic_temporal",
-         "on: the caustic buffer smoothed over frames (reprojected history, the GI filter's "
-         "reset rules); off: every frame's caustic stands alone",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.causticTemporal = parseOnOff("caustic_temporal", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.causticTemporal); }},
-        {"specular_temporal",
-         "on: the light of the reflected / refracted hits (L'_rv, L'_r) smoothed over frames, "
-         "history rejected where a hit moved; off: every frame's stands alone",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.specularTemporal = parseOnOff("specular_temporal", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.specularTemporal); }},
-        {"pose_jitter",
-         "tracking-like noise on every frame's pose: mm of translation (1 sigma per axis) and "
-         "a tenth of that in degrees of rotation (0..10; 0: the exact ground-truth pose)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
-         [](BenchConfig& c, const std::string& v) {
-             char* end = nullptr;
-             const double q = std::strtod(v.c_str(), &end);
-             if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.0 && q <= 10.0))
-                 throw Error(fmt::format(
-                     "bench: knob pose_jitter: '{}' is not a number of mm in [0, 10]", v));
-             c.poseJitterMm = q;
-         },
-         [](const BenchConfig& c) { return fmt::format("{:g}", c.poseJitterMm); }},
-        // Fuzzy reflections of rough metals (docs/specular.md): one default value each.
-        {"fuzzy",
-         "on: the fuzzy-reflection filter over rough metals' mirror reflections; off: rough "
-         "metals reflect sharply (their roughness ignored)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.fuzzyReflections = parseOnOff("fuzzy", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.fuzzyReflections); }},
-        {"fuzzy_cone", "the fuzzy filter's cone bound Theta in degrees (0 < Theta <= 60)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"20"}; },
-         [](BenchConfig& c, const std::string& v) {
-             char* end = nullptr;
-             const float q = std::strtof(v.c_str(), &end);
-             if (v.empty() || end != v.c_str() + v.size() || !(q > 0.0f && q <= 60.0f))
-                 throw Error(
-                     fmt::format("bench: knob fuzzy_cone: '{}' is not a number in (0, 60]", v));
-             c.options.fuzzyConeDeg = q;
-         },
-         [](const BenchConfig& c) { return fmt::format("{:g}", c.options.fuzzyConeDeg); }},
-        {"fuzzy_taps", "taps per side of each separable fuzzy-filter pass (1..64)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"12"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.fuzzyTaps = parseInt("fuzzy_taps", v, 1, 64);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.fuzzyTaps); }},
-        // Rough glass (docs/specular.md, "Rough refraction"): one default value each.
-        {"rough_method",
-         "how rough glass blurs what is seen through it: lean (LEAN-mapped back faces, one "
-         "lobe), gsr (Gaussian sum reduction, one lobe per hemisphere subdivision) or filter "
-         "(the fuzzy pass's image-space filter)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"lean"}; },
-         [](BenchConfig& c, const std::string& v) {
-             if (v == "lean")
-                 c.options.roughRefraction = RoughRefractionMethod::Lean;
-             else if (v == "gsr")
-                 c.options.roughRefraction = RoughRefractionMethod::Gsr;
-             else if (v == "filter")
-                 c.options.roughRefraction = RoughRefractionMethod::Filter;
-             else
-                 throw Error(fmt::format(
-                     "bench: knob rough_method: '{}' is not one of lean, gsr, filter", v));
-         },
-         [](const BenchConfig& c) {
-             return std::string(roughRefractionMethodName(c.options.roughRefraction));
-         }},
-        {"gsr_subdivisions", "hemisphere sectors of the Gaussian sum reduction (1..8)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.gsrSubdivisions = parseInt("gsr_subdivisions", v, 1, 8);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.gsrSubdivisions); }},
-        {"lean_mip_levels",
-         "mip levels of the rough-refraction chains (LEAN moments, camera image, rough-glass "
-         "radiance; 1..12): a wider lobe is cut at the last",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"8"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.roughMipLevels = parseInt("lean_mip_levels", v, 1, 12);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.roughMipLevels); }},
-        {"translucent_shadows",
-         "on: a translucent object lets light through in the shadow maps (its optical "
-         "thickness along the light's ray, coloured by its medium); off: it is opaque there",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.translucentShadows = parseOnOff("translucent_shadows", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.options.translucentShadows); }},
-        {"vnm_resolution",
-         "voxels along a translucent object's longest side in its voxel number map (2..512; "
-         "the LUT grows with the 4th power)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.vnmResolution = parseInt("vnm_resolution", v, 2, 512);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.vnmResolution); }},
-        {"moving_objects",
-         "on: the virtual objects move before every frame (to 1 cm along +X and back), so "
-         "every frame redoes what depends on where they stand: shadows, VPLs, ISMs, caustics, "
-         "impostors (docs/live.md)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.movingObjects = parseOnOff("moving_objects", v);
-         },
-         [](const BenchConfig& c) { return onOff(c.movingObjects); }},
-        // The environment (docs/environment.md). Defaults keep the static map, so the default
-        // grid is unchanged; sweep with --knob env_source=static,camera --knob env_resolution=...
-        {"env_source",
-         "static: the scene's environment map; camera: the session's environment camera, a new "
-         "frame every frame",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"static"}; },
-         [](BenchConfig& c, const std::string& v) {
-             if (v != "static" && v != "camera")
-                 throw Error(
-                     fmt::format("bench: knob env_source: '{}' is not static or camera", v));
-             c.environmentCamera = v == "camera";
-         },
-         [](const BenchConfig& c) {
-             return std::string(c.environmentCamera ? "camera" : "static");
-         }},
-        {"env_resolution",
-         "width of the environment map built from each environment-camera frame (height = width "
-         "/ 2; with env_source=camera)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"512"}; },
-         [](BenchConfig& c, const std::string& v) {
-             const int w = parseInt("env_resolution", v, 16, 4096);
-             if (w % 2 != 0)
-                 throw Error(fmt::format("bench: knob env_resolution: '{}' is not even", v));
-             c.options.environmentMapWidth = w;
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.environmentMapWidth); }},
-        {"env_lights",
-         "lights found in each environment-camera frame placed as shadow-casting lights, taken "
-         "out of the environment light (0 = none; with env_source=camera)",
-         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
-         [](BenchConfig& c, const std::string& v) {
-             c.options.environmentLights = parseInt("env_lights", v, 0, kMaxLights);
-         },
-         [](const BenchConfig& c) { return std::to_string(c.options.environmentLights); }},
-    };
+    static const std::vector<BenchKnob> knobs = [] {
+        std::vector<BenchKnob> k;
+        frameKnobs(k);
+        specularKnobs(k);
+        causticKnobs(k);
+        roughKnobs(k);
+        translucencyKnobs(k);
+        environmentKnobs(k);
+        return k;
+    }();
     return knobs;
 }
 

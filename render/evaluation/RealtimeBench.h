@@ -21,8 +21,8 @@
 #include "core/session/Session.h"
 #include "render/EnvironmentCamera.h"
 #include "render/FrameContext.h"
-#include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/ImageComparison.h"
+#include "render/raytrace/GroundTruthComposite.h"
 
 namespace mirage::render {
 

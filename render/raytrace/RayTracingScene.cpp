@@ -85,27 +85,7 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
 
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     // Lights and meshes reachable from the scene's roots, with world transforms and origins.
-    for (const LightInstance& li : scene.lightInstances()) {
-        if (!included(li.origin)) continue;
-        const Node& node = scene.nodes[size_t(li.node)];
-        if (li.light < 0 || li.light >= int(scene.lights.size()))
-            throw Error("scene node '" + node.name + "': light index out of range");
-        const Light& l = scene.lights[size_t(li.light)];
-        PunctualLight pl;
-        pl.type = l.type;
-        pl.position = glm::vec3(li.position);
-        if (!(glm::length(li.direction) > 0))
-            throw Error("scene node '" + node.name + "': degenerate light transform");
-        pl.direction = glm::vec3(glm::normalize(li.direction));
-        pl.intensity = l.color * l.intensity;
-        pl.cosInner = std::cos(std::clamp(l.innerConeAngle, 0.0f, kPi / 2));
-        pl.cosOuter = std::cos(std::clamp(l.outerConeAngle, 0.0f, kPi / 2));
-        pl.origin = li.origin;
-        if (!isFiniteVec(pl.position) || !isFiniteVec(pl.intensity) ||
-            std::min(pl.intensity.x, std::min(pl.intensity.y, pl.intensity.z)) < 0)
-            throw Error("scene light '" + l.name + "': non-finite or negative position/intensity");
-        lights_.push_back(pl);
-    }
+    addLights(scene);
     for (const MeshInstance& mi : scene.meshInstances()) {
         if (!included(mi.origin)) continue;
         const Node& node = scene.nodes[size_t(mi.node)];
@@ -182,26 +162,7 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
             for (const auto& p : g.positions)
                 g.bounds.radius = std::max(g.bounds.radius, glm::length(p - g.bounds.centre));
 
-            RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-            device.throwIfError("rtcNewGeometry");
-            auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-                geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
-            auto* ib = static_cast<uint32_t*>(
-                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                        3 * sizeof(uint32_t), g.indices.size() / 3));
-            device.throwIfError("rtcSetNewGeometryBuffer");
-            for (size_t i = 0; i < nv; ++i) {
-                vb[3 * i] = g.positions[i].x;
-                vb[3 * i + 1] = g.positions[i].y;
-                vb[3 * i + 2] = g.positions[i].z;
-            }
-            std::copy(g.indices.begin(), g.indices.end(), ib);
-            rtcCommitGeometry(geom);
-            unsigned id = rtcAttachGeometry(scene_.get(), geom);
-            rtcReleaseGeometry(geom);
-            device.throwIfError("rtcAttachGeometry");
-            MR_CHECK(id == geometries_.size(), "Embree geometry ids are expected to be dense");
-            geometries_.push_back(std::move(g));
+            attach(std::move(g));
         }
     }
     rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_HIGH);
@@ -213,27 +174,81 @@ RayTracingScene::RayTracingScene(const Scene& scene, SceneSubset subset, const E
     }
 
     const Environment& env = scene.environment;
-    if (env.kind != Environment::Kind::None && included(env.origin)) {
-        if (env.kind == Environment::Kind::Fisheye) {
-            // The camera frame resampled onto an equirectangular map exactly as the real-time
-            // renderer's environment pass does (core/camera/EquirectProjection.h: same
-            // directions, same fill of the unseen part), so ground truth exists for it.
-            const CameraCalibration cal = loadCalibration(env.calibration);
-            const cv::Mat frame = readLinearRgb(env.image);
-            if (frame.cols != cal.intrinsics.width || frame.rows != cal.intrinsics.height)
-                throw FileError(env.image.string(),
-                                fmt::format("the fish-eye image is {}x{}, but its calibration {} "
-                                            "is for {}x{}",
-                                            frame.cols, frame.rows, env.calibration.string(),
-                                            cal.intrinsics.width, cal.intrinsics.height));
-            const cv::Mat map = equirectFromCamera(frame, cal.intrinsics, env.T_world_camera,
-                                                   kFisheyeEnvironmentWidth,
-                                                   kFisheyeEnvironmentWidth / 2, cal.reachDeg);
-            environment_ = std::make_unique<EnvironmentLight>(map, env.intensity, 0.0);
-        } else {
-            cv::Mat img = readLinearRgb(env.image);
-            environment_ = std::make_unique<EnvironmentLight>(img, env.intensity, env.rotationYDeg);
-        }
+    if (env.kind != Environment::Kind::None && included(env.origin)) loadEnvironment(env);
+}
+
+// The scene's punctual lights reachable from its roots (the subset's), in world space.
+void RayTracingScene::addLights(const Scene& scene) {
+    auto included = [&](Origin o) { return subset_ == SceneSubset::All || o == Origin::Real; };
+    for (const LightInstance& li : scene.lightInstances()) {
+        if (!included(li.origin)) continue;
+        const Node& node = scene.nodes[size_t(li.node)];
+        if (li.light < 0 || li.light >= int(scene.lights.size()))
+            throw Error("scene node '" + node.name + "': light index out of range");
+        const Light& l = scene.lights[size_t(li.light)];
+        PunctualLight pl;
+        pl.type = l.type;
+        pl.position = glm::vec3(li.position);
+        if (!(glm::length(li.direction) > 0))
+            throw Error("scene node '" + node.name + "': degenerate light transform");
+        pl.direction = glm::vec3(glm::normalize(li.direction));
+        pl.intensity = l.color * l.intensity;
+        pl.cosInner = std::cos(std::clamp(l.innerConeAngle, 0.0f, kPi / 2));
+        pl.cosOuter = std::cos(std::clamp(l.outerConeAngle, 0.0f, kPi / 2));
+        pl.origin = li.origin;
+        if (!isFiniteVec(pl.position) || !isFiniteVec(pl.intensity) ||
+            std::min(pl.intensity.x, std::min(pl.intensity.y, pl.intensity.z)) < 0)
+            throw Error("scene light '" + l.name + "': non-finite or negative position/intensity");
+        lights_.push_back(pl);
+    }
+}
+
+// Uploads a geometry's triangles to Embree; its Embree id is its index in geometries_.
+void RayTracingScene::attach(Geometry g) {
+    RTCGeometry geom = rtcNewGeometry(device_->get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    device_->throwIfError("rtcNewGeometry");
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), g.positions.size()));
+    auto* ib = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(uint32_t), g.indices.size() / 3));
+    device_->throwIfError("rtcSetNewGeometryBuffer");
+    for (size_t i = 0; i < g.positions.size(); ++i) {
+        vb[3 * i] = g.positions[i].x;
+        vb[3 * i + 1] = g.positions[i].y;
+        vb[3 * i + 2] = g.positions[i].z;
+    }
+    std::copy(g.indices.begin(), g.indices.end(), ib);
+    rtcCommitGeometry(geom);
+    unsigned id = rtcAttachGeometry(scene_.get(), geom);
+    rtcReleaseGeometry(geom);
+    device_->throwIfError("rtcAttachGeometry");
+    MR_CHECK(id == geometries_.size(), "Embree geometry ids are expected to be dense");
+    geometries_.push_back(std::move(g));
+}
+
+// The scene's environment map (an equirectangular image, or a fish-eye camera frame resampled
+// onto one).
+void RayTracingScene::loadEnvironment(const Environment& env) {
+    if (env.kind == Environment::Kind::Fisheye) {
+        // The camera frame resampled onto an equirectangular map exactly as the real-time
+        // renderer's environment pass does (core/camera/EquirectProjection.h: same
+        // directions, same fill of the unseen part), so ground truth exists for it.
+        const CameraCalibration cal = loadCalibration(env.calibration);
+        const cv::Mat frame = readLinearRgb(env.image);
+        if (frame.cols != cal.intrinsics.width || frame.rows != cal.intrinsics.height)
+            throw FileError(env.image.string(),
+                            fmt::format("the fish-eye image is {}x{}, but its calibration {} "
+                                        "is for {}x{}",
+                                        frame.cols, frame.rows, env.calibration.string(),
+                                        cal.intrinsics.width, cal.intrinsics.height));
+        const cv::Mat map =
+            equirectFromCamera(frame, cal.intrinsics, env.T_world_camera, kFisheyeEnvironmentWidth,
+                               kFisheyeEnvironmentWidth / 2, cal.reachDeg);
+        environment_ = std::make_unique<EnvironmentLight>(map, env.intensity, 0.0);
+    } else {
+        cv::Mat img = readLinearRgb(env.image);
+        environment_ = std::make_unique<EnvironmentLight>(img, env.intensity, env.rotationYDeg);
     }
 }
 

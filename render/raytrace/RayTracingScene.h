@@ -131,6 +131,10 @@ private:
         BoundingSphere bounds;
     };
     glm::vec3 sampleTexture(int texture, glm::vec2 uv) const;
+    // The constructor's steps.
+    void addLights(const Scene& scene);
+    void attach(Geometry g);
+    void loadEnvironment(const Environment& env);
 
     const EmbreeDevice* device_ = nullptr;
     EmbreeScene scene_;

@@ -354,6 +354,42 @@ glm::vec3 gatherPhotons(const PhotonMap& map, const Bsdf& bsdf, const Frame& fra
     return sum / (kPi * r * r);
 }
 
+// Adds to L the light of the scene's punctual lights reflected at `hit` towards wo (local
+// frame) times the path throughput beta, each light's visibility through glass and translucent
+// media included.
+void addPunctualLight(const RayTracingScene& scene, const SurfaceHit& hit, const Bsdf& bsdf,
+                      const Frame& frame, const glm::vec3& wo, const Medium* volume,
+                      const glm::vec3& beta, Rng& rng, glm::vec3& L) {
+    for (const PunctualLight& l : scene.lights()) {
+        glm::vec3 wi;
+        float dist;
+        glm::vec3 Li;
+        if (l.type == Light::Type::Directional) {
+            wi = -l.direction;
+            dist = std::numeric_limits<float>::infinity();
+            Li = l.intensity;
+        } else {
+            glm::vec3 v = l.position - hit.p;
+            float d2 = glm::dot(v, v);
+            if (!(d2 > 0)) continue;
+            dist = std::sqrt(d2);
+            wi = v / dist;
+            Li = l.intensity * (l.spotFactor(glm::dot(l.direction, -wi)) / d2);
+        }
+        if (maxComponent(Li) <= 0) continue;
+        glm::vec3 wiLocal = frame.toLocal(wi);
+        glm::vec3 f = bsdf.eval(wo, wiLocal, TransportMode::Radiance);
+        if (maxComponent(f) <= 0) continue;
+        glm::vec3 so = spawnOrigin(hit, wi);
+        const float T = shadowTransmittance(
+            scene, so, wi,
+            std::isfinite(dist) ? glm::length(l.position - so) * (1.0f - 1e-4f) : dist, volume,
+            rng);
+        if (!(T > 0)) continue;
+        L += beta * f * std::abs(wiLocal.z) * Li * T;
+    }
+}
+
 // Radiance along one camera ray. `firstHitVirtual` reports whether the first surface is virtual.
 glm::vec3 tracePath(const PathContext& ctx, glm::vec3 o, glm::vec3 d, Rng& rng,
                     bool& firstHitVirtual) {
@@ -430,34 +466,7 @@ glm::vec3 tracePath(const PathContext& ctx, glm::vec3 o, glm::vec3 d, Rng& rng,
 
         if (bsdf.hasNonDelta()) {
             // Direct light from punctual lights (delta lights: no MIS).
-            for (const PunctualLight& l : scene.lights()) {
-                glm::vec3 wi;
-                float dist;
-                glm::vec3 Li;
-                if (l.type == Light::Type::Directional) {
-                    wi = -l.direction;
-                    dist = std::numeric_limits<float>::infinity();
-                    Li = l.intensity;
-                } else {
-                    glm::vec3 v = l.position - hit.p;
-                    float d2 = glm::dot(v, v);
-                    if (!(d2 > 0)) continue;
-                    dist = std::sqrt(d2);
-                    wi = v / dist;
-                    Li = l.intensity * (l.spotFactor(glm::dot(l.direction, -wi)) / d2);
-                }
-                if (maxComponent(Li) <= 0) continue;
-                glm::vec3 wiLocal = frame.toLocal(wi);
-                glm::vec3 f = bsdf.eval(wo, wiLocal, TransportMode::Radiance);
-                if (maxComponent(f) <= 0) continue;
-                glm::vec3 so = spawnOrigin(hit, wi);
-                const float T = shadowTransmittance(
-                    scene, so, wi,
-                    std::isfinite(dist) ? glm::length(l.position - so) * (1.0f - 1e-4f) : dist,
-                    volume, rng);
-                if (!(T > 0)) continue;
-                L += beta * f * std::abs(wiLocal.z) * Li * T;
-            }
+            addPunctualLight(scene, hit, bsdf, frame, wo, volume, beta, rng, L);
             // Environment: light sample with MIS against BSDF sampling.
             if (env) {
                 glm::vec3 wi;

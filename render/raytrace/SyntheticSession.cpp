@@ -18,7 +18,7 @@
 #include "core/camera/Radiometry.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
-#include "render/evaluation/GroundTruthComposite.h"
+#include "render/raytrace/GroundTruthComposite.h"
 #include "render/raytrace/ReferenceRenderer.h"
 
 namespace mirage::raytrace {

@@ -3,7 +3,7 @@
 // rendered by the reference renderer along a camera path with exact ground-truth poses, with
 // sensor effects, plus the fish-eye environment camera — and optionally, per frame, the ground-
 // truth composite (the real AND virtual parts rendered the same way) that real-time composites are
-// judged against (render/evaluation/GroundTruthComposite.h). `mirage synth` is this plus argument
+// judged against (render/raytrace/GroundTruthComposite.h). `mirage synth` is this plus argument
 // parsing; tests call it with scenes built in memory.
 #include <cstdint>
 #include <filesystem>

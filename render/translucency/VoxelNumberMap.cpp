@@ -163,25 +163,9 @@ int VoxelNumberMap::surfaceVoxelAt(const glm::vec3& p) const {
     return best;
 }
 
-VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettings& s) {
-    if (s.resolution < 2 || s.resolution > 512)
-        throw Error("voxel number map: resolution " + std::to_string(s.resolution) +
-                    " is outside 2..512");
-    if (o.indices.size() < 3 || o.indices.size() % 3)
-        throw Error("voxel number map: translucent object '" + o.name + "' has no triangles");
-    const auto start = std::chrono::steady_clock::now();
-    VoxelNumberMap m;
-    const std::string key = cacheKey(o, s.resolution);
-    const fs::path cacheFile =
-        s.cacheDir.empty() ? fs::path() : s.cacheDir / ("vnm-" + key + ".bin");
-    if (!cacheFile.empty() && m.readCache(cacheFile)) {
-        m.fromCache_ = true;
-        m.seconds_ =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return m;
-    }
-
-    // ---- voxelise: cubic voxels over the bounding box, one empty voxel of margin ----
+// Cubic voxels over the bounding box with one empty voxel of margin (sets the grid); returns
+// 1 per voxel whose centre is inside the mesh.
+std::vector<uint8_t> VoxelNumberMap::voxelise(const TranslucentObject& o, int resolution) {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (const auto& p : o.positions) {
         lo = glm::min(lo, p);
@@ -191,12 +175,12 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
     const float longest = std::max(extent.x, std::max(extent.y, extent.z));
     if (!(longest > 0) || !std::isfinite(longest))
         throw Error("voxel number map: translucent object '" + o.name + "' has no extent");
-    m.voxelSize_ = longest / float(s.resolution);
-    const float h = m.voxelSize_;
-    m.dims_ = glm::ivec3(glm::ceil(extent / h - 1e-4f)) + 2;
-    m.dims_ = glm::max(m.dims_, glm::ivec3(3));
-    m.origin_ = lo - glm::vec3(h);
-    const glm::ivec3 n = m.dims_;
+    voxelSize_ = longest / float(resolution);
+    const float h = voxelSize_;
+    dims_ = glm::ivec3(glm::ceil(extent / h - 1e-4f)) + 2;
+    dims_ = glm::max(dims_, glm::ivec3(3));
+    origin_ = lo - glm::vec3(h);
+    const glm::ivec3 n = dims_;
     const size_t cells = size_t(n.x) * size_t(n.y) * size_t(n.z);
     std::vector<uint8_t> inside(cells, 0);
     // Inside test by parity along +x rows through the voxel centres (rows nudged off the voxel
@@ -207,14 +191,14 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
         const glm::vec3 a = o.positions[o.indices[t]], b = o.positions[o.indices[t + 1]],
                         c = o.positions[o.indices[t + 2]];
         const glm::vec3 tlo = glm::min(a, glm::min(b, c)), thi = glm::max(a, glm::max(b, c));
-        int y0 = std::max(0, int(std::floor((tlo.y - m.origin_.y) / h - 0.5f)));
-        int y1 = std::min(n.y - 1, int(std::ceil((thi.y - m.origin_.y) / h - 0.5f)));
-        int z0 = std::max(0, int(std::floor((tlo.z - m.origin_.z) / h - 0.5f)));
-        int z1 = std::min(n.z - 1, int(std::ceil((thi.z - m.origin_.z) / h - 0.5f)));
+        int y0 = std::max(0, int(std::floor((tlo.y - origin_.y) / h - 0.5f)));
+        int y1 = std::min(n.y - 1, int(std::ceil((thi.y - origin_.y) / h - 0.5f)));
+        int z0 = std::max(0, int(std::floor((tlo.z - origin_.z) / h - 0.5f)));
+        int z1 = std::min(n.z - 1, int(std::ceil((thi.z - origin_.z) / h - 0.5f)));
         for (int z = z0; z <= z1; ++z)
             for (int y = y0; y <= y1; ++y) {
-                const float py = m.origin_.y + (float(y) + 0.5f) * h + nudgeY;
-                const float pz = m.origin_.z + (float(z) + 0.5f) * h + nudgeZ;
+                const float py = origin_.y + (float(y) + 0.5f) * h + nudgeY;
+                const float pz = origin_.z + (float(z) + 0.5f) * h + nudgeZ;
                 // Barycentric test in the yz projection.
                 const float d = (b.y - a.y) * (c.z - a.z) - (c.y - a.y) * (b.z - a.z);
                 if (std::abs(d) < 1e-20f) continue;
@@ -231,29 +215,41 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
             std::sort(xs.begin(), xs.end());
             for (size_t k = 0; k + 1 < xs.size(); k += 2)
                 for (int x = 0; x < n.x; ++x) {
-                    float px = m.origin_.x + (float(x) + 0.5f) * h;
-                    if (px >= xs[k] && px < xs[k + 1]) inside[size_t(m.cellIndex({x, y, z}))] = 1;
+                    float px = origin_.x + (float(x) + 0.5f) * h;
+                    if (px >= xs[k] && px < xs[k + 1]) inside[size_t(cellIndex({x, y, z}))] = 1;
                 }
         }
 
-    // ---- extinction per voxel: mean of 8 sub-samples of sigma_t inside, 0 outside ----
-    std::vector<float> sigma(cells, 0.0f);
+    return inside;
+}
+
+// Extinction per voxel: the mean of 8 sub-samples of sigma_t inside, 0 outside.
+std::vector<float> VoxelNumberMap::extinction(const TranslucentObject& o,
+                                              const std::vector<uint8_t>& inside) const {
+    const float h = voxelSize_;
+    const glm::ivec3 n = dims_;
+    std::vector<float> sigma(inside.size(), 0.0f);
     for (int z = 0; z < n.z; ++z)
         for (int y = 0; y < n.y; ++y)
             for (int x = 0; x < n.x; ++x) {
-                size_t idx = size_t(m.cellIndex({x, y, z}));
+                size_t idx = size_t(cellIndex({x, y, z}));
                 if (!inside[idx]) continue;
                 float sum = 0.0f;
                 for (int k = 0; k < 8; ++k) {
                     glm::vec3 sub(k & 1 ? 0.75f : 0.25f, k & 2 ? 0.75f : 0.25f,
                                   k & 4 ? 0.75f : 0.25f);
-                    sum += o.medium.sigmaT(m.origin_ + (glm::vec3(x, y, z) + sub) * h);
+                    sum += o.medium.sigmaT(origin_ + (glm::vec3(x, y, z) + sub) * h);
                 }
                 sigma[idx] = sum / 8.0f;
             }
 
-    // ---- the exterior: empty voxels reached from the grid's border (the rest are cavities) ----
-    std::vector<uint8_t> exterior(cells, 0);
+    return sigma;
+}
+
+// The exterior: empty voxels reached from the grid's border (the other empty ones are cavities).
+std::vector<uint8_t> VoxelNumberMap::exteriorOf(const std::vector<uint8_t>& inside) const {
+    const glm::ivec3 n = dims_;
+    std::vector<uint8_t> exterior(inside.size(), 0);
     {
         std::vector<glm::ivec3> stack;
         for (int z = 0; z < n.z; ++z)
@@ -266,7 +262,7 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
             stack.pop_back();
             if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, n)))
                 continue;
-            size_t idx = size_t(m.cellIndex(c));
+            size_t idx = size_t(cellIndex(c));
             if (inside[idx] || exterior[idx]) continue;
             exterior[idx] = 1;
             for (int axis = 0; axis < 3; ++axis)
@@ -278,14 +274,23 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
         }
     }
 
-    // ---- surface voxels: inside with an outside 6-neighbour; normals from 26 neighbours ----
-    m.number_.assign(cells, -1);
+    return exterior;
+}
+
+// Surface voxels: inside with an outside 6-neighbour, normals from 26 neighbours, areas the
+// mesh's area shared in proportion to each voxel's exposed faces.
+void VoxelNumberMap::findSurface(const TranslucentObject& o, const VnmSettings& s,
+                                 const std::vector<uint8_t>& inside,
+                                 const std::vector<uint8_t>& exterior) {
+    const float h = voxelSize_;
+    const glm::ivec3 n = dims_;
+    number_.assign(inside.size(), -1);
     int exposedTotal = 0;
     std::vector<int> exposed;
     auto isInside = [&](glm::ivec3 q) {
         if (glm::any(glm::lessThan(q, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(q, n)))
             return false;
-        return inside[size_t(m.cellIndex(q))] != 0;
+        return inside[size_t(cellIndex(q))] != 0;
     };
     for (int z = 0; z < n.z; ++z)
         for (int y = 0; y < n.y; ++y)
@@ -300,7 +305,7 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
                         q[axis] += sgn;
                         if (isInside(q)) continue;
                         ++faces;
-                        outer = outer || exterior[size_t(m.cellIndex(q))];
+                        outer = outer || exterior[size_t(cellIndex(q))];
                     }
                 if (!faces) continue;
                 glm::vec3 normal(0.0f);
@@ -314,14 +319,14 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
                 SurfaceVoxel sv;
                 sv.cell = c;
                 sv.exterior = outer ? 1 : 0;
-                sv.position = m.origin_ + (glm::vec3(c) + 0.5f) * h;
+                sv.position = origin_ + (glm::vec3(c) + 0.5f) * h;
                 sv.normal = glm::length(normal) > 0 ? glm::normalize(normal) : glm::vec3(0, 1, 0);
-                m.number_[size_t(m.cellIndex(c))] = int32_t(m.surface_.size());
-                m.surface_.push_back(sv);
+                number_[size_t(cellIndex(c))] = int32_t(surface_.size());
+                surface_.push_back(sv);
                 exposed.push_back(faces);
                 exposedTotal += faces;
             }
-    const size_t S = m.surface_.size();
+    const size_t S = surface_.size();
     if (S == 0)
         throw Error("voxel number map: translucent object '" + o.name +
                     "' has no inside voxel at "
@@ -341,17 +346,23 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
         area += 0.5 * double(glm::length(
                           glm::cross(o.positions[o.indices[t + 1]] - o.positions[o.indices[t]],
                                      o.positions[o.indices[t + 2]] - o.positions[o.indices[t]])));
-    for (size_t i = 0; i < S; ++i) m.surface_[i].area = float(area * exposed[i] / exposedTotal);
+    for (size_t i = 0; i < S; ++i) surface_[i].area = float(area * exposed[i] / exposedTotal);
     // The outer surface's area: light leaves the object only there (a cavity wall passes what
     // reaches it on through the cavity, which the LUT's optical thickness already skips).
-    m.area_ = 0.0f;
-    for (const SurfaceVoxel& v : m.surface_) m.area_ += v.exterior ? v.area : 0.0f;
+    area_ = 0.0f;
+    for (const SurfaceVoxel& v : surface_) area_ += v.exterior ? v.area : 0.0f;
+}
 
-    // ---- optical thickness between every pair: 3D DDA through the voxel extinctions ----
-    m.tau_.assign(S * S, 0);
+// Optical thickness between every pair of surface voxels (3D DDA through the voxel
+// extinctions), and the kernel scales c_i = 1/W_i - 1/A.
+void VoxelNumberMap::opticalThickness(const std::vector<float>& sigma, int threads) {
+    const float h = voxelSize_;
+    const glm::ivec3 n = dims_;
+    const size_t S = surface_.size();
+    tau_.assign(S * S, 0);
     auto march = [&](glm::vec3 a, glm::vec3 b) {
         // Voxel-space coordinates.
-        glm::vec3 pa = (a - m.origin_) / h, pb = (b - m.origin_) / h;
+        glm::vec3 pa = (a - origin_) / h, pb = (b - origin_) / h;
         glm::vec3 d = pb - pa;
         float len = glm::length(d);
         if (len <= 0) return 0.0f;
@@ -375,7 +386,7 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
             int k = tMax.x < tMax.y ? (tMax.x < tMax.z ? 0 : 2) : (tMax.y < tMax.z ? 1 : 2);
             float tNext = std::min(tMax[k], 1.0f);
             if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, n)))
-                tau += sigma[size_t(m.cellIndex(c))] * (tNext - t);
+                tau += sigma[size_t(cellIndex(c))] * (tNext - t);
             if (tNext >= 1.0f || c == last) break;
             t = tNext;
             c[k] += step[k];
@@ -383,23 +394,44 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
         }
         return tau * len * h;
     };
-    parallelFor(int(S), threadCount(s.threads), [&](int i) {
+    parallelFor(int(S), threadCount(threads), [&](int i) {
         for (size_t j = size_t(i) + 1; j < S; ++j) {
             uint16_t v = glm::packHalf1x16(
-                std::min(65000.0f, march(m.surface_[size_t(i)].position, m.surface_[j].position)));
-            m.tau_[size_t(i) * S + j] = v;
-            m.tau_[j * S + size_t(i)] = v;
+                std::min(65000.0f, march(surface_[size_t(i)].position, surface_[j].position)));
+            tau_[size_t(i) * S + j] = v;
+            tau_[j * S + size_t(i)] = v;
         }
     });
-    // Kernel scales c_i = 1/W_i - 1/A.
-    parallelFor(int(S), threadCount(s.threads), [&](int i) {
+    parallelFor(int(S), threadCount(threads), [&](int i) {
         double W = 0.0;
         for (size_t j = 0; j < S; ++j)
-            if (m.surface_[j].exterior)
-                W += m.surface_[j].area * std::exp(-double(m.tau(i, int(j))));
-        m.surface_[size_t(i)].kernelScale =
-            W > 0 ? float(std::max(0.0, 1.0 / W - 1.0 / double(m.area_))) : 0.0f;
+            if (surface_[j].exterior) W += surface_[j].area * std::exp(-double(tau(i, int(j))));
+        surface_[size_t(i)].kernelScale =
+            W > 0 ? float(std::max(0.0, 1.0 / W - 1.0 / double(area_))) : 0.0f;
     });
+}
+
+VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettings& s) {
+    if (s.resolution < 2 || s.resolution > 512)
+        throw Error("voxel number map: resolution " + std::to_string(s.resolution) +
+                    " is outside 2..512");
+    if (o.indices.size() < 3 || o.indices.size() % 3)
+        throw Error("voxel number map: translucent object '" + o.name + "' has no triangles");
+    const auto start = std::chrono::steady_clock::now();
+    VoxelNumberMap m;
+    const std::string key = cacheKey(o, s.resolution);
+    const fs::path cacheFile =
+        s.cacheDir.empty() ? fs::path() : s.cacheDir / ("vnm-" + key + ".bin");
+    if (!cacheFile.empty() && m.readCache(cacheFile)) {
+        m.fromCache_ = true;
+        m.seconds_ =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return m;
+    }
+
+    const std::vector<uint8_t> inside = m.voxelise(o, s.resolution);
+    m.findSurface(o, s, inside, m.exteriorOf(inside));
+    m.opticalThickness(m.extinction(o, inside), s.threads);
     m.seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!cacheFile.empty()) m.writeCache(cacheFile);
     return m;

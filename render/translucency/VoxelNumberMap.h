@@ -114,6 +114,14 @@ public:
 
 private:
     int cellIndex(glm::ivec3 c) const { return (c.z * dims_.y + c.y) * dims_.x + c.x; }
+    // The steps of build().
+    std::vector<uint8_t> voxelise(const TranslucentObject& o, int resolution);
+    std::vector<float> extinction(const TranslucentObject& o,
+                                  const std::vector<uint8_t>& inside) const;
+    std::vector<uint8_t> exteriorOf(const std::vector<uint8_t>& inside) const;
+    void findSurface(const TranslucentObject& o, const VnmSettings& s,
+                     const std::vector<uint8_t>& inside, const std::vector<uint8_t>& exterior);
+    void opticalThickness(const std::vector<float>& sigma, int threads);
     bool readCache(const std::filesystem::path& file);
     void writeCache(const std::filesystem::path& file) const;
 

@@ -18,6 +18,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/caustic/CausticPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/render/CausticReference.h"
@@ -67,7 +68,7 @@ Realtime realtime(const test::CausticScene& s, const cv::Mat& footage, RendererO
     out.composite = r.compositeSrgb();
     out.linear = r.compositeLinear();
     EXPECT_TRUE(cv::checkRange(out.linear)) << "NaN/Inf in the composite";
-    out.caustic = out.report.ran("caustic") ? r.readBuffer(Resource::CausticRv)
+    out.caustic = out.report.ran("caustic") ? r.readBuffer(kCausticRv)
                                             : cv::Mat::zeros(footage.size(), CV_32FC3);
     EXPECT_TRUE(cv::checkRange(out.caustic)) << "NaN/Inf in the caustic buffer";
     return out;
@@ -292,8 +293,8 @@ TEST(CausticRouting, CausticReachesLrOnlyWhenLightObjectAndReceiverAreReal) {
         Renderer r(s.scene, s.cam, opt);
         const FrameReport& rep = r.render({s.pose, cv::Mat(), true});
         ASSERT_TRUE(rep.ran("caustic")) << rep.summary();
-        const double rv = cv::sum(linearLuminance(r.readBuffer(Resource::CausticRv)))[0];
-        const double lr = cv::sum(linearLuminance(r.readBuffer(Resource::CausticR)))[0];
+        const double rv = cv::sum(linearLuminance(r.readBuffer(kCausticRv)))[0];
+        const double lr = cv::sum(linearLuminance(r.readBuffer(kCausticR)))[0];
         std::cout << "[ caustics ] light " << (o.lightReal ? "R" : "V") << ", glass "
                   << (o.sphereReal ? "R" : "V") << ", table " << (o.tableReal ? "R" : "V")
                   << ": caustic in L_rv " << rv << ", in L_r " << lr << "\n";

@@ -16,6 +16,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/render/CausticReference.h"
@@ -99,9 +100,9 @@ Realtime realtime(const test::CausticScene& s, const cv::Mat& footage, bool gath
     out.report = r.render({s.pose, footage, true});
     out.composite = r.compositeSrgb();
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
-    out.specRv = r.readBuffer(Resource::SpecularRv);
-    out.specR = r.readBuffer(Resource::SpecularR);
-    out.lenv = r.readBuffer(Resource::Lenv);
+    out.specRv = r.readBuffer(kSpecularRv);
+    out.specR = r.readBuffer(kSpecularR);
+    out.lenv = r.readBuffer(kLenv);
     for (const cv::Mat* m : {&out.specRv, &out.specR, &out.lenv})
         EXPECT_TRUE(cv::checkRange(*m)) << "NaN/Inf in the specular buffers";
     return out;

@@ -21,6 +21,8 @@
 #include "core/scene/ScenePlacement.h"
 #include "render/Renderer.h"
 #include "render/evaluation/PoseJitter.h"
+#include "render/passes/caustic/CausticPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "tests/render/CausticReference.h"
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
@@ -63,8 +65,7 @@ std::string passReason(const FrameReport& r, const std::string& name) {
 }
 
 cv::Mat causticLuminance(const Renderer& r, Judged judged = Judged::Caustic) {
-    const cv::Mat c =
-        r.readBuffer(judged == Judged::Caustic ? Resource::CausticRv : Resource::SpecularRv);
+    const cv::Mat c = r.readBuffer(judged == Judged::Caustic ? kCausticRv : kSpecularRv);
     EXPECT_TRUE(cv::checkRange(c)) << "NaN/Inf in the judged buffer";
     return test::linearLuminance(c);
 }

@@ -16,6 +16,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "tests/render/CausticReference.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
@@ -51,7 +52,7 @@ Realtime realtime(const test::CausticScene& s, const cv::Mat& footage, RendererO
     out.report = r.render({s.pose, footage, true});
     out.composite = r.compositeSrgb();
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
-    out.specRv = out.report.ran("speclight") ? r.readBuffer(Resource::SpecularRv)
+    out.specRv = out.report.ran("speclight") ? r.readBuffer(kSpecularRv)
                                              : cv::Mat::zeros(footage.size(), CV_32FC3);
     EXPECT_TRUE(cv::checkRange(out.specRv)) << "NaN/Inf in L'_rv";
     return out;

@@ -20,6 +20,8 @@
 #include "render/EnvironmentLights.h"
 #include "render/Renderer.h"
 #include "render/SessionEnvironment.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
@@ -142,8 +144,8 @@ std::vector<FrameMeasure> replayTopDown(const fs::path& sessionDir, int environm
             m.lightAzimuthDeg = azimuthDeg(d.x, -d.z);
             m.lightElevationDeg = glm::degrees(std::asin(d.y));
         }
-        const cv::Mat pos = r.readBuffer(Resource::GBufferPosition);
-        const cv::Mat rv = r.readBuffer(Resource::DirectRv), rr = r.readBuffer(Resource::DirectR);
+        const cv::Mat pos = r.readBuffer(kGBufferPosition);
+        const cv::Mat rv = r.readBuffer(kDirectRv), rr = r.readBuffer(kDirectR);
         const cv::Mat cov = r.coverage();
         glm::dvec2 sum(0.0);
         int table = 0;

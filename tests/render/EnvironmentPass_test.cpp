@@ -14,6 +14,7 @@
 #include "core/camera/EquirectProjection.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/SyntheticFootage.h"
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
@@ -253,7 +254,7 @@ TEST_F(EnvironmentPassTest, DiffuseLightFollowsEachNewFrameAndOnlyThen) {
     Renderer r(floorScene(0.5f), cam);
     const Pose view = lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
     auto floor = [&] {
-        return r.readBuffer(Resource::DirectRv).at<cv::Vec3f>(cam.height / 2, cam.width / 2)[0];
+        return r.readBuffer(kDirectRv).at<cv::Vec3f>(cam.height / 2, cam.width / 2)[0];
     };
     r.render({view, {}, false});
     EXPECT_FALSE(r.lastReport().reused("environment"));
@@ -310,7 +311,7 @@ TEST_F(EnvironmentPassTest, LightingTurnsWithTheEnvironmentWithinOneFrame) {
         };
     };
     auto faces = [&] {
-        const cv::Mat rv = r.readBuffer(Resource::DirectRv);
+        const cv::Mat rv = r.readBuffer(kDirectRv);
         auto at = [&](glm::dvec3 w) {
             const auto px = cam.project(view.inverse() * w);
             EXPECT_TRUE(px.has_value());

@@ -12,6 +12,7 @@
 #include "core/scene/Scene.h"
 #include "render/FrameContext.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
@@ -39,11 +40,11 @@ Buffers render(const Scene& scene, bool keepDirect, int vplCount) {
     const FrameReport& report = r.render({kPose, footage, true});
     Buffers b;
     b.gathered = report.ran("gifilter");
-    b.lightRv = r.readBuffer(Resource::LRv);
-    b.lightR = r.readBuffer(Resource::LR);
+    b.lightRv = r.readBuffer(kLRv);
+    b.lightR = r.readBuffer(kLR);
     if (keepDirect || !b.gathered) {
-        b.directRv = r.readBuffer(Resource::DirectRv);
-        b.directR = r.readBuffer(Resource::DirectR);
+        b.directRv = r.readBuffer(kDirectRv);
+        b.directR = r.readBuffer(kDirectR);
     }
     b.composite = r.compositeLinear();
     return b;

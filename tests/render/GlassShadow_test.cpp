@@ -14,6 +14,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
@@ -70,7 +71,7 @@ TEST(GlassShadow, ShadowOfGlassIsLitLikeTheReferenceAndOpaqueFails) {
         r.render({s.pose, ref.footage, true});
         const cv::Mat lin = r.compositeLinear();
         EXPECT_TRUE(cv::checkRange(lin));
-        if (lr) *lr = r.readBuffer(Resource::LR);
+        if (lr) *lr = r.readBuffer(kLR);
         return lin;
     };
     cv::Mat lr;

@@ -18,10 +18,11 @@
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
 #include "render/Renderer.h"
-#include "render/evaluation/GroundTruthComposite.h"
 #include "render/evaluation/ImageComparison.h"
 #include "render/evaluation/RealtimeBench.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
+#include "render/raytrace/GroundTruthComposite.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
@@ -301,8 +302,8 @@ TEST(RealtimeBench, HardCasesStayFiniteThroughGroundTruthAndBench) {
     Renderer renderer(scene, camera);
     for (const auto& f : frames) {
         renderer.render({f.T_world_camera, f.footage, true});
-        for (const cv::Mat& m : {renderer.compositeLinear(), renderer.readBuffer(Resource::LRv),
-                                 renderer.readBuffer(Resource::LR)})
+        for (const cv::Mat& m :
+             {renderer.compositeLinear(), renderer.readBuffer(kLRv), renderer.readBuffer(kLR)})
             EXPECT_TRUE(cv::checkRange(m, true, nullptr, -1e30, 1e30));
     }
 }

@@ -12,6 +12,7 @@
 #include "core/Error.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
@@ -117,7 +118,7 @@ TEST_F(RealtimeRenderer, SpotLitPlaneMatchesClosedForm) {
     const FrameReport& rep = r.render({s.pose, {}, false});
     EXPECT_TRUE(rep.ran("gbuffer"));
     EXPECT_TRUE(rep.ran("direct"));
-    cv::Mat rv = r.readBuffer(Resource::DirectRv), lr = r.readBuffer(Resource::DirectR);
+    cv::Mat rv = r.readBuffer(kDirectRv), lr = r.readBuffer(kDirectR);
     int inside = 0, outside = 0;
     for (int y = 0; y < s.cam.height; ++y)
         for (int x = 0; x < s.cam.width; ++x) {
@@ -159,7 +160,7 @@ TEST_F(RealtimeRenderer, PointAndDirectionalLightsMatchClosedForm) {
         const FrameReport& rep = r.render({pose, {}, false});
         ASSERT_TRUE(rep.ran("shadow"));
         EXPECT_EQ(r.plan().lights[0].layers, type == Light::Type::Point ? 6 : 1);
-        cv::Mat rv = r.readBuffer(Resource::DirectRv), lr = r.readBuffer(Resource::DirectR);
+        cv::Mat rv = r.readBuffer(kDirectRv), lr = r.readBuffer(kDirectR);
         cv::Mat cover = r.coverage();
         int lit = 0, shadowed = 0;
         for (int y = 0; y < cam.height; ++y)
@@ -213,7 +214,7 @@ TEST_F(RealtimeRenderer, ClosedFormComparisonFailsOnBrokenRender) {
     auto renderMasked = [&](const Scene& scene, const Pose& pose) {
         Renderer r(scene, s.cam);
         r.render({pose, {}, false});
-        cv::Mat got = r.readBuffer(Resource::DirectRv), out(got.size(), got.type(), cv::Scalar(0));
+        cv::Mat got = r.readBuffer(kDirectRv), out(got.size(), got.type(), cv::Scalar(0));
         got.copyTo(out, mask);
         return out;
     };
@@ -249,13 +250,13 @@ TEST_F(RealtimeRenderer, VirtualShadowOnlyInLrv) {
     Renderer r(s.scene, s.cam, opt);
     // Footage: the real world alone, as the camera would see it (L_r, sRGB-encoded).
     r.render({s.pose, {}, false});
-    cv::Mat footage = linearRgbToSrgbBgr8(r.readBuffer(Resource::LR));
+    cv::Mat footage = linearRgbToSrgbBgr8(r.readBuffer(kLR));
     const FrameReport& rep = r.render({s.pose, footage, false});
     // Second frame, same plan: the shadow maps and VPLs of the first are reused.
     EXPECT_TRUE(rep.reused("shadow")) << rep.summary();
     EXPECT_TRUE(rep.reused("vpl")) << rep.summary();
     EXPECT_TRUE(r.plan().lights[0].needsRealOnlyMap);
-    cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
+    cv::Mat drv = r.readBuffer(kDirectRv), dr = r.readBuffer(kDirectR);
     cv::Mat comp = r.compositeLinear(), cover = r.coverage();
     cv::Mat ci = srgbBgr8ToLinearRgb(footage);
 
@@ -317,7 +318,7 @@ TEST_F(RealtimeRenderer, RealOnlySceneCompositeEqualsFootage) {
     ASSERT_TRUE(rep.ran("vpl")) << rep.summary();
     ASSERT_TRUE(rep.ran("ism"));
     ASSERT_TRUE(rep.ran("gifilter"));
-    cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
+    cv::Mat rv = r.readBuffer(kLRv), lr = r.readBuffer(kLR);
     EXPECT_LE(cv::norm(rv, lr, cv::NORM_INF), 1e-6);
     EXPECT_GT(cv::norm(rv, cv::NORM_INF), 0.1);  // something was lit
     EXPECT_GT(test::psnr(r.compositeSrgb(), footage, 255.0), 50.0);
@@ -337,8 +338,7 @@ TEST_F(RealtimeRenderer, ZeroLrIsGuarded) {
     Renderer r(scene, cam);
     cv::Mat footage(cam.height, cam.width, CV_8UC3, cv::Scalar(40, 90, 140));
     r.render({pose, footage, false});
-    cv::Mat comp = r.compositeLinear(), lr = r.readBuffer(Resource::DirectR),
-            rv = r.readBuffer(Resource::DirectRv);
+    cv::Mat comp = r.compositeLinear(), lr = r.readBuffer(kDirectR), rv = r.readBuffer(kDirectRv);
     ASSERT_TRUE(allFinite(comp));
     EXPECT_EQ(cv::norm(lr, cv::NORM_INF), 0.0);  // a virtual light never reaches L_r
     EXPECT_GT(cv::norm(rv, cv::NORM_INF), 0.5);  // but lights the grey tile in L_rv
@@ -367,7 +367,7 @@ TEST_F(RealtimeRenderer, BrightLightAndNearPlaneStayFinite) {
     cv::Mat footage(cam.height, cam.width, CV_8UC3, cv::Scalar(200, 200, 200));
     const FrameReport& rep = r.render({pose, footage, false});
     ASSERT_TRUE(rep.ran("vpl")) << rep.summary();
-    for (Resource b : {Resource::DirectRv, Resource::DirectR, Resource::LRv, Resource::LR})
+    for (Resource b : {kDirectRv, kDirectR, kLRv, kLR})
         EXPECT_TRUE(allFinite(r.readBuffer(b))) << resourceName(b);
     EXPECT_TRUE(allFinite(r.compositeLinear()));
     EXPECT_GT(cv::countNonZero(r.coverage() == 2), 50);
@@ -475,14 +475,14 @@ TEST_F(RealtimeRenderer, VirtualColourBleedsOntoRealFloor) {
     const Pose pose = lookAtPose({-0.5, 1.6, 2.2}, {0.1, 0.0, 0.0});
     Renderer r(scene, cam, directLightKept());
     r.render({pose, {}, false});
-    cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
+    cv::Mat rv = r.readBuffer(kLRv), lr = r.readBuffer(kLR);
     // For inspection (linear EXR; PNG is sRGB-encoded).
     const auto out = test::outputDir("realtime_bleed");
     writeLinearRgb(out / "L_rv.exr", rv);
     writeLinearRgb(out / "L_r.exr", lr);
     writeLinearRgb(out / "L_rv.png", rv);
     writeLinearRgb(out / "L_r.png", lr);
-    cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
+    cv::Mat drv = r.readBuffer(kDirectRv), dr = r.readBuffer(kDirectR);
     cv::Mat cover = r.coverage();
     double sumR = 0, sumG = 0;
     int n = 0;
@@ -551,8 +551,8 @@ TEST_F(RealtimeRenderer, VirtualOccluderBlocksBouncedLightOnlyInLrv) {
     Renderer r(scene, cam, directLightKept());
     const FrameReport& rep = r.render({pose, {}, false});
     ASSERT_TRUE(rep.ran("ism")) << rep.summary();
-    cv::Mat rv = r.readBuffer(Resource::LRv), lr = r.readBuffer(Resource::LR);
-    cv::Mat drv = r.readBuffer(Resource::DirectRv), dr = r.readBuffer(Resource::DirectR);
+    cv::Mat rv = r.readBuffer(kLRv), lr = r.readBuffer(kLR);
+    cv::Mat drv = r.readBuffer(kDirectRv), dr = r.readBuffer(kDirectR);
     cv::Mat cover = r.coverage();
     double indRv = 0, indR = 0;
     int n = 0;
@@ -581,10 +581,10 @@ TEST_F(RealtimeRenderer, TemporalHistoryUsedAndReset) {
     Renderer r(s.scene, s.cam);
     r.render({s.pose, {}, false});
     EXPECT_NE(r.lastReport().summary().find("history reset"), std::string::npos);
-    cv::Mat first = r.readBuffer(Resource::LRv);
+    cv::Mat first = r.readBuffer(kLRv);
     r.render({s.pose, {}, false});
     EXPECT_NE(r.lastReport().summary().find("history used"), std::string::npos);
-    cv::Mat second = r.readBuffer(Resource::LRv);
+    cv::Mat second = r.readBuffer(kLRv);
     EXPECT_GT(test::psnr(first, second, 1.0), 50.0);  // static: nothing to flicker
     r.render({s.pose, {}, true});
     EXPECT_NE(r.lastReport().summary().find("history reset"), std::string::npos);
@@ -592,7 +592,7 @@ TEST_F(RealtimeRenderer, TemporalHistoryUsedAndReset) {
     for (int i = 0; i < 3; ++i) {
         Pose p = lookAtPose({0.1 * i, 2.5, 2.5}, {0, 0, 0});
         r.render({p, {}, false});
-        EXPECT_TRUE(allFinite(r.readBuffer(Resource::LRv)));
+        EXPECT_TRUE(allFinite(r.readBuffer(kLRv)));
     }
 }
 
@@ -610,10 +610,10 @@ TEST_F(RealtimeRenderer, TemporalHistoryReachesTheImage) {
     smoothed.render({before, {}, false});
     smoothed.render({after, {}, false});
     ASSERT_TRUE(smoothed.lastReport().summary().find("history used") != std::string::npos);
-    const cv::Mat withHistory = smoothed.readBuffer(Resource::LRv);
+    const cv::Mat withHistory = smoothed.readBuffer(kLRv);
     Renderer fresh(s.scene, s.cam);
     fresh.render({after, {}, true});
-    const cv::Mat withoutHistory = fresh.readBuffer(Resource::LRv);
+    const cv::Mat withoutHistory = fresh.readBuffer(kLRv);
     double maxDiff = 0.0;
     const cv::Mat diff = cv::abs(withHistory - withoutHistory);
     cv::minMaxLoc(diff.reshape(1), nullptr, &maxDiff);
@@ -637,7 +637,7 @@ TEST_F(RealtimeRenderer, ConstantEnvironmentGivesAlbedoTimesRadiance) {
     const CameraIntrinsics cam = smallCamera();
     Renderer r(scene, cam);
     r.render({lookAtPose({0, 2.5, 2.5}, {0, 0, 0}), {}, false});
-    cv::Mat rv = r.readBuffer(Resource::DirectRv);
+    cv::Mat rv = r.readBuffer(kDirectRv);
     // Lambert part 0.5 * 0.7 = 0.35 (plus (1-F) weighting: F0 = 0.04 -> within 5 %).
     const cv::Vec3f c = rv.at<cv::Vec3f>(cam.height / 2, cam.width / 2);
     EXPECT_NEAR(c[0], 0.35, 0.35 * 0.05);
@@ -668,7 +668,7 @@ TEST_F(RealtimeRenderer, BaseColorTextureIsDecodedAndMapped) {
     const Pose pose = lookAtPose({0, 4.0, 0.5}, {0, 0, 0});
     Renderer r(scene, cam);
     r.render({pose, {}, false});
-    cv::Mat rv = r.readBuffer(Resource::DirectRv);
+    cv::Mat rv = r.readBuffer(kDirectRv);
     auto at = [&](glm::dvec3 w) {
         auto px = cam.project(pose.inverse() * w);
         EXPECT_TRUE(px.has_value());

@@ -16,6 +16,8 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
@@ -177,10 +179,8 @@ StepPixels specularAtHitSteps(const Comparison& c, const test::SpecularScene& s,
     opt.temporalBlend = 0.0f;
     Renderer r(s.scene, s.cam, opt);
     r.render({s.pose, c.footage, true});
-    StepPixels out{r.readBuffer(Resource::SpecularRv),
-                   cv::Mat(c.mask.size(), CV_8U, cv::Scalar(0))};
-    const cv::Mat hits[2] = {r.readBuffer(Resource::ReflectionNormal),
-                             r.readBuffer(Resource::RefractionNormal)};
+    StepPixels out{r.readBuffer(kSpecularRv), cv::Mat(c.mask.size(), CV_8U, cv::Scalar(0))};
+    const cv::Mat hits[2] = {r.readBuffer(kReflectionNormal), r.readBuffer(kRefractionNormal)};
     for (int y = 1; y + 1 < c.mask.rows; ++y)
         for (int x = 1; x + 1 < c.mask.cols; ++x) {
             if (c.mask.at<uint8_t>(y, x) == 0) continue;

@@ -16,6 +16,9 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
@@ -26,8 +29,7 @@ namespace {
 
 void expectFiniteBuffers(const Renderer& r) {
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "composite";
-    for (Resource res : {Resource::SpecularRv, Resource::SpecularR, Resource::Lenv,
-                         Resource::ReflectionGBuffer, Resource::RefractionGBuffer}) {
+    for (Resource res : {kSpecularRv, kSpecularR, kLenv, kReflectionGBuffer, kRefractionGBuffer}) {
         const cv::Mat b = r.readBuffer(res);
         EXPECT_TRUE(cv::checkRange(b)) << resourceName(res);
     }
@@ -263,7 +265,7 @@ TEST(SpecularHardCases, RaysLeavingTheSceneShowTheEnvironment) {
     Renderer r(s.scene, s.cam, singleFrame());
     r.render({s.pose, ref.footage, true});
     expectFiniteBuffers(r);
-    const cv::Mat env = r.readBuffer(Resource::Lenv);
+    const cv::Mat env = r.readBuffer(kLenv);
     EXPECT_GT(cv::mean(env)[2], 0.0);
     const cv::Mat mask = test::sphereMask(s, 1.5);
     const double p = test::psnr(r.compositeSrgb(), ref.composite, 255.0, mask);
@@ -363,7 +365,7 @@ TEST(SpecularHardCases, EveryMirrorPixelIsShadedAtTheImageEdgeAndUpClose) {
         // The early-depth mask the specular passes shade through (docs/specular.md): depth 0
         // on exactly the mirror pixels, 1 everywhere else (this camera has no lens distortion,
         // so canvas and camera pixels coincide).
-        const cv::Mat mask = r.readBuffer(Resource::SpecularMask);
+        const cv::Mat mask = r.readBuffer(kSpecularMask);
         ASSERT_EQ(mask.size(), coverage.size()) << v.what;
         int maskWrong = 0;
         for (int y = 0; y < mask.rows; ++y)
@@ -447,13 +449,13 @@ TEST(SpecularHardCases, RealSurfacesAreTheNearestRealSurfaceUnderVirtualObjects)
         Renderer r(s.scene, s.cam, singleFrame());
         const FrameReport& rep = r.render({s.pose, cv::Mat(), true});
         ASSERT_TRUE(rep.ran("backface")) << rep.summary();
-        realSurfaces = r.readBuffer(Resource::RealSurfaces);
-        mixedPosition = r.readBuffer(Resource::GBufferPosition);
+        realSurfaces = r.readBuffer(kRealSurfaces);
+        mixedPosition = r.readBuffer(kGBufferPosition);
     }
     {
         Renderer r(realOnly, s.cam, singleFrame());
         r.render({s.pose, cv::Mat(), true});
-        realPosition = r.readBuffer(Resource::GBufferPosition);
+        realPosition = r.readBuffer(kGBufferPosition);
     }
     ASSERT_EQ(realSurfaces.size(), realPosition.size());
     auto differing = [](const cv::Mat& a, const cv::Mat& b) {

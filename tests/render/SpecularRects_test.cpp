@@ -16,6 +16,10 @@
 #include "core/scene/Scene.h"
 #include "render/FrameContext.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
@@ -92,11 +96,11 @@ void renderFrame(Renderer& r, const Pose& pose) {
 Frame readFrame(const Renderer& r) {
     Frame f;
     f.composite = r.compositeLinear();
-    f.reflection = r.readBuffer(Resource::ReflectionGBuffer);
-    f.refraction = r.readBuffer(Resource::RefractionGBuffer);
-    f.specularRv = r.readBuffer(Resource::SpecularRv);
-    f.directRv = r.readBuffer(Resource::DirectRv);
-    f.lightRv = r.readBuffer(Resource::LRv);
+    f.reflection = r.readBuffer(kReflectionGBuffer);
+    f.refraction = r.readBuffer(kRefractionGBuffer);
+    f.specularRv = r.readBuffer(kSpecularRv);
+    f.directRv = r.readBuffer(kDirectRv);
+    f.lightRv = r.readBuffer(kLRv);
     f.rects = r.specularRects();
     f.glassRects = r.refractiveRects();
     return f;
@@ -188,8 +192,8 @@ TEST_F(SpecularRectsRender, DiffusePassesSkipTheSpecularPixelsAndChangeNoComposi
         Renderer r(scene, camera, o);
         const cv::Mat footage(camera.height, camera.width, CV_8UC3, cv::Scalar(90, 110, 130));
         r.render({kPose, footage, true});
-        return std::make_tuple(r.compositeLinear(), r.readBuffer(Resource::DirectRv),
-                               r.readBuffer(Resource::LRv), r.readBuffer(Resource::SpecularMask));
+        return std::make_tuple(r.compositeLinear(), r.readBuffer(kDirectRv), r.readBuffer(kLRv),
+                               r.readBuffer(kSpecularMask));
     };
     const auto [skipped, skippedDirect, skippedLight, mask] = renderWith(false, kCamera);
     const auto [shaded, shadedDirect, shadedLight, mask2] = renderWith(true, kCamera);
@@ -241,15 +245,14 @@ TEST_F(SpecularRectsRender, RoughPassesLeaveNoPixelOfTheFrameBefore) {
     const Pose other = test::lookAtPose({0.45, 0.30, 0.10}, {-0.10, 0.02, -0.05});
     Renderer moved(scene, kCamera, options(true));
     renderFrame(moved, other);
-    const cv::Mat before = moved.readBuffer(Resource::FuzzySpecularRv);
-    const cv::Mat beforeRough = moved.readBuffer(Resource::RoughSpecularRv);
+    const cv::Mat before = moved.readBuffer(kFuzzySpecularRv);
+    const cv::Mat beforeRough = moved.readBuffer(kRoughSpecularRv);
     renderFrame(moved, kPose);
     Renderer fresh(scene, kCamera, options(true));
     renderFrame(fresh, kPose);
-    ASSERT_GT(maxAbsDiff(before, fresh.readBuffer(Resource::FuzzySpecularRv)), 1e-2);
-    ASSERT_GT(maxAbsDiff(beforeRough, fresh.readBuffer(Resource::RoughSpecularRv)), 1e-2);
-    for (Resource r : {Resource::FuzzySpecularRv, Resource::FuzzyReflectionVideo,
-                       Resource::RoughSpecularRv, Resource::RoughVideo})
+    ASSERT_GT(maxAbsDiff(before, fresh.readBuffer(kFuzzySpecularRv)), 1e-2);
+    ASSERT_GT(maxAbsDiff(beforeRough, fresh.readBuffer(kRoughSpecularRv)), 1e-2);
+    for (Resource r : {kFuzzySpecularRv, kFuzzyReflectionVideo, kRoughSpecularRv, kRoughVideo})
         EXPECT_LT(maxAbsDiff(moved.readBuffer(r), fresh.readBuffer(r)), 1e-5) << resourceName(r);
     EXPECT_LT(maxAbsDiff(moved.compositeLinear(), fresh.compositeLinear()), 1e-5);
 }

@@ -18,6 +18,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
@@ -99,7 +100,7 @@ Frame renderRealtime(const RelayScene& s, const cv::Mat& footage, RendererOption
     f.report = r.render({s.pose, footage, true});
     f.vpls = sumVpls(r.readVpls());
     f.composite = r.compositeSrgb();
-    f.lrv = r.readBuffer(Resource::LRv);
+    f.lrv = r.readBuffer(kLRv);
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
     return f;
 }

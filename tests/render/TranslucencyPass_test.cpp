@@ -15,6 +15,8 @@
 #include "core/image/ImageCompare.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
 #include "render/raytrace/SyntheticFootage.h"
 #include "render/translucency/VoxelNumberMap.h"
 #include "tests/support/HeadlessGlSuite.h"
@@ -52,9 +54,9 @@ Realtime renderRealtime(const Scene& scene, bool translucency = true) {
     Realtime out;
     out.ran = rep.ran("translucency");
     out.summary = rep.summary();
-    out.rv = r.readBuffer(Resource::DirectRv);
-    out.r = r.readBuffer(Resource::DirectR);
-    out.position = r.readBuffer(Resource::GBufferPosition);
+    out.rv = r.readBuffer(kDirectRv);
+    out.r = r.readBuffer(kDirectR);
+    out.position = r.readBuffer(kGBufferPosition);
     return out;
 }
 
@@ -194,7 +196,7 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     opt.vnmResolution = 8;
     Renderer r(scene, cam.intrinsics, opt);
     auto objectMean = [&](const cv::Mat& rv) {
-        const cv::Mat pos = r.readBuffer(Resource::GBufferPosition);
+        const cv::Mat pos = r.readBuffer(kGBufferPosition);
         cv::Mat mask(pos.size(), CV_8U, cv::Scalar(0));
         for (int y = 0; y < pos.rows; ++y)
             for (int x = 0; x < pos.cols; ++x) {
@@ -208,7 +210,7 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     };
     const FrameReport& first = r.render({cam.T_world_camera, cv::Mat(), true});
     ASSERT_TRUE(first.ran("translucency")) << first.summary();
-    const double mean1 = objectMean(r.readBuffer(Resource::DirectRv));
+    const double mean1 = objectMean(r.readBuffer(kDirectRv));
 
     // Same lights and environment, the camera moved a little: reused, the same light.
     Pose moved = cam.T_world_camera;
@@ -219,7 +221,7 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     const std::string summary = second.summary();
     EXPECT_NE(summary.find("translucency reused"), std::string::npos) << summary;
     EXPECT_NE(summary.find("nothing changed"), std::string::npos) << summary;
-    EXPECT_NEAR(objectMean(r.readBuffer(Resource::DirectRv)), mean1, 0.02 * mean1);
+    EXPECT_NEAR(objectMean(r.readBuffer(kDirectRv)), mean1, 0.02 * mean1);
 
     // A live environment (a bright uniform fish-eye frame): recomputed, and brighter.
     EnvironmentCameraSetup env;
@@ -230,7 +232,7 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
         cv::Mat(env.intrinsics.height, env.intrinsics.width, CV_8UC3, cv::Scalar::all(255)), 1.0));
     const FrameReport& third = r.render({cam.T_world_camera, cv::Mat(), false});
     EXPECT_TRUE(third.ran("translucency")) << third.summary();
-    const double mean3 = objectMean(r.readBuffer(Resource::DirectRv));
+    const double mean3 = objectMean(r.readBuffer(kDirectRv));
     EXPECT_GT(mean3, 1.5 * mean1);
     const FrameReport& fourth = r.render({cam.T_world_camera, cv::Mat(), false});
     EXPECT_TRUE(fourth.reused("translucency")) << fourth.summary();
@@ -239,7 +241,7 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     r.useStaticEnvironment();
     const FrameReport& fifth = r.render({cam.T_world_camera, cv::Mat(), false});
     EXPECT_TRUE(fifth.ran("translucency")) << fifth.summary();
-    EXPECT_NEAR(objectMean(r.readBuffer(Resource::DirectRv)), mean1, 0.02 * mean1);
+    EXPECT_NEAR(objectMean(r.readBuffer(kDirectRv)), mean1, 0.02 * mean1);
 
     // Reuse off (RendererOptions::reuseStaticPasses): every frame dispatches.
     opt.reuseStaticPasses = false;
@@ -299,8 +301,8 @@ TEST_F(TranslucencyPass, TwoObjectsEachHaveTheirOwnMap) {
     const FrameReport& rep = r.render({cam.T_world_camera, cv::Mat(), true});
     ASSERT_TRUE(rep.ran("translucency")) << rep.summary();
     EXPECT_NE(rep.summary().find("2 translucent object(s)"), std::string::npos) << rep.summary();
-    const cv::Mat rv = r.readBuffer(Resource::DirectRv);
-    const cv::Mat position = r.readBuffer(Resource::GBufferPosition);
+    const cv::Mat rv = r.readBuffer(kDirectRv);
+    const cv::Mat position = r.readBuffer(kGBufferPosition);
 
     // The CPU formula per object, each with its own map; `other`: each cube's pixels from the
     // other cube's map and medium at the same point (clamped into that cube's surface voxels).

@@ -17,6 +17,7 @@
 #include "core/gl/Context.h"
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
+#include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
@@ -74,8 +75,8 @@ Realtime renderRealtime(const test::CausticScene& s, const cv::Mat& footage, boo
     const FrameReport& rep = r.render({s.pose, footage, true});
     EXPECT_EQ(rep.summary().find("a translucent object transmits") != std::string::npos, shadows)
         << rep.summary();
-    Realtime out{r.compositeLinear(), r.readBuffer(directOnly ? Resource::DirectRv : Resource::LRv),
-                 r.readBuffer(directOnly ? Resource::DirectR : Resource::LR)};
+    Realtime out{r.compositeLinear(), r.readBuffer(directOnly ? kDirectRv : kLRv),
+                 r.readBuffer(directOnly ? kDirectR : kLR)};
     EXPECT_TRUE(cv::checkRange(out.composite));
     return out;
 }

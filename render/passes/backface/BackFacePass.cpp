@@ -13,8 +13,8 @@ BackFacePass::BackFacePass()
 }
 
 void BackFacePass::setup(PassBuilder& b) const {
-    b.write(Resource::BackFacePosition, GL_RGBA32F, SizeRule::Canvas);
-    b.write(Resource::BackFaceNormal, GL_RGBA16F, SizeRule::Canvas);
+    b.create(kBackFacePosition, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kBackFaceNormal, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 PassDecision BackFacePass::decide(const FrameContext& ctx) const {
@@ -69,8 +69,8 @@ void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
     ctx.clearForRects(ctx.specularRects, drawn_, 0, 2, true);
     const std::vector<int>& spec = ctx.scene.specularDraws();
     for (size_t s = 0; s < spec.size(); ++s) draw(ctx.scene.draws()[size_t(spec[s])], int(s));
-    res.publish(Resource::BackFacePosition, position_);
-    res.publish(Resource::BackFaceNormal, normal_);
+    res.publish(kBackFacePosition, position_);
+    res.publish(kBackFaceNormal, normal_);
     glDisable(GL_DEPTH_TEST);
 }
 

@@ -8,6 +8,10 @@
 
 namespace mirage::render {
 
+// Specular objects' back faces (canvas size): xyz world, w = slot + 1; xyz outward unit normal.
+inline constexpr Resource kBackFacePosition{"BackFacePosition"};
+inline constexpr Resource kBackFaceNormal{"BackFaceNormal"};
+
 class BackFacePass final : public RenderPass {
 public:
     BackFacePass();

@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include "render/FrameGraph.h"
+#include "render/passes/caustic/PhotonGBufferPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
 
 namespace mirage::render {
 
@@ -18,15 +20,14 @@ float causticBlend(const FrameContext& ctx) {
 }  // namespace
 
 void CausticPass::setup(PassBuilder& b) const {
-    for (Resource r : {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonHitRefr,
-                       Resource::PhotonPowerRefr, Resource::GBufferPosition,
-                       Resource::GBufferNormal, Resource::GBufferAlbedo, Resource::GBufferEmissive})
+    for (Resource r : {kPhotonHitRefl, kPhotonPowerRefl, kPhotonHitRefr, kPhotonPowerRefr,
+                       kGBufferPosition, kGBufferNormal, kGBufferAlbedo, kGBufferEmissive})
         b.read(r);
-    b.write(Resource::CausticRv, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::CausticR, GL_RGBA16F, SizeRule::Canvas);
+    b.create(kCausticRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kCausticR, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     // This frame's smoothed irradiance, read back by the next frame as temporal history.
-    b.write(Resource::CausticHistoryRv, GL_RGBA32F, SizeRule::Canvas, true);
-    b.write(Resource::CausticHistoryR, GL_RGBA32F, SizeRule::Canvas, true);
+    b.create(kCausticHistoryRv, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
+    b.create(kCausticHistoryR, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
 }
 
 PassDecision CausticPass::decide(const FrameContext& ctx) const {
@@ -72,13 +73,13 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
     const float fixedScale = 16777216.0f / (64.0f * std::max(ctx.plan.causticIrradiance, 1e-6f));
     splat_.use();
     ctx.bindFrameBlocks();
-    glBindTextureUnit(kUnitSplatReflHit, res.texture(Resource::PhotonHitRefl).id());
-    glBindTextureUnit(kUnitSplatReflPower, res.texture(Resource::PhotonPowerRefl).id());
-    glBindTextureUnit(kUnitSplatRefrHit, res.texture(Resource::PhotonHitRefr).id());
-    glBindTextureUnit(kUnitSplatRefrPower, res.texture(Resource::PhotonPowerRefr).id());
-    glBindTextureUnit(kUnitSplatPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitSplatNormal, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(kUnitSplatEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitSplatReflHit, res.texture(kPhotonHitRefl).id());
+    glBindTextureUnit(kUnitSplatReflPower, res.texture(kPhotonPowerRefl).id());
+    glBindTextureUnit(kUnitSplatRefrHit, res.texture(kPhotonHitRefr).id());
+    glBindTextureUnit(kUnitSplatRefrPower, res.texture(kPhotonPowerRefr).id());
+    glBindTextureUnit(kUnitSplatPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitSplatNormal, res.texture(kGBufferNormal).id());
+    glBindTextureUnit(kUnitSplatEmissive, res.texture(kGBufferEmissive).id());
     glBindImageTexture(kImageCausticAccum, accum_.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
     const int s = ctx.options.causticMapSize;
     glUniform1i(splat_.uniformLocation("mapSize"), s);
@@ -91,9 +92,9 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
     fbo_[write].bind();
     ctx.beginFullscreen(resolve_, width_, height_);
     glBindTextureUnit(kUnitResolveAccum, accum_.id());
-    glBindTextureUnit(kUnitResolvePosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitResolveAlbedo, res.texture(Resource::GBufferAlbedo).id());
-    glBindTextureUnit(kUnitResolveEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitResolvePosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitResolveAlbedo, res.texture(kGBufferAlbedo).id());
+    glBindTextureUnit(kUnitResolveEmissive, res.texture(kGBufferEmissive).id());
     glBindTextureUnit(kUnitResolveHistoryRv, historyRv_[read].id());
     glBindTextureUnit(kUnitResolveHistoryR, historyR_[read].id());
     glUniform1f(resolve_.uniformLocation("invFixedScale"), 1.0f / fixedScale);
@@ -102,10 +103,10 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
                 history_.usable(ctx, blend) ? blend : 0.0f);
     ctx.drawFullscreenTriangle();
     history_.written(ctx);
-    res.publish(Resource::CausticHistoryRv, historyRv_[write]);
-    res.publish(Resource::CausticHistoryR, historyR_[write]);
-    res.publish(Resource::CausticRv, rv_);
-    res.publish(Resource::CausticR, r_);
+    res.publish(kCausticHistoryRv, historyRv_[write]);
+    res.publish(kCausticHistoryR, historyR_[write]);
+    res.publish(kCausticRv, rv_);
+    res.publish(kCausticR, r_);
 }
 
 }  // namespace mirage::render

@@ -11,6 +11,16 @@
 
 namespace mirage::render {
 
+// Caustic radiance reflected by the receiver towards the camera (Eq. 12) and the same for L_r
+// (light, specular object and receiver real: Eqs. 13-14).
+inline constexpr Resource kCausticRv{"CausticRv"};
+inline constexpr Resource kCausticR{"CausticR"};
+// The caustic irradiance (rgb W/m^2, before the receiver's albedo) for L_rv / L_r after temporal
+// smoothing, a = camera distance (m) of the receiver (0: none): the next frame's history
+// (persistent, canvas size).
+inline constexpr Resource kCausticHistoryRv{"CausticHistoryRv"};
+inline constexpr Resource kCausticHistoryR{"CausticHistoryR"};
+
 class CausticPass final : public RenderPass {
 public:
     CausticPass();

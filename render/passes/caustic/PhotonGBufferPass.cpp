@@ -2,6 +2,7 @@
 
 #include "render/FrameGraph.h"
 #include "render/passes/impostor/ImpostorPass.h"
+#include "render/passes/shadow/ShadowPass.h"
 
 namespace mirage::render {
 
@@ -15,14 +16,14 @@ PhotonGBufferPass::PhotonGBufferPass(const GpuScene& scene)
 
 void PhotonGBufferPass::setup(PassBuilder& b) const {
     ImpostorPass::declareTracing(b);
-    b.readOptional(Resource::ShadowMaps);  // light visibility of the photons' first surface
-    b.readOptional(Resource::ShadowMapsReal);
-    b.write(Resource::PhotonHitRefl, GL_RGBA32F, SizeRule::CausticMap);
-    b.write(Resource::PhotonPowerRefl, GL_RGBA32F, SizeRule::CausticMap);
-    b.write(Resource::PhotonHitRefr, GL_RGBA32F, SizeRule::CausticMap);
-    b.write(Resource::PhotonPowerRefr, GL_RGBA32F, SizeRule::CausticMap);
-    b.write(Resource::PhotonSurfaceRefl, GL_RGBA32UI, SizeRule::CausticMap);
-    b.write(Resource::PhotonSurfaceRefr, GL_RGBA32UI, SizeRule::CausticMap);
+    b.readOptional(kShadowMaps);  // light visibility of the photons' first surface
+    b.readOptional(kShadowMapsReal);
+    b.create(kPhotonHitRefl, {GL_RGBA32F, SizeRule::CausticMap, Storage::PassOwned});
+    b.create(kPhotonPowerRefl, {GL_RGBA32F, SizeRule::CausticMap, Storage::PassOwned});
+    b.create(kPhotonHitRefr, {GL_RGBA32F, SizeRule::CausticMap, Storage::PassOwned});
+    b.create(kPhotonPowerRefr, {GL_RGBA32F, SizeRule::CausticMap, Storage::PassOwned});
+    b.create(kPhotonSurfaceRefl, {GL_RGBA32UI, SizeRule::CausticMap, Storage::PassOwned});
+    b.create(kPhotonSurfaceRefr, {GL_RGBA32UI, SizeRule::CausticMap, Storage::PassOwned});
 }
 
 PassDecision PhotonGBufferPass::decide(const FrameContext& ctx) const {
@@ -110,9 +111,9 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         glBindTextureUnit(kUnitPhotonBackPosition, backPosition_.id());
         glBindTextureUnit(kUnitPhotonBackNormal, backNormal_.id());
         glBindTextureUnit(kUnitPhotonShadowAll,
-                          res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+                          res.textureOr(kShadowMaps, ctx.farShadowTexture()).id());
         glBindTextureUnit(kUnitPhotonShadowReal,
-                          res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
+                          res.textureOr(kShadowMapsReal, ctx.farShadowTexture()).id());
         glUniformMatrix4fv(photonProgram_.uniformLocation("lightViewProj"), 1, GL_FALSE,
                            &lp.causticViewProj[0][0]);
         glUniform1i(photonProgram_.uniformLocation("lightIndex"), int(li));
@@ -126,12 +127,12 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         }
     }
     glDisable(GL_DEPTH_TEST);
-    res.publish(Resource::PhotonHitRefl, reflHit_);
-    res.publish(Resource::PhotonPowerRefl, reflPower_);
-    res.publish(Resource::PhotonHitRefr, refrHit_);
-    res.publish(Resource::PhotonPowerRefr, refrPower_);
-    res.publish(Resource::PhotonSurfaceRefl, reflSurface_);
-    res.publish(Resource::PhotonSurfaceRefr, refrSurface_);
+    res.publish(kPhotonHitRefl, reflHit_);
+    res.publish(kPhotonPowerRefl, reflPower_);
+    res.publish(kPhotonHitRefr, refrHit_);
+    res.publish(kPhotonPowerRefr, refrPower_);
+    res.publish(kPhotonSurfaceRefl, reflSurface_);
+    res.publish(kPhotonSurfaceRefr, refrSurface_);
 }
 
 }  // namespace mirage::render

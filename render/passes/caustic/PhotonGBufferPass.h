@@ -10,6 +10,19 @@
 
 namespace mirage::render {
 
+// Photon G-buffers, one layer per caustic spot light (causticMapSize^2): per texel of the
+// specular objects seen from the light, the receiver hit of the reflected / refracted photon (xyz
+// world; w = 4 x hit origin + the photon's real-path visibility, 0 = no photon) and its power
+// (rgb W, a = visibility from the light through all occluders); and the receiver of each photon
+// for reflected / refracted VPLs: packHalf2x16 of (normal.xy), (normal.z, diffuse albedo r),
+// (albedo g, b), the normal facing the arriving photon.
+inline constexpr Resource kPhotonHitRefl{"PhotonHitRefl"};
+inline constexpr Resource kPhotonPowerRefl{"PhotonPowerRefl"};
+inline constexpr Resource kPhotonHitRefr{"PhotonHitRefr"};
+inline constexpr Resource kPhotonPowerRefr{"PhotonPowerRefr"};
+inline constexpr Resource kPhotonSurfaceRefl{"PhotonSurfaceRefl"};
+inline constexpr Resource kPhotonSurfaceRefr{"PhotonSurfaceRefr"};
+
 class PhotonGBufferPass final : public RenderPass {
 public:
     PhotonGBufferPass(const GpuScene& scene);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "render/FrameGraph.h"
+#include "render/passes/caustic/PhotonGBufferPass.h"
 
 namespace mirage::render {
 
@@ -13,12 +14,11 @@ PhotonGridPass::PhotonGridPass()
       grid_("photon grid", (2 * size_t(kPhotonGridCells) + 1) * sizeof(GLuint)) {}
 
 void PhotonGridPass::setup(PassBuilder& b) const {
-    for (Resource r :
-         {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonSurfaceRefl,
-          Resource::PhotonHitRefr, Resource::PhotonPowerRefr, Resource::PhotonSurfaceRefr})
+    for (Resource r : {kPhotonHitRefl, kPhotonPowerRefl, kPhotonSurfaceRefl, kPhotonHitRefr,
+                       kPhotonPowerRefr, kPhotonSurfaceRefr})
         b.read(r);
-    b.writeBuffer(Resource::PhotonGrid, SizeRule::CausticMap);
-    b.writeBuffer(Resource::PhotonRecords, SizeRule::CausticMap);
+    b.createBuffer(kPhotonGrid, SizeRule::CausticMap);
+    b.createBuffer(kPhotonRecords, SizeRule::CausticMap);
 }
 
 PassDecision PhotonGridPass::gatherDecision(const FrameContext& ctx) {
@@ -60,12 +60,12 @@ void PhotonGridPass::execute(FrameContext& ctx, PassResources& res) {
     const int s = ctx.options.causticMapSize;
     const GLuint groups = GLuint((s + 7) / 8), layers = GLuint(2 * ctx.plan.causticLayers);
     const float cell = cellSize(ctx.options);
-    glBindTextureUnit(kUnitGridReflHit, res.texture(Resource::PhotonHitRefl).id());
-    glBindTextureUnit(kUnitGridReflPower, res.texture(Resource::PhotonPowerRefl).id());
-    glBindTextureUnit(kUnitGridReflSurface, res.texture(Resource::PhotonSurfaceRefl).id());
-    glBindTextureUnit(kUnitGridRefrHit, res.texture(Resource::PhotonHitRefr).id());
-    glBindTextureUnit(kUnitGridRefrPower, res.texture(Resource::PhotonPowerRefr).id());
-    glBindTextureUnit(kUnitGridRefrSurface, res.texture(Resource::PhotonSurfaceRefr).id());
+    glBindTextureUnit(kUnitGridReflHit, res.texture(kPhotonHitRefl).id());
+    glBindTextureUnit(kUnitGridReflPower, res.texture(kPhotonPowerRefl).id());
+    glBindTextureUnit(kUnitGridReflSurface, res.texture(kPhotonSurfaceRefl).id());
+    glBindTextureUnit(kUnitGridRefrHit, res.texture(kPhotonHitRefr).id());
+    glBindTextureUnit(kUnitGridRefrPower, res.texture(kPhotonPowerRefr).id());
+    glBindTextureUnit(kUnitGridRefrSurface, res.texture(kPhotonSurfaceRefr).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotonGrid, grid_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons, records_.id());
 
@@ -86,8 +86,8 @@ void PhotonGridPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1ui(scatter_.uniformLocation("capacity"), GLuint(capacity_));
     glDispatchCompute(groups, groups, layers);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    res.publish(Resource::PhotonGrid, grid_);
-    res.publish(Resource::PhotonRecords, records_);
+    res.publish(kPhotonGrid, grid_);
+    res.publish(kPhotonRecords, records_);
 }
 
 }  // namespace mirage::render

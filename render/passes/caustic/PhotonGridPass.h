@@ -9,6 +9,12 @@
 
 namespace mirage::render {
 
+// A hashed uniform grid of the photons' receiver hits, for the caustics seen in reflections and
+// refractions. PhotonGrid: uint per hash cell (kPhotonGridCells counts, then kPhotonGridCells + 1
+// first indices); PhotonRecords: GpuPhoton per photon, sorted by cell.
+inline constexpr Resource kPhotonGrid{"PhotonGrid"};
+inline constexpr Resource kPhotonRecords{"PhotonRecords"};
+
 class PhotonGridPass final : public RenderPass {
 public:
     PhotonGridPass();

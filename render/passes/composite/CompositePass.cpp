@@ -4,17 +4,19 @@
 #include <cmath>
 
 #include "render/FrameGraph.h"
+#include "render/FrameImports.h"
+#include "render/passes/caustic/CausticPass.h"
+#include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/fuzzy/FuzzyReflectionPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 
 namespace mirage::render {
 namespace {
-constexpr Resource kFuzzyBuffers[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
-                                       Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
-                                       Resource::FuzzyReflectionVideo};
-// Rough glass by LEAN / GSR (render/passes/rough): the same five buffers, the fuzzy pass's
-// passed through on every other pixel; preferred when that pass ran.
-constexpr Resource kRoughBuffers[5] = {Resource::RoughSpecularRv, Resource::RoughSpecularR,
-                                       Resource::RoughSpecularRReflection, Resource::RoughLenv,
-                                       Resource::RoughVideo};
+// L'_rv, L'_r, its reflection share and L_env at their newest version: the specular light
+// pass's, or the fuzzy / rough passes' filtered ones (equal to it outside their pixels).
+constexpr Resource kSpecularBuffers[4] = {kSpecularRv, kSpecularR, kSpecularRReflection, kLenv};
 static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
 }  // namespace
 
@@ -58,23 +60,20 @@ bool CompositePass::isIdentityRemap(const CameraProjection& p) {
 }
 
 void CompositePass::setup(PassBuilder& b) const {
-    b.read(Resource::CameraImage);
+    b.read(kCameraImage);
     // The two GI solutions (direct light alone when no VPL light was filtered into them).
-    b.read(Resource::LRv);
-    b.read(Resource::LR);
-    for (Resource r : {Resource::CausticRv, Resource::CausticR, Resource::GBufferPosition})
-        b.readOptional(r);
+    b.read(kLRv);
+    b.read(kLR);
+    for (Resource r : {kCausticRv, kCausticR, kGBufferPosition}) b.readOptional(r);
     // Mirror / glass pixels (Eqs. 6-11): only when the specular passes ran.
-    for (Resource r : {Resource::GBufferEmissive, Resource::ReflectionGBuffer,
-                       Resource::RefractionGBuffer, Resource::ReflectionWeight,
-                       Resource::RefractionWeight, Resource::SpecularRv, Resource::SpecularR,
-                       Resource::SpecularRReflection, Resource::Lenv, Resource::RealSurfaces})
+    for (Resource r :
+         {kGBufferEmissive, kReflectionGBuffer, kRefractionGBuffer, kReflectionWeight,
+          kRefractionWeight, kSpecularRv, kSpecularR, kSpecularRReflection, kLenv, kRealSurfaces})
         b.readOptional(r);
-    // Rough metals: the fuzzy pass's filtered buffers, when it ran.
-    for (Resource r : kFuzzyBuffers) b.readOptional(r);
-    for (Resource r : kRoughBuffers) b.readOptional(r);
-    b.write(Resource::Composite, GL_RGBA32F, SizeRule::Camera);
-    b.write(Resource::CompositeSrgb, GL_SRGB8_ALPHA8, SizeRule::Camera);
+    // Rough metals and glass: the filtered video term, when the fuzzy or rough pass ran.
+    b.readOptional(kFilteredVideo);
+    b.create(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
+    b.create(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
 }
 
 PassDecision CompositePass::decide(const FrameContext&) const {
@@ -147,8 +146,8 @@ glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& 
 }
 
 void CompositePass::execute(FrameContext& ctx, PassResources& res) {
-    const bool specular = res.has(Resource::SpecularRv) && res.has(Resource::RealSurfaces) &&
-                          res.has(Resource::ReflectionGBuffer);
+    const bool specular =
+        res.has(kSpecularRv) && res.has(kRealSurfaces) && res.has(kReflectionGBuffer);
     // The camera pixels of each specular object's canvas rectangle (the lens map can make two
     // overlap: merged again).
     std::vector<glm::ivec4> rects;
@@ -163,7 +162,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         maskProgram_.use();
         glViewport(0, 0, ctx.projection.camera.width, ctx.projection.camera.height);
         glBindTextureUnit(kUnitCompositeRemap, remap_.id());
-        glBindTextureUnit(kUnitCompositeEmissive, res.texture(Resource::GBufferEmissive).id());
+        glBindTextureUnit(kUnitCompositeEmissive, res.texture(kGBufferEmissive).id());
         glDepthMask(GL_TRUE);  // also lets the clear write
         ctx.clearForRects(rects, maskDrawn_, 0, 0, true);
         glEnable(GL_DEPTH_TEST);
@@ -177,7 +176,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // The diffuse variant on every pixel the full one (Eqs. 6-11) does not draw. Without a
     // caustic pass the variant that never reads the caustic buffers: reading the black stand-in
     // costs as much as a real buffer on llvmpipe, even behind a uniform branch.
-    const int withCaustics = res.has(Resource::CausticRv) ? 1 : 0;
+    const int withCaustics = res.has(kCausticRv) ? 1 : 0;
     if (withCaustics) {
         ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
@@ -188,29 +187,25 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                             ctx.projection.camera.height);
         glUniform1i(locShowVirtualNoCaustics_, ctx.options.showVirtual ? 1 : 0);
     }
-    glBindTextureUnit(kUnitCompositeCamera, res.texture(Resource::CameraImage).id());
-    glBindTextureUnit(kUnitCompositeLRv, res.texture(Resource::LRv).id());
-    glBindTextureUnit(kUnitCompositeLR, res.texture(Resource::LR).id());
-    glBindTextureUnit(kUnitCompositeCausticRv,
-                      res.textureOr(Resource::CausticRv, ctx.blackTexture()).id());
-    glBindTextureUnit(kUnitCompositeCausticR,
-                      res.textureOr(Resource::CausticR, ctx.blackTexture()).id());
+    glBindTextureUnit(kUnitCompositeCamera, res.texture(kCameraImage).id());
+    glBindTextureUnit(kUnitCompositeLRv, res.texture(kLRv).id());
+    glBindTextureUnit(kUnitCompositeLR, res.texture(kLR).id());
+    glBindTextureUnit(kUnitCompositeCausticRv, res.textureOr(kCausticRv, ctx.blackTexture()).id());
+    glBindTextureUnit(kUnitCompositeCausticR, res.textureOr(kCausticR, ctx.blackTexture()).id());
     glBindTextureUnit(kUnitCompositePosition,
-                      res.textureOr(Resource::GBufferPosition, ctx.blackTexture()).id());
+                      res.textureOr(kGBufferPosition, ctx.blackTexture()).id());
     glBindTextureUnit(kUnitCompositeRemap, remap_.id());
     if (specular) {
-        glBindTextureUnit(kUnitCompositeEmissive, res.texture(Resource::GBufferEmissive).id());
-        glBindTextureUnit(kUnitCompositeReflPosition,
-                          res.texture(Resource::ReflectionGBuffer).id());
-        glBindTextureUnit(kUnitCompositeRefrPosition,
-                          res.texture(Resource::RefractionGBuffer).id());
-        glBindTextureUnit(kUnitCompositeReflWeight, res.texture(Resource::ReflectionWeight).id());
-        glBindTextureUnit(kUnitCompositeRefrWeight, res.texture(Resource::RefractionWeight).id());
-        glBindTextureUnit(kUnitCompositeSpecRv, res.texture(Resource::SpecularRv).id());
-        glBindTextureUnit(kUnitCompositeSpecR, res.texture(Resource::SpecularR).id());
-        glBindTextureUnit(kUnitCompositeSpecRRefl, res.texture(Resource::SpecularRReflection).id());
-        glBindTextureUnit(kUnitCompositeLenv, res.texture(Resource::Lenv).id());
-        glBindTextureUnit(kUnitCompositeRealSurfaces, res.texture(Resource::RealSurfaces).id());
+        glBindTextureUnit(kUnitCompositeEmissive, res.texture(kGBufferEmissive).id());
+        glBindTextureUnit(kUnitCompositeReflPosition, res.texture(kReflectionGBuffer).id());
+        glBindTextureUnit(kUnitCompositeRefrPosition, res.texture(kRefractionGBuffer).id());
+        glBindTextureUnit(kUnitCompositeReflWeight, res.texture(kReflectionWeight).id());
+        glBindTextureUnit(kUnitCompositeRefrWeight, res.texture(kRefractionWeight).id());
+        glBindTextureUnit(kUnitCompositeSpecRv, res.texture(kSpecularRv).id());
+        glBindTextureUnit(kUnitCompositeSpecR, res.texture(kSpecularR).id());
+        glBindTextureUnit(kUnitCompositeSpecRRefl, res.texture(kSpecularRReflection).id());
+        glBindTextureUnit(kUnitCompositeLenv, res.texture(kLenv).id());
+        glBindTextureUnit(kUnitCompositeRealSurfaces, res.texture(kRealSurfaces).id());
         glBindTextureUnit(kUnitCompositeCanvasToCamera, canvasToCamera_.id());
     } else {
         for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
@@ -230,13 +225,14 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
-        const bool rough = res.has(Resource::RoughVideo);
-        const bool fuzzy = rough || res.has(Resource::FuzzyReflectionVideo);
+        // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
+        // the newest versions, as the sharp units.
+        const bool fuzzy = res.has(kFilteredVideo);
         for (int i = 0; i < 5; ++i)
-            glBindTextureUnit(
-                GLuint(kUnitCompositeFuzzyRv + i),
-                res.textureOr(rough ? kRoughBuffers[i] : kFuzzyBuffers[i], ctx.blackTexture())
-                    .id());
+            glBindTextureUnit(GLuint(kUnitCompositeFuzzyRv + i),
+                              (i < 4 ? res.textureOr(kSpecularBuffers[i], ctx.blackTexture())
+                                     : res.textureOr(kFilteredVideo, ctx.blackTexture()))
+                                  .id());
         glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
         ctx.drawFullscreenTriangleIn(rects);  // the pixels the diffuse variant left
         glDepthMask(GL_TRUE);
@@ -244,8 +240,8 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glDisable(GL_DEPTH_TEST);
     }
     glDisable(GL_FRAMEBUFFER_SRGB);
-    res.publish(Resource::Composite, linear_);
-    res.publish(Resource::CompositeSrgb, srgb_);
+    res.publish(kComposite, linear_);
+    res.publish(kCompositeSrgb, srgb_);
 }
 
 }  // namespace mirage::render

@@ -5,6 +5,10 @@
 
 namespace mirage::render {
 
+// The output (camera image size): linear RGBA32F, a = coverage; the same, sRGB8.
+inline constexpr Resource kComposite{"Composite"};
+inline constexpr Resource kCompositeSrgb{"CompositeSrgb"};
+
 class CompositePass final : public RenderPass {
 public:
     CompositePass() = default;  // the programs are built by resize(), for the camera

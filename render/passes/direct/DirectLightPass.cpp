@@ -1,6 +1,11 @@
 #include "render/passes/direct/DirectLightPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/passes/environment/EnvironmentPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/gifilter/GiFilterPass.h"
+#include "render/passes/shadow/ShadowPass.h"
+#include "render/passes/translucency/TranslucencyPass.h"
 
 namespace mirage::render {
 
@@ -45,25 +50,25 @@ gl::Program& DirectLightPass::program(bool glass, bool indirect, bool keepDirect
 }
 
 void DirectLightPass::setup(PassBuilder& b) const {
-    b.read(Resource::GBufferPosition);
-    b.read(Resource::GBufferNormal);
-    b.read(Resource::GBufferAlbedo);
-    b.read(Resource::GBufferEmissive);
-    b.read(Resource::EnvironmentLight);
-    b.readOptional(Resource::ShadowMaps);  // none: no light has a caster (unshadowed)
-    b.readOptional(Resource::ShadowMapsReal);
-    b.readOptional(Resource::ShadowGlass);  // none: no glass in a light's cone
-    b.readOptional(Resource::ShadowGlassReal);
-    b.readOptional(Resource::TranslucentGrid);  // none: no translucent object (or its pass off)
-    b.readOptional(Resource::TranslucentRadiance);
-    b.readOptional(Resource::SpecularMask);  // none: no mirror or glass object in view
-    b.readOptional(Resource::GatherLight);   // none: no VPL light this frame
-    b.write(Resource::LRv, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::LR, GL_RGBA16F, SizeRule::Canvas);
+    b.read(kGBufferPosition);
+    b.read(kGBufferNormal);
+    b.read(kGBufferAlbedo);
+    b.read(kGBufferEmissive);
+    b.read(kEnvironmentLight);
+    b.readOptional(kShadowMaps);  // none: no light has a caster (unshadowed)
+    b.readOptional(kShadowMapsReal);
+    b.readOptional(kShadowGlass);  // none: no glass in a light's cone
+    b.readOptional(kShadowGlassReal);
+    b.readOptional(kTranslucentGrid);  // none: no translucent object (or its pass off)
+    b.readOptional(kTranslucentRadiance);
+    b.readOptional(kSpecularMask);  // none: no mirror or glass object in view
+    b.readOptional(kGatherLight);   // none: no VPL light this frame
+    b.create(kLRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kLR, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     // The direct light alone: LRv / LR themselves in frames without VPL light, else written
     // apart only with RendererOptions::keepDirectLight.
-    b.write(Resource::DirectRv, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::DirectR, GL_RGBA16F, SizeRule::Canvas);
+    b.create(kDirectRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kDirectR, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
@@ -95,15 +100,14 @@ void DirectLightPass::resize(const FrameContext& ctx) {
 }
 
 void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
-    const bool indirect = res.has(Resource::GatherLight);
+    const bool indirect = res.has(kGatherLight);
     const bool keep = indirect && ctx.options.keepDirectLight;
     gl::Framebuffer& fbo = keep ? keepFbo_ : fbo_;
     const int targets = keep ? 4 : 2;
     GLuint& attached = keep ? keepAttachedMask_ : attachedMask_;
-    const gl::Texture* mask =
-        res.has(Resource::SpecularMask) && !ctx.options.diffuseOnSpecularPixels
-            ? &res.texture(Resource::SpecularMask)
-            : nullptr;
+    const gl::Texture* mask = res.has(kSpecularMask) && !ctx.options.diffuseOnSpecularPixels
+                                  ? &res.texture(kSpecularMask)
+                                  : nullptr;
     if (mask && mask->id() != attached) {  // reallocated only on a resize
         fbo.attachDepth(*mask);
         fbo.finalize(targets);
@@ -114,31 +118,28 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     gl::Program& prog = program(ctx.plan.glassShadows, indirect, keep);
     fbo.bind();
     ctx.beginFullscreen(prog, ctx.canvasWidth(), ctx.canvasHeight());
-    glBindTextureUnit(kUnitDirectPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitDirectNormal, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(kUnitDirectAlbedo, res.texture(Resource::GBufferAlbedo).id());
-    glBindTextureUnit(kUnitDirectEmissive, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitDirectPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitDirectNormal, res.texture(kGBufferNormal).id());
+    glBindTextureUnit(kUnitDirectAlbedo, res.texture(kGBufferAlbedo).id());
+    glBindTextureUnit(kUnitDirectEmissive, res.texture(kGBufferEmissive).id());
     glBindTextureUnit(kUnitDirectShadowAll,
-                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+                      res.textureOr(kShadowMaps, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitDirectShadowReal,
-                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
-    glBindTextureUnit(kUnitDirectGlassAll,
-                      res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
+                      res.textureOr(kShadowMapsReal, ctx.farShadowTexture()).id());
+    glBindTextureUnit(kUnitDirectGlassAll, res.textureOr(kShadowGlass, ctx.noGlassTexture()).id());
     glBindTextureUnit(kUnitDirectGlassReal,
-                      res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
-    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
-                     res.buffer(Resource::EnvironmentLight).id());
-    const bool translucent =
-        res.has(Resource::TranslucentGrid) && res.has(Resource::TranslucentRadiance);
+                      res.textureOr(kShadowGlassReal, ctx.noGlassTexture()).id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment, res.buffer(kEnvironmentLight).id());
+    const bool translucent = res.has(kTranslucentGrid) && res.has(kTranslucentRadiance);
     if (translucent) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentGrid,
-                         res.buffer(Resource::TranslucentGrid).id());
+                         res.buffer(kTranslucentGrid).id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentRadiance,
-                         res.buffer(Resource::TranslucentRadiance).id());
+                         res.buffer(kTranslucentRadiance).id());
     }
     glUniform1i(prog.uniformLocation("translucentOn"), translucent ? 1 : 0);
     if (indirect) {
-        glBindTextureUnit(kUnitDirectGatherLight, res.texture(Resource::GatherLight).id());
+        glBindTextureUnit(kUnitDirectGatherLight, res.texture(kGatherLight).id());
         glUniform1i(prog.uniformLocation("gatherScale"), ctx.gatherScale());
         glUniformMatrix3fv(prog.uniformLocation("rayFromPixel"), 1, GL_FALSE,
                            &rayFromCanvasPixel(ctx)[0][0]);
@@ -148,14 +149,14 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
         ctx.drawFullscreenTriangleOutsideSpecular(0, targets);
     else
         ctx.drawFullscreenTriangle();
-    res.publish(Resource::LRv, rv_);
-    res.publish(Resource::LR, r_);
+    res.publish(kLRv, rv_);
+    res.publish(kLR, r_);
     if (!indirect) {  // the GI solutions are the direct light
-        res.publish(Resource::DirectRv, rv_);
-        res.publish(Resource::DirectR, r_);
+        res.publish(kDirectRv, rv_);
+        res.publish(kDirectR, r_);
     } else if (keep) {
-        res.publish(Resource::DirectRv, directRv_);
-        res.publish(Resource::DirectR, directR_);
+        res.publish(kDirectRv, directRv_);
+        res.publish(kDirectR, directR_);
     }
 }
 

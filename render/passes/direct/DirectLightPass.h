@@ -12,6 +12,15 @@
 
 namespace mirage::render {
 
+// Direct + environment + emission (canvas size): LRv itself in frames without VPL light, else
+// written apart only with RendererOptions::keepDirectLight.
+inline constexpr Resource kDirectRv{"DirectRv"};
+inline constexpr Resource kDirectR{"DirectR"};
+// The two GI solutions: direct + filtered, upsampled indirect (canvas size); LRv.a = the pixel's
+// origin (ORIGIN_*; 0 on the specular pixels it skips).
+inline constexpr Resource kLRv{"LRv"};
+inline constexpr Resource kLR{"LR"};
+
 class DirectLightPass final : public RenderPass {
 public:
     explicit DirectLightPass(const GpuScene& scene);

@@ -8,6 +8,7 @@
 
 #include "core/Error.h"
 #include "render/FrameGraph.h"
+#include "render/FrameImports.h"
 
 namespace mirage::render {
 namespace {
@@ -41,10 +42,10 @@ EnvironmentPass::EnvironmentPass()
 }
 
 void EnvironmentPass::setup(PassBuilder& b) const {
-    b.read(Resource::SceneEnvironmentMap);
-    b.readOptional(Resource::EnvironmentCamera);  // imported only while the environment is live
-    b.write(Resource::EnvironmentMap, GL_RGBA16F, SizeRule::Scene, /*persistent=*/true);
-    b.writeBuffer(Resource::EnvironmentLight, SizeRule::Scene, /*persistent=*/true);
+    b.read(kSceneEnvironmentMap);
+    b.readOptional(kEnvironmentCamera);  // imported only while the environment is live
+    b.create(kEnvironmentMap, {GL_RGBA16F, SizeRule::Scene, Storage::Persistent});
+    b.createBuffer(kEnvironmentLight, SizeRule::Scene, /*persistent=*/true);
 }
 
 PassDecision EnvironmentPass::decide(const FrameContext& ctx) const {
@@ -85,15 +86,15 @@ void EnvironmentPass::execute(FrameContext& ctx, PassResources& res) {
         g.envRotation = ctx.scene.environmentRotation();
         g.envSeenFraction = 1.0f;
         light_.upload(&g, sizeof(g));
-        res.publish(Resource::EnvironmentMap, res.texture(Resource::SceneEnvironmentMap));
+        res.publish(kEnvironmentMap, res.texture(kSceneEnvironmentMap));
     }
-    res.publish(Resource::EnvironmentLight, light_);
+    res.publish(kEnvironmentLight, light_);
     doneGeneration_ = ctx.environment.generation;
 }
 
 void EnvironmentPass::executeLive(FrameContext& ctx, PassResources& res) {
     const EnvironmentInput& e = ctx.environment;
-    MR_CHECK(res.has(Resource::EnvironmentCamera),
+    MR_CHECK(res.has(kEnvironmentCamera),
              "live environment without an imported environment-camera frame");
     const CameraIntrinsics& K = e.camera;
     const bool kb = K.model == DistortionModel::KannalaBrandt;
@@ -112,7 +113,7 @@ void EnvironmentPass::executeLive(FrameContext& ctx, PassResources& res) {
     glUniform2f(uImageSize_, float(K.width), float(K.height));
     glUniform1f(uMaxTheta_, float(maxTheta));
     glUniform3f(uGain_, e.gain.r, e.gain.g, e.gain.b);
-    glBindTextureUnit(kUnitEnvFisheye, res.texture(Resource::EnvironmentCamera).id());
+    glBindTextureUnit(kUnitEnvFisheye, res.texture(kEnvironmentCamera).id());
     ctx.drawFullscreenTriangle();
     // The levels below serve the SH9 projection now and blurrier lookups (rough reflections).
     glGenerateTextureMipmap(map_.id());
@@ -125,7 +126,7 @@ void EnvironmentPass::executeLive(FrameContext& ctx, PassResources& res) {
         g.envRotation = 0.0f;
         g.envSeenFraction = e.lightFreeSeenFraction;
         light_.upload(&g, sizeof(g));
-        res.publish(Resource::EnvironmentMap, map_);
+        res.publish(kEnvironmentMap, map_);
         return;
     }
     int level = 0;
@@ -136,7 +137,7 @@ void EnvironmentPass::executeLive(FrameContext& ctx, PassResources& res) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingEnvironment, light_.id());
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    res.publish(Resource::EnvironmentMap, map_);
+    res.publish(kEnvironmentMap, map_);
 }
 
 }  // namespace mirage::render

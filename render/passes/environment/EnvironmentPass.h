@@ -18,6 +18,12 @@
 
 namespace mirage::render {
 
+// The environment light: the map every environment lookup uses (equirectangular RGBA16F, rgb
+// linear radiance, a = 1 where the camera saw the direction, 0 where the unseen part was filled
+// in; mip-mapped when live) and its SH9 (EnvironmentBlock). Persistent.
+inline constexpr Resource kEnvironmentMap{"EnvironmentMap"};
+inline constexpr Resource kEnvironmentLight{"EnvironmentLight"};
+
 class EnvironmentPass final : public RenderPass {
 public:
     EnvironmentPass();

@@ -5,14 +5,16 @@
 #include <fmt/format.h>
 
 #include "render/FrameGraph.h"
+#include "render/FrameImports.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 
 namespace mirage::render {
 namespace {
-constexpr Resource kOutputs[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
-                                  Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
-                                  Resource::FuzzyReflectionVideo};
-constexpr Resource kInputs[4] = {Resource::SpecularRv, Resource::SpecularR,
-                                 Resource::SpecularRReflection, Resource::Lenv};
+// The buffers this pass writes a new version of (filtered on rough pixels, passed through
+// elsewhere), in the filter's input order; the fifth input is the video term it creates.
+constexpr Resource kFiltered[4] = {kSpecularRv, kSpecularR, kSpecularRReflection, kLenv};
 constexpr float kPi = 3.14159265358979f;
 
 void attachAll(gl::Framebuffer& fbo, gl::Texture (&t)[5]) {
@@ -35,15 +37,13 @@ FuzzyReflectionPass::FuzzyReflectionPass()
 
 void FuzzyReflectionPass::setup(PassBuilder& b) const {
     for (Resource r :
-         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
-          Resource::ReflectionGBuffer, Resource::ReflectionWeight, Resource::RefractionGBuffer,
-          Resource::RefractionWeight, Resource::RealSurfaces, Resource::CameraImage})
+         {kGBufferPosition, kGBufferNormal, kGBufferEmissive, kReflectionGBuffer, kReflectionWeight,
+          kRefractionGBuffer, kRefractionWeight, kRealSurfaces, kCameraImage})
         b.read(r);
-    for (Resource r : kInputs) b.read(r);
     // In float32, as the L' buffers come and as the composite computes the video term for a
     // sharp pixel: a kernel of one pixel then reproduces the mirror path exactly.
-    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA32F, SizeRule::Canvas);
-    b.write(Resource::FuzzyReflectionVideo, GL_RGBA32F, SizeRule::Canvas);
+    for (Resource r : kFiltered) b.modify(r, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kFilteredVideo, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 PassDecision FuzzyReflectionPass::decide(const FrameContext& ctx) const {
@@ -94,18 +94,18 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
                      ctx.scene.specularDrawBuffer().id());
-    glBindTextureUnit(kUnitFuzzyPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitFuzzyEmissive, res.texture(Resource::GBufferEmissive).id());
-    glBindTextureUnit(kUnitFuzzyReflHit, res.texture(Resource::ReflectionGBuffer).id());
-    glBindTextureUnit(kUnitFuzzyReflWeight, res.texture(Resource::ReflectionWeight).id());
-    glBindTextureUnit(kUnitFuzzyCamera, res.texture(Resource::CameraImage).id());
-    glBindTextureUnit(kUnitFuzzyRealSurfaces, res.texture(Resource::RealSurfaces).id());
+    glBindTextureUnit(kUnitFuzzyPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitFuzzyEmissive, res.texture(kGBufferEmissive).id());
+    glBindTextureUnit(kUnitFuzzyReflHit, res.texture(kReflectionGBuffer).id());
+    glBindTextureUnit(kUnitFuzzyReflWeight, res.texture(kReflectionWeight).id());
+    glBindTextureUnit(kUnitFuzzyCamera, res.texture(kCameraImage).id());
+    glBindTextureUnit(kUnitFuzzyRealSurfaces, res.texture(kRealSurfaces).id());
     glBindTextureUnit(kUnitFuzzyCanvasToCamera, canvasToCamera_.id());
-    glBindTextureUnit(kUnitFuzzySpecRRefl, res.texture(Resource::SpecularRReflection).id());
-    glBindTextureUnit(kUnitFuzzySpecR, res.texture(Resource::SpecularR).id());
-    glBindTextureUnit(kUnitFuzzyRefrHit, res.texture(Resource::RefractionGBuffer).id());
-    glBindTextureUnit(kUnitFuzzyRefrWeight, res.texture(Resource::RefractionWeight).id());
-    glBindTextureUnit(kUnitFuzzyNormal, res.texture(Resource::GBufferNormal).id());
+    glBindTextureUnit(kUnitFuzzySpecRRefl, res.texture(kSpecularRReflection).id());
+    glBindTextureUnit(kUnitFuzzySpecR, res.texture(kSpecularR).id());
+    glBindTextureUnit(kUnitFuzzyRefrHit, res.texture(kRefractionGBuffer).id());
+    glBindTextureUnit(kUnitFuzzyRefrWeight, res.texture(kRefractionWeight).id());
+    glBindTextureUnit(kUnitFuzzyNormal, res.texture(kGBufferNormal).id());
     const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
 
     // 1. The reflection's video term per rough pixel (the composite's back-projection).
@@ -127,7 +127,9 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
         (pass == 0 ? rowsFbo_ : outFbo_).bind();
         ctx.beginFullscreen(filter_, w, h);
         for (int i = 0; i < 5; ++i) {
-            const gl::Texture& in = pass == 1 ? rows_[i] : i < 4 ? res.texture(kInputs[i]) : video_;
+            const gl::Texture& in = pass == 1 ? rows_[i]
+                                    : i < 4   ? res.texture(kFiltered[i])
+                                              : video_;
             glBindTextureUnit(GLuint(kUnitFuzzyInputFirst + i), in.id());
         }
         glUniform2i(locStep_, pass == 0 ? 1 : 0, pass == 0 ? 0 : 1);
@@ -138,7 +140,8 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
         ctx.clearForRects(rect, pass == 0 ? rowsDrawn_ : outDrawn_, 0, 5);
         ctx.drawFullscreenTriangleIn(rect);
     }
-    for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);
+    for (int i = 0; i < 4; ++i) res.publish(kFiltered[i], out_[i]);
+    res.publish(kFilteredVideo, out_[4]);
 }
 
 }  // namespace mirage::render

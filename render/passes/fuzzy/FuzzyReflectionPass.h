@@ -14,6 +14,11 @@
 
 namespace mirage::render {
 
+// The filtered video term of a rough reflection or refraction (rgb camera units: eta1
+// CI_r(p_refl) or the rendered real share; a = 1 on a filtered pixel): created by this pass,
+// a new version written by the rough pass.
+inline constexpr Resource kFilteredVideo{"FilteredVideo"};
+
 class FuzzyReflectionPass final : public RenderPass {
 public:
     FuzzyReflectionPass();

@@ -47,7 +47,13 @@ layout(location = 4) out vec4 out4;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    out0 = out1 = out2 = out3 = out4 = vec4(0.0);
+    // Every pixel the filter leaves passes its input through (this pass writes the next version
+    // of the L' buffers: the composite reads it on every specular pixel), the video term 0.
+    out0 = texelFetch(in0, px, 0);
+    out1 = texelFetch(in1, px, 0);
+    out2 = texelFetch(in2, px, 0);
+    out3 = texelFetch(in3, px, 0);
+    out4 = vec4(0.0);
     int slot = roughSlot(texelFetch(gEmissive, px, 0).a);
     if (slot < 0) return;
     vec3 a = texelFetch(gPosition, px, 0).xyz;

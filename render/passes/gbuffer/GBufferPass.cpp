@@ -16,12 +16,12 @@ GBufferPass::GBufferPass(MaterialMaps maps)
 }
 
 void GBufferPass::setup(PassBuilder& b) const {
-    b.write(Resource::GBufferPosition, GL_RGBA32F, SizeRule::Canvas);
-    b.write(Resource::GBufferNormal, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::GBufferAlbedo, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::GBufferEmissive, GL_RGBA16F, SizeRule::Canvas);
-    b.write(Resource::RealSurfaces, GL_RGBA32F, SizeRule::Canvas);
-    b.write(Resource::SpecularMask, GL_DEPTH_COMPONENT32F, SizeRule::Canvas);
+    b.create(kGBufferPosition, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kGBufferNormal, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kGBufferAlbedo, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kGBufferEmissive, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kRealSurfaces, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
+    b.create(kSpecularMask, {GL_DEPTH_COMPONENT32F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 bool GBufferPass::specularInView(const FrameContext& ctx) {
@@ -110,13 +110,13 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
         glColorMaski(4, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         drawAll(false, true);
         glColorMaski(4, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-        res.publish(Resource::RealSurfaces, realSurfaces_);
+        res.publish(kRealSurfaces, realSurfaces_);
     } else {
         glColorMaski(4, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         drawAll(true, true);
         glColorMaski(4, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         // Every surface is real, or no pass reads RealSurfaces this frame.
-        res.publish(Resource::RealSurfaces, position_);
+        res.publish(kRealSurfaces, position_);
     }
     if (specularInView(ctx)) {
         // The mask over the specular rectangles; outside them it stays cleared (1).
@@ -129,13 +129,13 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
         glDepthFunc(GL_ALWAYS);
         ctx.drawFullscreenTriangleIn(ctx.specularRects);
         glDepthFunc(GL_LESS);
-        res.publish(Resource::SpecularMask, mask_);
+        res.publish(kSpecularMask, mask_);
     }
     glDisable(GL_DEPTH_TEST);
-    res.publish(Resource::GBufferPosition, position_);
-    res.publish(Resource::GBufferNormal, normal_);
-    res.publish(Resource::GBufferAlbedo, albedo_);
-    res.publish(Resource::GBufferEmissive, emissive_);
+    res.publish(kGBufferPosition, position_);
+    res.publish(kGBufferNormal, normal_);
+    res.publish(kGBufferAlbedo, albedo_);
+    res.publish(kGBufferEmissive, emissive_);
 }
 
 }  // namespace mirage::render

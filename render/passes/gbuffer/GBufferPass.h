@@ -22,6 +22,19 @@
 
 namespace mirage::render {
 
+// The primary G-buffer (canvas size).
+inline constexpr Resource kGBufferPosition{"GBufferPosition"};  // xyz world (m), w = origin
+                                                                // (ORIGIN_*, 0 = empty)
+inline constexpr Resource kGBufferNormal{"GBufferNormal"};  // xyz unit world normal, w = roughness
+inline constexpr Resource kGBufferAlbedo{"GBufferAlbedo"};  // rgb linear base colour, a = metallic
+// rgb linear emitted radiance, a = specular slot + 1 (0 = not specular, -1 = translucent)
+inline constexpr Resource kGBufferEmissive{"GBufferEmissive"};
+// The nearest REAL surface per pixel: xyz world, w = origin.
+inline constexpr Resource kRealSurfaces{"RealSurfaces"};
+// Depth 0 on specular pixels, 1 elsewhere: the passes that shade only those test against it
+// (early depth test skips the rest).
+inline constexpr Resource kSpecularMask{"SpecularMask"};
+
 class GBufferPass final : public RenderPass {
 public:
     // Which material textures the scene's draws have: the shader reads only those (llvmpipe pays

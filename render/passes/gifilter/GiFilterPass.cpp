@@ -4,6 +4,8 @@
 #include <string>
 
 #include "render/FrameGraph.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/indirect/IndirectLightPass.h"
 
 namespace mirage::render {
 
@@ -13,14 +15,14 @@ GiFilterPass::GiFilterPass(int interleave)
           "#define MIRAGE_INTERLEAVE " + std::to_string(std::max(1, interleave)))) {}
 
 void GiFilterPass::setup(PassBuilder& b) const {
-    b.read(Resource::GBufferPosition);
-    b.read(Resource::GBufferNormal);
-    b.read(Resource::IndirectRv);
-    b.read(Resource::IndirectR);
+    b.read(kGBufferPosition);
+    b.read(kGBufferNormal);
+    b.read(kIndirectRv);
+    b.read(kIndirectR);
     // This frame's filtered indirect light, read back by the next frame as temporal history.
-    b.write(Resource::GiHistoryRv, GL_RGBA32F, SizeRule::Gather, true);
-    b.write(Resource::GiHistoryR, GL_RGBA32F, SizeRule::Gather, true);
-    b.write(Resource::GatherLight, GL_RGBA32UI, SizeRule::Gather);
+    b.create(kGiHistoryRv, {GL_RGBA32F, SizeRule::Gather, Storage::Persistent});
+    b.create(kGiHistoryR, {GL_RGBA32F, SizeRule::Gather, Storage::Persistent});
+    b.create(kGatherLight, {GL_RGBA32UI, SizeRule::Gather, Storage::PassOwned});
 }
 
 PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
@@ -59,17 +61,17 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1i(filter_.uniformLocation("scale"), ctx.gatherScale());
     glUniform1f(filter_.uniformLocation("historyWeight"),
                 history_.usable(ctx, ctx.options.temporalBlend) ? ctx.options.temporalBlend : 0.0f);
-    glBindTextureUnit(kUnitFilterPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitFilterNormal, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(kUnitFilterIndirectRv, res.texture(Resource::IndirectRv).id());
-    glBindTextureUnit(kUnitFilterIndirectR, res.texture(Resource::IndirectR).id());
+    glBindTextureUnit(kUnitFilterPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitFilterNormal, res.texture(kGBufferNormal).id());
+    glBindTextureUnit(kUnitFilterIndirectRv, res.texture(kIndirectRv).id());
+    glBindTextureUnit(kUnitFilterIndirectR, res.texture(kIndirectR).id());
     glBindTextureUnit(kUnitFilterHistoryRv, lowRv_[read].id());
     glBindTextureUnit(kUnitFilterHistoryR, lowR_[read].id());
     ctx.drawFullscreenTriangle();
     history_.written(ctx);
-    res.publish(Resource::GiHistoryRv, lowRv_[write]);
-    res.publish(Resource::GiHistoryR, lowR_[write]);
-    res.publish(Resource::GatherLight, gatherLight_);
+    res.publish(kGiHistoryRv, lowRv_[write]);
+    res.publish(kGiHistoryR, lowR_[write]);
+    res.publish(kGatherLight, gatherLight_);
 }
 
 }  // namespace mirage::render

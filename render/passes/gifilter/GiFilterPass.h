@@ -3,11 +3,20 @@
 // temporal smoothing at gather resolution (filter.frag; its output is the next frame's history,
 // so two gather-size buffers ping-pong), and the same light packed per gather pixel
 // (GatherLight) for the joint bilateral upsampling, which the direct-light pass does while it
-// sums direct and indirect light into LRv / LR (passes/direct/gi_upsample.glsl): one canvas-size pass fewer.
+// sums direct and indirect light into LRv / LR (passes/direct/gi_upsample.glsl): one canvas-size
+// pass fewer.
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"
 
 namespace mirage::render {
+
+// Filtered indirect light at gather resolution, a = camera distance (m); kept as the next
+// frame's temporal history (persistent).
+inline constexpr Resource kGiHistoryRv{"GiHistoryRv"};
+inline constexpr Resource kGiHistoryR{"GiHistoryR"};
+// The filtered indirect light packed per gather pixel for the upsample: L_rv, L_r as halves,
+// camera-frame depth as a half, 8-bit oct normal (RGBA32UI).
+inline constexpr Resource kGatherLight{"GatherLight"};
 
 class GiFilterPass final : public RenderPass {
 public:

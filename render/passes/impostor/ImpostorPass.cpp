@@ -53,18 +53,6 @@ glm::mat4 boxViewProj(const GpuImpostor& b, float renderExtentW) {
     return m;
 }
 
-size_t bytesPerTexel(GLenum f) {
-    switch (f) {
-        case GL_RGBA32F:
-            return 16;
-        case GL_RGBA16F:
-        case GL_RG32F:
-            return 8;
-        default:
-            return 4;
-    }
-}
-
 }  // namespace
 
 std::string ImpostorBuildStats::summary() const {
@@ -89,9 +77,8 @@ ImpostorPass::ImpostorPass()
 namespace {
 // The resources trace.glsl reads: texture units kUnitImpostorCubePosition + i, then buffers.
 constexpr Resource kTracingTextures[8] = {
-    Resource::ImpostorCubePosition, Resource::ImpostorCubeNormal, Resource::ImpostorCubeAlbedo,
-    Resource::ImpostorCubeEmissive, Resource::ImpostorDepth,      Resource::ImpostorNormal,
-    Resource::ImpostorAlbedo,       Resource::ImpostorEmissive};
+    kImpostorCubePosition, kImpostorCubeNormal, kImpostorCubeAlbedo, kImpostorCubeEmissive,
+    kImpostorDepth,        kImpostorNormal,     kImpostorAlbedo,     kImpostorEmissive};
 constexpr GLenum kTracingFormats[8] = {GL_RGBA32F, GL_RGBA16F, GL_RGBA8, GL_RGBA16F,
                                        GL_RG32F,   GL_RGBA16F, GL_RGBA8, GL_RGBA16F};
 static_assert(kUnitImpostorEmissive - kUnitImpostorCubePosition == 7);
@@ -99,15 +86,16 @@ static_assert(kUnitImpostorEmissive - kUnitImpostorCubePosition == 7);
 
 void ImpostorPass::setup(PassBuilder& b) const {
     for (int i = 0; i < 8; ++i)
-        b.write(kTracingTextures[i], kTracingFormats[i], SizeRule::Impostor, true);
-    b.writeBuffer(Resource::ImpostorRecords, SizeRule::Scene, true);
-    b.writeBuffer(Resource::ImpostorObjects, SizeRule::Scene, true);
+        b.create(kTracingTextures[i],
+                 {kTracingFormats[i], SizeRule::Impostor, Storage::Persistent});
+    b.createBuffer(kImpostorRecords, SizeRule::Scene, true);
+    b.createBuffer(kImpostorObjects, SizeRule::Scene, true);
 }
 
 void ImpostorPass::declareTracing(PassBuilder& b) {
     for (Resource r : kTracingTextures) b.read(r);
-    b.read(Resource::ImpostorRecords);
-    b.read(Resource::ImpostorObjects);
+    b.read(kImpostorRecords);
+    b.read(kImpostorObjects);
 }
 
 namespace {
@@ -129,7 +117,7 @@ void bindTables(const gl::Buffer& records, const gl::Buffer& objects,
 void ImpostorPass::bindForTracing(const PassResources& res, TableViews& views) {
     for (unsigned i = 0; i < 8; ++i)
         glBindTextureUnit(kUnitImpostorCubePosition + i, res.texture(kTracingTextures[i]).id());
-    bindTables(res.buffer(Resource::ImpostorRecords), res.buffer(Resource::ImpostorObjects), views);
+    bindTables(res.buffer(kImpostorRecords), res.buffer(kImpostorObjects), views);
 }
 
 PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
@@ -152,8 +140,8 @@ void ImpostorPass::execute(FrameContext& ctx, PassResources& res) {
     const gl::Texture* textures[8] = {&cubePosition_, &cubeNormal_, &cubeAlbedo_, &cubeEmissive_,
                                       &depth_,        &normal_,     &albedo_,     &emissive_};
     for (int i = 0; i < 8; ++i) res.publish(kTracingTextures[i], *textures[i]);
-    res.publish(Resource::ImpostorRecords, records_);
-    res.publish(Resource::ImpostorObjects, objects_);
+    res.publish(kImpostorRecords, records_);
+    res.publish(kImpostorObjects, objects_);
 }
 
 bool ImpostorPass::update(const GpuScene& scene, const RendererOptions& o) {

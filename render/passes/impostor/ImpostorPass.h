@@ -26,6 +26,21 @@
 
 namespace mirage::render {
 
+// Reflected-scene impostors of the specular objects' surroundings (persistent: built once per
+// scene; trace.glsl reads them): G-buffer cube maps (12 layers per specular object), depth
+// impostors (one layer each), and their tables.
+inline constexpr Resource kImpostorCubePosition{"ImpostorCubePosition"};
+inline constexpr Resource kImpostorCubeNormal{"ImpostorCubeNormal"};
+inline constexpr Resource kImpostorCubeAlbedo{"ImpostorCubeAlbedo"};
+inline constexpr Resource kImpostorCubeEmissive{"ImpostorCubeEmissive"};
+inline constexpr Resource kImpostorDepth{"ImpostorDepth"};
+inline constexpr Resource kImpostorNormal{"ImpostorNormal"};
+inline constexpr Resource kImpostorAlbedo{"ImpostorAlbedo"};
+inline constexpr Resource kImpostorEmissive{"ImpostorEmissive"};
+inline constexpr Resource kImpostorRecords{"ImpostorRecords"};  // SSBO of GpuImpostor
+// SSBO: header + GpuImpostorObject per specular object.
+inline constexpr Resource kImpostorObjects{"ImpostorObjects"};
+
 // A ray for the offline query (tests, accuracy benchmark): world, metres; direction unit.
 struct ImpostorRay {
     glm::vec3 origin{0.0f};

@@ -4,6 +4,10 @@
 
 namespace mirage::render {
 
+// Interleaved VPL gather, deinterleaved and unfiltered (gather size, transient).
+inline constexpr Resource kIndirectRv{"IndirectRv"};
+inline constexpr Resource kIndirectR{"IndirectR"};
+
 class IndirectLightPass final : public RenderPass {
 public:
     IndirectLightPass();
@@ -15,8 +19,7 @@ public:
 
 private:
     gl::Program program_;
-    gl::Texture rv_, r_;
-    gl::Framebuffer fbo_;
+    TargetFramebuffer fbo_{"indirect fbo"};
     gl::Texture vplTexels_ = gl::Texture::createBufferView("VPL texels (indirect)");
 };
 

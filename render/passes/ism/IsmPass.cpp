@@ -3,14 +3,15 @@
 #include <cmath>
 
 #include "render/FrameGraph.h"
+#include "render/passes/vpl/VplPass.h"
 namespace mirage::render {
 
 IsmPass::IsmPass() : program_(computeProgram("ism", "passes/ism/ism.comp")) {}
 
 void IsmPass::setup(PassBuilder& b) const {
-    b.read(Resource::Vpls);
-    b.write(Resource::ImperfectShadowMaps, GL_R32UI, SizeRule::IsmAtlas);
-    b.write(Resource::ImperfectShadowMapsReal, GL_R32UI, SizeRule::IsmAtlas);
+    b.read(kVpls);
+    b.create(kImperfectShadowMaps, {GL_R32UI, SizeRule::IsmAtlas, Storage::PassOwned});
+    b.create(kImperfectShadowMapsReal, {GL_R32UI, SizeRule::IsmAtlas, Storage::PassOwned});
 }
 
 PassDecision IsmPass::decide(const FrameContext& ctx) const {
@@ -37,7 +38,7 @@ void IsmPass::execute(FrameContext& ctx, PassResources& res) {
         glClearTexImage(real_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &far);
     program_.use();
     ctx.bindFrameBlocks();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(Resource::Vpls).id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, res.buffer(kVpls).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingIsmPoints,
                      ctx.scene.surfacePointBuffer().id());
     glBindImageTexture(kImageIsmAll, all_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
@@ -50,8 +51,8 @@ void IsmPass::execute(FrameContext& ctx, PassResources& res) {
     const long long invocations = (long long)ctx.options.vplCount * ctx.options.ismPointsPerVpl;
     glDispatchCompute(GLuint((invocations + 63) / 64), 1, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    res.publish(Resource::ImperfectShadowMaps, all_);
-    res.publish(Resource::ImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? real_ : all_);
+    res.publish(kImperfectShadowMaps, all_);
+    res.publish(kImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? real_ : all_);
 }
 
 }  // namespace mirage::render

@@ -6,6 +6,11 @@
 
 namespace mirage::render {
 
+// r32ui atlas, one paraboloid tile per VPL (all occluders), and the same with real points only
+// (aliases the first without them).
+inline constexpr Resource kImperfectShadowMaps{"ImperfectShadowMaps"};
+inline constexpr Resource kImperfectShadowMapsReal{"ImperfectShadowMapsReal"};
+
 class IsmPass final : public RenderPass {
 public:
     IsmPass();

@@ -5,17 +5,18 @@
 #include <fmt/format.h>
 
 #include "render/FrameGraph.h"
+#include "render/FrameImports.h"
+#include "render/passes/backface/BackFacePass.h"
+#include "render/passes/fuzzy/FuzzyReflectionPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/specular/SpecularLightPass.h"
 
 namespace mirage::render {
 namespace {
-constexpr Resource kOutputs[5] = {Resource::RoughSpecularRv, Resource::RoughSpecularR,
-                                  Resource::RoughSpecularRReflection, Resource::RoughLenv,
-                                  Resource::RoughVideo};
-constexpr Resource kSharp[4] = {Resource::SpecularRv, Resource::SpecularR,
-                                Resource::SpecularRReflection, Resource::Lenv};
-constexpr Resource kFuzzy[5] = {Resource::FuzzySpecularRv, Resource::FuzzySpecularR,
-                                Resource::FuzzySpecularRReflection, Resource::FuzzyLenv,
-                                Resource::FuzzyReflectionVideo};
+// The buffers this pass writes a new version of (rough glass filtered, every other pixel passed
+// through from the version before: the fuzzy pass's, or the specular light pass's).
+constexpr Resource kFiltered[4] = {kSpecularRv, kSpecularR, kSpecularRReflection, kLenv};
 static_assert(kUnitRoughPrefilteredFirst == kUnitRoughLeanFirst + 3);
 
 int fullChain(int w, int h) {
@@ -36,18 +37,15 @@ RoughRefractionPass::RoughRefractionPass()
 }
 
 void RoughRefractionPass::setup(PassBuilder& b) const {
-    for (Resource r :
-         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
-          Resource::ReflectionGBuffer, Resource::ReflectionWeight, Resource::RefractionGBuffer,
-          Resource::RefractionWeight, Resource::RealSurfaces, Resource::CameraImage,
-          Resource::BackFacePosition, Resource::BackFaceNormal})
+    for (Resource r : {kGBufferPosition, kGBufferNormal, kGBufferEmissive, kReflectionGBuffer,
+                       kReflectionWeight, kRefractionGBuffer, kRefractionWeight, kRealSurfaces,
+                       kCameraImage, kBackFacePosition, kBackFaceNormal})
         b.read(r);
-    for (Resource r : kSharp) b.read(r);
-    for (Resource r : kFuzzy) b.readOptional(r);  // rough metals filtered in the same frame
     // In float32 as the L' buffers come and as the fuzzy pass's: the limit of a one-texel lobe
-    // reproduces the smooth path exactly.
-    for (int i = 0; i < 4; ++i) b.write(kOutputs[i], GL_RGBA32F, SizeRule::Canvas);
-    b.write(Resource::RoughVideo, GL_RGBA32F, SizeRule::Canvas);
+    // reproduces the smooth path exactly. The video term is the fuzzy pass's when it ran (rough
+    // metals filtered in the same frame), else made here.
+    for (Resource r : kFiltered) b.modify(r, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
+    b.modifyOptional(kFilteredVideo, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 PassDecision RoughRefractionPass::decide(const FrameContext& ctx) const {
@@ -106,20 +104,20 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
                      ctx.scene.specularDrawBuffer().id());
     const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
-    glBindTextureUnit(kUnitRoughPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitRoughNormal, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(kUnitRoughEmissive, res.texture(Resource::GBufferEmissive).id());
-    glBindTextureUnit(kUnitRoughReflHit, res.texture(Resource::ReflectionGBuffer).id());
-    glBindTextureUnit(kUnitRoughReflWeight, res.texture(Resource::ReflectionWeight).id());
-    glBindTextureUnit(kUnitRoughRefrHit, res.texture(Resource::RefractionGBuffer).id());
-    glBindTextureUnit(kUnitRoughRefrWeight, res.texture(Resource::RefractionWeight).id());
-    glBindTextureUnit(kUnitRoughRealSurfaces, res.texture(Resource::RealSurfaces).id());
+    glBindTextureUnit(kUnitRoughPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitRoughNormal, res.texture(kGBufferNormal).id());
+    glBindTextureUnit(kUnitRoughEmissive, res.texture(kGBufferEmissive).id());
+    glBindTextureUnit(kUnitRoughReflHit, res.texture(kReflectionGBuffer).id());
+    glBindTextureUnit(kUnitRoughReflWeight, res.texture(kReflectionWeight).id());
+    glBindTextureUnit(kUnitRoughRefrHit, res.texture(kRefractionGBuffer).id());
+    glBindTextureUnit(kUnitRoughRefrWeight, res.texture(kRefractionWeight).id());
+    glBindTextureUnit(kUnitRoughRealSurfaces, res.texture(kRealSurfaces).id());
     glBindTextureUnit(kUnitRoughCanvasToCamera, canvasToCamera_.id());
-    glBindTextureUnit(kUnitRoughCamera, res.texture(Resource::CameraImage).id());
-    glBindTextureUnit(kUnitRoughBackPosition, res.texture(Resource::BackFacePosition).id());
-    glBindTextureUnit(kUnitRoughBackNormal, res.texture(Resource::BackFaceNormal).id());
+    glBindTextureUnit(kUnitRoughCamera, res.texture(kCameraImage).id());
+    glBindTextureUnit(kUnitRoughBackPosition, res.texture(kBackFacePosition).id());
+    glBindTextureUnit(kUnitRoughBackNormal, res.texture(kBackFaceNormal).id());
     for (int i = 0; i < 4; ++i)
-        glBindTextureUnit(GLuint(kUnitRoughSpecFirst + i), res.texture(kSharp[i]).id());
+        glBindTextureUnit(GLuint(kUnitRoughSpecFirst + i), res.texture(kFiltered[i]).id());
 
     // 1. Level 0 of the chains over the specular rectangle (zero elsewhere: no coverage), then
     // the box-filtered levels.
@@ -134,11 +132,9 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     // 2. The lobes per rough-glass pixel.
     for (int i = 0; i < kChains; ++i)
         glBindTextureUnit(GLuint(kUnitRoughLeanFirst + i), chains_[i].id());
-    const bool fuzzy = res.has(Resource::FuzzyReflectionVideo);
     for (int i = 0; i < 5; ++i) {
-        const gl::Texture& in = fuzzy   ? res.texture(kFuzzy[i])
-                                : i < 4 ? res.texture(kSharp[i])
-                                        : ctx.blackTexture();
+        const gl::Texture& in =
+            i < 4 ? res.texture(kFiltered[i]) : res.textureOr(kFilteredVideo, ctx.blackTexture());
         glBindTextureUnit(GLuint(kUnitRoughInputFirst + i), in.id());
     }
     outFbo_.bind();
@@ -150,7 +146,8 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1f(locMaxLevel_, float(levels_ - 1));
     ctx.clearForRects(rect, outDrawn_, 0, 5);
     ctx.drawFullscreenTriangleIn(rect);
-    for (int i = 0; i < 5; ++i) res.publish(kOutputs[i], out_[i]);
+    for (int i = 0; i < 4; ++i) res.publish(kFiltered[i], out_[i]);
+    res.publish(kFilteredVideo, out_[4]);
 }
 
 }  // namespace mirage::render

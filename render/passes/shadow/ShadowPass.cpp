@@ -27,13 +27,15 @@ ShadowPass::ShadowPass()
 }
 
 void ShadowPass::setup(PassBuilder& b) const {
-    b.write(Resource::ShadowMaps, GL_R32F, SizeRule::ShadowAtlas);
-    b.write(Resource::ShadowMapsReal, GL_R32F, SizeRule::ShadowAtlas);
-    b.write(Resource::ShadowGlass, GL_RGBA32F, SizeRule::ShadowAtlas);  // only with glass in a cone
-    b.write(Resource::ShadowGlassReal, GL_RGBA32F, SizeRule::ShadowAtlas);
-    b.write(Resource::RsmFlux, GL_RGBA16F, SizeRule::ShadowAtlas);  // only when VPLs are needed
-    b.write(Resource::RsmNormal, GL_RGBA16F, SizeRule::ShadowAtlas);
-    b.write(Resource::RsmPosition, GL_RGBA32F, SizeRule::ShadowAtlas);
+    b.create(kShadowMaps, {GL_R32F, SizeRule::ShadowAtlas, Storage::PassOwned});
+    b.create(kShadowMapsReal, {GL_R32F, SizeRule::ShadowAtlas, Storage::PassOwned});
+    b.create(kShadowGlass,
+             {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});  // only with glass in a cone
+    b.create(kShadowGlassReal, {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});
+    b.create(kRsmFlux,
+             {GL_RGBA16F, SizeRule::ShadowAtlas, Storage::PassOwned});  // only when VPLs are needed
+    b.create(kRsmNormal, {GL_RGBA16F, SizeRule::ShadowAtlas, Storage::PassOwned});
+    b.create(kRsmPosition, {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});
 }
 
 PassDecision ShadowPass::decide(const FrameContext& ctx) const {
@@ -187,16 +189,16 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
         }
     }
     glDisable(GL_DEPTH_TEST);
-    res.publish(Resource::ShadowMaps, distance_);
-    res.publish(Resource::ShadowMapsReal, ctx.plan.needRealOnlyShadows ? distanceReal_ : distance_);
+    res.publish(kShadowMaps, distance_);
+    res.publish(kShadowMapsReal, ctx.plan.needRealOnlyShadows ? distanceReal_ : distance_);
     if (ctx.plan.glassShadows) {
-        res.publish(Resource::ShadowGlass, glass_);
-        res.publish(Resource::ShadowGlassReal, ctx.plan.needRealOnlyGlass ? glassReal_ : glass_);
+        res.publish(kShadowGlass, glass_);
+        res.publish(kShadowGlassReal, ctx.plan.needRealOnlyGlass ? glassReal_ : glass_);
     }
     if (ctx.plan.needVpls) {
-        res.publish(Resource::RsmFlux, rsmFlux_);
-        res.publish(Resource::RsmNormal, rsmNormal_);
-        res.publish(Resource::RsmPosition, rsmPosition_);
+        res.publish(kRsmFlux, rsmFlux_);
+        res.publish(kRsmNormal, rsmNormal_);
+        res.publish(kRsmPosition, rsmPosition_);
     }
 }
 

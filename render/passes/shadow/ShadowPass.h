@@ -14,6 +14,20 @@
 
 namespace mirage::render {
 
+// Per light layer (shadow atlas: shadowMapSize^2 x layers).
+inline constexpr Resource kShadowMaps{"ShadowMaps"};  // distance to the nearest occluder (m)
+// The same with real occluders only (aliases ShadowMaps where equal).
+inline constexpr Resource kShadowMapsReal{"ShadowMapsReal"};
+// Glass between light and texel: rgb = sum of ln(transmittance) terms (Fresnel, colour,
+// Beer-Lambert), a = nearest glass (m); and the same with real glass only.
+inline constexpr Resource kShadowGlass{"ShadowGlass"};
+inline constexpr Resource kShadowGlassReal{"ShadowGlassReal"};
+// Reflective shadow map: rgb reflected intensity, a = real; normal facing the light; xyz world
+// (m), w = 1 where covered.
+inline constexpr Resource kRsmFlux{"RsmFlux"};
+inline constexpr Resource kRsmNormal{"RsmNormal"};
+inline constexpr Resource kRsmPosition{"RsmPosition"};
+
 class ShadowPass final : public RenderPass {
 public:
     ShadowPass();

@@ -3,6 +3,8 @@
 #include <array>
 
 #include "render/FrameGraph.h"
+#include "render/passes/backface/BackFacePass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
 
 namespace mirage::render {
@@ -37,8 +39,9 @@ void publish(PassResources& res, const SpecularHitBuffer& b, Resource position, 
 
 void declare(PassBuilder& b, Resource position, Resource normal, Resource albedo, Resource emissive,
              Resource weight) {
-    b.write(position, GL_RGBA32F, SizeRule::Canvas);
-    for (Resource r : {normal, albedo, emissive, weight}) b.write(r, GL_RGBA16F, SizeRule::Canvas);
+    b.create(position, {GL_RGBA32F, SizeRule::Canvas, Storage::PassOwned});
+    for (Resource r : {normal, albedo, emissive, weight})
+        b.create(r, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 }  // namespace
@@ -52,15 +55,14 @@ SpecularGBufferPass::SpecularGBufferPass()
                                   "#define MIRAGE_SPECULAR_MODE 1")} {}
 
 void SpecularGBufferPass::setup(PassBuilder& b) const {
-    for (Resource r :
-         {Resource::GBufferPosition, Resource::GBufferNormal, Resource::GBufferEmissive,
-          Resource::BackFacePosition, Resource::BackFaceNormal, Resource::SpecularMask})
+    for (Resource r : {kGBufferPosition, kGBufferNormal, kGBufferEmissive, kBackFacePosition,
+                       kBackFaceNormal, kSpecularMask})
         b.read(r);
     ImpostorPass::declareTracing(b);
-    declare(b, Resource::ReflectionGBuffer, Resource::ReflectionNormal, Resource::ReflectionAlbedo,
-            Resource::ReflectionEmissive, Resource::ReflectionWeight);
-    declare(b, Resource::RefractionGBuffer, Resource::RefractionNormal, Resource::RefractionAlbedo,
-            Resource::RefractionEmissive, Resource::RefractionWeight);
+    declare(b, kReflectionGBuffer, kReflectionNormal, kReflectionAlbedo, kReflectionEmissive,
+            kReflectionWeight);
+    declare(b, kRefractionGBuffer, kRefractionNormal, kRefractionAlbedo, kRefractionEmissive,
+            kRefractionWeight);
 }
 
 PassDecision SpecularGBufferPass::decide(const FrameContext& ctx) const {
@@ -80,15 +82,15 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
 
 void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     ctx.scene.bindTableTexels(sceneTables_, kUnitSpecGbufMaterials, kUnitSpecGbufSpecularDraws);
-    glBindTextureUnit(kUnitSpecGbufPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitSpecGbufNormal, res.texture(Resource::GBufferNormal).id());
-    glBindTextureUnit(kUnitSpecGbufEmissive, res.texture(Resource::GBufferEmissive).id());
-    glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(Resource::BackFacePosition).id());
-    glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(Resource::BackFaceNormal).id());
+    glBindTextureUnit(kUnitSpecGbufPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitSpecGbufNormal, res.texture(kGBufferNormal).id());
+    glBindTextureUnit(kUnitSpecGbufEmissive, res.texture(kGBufferEmissive).id());
+    glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(kBackFacePosition).id());
+    glBindTextureUnit(kUnitSpecGbufBackNormal, res.texture(kBackFaceNormal).id());
     ImpostorPass::bindForTracing(res, impostorTables_);  // kUnitImpostor*, the header block
     // The G-buffer pass's specular-pixel mask as both hit buffers' depth (it reallocates it only
     // on a resize).
-    const gl::Texture& mask = res.texture(Resource::SpecularMask);
+    const gl::Texture& mask = res.texture(kSpecularMask);
     if (mask.id() != attachedMask_) {
         for (SpecularHitBuffer* hits : {&refl_, &refr_}) {
             hits->fbo.attachDepth(mask);
@@ -115,10 +117,10 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
-    publish(res, refl_, Resource::ReflectionGBuffer, Resource::ReflectionNormal,
-            Resource::ReflectionAlbedo, Resource::ReflectionEmissive, Resource::ReflectionWeight);
-    publish(res, refr_, Resource::RefractionGBuffer, Resource::RefractionNormal,
-            Resource::RefractionAlbedo, Resource::RefractionEmissive, Resource::RefractionWeight);
+    publish(res, refl_, kReflectionGBuffer, kReflectionNormal, kReflectionAlbedo,
+            kReflectionEmissive, kReflectionWeight);
+    publish(res, refr_, kRefractionGBuffer, kRefractionNormal, kRefractionAlbedo,
+            kRefractionEmissive, kRefractionWeight);
 }
 
 }  // namespace mirage::render

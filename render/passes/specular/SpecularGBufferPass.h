@@ -9,6 +9,20 @@
 
 namespace mirage::render {
 
+// GBuf_refl: the reflected-ray hit position + origin (or the ray on a miss), normal (w =
+// roughness), base colour (a = metallic), emission (a = specular-pixel flag), Fresnel weight (a =
+// distance inside); GBuf_refr: the same for the two-interface refracted ray (Wyman 2005).
+inline constexpr Resource kReflectionGBuffer{"ReflectionGBuffer"};
+inline constexpr Resource kReflectionNormal{"ReflectionNormal"};
+inline constexpr Resource kReflectionAlbedo{"ReflectionAlbedo"};
+inline constexpr Resource kReflectionEmissive{"ReflectionEmissive"};
+inline constexpr Resource kReflectionWeight{"ReflectionWeight"};
+inline constexpr Resource kRefractionGBuffer{"RefractionGBuffer"};
+inline constexpr Resource kRefractionNormal{"RefractionNormal"};
+inline constexpr Resource kRefractionAlbedo{"RefractionAlbedo"};
+inline constexpr Resource kRefractionEmissive{"RefractionEmissive"};
+inline constexpr Resource kRefractionWeight{"RefractionWeight"};
+
 // One specular G-buffer: hit position + origin (or the ray direction on a miss), normal +
 // roughness, albedo + metallic, emission + specular-pixel flag, weight + distance inside.
 struct SpecularHitBuffer {

@@ -4,16 +4,21 @@
 
 #include "render/FrameGraph.h"
 #include "render/passes/caustic/PhotonGridPass.h"
+#include "render/passes/environment/EnvironmentPass.h"
+#include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/ism/IsmPass.h"
+#include "render/passes/shadow/ShadowPass.h"
+#include "render/passes/specular/SpecularGBufferPass.h"
+#include "render/passes/vpl/VplPass.h"
 
 namespace mirage::render {
 
 namespace {
 // GBuf_refl then GBuf_refr, at kUnitSpecLightReflFirst + 0..4 and kUnitSpecLightRefrFirst + 0..4.
-constexpr Resource kHitBuffers[10] = {Resource::ReflectionGBuffer,  Resource::ReflectionNormal,
-                                      Resource::ReflectionAlbedo,   Resource::ReflectionEmissive,
-                                      Resource::ReflectionWeight,   Resource::RefractionGBuffer,
-                                      Resource::RefractionNormal,   Resource::RefractionAlbedo,
-                                      Resource::RefractionEmissive, Resource::RefractionWeight};
+constexpr Resource kHitBuffers[10] = {kReflectionGBuffer,  kReflectionNormal, kReflectionAlbedo,
+                                      kReflectionEmissive, kReflectionWeight, kRefractionGBuffer,
+                                      kRefractionNormal,   kRefractionAlbedo, kRefractionEmissive,
+                                      kRefractionWeight};
 static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
 // L'_rv, L'_r, reflection share (each also the next frame's history), L_env, the hits.
 constexpr int kAttachments = 5;
@@ -63,22 +68,20 @@ SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOption
 
 void SpecularLightPass::setup(PassBuilder& b) const {
     for (Resource r : kHitBuffers) b.read(r);
-    b.read(Resource::GBufferPosition);
-    b.read(Resource::GBufferEmissive);  // the specular slot (half-resolution upsample)
-    b.read(Resource::SpecularMask);     // depth attachment: shade specular pixels only
-    b.read(Resource::EnvironmentMap);
-    b.read(Resource::EnvironmentLight);
-    for (Resource r :
-         {Resource::ShadowMaps, Resource::ShadowMapsReal, Resource::ShadowGlass,
-          Resource::ShadowGlassReal, Resource::Vpls, Resource::ImperfectShadowMaps,
-          Resource::ImperfectShadowMapsReal, Resource::PhotonGrid, Resource::PhotonRecords})
+    b.read(kGBufferPosition);
+    b.read(kGBufferEmissive);  // the specular slot (half-resolution upsample)
+    b.read(kSpecularMask);     // depth attachment: shade specular pixels only
+    b.read(kEnvironmentMap);
+    b.read(kEnvironmentLight);
+    for (Resource r : {kShadowMaps, kShadowMapsReal, kShadowGlass, kShadowGlassReal, kVpls,
+                       kImperfectShadowMaps, kImperfectShadowMapsReal, kPhotonGrid, kPhotonRecords})
         b.readOptional(r);
     // This frame's smoothed L', read back by the next frame as temporal history (32-bit: the
     // alpha channels hold the world positions and distances the history test compares).
-    b.write(Resource::SpecularRv, GL_RGBA32F, SizeRule::Canvas, true);
-    b.write(Resource::SpecularR, GL_RGBA32F, SizeRule::Canvas, true);
-    b.write(Resource::SpecularRReflection, GL_RGBA32F, SizeRule::Canvas, true);
-    b.write(Resource::Lenv, GL_RGBA16F, SizeRule::Canvas);
+    b.create(kSpecularRv, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
+    b.create(kSpecularR, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
+    b.create(kSpecularRReflection, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
+    b.create(kLenv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
 }
 
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
@@ -178,7 +181,7 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     const gl::Texture* half[4] = {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_};
     for (int i = 0; i < 4; ++i)
         glBindTextureUnit(GLuint(kUnitSpecResolveHalfFirst + i), half[i]->id());
-    glBindTextureUnit(kUnitSpecResolveSlot, res.texture(Resource::GBufferEmissive).id());
+    glBindTextureUnit(kUnitSpecResolveSlot, res.texture(kGBufferEmissive).id());
     glUniform1i(resolve_.uniformLocation("geometryTest"),
                 ctx.options.specularUpsampleGeometry ? 1 : 0);
     glEnable(GL_DEPTH_TEST);
@@ -191,8 +194,7 @@ void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources
                                     const Variant& v) const {
     if (v.cellSize >= 0) glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
     if (v.gatherCap >= 0) glUniform1ui(v.gatherCap, GLuint(ctx.options.causticGatherCap));
-    const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
-                      res.has(Resource::ImperfectShadowMaps);
+    const bool vpls = ctx.options.specularVpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
     glUniform1i(v.useVpls, vpls ? 1 : 0);
     glUniform1i(v.vplStride, ctx.options.specularVplStride);
     if (v.historyWeight >= 0) {
@@ -203,7 +205,7 @@ void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources
 
 void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     const int write = history_.writeSlot(), read = history_.readSlot();
-    const gl::Texture& mask = res.texture(Resource::SpecularMask);
+    const gl::Texture& mask = res.texture(kSpecularMask);
     if (mask.id() != attachedMask_[write]) {  // specgbuf reallocates it only on a resize
         fbo_[write].attachDepth(mask);
         fbo_[write].finalize(kAttachments);
@@ -211,42 +213,38 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     }
     // The gather variant only in frames with a photon grid: llvmpipe pays for a branch's buffer
     // reads even when no pixel takes it.
-    const bool gather =
-        sceneCanGather_ && res.has(Resource::PhotonGrid) && res.has(Resource::PhotonRecords);
+    const bool gather = sceneCanGather_ && res.has(kPhotonGrid) && res.has(kPhotonRecords);
     for (int i = 0; i < 10; ++i)
         glBindTextureUnit(GLuint(kUnitSpecLightReflFirst + i), res.texture(kHitBuffers[i]).id());
     glBindTextureUnit(kUnitSpecLightShadowAll,
-                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+                      res.textureOr(kShadowMaps, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitSpecLightShadowReal,
-                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
+                      res.textureOr(kShadowMapsReal, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitSpecLightGlassAll,
-                      res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
+                      res.textureOr(kShadowGlass, ctx.noGlassTexture()).id());
     glBindTextureUnit(kUnitSpecLightGlassReal,
-                      res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
-    const bool vpls = ctx.options.specularVpls && res.has(Resource::Vpls) &&
-                      res.has(Resource::ImperfectShadowMaps);
+                      res.textureOr(kShadowGlassReal, ctx.noGlassTexture()).id());
+    const bool vpls = ctx.options.specularVpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
     if (vpls) {
-        vplTexels_.attachBuffer(res.buffer(Resource::Vpls), GL_RGBA32F);
+        vplTexels_.attachBuffer(res.buffer(kVpls), GL_RGBA32F);
         glBindTextureUnit(kUnitSpecLightVpls, vplTexels_.id());
-        glBindTextureUnit(kUnitSpecLightIsmAll, res.texture(Resource::ImperfectShadowMaps).id());
-        glBindTextureUnit(kUnitSpecLightIsmReal,
-                          res.textureOr(Resource::ImperfectShadowMapsReal,
-                                        res.texture(Resource::ImperfectShadowMaps))
-                              .id());
+        glBindTextureUnit(kUnitSpecLightIsmAll, res.texture(kImperfectShadowMaps).id());
+        glBindTextureUnit(
+            kUnitSpecLightIsmReal,
+            res.textureOr(kImperfectShadowMapsReal, res.texture(kImperfectShadowMaps)).id());
     } else {
         glBindTextureUnit(kUnitSpecLightVpls, 0);
         glBindTextureUnit(kUnitSpecLightIsmAll, 0);
         glBindTextureUnit(kUnitSpecLightIsmReal, 0);
     }
-    glBindTextureUnit(kUnitSpecLightPosition, res.texture(Resource::GBufferPosition).id());
-    glBindTextureUnit(kUnitEnvironmentMap, res.texture(Resource::EnvironmentMap).id());
-    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
-                     res.buffer(Resource::EnvironmentLight).id());
+    glBindTextureUnit(kUnitSpecLightPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitEnvironmentMap, res.texture(kEnvironmentMap).id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment, res.buffer(kEnvironmentLight).id());
     if (gather) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotonGrid,
-                         res.buffer(Resource::PhotonGrid).id());
+                         res.buffer(kPhotonGrid).id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotons,
-                         res.buffer(Resource::PhotonRecords).id());
+                         res.buffer(kPhotonRecords).id());
     }
     glBindTextureUnit(kUnitSpecLightHistoryRv, rv_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryR, r_[read].id());
@@ -270,10 +268,10 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     glDisable(GL_DEPTH_TEST);
-    res.publish(Resource::SpecularRv, rv_[write]);
-    res.publish(Resource::SpecularR, r_[write]);
-    res.publish(Resource::SpecularRReflection, rRefl_[write]);
-    res.publish(Resource::Lenv, env_[write]);
+    res.publish(kSpecularRv, rv_[write]);
+    res.publish(kSpecularR, r_[write]);
+    res.publish(kSpecularRReflection, rRefl_[write]);
+    res.publish(kLenv, env_[write]);
     history_.written(ctx);
 }
 

@@ -14,6 +14,17 @@
 
 namespace mirage::render {
 
+// L'_rv (Eq. 3, Fresnel-weighted), L'_r (Eq. 4) and the reflection's share of L'_r, after
+// temporal smoothing (RGBA32F; version 0 is this pass's history, persistent); L_env, the
+// environment seen where a ray leaves the modelled scene. SpecularRv.a = the specular surface's
+// camera distance (m, 0: none); SpecularR.a and SpecularRReflection.a = y and z of the refracted
+// ray's hit (world, m). The fuzzy and rough passes write later versions of all four (filtered on
+// their pixels, the version before elsewhere).
+inline constexpr Resource kSpecularRv{"SpecularRv"};
+inline constexpr Resource kSpecularR{"SpecularR"};
+inline constexpr Resource kSpecularRReflection{"SpecularRReflection"};
+inline constexpr Resource kLenv{"Lenv"};
+
 class SpecularLightPass final : public RenderPass {
 public:
     SpecularLightPass(const GpuScene& scene, const RendererOptions& options);

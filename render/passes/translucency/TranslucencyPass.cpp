@@ -7,6 +7,8 @@
 
 #include "core/Error.h"
 #include "render/FrameGraph.h"
+#include "render/passes/environment/EnvironmentPass.h"
+#include "render/passes/shadow/ShadowPass.h"
 #include "render/translucency/VoxelNumberMap.h"
 
 namespace mirage::render {
@@ -108,13 +110,13 @@ TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
 }
 
 void TranslucencyPass::setup(PassBuilder& b) const {
-    b.read(Resource::EnvironmentLight);
-    b.readOptional(Resource::ShadowMaps);  // none: no light has a caster (unshadowed)
-    b.readOptional(Resource::ShadowMapsReal);
-    b.readOptional(Resource::ShadowGlass);
-    b.readOptional(Resource::ShadowGlassReal);
-    b.writeBuffer(Resource::TranslucentGrid, SizeRule::Scene, true);
-    b.writeBuffer(Resource::TranslucentRadiance, SizeRule::Scene);
+    b.read(kEnvironmentLight);
+    b.readOptional(kShadowMaps);  // none: no light has a caster (unshadowed)
+    b.readOptional(kShadowMapsReal);
+    b.readOptional(kShadowGlass);
+    b.readOptional(kShadowGlassReal);
+    b.createBuffer(kTranslucentGrid, SizeRule::Scene, true);
+    b.createBuffer(kTranslucentRadiance, SizeRule::Scene);
 }
 
 PassDecision TranslucencyPass::decide(const FrameContext& ctx) const {
@@ -137,21 +139,20 @@ bool TranslucencyPass::upToDate(const FrameContext& ctx) const {
 void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
-    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment,
-                     res.buffer(Resource::EnvironmentLight).id());
+    glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment, res.buffer(kEnvironmentLight).id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentGrid, grid_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentVoxels, voxels_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentLut, lut_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentIrradiance, irradiance_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentRadiance, radiance_.id());
     glBindTextureUnit(kUnitTranslucencyShadowAll,
-                      res.textureOr(Resource::ShadowMaps, ctx.farShadowTexture()).id());
+                      res.textureOr(kShadowMaps, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitTranslucencyShadowReal,
-                      res.textureOr(Resource::ShadowMapsReal, ctx.farShadowTexture()).id());
+                      res.textureOr(kShadowMapsReal, ctx.farShadowTexture()).id());
     glBindTextureUnit(kUnitTranslucencyGlassAll,
-                      res.textureOr(Resource::ShadowGlass, ctx.noGlassTexture()).id());
+                      res.textureOr(kShadowGlass, ctx.noGlassTexture()).id());
     glBindTextureUnit(kUnitTranslucencyGlassReal,
-                      res.textureOr(Resource::ShadowGlassReal, ctx.noGlassTexture()).id());
+                      res.textureOr(kShadowGlassReal, ctx.noGlassTexture()).id());
     const GLint stage = program_.uniformLocation("stage");
     const GLint object = program_.uniformLocation("objectIndex");
     // Stage 0 (irradiance) of every object, then stage 1 (radiance out) of every object: one
@@ -164,8 +165,8 @@ void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
         }
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    res.publish(Resource::TranslucentGrid, grid_);
-    res.publish(Resource::TranslucentRadiance, radiance_);
+    res.publish(kTranslucentGrid, grid_);
+    res.publish(kTranslucentRadiance, radiance_);
     doneKey_ = inputKey(ctx);
 }
 

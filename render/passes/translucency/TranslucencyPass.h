@@ -17,6 +17,13 @@
 
 namespace mirage::render {
 
+// SSBOs of the first translucent object (docs/translucency.md). TranslucentGrid: header + the
+// voxel number of every grid cell (persistent, uploaded once); TranslucentRadiance: per surface
+// voxel the radiance (1/pi) a_eff sum E A c e^{-tau} leaving it before the exit F_t, S vec4 for
+// L_rv then S vec4 for L_r.
+inline constexpr Resource kTranslucentGrid{"TranslucentGrid"};
+inline constexpr Resource kTranslucentRadiance{"TranslucentRadiance"};
+
 class TranslucencyPass final : public RenderPass {
 public:
     TranslucencyPass(const Scene& scene, const GpuScene& gpu, const RendererOptions& options);

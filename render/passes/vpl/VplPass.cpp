@@ -1,20 +1,21 @@
 #include "render/passes/vpl/VplPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/passes/caustic/PhotonGBufferPass.h"
+#include "render/passes/shadow/ShadowPass.h"
 namespace mirage::render {
 
 VplPass::VplPass() : program_(computeProgram("vpl", "passes/vpl/vpl.comp")) {}
 
 void VplPass::setup(PassBuilder& b) const {
-    b.read(Resource::RsmFlux);
-    b.read(Resource::RsmNormal);
-    b.read(Resource::RsmPosition);
+    b.read(kRsmFlux);
+    b.read(kRsmNormal);
+    b.read(kRsmPosition);
     // Reflected / refracted VPLs follow the photons (none: no caustic light, or the option off).
-    for (Resource r :
-         {Resource::PhotonHitRefl, Resource::PhotonPowerRefl, Resource::PhotonSurfaceRefl,
-          Resource::PhotonHitRefr, Resource::PhotonPowerRefr, Resource::PhotonSurfaceRefr})
+    for (Resource r : {kPhotonHitRefl, kPhotonPowerRefl, kPhotonSurfaceRefl, kPhotonHitRefr,
+                       kPhotonPowerRefr, kPhotonSurfaceRefr})
         b.readOptional(r);
-    b.writeBuffer(Resource::Vpls, SizeRule::Vpl);
+    b.createBuffer(kVpls, SizeRule::Vpl);
 }
 
 PassDecision VplPass::decide(const FrameContext& ctx) const {
@@ -38,13 +39,12 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     program_.use();
     ctx.bindFrameBlocks();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingVpls, vpls_.id());
-    glBindTextureUnit(kUnitVplRsmFlux, res.texture(Resource::RsmFlux).id());
-    glBindTextureUnit(kUnitVplRsmNormal, res.texture(Resource::RsmNormal).id());
-    glBindTextureUnit(kUnitVplRsmPosition, res.texture(Resource::RsmPosition).id());
-    const bool follow = ctx.options.reflectedRefractedVpls && res.has(Resource::PhotonHitRefl);
-    const Resource photons[6] = {Resource::PhotonHitRefl,     Resource::PhotonPowerRefl,
-                                 Resource::PhotonSurfaceRefl, Resource::PhotonHitRefr,
-                                 Resource::PhotonPowerRefr,   Resource::PhotonSurfaceRefr};
+    glBindTextureUnit(kUnitVplRsmFlux, res.texture(kRsmFlux).id());
+    glBindTextureUnit(kUnitVplRsmNormal, res.texture(kRsmNormal).id());
+    glBindTextureUnit(kUnitVplRsmPosition, res.texture(kRsmPosition).id());
+    const bool follow = ctx.options.reflectedRefractedVpls && res.has(kPhotonHitRefl);
+    const Resource photons[6] = {kPhotonHitRefl, kPhotonPowerRefl, kPhotonSurfaceRefl,
+                                 kPhotonHitRefr, kPhotonPowerRefr, kPhotonSurfaceRefr};
     const int units[6] = {kUnitVplPhotonHitRefl,     kUnitVplPhotonPowerRefl,
                           kUnitVplPhotonSurfaceRefl, kUnitVplPhotonHitRefr,
                           kUnitVplPhotonPowerRefr,   kUnitVplPhotonSurfaceRefr};
@@ -68,7 +68,7 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1i(program_.uniformLocation("photonMapSize"), ctx.options.causticMapSize);
     glDispatchCompute(GLuint((ctx.options.vplCount + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    res.publish(Resource::Vpls, vpls_);
+    res.publish(kVpls, vpls_);
 }
 
 }  // namespace mirage::render

@@ -4,6 +4,9 @@
 
 namespace mirage::render {
 
+// SSBO of GpuVpl (vplCount entries).
+inline constexpr Resource kVpls{"Vpls"};
+
 class VplPass final : public RenderPass {
 public:
     VplPass();

@@ -1,4 +1,4 @@
-#include "render/evaluation/GroundTruthComposite.h"
+#include "render/raytrace/GroundTruthComposite.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
