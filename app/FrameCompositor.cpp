@@ -33,6 +33,7 @@ CompositedFrame FrameCompositor::process(const cv::Mat& bgr, double t, const std
         tracking::TrackedFrame tf = tracker_->process(bgr, t);
         pr.state = tracking::trackingStateName(tf.estimate.state);
         pr.reason = tf.estimate.reason;
+        out.trackingMode = tracking::trackingModeName(tf.mode);
         if (tf.estimate.state == tracking::TrackingState::Ok)
             pr.pose = tf.filtered ? tf.filtered : tf.estimate.pose;
     } else {

@@ -87,6 +87,7 @@ struct LiveArgs {
     float exposure = 1.0f;
     int jpegQuality = 92;
     bool headless = false;
+    bool boardOnly = false;  // no natural features (extended tracking off)
     bool force = false;
     bool loop = false;  // a stand-in starts again at its end
     bool listCameras = false;
@@ -461,7 +462,9 @@ void runLive(const LiveArgs& a) {
     if (!scene.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
     const tracking::Board board = tracking::Board::load(boardPath);
-    tracking::Tracker tracker(board, calib.intrinsics);
+    tracking::TrackerOptions trackerOptions;
+    trackerOptions.features.enabled = !a.boardOnly;
+    tracking::Tracker tracker(board, calib.intrinsics, trackerOptions);
     // Where the virtual objects stand: the saved placement (moves within the board's plane).
     const fs::path placementFile =
         a.placement.empty() ? placementPath(a.scene) : fs::path(a.placement);
@@ -876,10 +879,12 @@ void runLive(const LiveArgs& a) {
         ImGui::Text("dropped %lld (driver %lld)", static_cast<long long>(capture.dropped()),
                     static_cast<long long>(capture.deviceDropped()));
         const std::string& st = last.pose.state;
-        ImGui::TextColored(st == "ok"   ? green
-                           : st.empty() ? amber
-                                        : red,
-                           "tracking: %s", st.empty() ? "waiting for a frame" : st.c_str());
+        ImGui::TextColored(
+            st == "ok"   ? green
+            : st.empty() ? amber
+                         : red,
+            "tracking: %s%s", st.empty() ? "waiting for a frame" : st.c_str(),
+            last.trackingMode.empty() ? "" : (" (" + last.trackingMode + ")").c_str());
         ImGui::PushTextWrapPos(0);
         if (!last.pose.reason.empty()) ImGui::TextWrapped("%s", last.pose.reason.c_str());
         ImGui::TextWrapped("exposure: %s", cam.exposureText.c_str());
@@ -1071,6 +1076,8 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_flag("--camera-loop", args->loop,
                   "Play a stand-in session or video again from the start when it ends");
     cmd->add_flag("--headless", args->headless, "No window (EGL): for tests and benchmarks");
+    cmd->add_flag("--board-only", args->boardOnly,
+                  "Track the board's tags only, no natural features (docs/tracking.md)");
     cmd->add_option("--frames", args->maxFrames, "Stop after N processed frames")
         ->check(wholeIn(-1, 100000000));
     cmd->add_option("-o,--output", args->output,

@@ -106,6 +106,7 @@ struct ReplayArgs {
     bool window = false;
     bool verbose = false;
     bool groundTruth = false;
+    bool boardOnly = false;  // no natural features (extended tracking off)
     bool force = false;
     bool estimateLights = false;  // place the environment's lights (and report them)
     bool reportLights = false;    // report them only
@@ -218,8 +219,10 @@ void runReplay(const ReplayArgs& a) {
         poses = readPosesCsv(a.poses);
     } else if (!a.groundTruth && !session.board.empty() &&
                std::filesystem::exists(session.path(session.board))) {
+        tracking::TrackerOptions trackerOptions;
+        trackerOptions.features.enabled = !a.boardOnly;
         tracker = std::make_unique<tracking::Tracker>(
-            tracking::Board::load(session.path(session.board)), calib.intrinsics);
+            tracking::Board::load(session.path(session.board)), calib.intrinsics, trackerOptions);
         spdlog::info("replay: tracking the camera on {}", session.path(session.board).string());
     } else {
         spdlog::info("replay: camera poses from the session's ground truth (frames.csv){}",
@@ -518,6 +521,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_flag("--report-lights", args->reportLights,
                   "Report the dominant lights of the environment (direction, colour, intensity) "
                   "whenever it changes, without placing them");
+    cmd->add_flag("--board-only", args->boardOnly,
+                  "Track the board's tags only, no natural features (docs/tracking.md)");
     cmd->add_flag("--ground-truth", args->groundTruth,
                   "Use the session's ground-truth poses (frames.csv) instead of tracking");
     cmd->add_flag("--force", args->force,

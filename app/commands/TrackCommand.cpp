@@ -2,6 +2,7 @@
 // with a summary (docs/tracking.md). Wiring only: the work is in tracking/.
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 
@@ -14,6 +15,7 @@
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/image/ImageIO.h"
+#include "core/plot/SvgPlot.h"
 #include "core/session/Session.h"
 #include "tracking/Board.h"
 #include "tracking/EnvironmentMap.h"
@@ -32,6 +34,8 @@ struct TrackArgs {
     bool noTagTracking = false;
     bool noTextureRegion = false;
     bool noCoarseFirst = false;
+    bool boardOnly = false;
+    std::string driftSvg;  // drift of extended tracking against the time without the board
     bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
@@ -41,6 +45,26 @@ glm::dvec3 boardCentre(const tracking::Board& b) {
     glm::dvec3 c(0.0);
     for (const auto& t : b.tags) c += t.T_world_tag.translation;
     return c / double(b.tags.size());
+}
+
+// Rotation error and translation error (percent of the distance) of the poses not from the board
+// alone, against the seconds since the last board pose.
+void writeDriftPlot(const tracking::TrackingReport& report, const std::filesystem::path& svg,
+                    const std::string& source) {
+    plot::LinePlot p;
+    p.title = "Extended tracking: error without the board (" +
+              std::filesystem::path(source).filename().string() + ")";
+    p.xLabel = "seconds since the last pose from the board";
+    p.yLabel = "error (deg, % of distance)";
+    plot::Series rot{"rotation error (deg)", {}}, pos{"translation error (% of distance)", {}};
+    for (const auto& d : report.drift()) {
+        rot.points.push_back({d.secondsWithoutBoard, d.rotErrDeg, ""});
+        pos.points.push_back({d.secondsWithoutBoard, 100 * d.posErrRel, ""});
+    }
+    p.series = {rot, pos};
+    std::ofstream out(svg);
+    out << plot::svgLines(p);
+    if (!out) throw FileError(svg.string(), "cannot write the drift plot");
 }
 
 void run(const TrackArgs& a) {
@@ -81,7 +105,8 @@ void run(const TrackArgs& a) {
     rule.inputs.push_back(calibPath);
     rule.inputs.push_back(boardPath);
     OutputFile posesOut(a.output, OutputOrigin::Named, rule);
-    std::optional<OutputFile> envmapOut, validOut;
+    std::optional<OutputFile> envmapOut, validOut, driftOut;
+    if (!a.driftSvg.empty()) driftOut.emplace(a.driftSvg, OutputOrigin::Named, rule);
     if (!a.envmap.empty()) {
         auto validPath = std::filesystem::path(a.envmap);
         validPath.replace_filename(validPath.stem().string() + "_valid.png");
@@ -96,6 +121,7 @@ void run(const TrackArgs& a) {
     opt.tagTracking = !a.noTagTracking;
     opt.textureRegion = !a.noTextureRegion;
     opt.coarseFirst = !a.noCoarseFirst;
+    opt.features.enabled = !a.boardOnly;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -219,6 +245,10 @@ void run(const TrackArgs& a) {
     }
     report.close();
     posesOut.commit();
+    if (driftOut) {
+        writeDriftPlot(report, driftOut->temp(), a.session.empty() ? a.video : a.session);
+        driftOut->commit();
+    }
     if (repeats > 0)
         spdlog::warn("{} frame(s) repeat the previous frame exactly (frozen or duplicated)",
                      repeats);
@@ -276,6 +306,12 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_flag("--no-coarse-first", a->noCoarseFirst,
                   "Without a recent pose, do not pick a coarse-to-fine decimation from the "
                   "size of the textured region (docs/tracking.md, Single frames: coarse-first)");
+    cmd->add_flag("--board-only", a->boardOnly,
+                  "Poses from the board's tags only: no natural features (docs/tracking.md, "
+                  "Extended tracking)");
+    cmd->add_option("--drift-svg", a->driftSvg,
+                    "Plot the error of the poses from natural features against the time "
+                    "without the board (needs ground truth) to this SVG file");
     cmd->callback([a] { run(*a); });
 });
 
