@@ -209,8 +209,6 @@ void FeatureTracker::learn(const cv::Mat& grey, const PoseEstimate& pose, bool f
             mapCovariance_[k] = mapCovariance_[k] == 0 && k % 7 == 0
                                     ? pose.covariance[k]
                                     : 0.8 * mapCovariance_[k] + 0.2 * pose.covariance[k];
-    } else {
-        derivedCovariance_ = pose.covariance;
     }
     // Every track must stay where its landmark says it is under the pose (else: a moving
     // object, a track that slid); at a board pose the agreeing ones refine their landmarks.
@@ -247,7 +245,7 @@ void FeatureTracker::learn(const cv::Mat& grey, const PoseEstimate& pose, bool f
         kept.push_back(t);
     }
     tracks_ = std::move(kept);
-    const int maxFeatures = int(options_.maxFeatures * scale_ * scale_);
+    const int maxFeatures = int(options_.maxFeatures * scale_);
     if (options_.enabled && (fromBoard || options_.derivedLandmarks) &&
         (++framesSinceDetect_ >= options_.detectEvery ||
          double(tracks_.size()) < options_.refillFraction * maxFeatures)) {
@@ -259,7 +257,7 @@ void FeatureTracker::learn(const cv::Mat& grey, const PoseEstimate& pose, bool f
 
 void FeatureTracker::detect(const cv::Mat& grey, const PoseEstimate& pose, bool derived,
                             const cv::Rect& boardPixels) {
-    const int maxFeatures = int(options_.maxFeatures * scale_ * scale_);
+    const int maxFeatures = int(options_.maxFeatures * scale_);
     const int want = maxFeatures - int(tracks_.size());
     if (want <= 0) return;
     const double minDist = options_.minDistancePx * scale_;
@@ -273,10 +271,13 @@ void FeatureTracker::detect(const cv::Mat& grey, const PoseEstimate& pose, bool 
     cv::cornerSubPix(grey, corners, cv::Size(3, 3), cv::Size(-1, -1), term);
     const double rotSigma = glm::radians(pose.sigmaRotDeg());
     const double depth = pose.distanceM > 0 ? pose.distanceM : 0.5;
+    // A derived landmark's share of its pose's error is common to all landmarks made from that
+    // pose: added once to every later pose from them (derivedCovariance_), not per landmark.
+    if (derived) derivedCovariance_ = pose.covariance;
     for (const auto& c : corners) {
-        const int id =
-            map_.add(camera_, *pose.pose, {c.x, c.y}, options_.featureSigmaPx * scale_, rotSigma,
-                     pose.sigmaPosM(), depth, options_.rhoSigmaFraction, derived);
+        const int id = map_.add(camera_, *pose.pose, {c.x, c.y}, options_.featureSigmaPx * scale_,
+                                derived ? 0.0 : rotSigma, derived ? 0.0 : pose.sigmaPosM(), depth,
+                                options_.rhoSigmaFraction, derived);
         if (id >= 0) tracks_.push_back({c, id});
     }
 }
@@ -433,7 +434,7 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
     const double whitenedRms = std::sqrt(whitened / double(std::max<size_t>(1, r.size())));
     // Unwhitened pixel RMS of the landmark inliers, and their spread and depth.
     double px2 = 0;
-    cv::Rect2d box;
+    double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;  // the inliers' image box
     std::vector<double> depths;
     int derived = 0;
     for (size_t k = 0; k < inliers.size(); ++k) {
@@ -441,8 +442,8 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
         PosePoint p = c.point;
         p.W = glm::dmat2(1.0);
         px2 += chi2At(camera_, T, p);
-        const cv::Rect2d one(c.pixel.x, c.pixel.y, 0, 0);
-        box = k == 0 ? one : (box | one);
+        x0 = std::min(x0, c.pixel.x), x1 = std::max(x1, c.pixel.x);
+        y0 = std::min(y0, c.pixel.y), y1 = std::max(y1, c.pixel.y);
         depths.push_back(c.depthM);
         derived += c.landmark->derived;
     }
@@ -470,7 +471,8 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
 
     // The same bounds as for tags, after the consistency checks.
     const double share = double(inliers.size()) / double(corr.size());
-    const double spread = box.area() / (double(camera_.width) * camera_.height);
+    const double spread =
+        inliers.empty() ? 0.0 : (x1 - x0) * (y1 - y0) / (double(camera_.width) * camera_.height);
     const double sigmaRot = e.sigmaRotDeg(),
                  sigmaPosRel = e.sigmaPosM() / std::max(1e-6, e.distanceM);
     char buf[320];

@@ -24,7 +24,7 @@ namespace mirage::tracking {
 
 struct FeatureTrackingOptions {
     bool enabled = true;
-    // Features kept at 640 pixels of image width (scaled with the width's square).
+    // Features kept at 640 pixels of image width (scaled with the width).
     int maxFeatures = 150;
     // New features are detected every detectEvery-th frame with a known pose, or as soon as fewer
     // than refillFraction x maxFeatures are tracked.
