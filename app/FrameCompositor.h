@@ -17,6 +17,9 @@ struct CompositedFrame {
     // State and reason of the frame, and the pose composited (T_world_camera, OpenCV axes);
     // no pose: the footage passed through unchanged.
     PoseRow pose;
+    // What made the tracked pose ("board", "board+features", "features only"; empty: the pose
+    // was given, not tracked).
+    std::string trackingMode;
     double trackingMs = 0;                 // wall time of the pose decision (tracking), ms
     std::map<std::string, double> passMs;  // GL timer-query time per pass that ran, ms
     double gpuMs = 0, readbackMs = 0;

@@ -7,6 +7,7 @@ PoseStage::PoseStage(tracking::Tracker* tracker) : tracker_(tracker) {}
 PoseRow PoseStage::decide(const cv::Mat& bgr, double t, const std::string& problem,
                           std::optional<PoseRow> given) {
     PoseRow pr;
+    lastMode_.clear();
     if (bgr.empty()) {
         // Lost (damaged bytes): no image to composite into and no pose to trust; the row says
         // why, the output skips the frame.
@@ -18,6 +19,7 @@ PoseRow PoseStage::decide(const cv::Mat& bgr, double t, const std::string& probl
         tracking::TrackedFrame tf = tracker_->process(bgr, t);
         pr.state = tracking::trackingStateName(tf.estimate.state);
         pr.reason = tf.estimate.reason;
+        lastMode_ = tracking::trackingModeName(tf.mode);
         if (tf.estimate.state == tracking::TrackingState::Ok)
             pr.pose = tf.filtered ? tf.filtered : tf.estimate.pose;
     } else {

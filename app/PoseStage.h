@@ -29,6 +29,10 @@ public:
     PoseRow decide(const cv::Mat& bgr, double t, const std::string& problem,
                    std::optional<PoseRow> given);
 
+    // What made the last frame's tracked pose ("board", "board+features", "features only");
+    // empty when the pose was given or the frame lost before tracking.
+    const std::string& lastMode() const { return lastMode_; }
+
     // Forgets the held pose (a renderer built anew starts its history again).
     void restart();
 
@@ -36,6 +40,7 @@ private:
     tracking::Tracker* tracker_;
     std::optional<Pose> lastGood_;  // the last ok (or given) pose, and its time (seconds)
     double lastGoodT_ = 0;
+    std::string lastMode_;
 };
 
 }  // namespace mirage::app

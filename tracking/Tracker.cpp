@@ -15,6 +15,28 @@ namespace {
 double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
+
+// The step d = (world-frame rotation vector, radians; camera-centre offset, metres) that takes
+// pose a to pose b (the pose estimator's perturbation convention).
+std::array<double, 6> poseDifference(const Pose& a, const Pose& b) {
+    glm::dquat q = b.rotation * glm::inverse(a.rotation);
+    if (q.w < 0) q = -q;
+    const double s = glm::length(glm::dvec3(q.x, q.y, q.z));
+    const double angle = 2.0 * std::atan2(s, q.w);
+    const glm::dvec3 w = s > 1e-15 ? glm::dvec3(q.x, q.y, q.z) * (angle / s) : glm::dvec3(0.0);
+    const glm::dvec3 c = b.translation - a.translation;
+    return {w.x, w.y, w.z, c.x, c.y, c.z};
+}
+
+// Pose p moved by the fraction `weight` of the step d (poseDifference).
+Pose applyPoseDifference(const Pose& p, const std::array<double, 6>& d, double weight) {
+    const glm::dvec3 w = weight * glm::dvec3(d[0], d[1], d[2]);
+    const double a = glm::length(w);
+    Pose q = p;
+    if (a > 0) q.rotation = glm::normalize(glm::angleAxis(a, w / a) * p.rotation);
+    q.translation += weight * glm::dvec3(d[3], d[4], d[5]);
+    return q;
+}
 }  // namespace
 
 double imageSharpness(const cv::Mat& grey) {
@@ -157,6 +179,9 @@ Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
       estimator_(std::move(board), std::move(camera), options.pose),
       filter_(options.filter),
       oneEuro_(options.oneEuro) {
+    if (options_.features.enabled)
+        features_ = std::make_unique<FeatureTracker>(estimator_.board(), estimator_.camera(),
+                                                     options_.features, options_.pose);
     coarseCellsAtBorder_ = TagFamily(options_.detector.family).widthAtBorder();
     double diameter = 0, largest = 0;
     const auto& tags = estimator_.board().tags;
@@ -329,190 +354,262 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     if (lastOk_ && t - lastOkT_ <= options_.priorMaxAgeS && t >= lastOkT_) prior = lastOk_;
     // Only a well-determined previous pose may decide the planar ambiguity.
     const std::optional<Pose> ambiguityPrior = lastOkWellDetermined_ ? prior : std::nullopt;
-
-    const cv::Rect full(0, 0, grey.cols, grey.rows);
-    f.searchRegion = full;
+    f.searchRegion = cv::Rect(0, 0, grey.cols, grey.rows);
     // The previous pose may guide this frame unless a full search is due.
     const bool usePrior = prior && ++framesSinceFullSearch_ < options_.fullFrameEvery;
 
-    auto t0 = std::chrono::steady_clock::now();
-    if (options_.tagTracking && usePrior) {
-        // Tracking mode: the tags where the predicted pose puts them, verified.
-        f.tagTrackingTried = true;
-        const Pose predicted = predictPose(t);
-        f.predictedPose = predicted;
-        auto dets = tagFinder_.find(grey, predicted, *lastOk_, &f.prediction);
-        const int need =
-            std::max(options_.trackMinTags,
-                     int(std::ceil(options_.trackMinFraction * double(f.prediction.predicted))));
-        f.detectMs = msSince(t0);
-        if (f.prediction.verified >= need) {
-            t0 = std::chrono::steady_clock::now();
-            measureBlur(grey, dets);
-            PoseEstimate e = estimator_.estimate(dets, ambiguityPrior, predicted);
-            f.poseMs = msSince(t0);
-            if (e.state == TrackingState::Ok) {
-                f.tagTracked = true;
-                f.detections = std::move(dets);
-                f.estimate = std::move(e);
-                f.searchRegion = cv::Rect();
-            }
-        }
+    if (features_) {
+        std::optional<Pose> predicted;
+        if (lastOk_ && t >= lastOkT_ && t - lastOkT_ <= options_.features.maxGapS)
+            predicted = predictPose(t);
+        features_->track(grey, predicted);
+        f.featureMs = features_->stats().trackMs;
     }
-
+    if (options_.tagTracking && usePrior) trackPredictedTags(grey, t, ambiguityPrior, f);
     if (!f.tagTracked) {
-        if (options_.roiEnabled && usePrior) {
-            const auto r = boardRegion(*prior, grey.size(), true);
-            // Not worth it when the box covers most of the image.
-            if (r && r->area() > 0 && r->area() < 0.7 * full.area()) f.searchRegion = *r;
-        }
-        if (f.searchRegion == full) framesSinceFullSearch_ = 0;
-        // No pose to say where the board is: where the image has the tags' contrast.
-        const cv::Rect r = !prior && (options_.textureRegion || options_.coarseFirst)
-                               ? texturedRegion(grey)
-                               : cv::Rect();
-        const double m = options_.textureMarginPx;
-        const cv::Rect grown =
-            cv::Rect(cv::Point(std::max(0, int(r.x - m)) / kTextureBlockPx * kTextureBlockPx,
-                               std::max(0, int(r.y - m)) / kTextureBlockPx * kTextureBlockPx),
-                     cv::Point(int(r.br().x + m), int(r.br().y + m))) &
-            full;
-        if (options_.textureRegion && !prior) {
-            if (r.area() > 0 && grown.area() <= options_.textureMaxFraction * full.area()) {
-                f.searchRegion = grown;
-                f.textureRegionUsed = true;
-            }
-        }
+        const SearchPlan plan = planSearch(grey, prior, usePrior, f);
+        searchTags(grey, plan, ambiguityPrior, f);
+    }
+    classifyNoTags(grey, f);
+    extendWithFeatures(grey, t, f);
+    guardPrediction(t, prior, f);
+    record(t, f);
+    return f;
+}
 
-        const bool coarseRegion = f.searchRegion == full || f.textureRegionUsed;
-        float coarseDecimate = options_.coarseToFine && grey.cols >= options_.coarseMinWidth
-                                   ? options_.coarseDecimate
-                                   : 0.0f;
-        if (options_.coarseFirst && r.area() > 0) {
-            // The tags' size from the textured region picks the decimation (or none).
-            f.coarseFirstSidePx =
-                largestTagOverDiameter_ * std::hypot(double(r.width), double(r.height));
-            coarseDecimate = 0;
-            for (float d : options_.coarseFirstDecimations)
-                if (d > coarseDecimate && f.coarseFirstSidePx >= d * options_.coarseFirstMinSidePx)
-                    coarseDecimate = d;
-            f.coarseFirstDecimate = coarseDecimate;
-        }
-        // The coarse search reads only the textured region also when it is too large for the
-        // ordinary search (a near board): a confirmed coarse pose has every board tag predicted
-        // in the whole image searched by the finder, and an unconfirmed one falls back to the
-        // ordinary search of f.searchRegion.
-        cv::Rect coarseSearch = f.searchRegion;
-        if (options_.coarseFirst && options_.textureRegion && r.area() > 0) {
-            coarseSearch = grown;
-            if (options_.coarseWindowFraction > 0 && options_.coarseWindowFraction < 1) {
-                // The window about the region's centre, origin aligned like the region's.
-                const double hw = 0.5 * options_.coarseWindowFraction * r.width + m;
-                const double hh = 0.5 * options_.coarseWindowFraction * r.height + m;
-                const double cx = r.x + 0.5 * r.width, cy = r.y + 0.5 * r.height;
-                coarseSearch =
-                    cv::Rect(
-                        cv::Point(std::max(0, int(cx - hw)) / kTextureBlockPx * kTextureBlockPx,
-                                  std::max(0, int(cy - hh)) / kTextureBlockPx * kTextureBlockPx),
-                        cv::Point(int(cx + hw), int(cy + hh))) &
-                    full;
-            }
-        }
-        // Decimation 1 is a coarse stage too (coarseFirstDecimations): libapriltag at full
-        // resolution in the window.
-        if (!(coarseDecimate >= 1.0f && coarseRegion &&
-              coarseToFine(grey, coarseSearch, coarseDecimate, ambiguityPrior, f))) {
-            t0 = std::chrono::steady_clock::now();
-            f.detections = detector_.detect(grey, f.searchRegion);
-            f.detectMs += msSince(t0);
-            t0 = std::chrono::steady_clock::now();
-            measureBlur(grey, f.detections);
-            f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
-            f.poseMs += msSince(t0);
-        }
-        bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
-        if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
-            const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
-            retry = !now || (*now & f.searchRegion) != *now;
-        }
-        if (f.textureRegionUsed && f.estimate.pose) {
-            // The textured region holds the whole board under the frame's pose (ok or not):
-            // searching the rest of the image cannot add a tag of that board. Else the region
-            // may have cut off tags: search the whole image.
-            const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
-            retry = !now || (*now & f.searchRegion) != *now;
-        }
-        if (retry) {
-            // The region missed the board or part of it (fast motion, occlusion): search the
-            // whole image before giving up or using fewer tags than the frame shows.
-            f.fullFrameRetry = true;
-            framesSinceFullSearch_ = 0;
-            t0 = std::chrono::steady_clock::now();
-            f.detections = detector_.detect(grey);
-            f.detectMs += msSince(t0);
-            t0 = std::chrono::steady_clock::now();
-            measureBlur(grey, f.detections);
-            f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
-            f.poseMs += msSince(t0);
+void Tracker::trackPredictedTags(const cv::Mat& grey, double t,
+                                 const std::optional<Pose>& ambiguityPrior, TrackedFrame& f) {
+    // Tracking mode: the tags where the predicted pose puts them, verified.
+    auto t0 = std::chrono::steady_clock::now();
+    f.tagTrackingTried = true;
+    const Pose predicted = predictPose(t);
+    f.predictedPose = predicted;
+    auto dets = tagFinder_.find(grey, predicted, *lastOk_, &f.prediction);
+    const int need =
+        std::max(options_.trackMinTags,
+                 int(std::ceil(options_.trackMinFraction * double(f.prediction.predicted))));
+    f.detectMs = msSince(t0);
+    if (f.prediction.verified < need) return;
+    t0 = std::chrono::steady_clock::now();
+    measureBlur(grey, dets);
+    PoseEstimate e = estimator_.estimate(dets, ambiguityPrior, predicted);
+    f.poseMs = msSince(t0);
+    if (e.state != TrackingState::Ok) return;
+    f.tagTracked = true;
+    f.detections = std::move(dets);
+    f.estimate = std::move(e);
+    f.searchRegion = cv::Rect();
+}
+
+Tracker::SearchPlan Tracker::planSearch(const cv::Mat& grey, const std::optional<Pose>& prior,
+                                        bool usePrior, TrackedFrame& f) {
+    const cv::Rect full(0, 0, grey.cols, grey.rows);
+    if (options_.roiEnabled && usePrior) {
+        const auto r = boardRegion(*prior, grey.size(), true);
+        // Not worth it when the box covers most of the image.
+        if (r && r->area() > 0 && r->area() < 0.7 * full.area()) f.searchRegion = *r;
+    }
+    if (f.searchRegion == full) framesSinceFullSearch_ = 0;
+    // No pose to say where the board is: where the image has the tags' contrast.
+    const cv::Rect r = !prior && (options_.textureRegion || options_.coarseFirst)
+                           ? texturedRegion(grey)
+                           : cv::Rect();
+    const double m = options_.textureMarginPx;
+    const cv::Rect grown =
+        cv::Rect(cv::Point(std::max(0, int(r.x - m)) / kTextureBlockPx * kTextureBlockPx,
+                           std::max(0, int(r.y - m)) / kTextureBlockPx * kTextureBlockPx),
+                 cv::Point(int(r.br().x + m), int(r.br().y + m))) &
+        full;
+    if (options_.textureRegion && !prior) {
+        if (r.area() > 0 && grown.area() <= options_.textureMaxFraction * full.area()) {
+            f.searchRegion = grown;
+            f.textureRegionUsed = true;
         }
     }
 
-    t0 = std::chrono::steady_clock::now();
-    if (f.estimate.state == TrackingState::NoTags) {
-        f.sharpness = imageSharpness(grey);
-        if (f.sharpness > 0 && f.sharpness < options_.minSharpness) {
-            f.estimate.state = TrackingState::TooBlurred;
-            char buf[160];
-            std::snprintf(buf, sizeof buf,
-                          "no tag found and the image is blurred (sharpness %.3f < %.3f)",
-                          f.sharpness, options_.minSharpness);
-            f.estimate.reason = buf;
+    SearchPlan plan;
+    plan.coarseRegion = f.searchRegion == full || f.textureRegionUsed;
+    plan.coarseDecimate = options_.coarseToFine && grey.cols >= options_.coarseMinWidth
+                              ? options_.coarseDecimate
+                              : 0.0f;
+    if (options_.coarseFirst && r.area() > 0) {
+        // The tags' size from the textured region picks the decimation (or none).
+        f.coarseFirstSidePx =
+            largestTagOverDiameter_ * std::hypot(double(r.width), double(r.height));
+        plan.coarseDecimate = 0;
+        for (float d : options_.coarseFirstDecimations)
+            if (d > plan.coarseDecimate && f.coarseFirstSidePx >= d * options_.coarseFirstMinSidePx)
+                plan.coarseDecimate = d;
+        f.coarseFirstDecimate = plan.coarseDecimate;
+    }
+    // The coarse search reads only the textured region also when it is too large for the
+    // ordinary search (a near board): a confirmed coarse pose has every board tag predicted
+    // in the whole image searched by the finder, and an unconfirmed one falls back to the
+    // ordinary search of f.searchRegion.
+    plan.coarseSearch = f.searchRegion;
+    if (options_.coarseFirst && options_.textureRegion && r.area() > 0) {
+        plan.coarseSearch = grown;
+        if (options_.coarseWindowFraction > 0 && options_.coarseWindowFraction < 1) {
+            // The window about the region's centre, origin aligned like the region's.
+            const double hw = 0.5 * options_.coarseWindowFraction * r.width + m;
+            const double hh = 0.5 * options_.coarseWindowFraction * r.height + m;
+            const double cx = r.x + 0.5 * r.width, cy = r.y + 0.5 * r.height;
+            plan.coarseSearch =
+                cv::Rect(cv::Point(std::max(0, int(cx - hw)) / kTextureBlockPx * kTextureBlockPx,
+                                   std::max(0, int(cy - hh)) / kTextureBlockPx * kTextureBlockPx),
+                         cv::Point(int(cx + hw), int(cy + hh))) &
+                full;
         }
+    }
+    return plan;
+}
+
+void Tracker::searchTags(const cv::Mat& grey, const SearchPlan& plan,
+                         const std::optional<Pose>& ambiguityPrior, TrackedFrame& f) {
+    const cv::Rect full(0, 0, grey.cols, grey.rows);
+    auto detectAndEstimate = [&](const cv::Rect& region) {
+        auto t0 = std::chrono::steady_clock::now();
+        f.detections = region == full ? detector_.detect(grey) : detector_.detect(grey, region);
+        f.detectMs += msSince(t0);
+        t0 = std::chrono::steady_clock::now();
+        measureBlur(grey, f.detections);
+        f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
+        f.poseMs += msSince(t0);
+    };
+    // Decimation 1 is a coarse stage too (coarseFirstDecimations): libapriltag at full
+    // resolution in the window.
+    if (!(plan.coarseDecimate >= 1.0f && plan.coarseRegion &&
+          coarseToFine(grey, plan.coarseSearch, plan.coarseDecimate, ambiguityPrior, f)))
+        detectAndEstimate(f.searchRegion);
+    bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
+    if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
+        const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
+        retry = !now || (*now & f.searchRegion) != *now;
+    }
+    if (f.textureRegionUsed && f.estimate.pose) {
+        // The textured region holds the whole board under the frame's pose (ok or not):
+        // searching the rest of the image cannot add a tag of that board. Else the region
+        // may have cut off tags: search the whole image.
+        const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
+        retry = !now || (*now & f.searchRegion) != *now;
+    }
+    if (retry) {
+        // The region missed the board or part of it (fast motion, occlusion): search the
+        // whole image before giving up or using fewer tags than the frame shows.
+        f.fullFrameRetry = true;
+        framesSinceFullSearch_ = 0;
+        detectAndEstimate(full);
+    }
+}
+
+void Tracker::classifyNoTags(const cv::Mat& grey, TrackedFrame& f) const {
+    if (f.estimate.state != TrackingState::NoTags) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    f.sharpness = imageSharpness(grey);
+    if (f.sharpness > 0 && f.sharpness < options_.minSharpness) {
+        f.estimate.state = TrackingState::TooBlurred;
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      "no tag found and the image is blurred (sharpness %.3f < %.3f)", f.sharpness,
+                      options_.minSharpness);
+        f.estimate.reason = buf;
     }
     f.poseMs += msSince(t0);
+}
 
-    const auto wellDetermined = [&](const PoseEstimate& e) {
-        return e.wellDetermined(options_.priorMinTags, options_.priorMaxSigmaRotDeg);
+void Tracker::extendWithFeatures(const cv::Mat& grey, double t, TrackedFrame& f) {
+    f.mode = TrackingMode::Board;
+    if (!features_) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto boardBox = [&](const Pose& T) {
+        const auto r = boardRegion(T, grey.size(), false);
+        return r ? *r : cv::Rect();
     };
-    if (f.estimate.state == TrackingState::Ok && prior && !wellDetermined(f.estimate)) {
-        // Prediction guard: a weak fit far from where the recent motion puts the camera.
-        const Pose predicted = f.predictedPose ? *f.predictedPose : predictPose(t);
-        const double rotDeg =
-            glm::degrees(rotationAngleBetween(predicted.rotation, f.estimate.pose->rotation));
-        const double pos = glm::length(predicted.translation - f.estimate.pose->translation);
-        const double dist = std::max(1e-6, f.estimate.distanceM);
-        if (rotDeg > options_.guardMaxRotDeg || pos > options_.guardMaxPosFraction * dist) {
-            f.estimate.state = TrackingState::Uncertain;
-            char buf[200];
-            std::snprintf(buf, sizeof buf,
-                          "; %.1f deg / %.1f %% of the distance from the motion prediction with "
-                          "a weak fit (bounds %.1f deg / %.1f %%)",
-                          rotDeg, 100 * pos / dist, options_.guardMaxRotDeg,
-                          100 * options_.guardMaxPosFraction);
-            f.estimate.reason += buf;
-        }
-    }
-
-    t0 = std::chrono::steady_clock::now();
     if (f.estimate.state == TrackingState::Ok) {
-        lastOkWellDetermined_ = wellDetermined(f.estimate);
+        // Back on the board after poses from the features: how far the landmarks had drifted
+        // from it is blended out over the next frames instead of jumping.
+        reanchorLeft_ = 0;
+        if (lastMode_ != TrackingMode::Board && options_.reanchorFrames > 0 && lastOk_ &&
+            t - lastOkT_ <= options_.features.maxGapS) {
+            const PoseEstimate drifted = features_->estimate(predictPose(t), {});
+            if (drifted.state == TrackingState::Ok) {
+                reanchorOffset_ = poseDifference(*f.estimate.pose, *drifted.pose);
+                reanchorLeft_ = options_.reanchorFrames;
+            }
+        }
+        features_->learn(grey, f.estimate, true, boardBox(*f.estimate.pose));
+    } else if (lastOk_ && t >= lastOkT_ && t - lastOkT_ <= options_.features.maxGapS) {
+        PoseEstimate e = features_->estimate(predictPose(t), f.detections);
+        if (e.state == TrackingState::Ok) {
+            f.mode =
+                e.tagsUsed.empty() ? TrackingMode::FeaturesOnly : TrackingMode::BoardAndFeatures;
+            f.estimate = std::move(e);
+            features_->learn(grey, f.estimate, false, boardBox(*f.estimate.pose));
+        } else if (!e.reason.empty()) {
+            f.estimate.reason += (f.estimate.reason.empty() ? "" : "; ") + e.reason;
+        }
+    } else {
+        features_->reset();
+    }
+    f.features = features_->stats();
+    f.featureMs += msSince(t0);
+}
+
+void Tracker::guardPrediction(double t, const std::optional<Pose>& prior, TrackedFrame& f) const {
+    // A pose from the features is always checked against the motion; one from tags when it is
+    // not well determined.
+    if (f.estimate.state != TrackingState::Ok || !prior) return;
+    if (f.mode == TrackingMode::Board &&
+        f.estimate.wellDetermined(options_.priorMinTags, options_.priorMaxSigmaRotDeg))
+        return;
+    // Prediction guard: a weak fit far from where the recent motion puts the camera.
+    const Pose predicted = f.predictedPose ? *f.predictedPose : predictPose(t);
+    const double rotDeg =
+        glm::degrees(rotationAngleBetween(predicted.rotation, f.estimate.pose->rotation));
+    const double pos = glm::length(predicted.translation - f.estimate.pose->translation);
+    const double dist = std::max(1e-6, f.estimate.distanceM);
+    if (rotDeg > options_.guardMaxRotDeg || pos > options_.guardMaxPosFraction * dist) {
+        f.estimate.state = TrackingState::Uncertain;
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "; %.1f deg / %.1f %% of the distance from the motion prediction with "
+                      "a weak fit (bounds %.1f deg / %.1f %%)",
+                      rotDeg, 100 * pos / dist, options_.guardMaxRotDeg,
+                      100 * options_.guardMaxPosFraction);
+        f.estimate.reason += buf;
+    }
+}
+
+void Tracker::record(double t, TrackedFrame& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (f.estimate.state == TrackingState::Ok) {
+        lastOkWellDetermined_ =
+            f.mode == TrackingMode::Board &&
+            f.estimate.wellDetermined(options_.priorMinTags, options_.priorMaxSigmaRotDeg);
         previousOk_ = lastOk_;
         previousOkT_ = lastOkT_;
         lastOk_ = f.estimate.pose;
         lastOkT_ = t;
+        lastMode_ = f.mode;
         if (!options_.filterEnabled)
             f.filtered = *f.estimate.pose;
         else if (options_.filterKind == FilterKind::OneEuro)
             f.filtered = oneEuro_.update(*f.estimate.pose, t);
         else
             f.filtered = filter_.update(*f.estimate.pose, t, &f.estimate.covariance);
+        if (reanchorLeft_ > 0 && f.mode == TrackingMode::Board) {
+            // The reported pose approaches the board's in reanchorFrames equal steps.
+            f.reanchorWeight = double(reanchorLeft_) / double(options_.reanchorFrames + 1);
+            f.filtered = applyPoseDifference(*f.filtered, reanchorOffset_, f.reanchorWeight);
+            --reanchorLeft_;
+        }
     } else {
         // Never smooth across a loss: the next ok pose starts afresh.
         filter_.reset();
         oneEuro_.reset();
+        reanchorLeft_ = 0;
     }
     f.filterMs = msSince(t0);
-    return f;
 }
 
 TrackedFrame Tracker::markLost(double t, const std::string& reason) {
@@ -522,6 +619,9 @@ TrackedFrame Tracker::markLost(double t, const std::string& reason) {
     f.estimate.reason = reason;
     filter_.reset();
     oneEuro_.reset();
+    reanchorLeft_ = 0;
+    // The next frame's features cannot be followed from the last readable one.
+    if (features_) features_->reset();
     return f;
 }
 

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "tracking/Detector.h"
+#include "tracking/FeatureTracker.h"
 #include "tracking/PoseEstimator.h"
 #include "tracking/PoseFilter.h"
 #include "tracking/PredictedTagFinder.h"
@@ -113,6 +114,13 @@ struct TrackerOptions {
     // follows the tag edges it reads; the coarse pose needs only a few tags, one large tag may
     // settle it, and the finder looks for the others). 1 (or more) = the whole grown region.
     double coarseWindowFraction = 0.5;
+    // Extended tracking (docs/tracking.md, "Extended tracking"): natural features tracked while
+    // the board gives the pose, and the pose from them when its tags do not give an ok one
+    // (board partly or wholly out of view, covered). features.enabled = false: the board only.
+    FeatureTrackingOptions features;
+    // When the board gives the pose again after poses from the features, the reported (filtered)
+    // pose moves from where the features put it to the board's in this many equal steps.
+    int reanchorFrames = 5;
 };
 
 struct TrackedFrame {
@@ -147,6 +155,13 @@ struct TrackedFrame {
     cv::Rect coarseWindow;
     // Textured-region search: the frame's search began in texturedRegion's box (searchRegion).
     bool textureRegionUsed = false;
+    // Extended tracking: what made the pose (Board also when features are off or not needed),
+    // the features' counts and cost (tracking, pose, map upkeep), and the share of the drift
+    // still blended into `filtered` after the board came back (0: none).
+    TrackingMode mode = TrackingMode::Board;
+    FeatureStats features;
+    double featureMs = 0;
+    double reanchorWeight = 0;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -184,8 +199,34 @@ public:
     TrackedFrame markLost(double t, const std::string& reason);
 
     const PoseEstimator& estimator() const { return estimator_; }
+    // The natural-feature tracker (nullptr when options.features.enabled is false).
+    const FeatureTracker* features() const { return features_.get(); }
 
 private:
+    // The stages of process(), in order.
+    // Tracking mode: the tags where the predicted pose puts them (f.tagTracked when they gave it).
+    void trackPredictedTags(const cv::Mat& grey, double t,
+                            const std::optional<Pose>& ambiguityPrior, TrackedFrame& f);
+    // Where libapriltag searches: region of interest, textured region, coarse-first window.
+    struct SearchPlan {
+        cv::Rect coarseSearch;
+        float coarseDecimate = 0;
+        bool coarseRegion = false;
+    };
+    SearchPlan planSearch(const cv::Mat& grey, const std::optional<Pose>& prior, bool usePrior,
+                          TrackedFrame& f);
+    // libapriltag's search (coarse to fine, or ordinary) and the full-image retry.
+    void searchTags(const cv::Mat& grey, const SearchPlan& plan,
+                    const std::optional<Pose>& ambiguityPrior, TrackedFrame& f);
+    // No tag: too_blurred when the image is blurred.
+    void classifyNoTags(const cv::Mat& grey, TrackedFrame& f) const;
+    // Natural features: learn from an ok board pose, or give the pose when the tags did not.
+    void extendWithFeatures(const cv::Mat& grey, double t, TrackedFrame& f);
+    // Uncertain when a weak (or feature) pose is far from the motion prediction.
+    void guardPrediction(double t, const std::optional<Pose>& prior, TrackedFrame& f) const;
+    // The ok pose's history, the temporal filter and the re-anchoring blend.
+    void record(double t, TrackedFrame& f);
+
     // Image box of the board projected with T_world_camera, grown by the margins (or not), clipped
     // to the image; nullopt when a board corner is behind the camera.
     std::optional<cv::Rect> boardRegion(const Pose& T_world_camera, cv::Size image,
@@ -223,6 +264,10 @@ private:
     std::optional<Pose> previousOk_;  // the ok pose before lastOk_ (for the velocity)
     double previousOkT_ = 0;
     int framesSinceFullSearch_ = 0;
+    std::unique_ptr<FeatureTracker> features_;
+    TrackingMode lastMode_ = TrackingMode::Board;  // of the last ok frame
+    std::array<double, 6> reanchorOffset_{};       // board pose -> drifted pose (poseDifference)
+    int reanchorLeft_ = 0;                         // frames of the blend still to come
 };
 
 }  // namespace mirage::tracking

@@ -29,7 +29,8 @@ TrackingReport::TrackingReport(const std::filesystem::path& csvPath, glm::dvec3 
     if (!csv_) throw FileError(csvPath.string(), "cannot write the poses CSV");
     csv_ << "frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz,tags,rms_px,"
             "raw_tx,raw_ty,raw_tz,raw_qw,raw_qx,raw_qy,raw_qz,std_rot_deg,std_pos_m,alt_rms_px,"
-            "detect_ms,pose_ms,gt_rot_err_deg,gt_pos_err_m\n";
+            "detect_ms,pose_ms,gt_rot_err_deg,gt_pos_err_m,mode,feature_ms,landmarks,"
+            "feature_inliers\n";
 }
 
 namespace {
@@ -55,7 +56,12 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
     detectMs_.push_back(f.detectMs);
     poseMs_.push_back(f.poseMs);
     filterMs_.push_back(f.filterMs);
+    featureMs_.push_back(f.featureMs);
     const bool ok = e.state == TrackingState::Ok;
+    if (ok && f.mode != TrackingMode::Board) {
+        ++(f.mode == TrackingMode::FeaturesOnly ? featuresOnly_ : boardAndFeatures_);
+    }
+    if (ok && f.mode == TrackingMode::Board) lastBoardT_ = f.t;
     std::string tags;
     for (int id : e.tagsUsed) tags += (tags.empty() ? "" : " ") + std::to_string(id);
     char b[512];
@@ -106,12 +112,16 @@ void TrackingReport::add(int frameIndex, const TrackedFrame& f,
             posErrFiltRel_.push_back(filtErr / dist);
         }
         if (rotErr > 2.0 || posErr / dist > 0.02) ++wrongOk_;
+        if (f.mode != TrackingMode::Board && lastBoardT_)
+            drift_.push_back({f.t - *lastBoardT_, rotErr, posErr / dist});
         std::snprintf(b, sizeof b, "%.5f,%.6f", rotErr, posErr);
         csv_ << b;
     } else {
         csv_ << ",";
     }
-    csv_ << "\n";
+    std::snprintf(b, sizeof b, ",%s,%.3f,%d,%d\n", trackingModeName(f.mode), f.featureMs,
+                  f.features.landmarks, f.features.inliers);
+    csv_ << b;
     csv_.flush();
 }
 
@@ -125,6 +135,7 @@ void TrackingReport::addUnreadableFrame(int frameIndex, const TrackedFrame& lost
     detectMs_.pop_back();
     poseMs_.pop_back();
     filterMs_.pop_back();
+    featureMs_.pop_back();
 }
 
 void TrackingReport::close() {
@@ -157,6 +168,11 @@ std::string TrackingReport::summary() const {
         "tracking mode (tags where the predicted pose puts them): %d frames, %d fell back "
         "to the search\n",
         tagTracked_, trackFallbacks_);
+    s += b;
+    std::snprintf(b, sizeof b,
+                  "extended tracking: %d ok frames from board+features, %d from features only; "
+                  "features %.2f ms per frame (median)\n",
+                  boardAndFeatures_, featuresOnly_, errorStats(featureMs_).median);
     s += b;
     const ErrorStats rms = errorStats(rms_);
     std::snprintf(b, sizeof b, "reprojection RMS (ok frames): median %.3f px, p95 %.3f, max %.3f\n",

@@ -5,10 +5,12 @@
 // metres, OpenCV camera axes, glTF world):
 //   frame,t,state,reason,tx,ty,tz,qw,qx,qy,qz,tags,rms_px,
 //   raw_tx,raw_ty,raw_tz,raw_qw,raw_qx,raw_qy,raw_qz,std_rot_deg,std_pos_m,alt_rms_px,
-//   detect_ms,pose_ms,gt_rot_err_deg,gt_pos_err_m
+//   detect_ms,pose_ms,gt_rot_err_deg,gt_pos_err_m,mode,feature_ms,landmarks,feature_inliers
 // tx..qz is the filtered pose (the raw one with filtering off), raw_* the single-frame estimate.
 // Non-ok rows leave the pose columns empty; uncertain rows fill raw_*, std_* and alt_rms_px. `tags`
-// lists the used tag ids separated by spaces.
+// lists the used tag ids separated by spaces. mode: what made the pose ("board", "board+features",
+// "features only"; docs/tracking.md, "Extended tracking"); feature_ms the natural features' cost,
+// landmarks those tracked into the frame, feature_inliers those in the pose (0: none tried).
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -50,15 +52,24 @@ public:
     int wrongButOk() const { return wrongOk_; }
     ErrorStats rotationErrorDeg() const { return errorStats(rotErrDeg_); }
     ErrorStats translationErrorRel() const { return errorStats(posErrRel_); }
+    // Error of the ok poses not from the board alone against the time since the last ok board
+    // pose (needs truth): the drift of extended tracking.
+    struct DriftSample {
+        double secondsWithoutBoard, rotErrDeg, posErrRel;
+    };
+    const std::vector<DriftSample>& drift() const { return drift_; }
 
 private:
     std::ofstream csv_;
     std::filesystem::path path_;
     glm::dvec3 boardCentre_;
     int frames_ = 0, withTags_ = 0, unreadable_ = 0, wrongOk_ = 0;
-    int tagTracked_ = 0, trackFallbacks_ = 0;  // frames from the tracking mode / its fallbacks
-    std::array<int, 7> stateCount_{};          // per TrackingState
-    std::vector<double> rms_, decodeMs_, detectMs_, poseMs_, filterMs_;
+    int tagTracked_ = 0, trackFallbacks_ = 0;      // frames from the tracking mode / its fallbacks
+    int boardAndFeatures_ = 0, featuresOnly_ = 0;  // ok frames by mode
+    std::optional<double> lastBoardT_;
+    std::vector<DriftSample> drift_;
+    std::array<int, 7> stateCount_{};  // per TrackingState
+    std::vector<double> rms_, decodeMs_, detectMs_, poseMs_, filterMs_, featureMs_;
     std::vector<double> rotErrDeg_, posErrM_, posErrRel_;              // raw estimate vs truth
     std::vector<double> rotErrFiltDeg_, posErrFiltM_, posErrFiltRel_;  // filtered vs truth
 };

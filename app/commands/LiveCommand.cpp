@@ -65,6 +65,8 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_flag("--camera-loop", args->loop,
                   "Play a stand-in session or video again from the start when it ends");
     cmd->add_flag("--headless", args->headless, "No window (EGL): for tests and benchmarks");
+    cmd->add_flag("--board-only", args->boardOnly,
+                  "Track the board's tags only, no natural features (docs/tracking.md)");
     cmd->add_option("--frames", args->maxFrames, "Stop after N processed frames")
         ->check(wholeIn(-1, 100000000));
     cmd->add_option("-o,--output", args->output,

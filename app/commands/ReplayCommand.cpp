@@ -91,6 +91,8 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
     cmd->add_flag("--report-lights", args->reportLights,
                   "Report the dominant lights of the environment (direction, colour, intensity) "
                   "whenever it changes, without placing them");
+    cmd->add_flag("--board-only", args->boardOnly,
+                  "Track the board's tags only, no natural features (docs/tracking.md)");
     cmd->add_flag("--ground-truth", args->groundTruth,
                   "Use the session's ground-truth poses (frames.csv) instead of tracking");
     cmd->add_flag("--force", args->force,

@@ -2,6 +2,7 @@
 // with a summary (docs/tracking.md). Wiring only: the work is in tracking/.
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 
@@ -15,6 +16,7 @@
 #include "core/OutputFile.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/image/ImageIO.h"
+#include "core/plot/SvgPlot.h"
 #include "core/session/Session.h"
 #include "core/session/SessionReadOptions.h"
 #include "tracking/Board.h"
@@ -34,6 +36,8 @@ struct TrackArgs {
     bool noTagTracking = false;
     bool noTextureRegion = false;
     bool noCoarseFirst = false;
+    bool boardOnly = false;
+    std::string driftSvg;  // drift of extended tracking against the time without the board
     bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
@@ -159,12 +163,33 @@ std::unique_ptr<EnvironmentInput> openEnvironment(const TrackArgs& a, const Trac
     return env;
 }
 
+// Rotation error and translation error (percent of the distance) of the poses not from the board
+// alone, against the seconds since the last board pose.
+void writeDriftPlot(const tracking::TrackingReport& report, const std::filesystem::path& svg,
+                    const std::string& source) {
+    plot::LinePlot p;
+    p.title = "Extended tracking: error without the board (" +
+              std::filesystem::path(source).filename().string() + ")";
+    p.xLabel = "seconds since the last pose from the board";
+    p.yLabel = "error (deg, % of distance)";
+    plot::Series rot{"rotation error (deg)", {}}, pos{"translation error (% of distance)", {}};
+    for (const auto& d : report.drift()) {
+        rot.points.push_back({d.secondsWithoutBoard, d.rotErrDeg, ""});
+        pos.points.push_back({d.secondsWithoutBoard, 100 * d.posErrRel, ""});
+    }
+    p.series = {rot, pos};
+    std::ofstream out(svg);
+    out << plot::svgLines(p);
+    if (!out) throw FileError(svg.string(), "cannot write the drift plot");
+}
+
 tracking::TrackerOptions trackerOptions(const TrackArgs& a) {
     tracking::TrackerOptions opt = a.options;
     opt.filterEnabled = !a.noFilter;
     opt.tagTracking = !a.noTagTracking;
     opt.textureRegion = !a.noTextureRegion;
     opt.coarseFirst = !a.noCoarseFirst;
+    opt.features.enabled = !a.boardOnly;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -278,7 +303,8 @@ void run(const TrackArgs& a) {
     rule.inputs.push_back(in.calibPath);
     rule.inputs.push_back(in.boardPath);
     OutputFile posesOut(a.output, OutputOrigin::Named, rule);
-    std::optional<OutputFile> envmapOut, validOut;
+    std::optional<OutputFile> envmapOut, validOut, driftOut;
+    if (!a.driftSvg.empty()) driftOut.emplace(a.driftSvg, OutputOrigin::Named, rule);
     if (!a.envmap.empty()) {
         auto validPath = std::filesystem::path(a.envmap);
         validPath.replace_filename(validPath.stem().string() + "_valid.png");
@@ -312,6 +338,10 @@ void run(const TrackArgs& a) {
     }
     report.close();
     posesOut.commit();
+    if (driftOut) {
+        writeDriftPlot(report, driftOut->temp(), a.session.empty() ? a.video : a.session);
+        driftOut->commit();
+    }
     reportOutcome(a, in, report, n);
 }
 
@@ -364,6 +394,13 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_flag("--no-coarse-first", a->noCoarseFirst,
                   "Without a recent pose, do not pick a coarse-to-fine decimation from the "
                   "size of the textured region (docs/tracking.md, Single frames: coarse-first)");
+    cmd->add_flag("--board-only", a->boardOnly,
+                  "Poses from the board's tags only: no natural features (docs/tracking.md, "
+                  "Extended tracking)");
+    cmd->add_option("--drift-svg", a->driftSvg,
+                    "Plot the error of the poses from natural features against the time "
+                    "without the board (needs ground truth) to this SVG file")
+        ->check(outputPath(OutputShape::File));
     cmd->callback([a] { run(*a); });
 });
 

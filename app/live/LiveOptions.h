@@ -17,6 +17,7 @@ struct LiveOptions {
     float exposure = 1.0f;
     int jpegQuality = 92;
     bool headless = false;
+    bool boardOnly = false;  // no natural features (extended tracking off)
     bool force = false;
     bool loop = false;  // a stand-in starts again at its end
     bool listCameras = false;

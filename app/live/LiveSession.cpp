@@ -84,7 +84,9 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     if (!scene_.hasVirtual())
         spdlog::warn("scene {} has no virtual object: the output will equal the footage", a.scene);
     const tracking::Board board = tracking::Board::load(boardPath_);
-    tracker_ = std::make_unique<tracking::Tracker>(board, calibration_.intrinsics);
+    tracking::TrackerOptions trackerOptions;
+    trackerOptions.features.enabled = !a.boardOnly;
+    tracker_ = std::make_unique<tracking::Tracker>(board, calibration_.intrinsics, trackerOptions);
     // Where the virtual objects stand: the saved placement (moves within the board's plane).
     placementFile_ = a.placement.empty() ? placementPath(a.scene) : fs::path(a.placement);
     const ScenePlacement placement = loadPlacement(placementFile_).value_or(ScenePlacement{});
@@ -245,6 +247,7 @@ void LiveSession::process(LiveFrame& frame) {
     const double trackingMs = msSince(t0);
     CompositedFrame cf = render_->composite(f.bgr, std::move(pose), !controls_.hideVirtual);
     cf.trackingMs = trackingMs;
+    cf.trackingMode = track_->lastMode();
     if (f.bgr.empty()) spdlog::warn("live: {}", cf.pose.reason);
     if (!cf.image.empty()) {
         outputs_->writeImage(processed_, cf.image, f.captureSeconds);

@@ -124,10 +124,13 @@ HudRequests LiveWindow::drawHud(const HudStatus& s, LiveControls& controls, int 
     ImGui::Text("%.1f frames/s | latency %.0f ms", s.fps, s.latencyMs);
     ImGui::Text("dropped %lld (driver %lld)", s.dropped, s.driverDropped);
     const std::string st = s.last ? s.last->pose.state : std::string();
+    const std::string mode =
+        s.last && !s.last->trackingMode.empty() ? " (" + s.last->trackingMode + ")" : "";
     ImGui::TextColored(st == "ok"   ? green
                        : st.empty() ? amber
                                     : red,
-                       "tracking: %s", st.empty() ? "waiting for a frame" : st.c_str());
+                       "tracking: %s%s", st.empty() ? "waiting for a frame" : st.c_str(),
+                       mode.c_str());
     ImGui::PushTextWrapPos(0);
     if (s.last && !s.last->pose.reason.empty())
         ImGui::TextWrapped("%s", s.last->pose.reason.c_str());

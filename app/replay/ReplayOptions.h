@@ -20,6 +20,7 @@ struct ReplayOptions {
     bool window = false;
     bool verbose = false;
     bool groundTruth = false;
+    bool boardOnly = false;  // no natural features (extended tracking off)
     bool force = false;
     bool estimateLights = false;  // place the environment's lights (and report them)
     bool reportLights = false;    // report them only

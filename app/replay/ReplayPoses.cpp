@@ -7,15 +7,17 @@
 namespace mirage::app {
 
 ReplayPoses::ReplayPoses(const Session& session, const CameraIntrinsics& camera,
-                         const std::string& posesFile, bool groundTruth) {
+                         const std::string& posesFile, bool groundTruth, bool boardOnly) {
     if (!posesFile.empty()) {
         poses_ = readPosesCsv(posesFile);
         checkPoseFrames(poses_, session, posesFile);
         usePosesFile_ = true;
     } else if (!groundTruth && !session.board.empty() &&
                std::filesystem::exists(session.path(session.board))) {
+        tracking::TrackerOptions trackerOptions;
+        trackerOptions.features.enabled = !boardOnly;
         tracker_ = std::make_unique<tracking::Tracker>(
-            tracking::Board::load(session.path(session.board)), camera);
+            tracking::Board::load(session.path(session.board)), camera, trackerOptions);
         spdlog::info("replay: tracking the camera on {}", session.path(session.board).string());
     } else {
         spdlog::info("replay: camera poses from the session's ground truth (frames.csv){}",

@@ -19,9 +19,10 @@ namespace mirage::app {
 
 class ReplayPoses {
 public:
-    // `posesFile` empty: no poses file. Logs which source it chose.
+    // `posesFile` empty: no poses file. `boardOnly`: track the tags alone, no natural features.
+    // Logs which source it chose.
     ReplayPoses(const Session& session, const CameraIntrinsics& camera,
-                const std::string& posesFile, bool groundTruth);
+                const std::string& posesFile, bool groundTruth, bool boardOnly = false);
 
     // The pose decided outside tracking for session row `row` whose image is `bgr`: nullopt
     // when the frame is tracked (or is lost: an empty image). A row missing from the poses

@@ -80,8 +80,8 @@ ReplaySession::ReplaySession(const ReplayOptions& a) : options_(a) {
                                        "and name the YAML in session.json");
     calibration_ = loadCalibration(session_.path(main_->calibration));
     loadScene();
-    poses_ =
-        std::make_unique<ReplayPoses>(session_, calibration_.intrinsics, a.poses, a.groundTruth);
+    poses_ = std::make_unique<ReplayPoses>(session_, calibration_.intrinsics, a.poses,
+                                           a.groundTruth, a.boardOnly);
     track_ = std::make_unique<PoseStage>(poses_->tracker());
     createRenderer();
     outputs_->open(session_.fps, a.jpegQuality, renderer_->passNames());

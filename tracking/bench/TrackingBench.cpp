@@ -5,6 +5,7 @@
 // method and resolution and attached to the benchmark as counters.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <map>
 #include <memory>
 
@@ -15,6 +16,7 @@
 #include "tracking/ArucoComparison.h"
 #include "tracking/Detector.h"
 #include "tracking/PoseEstimator.h"
+#include "tracking/SyntheticTabletop.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::tracking {
@@ -31,6 +33,31 @@ const BoardFrames& sequence(int width) {
     static std::map<int, std::unique_ptr<BoardFrames>> cache;
     auto& f = cache[width];
     if (!f) f = std::make_unique<BoardFrames>(orbitBoardVideo(width));
+    return *f;
+}
+
+// A textured tabletop video (SyntheticTabletop: the board's sheet in 2 m x 2 m of value noise):
+// an orbit over the board (30 frames) and a pan of 80 degrees that takes it out of view
+// (36 frames, the last ~16 without the board), then the same path backwards, so that cycling
+// over it is continuous motion; 30 fps, the camera of the single views.
+const BoardFrames& texturedVideo(int width) {
+    static std::map<int, std::unique_ptr<BoardFrames>> cache;
+    auto& f = cache[width];
+    if (f) return *f;
+    f = std::make_unique<BoardFrames>();
+    f->camera = frames(width).camera;
+    const SyntheticTabletop table(frames(width).board);
+    f->board = table.board();
+    const TexturedPlaneRenderer renderer(f->camera, 2);
+    const int orbit = 30, pan = 36;
+    std::vector<int> order;
+    for (int i = 0; i < orbit + pan; ++i) order.push_back(i);
+    for (int i = orbit + pan - 2; i > 0; --i) order.push_back(i);
+    for (int i : order) {
+        const Pose T = orbitThenPan(i, orbit, pan, 80.0);
+        f->images.push_back(table.render(renderer, T));
+        f->truth.push_back(T);
+    }
     return *f;
 }
 
@@ -128,6 +155,8 @@ void BM_MirageTrack(benchmark::State& state) {
     // search, as by default.
     opt.coarseToFine = state.range(1) >= 2;
     opt.coarseFirst = state.range(1) >= 2;
+    // The board only, as before extended tracking (BM_MirageTrackTextured has the features).
+    opt.features.enabled = false;
     Tracker tracker(f.board, f.camera, opt);
     TrackingAccuracy acc;
     const double dt = 1.0 / 30.0;
@@ -167,6 +196,52 @@ BENCHMARK(BM_MirageTrack)
     ->Args({1280, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+void runAruco(benchmark::State& state, const BoardFrames& f);
+
+// mirage's Tracker (defaults) over the textured tabletop video that pans away from the board and
+// back (texturedVideo), with natural features (features 1, the default) or the board only (0).
+// Counters over one pass after a warm-up pass: ok rate (pose_rate), wrong-but-ok poses, frames
+// from the features alone, and the features' own cost (tracking, pose, map; wall ms per frame).
+void BM_MirageTrackTextured(benchmark::State& state) {
+    const BoardFrames& f = texturedVideo(int(state.range(0)));
+    TrackerOptions opt;
+    opt.features.enabled = state.range(1) == 1;
+    Tracker tracker(f.board, f.camera, opt);
+    TrackingAccuracy acc;
+    const double dt = 1.0 / 30.0;
+    size_t i = 0;
+    int featuresOnly = 0;
+    std::vector<double> featureMs;
+    for (; i < f.images.size(); ++i) tracker.process(f.images[i], double(i) * dt);
+    for (size_t v = 0; v < f.images.size(); ++v, ++i) {
+        const TrackedFrame t = tracker.process(f.images[v], double(i) * dt);
+        acc.addFrame(f, v, foundTags(t.detections), okPose(t.estimate));
+        featuresOnly +=
+            t.estimate.state == TrackingState::Ok && t.mode == TrackingMode::FeaturesOnly;
+        featureMs.push_back(t.featureMs);
+    }
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(tracker.process(f.images[i % f.images.size()], double(i) * dt));
+        ++i;
+    }
+    report(state, acc);
+    std::sort(featureMs.begin(), featureMs.end());
+    state.counters["features_only"] = featuresOnly;
+    state.counters["feature_ms_med"] = featureMs[featureMs.size() / 2];
+}
+
+BENCHMARK(BM_MirageTrackTextured)
+    ->ArgNames({"width", "features"})
+    ->Args({640, 1})
+    ->Args({640, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// ArUco per frame over the textured video of BM_MirageTrackTextured.
+void BM_ArucoTrackTextured(benchmark::State& state) {
+    runAruco(state, texturedVideo(int(state.range(0))));
+}
 
 // mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
 // apart). Args: mode 2 = coarse-first (the default: the coarse-to-fine search at the decimation
@@ -231,6 +306,12 @@ void BM_Aruco(benchmark::State& state) {
 void BM_ArucoTrack(benchmark::State& state) {
     runAruco(state, sequence(int(state.range(0))));
 }
+
+BENCHMARK(BM_ArucoTrackTextured)
+    ->ArgNames({"width", "refine"})
+    ->Args({640, cv::aruco::CORNER_REFINE_APRILTAG})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 BENCHMARK(BM_ArucoTrack)
     ->ArgNames({"width", "refine"})

@@ -1,0 +1,142 @@
+// Extended tracking from natural features (docs/tracking.md, "Extended tracking"): the pose kept
+// when the board leaves the view, never a wrong ok pose when features lie.
+//
+// The views are rendered in process (core's TexturedPlaneRenderer): the board's sheet pasted into
+// a large textured tabletop (value noise, like wood or stone at millimetre scale), seen by a
+// camera that orbits the board and then pans away from it until the board is out of view.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include <opencv2/imgproc.hpp>
+
+#include "tests/support/TestSupport.h"
+#include "testscenes/TrackingViews.h"
+#include "tracking/LandmarkMap.h"
+#include "tracking/SyntheticTabletop.h"
+#include "tracking/Tracker.h"
+
+namespace mirage::tracking {
+namespace {
+
+constexpr double kFps = 30.0;
+constexpr int kOrbitFrames = 30, kPanFrames = 36;
+
+const SyntheticTabletop& tabletop() {
+    static const SyntheticTabletop t(BoardLayout().makeBoard());
+    return t;
+}
+
+struct RunResult {
+    int frames = 0, ok = 0, wrongOk = 0, featuresOnlyOk = 0, boardOutOfView = 0;
+    std::vector<double> rotErrDeg, posErrRel;
+    double medianRot() const { return median(rotErrDeg); }
+    double medianPos() const { return median(posErrRel); }
+    static double median(std::vector<double> v) {
+        if (v.empty()) return 0;
+        std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    }
+};
+
+// Runs the tracker over the path; `lie` paints a second textured surface over the left half of
+// every frame that moves on its own (3 px right, 1 px down per frame).
+RunResult run(const TrackerOptions& options, double panDeg, bool lie) {
+    const auto& scene = tabletop();
+    const CameraIntrinsics cam = testing::pinholeCamera();
+    TexturedPlaneRenderer renderer(cam, 2);
+    Tracker tracker(scene.board(), cam, options);
+    const cv::Mat liar = valueNoiseTexture(1024, 99);
+    RunResult r;
+    for (int i = 0; i < kOrbitFrames + kPanFrames; ++i) {
+        const Pose T = orbitThenPan(i, kOrbitFrames, kPanFrames, panDeg);
+        cv::Mat img = scene.render(renderer, T);
+        if (lie) {
+            const cv::Mat shift =
+                (cv::Mat_<double>(2, 3) << 1, 0, -100 - 3.0 * i, 0, 1, -80 - 1.0 * i);
+            cv::Mat moved;
+            cv::warpAffine(liar, moved, shift, cv::Size(cam.width / 2, cam.height));
+            moved.copyTo(img(cv::Rect(0, 0, cam.width / 2, cam.height)));
+        }
+        const TrackedFrame f = tracker.process(img, i / kFps);
+        ++r.frames;
+        r.boardOutOfView += !boardInView(cam, scene.board(), T);
+        if (f.estimate.state != TrackingState::Ok) continue;
+        ++r.ok;
+        r.featuresOnlyOk += f.mode == TrackingMode::FeaturesOnly;
+        const double rot =
+            glm::degrees(rotationAngleBetween(f.estimate.pose->rotation, T.rotation));
+        const double pos =
+            glm::length(f.estimate.pose->translation - T.translation) / glm::length(T.translation);
+        r.rotErrDeg.push_back(rot);
+        r.posErrRel.push_back(pos);
+        if (rot > 2.0 || pos > 0.02) {
+            ++r.wrongOk;
+            ADD_FAILURE() << "frame " << i << " ok but off by " << rot << " deg, " << 100 * pos
+                          << " %: " << f.estimate.reason;
+        }
+    }
+    return r;
+}
+
+TEST(ExtendedTracking, PanAwayFromTheBoardKeepsTheRightPose) {
+    const RunResult r = run({}, 80.0, false);
+    // The path does take the board out of view for the last part of the pan.
+    EXPECT_GE(r.boardOutOfView, 6);
+    // Measured: 59 of 66 ok, 4 of the 7 frames without the board ok from features alone (the
+    // rest uncertain: the new landmarks of the pan have no depth yet, so the position's
+    // uncertainty grows past 0.5 % of the distance); the goal of 95 % is not reached yet.
+    EXPECT_GE(r.ok, 59) << r.ok << " of " << r.frames;
+    EXPECT_GE(r.featuresOnlyOk, 4);
+    EXPECT_LE(r.medianRot(), 0.3);
+    EXPECT_LE(r.medianPos(), 0.01);
+    EXPECT_EQ(r.wrongOk, 0);
+}
+
+TEST(ExtendedTracking, BoardOnlyLosesTheFramesWithoutTheBoard) {
+    TrackerOptions o;
+    o.features.enabled = false;
+    const RunResult r = run(o, 80.0, false);
+    EXPECT_LE(r.ok, r.frames - r.boardOutOfView);
+    EXPECT_EQ(r.featuresOnlyOk, 0);
+    EXPECT_EQ(r.wrongOk, 0);
+}
+
+TEST(ExtendedTracking, MovingTexturedObjectOverHalfTheViewNeverGivesAWrongOkPose) {
+    const RunResult r = run({}, 80.0, true);
+    EXPECT_EQ(r.wrongOk, 0);
+    // The board's frames stay ok (the board is in the right half for most of the orbit).
+    EXPECT_GT(r.ok, 0);
+}
+
+// A landmark seen from two places converges to the true point, with a covariance that covers the
+// error; one seen only from one place keeps an uncertain depth but the right direction.
+TEST(ExtendedTracking, LandmarkTriangulatesFromKnownPoses) {
+    const CameraIntrinsics cam = testing::pinholeCamera();
+    const glm::dvec3 X(0.1, 0.02, -0.05);
+    LandmarkMap map;
+    const Pose A = testing::lookAt({0.0, 0.35, 0.3}, {0, 0, 0});
+    const auto pa = cam.project(A.inverse() * X);
+    ASSERT_TRUE(pa);
+    const int id = map.add(cam, A, *pa, 0.3, 0.0, 0.0, 0.8, 1.0, false);
+    ASSERT_GE(id, 0);
+    {
+        const Landmark& l = *map.find(id);
+        EXPECT_LT(glm::length(glm::cross(l.direction, glm::normalize(X - A.translation))), 1e-6);
+        EXPECT_GT(std::sqrt(l.covariance[8]), 0.5 / 0.8);  // depth still a guess
+    }
+    for (int k = 1; k <= 4; ++k) {
+        const Pose B = testing::lookAt({0.03 * k, 0.35, 0.3 - 0.01 * k}, {0, 0, 0});
+        const auto pb = cam.project(B.inverse() * X);
+        ASSERT_TRUE(pb);
+        map.observe(id, cam, {B, *pb, 0.3}, 0.004, glm::radians(1.0));
+    }
+    const Landmark& l = *map.find(id);
+    EXPECT_LT(glm::length(l.point() - X), 1e-4);
+    EXPECT_LT(l.rmsPx, 1e-3);
+    EXPECT_LT(std::sqrt(l.covariance[8]), 0.05 * l.rho);
+}
+
+}  // namespace
+}  // namespace mirage::tracking
