@@ -1,8 +1,10 @@
-# mirage_module(NAME DIR [DEPS targets...])
+# mirage_module(NAME DIR [DEPS targets...] [EXCLUDE folders...])
 # One static library per top-level module. Sources are every .cpp under the module folder: a new
 # file (or a new render pass folder) joins the build without touching shared CMake files.
+# EXCLUDE names sub-folders (relative to the module) that are libraries of their own, with their
+# own CMakeLists.txt and dependencies (render/reconstruction/).
 function(mirage_module name)
-  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "DEPS;EXCLUDE" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   # Benchmarks and tools live beside their module but are not part of the library.
   # Matched on the path relative to the module, so a checkout inside a folder named e.g. bench/
@@ -10,7 +12,13 @@ function(mirage_module name)
   set(kept "")
   foreach(src IN LISTS sources)
     file(RELATIVE_PATH rel ${CMAKE_CURRENT_SOURCE_DIR} ${src})
-    if(NOT rel MATCHES "(^|/)(bench|tools)/")
+    set(excluded FALSE)
+    foreach(dir IN LISTS ARG_EXCLUDE)
+      if(rel MATCHES "^${dir}/")
+        set(excluded TRUE)
+      endif()
+    endforeach()
+    if(NOT rel MATCHES "(^|/)(bench|tools)/" AND NOT excluded)
       list(APPEND kept ${src})
     endif()
   endforeach()
