@@ -7,7 +7,7 @@ packages=(
   cmake ninja-build pkg-config g++ git
   libopencv-dev libapriltag-dev libembree-dev libglfw3-dev libglm-dev libv4l-dev libepoxy-dev
   libtinygltf-dev libcli11-dev libspdlog-dev nlohmann-json3-dev libimgui-dev libjpeg62-turbo-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libopen3d-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri glslang-tools libopenexr-dev
   ffmpeg xvfb xauth clang-format
   slurm-wlm munge

@@ -1,7 +1,8 @@
 # mirage_module(NAME [DEPS targets...] [EXCLUDE folders...])
 # One static library per top-level module. Sources are every .cpp under the module folder: a new
 # file (or a new render pass folder) joins the build without touching shared CMake files.
-# EXCLUDE: sub-folders that are libraries of their own, layered above this one (render/evaluation).
+# EXCLUDE: sub-folders that are libraries of their own, layered above this one (render/evaluation,
+# render/reconstruction).
 function(mirage_module name)
   cmake_parse_arguments(ARG "" "" "DEPS;EXCLUDE" ${ARGN})
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)

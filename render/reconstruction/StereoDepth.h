@@ -1,0 +1,49 @@
+#pragma once
+// Dense depth from pairs of tracked frames (poses known from the tags, so this is two-view
+// stereo, not structure from motion): each pair is rectified (cv::stereoRectify, which also undoes
+// the Brown-Conrady distortion), matched by semi-global matching (cv::StereoSGBM: its smoothness
+// term carries depth across the plain, textureless faces of real objects from their edges, where
+// a window correlation finds nothing), and turned into a depth map of the rectified left camera.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "render/reconstruction/Footage.h"
+
+namespace mirage::reconstruction {
+
+struct StereoOptions {
+    // A partner frame's baseline (distance between the camera centres), metres: long enough for
+    // depth resolution (1 px of disparity at 0.5 m and 320 px width is about 1.4 cm at 7 cm),
+    // short enough that the views still look alike.
+    double minBaselineM = 0.035, maxBaselineM = 0.14, preferredBaselineM = 0.07;
+    double maxViewAngleDeg = 25.0;  // between the two optical axes
+    // Depths kept (metres along the rectified optical axis).
+    double minDepthM = 0.15, maxDepthM = 2.0;
+    int blockSize = 5;  // SGBM matching window (pixels, odd)
+    int maxPairs = 24;  // depth maps computed (spread over the frames)
+};
+
+// A depth map in a rectified camera: pinhole, no distortion.
+struct DepthView {
+    int frame = 0, partner = 0;  // session frame numbers of the left and right image
+    cv::Mat depth;               // CV_32F metres along the optical axis, 0 = no depth
+    cv::Mat bgr;                 // the rectified left image (8-bit BGR, sRGB)
+    double fx = 0, fy = 0, cx = 0, cy = 0;
+    Pose T_world_camera;  // of the rectified left camera (OpenCV axes)
+    double baselineM = 0;
+    double validFraction = 0;  // of the pixels
+};
+
+// Pairs frames (every frame at most once as the left image) and computes their depth maps.
+// `progress` is called after each pair (done, total).
+std::vector<DepthView> computeDepthViews(const Footage& footage, const StereoOptions& options = {},
+                                         const std::function<void(int, int)>& progress = {});
+
+// The pairs computeDepthViews would match (indices into footage.frames), for reports and tests.
+std::vector<std::pair<int, int>> chooseStereoPairs(const Footage& footage,
+                                                   const StereoOptions& options);
+
+}  // namespace mirage::reconstruction

@@ -1,0 +1,270 @@
+// The reconstruction of real proxies and lights (render/reconstruction/) against exact truth:
+// the bundled tabletop's real geometry (depth maps ray cast along `mirage synth`'s orbit), and a
+// table lit by a known spot light. Fast: no reference rendering (the stereo step on rendered
+// footage is measured by `mirage proxies --truth`, docs/results.md).
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <open3d/core/Tensor.h>
+#include <open3d/t/geometry/RaycastingScene.h>
+
+#include "core/image/ImageIO.h"
+#include "core/scene/Scene.h"
+#include "core/session/Session.h"
+#include "render/raytrace/SyntheticFootage.h"
+#include "render/reconstruction/GeometryEvaluation.h"
+#include "render/reconstruction/ProxyReconstruction.h"
+#include "tests/support/TestSupport.h"
+
+namespace mirage::reconstruction {
+namespace {
+
+namespace fs = std::filesystem;
+
+BoardPlane tabletopPlane() {
+    BoardPlane p;  // the board lies on the table top at y = 0, page +x along world +X
+    p.point = {0, 0, 0};
+    p.normal = {0, 1, 0};
+    p.axisU = {1, 0, 0};
+    p.halfU = 0.14, p.halfV = 0.1;
+    return p;
+}
+
+const Scene& tabletop() {
+    static const Scene s = loadScene(test::dataDir() / "scenes/tabletop/tabletop.gltf");
+    return s;
+}
+
+// Exact depth maps of the scene's real meshes from the synthetic camera path's orbit.
+std::vector<DepthView> exactViews(const Scene& scene, int count) {
+    open3d::t::geometry::RaycastingScene rc;
+    std::vector<glm::vec3> colourOfGeometry;
+    for (const MeshInstance& inst : scene.meshInstances()) {
+        if (inst.origin != Origin::Real) continue;
+        for (const Primitive& p : scene.meshes[size_t(inst.mesh)].primitives) {
+            std::vector<float> v;
+            for (const auto& q : p.positions) {
+                const glm::dvec4 w = inst.world * glm::dvec4(glm::dvec3(q), 1.0);
+                v.insert(v.end(), {float(w.x), float(w.y), float(w.z)});
+            }
+            std::vector<uint32_t> idx(p.indices);
+            rc.AddTriangles(
+                open3d::core::Tensor(v, {int64_t(p.positions.size()), 3}, open3d::core::Float32),
+                open3d::core::Tensor(idx, {int64_t(idx.size() / 3), 3}, open3d::core::UInt32));
+            colourOfGeometry.push_back(glm::vec3(scene.material(p.material).baseColor));
+        }
+    }
+    const CameraIntrinsics K = raytrace::pinholeFromHorizontalFov(320, 240, 60.0);
+    raytrace::CameraPathOptions path;
+    path.duration = 6.0;
+    std::vector<DepthView> views;
+    for (int k = 0; k < count; ++k) {
+        const double t = 3.0 * k / (count - 1);  // the orbit: the first half of the path
+        DepthView v;
+        v.T_world_camera = raytrace::cameraPathPose(path, t);
+        v.fx = K.fx, v.fy = K.fy, v.cx = K.cx, v.cy = K.cy;
+        std::vector<float> rays;
+        for (int y = 0; y < K.height; ++y)
+            for (int x = 0; x < K.width; ++x) {
+                const glm::dvec3 d =
+                    glm::normalize(v.T_world_camera.rotation *
+                                   glm::dvec3((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1.0));
+                const glm::dvec3 o = v.T_world_camera.translation;
+                rays.insert(rays.end(), {float(o.x), float(o.y), float(o.z), float(d.x), float(d.y),
+                                         float(d.z)});
+            }
+        const int64_t n = int64_t(K.width) * K.height;
+        auto hit = rc.CastRays(open3d::core::Tensor(rays, {n, 6}, open3d::core::Float32));
+        const auto tHit = hit["t_hit"].ToFlatVector<float>();
+        const auto ids = hit["geometry_ids"].ToFlatVector<uint32_t>();
+        v.depth = cv::Mat(K.height, K.width, CV_32F, 0.0f);
+        v.bgr = cv::Mat(K.height, K.width, CV_8UC3, cv::Scalar::all(0));
+        for (int y = 0; y < K.height; ++y)
+            for (int x = 0; x < K.width; ++x) {
+                const size_t i = size_t(y) * size_t(K.width) + size_t(x);
+                if (!std::isfinite(tHit[i])) continue;
+                const glm::dvec3 dCam =
+                    glm::normalize(glm::dvec3((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1.0));
+                v.depth.at<float>(y, x) = float(tHit[i] * dCam.z);
+                const glm::vec3 c = colourOfGeometry[ids[i]];
+                for (int ch = 0; ch < 3; ++ch)
+                    v.bgr.at<cv::Vec3b>(y, x)[2 - ch] =
+                        uchar(std::lround(255 * linearToSrgb(std::clamp(c[ch], 0.0f, 1.0f))));
+            }
+        views.push_back(std::move(v));
+    }
+    return views;
+}
+
+// The reconstructed geometry as an in-memory scene of real meshes (table top and objects).
+Scene asScene(const FusedGeometry& g, const std::string& leaveOut = "") {
+    Scene s;
+    auto add = [&](const std::string& name, std::vector<glm::vec3> pos, std::vector<uint32_t> idx) {
+        Mesh m;
+        m.name = name;
+        Primitive p;
+        p.positions = std::move(pos);
+        p.indices = std::move(idx);
+        m.primitives.push_back(std::move(p));
+        s.meshes.push_back(std::move(m));
+        Node n;
+        n.name = name;
+        n.mesh = int(s.meshes.size()) - 1;
+        n.origin = Origin::Real;
+        s.nodes.push_back(n);
+        s.roots.push_back(int(s.nodes.size()) - 1);
+    };
+    const TableEstimate& t = g.table;
+    auto at = [&](double u, double v) { return glm::vec3(t.plane.toWorld({u, v, 0})); };
+    add("table", {at(t.uMin, t.vMin), at(t.uMax, t.vMin), at(t.uMax, t.vMax), at(t.uMin, t.vMax)},
+        {0, 1, 2, 0, 2, 3});
+    for (const auto& o : g.objects)
+        if (o.name != leaveOut) add(o.name, o.positions, o.indices);
+    return s;
+}
+
+struct TabletopFixture : ::testing::Test {
+    static const FusedGeometry& geometry() {
+        static const FusedGeometry g = [] {
+            Footage f;
+            f.camera = raytrace::pinholeFromHorizontalFov(320, 240, 60.0);
+            f.board = tabletopPlane();
+            return reconstructGeometry(f, exactViews(tabletop(), 10));
+        }();
+        return g;
+    }
+};
+
+TEST_F(TabletopFixture, TableExtentStaysOnTheTable) {
+    const TableEstimate& t = geometry().table;
+    // The orbit sees the table's middle; the extent never leaves the true top (1.2 x 0.8 m).
+    EXPECT_LT(t.uMin, -0.25);
+    EXPECT_GT(t.uMax, 0.25);
+    EXPECT_GE(t.uMin, -0.62);
+    EXPECT_LE(t.uMax, 0.62);
+    EXPECT_GE(t.vMin, -0.42);
+    EXPECT_LE(t.vMax, 0.42);
+    EXPECT_LT(t.rmsHeightM, 0.002);
+}
+
+TEST_F(TabletopFixture, BookMugAndBlockAreRebuilt) {
+    const FusedGeometry& g = geometry();
+    ASSERT_EQ(g.objects.size(), 3u);
+    for (const auto& o : g.objects) EXPECT_LE(o.indices.size() / 3, 1500u) << o.name;
+    const GeometryScore s = evaluateGeometry(tabletop(), asScene(g), tabletopPlane());
+    ASSERT_EQ(s.objects.size(), 3u);
+    for (const ObjectScore& o : s.objects) {
+        EXPECT_GE(o.completeness, 0.8) << o.name;
+        EXPECT_LT(o.p95Mm, 10.0) << o.name;
+    }
+    EXPECT_GE(s.accuracy, 0.8);
+}
+
+// Must fail: a reconstruction that lost an object shows it as a large distance.
+TEST_F(TabletopFixture, AMissingObjectShowsAsALargeDistance) {
+    const FusedGeometry& g = geometry();
+    ASSERT_FALSE(g.objects.empty());
+    // The object nearest the true block (0.33, 0, 0.2).
+    std::string nearest;
+    double best = 1e9;
+    for (const auto& o : g.objects)
+        if (const double d = glm::length(o.centre - glm::dvec3(0.33, 0, 0.2)); d < best)
+            best = d, nearest = o.name;
+    ASSERT_LT(best, 0.02);
+    const GeometryScore s = evaluateGeometry(tabletop(), asScene(g, nearest), tabletopPlane());
+    for (const ObjectScore& o : s.objects)
+        if (o.name == "block") {
+            EXPECT_LT(o.completeness, 0.5);  // only its underside, on the table, is still near
+            EXPECT_GT(o.p95Mm, 30.0);
+        }
+}
+
+// A table lit by the environment and a spot light, observed exactly (radiance per cell).
+FusedGeometry litTable(bool withSpot, FittedSpotLight& spot, glm::dvec3& environment,
+                       glm::dvec3& albedo) {
+    FusedGeometry g;
+    g.table.plane = tabletopPlane();
+    g.table.uMin = -0.5, g.table.uMax = 0.5, g.table.vMin = -0.35, g.table.vMax = 0.35;
+    g.tableCellM = 0.004;
+    spot.position = {0.35, 0.95, 0.45};
+    spot.direction = glm::normalize(-spot.position);
+    spot.innerConeRad = 0.35, spot.outerConeRad = 0.55;
+    spot.intensity = 1.6 * glm::dvec3(1.0, 0.95, 0.85);
+    environment = {0.55, 0.56, 0.6};
+    albedo = {0.35, 0.22, 0.12};
+    const int cols = 250, rows = 175;
+    g.tableColour = cv::Mat(rows, cols, CV_32FC3);
+    g.tableObserved = cv::Mat(rows, cols, CV_8U, cv::Scalar(255));
+    for (int y = 0; y < rows; ++y)
+        for (int x = 0; x < cols; ++x) {
+            const glm::dvec3 w = g.table.plane.toWorld(
+                {g.table.uMin + (x + 0.5) * 0.004, g.table.vMin + (y + 0.5) * 0.004, 0});
+            glm::dvec3 E = environment;
+            if (withSpot) E += spot.intensity * spotGeometry(spot, w, {0, 1, 0});
+            const glm::dvec3 L = albedo * E / 3.14159265358979;
+            g.tableColour.at<cv::Vec3f>(y, x) = cv::Vec3f(float(L.x), float(L.y), float(L.z));
+        }
+    return g;
+}
+
+TEST(LightFit, RecoversTheSpotFromTheTable) {
+    FittedSpotLight truth;
+    glm::dvec3 environment, albedo;
+    const FusedGeometry g = litTable(true, truth, environment, albedo);
+    const LightingEstimate e = estimateLighting(g, environment);
+    ASSERT_TRUE(e.spot.has_value());
+    EXPECT_LT(glm::length(e.spot->position - truth.position), 0.02);
+    EXPECT_LT(glm::degrees(std::acos(std::min(1.0, glm::dot(e.spot->direction, truth.direction)))),
+              1.0);
+    EXPECT_NEAR(e.spot->outerConeRad, truth.outerConeRad, 0.02);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(e.spot->intensity[c] / truth.intensity[c], 1.0, 0.05) << c;
+        EXPECT_NEAR(e.tableAlbedo[c] / albedo[c], 1.0, 0.03) << c;
+    }
+}
+
+TEST(LightFit, AnEvenlyLitTableHasNoSpot) {
+    FittedSpotLight truth;
+    glm::dvec3 environment, albedo;
+    const FusedGeometry g = litTable(false, truth, environment, albedo);
+    const LightingEstimate e = estimateLighting(g, environment);
+    EXPECT_FALSE(e.spot.has_value());
+    EXPECT_NEAR(e.tableAlbedo.x, albedo.x, 0.01);
+}
+
+Footage footageAt(const std::vector<Pose>& poses) {
+    Footage f;
+    f.camera = raytrace::pinholeFromHorizontalFov(320, 240, 60.0);
+    f.board = tabletopPlane();
+    for (size_t i = 0; i < poses.size(); ++i)
+        f.frames.push_back({int(i), double(i), cv::Mat(240, 320, CV_8UC3), poses[i]});
+    return f;
+}
+
+TEST(FootageCheck, PureRotationIsRefused) {
+    std::vector<Pose> poses;
+    for (int k = 0; k < 12; ++k)  // turning on the spot: a pan of 40 degrees
+        poses.push_back(
+            cameraLookingAt({0, 0.32, 0.42}, {0.4 * std::sin(0.06 * k - 0.3), 0, 0}, {0, 1, 0}));
+    const Footage f = footageAt(poses);
+    const FootageCheck c = checkFootage(f);
+    EXPECT_FALSE(c.ok);
+    EXPECT_NE(c.problem.find("pure rotation"), std::string::npos) << c.problem;
+    EXPECT_THROW(reconstruct(f, std::nullopt), FootageRefused);
+}
+
+TEST(FootageCheck, TooFewFramesAreRefusedAndAnOrbitIsAccepted) {
+    raytrace::CameraPathOptions path;
+    std::vector<Pose> poses;
+    for (int k = 0; k < 12; ++k) poses.push_back(raytrace::cameraPathPose(path, 0.125 * k));
+    EXPECT_TRUE(checkFootage(footageAt(poses)).ok);
+    poses.resize(5);
+    const FootageCheck c = checkFootage(footageAt(poses));
+    EXPECT_FALSE(c.ok);
+    EXPECT_NE(c.problem.find("only 5 tracked frame"), std::string::npos) << c.problem;
+}
+
+}  // namespace
+}  // namespace mirage::reconstruction
