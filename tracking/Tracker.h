@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "tracking/Detector.h"
+#include "tracking/MissingTagRegion.h"
 #include "tracking/PoseEstimator.h"
 #include "tracking/PoseFilter.h"
 #include "tracking/PredictedTagFinder.h"
@@ -113,6 +114,26 @@ struct TrackerOptions {
     // follows the tag edges it reads; the coarse pose needs only a few tags, one large tag may
     // settle it, and the finder looks for the others). 1 (or more) = the whole grown region.
     double coarseWindowFraction = 0.5;
+    // Adaptive detection (docs/tracking.md, "Adaptive detection"): libapriltag's decimated search
+    // (DetectorOptions::decimate) misses tags under ~15-25 px (distant or steep views). When it
+    // found some tags but no settled pose (ok or uncertain), libapriltag searches again at full
+    // resolution: where the motion prediction of the recent ok poses puts the board tags it
+    // missed (video; missingTags), else the whole search region. Once a pose of the frame is
+    // settled, the board tags it predicts fully in view and large enough but not found are
+    // looked for by the tracking mode's finder (PredictedTagFinder, within coarseSearchPx,
+    // every cell verified), and the pose is estimated again from all tags. Off = the decimated
+    // search alone (then a full-resolution retry only when it finds no tag at all,
+    // DetectorOptions::fullResolutionRetry).
+    bool fullResolutionFallback = true;
+    MissingTagOptions missingTags;
+    // libapriltag's knobs for the full-resolution pass (measured in docs/tracking.md): Gaussian
+    // blur before the quad search (quad_sigma; 0 = none), the sharpening of the sampled bits
+    // (decode_sharpening) and the snapping of the quad's edges to the image's gradients
+    // (refine_edges; libapriltag applies it at any decimation). The other detector options are
+    // those of `detector`.
+    float fullResolutionBlurSigma = 0.0f;
+    double fullResolutionSharpening = 0.25;
+    bool fullResolutionRefineEdges = true;
 };
 
 struct TrackedFrame {
@@ -147,6 +168,14 @@ struct TrackedFrame {
     cv::Rect coarseWindow;
     // Textured-region search: the frame's search began in texturedRegion's box (searchRegion).
     bool textureRegionUsed = false;
+    // Adaptive detection: the image box libapriltag searched again at full resolution (empty:
+    // no such pass), the board tags that pass looked for (0 when it searched a whole region
+    // without a pose) and how many it found; then the board tags the finder added where this
+    // frame's settled pose put them.
+    cv::Rect fullResolutionRegion;
+    int fullResolutionSought = 0;
+    int fullResolutionFound = 0;
+    int fullResolutionFinderFound = 0;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -203,11 +232,19 @@ private:
     bool coarseToFine(const cv::Mat& grey, const cv::Rect& region, float decimate,
                       const std::optional<Pose>& prior, TrackedFrame& f);
 
+    // libapriltag's search of `region` at DetectorOptions::decimate, the pose, then the adaptive
+    // full-resolution pass (TrackerOptions::fullResolutionFallback); fills the frame's
+    // detections and estimate and adds to its timings.
+    void searchTags(const cv::Mat& grey, const cv::Rect& region,
+                    const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f);
+
     // Fills TagDetection::edgeWidthPx of the board tags: the edge width (blur) around the
     // largest one, for the estimator's corner-noise model (~0.02-0.05 ms).
     void measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const;
 
     PredictedTagFinder tagFinder_;
+    // The full-resolution pass's detector (adaptive detection), created when first needed.
+    std::unique_ptr<Detector> fullResolutionDetector_;
     // Coarse detectors by decimation, created when first needed.
     std::vector<std::pair<float, std::unique_ptr<Detector>>> coarseDetectors_;
     int coarseCellsAtBorder_ = 8;

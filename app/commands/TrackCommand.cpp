@@ -32,6 +32,7 @@ struct TrackArgs {
     bool noTagTracking = false;
     bool noTextureRegion = false;
     bool noCoarseFirst = false;
+    bool noFullResolutionFallback = false;
     bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
@@ -96,6 +97,7 @@ void run(const TrackArgs& a) {
     opt.tagTracking = !a.noTagTracking;
     opt.textureRegion = !a.noTextureRegion;
     opt.coarseFirst = !a.noCoarseFirst;
+    opt.fullResolutionFallback = !a.noFullResolutionFallback;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -276,6 +278,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_flag("--no-coarse-first", a->noCoarseFirst,
                   "Without a recent pose, do not pick a coarse-to-fine decimation from the "
                   "size of the textured region (docs/tracking.md, Single frames: coarse-first)");
+    cmd->add_flag("--no-full-resolution-fallback", a->noFullResolutionFallback,
+                  "Do not search again at full resolution for the board tags the decimated "
+                  "search missed (docs/tracking.md, Adaptive detection)");
     cmd->callback([a] { run(*a); });
 });
 
