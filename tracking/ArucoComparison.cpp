@@ -12,6 +12,7 @@
 #include "tracking/BoardImage.h"
 #include "tracking/BoardLayout.h"
 #include "tracking/SyntheticBoardView.h"
+#include "tracking/SyntheticTrials.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::tracking {
@@ -89,6 +90,12 @@ struct OneOpenCvThread {
     OneOpenCvThread& operator=(const OneOpenCvThread&) = delete;
 };
 
+// The hard views' ranges (hardBoardViews).
+constexpr double kHardViewMinDistanceM = 0.6, kHardViewMaxDistanceM = 1.1;
+constexpr double kHardViewMinTiltDeg = 45, kHardViewMaxTiltDeg = 70;
+constexpr double kHardViewMaxBlurPx = 2.5;
+constexpr int kHardViewMinJpegQuality = 60;
+
 }  // namespace
 
 BoardFrames singleBoardViews(int width) {
@@ -120,6 +127,35 @@ BoardFrames orbitBoardVideo(int width) {
         const glm::dvec3 target(0.02 * std::sin(3 * a), 0, 0.02 * std::cos(2 * a));
         const Pose T = cameraLookingAt(eye, target, {0, 1, 0}, 0.1 * std::sin(a));
         f.images.push_back(renderSyntheticBoardView(f.board, texture, f.camera, T));
+        f.truth.push_back(T);
+    }
+    return f;
+}
+
+BoardFrames hardBoardViews(int width, uint64_t seed, int frames) {
+    if (frames < 1) throw Error("hard views: frames must be at least 1");
+    BoardFrames f = emptyFrames(width);
+    const BoardRaster texture = renderBoard(f.board, 8000, false);
+    cv::RNG rng(seed * 2654435761ull + 777);
+    const glm::dvec3 centre = boardCentre(f.board);
+    for (int i = 0; i < frames; ++i) {
+        const double d = rng.uniform(kHardViewMinDistanceM, kHardViewMaxDistanceM);
+        const double el =
+            glm::radians(rng.uniform(90.0 - kHardViewMaxTiltDeg, 90.0 - kHardViewMinTiltDeg));
+        const double az = glm::radians(rng.uniform(-70.0, 70.0));
+        const glm::dvec3 eye = centre + d * glm::dvec3(std::cos(el) * std::sin(az), std::sin(el),
+                                                       std::cos(el) * std::cos(az));
+        const glm::dvec3 target =
+            centre + glm::dvec3(rng.uniform(-0.05, 0.05), 0, rng.uniform(-0.04, 0.04));
+        const Pose T = cameraLookingAt(eye, target, {0, 1, 0}, rng.uniform(-0.3, 0.3));
+        Degradation g;
+        g.seed = seed * 1000 + uint64_t(i);
+        g.blurPx = rng.uniform(0.0, kHardViewMaxBlurPx);
+        g.blurAngleRad = rng.uniform(0.0, M_PI);
+        g.jpegQuality = rng.uniform(kHardViewMinJpegQuality, 91);
+        g.gain = rng.uniform(0.6, 1.3);
+        g.noiseLevels = rng.uniform(0.3, 1.2);
+        f.images.push_back(degradeView(renderSyntheticBoardView(f.board, texture, f.camera, T), g));
         f.truth.push_back(T);
     }
     return f;

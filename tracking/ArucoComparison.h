@@ -5,6 +5,7 @@
 // --suite`). The Google Benchmark of tracking/bench/ uses the same frames and measures for its
 // finer sweeps.
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -31,6 +32,12 @@ struct BoardFrames {
 // 16 unrelated views: 0.3-0.8 m, 25-88 degrees elevation, several azimuths and rolls. `width`
 // 640 (480 high, f = 600 px) or 1280 (720 high, f = 1000 px), mild Brown-Conrady distortion.
 BoardFrames singleBoardViews(int width);
+// Hard views: `frames` unrelated views far from the board and at a steep angle (drawn from
+// `seed`: 0.6-1.1 m from the board centre, 45-70 degrees between the viewing direction and the
+// board normal, any azimuth within +-70 degrees, roll +-0.3 rad), each degraded as a webcam's
+// frame (motion blur 0-2.5 px, JPEG quality 60-90, exposure 0.6-1.3, sensor noise 0.3-1.2
+// levels). Tags of 8-25 px on their shortest side: what a decimated search misses.
+BoardFrames hardBoardViews(int width, uint64_t seed, int frames = 16);
 // A video: 60 frames at 30 fps of a closed orbit around the board (one turn in 2 s, 180 deg/s,
 // 0.45-0.65 m from the board centre, height and aim wobbling): cycling over it is continuous
 // motion.

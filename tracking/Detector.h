@@ -26,7 +26,8 @@ struct DetectorOptions {
     bool fullResolutionRetry = true;
     // Gaussian blur sigma (pixels) before quad search; 0 = none. ~0.8 helps on noisy images.
     float blurSigma = 0.0f;
-    // Snap quad edges to strong full-resolution gradients (only used when decimate > 1).
+    // Snap quad edges to strong full-resolution gradients (libapriltag applies it at any
+    // decimation; after a decimated quad search it restores the full-resolution edge).
     bool refineEdges = true;
     // Sharpening of the sampled code bits, helps small tags. libapriltag default: 0.25.
     double decodeSharpening = 0.25;

@@ -342,6 +342,101 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
     return true;
 }
 
+void Tracker::searchTags(const cv::Mat& grey, const cv::Rect& region,
+                         const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f) {
+    f.fullResolutionRegion = cv::Rect();
+    f.fullResolutionSought = f.fullResolutionFound = f.fullResolutionFinderFound = 0;
+    auto t0 = std::chrono::steady_clock::now();
+    f.detections = detector_.detect(grey, region);
+    f.detectMs += msSince(t0);
+    t0 = std::chrono::steady_clock::now();
+    measureBlur(grey, f.detections);
+    f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
+    f.poseMs += msSince(t0);
+    // With no tag found the detector has searched the region at full resolution already
+    // (DetectorOptions::fullResolutionRetry).
+    if (!options_.fullResolutionFallback || !(options_.detector.decimate > 1.0f) ||
+        f.detections.empty())
+        return;
+    const auto settled = [&] {
+        return f.estimate.pose && (f.estimate.state == TrackingState::Ok ||
+                                   f.estimate.state == TrackingState::Uncertain);
+    };
+    if (!settled()) {
+        // No pose of this frame to say where the missed tags are: where the motion prediction
+        // of the recent ok poses puts them (video), else anywhere in the region, searched by
+        // libapriltag at full resolution.
+        t0 = std::chrono::steady_clock::now();
+        cv::Rect again = region & cv::Rect(0, 0, grey.cols, grey.rows);
+        if (lastOk_ && t >= lastOkT_ && t - lastOkT_ <= options_.priorMaxAgeS) {
+            const MissingTags m =
+                findMissingTags(estimator_.board(), estimator_.camera(), predictPose(t),
+                                f.detections, options_.missingTags);
+            f.fullResolutionSought = int(m.ids.size());
+            again = m.region;
+        }
+        if (!again.empty()) {
+            if (!fullResolutionDetector_) {
+                DetectorOptions o = options_.detector;
+                o.decimate = 1.0f;
+                o.fullResolutionRetry = false;
+                o.blurSigma = options_.fullResolutionBlurSigma;
+                o.decodeSharpening = options_.fullResolutionSharpening;
+                o.refineEdges = options_.fullResolutionRefineEdges;
+                fullResolutionDetector_ = std::make_unique<Detector>(o);
+            }
+            f.fullResolutionRegion = again;
+            for (auto& d : fullResolutionDetector_->detect(grey, again)) {
+                // Board tags the decimated search missed join the frame's (a tag id seen twice
+                // would be dropped by the estimator).
+                if (!estimator_.board().find(d.id)) continue;
+                const bool have = std::any_of(f.detections.begin(), f.detections.end(),
+                                              [&](const TagDetection& e) { return e.id == d.id; });
+                if (have) continue;
+                f.detections.push_back(d);
+                ++f.fullResolutionFound;
+            }
+        }
+        f.detectMs += msSince(t0);
+        if (f.fullResolutionFound == 0) return;
+        t0 = std::chrono::steady_clock::now();
+        measureBlur(grey, f.detections);
+        f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
+        f.poseMs += msSince(t0);
+        if (!settled()) return;
+    }
+    // A settled pose of this frame predicts the missed tags to a few pixels: the tracking mode's
+    // finder looks for each where the pose puts them (edges at full resolution, sub-pixel
+    // corners, every cell verified against the expected code), corrected by the offsets of the
+    // tags found; it follows tags from 12 px, smaller and steeper than libapriltag decodes.
+    t0 = std::chrono::steady_clock::now();
+    const MissingTags m = findMissingTags(estimator_.board(), estimator_.camera(), *f.estimate.pose,
+                                          f.detections, options_.missingTags);
+    if (m.ids.empty()) {
+        f.detectMs += msSince(t0);
+        return;
+    }
+    const size_t before = f.detections.size();
+    std::vector<TagDetection> dets =
+        tagFinder_.find(grey, *f.estimate.pose, options_.coarseSearchPx, f.detections);
+    // The finder returns the known tags it predicted and the verified others; known tags it did
+    // not predict (cut by the image border, too small for it) are kept.
+    for (const auto& d : f.detections) {
+        const bool have = std::any_of(dets.begin(), dets.end(),
+                                      [&](const TagDetection& e) { return e.id == d.id; });
+        if (!have) dets.push_back(d);
+    }
+    f.detectMs += msSince(t0);
+    if (dets.size() <= before) return;
+    f.fullResolutionFinderFound = int(dets.size() - before);
+    f.detections = std::move(dets);
+    t0 = std::chrono::steady_clock::now();
+    measureBlur(grey, f.detections);
+    const Pose initial = *f.estimate.pose;
+    f.estimate = estimator_.estimate(f.detections, ambiguityPrior, initial);
+    f.poseMs += msSince(t0);
+}
+
 TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     TrackedFrame f;
     f.t = t;
@@ -368,7 +463,7 @@ TrackedFrame Tracker::process(const cv::Mat& image, double t) {
     if (options_.tagTracking && usePrior) trackPredictedTags(grey, t, ambiguityPrior, f);
     if (!f.tagTracked) {
         const SearchPlan plan = planSearch(grey, prior, usePrior, f);
-        searchTags(grey, plan, ambiguityPrior, f);
+        searchPlanned(grey, plan, ambiguityPrior, t, f);
     }
     classifyNoTags(grey, f);
     extendWithFeatures(grey, t, f);
@@ -464,17 +559,11 @@ Tracker::SearchPlan Tracker::planSearch(const cv::Mat& grey, const std::optional
     return plan;
 }
 
-void Tracker::searchTags(const cv::Mat& grey, const SearchPlan& plan,
-                         const std::optional<Pose>& ambiguityPrior, TrackedFrame& f) {
+void Tracker::searchPlanned(const cv::Mat& grey, const SearchPlan& plan,
+                            const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f) {
     const cv::Rect full(0, 0, grey.cols, grey.rows);
     auto detectAndEstimate = [&](const cv::Rect& region) {
-        auto t0 = std::chrono::steady_clock::now();
-        f.detections = region == full ? detector_.detect(grey) : detector_.detect(grey, region);
-        f.detectMs += msSince(t0);
-        t0 = std::chrono::steady_clock::now();
-        measureBlur(grey, f.detections);
-        f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
-        f.poseMs += msSince(t0);
+        searchTags(grey, region, ambiguityPrior, t, f);
     };
     // Decimation 1 is a coarse stage too (coarseFirstDecimations): libapriltag at full
     // resolution in the window.

@@ -11,6 +11,7 @@
 
 #include "tracking/Detector.h"
 #include "tracking/FeatureTracker.h"
+#include "tracking/MissingTagRegion.h"
 #include "tracking/PoseEstimator.h"
 #include "tracking/PoseFilter.h"
 #include "tracking/PredictedTagFinder.h"
@@ -121,6 +122,26 @@ struct TrackerOptions {
     // When the board gives the pose again after poses from the features, the reported (filtered)
     // pose moves from where the features put it to the board's in this many equal steps.
     int reanchorFrames = 5;
+    // Adaptive detection (docs/tracking.md, "Adaptive detection"): libapriltag's decimated search
+    // (DetectorOptions::decimate) misses tags under ~15-25 px (distant or steep views). When it
+    // found some tags but no settled pose (ok or uncertain), libapriltag searches again at full
+    // resolution: where the motion prediction of the recent ok poses puts the board tags it
+    // missed (video; missingTags), else the whole search region. Once a pose of the frame is
+    // settled, the board tags it predicts fully in view and large enough but not found are
+    // looked for by the tracking mode's finder (PredictedTagFinder, within coarseSearchPx,
+    // every cell verified), and the pose is estimated again from all tags. Off = the decimated
+    // search alone (then a full-resolution retry only when it finds no tag at all,
+    // DetectorOptions::fullResolutionRetry).
+    bool fullResolutionFallback = true;
+    MissingTagOptions missingTags;
+    // libapriltag's knobs for the full-resolution pass (measured in docs/tracking.md): Gaussian
+    // blur before the quad search (quad_sigma; 0 = none), the sharpening of the sampled bits
+    // (decode_sharpening) and the snapping of the quad's edges to the image's gradients
+    // (refine_edges; libapriltag applies it at any decimation). The other detector options are
+    // those of `detector`.
+    float fullResolutionBlurSigma = 0.0f;
+    double fullResolutionSharpening = 0.25;
+    bool fullResolutionRefineEdges = true;
 };
 
 struct TrackedFrame {
@@ -162,6 +183,14 @@ struct TrackedFrame {
     FeatureStats features;
     double featureMs = 0;
     double reanchorWeight = 0;
+    // Adaptive detection: the image box libapriltag searched again at full resolution (empty:
+    // no such pass), the board tags that pass looked for (0 when it searched a whole region
+    // without a pose) and how many it found; then the board tags the finder added where this
+    // frame's settled pose put them.
+    cv::Rect fullResolutionRegion;
+    int fullResolutionSought = 0;
+    int fullResolutionFound = 0;
+    int fullResolutionFinderFound = 0;
 };
 
 // Sharpness of an 8-bit grey image: for each of 4 directions (0, 45, 90, 135 degrees) the 99.5th
@@ -216,8 +245,8 @@ private:
     SearchPlan planSearch(const cv::Mat& grey, const std::optional<Pose>& prior, bool usePrior,
                           TrackedFrame& f);
     // libapriltag's search (coarse to fine, or ordinary) and the full-image retry.
-    void searchTags(const cv::Mat& grey, const SearchPlan& plan,
-                    const std::optional<Pose>& ambiguityPrior, TrackedFrame& f);
+    void searchPlanned(const cv::Mat& grey, const SearchPlan& plan,
+                       const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f);
     // No tag: too_blurred when the image is blurred.
     void classifyNoTags(const cv::Mat& grey, TrackedFrame& f) const;
     // Natural features: learn from an ok board pose, or give the pose when the tags did not.
@@ -244,11 +273,19 @@ private:
     bool coarseToFine(const cv::Mat& grey, const cv::Rect& region, float decimate,
                       const std::optional<Pose>& prior, TrackedFrame& f);
 
+    // libapriltag's search of `region` at DetectorOptions::decimate, the pose, then the adaptive
+    // full-resolution pass (TrackerOptions::fullResolutionFallback); fills the frame's
+    // detections and estimate and adds to its timings.
+    void searchTags(const cv::Mat& grey, const cv::Rect& region,
+                    const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f);
+
     // Fills TagDetection::edgeWidthPx of the board tags: the edge width (blur) around the
     // largest one, for the estimator's corner-noise model (~0.02-0.05 ms).
     void measureBlur(const cv::Mat& grey, std::vector<TagDetection>& dets) const;
 
     PredictedTagFinder tagFinder_;
+    // The full-resolution pass's detector (adaptive detection), created when first needed.
+    std::unique_ptr<Detector> fullResolutionDetector_;
     // Coarse detectors by decimation, created when first needed.
     std::vector<std::pair<float, std::unique_ptr<Detector>>> coarseDetectors_;
     int coarseCellsAtBorder_ = 8;

@@ -38,6 +38,7 @@ struct TrackArgs {
     bool noCoarseFirst = false;
     bool boardOnly = false;
     std::string driftSvg;  // drift of extended tracking against the time without the board
+    bool noFullResolutionFallback = false;
     bool force = false;
     std::string filter = "predictive";
     tracking::TrackerOptions options;
@@ -190,6 +191,7 @@ tracking::TrackerOptions trackerOptions(const TrackArgs& a) {
     opt.textureRegion = !a.noTextureRegion;
     opt.coarseFirst = !a.noCoarseFirst;
     opt.features.enabled = !a.boardOnly;
+    opt.fullResolutionFallback = !a.noFullResolutionFallback;
     if (a.filter == "one-euro")
         opt.filterKind = tracking::FilterKind::OneEuro;
     else if (a.filter != "predictive")
@@ -401,6 +403,9 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
                     "Plot the error of the poses from natural features against the time "
                     "without the board (needs ground truth) to this SVG file")
         ->check(outputPath(OutputShape::File));
+    cmd->add_flag("--no-full-resolution-fallback", a->noFullResolutionFallback,
+                  "Do not search again at full resolution for the board tags the decimated "
+                  "search missed (docs/tracking.md, Adaptive detection)");
     cmd->callback([a] { run(*a); });
 });
 

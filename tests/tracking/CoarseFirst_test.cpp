@@ -163,7 +163,9 @@ TEST(CoarseFirst, ForcedOnSmallTagsFallsBackAndAWrongBoardGivesNoPose) {
     ASSERT_EQ(forced.estimate.state, o.estimate.state) << forced.estimate.reason;
     ASSERT_TRUE(forced.estimate.pose && o.estimate.pose);
     EXPECT_EQ(forced.estimate.tagsUsed, o.estimate.tagsUsed);
-    EXPECT_EQ(rotationDeg(*forced.estimate.pose, *o.estimate.pose), 0.0);
+    // The same tags and pose (adaptive detection's finder adds the same tags in both; the
+    // estimates then differ in the last digits: 2e-6 deg measured).
+    EXPECT_LT(rotationDeg(*forced.estimate.pose, *o.estimate.pose), 1e-4);
 
     const cv::Mat near = scene().render(testing::lookAt(orbit(0.35, 70, 10), {0, 0, 0}));
     BoardLayout wrongGap;

@@ -8,6 +8,10 @@
 // ordinary search the coarse-first path replaces.
 //
 //   tracking_single_stages [--width 640|1280] [--reps N] [--no-coarse-first]
+//                          [--no-full-resolution-fallback]
+// The path says where adaptive detection added tags: "+ full res F/S" = libapriltag at full
+// resolution found F of the S missed board tags (S = 0: the whole region searched, no pose to
+// predict them), "+ finder N" = the finder found N where the frame's settled pose put them.
 #include <apriltag/apriltag.h>
 #include <apriltag/common/timeprofile.h>
 
@@ -35,7 +39,7 @@ double cpuMs() {
 int main(int argc, char** argv) {
     using namespace mirage::tracking;
     int width = 640, reps = 20;
-    bool coarseFirst = true;
+    bool coarseFirst = true, fullResolutionFallback = true;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--width") && i + 1 < argc)
             width = std::atoi(argv[++i]);
@@ -43,8 +47,12 @@ int main(int argc, char** argv) {
             reps = std::max(1, std::atoi(argv[++i]));
         else if (!std::strcmp(argv[i], "--no-coarse-first"))
             coarseFirst = false;
+        else if (!std::strcmp(argv[i], "--no-full-resolution-fallback"))
+            fullResolutionFallback = false;
         else {
-            std::fprintf(stderr, "usage: %s [--width 640|1280] [--reps N] [--no-coarse-first]\n",
+            std::fprintf(stderr,
+                         "usage: %s [--width 640|1280] [--reps N] [--no-coarse-first] "
+                         "[--no-full-resolution-fallback]\n",
                          argv[0]);
             return 2;
         }
@@ -53,6 +61,7 @@ int main(int argc, char** argv) {
     TrackerOptions opt;
     opt.filterEnabled = false;
     opt.coarseFirst = coarseFirst;
+    opt.fullResolutionFallback = fullResolutionFallback;
     Tracker tracker(f.board, f.camera, opt);
     PoseEstimator estimator(f.board, f.camera);
     const TagFamily family("tag36h11");
@@ -105,12 +114,22 @@ int main(int argc, char** argv) {
         }
         const double aprilMs = (cpuMs() - c0) / reps;
 
-        char path[64];
+        char path[96];
         if (r.coarseTried)
             std::snprintf(path, sizeof path, "coarse d%.0f %s", double(r.coarseFirstDecimate),
                           r.coarseUsed ? "used" : "fell back");
         else
             std::snprintf(path, sizeof path, "search%s", r.fullFrameRetry ? " + full retry" : "");
+        if (!r.fullResolutionRegion.empty()) {
+            const size_t len = std::strlen(path);
+            std::snprintf(path + len, sizeof path - len, " + full res %d/%d", r.fullResolutionFound,
+                          r.fullResolutionSought);
+        }
+        if (r.fullResolutionFinderFound > 0) {
+            const size_t len = std::strlen(path);
+            std::snprintf(path + len, sizeof path - len, " + finder %d",
+                          r.fullResolutionFinderFound);
+        }
         std::printf("%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f\n", v, frameMs, path,
                     r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
                     trackingStateName(r.estimate.state), refineMs, poseMs, aprilMs);

@@ -245,9 +245,13 @@ void BM_ArucoTrackTextured(benchmark::State& state) {
 
 // mirage's Tracker on the single unrelated frames of BM_Mirage (no previous pose: frames 10 s
 // apart). Args: mode 2 = coarse-first (the default: the coarse-to-fine search at the decimation
-// the textured region's size picks, 4, 3 or none, in a window about the region's centre), 3 =
-// coarse-first as before the window (the whole grown region), 4 = the default with decimation 1
-// for the small tags (libapriltag at full resolution in the window), 1 = coarse-to-fine at the
+// the textured region's size picks, 4, 3 or none, in a window about the region's centre; then,
+// where the decimated search missed tags, the adaptive full-resolution pass), 5 = the default
+// with the full-resolution pass off (the default before it), 6-8 = the default with one of
+// libapriltag's knobs changed in the full-resolution pass: 6 quad_sigma 0.8, 7 decode_sharpening
+// 0.5, 8 refine_edges off; 3 = coarse-first as before the window (the whole grown region), 4 =
+// the default with decimation 1 for the small tags (libapriltag at full resolution in the
+// window), 1 = coarse-to-fine at the
 // fixed `coarse` decimation (libapriltag at that decimation, the other board tags found from that
 // pose at full resolution and verified; the previous default from 1000 px width), 0 = libapriltag's
 // search at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker); texture 1 = the search
@@ -256,6 +260,10 @@ void BM_MirageSingle(benchmark::State& state) {
     const BoardFrames& f = frames(int(state.range(0)));
     TrackerOptions opt;
     opt.coarseFirst = state.range(1) >= 2;
+    opt.fullResolutionFallback = state.range(1) != 5;
+    if (state.range(1) == 6) opt.fullResolutionBlurSigma = 0.8f;
+    if (state.range(1) == 7) opt.fullResolutionSharpening = 0.5;
+    if (state.range(1) == 8) opt.fullResolutionRefineEdges = false;
     if (state.range(1) == 3) opt.coarseWindowFraction = 1.0;
     if (state.range(1) == 4) opt.coarseFirstDecimations = {4.0f, 3.0f, 1.0f};
     opt.coarseToFine = state.range(1) == 1;
@@ -266,11 +274,12 @@ void BM_MirageSingle(benchmark::State& state) {
     Tracker tracker(f.board, f.camera, opt);
     TrackingAccuracy acc;
     double t = 0;
-    int coarseUsed = 0, regionUsed = 0;
+    int coarseUsed = 0, regionUsed = 0, fullResolution = 0;
     for (size_t v = 0; v < f.images.size(); ++v) {
         const TrackedFrame r = tracker.process(f.images[v], t += 10.0);
         acc.addFrame(f, v, foundTags(r.detections), okPose(r.estimate));
         coarseUsed += r.coarseUsed;
+        fullResolution += !r.fullResolutionRegion.empty();
         regionUsed += r.textureRegionUsed && !r.fullFrameRetry;
     }
     size_t i = 0;
@@ -280,7 +289,82 @@ void BM_MirageSingle(benchmark::State& state) {
     state.counters["coarse_used"] = coarseUsed;
     // Frames whose search stayed inside the textured region (no full-image retry).
     state.counters["region_used"] = regionUsed;
+    // Frames with an adaptive full-resolution pass.
+    state.counters["full_res_pass"] = fullResolution;
 }
+
+// Hard footage (hardBoardViews: far, steep, blurred, JPEG; 16 frames at 12 fps per seed, seeds
+// 1-3 one after the other), tracked in order by mirage's Tracker (Arg fallback: the adaptive
+// full-resolution pass on (default) or off) and per frame by ArUco. Counter `right` = frames of
+// the 48 with a pose within 2 deg / 2 % of the distance (mirage: ok poses only), `wrong_ok` =
+// the others with a pose. The timing cycles over the 48 frames in order.
+const BoardFrames& hardFootage(int width) {
+    static std::map<int, std::unique_ptr<BoardFrames>> cache;
+    auto& f = cache[width];
+    if (!f) {
+        f = std::make_unique<BoardFrames>(hardBoardViews(width, 1));
+        for (uint64_t seed : {2, 3}) {
+            const BoardFrames more = hardBoardViews(width, seed);
+            f->images.insert(f->images.end(), more.images.begin(), more.images.end());
+            f->truth.insert(f->truth.end(), more.truth.begin(), more.truth.end());
+        }
+    }
+    return *f;
+}
+
+void reportHard(benchmark::State& state, const TrackingAccuracy& a) {
+    report(state, a);
+    state.counters["right"] = a.poses - a.wrongPoses;
+}
+
+void BM_MirageHard(benchmark::State& state) {
+    const BoardFrames& f = hardFootage(int(state.range(0)));
+    TrackerOptions opt;
+    opt.fullResolutionFallback = state.range(1) == 1;
+    TrackingAccuracy acc;
+    const double dt = 1.0 / 12.0;
+    // Each seed's pass is its own video: a fresh tracker per 16 frames.
+    for (size_t first = 0; first < f.images.size(); first += 16) {
+        Tracker tracker(f.board, f.camera, opt);
+        for (size_t v = first; v < std::min(first + 16, f.images.size()); ++v) {
+            const TrackedFrame r = tracker.process(f.images[v], double(v - first) * dt);
+            acc.addFrame(f, v, foundTags(r.detections), okPose(r.estimate));
+        }
+    }
+    Tracker tracker(f.board, f.camera, opt);
+    size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(tracker.process(f.images[i % f.images.size()], double(i) * dt));
+        ++i;
+    }
+    reportHard(state, acc);
+}
+
+void BM_ArucoHard(benchmark::State& state) {
+    const BoardFrames& f = hardFootage(int(state.range(0)));
+    ArucoBaseline aruco(int(state.range(1)));
+    TrackingAccuracy acc;
+    for (size_t v = 0; v < f.images.size(); ++v) {
+        const ArucoBaseline::Result r = aruco.process(f, f.images[v]);
+        acc.addFrame(f, v, r.tags, r.pose);
+    }
+    size_t i = 0;
+    for (auto _ : state)
+        benchmark::DoNotOptimize(aruco.process(f, f.images[i++ % f.images.size()]));
+    reportHard(state, acc);
+}
+
+BENCHMARK(BM_MirageHard)
+    ->ArgNames({"width", "fallback"})
+    ->Args({640, 1})
+    ->Args({640, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_ArucoHard)
+    ->ArgNames({"width", "refine"})
+    ->Args({640, cv::aruco::CORNER_REFINE_NONE})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // ---- OpenCV ArUco ----------------------------------------------------------------------------
 
@@ -338,6 +422,10 @@ BENCHMARK(BM_Mirage)
 BENCHMARK(BM_MirageSingle)
     ->ArgNames({"width", "mode", "coarse", "texture"})
     ->Args({640, 2, 0, 1})
+    ->Args({640, 5, 0, 1})
+    ->Args({640, 6, 0, 1})
+    ->Args({640, 7, 0, 1})
+    ->Args({640, 8, 0, 1})
     ->Args({640, 3, 0, 1})
     ->Args({640, 4, 0, 1})
     ->Args({640, 0, 0, 1})
@@ -345,6 +433,7 @@ BENCHMARK(BM_MirageSingle)
     ->Args({640, 1, 4, 1})
     ->Args({640, 1, 3, 1})
     ->Args({1280, 2, 0, 1})
+    ->Args({1280, 5, 0, 1})
     ->Args({1280, 3, 0, 1})
     ->Args({1280, 4, 0, 1})
     ->Args({1280, 1, 4, 1})
