@@ -530,6 +530,7 @@ pid_t startMirage(const std::vector<std::string>& args, const fs::path& log) {
         argv.push_back(nullptr);
         FILE* f = std::freopen(log.c_str(), "w", stderr);
         (void)f;
+        ::dup2(STDERR_FILENO, STDOUT_FILENO);  // the log lines (stdout) in the same file
         ::execv(argv[0], argv.data());
         _exit(127);
     }
