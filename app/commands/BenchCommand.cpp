@@ -335,7 +335,8 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
         ->check(wholeIn(-1, 100000000));
     cmd->add_option("--start", a->start, "First frame")->check(wholeIn(0, 100000000));
     cmd->add_option("--repeat", a->repeats, "Run the frame sequence R times (timings pooled)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(wholeIn(1, 10000));
     cmd->add_option("--exposure", a->exposure,
                     "Rendered radiance -> camera linear units (the synth's --exposure)")
         ->capture_default_str()

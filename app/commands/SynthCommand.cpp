@@ -234,7 +234,8 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
     cmd->add_option("--env-white-balance", a->envWhiteBalance,
                     "Environment camera's white balance: gains R,G,B on the radiance it films")
         ->delimiter(',')
-        ->expected(3);
+        ->expected(3)
+        ->check(finiteIn(NumberRange{0, 1e6, true, true}));
     cmd->add_option("--env-rotation", a->o.envRotationDegPerSecond,
                     "The room light moves: the scene's environment turns about +Y at this rate "
                     "(degrees per second; footage, environment camera and ground truth follow)")
