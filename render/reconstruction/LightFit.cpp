@@ -245,8 +245,16 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
             const double spot = glm::dot(b, glm::dvec3(1.0)) * spotGeometry(l, hit, normal);
             l.contrast = spot / std::max(1e-9, glm::dot(a, glm::dvec3(1.0)));
         }
-        if (l.contrast >= o.minContrast)
+        // A light far beyond the table or a cone near a hemisphere is the fit running away on
+        // too few or too noisy cells, not a lamp: reported as none rather than confidently wrong.
+        const bool plausible = glm::length(l.position - g.table.plane.point) < o.maxDistanceM &&
+                               l.outerConeRad < glm::radians(80.0);
+        if (l.contrast >= o.minContrast && plausible)
             e.spot = l;
+        else if (!plausible)
+            e.notes.push_back(
+                "the spot light fit ran away (too few or too noisy table cells): "
+                "no local light written");
         else
             e.notes.push_back("no local light: the table is lit evenly (spot contrast " +
                               std::to_string(l.contrast) + ")");

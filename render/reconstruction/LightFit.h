@@ -40,6 +40,7 @@ struct LightFitOptions {
     // the environment's (otherwise the table is lit evenly and there is nothing to fit).
     double minContrast = 0.15;
     int maxIterations = 60;
+    double maxDistanceM = 2.5;  // a fitted light farther from the board's centre is refused
 };
 
 struct LightingEstimate {

@@ -27,8 +27,29 @@ Eigen::Matrix4d toEigen(const glm::dmat4& m) {
 }
 
 // Fuses the depth maps; returns the marching-cubes mesh with its small pieces removed.
+// Depth of the working volume only: points within maxTableHalfExtentM of the board along the
+// plane and between maxDepthBelowM under it and maxHeightM over it. The floor and far walls
+// cost the sparse volume most of its blocks and say nothing about the table or its objects
+// (where the table ends, nothing in the band agrees with the plane either way).
+cv::Mat croppedDepth(const DepthView& v, const BoardPlane& plane, const GeometryOptions& o) {
+    cv::Mat d = v.depth.clone();
+    for (int y = 0; y < d.rows; ++y)
+        for (int x = 0; x < d.cols; ++x) {
+            float& z = d.at<float>(y, x);
+            if (z <= 0) continue;
+            const glm::dvec3 c((x - v.cx) / v.fx * z, (y - v.cy) / v.fy * z, z);
+            const glm::dvec3 uvh = plane.toPlane(v.T_world_camera * c);
+            if (std::abs(uvh.x) > o.maxTableHalfExtentM ||
+                std::abs(uvh.y) > o.maxTableHalfExtentM || uvh.z < -o.maxDepthBelowM ||
+                uvh.z > o.maxHeightM)
+                z = 0;
+        }
+    return d;
+}
+
 std::shared_ptr<TriangleMesh> fuseDepth(const std::vector<DepthView>& views,
-                                        const GeometryOptions& o, FusedGeometry& out) {
+                                        const BoardPlane& plane, const GeometryOptions& o,
+                                        FusedGeometry& out) {
     open3d::pipelines::integration::ScalableTSDFVolume volume(
         o.voxelM, o.truncationM, open3d::pipelines::integration::TSDFVolumeColorType::RGB8);
     for (const DepthView& v : views) {
@@ -39,7 +60,7 @@ std::shared_ptr<TriangleMesh> fuseDepth(const std::vector<DepthView>& views,
         cv::Mat rgb(h, w, CV_8UC3, colour.data_.data());
         cv::cvtColor(v.bgr, rgb, cv::COLOR_BGR2RGB);
         cv::Mat d(h, w, CV_32F, depth.data_.data());
-        v.depth.copyTo(d);
+        croppedDepth(v, plane, o).copyTo(d);
         auto rgbd = open3d::geometry::RGBDImage::CreateFromColorAndDepth(
             colour, depth, 1.0, 1e6, /*convert_rgb_to_intensity=*/false);
         const open3d::camera::PinholeCameraIntrinsic K(w, h, v.fx, v.fy, v.cx, v.cy);
@@ -312,7 +333,7 @@ void splitObjects(const TriangleMesh& mesh, const Footage& footage, const Geomet
 FusedGeometry reconstructGeometry(const Footage& footage, const std::vector<DepthView>& views,
                                   const GeometryOptions& o) {
     FusedGeometry out;
-    const auto mesh = fuseDepth(views, o, out);
+    const auto mesh = fuseDepth(views, footage.board, o, out);
     estimateTable(*mesh, footage, o, out);
     splitObjects(*mesh, footage, o, out);
     return out;

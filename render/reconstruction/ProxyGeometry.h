@@ -28,7 +28,9 @@ struct GeometryOptions {
     double cellM = 0.004;              // object height-field cell
     double minObjectHeightM = 0.015;   // lower bumps are the table's (stereo noise, paper)
     double minObjectAreaM2 = 0.0006;   // footprint (6 cm^2)
-    double maxTableHalfExtentM = 2.0;  // search radius for the table's extent
+    double maxTableHalfExtentM = 1.5;  // search radius for the table's extent
+    double maxHeightM = 0.5;           // objects taller than this are cut (walls, people)
+    double maxDepthBelowM = 0.1;       // fused below the plane (the table's edge)
     int minComponentTriangles = 60;    // fused pieces smaller than this are outliers
     // Triangles per object after simplification; the whole scene of proxies stays within
     // maxObjects x this (the real-time renderer draws real proxies into every shadow and

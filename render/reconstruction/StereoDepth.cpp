@@ -92,21 +92,26 @@ DepthView matchPair(const Footage& footage, const PosedFrame& left, const PosedF
     v.depth = cv::Mat(size, CV_32F, cv::Scalar(0));
     if (v.baselineM <= 0) return v;  // not a left-right pair after rectification
 
-    // The disparities the scene can have: around the board's distance, from 0.4x to 3x of it.
+    // The disparities the working volume can have: from 0.6x to 2x the board's distance (objects
+    // on the table up to about half the camera's height above it; the table's far side).
     const double boardDepth = std::max(0.05, (v.T_world_camera.inverse() * footage.board.point).z);
-    const double zNear = std::max(o.minDepthM, 0.4 * boardDepth);
-    const double zFar = std::min(o.maxDepthM, 3.0 * boardDepth);
+    const double zNear = std::max(o.minDepthM, 0.6 * boardDepth);
+    const double zFar = std::min(o.maxDepthM, 2.0 * boardDepth);
     const double fb = v.fx * v.baselineM;
     const int minDisparity = std::max(0, int(std::floor(fb / zFar)));
     int numDisparities = int(std::ceil(fb / zNear)) - minDisparity;
     numDisparities = std::clamp((numDisparities + 15) / 16 * 16, 16, 256);
     const int channels = v.bgr.channels();
     const int b = o.blockSize;
-    auto sgbm =
-        cv::StereoSGBM::create(minDisparity, numDisparities, b, 8 * channels * b * b,
-                               32 * channels * b * b, 1, 0, 10, 100, 2, cv::StereoSGBM::MODE_SGBM);
-    cv::Mat disparity;
-    sgbm->compute(v.bgr, rightRect, disparity);
+    // P2 (the cost of a disparity jump) high: plain faces take the depth of their edges.
+    auto sgbm = cv::StereoSGBM::create(minDisparity, numDisparities, b, 8 * channels * b * b,
+                                       o.smoothness * channels * b * b, 1, 0, o.uniquenessRatio,
+                                       100, 2, cv::StereoSGBM::MODE_HH);
+    // A light blur first: sensor (and render) noise is not texture the two views share.
+    cv::Mat leftSmooth, rightSmooth, disparity;
+    cv::GaussianBlur(v.bgr, leftSmooth, {3, 3}, 0.8);
+    cv::GaussianBlur(rightRect, rightSmooth, {3, 3}, 0.8);
+    sgbm->compute(leftSmooth, rightSmooth, disparity);
     const cv::Mat coveredLeft = rectifiedCoverage(map1x, map1y, size);
     int valid = 0;
     for (int y = 0; y < size.height; ++y)
@@ -120,6 +125,45 @@ DepthView matchPair(const Footage& footage, const PosedFrame& left, const PosedF
         }
     v.validFraction = double(valid) / double(size.area());
     return v;
+}
+
+// Geometric consistency between the depth maps: a depth is kept only when at least `minAgree`
+// other maps see the same point within `tolerance` (metres, plus 2 % of the depth) where it
+// projects into them. One pair's wrong match (a plain face, repeated texture) seldom agrees with
+// another pair's; surfaces seen by several pairs do.
+void keepConsistentDepth(std::vector<DepthView>& views, int minAgree, double tolerance) {
+    std::vector<cv::Mat> kept;
+    for (size_t i = 0; i < views.size(); ++i) {
+        const DepthView& v = views[i];
+        cv::Mat out = v.depth.clone();
+        int valid = 0;
+        for (int y = 0; y < out.rows; ++y)
+            for (int x = 0; x < out.cols; ++x) {
+                float& z = out.at<float>(y, x);
+                if (z <= 0) continue;
+                const glm::dvec3 world =
+                    v.T_world_camera * glm::dvec3((x - v.cx) / v.fx * z, (y - v.cy) / v.fy * z, z);
+                int agree = 0;
+                for (size_t j = 0; j < views.size() && agree < minAgree; ++j) {
+                    if (j == i) continue;
+                    const DepthView& w = views[j];
+                    const glm::dvec3 c = w.T_world_camera.inverse() * world;
+                    if (c.z <= 0) continue;
+                    const int u = int(std::lround(w.fx * c.x / c.z + w.cx));
+                    const int r = int(std::lround(w.fy * c.y / c.z + w.cy));
+                    if (u < 0 || r < 0 || u >= w.depth.cols || r >= w.depth.rows) continue;
+                    const float zw = w.depth.at<float>(r, u);
+                    if (zw > 0 && std::abs(zw - c.z) < tolerance + 0.02 * c.z) ++agree;
+                }
+                if (agree < minAgree)
+                    z = 0;
+                else
+                    ++valid;
+            }
+        kept.push_back(out);
+        views[i].validFraction = double(valid) / double(out.total());
+    }
+    for (size_t i = 0; i < views.size(); ++i) views[i].depth = kept[i];
 }
 
 }  // namespace
@@ -170,6 +214,7 @@ std::vector<DepthView> computeDepthViews(const Footage& footage, const StereoOpt
         if (v.validFraction > 0) views.push_back(std::move(v));
         if (progress) progress(++done, int(pairs.size()));
     }
+    if (o.minAgreeingMaps > 0) keepConsistentDepth(views, o.minAgreeingMaps, o.agreementM);
     return views;
 }
 

@@ -23,7 +23,15 @@ struct StereoOptions {
     // Depths kept (metres along the rectified optical axis).
     double minDepthM = 0.15, maxDepthM = 2.0;
     int blockSize = 5;  // SGBM matching window (pixels, odd)
-    int maxPairs = 24;  // depth maps computed (spread over the frames)
+    // SGBM's margin (percent) by which the best disparity's cost must beat the second best:
+    // lower keeps more of the plain faces, higher drops more wrong matches.
+    int uniquenessRatio = 1;
+    int smoothness = 96;  // SGBM's P2 per channel and window pixel (P1 is 8)
+    int maxPairs = 24;    // depth maps computed (spread over the frames)
+    // A depth is kept when this many other depth maps see the same point (within agreementM
+    // plus 2 % of the depth, metres); 0 keeps every match.
+    int minAgreeingMaps = 2;
+    double agreementM = 0.006;
 };
 
 // A depth map in a rectified camera: pinhole, no distortion.
