@@ -362,28 +362,7 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
     }
     // Start poses: the prediction, and RANSAC over the landmarks' point estimates.
     std::vector<Pose> starts = {predicted};
-    {
-        std::vector<cv::Point3d> obj;
-        std::vector<cv::Point2d> img;
-        for (const auto& c : corr) {
-            const auto ray = camera_.unproject(c.pixel);
-            if (!ray || ray->z <= 1e-3) continue;
-            const glm::dvec3 X =
-                c.landmark->anchor + c.landmark->direction / std::max(c.landmark->rho, 1e-3);
-            obj.emplace_back(X.x, X.y, X.z);
-            img.emplace_back(ray->x / ray->z, ray->y / ray->z);
-        }
-        cv::Mat rvec, tvec;
-        std::vector<int> inl;
-        const double f = 0.5 * (camera_.fx + camera_.fy);
-        if (obj.size() >= 6 &&
-            cv::solvePnPRansac(obj, img, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec,
-                               false, options_.ransacIterations,
-                               float(options_.ransacThresholdPx * scale_ / f), 0.99, inl,
-                               cv::SOLVEPNP_AP3P) &&
-            inl.size() >= 6)
-            starts.push_back(poseFromRvecTvec(rvec, tvec));
-    }
+    if (auto start = ransacStart(corr)) starts.push_back(*start);
     auto inliersAt = [&](const Pose& T) {
         std::vector<size_t> in;
         for (size_t i = 0; i < corr.size(); ++i)
@@ -470,31 +449,61 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
     stats_.poseMs = msSince(t0);
 
     // The same bounds as for tags, after the consistency checks.
-    const double share = double(inliers.size()) / double(corr.size());
     const double spread =
         inliers.empty() ? 0.0 : (x1 - x0) * (y1 - y0) / (double(camera_.width) * camera_.height);
+    judge(e, {inliers.size(), corr.size(), tagIds.size(), whitenedRms, spread, cov.ok,
+              report.converged() || report.stop == lm::Stop::MaxIterations});
+    return e;
+}
+
+std::optional<Pose> FeatureTracker::ransacStart(const std::vector<Correspondence>& corr) const {
+    std::vector<cv::Point3d> obj;
+    std::vector<cv::Point2d> img;
+    for (const auto& c : corr) {
+        const auto ray = camera_.unproject(c.pixel);
+        if (!ray || ray->z <= 1e-3) continue;
+        const glm::dvec3 X =
+            c.landmark->anchor + c.landmark->direction / std::max(c.landmark->rho, 1e-3);
+        obj.emplace_back(X.x, X.y, X.z);
+        img.emplace_back(ray->x / ray->z, ray->y / ray->z);
+    }
+    cv::Mat rvec, tvec;
+    std::vector<int> inl;
+    const double f = 0.5 * (camera_.fx + camera_.fy);
+    if (obj.size() >= 6 &&
+        cv::solvePnPRansac(obj, img, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec, false,
+                           options_.ransacIterations,
+                           float(options_.ransacThresholdPx * scale_ / f), 0.99, inl,
+                           cv::SOLVEPNP_AP3P) &&
+        inl.size() >= 6)
+        return poseFromRvecTvec(rvec, tvec);
+    return std::nullopt;
+}
+
+void FeatureTracker::judge(PoseEstimate& e, const FitQuality& q) const {
+    const double share = double(q.inliers) / double(std::max<size_t>(1, q.landmarks));
     const double sigmaRot = e.sigmaRotDeg(),
                  sigmaPosRel = e.sigmaPosM() / std::max(1e-6, e.distanceM);
     char buf[320];
     std::snprintf(buf, sizeof buf,
                   "features: %zu of %zu landmarks, %zu tags; whitened RMS %.2f, spread %.0f %%; "
                   "1 sigma %.3f deg, %.2f %% of the distance",
-                  inliers.size(), corr.size(), tagIds.size(), whitenedRms, 100 * spread, sigmaRot,
+                  q.inliers, q.landmarks, q.tags, q.whitenedRms, 100 * q.spread, sigmaRot,
                   100 * sigmaPosRel);
     e.reason = buf;
-    const bool enoughFeatures = int(inliers.size()) >= options_.minInliers &&
+    const bool enoughFeatures = int(q.inliers) >= options_.minInliers &&
                                 share >= options_.minInlierFraction &&
-                                spread >= options_.minSpreadFraction;
+                                q.spread >= options_.minSpreadFraction;
     // Tags alone may carry the pose (board+features) when the landmarks add too little.
-    const bool enough = enoughFeatures || (tagIds.size() >= 1 && inliers.size() >= 6 &&
-                                           share >= options_.minInlierFraction);
-    if (!cov.ok || (!report.converged() && report.stop != lm::Stop::MaxIterations)) {
+    const bool enough =
+        enoughFeatures || (q.tags >= 1 && q.inliers >= 6 && share >= options_.minInlierFraction);
+    if (!q.covarianceOk || !q.converged) {
         e.state = TrackingState::Lost;
         e.reason += "; the fit did not converge";
     } else if (!enough) {
         e.state = TrackingState::Uncertain;
         e.reason += "; too few or too clustered inliers";
-    } else if (whitenedRms > options_.maxWhitenedRms) {
+    } else if (q.whitenedRms > options_.maxWhitenedRms) {
         e.state = TrackingState::Uncertain;
         e.reason += "; residuals larger than the noise model";
     } else if (sigmaRot > bounds_.okMaxSigmaRotDeg || sigmaPosRel > bounds_.okMaxSigmaPosFraction) {
@@ -503,7 +512,6 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
     } else {
         e.state = TrackingState::Ok;
     }
-    return e;
 }
 
 }  // namespace mirage::tracking

@@ -116,6 +116,17 @@ private:
     };
     struct Correspondence;
     std::vector<Correspondence> correspondences(const Pose& at) const;
+    // A start pose from PnP + RANSAC over the landmarks' point estimates (none: too few agree).
+    std::optional<Pose> ransacStart(const std::vector<Correspondence>& corr) const;
+    // What the pose fit found, for the ok/uncertain/lost decision.
+    struct FitQuality {
+        size_t inliers = 0, landmarks = 0, tags = 0;
+        double whitenedRms = 0;
+        double spread = 0;  // the inliers' image box as a share of the image
+        bool covarianceOk = false, converged = false;
+    };
+    // Sets e.state and e.reason: the same bounds as for tags, after the consistency checks.
+    void judge(PoseEstimate& e, const FitQuality& q) const;
     void detect(const cv::Mat& grey, const PoseEstimate& pose, bool derived,
                 const cv::Rect& boardPixels);
 
