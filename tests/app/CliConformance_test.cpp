@@ -77,7 +77,7 @@ bool isNumeric(const CliOption& o) {
     return t == "INT" || t == "UINT" || t == "FLOAT" || t == "NUMBER";
 }
 
-struct Run {
+struct RunResult {
     int exitCode = -1;  // -1: killed by a signal or timed out
     bool timedOut = false;
     std::string output;
@@ -115,7 +115,7 @@ private:
 };
 
 // Runs mirage with a time limit (seconds); stdout and stderr go to `log`.
-Run runLimited(const std::vector<std::string>& args, double seconds, const fs::path& log) {
+RunResult runLimited(const std::vector<std::string>& args, double seconds, const fs::path& log) {
     std::vector<std::string> all = {MIRAGE_BINARY};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -127,7 +127,7 @@ Run runLimited(const std::vector<std::string>& args, double seconds, const fs::p
     posix_spawn_file_actions_adddup2(&fa, 1, 2);
     posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
     pid_t pid = -1;
-    Run r;
+    RunResult r;
     if (posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ) != 0) return r;
     posix_spawn_file_actions_destroy(&fa);
     const auto start = std::chrono::steady_clock::now();
@@ -342,10 +342,11 @@ TEST_F(CliConformance, EveryNumericOptionUsesTheNumberCheck) {
     const auto options = listOptions();
     ASSERT_GT(options.size(), 50u);
     for (const CliOption& o : options)
-        if (isNumeric(o))
+        if (isNumeric(o)) {
             EXPECT_NE(o.validators.find("number-range"), std::string::npos)
                 << "mirage " << o.command << " " << o.name << " (" << o.type
                 << ") has no range check (app/NumberChecks.h)";
+        }
 }
 
 TEST_F(CliConformance, EveryCommandHasABaseInvocation) {
@@ -358,7 +359,7 @@ TEST_F(CliConformance, EveryCommandHasABaseInvocation) {
 TEST_F(CliConformance, BaseInvocationsSucceed) {
     for (const auto& [command, base] : bases(outputDir("cli_conformance_base"))) {
         const fs::path log = outputDir("cli_conformance_base_log") / "log.txt";
-        const Run r = runLimited(assemble(base, listOptions(), command, "", {}), 60, log);
+        const RunResult r = runLimited(assemble(base, listOptions(), command, "", {}), 60, log);
         EXPECT_FALSE(r.timedOut) << command;
         EXPECT_EQ(r.exitCode, 0) << command << "\n" << r.output;
     }
@@ -380,7 +381,7 @@ TEST_F(CliConformance, NumbersAreRefusedOrMeaningful) {
                     if (n == probe.at(o.command).option) v = probe.at(o.command).value;
             }
             const auto args = assemble(base, options, o.command, o.name, values);
-            const Run r = runLimited(args, 60, out.parent_path() / "cli_conformance_num.log");
+            const RunResult r = runLimited(args, 60, out.parent_path() / "cli_conformance_num.log");
             const std::string what = "mirage " + o.command + " " + o.name + " " + value;
             const bool reachedProbe =
                 probed && r.output.find(probe.at(o.command).marker) != std::string::npos;
@@ -421,14 +422,15 @@ TEST_F(CliConformance, PathsAreRefusedOrMeaningful) {
             const fs::path out = outputDir("cli_conformance_path_run");
             const auto args =
                 assemble(bases(out).at(o.command), options, o.command, o.name, {value.string()});
-            const Run r = runLimited(args, 60, dir / "run.log");
+            const RunResult r = runLimited(args, 60, dir / "run.log");
             const std::string what = "mirage " + o.command + " " + o.name + " " + value.string();
             ASSERT_FALSE(r.timedOut) << what << ": still running after 60 s\n" << r.output;
             EXPECT_TRUE(r.exitCode == 0 || r.exitCode == 1)
                 << what << " exit " << r.exitCode << "\n"
                 << r.output;
-            if (r.exitCode == 1)
+            if (r.exitCode == 1) {
                 EXPECT_NE(r.output.find("rror"), std::string::npos) << what << "\n" << r.output;
+            }
             ASSERT_EQ(special.damage(), "") << what << "\n" << r.output;
         }
     }
