@@ -218,7 +218,7 @@ TEST(OutputFile, TemporariesOfADeadProcessAreRemovedByTheNextWriter) {
     const std::string stale = "image.partial-" + std::to_string(pid) + ".png";
     writeText(dir / stale, "left by kill -9");
     writeText(dir / "image.partial-1.png", "pid 1 runs: not ours to remove");
-    writeText(dir / "other.partial-" + std::to_string(pid) + ".png", "another output's");
+    writeText(dir / ("other.partial-" + std::to_string(pid) + ".png"), "another output's");
     OutputFile f(dir / "image.png", OutputOrigin::Named, OutputRule{});
     EXPECT_FALSE(fs::exists(dir / stale));
     EXPECT_TRUE(fs::exists(dir / "image.partial-1.png"));

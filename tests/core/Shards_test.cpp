@@ -2,6 +2,8 @@
 // shards is one whole run (core/Shards.h).
 #include "core/Shards.h"
 
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "core/Error.h"
