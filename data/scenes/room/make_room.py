@@ -181,6 +181,11 @@ def main():
         path = os.path.join(HERE, name)
         if not os.path.exists(path) or "--force" in sys.argv:
             write_png(path, size, size, fn(size, rng))
+    # The tabletop's board texture and environment image, copied beside the scene: a scene may
+    # name only files inside its own folder (docs/scene.md).
+    import shutil
+    for name in ("board.png", "env.pfm"):
+        shutil.copyfile(os.path.join(TABLETOP, name), os.path.join(HERE, name))
 
     import json
     with open(os.path.join(TABLETOP, "board.json")) as f:
@@ -190,7 +195,7 @@ def main():
     b = tt.Builder()
     b.gltf["asset"]["generator"] = "mirage data/scenes/room/make_room.py"
     b.gltf["scenes"][0]["name"] = "room"
-    board_tex = b.texture("../tabletop/board.png")
+    board_tex = b.texture("board.png")
     wood_tex, floor_tex, wall_tex = b.texture("wood.png"), b.texture("floor.png"), b.texture("wall.png")
     for t in (wood_tex, floor_tex, wall_tex):  # repeat (the board texture stays clamped)
         b.gltf["samplers"][b.gltf["textures"][t]["sampler"]].update({"wrapS": 10497, "wrapT": 10497})
@@ -247,7 +252,7 @@ def main():
     b.node("main", True, camera=b.camera("main", 45.0), translation=eye,
            rotation=tt.look_at_rotation(eye, [0, 0, 0]))
     b.gltf["scenes"][0]["extras"] = {"mirage": {"environment": {
-        "type": "equirectangular", "image": "../tabletop/env.pfm", "intensity": 1.0, "rotation_y_deg": 0}}}
+        "type": "equirectangular", "image": "env.pfm", "intensity": 1.0, "rotation_y_deg": 0}}}
     b.write(os.path.join(HERE, "room.gltf"), "room.bin")
 
 
