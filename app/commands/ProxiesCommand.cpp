@@ -17,6 +17,8 @@
 #include "app/BoardPlane.h"
 #include "app/Command.h"
 #include "app/InputChecks.h"
+#include "app/NumberChecks.h"
+#include "app/PathChecks.h"
 #include "app/commands/TerminalProgress.h"
 #include "core/Error.h"
 #include "core/Log.h"
@@ -273,21 +275,31 @@ const CommandRegistrar registrar("proxies", [](CLI::App& parent) {
         "proxies", "Rebuild the real proxies and lights of a session's footage as a scene");
     cmd->add_option("session", a->session, "Session folder (tracked main camera, board)")
         ->required();
-    cmd->add_option("--scene", a->scene, "Scene (.gltf) whose virtual objects to keep")->required();
-    cmd->add_option("-o,--output", a->output, "Scene to write (.gltf)")->required();
-    cmd->add_option("--poses", a->poses, "Camera poses (mirage track's CSV) instead of tracking");
+    cmd->add_option("--scene", a->scene, "Scene (.gltf) whose virtual objects to keep")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", a->output, "Scene to write (.gltf)")
+        ->required()
+        ->check(outputPath(OutputShape::File));
+    cmd->add_option("--poses", a->poses, "Camera poses (mirage track's CSV) instead of tracking")
+        ->check(CLI::ExistingFile);
     cmd->add_flag("--ground-truth", a->groundTruth, "Use the session's ground-truth poses");
-    cmd->add_option("--max-frames", a->maxFrames, "Use at most this many frames");
+    cmd->add_option("--max-frames", a->maxFrames, "Use at most this many frames (-1: all)")
+        ->check(wholeIn(-1, 100000000));
     cmd->add_option("--min-frames", a->minFrames, "Tracked frames needed")
-        ->check(CLI::PositiveNumber);
+        ->capture_default_str()
+        ->check(wholeIn(1, 100000));
     cmd->add_option("--min-parallax", a->minParallaxDeg,
                     "Camera positions must span this angle seen from the board (degrees)")
-        ->check(CLI::NonNegativeNumber);
+        ->capture_default_str()
+        ->check(finiteIn(0, 180));
     cmd->add_option("--triangles", a->triangleBudget, "Triangle budget per object")
-        ->check(CLI::Range(12, 1000000));
+        ->capture_default_str()
+        ->check(wholeIn(12, 1000000));
     cmd->add_option("--truth", a->truth,
                     "The scene a synthetic session was made from: compare the rebuilt scene "
-                    "with it (report and console)");
+                    "with it (report and console)")
+        ->check(CLI::ExistingFile);
     cmd->add_flag("--force", a->force, "Overwrite an existing output");
     cmd->callback([a] { runProxies(*a); });
 });
