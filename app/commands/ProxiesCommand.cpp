@@ -231,6 +231,10 @@ void runProxies(const ProxiesArgs& a) {
         throw FileError(a.output, "the output must be a .gltf file (JSON, editable by hand)");
     checkOutput(out, OutputOrigin::Named, rule, /*outIsFolder=*/false);
     createParentFolders(out);
+    // The report beside the scene, checked before any work and written under a temporary name.
+    fs::path reportPath = out;
+    reportPath.replace_extension(".report.json");
+    OutputFile reportOut(reportPath, OutputOrigin::Derived, rule);
 
     const CameraCalibration calib = loadCalibration(session.path(main->calibration));
     const tracking::Board board = tracking::Board::load(session.path(session.board));
@@ -262,9 +266,12 @@ void runProxies(const ProxiesArgs& a) {
     report["dropped_real_nodes"] = written.droppedNodes;
     std::fputs(rc::reconstructionSummary(r).c_str(), stdout);
     if (!a.truth.empty()) report["truth"] = compareWithTruth(a.truth, out, r);
-    fs::path reportPath = out;
-    reportPath.replace_extension(".report.json");
-    std::ofstream(reportPath) << report.dump(2) << "\n";
+    {
+        std::ofstream file(reportOut.temp());
+        file << report.dump(2) << "\n";
+        if (!file.flush()) throw FileError(reportPath.string(), "cannot write the report");
+    }
+    reportOut.commit();
     spdlog::info("proxies: wrote {} ({} real node(s) of {} replaced) and {}", out.string(),
                  written.droppedNodes, a.scene, reportPath.string());
 }
