@@ -353,13 +353,16 @@ TEST(BadCommandLine, InterruptedSynthLeavesNothingAndTheRerunWorks) {
     const std::vector<std::string> args = {"synth",    scene(),    "-o", out.string(), "--width",
                                            "32",       "--height", "24", "--spp",      "1",
                                            "--no-env", "--fps",    "4"};
+    // An hour of footage (14,400 frames): minutes of work even on a fast machine, so the signal
+    // always arrives mid-run (60 s, 240 frames, finished within the 0.5 s wait on CI).
     auto longRun = args;
-    longRun.insert(longRun.end(), {"--seconds", "60"});
+    longRun.insert(longRun.end(), {"--seconds", "3600"});
     const pid_t pid = spawnMirage(longRun, dir / "log.txt");
     ASSERT_TRUE(waitFor([&] { return !partials(dir).empty(); }, 60)) << slurp(dir / "log.txt");
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    ::kill(pid, SIGINT);
     int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, WNOHANG), 0) << "synth ended before the signal was sent";
+    ::kill(pid, SIGINT);
     ASSERT_EQ(::waitpid(pid, &status, 0), pid);
     EXPECT_FALSE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
     EXPECT_EQ(partials(dir), std::vector<std::string>{}) << "a partial folder was left";
