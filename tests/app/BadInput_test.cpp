@@ -499,7 +499,7 @@ TEST(BadInput, StoppedSynthLeavesNoHalfSessionInTheWay) {
                                            "64",       "--height", "48", "--spp",      "1",
                                            "--no-env", "--fps",    "4"};
     auto longRun = args;
-    longRun.insert(longRun.end(), {"--seconds", "30"});
+    longRun.insert(longRun.end(), {"--seconds", "3600"});  // never done before the signal
     const pid_t pid = spawnMirage(longRun, dir / "log.txt");
     // Wait until frames are being written (into a temporary folder beside OUT), then stop it.
     bool writing = false;
