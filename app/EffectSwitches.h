@@ -16,22 +16,27 @@
 namespace mirage::app {
 
 struct EffectSwitch {
-    const char* name;   // as the bench knob
-    const char* label;  // as the HUD shows it
-    bool render::RendererOptions::*member;
+    const char* name;                         // as the bench knob
+    const char* label;                        // as the HUD shows it
+    bool& (*flag)(render::RendererOptions&);  // the option that switches it, in its pass's struct
 };
 
 inline constexpr EffectSwitch kEffectSwitches[] = {
-    {"caustics", "caustics", &render::RendererOptions::caustics},
-    {"caustic_temporal", "caustic smoothing", &render::RendererOptions::causticTemporal},
+    {"caustics", "caustics", [](render::RendererOptions& o) -> bool& { return o.caustic.enabled; }},
+    {"caustic_temporal", "caustic smoothing",
+     [](render::RendererOptions& o) -> bool& { return o.caustic.temporal; }},
     {"specular_temporal", "mirror/glass light smoothing",
-     &render::RendererOptions::specularTemporal},
-    {"glass_shadows", "shadows through glass", &render::RendererOptions::glassShadows},
+     [](render::RendererOptions& o) -> bool& { return o.specular.temporal; }},
+    {"glass_shadows", "shadows through glass",
+     [](render::RendererOptions& o) -> bool& { return o.shadow.glass; }},
     {"refl_refr_vpls", "VPLs through mirror/glass",
-     &render::RendererOptions::reflectedRefractedVpls},
-    {"specular_vpls", "VPLs in reflections", &render::RendererOptions::specularVpls},
-    {"fuzzy", "fuzzy reflections", &render::RendererOptions::fuzzyReflections},
-    {"translucency", "translucency", &render::RendererOptions::translucency},
+     [](render::RendererOptions& o) -> bool& { return o.vpl.throughSpecular; }},
+    {"specular_vpls", "VPLs in reflections",
+     [](render::RendererOptions& o) -> bool& { return o.specular.vpls; }},
+    {"fuzzy", "fuzzy reflections",
+     [](render::RendererOptions& o) -> bool& { return o.fuzzy.enabled; }},
+    {"translucency", "translucency",
+     [](render::RendererOptions& o) -> bool& { return o.translucency.enabled; }},
 };
 
 inline std::string effectSwitchNames() {
@@ -66,7 +71,7 @@ inline void switchEffectsOff(const std::vector<std::string>& names,
         if (!e)
             throw Error(fmt::format("--off: '{}' is not an effect; the effects are: {}", n,
                                     effectSwitchNames()));
-        options.*e->member = false;
+        e->flag(options) = false;
     }
 }
 

@@ -9,79 +9,23 @@
 namespace mirage::render {
 
 void RendererOptions::validate() const {
-    auto fail = [](const std::string& what) { throw Error("renderer option " + what); };
-    if (vplCount < 0 || vplCount > 16384)
-        fail("vplCount is " + std::to_string(vplCount) + ", out of range (0..16384)");
-    if (vnmResolution < 2 || vnmResolution > 512)
-        fail("vnmResolution must be 2..512, got " + std::to_string(vnmResolution));
-    if (interleave < 1 || interleave > 8)
-        fail("interleave must be 1..8, got " + std::to_string(interleave));
-    if (indirectScale < 0 || indirectScale > 4)
-        fail("indirectScale must be 0 (automatic) or 1..4, got " + std::to_string(indirectScale));
-    if (shadowMapSize < 16 || shadowMapSize > 4096)
-        fail("shadowMapSize must be 16..4096, got " + std::to_string(shadowMapSize));
-    if (ismTileSize < 8 || ismTileSize > 256)
-        fail("ismTileSize must be 8..256, got " + std::to_string(ismTileSize));
-    if (refractionMarchSteps < 2 || refractionMarchSteps > 128)
-        fail("refractionMarchSteps must be 2..128, got " + std::to_string(refractionMarchSteps));
-    if (specularVplStride != 1 && specularVplStride != 4 && specularVplStride != 16)
-        fail("specularVplStride must be 1, 4 or 16, got " + std::to_string(specularVplStride));
-    if (!(backProjectionEpsilon > 0.0f) || backProjectionEpsilon > 1.0f)
-        fail("backProjectionEpsilon must be in (0, 1] (relative depth tolerance)");
-    if (impostorResolution < 8 || impostorResolution > 2048)
-        fail("impostorResolution must be 8..2048 texels, got " +
-             std::to_string(impostorResolution));
-    if (!(shadowBias >= 0.0f && shadowBias <= 1.0f))
-        fail("shadowBias must be in [0, 1] metres, got " + std::to_string(shadowBias));
-    if (!(temporalBlend >= 0.0f && temporalBlend <= 0.98f))
-        fail("temporalBlend must be in [0, 0.98] (the history's weight), got " +
-             std::to_string(temporalBlend));
-    if (causticMapSize < 16 || causticMapSize > 2048 || causticMapSize % 8 != 0)
-        fail("causticMapSize must be a multiple of 8 in 16..2048 texels, got " +
-             std::to_string(causticMapSize));
-    if (!(causticQuadScale >= 0.25f && causticQuadScale <= 8.0f))
-        fail("causticQuadScale must be in [0.25, 8] (photon spacings), got " +
-             std::to_string(causticQuadScale));
-    if (!(causticGatherRadius >= 0.001f && causticGatherRadius <= 0.5f))
-        fail("causticGatherRadius must be in [0.001, 0.5] (metres), got " +
-             std::to_string(causticGatherRadius));
-    if (causticGatherCap < 0 || causticGatherCap > (1 << 20))
-        fail("causticGatherCap must be 0 (all photons) or 1..1048576 photons per bucket, got " +
-             std::to_string(causticGatherCap));
-    if (impostorRefineSteps < 0 || impostorRefineSteps > 64)
-        fail("impostorRefineSteps must be 0..64, got " + std::to_string(impostorRefineSteps));
-    if (!(fuzzyConeDeg > 0.0f && fuzzyConeDeg <= 60.0f))
-        fail("fuzzyConeDeg must be in (0, 60] degrees (the fuzzy-reflection cone bound), got " +
-             std::to_string(fuzzyConeDeg));
-    if (fuzzyTaps < 1 || fuzzyTaps > 64)
-        fail("fuzzyTaps must be 1..64 taps per side, got " + std::to_string(fuzzyTaps));
-    if (gsrSubdivisions < 1 || gsrSubdivisions > 8)
-        fail("gsrSubdivisions must be 1..8 hemisphere sectors, got " +
-             std::to_string(gsrSubdivisions));
-    if (roughMipLevels < 1 || roughMipLevels > 12)
-        fail("roughMipLevels must be 1..12 mip levels, got " + std::to_string(roughMipLevels));
-    if (environmentMapWidth < 16 || environmentMapWidth > 4096 || environmentMapWidth % 2 != 0)
-        fail("environmentMapWidth must be even, 16..4096 texels, got " +
-             std::to_string(environmentMapWidth));
-    if (environmentLights < 0 || environmentLights > kMaxLights)
-        fail("environmentLights must be 0.." + std::to_string(kMaxLights) + ", got " +
-             std::to_string(environmentLights));
-    if (environmentLightMapWidth < 16 || environmentLightMapWidth > 2048 ||
-        environmentLightMapWidth % 2 != 0)
-        fail("environmentLightMapWidth must be even, 16..2048 texels, got " +
-             std::to_string(environmentLightMapWidth));
-}
-
-const char* roughRefractionMethodName(RoughRefractionMethod m) {
-    switch (m) {
-        case RoughRefractionMethod::Filter:
-            return "filter";
-        case RoughRefractionMethod::Lean:
-            return "lean";
-        case RoughRefractionMethod::Gsr:
-            return "gsr";
-    }
-    return "?";
+    vpl.validate();
+    indirect.validate();
+    ism.validate();
+    shadow.validate();
+    direct.validate();
+    caustic.validate();
+    specular.validate();
+    fuzzy.validate();
+    rough.validate();
+    impostor.validate();
+    environment.validate();
+    translucency.validate();
+    composite.validate();
+    checkOption(temporalBlend >= 0.0f && temporalBlend <= 0.98f, "temporalBlend",
+                "in [0, 0.98] (the history's weight)", temporalBlend);
+    checkOption(clip.nearM > 0.0f && clip.farM > clip.nearM, "clip", "0 < nearM < farM (metres)",
+                clip.farM);
 }
 
 int ismTilesPerRow(int vplCount) {

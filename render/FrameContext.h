@@ -16,16 +16,27 @@
 #include "render/GpuScene.h"
 #include "render/GpuTypes.h"
 #include "render/Resource.h"
+#include "render/passes/caustic/CausticOptions.h"
+#include "render/passes/composite/CompositeOptions.h"
+#include "render/passes/direct/DirectOptions.h"
+#include "render/passes/environment/EnvironmentOptions.h"
+#include "render/passes/fuzzy/FuzzyOptions.h"
+#include "render/passes/impostor/ImpostorOptions.h"
+#include "render/passes/indirect/IndirectOptions.h"
+#include "render/passes/ism/IsmOptions.h"
+#include "render/passes/rough/RoughOptions.h"
+#include "render/passes/shadow/ShadowOptions.h"
+#include "render/passes/specular/SpecularOptions.h"
+#include "render/passes/translucency/TranslucencyOptions.h"
+#include "render/passes/vpl/VplOptions.h"
 
 namespace mirage::render {
 
-// How rough glass blurs what is seen through it (docs/specular.md, "Rough refraction").
-enum class RoughRefractionMethod {
-    Filter,  // the fuzzy pass's image-space filter with the transmitted lobe (render/passes/fuzzy)
-    Lean,    // LEAN-mapped back-face normals, one Gaussian lobe per pixel (render/passes/rough)
-    Gsr,     // the same with the back NDF reduced to one Gaussian per hemisphere subdivision
+// The camera's clip planes, metres from the camera.
+struct ClipRange {
+    float nearM = 0.01f;
+    float farM = 100.0f;
 };
-const char* roughRefractionMethodName(RoughRefractionMethod m);  // "filter", "lean", "gsr"
 
 // The rectangles (GL window x, y, width, height) that draws into a set of textures last covered.
 // Clearing those and the next draw's rectangles before that draw keeps the textures at their
@@ -38,124 +49,29 @@ struct DrawnRects {
     std::vector<glm::ivec4> rects;
 };
 
+// Every pass's options, one member per pass folder that has any (each struct, its defaults and its
+// validation live in that folder), plus the few that steer the whole frame.
 struct RendererOptions {
-    int vplCount = 256;          // total VPLs per frame, split over the lights with RSMs
-    int shadowMapSize = 512;     // texels per side of each shadow / RSM layer
-    int ismTileSize = 64;        // texels per side of one VPL's imperfect shadow map
-    int ismPointsPerVpl = 1024;  // surface points splatted into each VPL's ISM
-    int interleave = 4;          // K: each pixel gathers vplCount / K^2 VPLs
-    // VPL gather at 1/scale resolution per axis, 1..4, upsampled by the geometry-aware filter; 0:
-    // automatic, gatherScale(): a gather pixel every ~1/160 of the canvas width whatever the
-    // resolution, so that the indirect light keeps its detail relative to the image.
-    int indirectScale = 0;
-    float vplDistanceClamp = 0.1f;  // metres: VPL distance below this is clamped (no spikes)
-    float shadowBias = 0.001f;      // metres: constant depth bias of the shadow-map test
-                                    // (lighting.glsl adds 1.5 texels' footprint / cos)
+    VplOptions vpl;
+    IndirectOptions indirect;
+    IsmOptions ism;
+    ShadowOptions shadow;
+    DirectOptions direct;
+    CausticOptions caustic;
+    SpecularOptions specular;
+    FuzzyOptions fuzzy;
+    RoughOptions rough;
+    ImpostorOptions impostor;
+    EnvironmentOptions environment;
+    TranslucencyOptions translucency;
+    CompositeOptions composite;
+
     // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
-    // and where switched on below the caustic buffer and the specular-hit light L'. Each frame
-    // keeps (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend)
-    // frames. 0 .. 0.98.
+    // and where switched on the caustic buffer and the specular-hit light L'. Each frame keeps
+    // (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend) frames.
+    // 0 .. 0.98.
     float temporalBlend = 0.8f;
-    float exposure = 1.0f;               // rendered linear radiance -> camera linear units
-    float alphaMax = 8.0f;               // cap of alpha = CI / L_r
-    float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
-    float nearM = 0.01f, farM = 100.0f;  // camera clip planes (metres)
-    // Specular objects (docs/specular.md).
-    int refractionMarchSteps = 16;        // back-face depth march steps of the refracted ray
-    float backProjectionEpsilon = 0.02f;  // depth validation: |d - d_gbuf| < eps * d + 0.005 m
-    bool specularVpls = true;             // light GBuf_refl / GBuf_refr hits with the VPLs too
-    // A VPL whose reflective-shadow-map sample lands on a mirror or glass continues to the
-    // reflected or refracted photon's receiver (Knecht 2013 Sec. 5.2), for spot lights with
-    // photon G-buffers (caustics on); false: it stays on the mirror / glass, which scatters no
-    // diffuse light (the VPL is dark).
-    bool reflectedRefractedVpls = true;
-    // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
-    // false: glass is an opaque occluder, as mirrors are.
-    bool glassShadows = true;
-    // Caustics from spot lights (Knecht 2013 Sec. 4.2, 5.2; docs/caustics.md): photon G-buffers
-    // of causticMapSize^2 texels per spot light whose cone holds a mirror or glass object (the
-    // frustum fitted to the objects' bounding sphere), splatted as quads whose world radius is
-    // causticQuadScale x the spacing of neighbouring photons on the receiver (Wyman 2008).
-    bool caustics = true;
-    int causticMapSize = 256;
-    float causticQuadScale = 1.5f;
-    // Caustics seen in reflections and refractions (docs/caustics.md): the photons sorted into a
-    // world-space hashed grid (render/passes/caustic PhotonGridPass) and gathered at every
-    // reflected / refracted hit by the specular light pass, with each photon's kernel radius
-    // (causticQuadScale photon spacings, widened to 1.5 of the hit's pixel footprints) at most
-    // causticGatherRadius metres, or up to twice that where the pixels are coarser (the grid's
-    // cells are twice it: the gather's cost grows with it). false: those hits get no caustic.
-    bool causticGather = true;
-    float causticGatherRadius = 0.01f;
-    // Photons the gather reads per grid bucket (0: all). A focused caustic puts tens of thousands
-    // of photons into one cell, and every hit near it would read them all (a glass sphere alone
-    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read with a
-    // stride (every s-th photon from a per-pixel offset) and what is read is weighted
-    // by count / read, so the estimate keeps its expectation and gains noise only where photons
-    // are dense. Off by default: which photons a stride reads depends on the order the grid's
-    // scatter put them in, which atomics on a multithreaded rasteriser (llvmpipe) vary from run to
-    // run, so a capped frame is not reproducible (measured: up to 0.4 % of the peak between two
-    // renderers of the same frame); replays and sharded runs are expected to be.
-    int causticGatherCap = 0;
-    // Temporal smoothing of the caustic buffer (Knecht 2013 end of Sec. 4.2; render/passes/caustic
-    // caustic_resolve.frag): this frame's caustic irradiance blended with last frame's,
-    // reprojected by the receiver's world position and rejected where the surface there is at
-    // another distance, with the GI filter's reset rules (render/TemporalHistory.h). A tracked
-    // camera jitters every frame, which moves the photon footprints over the pixels: without it
-    // the caustic shimmers. false: every frame's caustic stands alone.
-    bool causticTemporal = true;
-    // The same for the light of the reflected / refracted hits, L'_rv and L'_r (gathered caustic
-    // included; render/passes/specular specular_light.frag), reprojected by the mirror / glass
-    // surface's position and rejected also where either ray's hit distance changed (a
-    // reflection's hit moves differently from the mirror under camera motion).
-    bool specularTemporal = true;
-    // Fuzzy reflections of rough metals (render/passes/fuzzy, docs/specular.md): the image-space
-    // filter (Kulikova and Dmitriev, Eqs. 1-5) over the mirror-ray buffers. fuzzyConeDeg is the
-    // cone bound Theta (degrees) that limits each pixel's kernel (Eq. 4); fuzzyTaps the taps per
-    // side of each separable pass (a wider kernel is sampled with a stride). false: the rough
-    // metal's reflection stays sharp (its roughness ignored; for comparison).
-    bool fuzzyReflections = true;
-    float fuzzyConeDeg = 20.0f;
-    int fuzzyTaps = 12;
-    // Rough glass (render/passes/rough, docs/specular.md): which method blurs the refraction;
-    // gsrSubdivisions = the hemisphere sectors of the Gaussian sum reduction (1..8);
-    // roughMipLevels = levels of the LEAN moment chains and of the prefiltered lookups (camera
-    // image, rough-glass radiance; 1..12): a lobe wider than the last level is cut there.
-    RoughRefractionMethod roughRefraction = RoughRefractionMethod::Lean;
-    int gsrSubdivisions = 4;
-    int roughMipLevels = 8;
-    // 1, 4 or 16: each hit sums every stride-th VPL (x stride), interleaved over 2x2 / 4x4
-    // pixels; each hit's VPL irradiance is then averaged over its 2x2 quad (specular_light.frag),
-    // so a quad sums 4 subsets. 16 costs about half of 4's speclight time; the quad average keeps
-    // its pattern weak enough for the specular tests' SSIM floors (docs/specular.md, "Cost").
-    int specularVplStride = 16;
-    // Specular lighting (speclight) at half the canvas resolution per axis: each 2x2 block's
-    // first specular pixel is shaded (lights, VPLs, caustic photons at its hits) and the canvas
-    // pixels take the hit radiance from the four half pixels around them, weighted by how well
-    // the representatives' hits match theirs (same object, tangent plane, normal), multiplied
-    // back by their own hit albedo, Fresnel weight and emission; L_env stays per pixel
-    // (specular_resolve.frag, docs/specular.md "Cost"). false: every specular pixel is shaded.
-    bool specularHalfResolution = false;
-    // Tests only: false drops the upsample's geometry test (plain bilinear weights; halos at
-    // depth steps in the reflections).
-    bool specularUpsampleGeometry = true;
-    // Tests only: false draws the specular passes over the one rectangle around every specular
-    // object (FrameContext::specularScissor) instead of each object's own (the same images).
-    bool specularRectsPerObject = true;
-    // false (the default): `direct` (with the GI upsample) and the composite's diffuse variant skip
-    // the pixels that show a mirror or glass object (their light comes from the specular passes;
-    // FrameContext::drawFullscreenTriangleOutsideSpecular). true: they shade them too (tests
-    // compare the two).
-    bool diffuseOnSpecularPixels = false;
-    // Where the lens remap is the identity (no distortion, a canvas of the camera's size) the
-    // composite reads each canvas buffer at its own pixel (CompositePass::isIdentityRemap).
-    // false: it reads through the remap table there too (tests compare the two).
-    bool compositeIdentityRemap = true;
-    // true: in frames with VPL light the direct-light pass also writes the direct light alone
-    // (DirectRv / DirectR; two more canvas targets), besides the GI solutions LRv / LR it sums
-    // with the upsampled indirect light. false (the default): DirectRv / DirectR exist only in
-    // frames without VPL light, where they are LRv / LR.
-    bool keepDirectLight = false;
+    ClipRange clip;  // the camera's near and far planes
     // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
     // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
     bool reuseStaticPasses = true;
@@ -165,50 +81,10 @@ struct RendererOptions {
     // a readback), so without this a pass's time can show up in the next pass's timer query, and
     // its queries miss compute dispatches. For benchmarks.
     bool syncPasses = false;
-    // false: the composite is the footage unchanged, as if no virtual object existed (the live
-    // view's "hide" key; the bench's `virtual=off` sanity point, which must score as the footage).
-    bool showVirtual = true;
-
-    // Reflected-scene impostors for specular objects (render/passes/impostor).
-    int impostorResolution = 256;  // texels per side of each impostor and cube face
-    // Secant refinement steps of the height-field search. 2: the first step removes most of the
-    // hit error (docs/impostors.md) and the composite is within 0.01 dB of 4 or 8 steps.
-    int impostorRefineSteps = 2;
-    bool impostorCubeMapBaseline = false;  // true: plain G-buffer cube map, looked up by direction
-
-    // Live environment (render/passes/environment, docs/environment.md): width of the
-    // equirectangular map built from each environment-camera frame (height = width / 2).
-    int environmentMapWidth = 512;
-    // The real light, placed (docs/environment.md, "Light estimation"): at most this many of the
-    // dominant lights found in each live environment frame become shadow-casting REAL
-    // directional lights, and the diffuse environment light is projected from the map without
-    // them (render/EnvironmentLights.h). 0: none (the environment's SH9 holds all its light).
-    // The scene's lights plus these are at most kMaxLights.
-    int environmentLights = 0;
-    // Width of the map the lights are found on (CPU, height = width / 2).
-    int environmentLightMapWidth = 256;
-
-    // Translucent objects (render/passes/translucency, docs/translucency.md): a voxel number
-    // map per translucent object (up to 8), vnmResolution voxels along its longest side (the tau
-    // LUT grows with the square of the surface voxels, ~36 n^4 bytes for a cube), its LUT cached
-    // in vnmCacheDir (empty: precomputed every time a renderer is created). false: translucent
-    // objects are drawn as opaque surfaces of their base colour.
-    bool translucency = true;
-    // A translucent object lets light through in the shadow maps (Fresnel at each crossing, its
-    // optical thickness along the light's ray; docs/translucency.md "Shadows"); false: it is an
-    // opaque occluder.
-    bool translucentShadows = true;
-    int vnmResolution = 16;
-    std::string vnmCacheDir;
 
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.
     void validate() const;
-    // The gather scale for a canvas this wide: indirectScale, or when 0 width / 160 in 1..4
-    // (4 at 640x480, 2 at 320x240, 1 at 160x120).
-    int gatherScale(int canvasWidth) const {
-        return indirectScale > 0 ? indirectScale : std::clamp(canvasWidth / 160, 1, 4);
-    }
 };
 
 // Tiles per row of the imperfect shadow map atlas (one square tile per VPL).
@@ -224,7 +100,7 @@ struct EnvironmentInput {
     double reachDeg = -1.0;   // the calibration's reach off-axis (<= 0: whole projectable field)
     Pose T_world_camera;      // the camera's pose (OpenCV axes) when the frame was taken
     glm::vec3 gain{1.0f};     // linearised pixel value -> scene radiance, per channel (R, G, B)
-    // Lights placed from this frame (RendererOptions::environmentLights): the diffuse light is
+    // Lights placed from this frame (RendererOptions::environment.lights): the diffuse light is
     // then the SH9 of the map without them, computed on the CPU (render/EnvironmentLights.h),
     // instead of the projection of the map on the GPU.
     bool lightFreeSHValid = false;
@@ -317,7 +193,7 @@ public:
     const gl::Texture& noGlassTexture() const { return noGlass_; }
 
     int canvasWidth() const { return projection.canvasWidth; }
-    int gatherScale() const { return options.gatherScale(canvasWidth()); }
+    int gatherScale() const { return options.indirect.gatherScale(canvasWidth()); }
     int canvasHeight() const { return projection.canvasHeight; }
     void bindFrameBlocks() const;
     // Full-screen pass set-up: viewport width x height, depth test and blending off, `program`

@@ -26,20 +26,20 @@ bool expectedSize(SizeRule s, const FrameContext& c, int& w, int& h, int& layers
             return true;
         case SizeRule::Gather:
         case SizeRule::GatherTiles: {
-            const int sc = c.gatherScale(), k = std::max(1, o.interleave);
+            const int sc = c.gatherScale(), k = std::max(1, o.indirect.interleave);
             w = (c.canvasWidth() + sc - 1) / sc, h = (c.canvasHeight() + sc - 1) / sc;
             if (s == SizeRule::GatherTiles) w = (w + k - 1) / k * k, h = (h + k - 1) / k * k;
             return true;
         }
         case SizeRule::ShadowAtlas:
-            w = h = o.shadowMapSize;
+            w = h = o.shadow.mapSize;
             layers = std::max(1, c.plan.shadowLayers);
             return true;
         case SizeRule::IsmAtlas:
-            w = h = ismTilesPerRow(o.vplCount) * o.ismTileSize;
+            w = h = ismTilesPerRow(o.vpl.count) * o.ism.tileSize;
             return true;
         case SizeRule::CausticMap:
-            w = h = o.causticMapSize;
+            w = h = o.caustic.mapSize;
             layers = std::max(1, c.plan.causticLayers);
             return true;
         case SizeRule::Impostor:

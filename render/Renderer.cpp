@@ -114,7 +114,7 @@ void specularRectangles(const GpuScene& s, const glm::mat4& view, const glm::mat
         }
         c.specularScissor = {lo.x, lo.y, hi.x - lo.x, hi.y - lo.y};
     }
-    if (!c.options.specularRectsPerObject) {
+    if (!c.options.specular.rectsPerObject) {
         const bool any = !all.empty(), anyGlass = !glass.empty();
         all.assign(any ? 1 : 0, c.specularScissor);
         glass.assign(anyGlass ? 1 : 0, c.specularScissor);
@@ -235,7 +235,7 @@ void shadowMatrices(const SceneLight& l, const BoundingSphere& B, float R, GpuLi
 // the lights with shadow maps (each gets a reflective shadow map).
 void planVpls(const RendererOptions& o, bool anyCaster, bool anyReachesVirtual, bool virtualInView,
               bool surfacePointsHaveVirtual, FramePlan& plan) {
-    if (o.vplCount <= 0) {
+    if (o.vpl.count <= 0) {
         plan.vplReason = "VPL count is 0";
     } else if (!anyCaster) {
         plan.vplReason = "no light reaches any geometry";
@@ -259,7 +259,7 @@ void planVpls(const RendererOptions& o, bool anyCaster, bool anyReachesVirtual, 
             if (!lp.castsShadow) continue;
             lp.hasRsm = true;
             lp.firstVpl = first;
-            lp.vplCount = ++k == withRsm ? o.vplCount - first : o.vplCount / withRsm;
+            lp.vplCount = ++k == withRsm ? o.vpl.count - first : o.vpl.count / withRsm;
             first += lp.vplCount;
         }
         plan.needRealOnlyIsm = surfacePointsHaveVirtual;
@@ -277,7 +277,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
         throw FileError(scene.source.empty() ? "scene" : scene.source.string(),
                         "the scene has no mesh in its node tree: nothing to render or composite "
                         "(add the real surfaces' proxies and the virtual objects as meshes)");
-    scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environmentLights);
+    scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environment.lights);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 
@@ -297,7 +297,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<IsmPass>());
     g.addPass(std::make_unique<TranslucencyPass>(scene, *scene_, options_));
     g.addPass(std::make_unique<IndirectLightPass>());
-    g.addPass(std::make_unique<GiFilterPass>(options_.interleave));
+    g.addPass(std::make_unique<GiFilterPass>(options_.indirect.interleave));
     g.addPass(std::make_unique<DirectLightPass>(*scene_));  // + the upsampled indirect light
     g.addPass(std::make_unique<CausticPass>());
     g.addPass(std::make_unique<BackFacePass>());
@@ -359,8 +359,8 @@ void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view
         glm::vec4(projection_.canvasWidth, projection_.canvasHeight,
                   1.0f / float(projection_.canvasWidth), 1.0f / float(projection_.canvasHeight));
     f.lightCount = int(s.lights().size());
-    f.vplCount = options_.vplCount;
-    f.interleave = options_.interleave;
+    f.vplCount = options_.vpl.count;
+    f.interleave = options_.indirect.interleave;
     f.frameIndex = c.frameIndex;
     // A live environment is the real world's, captured by a camera.
     const int envFlag = c.environment.live                      ? kOriginReal
@@ -376,15 +376,15 @@ void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view
                                                 : "";
     f.envOrigin = envFlag;
     f.historyValid = c.historyValid ? 1 : 0;
-    f.ismTileSize = options_.ismTileSize;
-    f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
-    f.vplDistanceClamp = options_.vplDistanceClamp;
-    f.shadowBias = options_.shadowBias;
+    f.ismTileSize = options_.ism.tileSize;
+    f.ismTilesPerRow = ismTilesPerRow(options_.vpl.count);
+    f.vplDistanceClamp = options_.indirect.distanceClamp;
+    f.shadowBias = options_.shadow.bias;
     f.temporalBlend = options_.temporalBlend;
-    f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
-    f.exposure = options_.exposure;
-    f.alphaMax = options_.alphaMax;
-    f.alphaFadeLr = options_.alphaFadeLr;
+    f.ismPointsPerVpl = float(options_.ism.pointsPerVpl);
+    f.exposure = options_.composite.exposure;
+    f.alphaMax = options_.composite.alphaMax;
+    f.alphaFadeLr = options_.composite.alphaFadeLr;
     c.frameUbo.upload(&f, sizeof(GpuFrame));
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
     prevViewProj_ = viewProj;
@@ -401,7 +401,7 @@ void Renderer::planFrame(const FrameInput& input) {
     // Camera.
     c.T_world_camera = input.T_world_camera;
     const glm::mat4 view(input.T_world_camera.inverse().matrix());
-    const glm::mat4 proj = projection_.projectionMatrix(options_.nearM, options_.farM);
+    const glm::mat4 proj = projection_.projectionMatrix(options_.clip.nearM, options_.clip.farM);
     const glm::mat4 viewProj = proj * view;
 
     bool virtualInView = false;
@@ -427,9 +427,9 @@ void Renderer::planFrame(const FrameInput& input) {
         lp.castsShadow = real || virt;
         lp.reachesVirtual = virt;
         lp.needsRealOnlyMap = lp.castsShadow && virt && real && l.origin == Origin::Real;
-        planCaustics(l, s, options_.caustics, lp, plan);
-        lp.glassTransmits = options_.glassShadows && (glassReal || glassVirtual) && !lp.caustics;
-        lp.translucentTransmits = options_.translucentShadows && translucentInCone;
+        planCaustics(l, s, options_.caustic.enabled, lp, plan);
+        lp.glassTransmits = options_.shadow.glass && (glassReal || glassVirtual) && !lp.caustics;
+        lp.translucentTransmits = options_.translucency.shadows && translucentInCone;
         lp.needsRealOnlyGlass = lp.needsRealOnlyMap && lp.hasGlassLayer();
         anyReachesVirtual = anyReachesVirtual || virt;
         anyCaster = anyCaster || lp.castsShadow;
@@ -452,7 +452,7 @@ void Renderer::planFrame(const FrameInput& input) {
     if (plan.causticLayers > 0) {
         plan.causticReason = std::to_string(plan.causticLayers) +
                              " spot light(s) with a mirror or glass object in the cone";
-    } else if (!options_.caustics) {
+    } else if (!options_.caustic.enabled) {
         plan.causticReason = "caustics off";
     } else {
         plan.causticReason = "no spot light's cone holds a mirror or glass object";
@@ -553,7 +553,7 @@ bool Renderer::updateEnvironment(const cv::Mat& bgr, double time) {
     cv::Mat rgba;
     cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
     envImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-    if (options_.environmentLights > 0) bgr.copyTo(envFrame_);
+    if (options_.environment.lights > 0) bgr.copyTo(envFrame_);
     e.live = true;
     e.time = time;
     ++e.generation;
@@ -571,16 +571,16 @@ bool Renderer::updateEnvironment(const cv::Mat& bgr, double time) {
 // Runs before the frame is planned, so that the frame's shadow maps are the new lights'.
 void Renderer::placeEnvironmentLights() {
     EnvironmentInput& e = ctx_->environment;
-    if (options_.environmentLights <= 0 || envLightsGeneration_ == e.generation) return;
+    if (options_.environment.lights <= 0 || envLightsGeneration_ == e.generation) return;
     envLightsGeneration_ = e.generation;
     envLights_ = EnvironmentLightSplit{};
     e.lightFreeSHValid = false;
     std::vector<SceneLight> placed;
     if (e.live && !envFrame_.empty()) {
         LightEstimationOptions o;
-        o.maxLights = options_.environmentLights;
+        o.maxLights = options_.environment.lights;
         envLights_ = envLightFinder_.find(envFrame_, e.camera, e.reachDeg, e.T_world_camera, e.gain,
-                                          options_.environmentLightMapWidth, o);
+                                          options_.environment.lightMapWidth, o);
         for (size_t k = 0; k < envLights_.lights.size(); ++k) {
             const EstimatedLight& found = envLights_.lights[k];
             SceneLight l;

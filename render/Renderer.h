@@ -71,7 +71,7 @@ public:
     void useStaticEnvironment();
     bool environmentLive() const { return ctx_->environment.live; }
     // The lights found in the live environment and placed as shadow-casting REAL directional
-    // lights (RendererOptions::environmentLights > 0), with the maps they were found on: updated
+    // lights (RendererOptions::environment.lights > 0), with the maps they were found on: updated
     // in the render() after each new environment frame; empty without a live environment.
     const EnvironmentLightSplit& environmentLights() const { return envLights_; }
     // This frame's environment map, level 0, as CV_32FC4 (R, G, B linear radiance; A = 1 where
@@ -92,7 +92,7 @@ public:
     // The imperfect shadow map atlas of this frame (all points, or real points only) as CV_32F
     // distances in metres, +inf where no point was splatted. Throws if no ISM ran.
     cv::Mat readIsmAtlas(bool realOnly) const;
-    // This frame's VPLs (RendererOptions::vplCount slots; unused ones have valid = 0). Throws if
+    // This frame's VPLs (RendererOptions::vpl.count slots; unused ones have valid = 0). Throws if
     // no VPL pass ran.
     std::vector<GpuVpl> readVpls() const;
 

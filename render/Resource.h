@@ -29,7 +29,7 @@ inline const char* resourceName(Resource r) {
 enum class SizeRule {
     Canvas,       // the render canvas (CameraProjection::canvasWidth/Height)
     Camera,       // the camera image
-    Gather,       // canvas / RendererOptions::indirectScale per axis, rounded up
+    Gather,       // canvas / RendererOptions::indirect.scale per axis, rounded up
     GatherTiles,  // Gather rounded up to a multiple of the interleave K (deinterleaved tiles)
     ShadowAtlas,  // shadowMapSize^2, one layer per shadow layer of the frame plan
     IsmAtlas,     // tilesPerRow(vplCount) * ismTileSize, square

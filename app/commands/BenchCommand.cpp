@@ -205,7 +205,7 @@ void runBench(const BenchArgs& a) {
 
     // The grid first: bad knobs fail before any frame is decoded.
     std::vector<render::BenchConfig> grid = render::benchGrid(calib.intrinsics, a.quick, overrides);
-    for (auto& c : grid) c.options.exposure = a.exposure;
+    for (auto& c : grid) c.options.composite.exposure = a.exposure;
 
     // Frames with a ground-truth pose and ground-truth composite, in session order.
     int skipped = 0;

@@ -194,8 +194,8 @@ void loadFrames(EffectRun& run) {
         throw FileError(run.session.string(), "no frame with a ground-truth composite");
     if (run.effect->environmentCamera) {
         std::string why;
-        run.environment =
-            render::SessionEnvironment::open(session, render::RendererOptions{}.exposure, why);
+        run.environment = render::SessionEnvironment::open(
+            session, render::RendererOptions{}.composite.exposure, why);
         if (!run.environment)
             throw FileError(run.session.string(),
                             "the effect needs the session's environment camera: " +

@@ -53,14 +53,14 @@ LiveRenderStage::LiveRenderStage(const Scene& scene, const PlacementPlane& plane
 void LiveRenderStage::rebuild() {
     const QualityPreset& q = kQualityPresets[settings_.preset];
     render::RendererOptions ropt = settings_.effects;
-    ropt.vplCount = settings_.vpls;
-    ropt.indirectScale = q.indirectScale;
-    ropt.impostorResolution = q.impostorResolution;
-    ropt.exposure = settings_.exposure;
-    ropt.environmentLights = settings_.environmentLights;
+    ropt.vpl.count = settings_.vpls;
+    ropt.indirect.scale = q.indirectScale;
+    ropt.impostor.resolution = q.impostorResolution;
+    ropt.composite.exposure = settings_.exposure;
+    ropt.environment.lights = settings_.environmentLights;
     // The HUD's direct-light views need the direct light apart in frames with VPLs (two more
     // canvas targets); a headless run shows no view and does not pay for them.
-    ropt.keepDirectLight = settings_.keepDirectLight;
+    ropt.direct.keepDirectLight = settings_.keepDirectLight;
     Scene placed = scene_;
     applyPlacement(placed, placement_, plane_);
     compositor_.reset();

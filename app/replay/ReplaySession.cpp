@@ -170,8 +170,8 @@ void ReplaySession::createRenderer() {
     context_ = std::make_unique<gl::Context>(a.window ? gl::Context::window(copt)
                                                       : gl::Context::headless(copt));
     render::RendererOptions ropt;
-    ropt.vplCount = a.vpls;
-    ropt.exposure = a.exposure;
+    ropt.vpl.count = a.vpls;
+    ropt.composite.exposure = a.exposure;
     switchEffectsOff(a.effectsOff, ropt);
     if (a.estimateLights) {
         // As many as light estimation reports, within the renderer's light budget.
@@ -181,7 +181,7 @@ void ReplaySession::createRenderer() {
                 "mirage replay --estimate-lights: scene {} already has {} lights, the real-time "
                 "renderer's limit; remove one or use --report-lights",
                 a.scene, render::kMaxLights));
-        ropt.environmentLights = std::min(render::LightEstimationOptions{}.maxLights, room);
+        ropt.environment.lights = std::min(render::LightEstimationOptions{}.maxLights, room);
     }
     renderer_ = std::make_unique<render::Renderer>(scene_, calibration_.intrinsics, ropt);
     compositor_ = std::make_unique<FrameCompositor>(*renderer_);

@@ -77,11 +77,11 @@ void BM_Frame(benchmark::State& state) {
     context();
     const int w = int(state.range(0)), h = int(state.range(1));
     render::RendererOptions opt;
-    opt.vplCount = int(state.range(2));
+    opt.vpl.count = int(state.range(2));
     opt.syncPasses = true;
-    opt.indirectScale =
+    opt.indirect.scale =
         int(state.range(4));  // per-pass attribution (see RendererOptions::syncPasses)
-    opt.specularVplStride = int(state.range(6));
+    opt.specular.vplStride = int(state.range(6));
     Scene scene = benchScene(int(state.range(3)), int(state.range(5)));
     CameraIntrinsics cam;
     cam.width = w;
@@ -99,7 +99,7 @@ void BM_Frame(benchmark::State& state) {
         const std::filesystem::path d(dump);
         std::filesystem::create_directories(d);
         const std::string tag =
-            cv::format("%dx%d_%dvpl_spec%d", w, h, opt.vplCount, int(state.range(5)));
+            cv::format("%dx%d_%dvpl_spec%d", w, h, opt.vpl.count, int(state.range(5)));
         writeBgr8(d / ("composite_" + tag + ".png"), r.compositeSrgb());
         writeLinearRgb(d / ("Lrv_" + tag + ".png"), r.readBuffer(render::kLRv));
         writeLinearRgb(d / ("Lr_" + tag + ".png"), r.readBuffer(render::kLR));
@@ -172,9 +172,9 @@ void BM_SpecularImpostorCurve(benchmark::State& state) {
     render::RendererOptions opt;
     opt.syncPasses = true;
     opt.temporalBlend = 0.0f;
-    opt.impostorResolution = int(state.range(0));
-    opt.impostorRefineSteps = int(state.range(1));
-    opt.impostorCubeMapBaseline = state.range(2) != 0;
+    opt.impostor.resolution = int(state.range(0));
+    opt.impostor.refineSteps = int(state.range(1));
+    opt.impostor.cubeMapBaseline = state.range(2) != 0;
     render::Renderer r(ref.scene.scene, ref.scene.cam, opt);
     r.render({ref.scene.pose, ref.footage, true});  // warm-up; builds the impostors
     double specMs = 0;
@@ -208,7 +208,7 @@ void BM_Translucency(benchmark::State& state) {
     context();
     render::RendererOptions opt;
     opt.syncPasses = true;
-    opt.vnmResolution = int(state.range(0));
+    opt.translucency.vnmResolution = int(state.range(0));
     const std::filesystem::path dir =
         std::filesystem::temp_directory_path() / "mirage_bench_translucency";
     std::filesystem::create_directories(dir);  // the scene's environment map is written there

@@ -92,15 +92,15 @@ void frameKnobs(std::vector<BenchKnob>& knobs) {
                  return c.width > 0 ? fmt::format("{}x{}", c.width, c.height)
                                     : std::string("session");
              }},
-            {"vpls", "virtual point lights per frame (RendererOptions::vplCount)",
+            {"vpls", "virtual point lights per frame (RendererOptions::vpl.count)",
              [](const CameraIntrinsics&, bool quick) {
                  return quick ? std::vector<std::string>{"64", "256"}
                               : std::vector<std::string>{"64", "256", "1024"};
              },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.vplCount = parseInt("vpls", v, 0, 16384);
+                 c.options.vpl.count = parseInt("vpls", v, 0, 16384);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.vplCount); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.vpl.count); }},
             {"indirect_scale",
              "VPL gather at 1/N resolution per axis (1..4), or auto: width / 160 in 1..4 (4 at "
              "640x480)",
@@ -109,11 +109,11 @@ void frameKnobs(std::vector<BenchKnob>& knobs) {
                               : std::vector<std::string>{"auto", "2", "1"};
              },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.indirectScale = v == "auto" ? 0 : parseInt("indirect_scale", v, 1, 4);
+                 c.options.indirect.scale = v == "auto" ? 0 : parseInt("indirect_scale", v, 1, 4);
              },
              [](const BenchConfig& c) {
-                 return c.options.indirectScale == 0 ? std::string("auto")
-                                                     : std::to_string(c.options.indirectScale);
+                 return c.options.indirect.scale == 0 ? std::string("auto")
+                                                      : std::to_string(c.options.indirect.scale);
              }},
             {"static_reuse",
              "on: reuse the camera-independent passes (shadow, vpl, ism) while the plan is "
@@ -150,61 +150,63 @@ void specularKnobs(std::vector<BenchKnob>& knobs) {
                  if (v != "impostors" && v != "cubemap")
                      throw Error(fmt::format(
                          "bench: knob specular_trace: '{}' is not impostors or cubemap", v));
-                 c.options.impostorCubeMapBaseline = v == "cubemap";
+                 c.options.impostor.cubeMapBaseline = v == "cubemap";
              },
              [](const BenchConfig& c) {
-                 return std::string(c.options.impostorCubeMapBaseline ? "cubemap" : "impostors");
+                 return std::string(c.options.impostor.cubeMapBaseline ? "cubemap" : "impostors");
              }},
             {"impostor_resolution", "texels per side of each impostor and cube-map face",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.impostorResolution = parseInt("impostor_resolution", v, 16, 2048);
+                 c.options.impostor.resolution = parseInt("impostor_resolution", v, 16, 2048);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.impostorResolution); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.impostor.resolution); }},
             {"impostor_steps", "refinement steps of the impostor height-field search",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"2"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.impostorRefineSteps = parseInt("impostor_steps", v, 0, 32);
+                 c.options.impostor.refineSteps = parseInt("impostor_steps", v, 0, 32);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.impostorRefineSteps); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.impostor.refineSteps); }},
             {"refraction_steps",
              "march steps of the refracted ray through the back-face buffer (the exit point; also "
              "the caustic photons')",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.refractionMarchSteps = parseInt("refraction_steps", v, 2, 128);
+                 c.options.specular.refractionMarchSteps = parseInt("refraction_steps", v, 2, 128);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.refractionMarchSteps); }},
+             [](const BenchConfig& c) {
+                 return std::to_string(c.options.specular.refractionMarchSteps);
+             }},
             {"specular_vpl_stride",
              "VPL interleaving at the reflected/refracted hits: each hit sums every N-th VPL (x N) "
              "over an N-pixel tile: 1 (all), 4 (2x2) or 16 (4x4)",
              [](const CameraIntrinsics&, bool) {
                  return std::vector<std::string>{
-                     std::to_string(RendererOptions{}.specularVplStride)};
+                     std::to_string(RendererOptions{}.specular.vplStride)};
              },
              [](BenchConfig& c, const std::string& v) {
                  const int n = parseInt("specular_vpl_stride", v, 1, 16);
                  if (n != 1 && n != 4 && n != 16)
                      throw Error(
                          fmt::format("bench: knob specular_vpl_stride: '{}' is not 1, 4 or 16", v));
-                 c.options.specularVplStride = n;
+                 c.options.specular.vplStride = n;
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.specularVplStride); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.specular.vplStride); }},
             {"specular_resolution",
              "resolution of the lighting at the reflected/refracted hits: full (every specular "
              "pixel) or half (one pixel per 2x2 block, upsampled by hit geometry)",
              [](const CameraIntrinsics&, bool) {
-                 return std::vector<std::string>{RendererOptions{}.specularHalfResolution ? "half"
-                                                                                          : "full"};
+                 return std::vector<std::string>{
+                     RendererOptions{}.specular.halfResolution ? "half" : "full"};
              },
              [](BenchConfig& c, const std::string& v) {
                  if (v != "full" && v != "half")
                      throw Error(fmt::format(
                          "bench: knob specular_resolution: '{}' is not full or half", v));
-                 c.options.specularHalfResolution = v == "half";
+                 c.options.specular.halfResolution = v == "half";
              },
              [](const BenchConfig& c) {
-                 return std::string(c.options.specularHalfResolution ? "half" : "full");
+                 return std::string(c.options.specular.halfResolution ? "half" : "full");
              }},
             {"virtual",
              "on: composite the virtual objects; off: the composite is the footage unchanged (a "
@@ -212,9 +214,9 @@ void specularKnobs(std::vector<BenchKnob>& knobs) {
              "not beat that row is broken)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.showVirtual = parseOnOff("virtual", v);
+                 c.options.composite.showVirtual = parseOnOff("virtual", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.showVirtual); }},
+             [](const BenchConfig& c) { return onOff(c.options.composite.showVirtual); }},
         });
 }
 
@@ -228,34 +230,34 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
              "on: photon G-buffers and the caustic splat for spot lights on mirror/glass",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.caustics = parseOnOff("caustics", v);
+                 c.options.caustic.enabled = parseOnOff("caustics", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.caustics); }},
+             [](const BenchConfig& c) { return onOff(c.options.caustic.enabled); }},
             {"glass_shadows",
              "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
              "off: glass is opaque there",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.glassShadows = parseOnOff("glass_shadows", v);
+                 c.options.shadow.glass = parseOnOff("glass_shadows", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.glassShadows); }},
+             [](const BenchConfig& c) { return onOff(c.options.shadow.glass); }},
             {"refl_refr_vpls",
              "on: a VPL on a mirror or glass follows the reflected / refracted photon to its "
              "receiver (spot lights with caustics); off: it stays dark on the object",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.reflectedRefractedVpls = parseOnOff("refl_refr_vpls", v);
+                 c.options.vpl.throughSpecular = parseOnOff("refl_refr_vpls", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.reflectedRefractedVpls); }},
+             [](const BenchConfig& c) { return onOff(c.options.vpl.throughSpecular); }},
             {"caustic_map", "texels per side of each photon G-buffer (a multiple of 8)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"256"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.causticMapSize = parseInt("caustic_map", v, 16, 2048);
-                 if (c.options.causticMapSize % 8 != 0)
+                 c.options.caustic.mapSize = parseInt("caustic_map", v, 16, 2048);
+                 if (c.options.caustic.mapSize % 8 != 0)
                      throw Error(
                          fmt::format("bench: knob caustic_map: {} is not a multiple of 8", v));
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.causticMapSize); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.caustic.mapSize); }},
             {"caustic_quad", "photon quad radius in photon spacings on the receiver (0.25..8)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"1.5"}; },
              [](BenchConfig& c, const std::string& v) {
@@ -264,17 +266,17 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                  if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.25f && q <= 8.0f))
                      throw Error(fmt::format(
                          "bench: knob caustic_quad: '{}' is not a number in [0.25, 8]", v));
-                 c.options.causticQuadScale = q;
+                 c.options.caustic.quadScale = q;
              },
-             [](const BenchConfig& c) { return fmt::format("{:g}", c.options.causticQuadScale); }},
+             [](const BenchConfig& c) { return fmt::format("{:g}", c.options.caustic.quadScale); }},
             {"caustic_gather",
              "on: the photons in a world-space grid, gathered at the reflected / refracted hits "
              "(caustics seen in mirrors and through glass); off: those hits get no caustic",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.causticGather = parseOnOff("caustic_gather", v);
+                 c.options.caustic.gather = parseOnOff("caustic_gather", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.causticGather); }},
+             [](const BenchConfig& c) { return onOff(c.options.caustic.gather); }},
             {"caustic_radius",
              "photon kernel radius cap of the caustic gather, in cm (0.1..50; grid cells are twice "
              "that)",
@@ -285,10 +287,10 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                  if (v.empty() || end != v.c_str() + v.size() || !(q >= 0.1f && q <= 50.0f))
                      throw Error(fmt::format(
                          "bench: knob caustic_radius: '{}' is not a number of cm in [0.1, 50]", v));
-                 c.options.causticGatherRadius = 0.01f * q;
+                 c.options.caustic.gatherRadius = 0.01f * q;
              },
              [](const BenchConfig& c) {
-                 return fmt::format("{:g}", 100.0f * c.options.causticGatherRadius);
+                 return fmt::format("{:g}", 100.0f * c.options.caustic.gatherRadius);
              }},
             {"caustic_gather_cap",
              "photons the caustic gather reads per grid bucket, 0 = all (fuller buckets are read "
@@ -303,25 +305,25 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                          fmt::format("bench: knob caustic_gather_cap: '{}' is not a photon "
                                      "count in 0..1048576 (0: all)",
                                      v));
-                 c.options.causticGatherCap = int(q);
+                 c.options.caustic.gatherCap = int(q);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.causticGatherCap); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.caustic.gatherCap); }},
             {"caustic_temporal",
              "on: the caustic buffer smoothed over frames (reprojected history, the GI filter's "
              "reset rules); off: every frame's caustic stands alone",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.causticTemporal = parseOnOff("caustic_temporal", v);
+                 c.options.caustic.temporal = parseOnOff("caustic_temporal", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.causticTemporal); }},
+             [](const BenchConfig& c) { return onOff(c.options.caustic.temporal); }},
             {"specular_temporal",
              "on: the light of the reflected / refracted hits (L'_rv, L'_r) smoothed over frames, "
              "history rejected where a hit moved; off: every frame's stands alone",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.specularTemporal = parseOnOff("specular_temporal", v);
+                 c.options.specular.temporal = parseOnOff("specular_temporal", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.specularTemporal); }},
+             [](const BenchConfig& c) { return onOff(c.options.specular.temporal); }},
             {"pose_jitter",
              "tracking-like noise on every frame's pose: mm of translation (1 sigma per axis) and "
              "a tenth of that in degrees of rotation (0..10; 0: the exact ground-truth pose)",
@@ -349,9 +351,9 @@ void roughKnobs(std::vector<BenchKnob>& knobs) {
              "metals reflect sharply (their roughness ignored)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.fuzzyReflections = parseOnOff("fuzzy", v);
+                 c.options.fuzzy.enabled = parseOnOff("fuzzy", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.fuzzyReflections); }},
+             [](const BenchConfig& c) { return onOff(c.options.fuzzy.enabled); }},
             {"fuzzy_cone", "the fuzzy filter's cone bound Theta in degrees (0 < Theta <= 60)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"20"}; },
              [](BenchConfig& c, const std::string& v) {
@@ -360,15 +362,15 @@ void roughKnobs(std::vector<BenchKnob>& knobs) {
                  if (v.empty() || end != v.c_str() + v.size() || !(q > 0.0f && q <= 60.0f))
                      throw Error(
                          fmt::format("bench: knob fuzzy_cone: '{}' is not a number in (0, 60]", v));
-                 c.options.fuzzyConeDeg = q;
+                 c.options.fuzzy.coneDeg = q;
              },
-             [](const BenchConfig& c) { return fmt::format("{:g}", c.options.fuzzyConeDeg); }},
+             [](const BenchConfig& c) { return fmt::format("{:g}", c.options.fuzzy.coneDeg); }},
             {"fuzzy_taps", "taps per side of each separable fuzzy-filter pass (1..64)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"12"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.fuzzyTaps = parseInt("fuzzy_taps", v, 1, 64);
+                 c.options.fuzzy.taps = parseInt("fuzzy_taps", v, 1, 64);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.fuzzyTaps); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.fuzzy.taps); }},
             // Rough glass (docs/specular.md, "Rough refraction"): one default value each.
             {"rough_method",
              "how rough glass blurs what is seen through it: lean (LEAN-mapped back faces, one "
@@ -377,32 +379,32 @@ void roughKnobs(std::vector<BenchKnob>& knobs) {
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"lean"}; },
              [](BenchConfig& c, const std::string& v) {
                  if (v == "lean")
-                     c.options.roughRefraction = RoughRefractionMethod::Lean;
+                     c.options.rough.method = RoughRefractionMethod::Lean;
                  else if (v == "gsr")
-                     c.options.roughRefraction = RoughRefractionMethod::Gsr;
+                     c.options.rough.method = RoughRefractionMethod::Gsr;
                  else if (v == "filter")
-                     c.options.roughRefraction = RoughRefractionMethod::Filter;
+                     c.options.rough.method = RoughRefractionMethod::Filter;
                  else
                      throw Error(fmt::format(
                          "bench: knob rough_method: '{}' is not one of lean, gsr, filter", v));
              },
              [](const BenchConfig& c) {
-                 return std::string(roughRefractionMethodName(c.options.roughRefraction));
+                 return std::string(roughRefractionMethodName(c.options.rough.method));
              }},
             {"gsr_subdivisions", "hemisphere sectors of the Gaussian sum reduction (1..8)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"4"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.gsrSubdivisions = parseInt("gsr_subdivisions", v, 1, 8);
+                 c.options.rough.gsrSubdivisions = parseInt("gsr_subdivisions", v, 1, 8);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.gsrSubdivisions); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.rough.gsrSubdivisions); }},
             {"lean_mip_levels",
              "mip levels of the rough-refraction chains (LEAN moments, camera image, rough-glass "
              "radiance; 1..12): a wider lobe is cut at the last",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"8"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.roughMipLevels = parseInt("lean_mip_levels", v, 1, 12);
+                 c.options.rough.mipLevels = parseInt("lean_mip_levels", v, 1, 12);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.roughMipLevels); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.rough.mipLevels); }},
         });
 }
 
@@ -416,17 +418,19 @@ void translucencyKnobs(std::vector<BenchKnob>& knobs) {
              "thickness along the light's ray, coloured by its medium); off: it is opaque there",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.translucentShadows = parseOnOff("translucent_shadows", v);
+                 c.options.translucency.shadows = parseOnOff("translucent_shadows", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.translucentShadows); }},
+             [](const BenchConfig& c) { return onOff(c.options.translucency.shadows); }},
             {"vnm_resolution",
              "voxels along a translucent object's longest side in its voxel number map (2..512; "
              "the LUT grows with the 4th power)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"16"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.vnmResolution = parseInt("vnm_resolution", v, 2, 512);
+                 c.options.translucency.vnmResolution = parseInt("vnm_resolution", v, 2, 512);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.vnmResolution); }},
+             [](const BenchConfig& c) {
+                 return std::to_string(c.options.translucency.vnmResolution);
+             }},
             {"moving_objects",
              "on: the virtual objects move before every frame (to 1 cm along +X and back), so "
              "every frame redoes what depends on where they stand: shadows, VPLs, ISMs, caustics, "
@@ -467,17 +471,17 @@ void environmentKnobs(std::vector<BenchKnob>& knobs) {
                  const int w = parseInt("env_resolution", v, 16, 4096);
                  if (w % 2 != 0)
                      throw Error(fmt::format("bench: knob env_resolution: '{}' is not even", v));
-                 c.options.environmentMapWidth = w;
+                 c.options.environment.mapWidth = w;
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.environmentMapWidth); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.environment.mapWidth); }},
             {"env_lights",
              "lights found in each environment-camera frame placed as shadow-casting lights, taken "
              "out of the environment light (0 = none; with env_source=camera)",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.environmentLights = parseInt("env_lights", v, 0, kMaxLights);
+                 c.options.environment.lights = parseInt("env_lights", v, 0, kMaxLights);
              },
-             [](const BenchConfig& c) { return std::to_string(c.options.environmentLights); }},
+             [](const BenchConfig& c) { return std::to_string(c.options.environment.lights); }},
         });
 }
 

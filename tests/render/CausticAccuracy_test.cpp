@@ -164,7 +164,7 @@ TEST(CausticAccuracy, CausticMatchesReferenceAndBrokenRendersFail) {
               << " dB; flux ratio " << f.fluxRatio << "; centroid error " << f.centroidError * 100
               << " % of the light-receiver distance\n";
     RendererOptions off;
-    off.caustics = false;
+    off.caustic.enabled = false;
     const Realtime noCaustics = realtime(s, ref.footage, off);
     const CausticFigures fOff = measure(s, ref, noCaustics);
     std::cout << "[ caustics ] broken: caustics off: region PSNR " << fOff.regionPsnr
@@ -178,7 +178,7 @@ TEST(CausticAccuracy, CausticMatchesReferenceAndBrokenRendersFail) {
               << " dB, SSIM " << fIor.regionSsim << ", sphere PSNR " << fIor.spherePsnr
               << " dB, flux ratio " << fIor.fluxRatio << "\n";
     RendererOptions noGather;
-    noGather.causticGather = false;
+    noGather.caustic.gather = false;
     const Realtime gatherOff = realtime(s, ref.footage, noGather);
     const CausticFigures fNoGather = measure(s, ref, gatherOff);
     std::cout << "[ caustics ] broken: caustic gather off: sphere PSNR " << fNoGather.spherePsnr

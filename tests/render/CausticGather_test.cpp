@@ -94,7 +94,7 @@ struct Realtime {
 Realtime realtime(const test::CausticScene& s, const cv::Mat& footage, bool gather,
                   RendererOptions opt = {}) {
     opt.temporalBlend = 0.0f;
-    opt.causticGather = gather;
+    opt.caustic.gather = gather;
     Renderer r(s.scene, s.cam, opt);
     Realtime out;
     out.report = r.render({s.pose, footage, true});
@@ -234,9 +234,9 @@ TEST(CausticGather, CappedBucketsKeepTheFocusedCausticAndACapOfOneFails) {
     const test::CausticScene s = focusedCausticInMirror();
     const Reference ref = reference(s, 12);
     RendererOptions all, capped, one;
-    all.causticGatherCap = 0;
-    capped.causticGatherCap = 256;
-    one.causticGatherCap = 1;
+    all.caustic.gatherCap = 0;
+    capped.caustic.gatherCap = 256;
+    one.caustic.gatherCap = 1;
     const Realtime off = realtime(s, ref.footage, false);
     const Realtime rAll = realtime(s, ref.footage, true, all);
     const Realtime rCapped = realtime(s, ref.footage, true, capped);
@@ -252,7 +252,7 @@ TEST(CausticGather, CappedBucketsKeepTheFocusedCausticAndACapOfOneFails) {
     const double fluxCapped = cv::sum(gatheredCaustic(rCapped, off, ref.mirror))[0] / fluxAll;
     const double psnrAll = test::psnr(rAll.composite, ref.compositeSrgb, 255.0, ref.region);
     const double psnrCapped = test::psnr(rCapped.composite, ref.compositeSrgb, 255.0, ref.region);
-    std::cout << "[ caustic gather ] focused, cap " << capped.causticGatherCap
+    std::cout << "[ caustic gather ] focused, cap " << capped.caustic.gatherCap
               << ": departure from reading all " << depCapped << " (cap 1: " << depOne << "), flux "
               << fluxCapped << " x; region PSNR " << psnrCapped << " dB (all " << psnrAll
               << " dB)\n";

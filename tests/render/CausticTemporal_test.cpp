@@ -44,8 +44,8 @@ enum class Judged { Caustic, Specular };
 
 RendererOptions options(bool smoothing, Judged judged = Judged::Caustic) {
     RendererOptions o;
-    (judged == Judged::Caustic ? o.causticTemporal : o.specularTemporal) = smoothing;
-    o.vplCount = 64;
+    (judged == Judged::Caustic ? o.caustic.temporal : o.specular.temporal) = smoothing;
+    o.vpl.count = 64;
     return o;
 }
 

@@ -93,10 +93,10 @@ TEST(CausticThroughGlass, CausticSeenThroughTheSphereMatchesReferenceAndBrokenRe
     const Realtime on = realtime(s, ref.footage);
     ASSERT_TRUE(on.report.ran("photongrid")) << on.report.summary();
     RendererOptions noCaustics;
-    noCaustics.caustics = false;
+    noCaustics.caustic.enabled = false;
     const Realtime off = realtime(s, ref.footage, noCaustics);
     RendererOptions noGather;
-    noGather.causticGather = false;
+    noGather.caustic.gather = false;
     const Realtime gatherOff = realtime(s, ref.footage, noGather);
     test::CausticSceneOptions wrongIor;
     wrongIor.ior = 1.7f;

@@ -121,10 +121,10 @@ std::vector<FrameMeasure> replayTopDown(const fs::path& sessionDir, int environm
     EXPECT_TRUE(env.has_value()) << why;
     if (!env) return {};
     RendererOptions o;
-    o.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
-    o.environmentLights = environmentLights;
-    o.environmentMapWidth = 128;
-    o.vplCount = 16;
+    o.direct.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
+    o.environment.lights = environmentLights;
+    o.environment.mapWidth = 128;
+    o.vpl.count = 16;
     o.temporalBlend = 0.0f;
     const CameraIntrinsics cam = test::smallCamera(160, 120, 110.0);
     const Pose view = test::lookAt({0.0, 1.3, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, -1.0});

@@ -98,7 +98,7 @@ TEST_F(EnvironmentPassTest, FisheyeFrameBecomesTheEnvironmentMap) {
     const Pose T = upwardPose();
     const cv::Mat frame = test::renderEnvironmentView(K, T, smoothSky);
     RendererOptions o;
-    o.environmentMapWidth = 128;
+    o.environment.mapWidth = 128;
     Renderer r(floorScene(0.5f), smallCamera(), o);
     r.setEnvironmentCamera(fixedCamera(K, T));
     ASSERT_TRUE(r.updateEnvironment(frame, 0.0));
@@ -158,7 +158,7 @@ TEST_F(EnvironmentPassTest, FillOfTheUnseenPartIsStatedWithItsError) {
     const CameraIntrinsics K = raytrace::equidistantFisheye(480, 190.0);
     const Pose T = upwardPose();
     RendererOptions o;
-    o.environmentMapWidth = 256;
+    o.environment.mapWidth = 256;
     Renderer r(floorScene(0.5f), smallCamera(), o);
     r.setEnvironmentCamera(fixedCamera(K, T));
     r.updateEnvironment(test::renderEnvironmentView(K, T, truth), 0.0);
@@ -197,7 +197,7 @@ TEST_F(EnvironmentPassTest, CpuAndGpuMappingsAgreeFillIncluded) {
     const Pose T = upwardPose();
     const cv::Mat frame = test::renderEnvironmentView(K, T, smoothSky);
     RendererOptions o;
-    o.environmentMapWidth = 128;
+    o.environment.mapWidth = 128;
     Renderer r(floorScene(0.5f), smallCamera(), o);
     r.setEnvironmentCamera(fixedCamera(K, T));
     r.updateEnvironment(frame, 0.0);
@@ -225,7 +225,7 @@ TEST_F(EnvironmentPassTest, GpuShMatchesTheCpuProjectionOfTheSameMap) {
     const CameraIntrinsics K = raytrace::equidistantFisheye(256, 190.0);
     const Pose T = upwardPose();
     RendererOptions o;
-    o.environmentMapWidth = 256;  // the SH9 reads mip level 1 (128 wide)
+    o.environment.mapWidth = 256;  // the SH9 reads mip level 1 (128 wide)
     Renderer r(floorScene(0.5f), smallCamera(), o);
     r.setEnvironmentCamera(fixedCamera(K, T));
     r.updateEnvironment(test::renderEnvironmentView(K, T, smoothSky), 0.0);
@@ -339,7 +339,7 @@ TEST_F(EnvironmentPassTest, MountedCameraFollowsTheMainCamera) {
     s.intrinsics = K;
     s.T_main_camera = Pose();  // identity: the fish-eye looks along the main camera's axis
     RendererOptions o;
-    o.environmentMapWidth = 64;
+    o.environment.mapWidth = 64;
     Renderer r(floorScene(0.5f), smallCamera(), o);
     r.setEnvironmentCamera(s);
     const cv::Mat grey(K.height, K.width, CV_8UC3, cv::Scalar::all(128));

@@ -116,7 +116,7 @@ TEST(FuzzyReflection, RoughMetalMatchesReferenceAndIgnoringRoughnessFails) {
         const Frame fuzzy = realtime(s, ref.footage);
         EXPECT_TRUE(fuzzy.report.ran("fuzzy")) << fuzzy.report.summary();
         RendererOptions off = singleFrame();
-        off.fuzzyReflections = false;
+        off.fuzzy.enabled = false;
         const Frame sharp = realtime(s, ref.footage, off);
         EXPECT_FALSE(sharp.report.ran("fuzzy"));
         const double pF = test::psnr(fuzzy.srgb, ref.refSrgb, 255.0, mask);
@@ -140,7 +140,7 @@ TEST(FuzzyReflection, RoughMetalMatchesReferenceAndIgnoringRoughnessFails) {
 // RoughRefraction_test.cpp). Compared over the slab's front face against the reference's GGX
 // dielectric.
 RendererOptions filterGlass(RendererOptions o = singleFrame()) {
-    o.roughRefraction = RoughRefractionMethod::Filter;
+    o.rough.method = RoughRefractionMethod::Filter;
     return o;
 }
 
@@ -158,7 +158,7 @@ TEST(FuzzyReflection, RoughGlassMatchesReferenceAndIgnoringRoughnessFails) {
         const Frame fuzzy = realtime(s, ref.footage, filterGlass());
         EXPECT_TRUE(fuzzy.report.ran("fuzzy")) << fuzzy.report.summary();
         RendererOptions off = filterGlass();
-        off.fuzzyReflections = false;
+        off.fuzzy.enabled = false;
         const Frame sharp = realtime(s, ref.footage, off);
         const double pF = test::psnr(fuzzy.srgb, ref.refSrgb, 255.0, mask);
         const double sF = test::ssim(fuzzy.srgb, ref.refSrgb, 255.0, mask);
@@ -192,11 +192,11 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     // Without VPLs: the plate's roughness changes the light it bounces onto the table (the
     // reflective shadow map's flux), which is not the filter's business.
     RendererOptions noVpl = singleFrame();
-    noVpl.vplCount = 0;
+    noVpl.vpl.count = 0;
     const Frame a = realtime(mirror, footage, noVpl);
     // The kernel of one pixel: at this camera (120 px per radian) 2.5 sigma of roughness 0.051
     // still reaches 1.1 px, so the cone bound (0.3 deg: 0.6 px) makes the limit.
-    noVpl.fuzzyConeDeg = 0.3f;
+    noVpl.fuzzy.coneDeg = 0.3f;
     const Frame b = realtime(limit, footage, noVpl);
     EXPECT_FALSE(a.report.ran("fuzzy"));
     EXPECT_NE(a.report.summary().find("no rough metal"), std::string::npos) << a.report.summary();
@@ -207,7 +207,7 @@ TEST(FuzzyReflection, RoughnessZeroLimitEqualsMirrorPathAndOnlyTheObjectChanges)
     const PlateScene rough = makePlate(0.3f, envDir);
     const Frame on = realtime(rough, footage);
     RendererOptions offOpt = singleFrame();
-    offOpt.fuzzyReflections = false;
+    offOpt.fuzzy.enabled = false;
     const Frame off = realtime(rough, footage, offOpt);
     EXPECT_NE(off.report.summary().find("fuzzy filter off"), std::string::npos);
     const cv::Mat changed = test::changedPixels(on.linear, off.linear);
@@ -233,9 +233,9 @@ TEST(FuzzyReflection, RoughRealPlateBlursOnlyTheVirtualReflection) {
     test::addBox(s.scene, "virtual box", {0.16f, 0.0f, -0.55f}, {0.3f, 0.25f, -0.4f}, green,
                  Origin::Virtual);
     RendererOptions on = singleFrame();
-    on.vplCount = 0;
+    on.vpl.count = 0;
     RendererOptions off = on;
-    off.fuzzyReflections = false;
+    off.fuzzy.enabled = false;
     const Frame blurred = realtime(s, footage, on), sharp = realtime(s, footage, off);
     EXPECT_TRUE(blurred.report.ran("fuzzy")) << blurred.report.summary();
     const cv::Mat plate = topMask(s), leftHalf = topMask(s, kPlateLo.x, -0.05);
@@ -303,7 +303,7 @@ TEST(FuzzyReflection, HalfRoughTextureSmoothHalfStaysSharp) {
     const cv::Mat footage = test::roughReference(s, 16).footage;
     const Frame half = realtime(s, footage);
     RendererOptions off = singleFrame();
-    off.fuzzyReflections = false;
+    off.fuzzy.enabled = false;
     const Frame sharp = realtime(s, footage, off);
     const Frame rough = realtime(texturedPlate(envDir, 255, 255), footage);  // = texture ignored
     EXPECT_TRUE(half.report.ran("fuzzy")) << half.report.summary();
@@ -357,7 +357,7 @@ TEST(FuzzyReflection, HardCasesStayFinite) {
             PlateScene s = makePlate(roughness, envDir);
             s.pose = pose;
             RendererOptions o = singleFrame();
-            o.fuzzyConeDeg = 60.0f;  // the widest cone: the longest kernels
+            o.fuzzy.coneDeg = 60.0f;  // the widest cone: the longest kernels
             const Frame f = realtime(s, footage, o);
             EXPECT_TRUE(f.report.ran("fuzzy")) << f.report.summary();
             EXPECT_LT(cv::norm(f.linear, cv::NORM_INF), 10.0);

@@ -1,6 +1,6 @@
 // The direct-light pass upsamples the filtered indirect light (gifilter's GatherLight) and adds
 // it in the same full-screen pass: LRv / LR are direct + indirect light, DirectRv / DirectR the
-// direct light alone when RendererOptions::keepDirectLight asks for it, and without VPL light
+// direct light alone when RendererOptions::direct.keepDirectLight asks for it, and without VPL light
 // the GI solutions are the direct light.
 #include <gtest/gtest.h>
 
@@ -32,9 +32,9 @@ struct Buffers {
 
 Buffers render(const Scene& scene, bool keepDirect, int vplCount) {
     RendererOptions o;
-    o.vplCount = vplCount;
+    o.vpl.count = vplCount;
     o.temporalBlend = 0.0f;
-    o.keepDirectLight = keepDirect;
+    o.direct.keepDirectLight = keepDirect;
     Renderer r(scene, kCamera, o);
     const cv::Mat footage(kCamera.height, kCamera.width, CV_8UC3, cv::Scalar(90, 110, 130));
     const FrameReport& report = r.render({kPose, footage, true});

@@ -66,7 +66,7 @@ TEST(GlassShadow, ShadowOfGlassIsLitLikeTheReferenceAndOpaqueFails) {
     auto realtime = [&](bool glassShadows, cv::Mat* lr = nullptr) {
         RendererOptions opt;
         opt.temporalBlend = 0.0f;
-        opt.glassShadows = glassShadows;
+        opt.shadow.glass = glassShadows;
         Renderer r(s.scene, s.cam, opt);
         r.render({s.pose, ref.footage, true});
         const cv::Mat lin = r.compositeLinear();

@@ -45,9 +45,9 @@ protected:
     }
     static RendererOptions options(int res, int steps, bool baseline) {
         RendererOptions o;
-        o.impostorResolution = res;
-        o.impostorRefineSteps = steps;
-        o.impostorCubeMapBaseline = baseline;
+        o.impostor.resolution = res;
+        o.impostor.refineSteps = steps;
+        o.impostor.cubeMapBaseline = baseline;
         return o;
     }
     static std::unique_ptr<gl::Context> context_;
@@ -220,7 +220,7 @@ TEST_F(ImpostorTrace, ThickTableUnderTheObjectIsTracedExactly) {
 
 TEST_F(ImpostorTrace, RendererRunsThePassOnlyWithSpecularObjectsAndCachesIt) {
     RendererOptions o = options(32, 2, false);
-    o.vplCount = 16;
+    o.vpl.count = 16;
     Renderer withSpecular(*scenes_[0], test::smallCamera(40, 30, 30.0), o);
     FrameInput in;
     in.T_world_camera = test::lookAtPose({1.5, 1.0, 1.5}, {0, 0.2, 0});

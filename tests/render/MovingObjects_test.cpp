@@ -47,7 +47,7 @@ Scene moved(const Scene& s) {
 
 RendererOptions options() {
     RendererOptions o;
-    o.vplCount = 64;
+    o.vpl.count = 64;
     return o;
 }
 

@@ -191,7 +191,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
               "resolution=160x120 vpls=256 indirect_scale=auto static_reuse=on sync_passes=on "
               "specular_trace=impostors impostor_resolution=256 impostor_steps=2 "
               "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
-                  std::string(RendererOptions{}.specularHalfResolution ? "half" : "full") +
+                  std::string(RendererOptions{}.specular.halfResolution ? "half" : "full") +
                   " virtual=on "
                   "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
                   "caustic_gather=on caustic_radius=1 caustic_gather_cap=0 caustic_temporal=on "
@@ -333,11 +333,13 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     EXPECT_THROW(benchGrid(cam, true, {{"fuzzy_taps", {"0"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"caustics", {"sometimes"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"vnm_resolution", {"1"}}}), Error);
-    EXPECT_EQ(benchGrid(cam, true, {{"vnm_resolution", {"48"}}})[0].options.vnmResolution, 48);
+    EXPECT_EQ(
+        benchGrid(cam, true, {{"vnm_resolution", {"48"}}})[0].options.translucency.vnmResolution,
+        48);
     const auto caustic = benchGrid(cam, true, {{"caustic_map", {"128", "512"}}});
     ASSERT_EQ(caustic.size(), 4u);  // x the quick grid's 64 / 256 VPLs
-    EXPECT_EQ(caustic[0].options.causticMapSize, 128);
-    EXPECT_EQ(caustic[1].options.causticMapSize, 512);
+    EXPECT_EQ(caustic[0].options.caustic.mapSize, 128);
+    EXPECT_EQ(caustic[1].options.caustic.mapSize, 512);
     EXPECT_THROW(benchGrid(cam, true, {{"virtual", {"hidden"}}}), Error);
 
     // Every knob reads back the value it applied (the results page's "default" is read this way),
@@ -351,17 +353,18 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
         }
     }
     const auto defaults = benchDefaultKnobs();
-    EXPECT_EQ(defaults.at("vpls"), std::to_string(RendererOptions{}.vplCount));
+    EXPECT_EQ(defaults.at("vpls"), std::to_string(RendererOptions{}.vpl.count));
     EXPECT_EQ(defaults.at("resolution"), "session");
     EXPECT_EQ(defaults.at("virtual"), "on");
-    EXPECT_EQ(defaults.at("impostor_steps"), std::to_string(RendererOptions{}.impostorRefineSteps));
+    EXPECT_EQ(defaults.at("impostor_steps"),
+              std::to_string(RendererOptions{}.impostor.refineSteps));
     EXPECT_EQ(defaults.at("refraction_steps"),
-              std::to_string(RendererOptions{}.refractionMarchSteps));
+              std::to_string(RendererOptions{}.specular.refractionMarchSteps));
     EXPECT_EQ(defaults.at("specular_vpl_stride"),
-              std::to_string(RendererOptions{}.specularVplStride));
+              std::to_string(RendererOptions{}.specular.vplStride));
     EXPECT_THROW(benchGrid(cam, true, {{"specular_vpl_stride", {"8"}}}), Error);
     EXPECT_EQ(defaults.at("specular_resolution"),
-              RendererOptions{}.specularHalfResolution ? "half" : "full");
+              RendererOptions{}.specular.halfResolution ? "half" : "full");
     EXPECT_THROW(benchGrid(cam, true, {{"specular_resolution", {"quarter"}}}), Error);
     EXPECT_THROW(benchGrid(cam, true, {{"refraction_steps", {"1"}}}), Error);
 }

@@ -157,8 +157,8 @@ TEST_F(RealtimeLens, IdentityRemapVariantComposesAsTheTable) {
     cv::randu(footage, 0, 255);
     auto composite = [&](const CameraIntrinsics& c, bool identity) {
         RendererOptions o;
-        o.vplCount = 64;
-        o.compositeIdentityRemap = identity;
+        o.vpl.count = 64;
+        o.composite.identityRemap = identity;
         Renderer r(scene, c, o);
         r.render({view, footage, true});
         EXPECT_GT(r.specularRects().size(), 0u);

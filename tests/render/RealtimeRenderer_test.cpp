@@ -24,7 +24,7 @@ namespace {
 // the direct-light pass otherwise writes only its sum with the indirect light (LRv / LR).
 RendererOptions directLightKept() {
     RendererOptions o;
-    o.keepDirectLight = true;
+    o.direct.keepDirectLight = true;
     return o;
 }
 
@@ -245,8 +245,8 @@ TEST_F(RealtimeRenderer, VirtualShadowOnlyInLrv) {
     addLight(s.scene, Light::Type::Spot, glm::vec3(s.lightPos), glm::vec3(axis), 8.0f, Origin::Real,
              1.0f, 0.9f);
     RendererOptions opt;
-    opt.keepDirectLight = true;  // DirectRv apart from LRv (this scene has VPLs)
-    opt.vplCount = 64;
+    opt.direct.keepDirectLight = true;  // DirectRv apart from LRv (this scene has VPLs)
+    opt.vpl.count = 64;
     Renderer r(s.scene, s.cam, opt);
     // Footage: the real world alone, as the camera would see it (L_r, sRGB-encoded).
     r.render({s.pose, {}, false});
@@ -310,7 +310,7 @@ TEST_F(RealtimeRenderer, RealOnlySceneCompositeEqualsFootage) {
     addBox(s.scene, "real box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f}, red, Origin::Real);
     RendererOptions opt;
     opt.cullPasses = false;
-    opt.vplCount = 64;
+    opt.vpl.count = 64;
     Renderer r(s.scene, s.cam, opt);
     cv::Mat footage(s.cam.height, s.cam.width, CV_8UC3);
     cv::randu(footage, 0, 255);
@@ -404,7 +404,7 @@ TEST_F(RealtimeRenderer, CameraIndependentPassesAreReusedAcrossFrames) {
     int red = addMaterial(s.scene, {0.8f, 0.1f, 0.1f});
     addBox(s.scene, "virtual box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f}, red, Origin::Virtual);
     RendererOptions opt;
-    opt.vplCount = 64;
+    opt.vpl.count = 64;
     opt.temporalBlend = 0.0f;  // frames comparable one by one
     cv::Mat footage(s.cam.height, s.cam.width, CV_8UC3, cv::Scalar(90, 100, 110));
     const Pose second = lookAtPose({0.8, 2.2, 2.6}, {0, 0.2, 0});
@@ -511,12 +511,12 @@ TEST_F(RealtimeRenderer, ImperfectShadowMapsAreFilled) {
     addBox(s.scene, "virtual box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.6f, 0.3f}, m, Origin::Virtual);
     addBox(s.scene, "real box", {0.5f, 0.0f, -0.3f}, {0.9f, 0.6f, 0.3f}, m, Origin::Real);
     RendererOptions opt;
-    opt.vplCount = 16;
+    opt.vpl.count = 16;
     Renderer r(s.scene, s.cam, opt);
     r.render({s.pose, {}, false});
     ASSERT_TRUE(r.plan().needRealOnlyIsm);
     cv::Mat all = r.readIsmAtlas(false), real = r.readIsmAtlas(true);
-    const int tile = opt.ismTileSize;
+    const int tile = opt.ism.tileSize;
     int coveredAll = 0, coveredReal = 0;
     for (int y = 0; y < all.rows; ++y)
         for (int x = 0; x < all.cols; ++x) {

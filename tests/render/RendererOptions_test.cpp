@@ -27,37 +27,38 @@ TEST(RendererOptions, DefaultsAreValid) {
 
 TEST(RendererOptions, ShadowBiasIsMetresInZeroToOne) {
     RendererOptions o;
-    EXPECT_FLOAT_EQ(o.shadowBias, 0.001f);  // 1 mm: what the shaders used before it was metres
+    EXPECT_FLOAT_EQ(o.shadow.bias, 0.001f);  // 1 mm: what the shaders used before it was metres
     for (float bad : {-0.001f, 1.5f, std::numeric_limits<float>::quiet_NaN(),
                       std::numeric_limits<float>::infinity()}) {
-        o.shadowBias = bad;
-        EXPECT_NE(refusal(o).find("shadowBias must be in [0, 1] metres"), std::string::npos) << bad;
+        o.shadow.bias = bad;
+        EXPECT_NE(refusal(o).find("shadow.bias must be in [0, 1] metres"), std::string::npos)
+            << bad;
     }
-    o.shadowBias = 0.0f;
+    o.shadow.bias = 0.0f;
     EXPECT_EQ(refusal(o), "accepted");
 }
 
 TEST(RendererOptions, OtherRangesNameTheOption) {
     RendererOptions o;
-    o.vplCount = -1;
-    EXPECT_NE(refusal(o).find("vplCount"), std::string::npos);
+    o.vpl.count = -1;
+    EXPECT_NE(refusal(o).find("vpl.count"), std::string::npos);
     for (int bad : {-1, 5}) {
         o = {};
-        o.indirectScale = bad;
-        EXPECT_NE(refusal(o).find("indirectScale"), std::string::npos) << bad;
+        o.indirect.scale = bad;
+        EXPECT_NE(refusal(o).find("indirect.scale"), std::string::npos) << bad;
     }
     o = {};
-    o.backProjectionEpsilon = std::numeric_limits<float>::quiet_NaN();
-    EXPECT_NE(refusal(o).find("backProjectionEpsilon"), std::string::npos);
+    o.specular.backProjectionEpsilon = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_NE(refusal(o).find("specular.backProjectionEpsilon"), std::string::npos);
     for (float bad : {0.0f, 0.6f, std::numeric_limits<float>::quiet_NaN()}) {
         o = {};
-        o.causticGatherRadius = bad;
-        EXPECT_NE(refusal(o).find("causticGatherRadius"), std::string::npos) << bad;
+        o.caustic.gatherRadius = bad;
+        EXPECT_NE(refusal(o).find("caustic.gatherRadius"), std::string::npos) << bad;
     }
     for (int bad : {-1, (1 << 20) + 1}) {
         o = {};
-        o.causticGatherCap = bad;
-        EXPECT_NE(refusal(o).find("causticGatherCap"), std::string::npos) << bad;
+        o.caustic.gatherCap = bad;
+        EXPECT_NE(refusal(o).find("caustic.gatherCap"), std::string::npos) << bad;
     }
 }
 
@@ -65,16 +66,16 @@ TEST(RendererOptions, OtherRangesNameTheOption) {
 // light's detail relative to the image does not depend on the resolution. An explicit scale wins.
 TEST(RendererOptions, AutomaticGatherScaleFollowsTheCanvasWidth) {
     RendererOptions o;
-    ASSERT_EQ(o.indirectScale, 0);
-    EXPECT_EQ(o.gatherScale(160), 1);
-    EXPECT_EQ(o.gatherScale(100), 1);  // never below 1
-    EXPECT_EQ(o.gatherScale(320), 2);
-    EXPECT_EQ(o.gatherScale(480), 3);
-    EXPECT_EQ(o.gatherScale(640), 4);
-    EXPECT_EQ(o.gatherScale(1920), 4);  // at most 4
-    o.indirectScale = 2;
-    EXPECT_EQ(o.gatherScale(640), 2);
-    EXPECT_EQ(o.gatherScale(160), 2);
+    ASSERT_EQ(o.indirect.scale, 0);
+    EXPECT_EQ(o.indirect.gatherScale(160), 1);
+    EXPECT_EQ(o.indirect.gatherScale(100), 1);  // never below 1
+    EXPECT_EQ(o.indirect.gatherScale(320), 2);
+    EXPECT_EQ(o.indirect.gatherScale(480), 3);
+    EXPECT_EQ(o.indirect.gatherScale(640), 4);
+    EXPECT_EQ(o.indirect.gatherScale(1920), 4);  // at most 4
+    o.indirect.scale = 2;
+    EXPECT_EQ(o.indirect.gatherScale(640), 2);
+    EXPECT_EQ(o.indirect.gatherScale(160), 2);
 }
 
 }  // namespace

@@ -30,8 +30,8 @@ using test::RoughTestScene;
 
 RendererOptions withMethod(RoughRefractionMethod m, int subdivisions = 4) {
     RendererOptions o = test::roughSingleFrame();
-    o.roughRefraction = m;
-    o.gsrSubdivisions = subdivisions;
+    o.rough.method = m;
+    o.rough.gsrSubdivisions = subdivisions;
     return o;
 }
 

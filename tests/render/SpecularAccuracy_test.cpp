@@ -141,7 +141,7 @@ TEST(SpecularAccuracy, PerEffectAndBrokenRenderFails) {
         // The other interleaving: the default is 16 (4x4 tiles); 4 (2x2) must meet the floors too
         // and, summing 4x the VPLs per hit, be no worse than the default.
         RendererOptions o;
-        o.specularVplStride = 4;
+        o.specular.vplStride = 4;
         const Result dense = realtime(c, s, o);
         std::cout << "[ specular ] both (glass), specularVplStride 4: PSNR " << dense.psnr
                   << " dB, SSIM " << dense.ssim << "\n";
@@ -204,7 +204,7 @@ double meanAbsDiff(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
     return (m[0] + m[1] + m[2]) / 3.0;
 }
 
-// Half-resolution specular lighting (RendererOptions::specularHalfResolution) against the
+// Half-resolution specular lighting (RendererOptions::specular.halfResolution) against the
 // reference over the glass and the mirror sphere: within the floors, and within 0.5 dB of the
 // full-resolution render over the glass sphere (2.5 dB over the small mirror sphere, see below).
 // What keeps it there at depth steps is the upsample's geometry test: over the glass sphere's
@@ -215,7 +215,7 @@ TEST(SpecularAccuracy, HalfResolutionLightingKeepsTheFloorsAndNeedsItsGeometryTe
     test::SpecularCase k;  // real light, virtual object, real surroundings
     const auto envDir = test::outputDir("specular_env_half");
     RendererOptions half;
-    half.specularHalfResolution = true;
+    half.specular.halfResolution = true;
     for (const auto kind : {test::SpecularKind::Glass, test::SpecularKind::Mirror}) {
         const auto s = test::makeSpecularScene(k, envDir, kind);
         const Comparison c = reference(s);
@@ -236,7 +236,7 @@ TEST(SpecularAccuracy, HalfResolutionLightingKeepsTheFloorsAndNeedsItsGeometryTe
     const auto s = test::makeSpecularScene(k, envDir);
     const Comparison c = reference(s);
     RendererOptions plain = half;
-    plain.specularUpsampleGeometry = false;
+    plain.specular.upsampleGeometry = false;
     const StepPixels full = specularAtHitSteps(c, s, {});
     const StepPixels withGeometry = specularAtHitSteps(c, s, half);
     const StepPixels bilinear = specularAtHitSteps(c, s, plain);

@@ -230,7 +230,7 @@ TEST(SpecularHardCases, RealObjectOccludedInVideoIsRejectedByDepth) {
     cv::Mat validated, unvalidated;
     for (float eps : {0.02f, 1.0f}) {
         RendererOptions o = singleFrame();
-        o.backProjectionEpsilon = eps;
+        o.specular.backProjectionEpsilon = eps;
         Renderer r(s.scene, s.cam, o);
         r.render({s.pose, ref.footage, true});
         expectFiniteBuffers(r);

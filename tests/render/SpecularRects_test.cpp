@@ -82,10 +82,10 @@ const Pose kOtherPose = test::lookAtPose({-0.25, 0.35, 0.55}, {0.05, 0.0, -0.05}
 
 RendererOptions options(bool perObject) {
     RendererOptions o;
-    o.vplCount = 64;
+    o.vpl.count = 64;
     o.temporalBlend = 0.0f;
-    o.specularRectsPerObject = perObject;
-    o.keepDirectLight = true;  // DirectRv apart from LRv (the tabletop has VPL light)
+    o.specular.rectsPerObject = perObject;
+    o.direct.keepDirectLight = true;  // DirectRv apart from LRv (the tabletop has VPL light)
     return o;
 }
 
@@ -189,7 +189,7 @@ TEST_F(SpecularRectsRender, DiffusePassesSkipTheSpecularPixelsAndChangeNoComposi
     const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf");
     auto renderWith = [&](bool diffuseOnSpecular, const CameraIntrinsics& camera) {
         RendererOptions o = options(true);
-        o.diffuseOnSpecularPixels = diffuseOnSpecular;
+        o.direct.onSpecularPixels = diffuseOnSpecular;
         Renderer r(scene, camera, o);
         const cv::Mat footage(camera.height, camera.width, CV_8UC3, cv::Scalar(90, 110, 130));
         r.render({kPose, footage, true});

@@ -130,7 +130,7 @@ TEST(SpecularVpl, MirrorVplsCarryTheReflectedFluxToTheWall) {
     const Frame bare = renderRealtime(makeRelay({false}), black, all);
     const Frame on = renderRealtime(makeRelay(), black);
     RendererOptions offOpt;
-    offOpt.reflectedRefractedVpls = false;
+    offOpt.vpl.throughSpecular = false;
     const Frame off = renderRealtime(makeRelay(), black, offOpt);
     ASSERT_TRUE(on.report.ran("photongbuf"));
     ASSERT_TRUE(on.vpls.finite && off.vpls.finite && bare.vpls.finite);
@@ -210,7 +210,7 @@ TEST(SpecularVpl, FloorLitByTheMirrorsBounceMatchesReference) {
     ASSERT_GT(cv::countNonZero(region), 200);
     const Frame on = renderRealtime(s, footage);
     RendererOptions offOpt;
-    offOpt.reflectedRefractedVpls = false;
+    offOpt.vpl.throughSpecular = false;
     const Frame off = renderRealtime(s, footage, offOpt);
     ASSERT_EQ(on.lrv.size(), ref.realAndVirtual.size());  // an undistorted camera: canvas = image
     // L_rv there is the light the mirror throws onto the wall, bounced once (the light's cone

@@ -46,9 +46,9 @@ struct Realtime {
 Realtime renderRealtime(const Scene& scene, bool translucency = true) {
     const raytrace::RenderCamera cam = testCamera();
     RendererOptions opt;
-    opt.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
-    opt.vnmResolution = kResolution;
-    opt.translucency = translucency;
+    opt.direct.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
+    opt.translucency.vnmResolution = kResolution;
+    opt.translucency.enabled = translucency;
     Renderer r(scene, cam.intrinsics, opt);
     const FrameReport& rep = r.render({cam.T_world_camera, cv::Mat(), true});
     Realtime out;
@@ -192,8 +192,8 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     const Scene scene = translucentTestScene({}, dir);
     const raytrace::RenderCamera cam = testCamera();
     RendererOptions opt;
-    opt.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
-    opt.vnmResolution = 8;
+    opt.direct.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
+    opt.translucency.vnmResolution = 8;
     Renderer r(scene, cam.intrinsics, opt);
     auto objectMean = [&](const cv::Mat& rv) {
         const cv::Mat pos = r.readBuffer(kGBufferPosition);
@@ -295,8 +295,8 @@ TEST_F(TranslucencyPass, TwoObjectsEachHaveTheirOwnMap) {
     const Scene scene = cubesScene(cubes, 0.3f, dir);
     const raytrace::RenderCamera cam = lookAtCamera(48, 32, 45.0, {0.2, 0.5, 1.4}, {0, 0, 0});
     RendererOptions opt;
-    opt.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
-    opt.vnmResolution = 8;
+    opt.direct.keepDirectLight = true;  // DirectRv apart from LRv in frames with VPLs
+    opt.translucency.vnmResolution = 8;
     Renderer r(scene, cam.intrinsics, opt);
     const FrameReport& rep = r.render({cam.T_world_camera, cv::Mat(), true});
     ASSERT_TRUE(rep.ran("translucency")) << rep.summary();
@@ -354,7 +354,7 @@ TEST_F(TranslucencyPass, TwoObjectsEachHaveTheirOwnMap) {
         nine.push_back({{-0.4f + 0.1f * float(i), 0.0f, 0.0f}, 8.0f, glm::vec3(0.8f)});
     const Scene many = cubesScene(nine, 0.06f, dir);
     RendererOptions small;
-    small.vnmResolution = 4;
+    small.translucency.vnmResolution = 4;
     Renderer r9(many, cam.intrinsics, small);
     const FrameReport& rep9 = r9.render({cam.T_world_camera, cv::Mat(), true});
     EXPECT_NE(rep9.summary().find("8 translucent object(s)"), std::string::npos) << rep9.summary();

@@ -69,8 +69,8 @@ Realtime renderRealtime(const test::CausticScene& s, const cv::Mat& footage, boo
                         bool directOnly = false) {
     RendererOptions opt;
     opt.temporalBlend = 0.0f;
-    opt.vnmResolution = 8;
-    opt.translucentShadows = shadows;
+    opt.translucency.vnmResolution = 8;
+    opt.translucency.shadows = shadows;
     Renderer r(s.scene, s.cam, opt);
     const FrameReport& rep = r.render({s.pose, footage, true});
     EXPECT_EQ(rep.summary().find("a translucent object transmits") != std::string::npos, shadows)

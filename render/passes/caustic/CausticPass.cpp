@@ -15,7 +15,7 @@ CausticPass::CausticPass()
 namespace {
 // The history's share this frame: RendererOptions::temporalBlend where caustics are smoothed.
 float causticBlend(const FrameContext& ctx) {
-    return ctx.options.causticTemporal ? ctx.options.temporalBlend : 0.0f;
+    return ctx.options.caustic.temporal ? ctx.options.temporalBlend : 0.0f;
 }
 }  // namespace
 
@@ -81,9 +81,9 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSplatNormal, res.texture(kGBufferNormal).id());
     glBindTextureUnit(kUnitSplatEmissive, res.texture(kGBufferEmissive).id());
     glBindImageTexture(kImageCausticAccum, accum_.id(), 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
-    const int s = ctx.options.causticMapSize;
+    const int s = ctx.options.caustic.mapSize;
     glUniform1i(splat_.uniformLocation("mapSize"), s);
-    glUniform1f(splat_.uniformLocation("quadScale"), ctx.options.causticQuadScale);
+    glUniform1f(splat_.uniformLocation("quadScale"), ctx.options.caustic.quadScale);
     glUniform1f(splat_.uniformLocation("fixedScale"), fixedScale);
     glDispatchCompute(GLuint((s + 7) / 8), GLuint((s + 7) / 8), GLuint(2 * ctx.plan.causticLayers));
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);

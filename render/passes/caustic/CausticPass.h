@@ -4,7 +4,7 @@
 // atomics into a fixed-point irradiance buffer, depth-rejected against the G-buffer), then
 // resolved into the caustic radiance the receivers reflect, routed into L_rv and L_r by Eqs.
 // 12-14. The composite adds CausticRv / CausticR to the GI solutions. The irradiance is
-// smoothed over time before the routing (RendererOptions::causticTemporal): two canvas-size
+// smoothed over time before the routing (RendererOptions::caustic.temporal): two canvas-size
 // buffers ping-pong as this frame's result and the next frame's history.
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"

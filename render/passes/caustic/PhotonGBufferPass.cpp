@@ -28,12 +28,12 @@ void PhotonGBufferPass::setup(PassBuilder& b) const {
 
 PassDecision PhotonGBufferPass::decide(const FrameContext& ctx) const {
     if (ctx.plan.causticLayers == 0) return {false, ctx.plan.causticReason};
-    const int s = ctx.options.causticMapSize;
+    const int s = ctx.options.caustic.mapSize;
     return {true, ctx.plan.causticReason + ": " + std::to_string(s) + "^2 photons each"};
 }
 
 void PhotonGBufferPass::resize(const FrameContext& ctx) {
-    const int s = ctx.options.causticMapSize, layers = std::max(1, ctx.plan.causticLayers);
+    const int s = ctx.options.caustic.mapSize, layers = std::max(1, ctx.plan.causticLayers);
     if (s == allocatedSize_ && layers == allocatedLayers_) return;
     backPosition_ = gl::Texture::create2D("photon back-face position", s, s, GL_RGBA32F);
     backNormal_ = gl::Texture::create2D("photon back-face normal", s, s, GL_RGBA16F);
@@ -119,7 +119,8 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1i(photonProgram_.uniformLocation("lightIndex"), int(li));
         glUniform1f(photonProgram_.uniformLocation("mapSize"), float(s));
         glUniform1f(photonProgram_.uniformLocation("tanHalf"), lp.causticTanHalf);
-        glUniform1i(photonProgram_.uniformLocation("marchSteps"), ctx.options.refractionMarchSteps);
+        glUniform1i(photonProgram_.uniformLocation("marchSteps"),
+                    ctx.options.specular.refractionMarchSteps);
         const GLint locPhotonSlot = photonProgram_.uniformLocation("specularSlot");
         for (size_t slot = 0; slot < spec.size(); ++slot) {
             glUniform1i(locPhotonSlot, int(slot));

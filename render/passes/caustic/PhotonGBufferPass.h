@@ -1,7 +1,7 @@
 #pragma once
 // Photon G-buffers (Knecht 2013 Sec. 5.2; docs/caustics.md): for every spot light whose cone
 // holds a mirror or glass object, the specular objects rendered from the light (a frustum
-// fitted to their bounding sphere, RendererOptions::causticMapSize^2 texels): per texel one
+// fitted to their bounding sphere, RendererOptions::caustic.mapSize^2 texels): per texel one
 // reflected and one refracted photon (PGBuf_refl, PGBuf_refr) with its power by pixel counting
 // and its receiver hit traced through the impostors. Camera-independent: reused while the scene,
 // lights and plan stay.

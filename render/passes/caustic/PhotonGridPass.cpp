@@ -23,7 +23,7 @@ void PhotonGridPass::setup(PassBuilder& b) const {
 
 PassDecision PhotonGridPass::gatherDecision(const FrameContext& ctx) {
     if (ctx.plan.causticLayers == 0) return {false, ctx.plan.causticReason};
-    if (!ctx.options.causticGather) return {false, "caustic gather off"};
+    if (!ctx.options.caustic.gather) return {false, "caustic gather off"};
     if (ctx.specularScissor.z <= 0 || ctx.specularScissor.w <= 0)
         return {false, "no mirror or glass object in view: no reflected or refracted hit"};
     return {true, "the photons of " + std::to_string(ctx.plan.causticLayers) +
@@ -31,7 +31,8 @@ PassDecision PhotonGridPass::gatherDecision(const FrameContext& ctx) {
 }
 
 bool PhotonGridPass::sceneCanGather(const GpuScene& scene, const RendererOptions& options) {
-    if (!options.caustics || !options.causticGather || scene.specularDraws().empty()) return false;
+    if (!options.caustic.enabled || !options.caustic.gather || scene.specularDraws().empty())
+        return false;
     for (const SceneLight& l : scene.lights())
         if (l.type == kLightSpot) return true;
     return false;
@@ -46,7 +47,7 @@ PassDecision PhotonGridPass::decide(const FrameContext& ctx) const {
 }
 
 void PhotonGridPass::resize(const FrameContext& ctx) {
-    const size_t s = size_t(ctx.options.causticMapSize);
+    const size_t s = size_t(ctx.options.caustic.mapSize);
     const size_t n = s * s * 2 * size_t(std::max(1, ctx.plan.causticLayers));
     if (n == capacity_) return;
     records_ = gl::Buffer("photon records", n * sizeof(GpuPhoton));
@@ -57,7 +58,7 @@ void PhotonGridPass::resize(const FrameContext& ctx) {
 }
 
 void PhotonGridPass::execute(FrameContext& ctx, PassResources& res) {
-    const int s = ctx.options.causticMapSize;
+    const int s = ctx.options.caustic.mapSize;
     const GLuint groups = GLuint((s + 7) / 8), layers = GLuint(2 * ctx.plan.causticLayers);
     const float cell = cellSize(ctx.options);
     glBindTextureUnit(kUnitGridReflHit, res.texture(kPhotonHitRefl).id());
@@ -82,7 +83,7 @@ void PhotonGridPass::execute(FrameContext& ctx, PassResources& res) {
     scatter_.use();
     glUniform1i(scatter_.uniformLocation("mapSize"), s);
     glUniform1f(scatter_.uniformLocation("cellSize"), cell);
-    glUniform1f(scatter_.uniformLocation("quadScale"), ctx.options.causticQuadScale);
+    glUniform1f(scatter_.uniformLocation("quadScale"), ctx.options.caustic.quadScale);
     glUniform1ui(scatter_.uniformLocation("capacity"), GLuint(capacity_));
     glDispatchCompute(groups, groups, layers);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

@@ -31,9 +31,9 @@ public:
     // Whether the scene can ever gather (a spot light and a mirror or glass object, caustics and
     // the gather on): the specular light pass compiles its gather variant only then.
     static bool sceneCanGather(const GpuScene& scene, const RendererOptions& options);
-    // Grid cell edge (m): twice RendererOptions::causticGatherRadius.
+    // Grid cell edge (m): twice RendererOptions::caustic.gatherRadius.
     static float cellSize(const RendererOptions& options) {
-        return 2.0f * options.causticGatherRadius;
+        return 2.0f * options.caustic.gatherRadius;
     }
 
 private:

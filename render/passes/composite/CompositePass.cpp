@@ -89,7 +89,7 @@ void CompositePass::resize(const FrameContext& ctx) {
                           canvasToCamera_.width() == p.canvasWidth &&
                           canvasToCamera_.height() == p.canvasHeight;
     if (!sameSize) remapIsIdentity_ = isIdentityRemap(p);
-    const bool identity = ctx.options.compositeIdentityRemap && remapIsIdentity_;
+    const bool identity = ctx.options.composite.identityRemap && remapIsIdentity_;
     if (!programsBuilt_ || identity != identityRemap_) buildPrograms(identity);
     if (sameSize) return;
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
@@ -151,7 +151,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // The camera pixels of each specular object's canvas rectangle (the lens map can make two
     // overlap: merged again).
     std::vector<glm::ivec4> rects;
-    if (specular && ctx.options.showVirtual)
+    if (specular && ctx.options.composite.showVirtual)
         for (const glm::ivec4& r : ctx.specularRects) rects.push_back(cameraRect(ctx, r));
     rects = mergeOverlappingRects(std::move(rects));
     if (!rects.empty()) {
@@ -180,12 +180,12 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     if (withCaustics) {
         ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
-        glUniform1i(locShowVirtualDiffuse_, ctx.options.showVirtual ? 1 : 0);
+        glUniform1i(locShowVirtualDiffuse_, ctx.options.composite.showVirtual ? 1 : 0);
         glUniform1i(locWithCausticsDiffuse_, 1);
     } else {
         ctx.beginFullscreen(programDiffuseNoCaustics_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
-        glUniform1i(locShowVirtualNoCaustics_, ctx.options.showVirtual ? 1 : 0);
+        glUniform1i(locShowVirtualNoCaustics_, ctx.options.composite.showVirtual ? 1 : 0);
     }
     glBindTextureUnit(kUnitCompositeCamera, res.texture(kCameraImage).id());
     glBindTextureUnit(kUnitCompositeLRv, res.texture(kLRv).id());
@@ -211,7 +211,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
             glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
-    if (!rects.empty() && !ctx.options.diffuseOnSpecularPixels) {
+    if (!rects.empty() && !ctx.options.direct.onSpecularPixels) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);  // the triangle lies at depth 0.5: where the mask is 1
         glDepthMask(GL_FALSE);
@@ -222,7 +222,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glDepthFunc(GL_GREATER);  // where the mask is 0
         glDepthMask(GL_FALSE);
         program_.use();
-        glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
+        glUniform1f(locEpsilon_, ctx.options.specular.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
         // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:

@@ -66,7 +66,7 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.create(kLRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     b.create(kLR, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     // The direct light alone: LRv / LR themselves in frames without VPL light, else written
-    // apart only with RendererOptions::keepDirectLight.
+    // apart only with RendererOptions::direct.keepDirectLight.
     b.create(kDirectRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     b.create(kDirectR, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
 }
@@ -87,7 +87,7 @@ void DirectLightPass::resize(const FrameContext& ctx) {
     fbo_.attachColor(1, r_);
     fbo_.finalize(2);
     attachedMask_ = 0;
-    if (!ctx.options.keepDirectLight) return;
+    if (!ctx.options.direct.keepDirectLight) return;
     directRv_ = gl::Texture::create2D("direct L_rv", w, h, GL_RGBA16F);
     directR_ = gl::Texture::create2D("direct L_r", w, h, GL_RGBA16F);
     keepFbo_ = gl::Framebuffer("direct fbo (direct light kept)");
@@ -101,11 +101,11 @@ void DirectLightPass::resize(const FrameContext& ctx) {
 
 void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     const bool indirect = res.has(kGatherLight);
-    const bool keep = indirect && ctx.options.keepDirectLight;
+    const bool keep = indirect && ctx.options.direct.keepDirectLight;
     gl::Framebuffer& fbo = keep ? keepFbo_ : fbo_;
     const int targets = keep ? 4 : 2;
     GLuint& attached = keep ? keepAttachedMask_ : attachedMask_;
-    const gl::Texture* mask = res.has(kSpecularMask) && !ctx.options.diffuseOnSpecularPixels
+    const gl::Texture* mask = res.has(kSpecularMask) && !ctx.options.direct.onSpecularPixels
                                   ? &res.texture(kSpecularMask)
                                   : nullptr;
     if (mask && mask->id() != attached) {  // reallocated only on a resize

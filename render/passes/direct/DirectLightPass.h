@@ -3,7 +3,7 @@
 // in frames with VPL light, the filtered indirect light (gifilter's GatherLight) is upsampled
 // to the pixel and added in the same pass (gi_upsample.glsl); otherwise LRv / LR are the direct
 // light alone and are published as DirectRv / DirectR too. With
-// RendererOptions::keepDirectLight the direct light alone is also written to DirectRv /
+// RendererOptions::direct.keepDirectLight the direct light alone is also written to DirectRv /
 // DirectR in VPL frames (two more targets; tests and buffer views).
 #include <map>
 #include <tuple>
@@ -13,7 +13,7 @@
 namespace mirage::render {
 
 // Direct + environment + emission (canvas size): LRv itself in frames without VPL light, else
-// written apart only with RendererOptions::keepDirectLight.
+// written apart only with RendererOptions::direct.keepDirectLight.
 inline constexpr Resource kDirectRv{"DirectRv"};
 inline constexpr Resource kDirectR{"DirectR"};
 // The two GI solutions: direct + filtered, upsampled indirect (canvas size); LRv.a = the pixel's

@@ -51,9 +51,9 @@ void EnvironmentPass::setup(PassBuilder& b) const {
 PassDecision EnvironmentPass::decide(const FrameContext& ctx) const {
     const EnvironmentInput& e = ctx.environment;
     if (e.live)
-        return {true,
-                fmt::format("environment camera frame t = {:.3f} s -> {}x{} map", e.time,
-                            ctx.options.environmentMapWidth, ctx.options.environmentMapWidth / 2)};
+        return {true, fmt::format("environment camera frame t = {:.3f} s -> {}x{} map", e.time,
+                                  ctx.options.environment.mapWidth,
+                                  ctx.options.environment.mapWidth / 2)};
     return {true, ctx.scene.hasEnvironment() ? "the scene's static environment map"
                                              : "no environment (black)"};
 }
@@ -64,7 +64,7 @@ bool EnvironmentPass::upToDate(const FrameContext& ctx) const {
 
 void EnvironmentPass::resize(const FrameContext& ctx) {
     if (!ctx.environment.live) return;  // the static map needs no target
-    const int w = ctx.options.environmentMapWidth, h = w / 2;
+    const int w = ctx.options.environment.mapWidth, h = w / 2;
     if (map_.width() == w && map_.height() == h) return;
     map_ = gl::Texture::create2D("environment map (live)", w, h, GL_RGBA16F, mipLevels(w));
     map_.setFilter(GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR);

@@ -8,7 +8,7 @@
 //    reprojected onto the map through its calibration and pose (fisheye_to_equirect.frag, the
 //    unseen part filled by mirroring through the camera's image plane), mip-mapped, and projected
 //    to SH9 on the GPU (environment_sh.comp); when lights found in the frame are placed as lights
-//    of their own (RendererOptions::environmentLights), the SH9 is that of the map without them,
+//    of their own (RendererOptions::environment.lights), the SH9 is that of the map without them,
 //    computed on the CPU (render/EnvironmentLights.h), while the map keeps them (what rays see).
 //    Runs only when a new frame arrived (upToDate); every other frame the graph republishes the
 //    last map and SH.

@@ -48,21 +48,21 @@ void FuzzyReflectionPass::setup(PassBuilder& b) const {
 
 PassDecision FuzzyReflectionPass::decide(const FrameContext& ctx) const {
     // Rough glass is this pass's only with rough_method=filter (else render/passes/rough).
-    const bool filterGlass = ctx.options.roughRefraction == RoughRefractionMethod::Filter;
+    const bool filterGlass = ctx.options.rough.method == RoughRefractionMethod::Filter;
     const int metals = ctx.scene.roughReflectorCount(),
               glass = filterGlass ? ctx.scene.roughGlassCount() : 0;
     if (metals == 0 && glass == 0 && ctx.scene.roughGlassCount() > 0)
         return {false, fmt::format("no rough metal; rough glass by rough_method={}",
-                                   roughRefractionMethodName(ctx.options.roughRefraction))};
+                                   roughRefractionMethodName(ctx.options.rough.method))};
     if (metals + glass == 0)
         return {false,
                 fmt::format("no rough metal (roughness {} .. {}) or rough glass",
                             Material::kMirrorMaxRoughness, Material::kRoughReflectorMaxRoughness)};
-    if (!ctx.options.fuzzyReflections)
+    if (!ctx.options.fuzzy.enabled)
         return {false, "fuzzy filter off: rough metals and glass render as smooth"};
     return {true, fmt::format("{} rough metal(s), {} rough glass: cone {:g} deg, separable, {} "
                               "taps per side",
-                              metals, glass, ctx.options.fuzzyConeDeg, ctx.options.fuzzyTaps)};
+                              metals, glass, ctx.options.fuzzy.coneDeg, ctx.options.fuzzy.taps)};
 }
 
 void FuzzyReflectionPass::resize(const FrameContext& ctx) {
@@ -111,8 +111,8 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     // 1. The reflection's video term per rough pixel (the composite's back-projection).
     videoFbo_.bind();
     ctx.beginFullscreen(resolve_, w, h);
-    glUniform1f(locEpsilon_, ctx.options.backProjectionEpsilon);
-    const int filterGlass = ctx.options.roughRefraction == RoughRefractionMethod::Filter ? 1 : 0;
+    glUniform1f(locEpsilon_, ctx.options.specular.backProjectionEpsilon);
+    const int filterGlass = ctx.options.rough.method == RoughRefractionMethod::Filter ? 1 : 0;
     glUniform1i(locGlassResolve_, filterGlass);
     // The filters read neighbours anywhere in the rectangle around every specular object.
     const std::vector<glm::ivec4> rect{ctx.specularScissor};
@@ -122,7 +122,7 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     // 2. Rows, then columns of the rows' result. The canvas has the camera's focal lengths
     // (pixels per radian near the axis: Eq. 5's image size / view angle).
     const float focalPx = float(0.5 * (ctx.projection.camera.fx + ctx.projection.camera.fy));
-    const float cone = ctx.options.fuzzyConeDeg * kPi / 180.0f;
+    const float cone = ctx.options.fuzzy.coneDeg * kPi / 180.0f;
     for (int pass = 0; pass < 2; ++pass) {
         (pass == 0 ? rowsFbo_ : outFbo_).bind();
         ctx.beginFullscreen(filter_, w, h);
@@ -135,7 +135,7 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
         glUniform2i(locStep_, pass == 0 ? 1 : 0, pass == 0 ? 0 : 1);
         glUniform1f(locCone_, cone);
         glUniform1f(locFocal_, focalPx);
-        glUniform1i(locTaps_, ctx.options.fuzzyTaps);
+        glUniform1i(locTaps_, ctx.options.fuzzy.taps);
         glUniform1i(locGlassFilter_, filterGlass);
         ctx.clearForRects(rect, pass == 0 ? rowsDrawn_ : outDrawn_, 0, 5);
         ctx.drawFullscreenTriangleIn(rect);

@@ -26,8 +26,8 @@ void GiFilterPass::setup(PassBuilder& b) const {
 }
 
 PassDecision GiFilterPass::decide(const FrameContext& ctx) const {
-    return {true, std::string("geometry-aware ") + std::to_string(ctx.options.interleave) + "x" +
-                      std::to_string(ctx.options.interleave) + ", " +
+    return {true, std::string("geometry-aware ") + std::to_string(ctx.options.indirect.interleave) +
+                      "x" + std::to_string(ctx.options.indirect.interleave) + ", " +
                       history_.note(ctx, ctx.options.temporalBlend)};
 }
 

@@ -20,7 +20,7 @@ inline constexpr Resource kGatherLight{"GatherLight"};
 
 class GiFilterPass final : public RenderPass {
 public:
-    // interleave: RendererOptions::interleave (K), compiled into the filter shader.
+    // interleave: RendererOptions::indirect.interleave (K), compiled into the filter shader.
     explicit GiFilterPass(int interleave);
     const char* name() const override { return "gifilter"; }
     void setup(PassBuilder& b) const override;

@@ -123,16 +123,16 @@ void ImpostorPass::bindForTracing(const PassResources& res, TableViews& views) {
 PassDecision ImpostorPass::decide(const FrameContext& ctx) const {
     const size_t n = ctx.scene.specularDraws().size();
     if (n == 0) return {false, "no specular object"};
-    const char* method = ctx.options.impostorCubeMapBaseline ? "cube-map baseline" : "impostors";
-    if (stale(ctx.scene, ctx.options.impostorResolution))
+    const char* method = ctx.options.impostor.cubeMapBaseline ? "cube-map baseline" : "impostors";
+    if (stale(ctx.scene, ctx.options.impostor.resolution))
         return {true, fmt::format("{} for {} specular object(s) at {}^2 ({})",
                                   builtScene_ == &ctx.scene &&
-                                          builtResolution_ == ctx.options.impostorResolution
+                                          builtResolution_ == ctx.options.impostor.resolution
                                       ? "rebuild (objects moved)"
                                       : "build",
-                                  n, ctx.options.impostorResolution, method)};
+                                  n, ctx.options.impostor.resolution, method)};
     return {true, fmt::format("cached ({}, {} refinement steps; built once: {})", method,
-                              ctx.options.impostorRefineSteps, stats_.summary())};
+                              ctx.options.impostor.refineSteps, stats_.summary())};
 }
 
 void ImpostorPass::execute(FrameContext& ctx, PassResources& res) {
@@ -145,19 +145,19 @@ void ImpostorPass::execute(FrameContext& ctx, PassResources& res) {
 }
 
 bool ImpostorPass::update(const GpuScene& scene, const RendererOptions& o) {
-    if (o.impostorResolution < 8 || o.impostorResolution > 2048)
+    if (o.impostor.resolution < 8 || o.impostor.resolution > 2048)
+        throw Error(fmt::format("impostorResolution must be 8..2048 texels, got {}",
+                                o.impostor.resolution));
+    if (o.impostor.refineSteps < 0 || o.impostor.refineSteps > 64)
         throw Error(
-            fmt::format("impostorResolution must be 8..2048 texels, got {}", o.impostorResolution));
-    if (o.impostorRefineSteps < 0 || o.impostorRefineSteps > 64)
-        throw Error(
-            fmt::format("impostorRefineSteps must be 0..64, got {}", o.impostorRefineSteps));
+            fmt::format("impostorRefineSteps must be 0..64, got {}", o.impostor.refineSteps));
     return ensureBuilt(scene, o);
 }
 
 bool ImpostorPass::ensureBuilt(const GpuScene& scene, const RendererOptions& o) {
     bool rebuilt = false;
-    if (stale(scene, o.impostorResolution)) {
-        build(scene, o.impostorResolution);
+    if (stale(scene, o.impostor.resolution)) {
+        build(scene, o.impostor.resolution);
         rebuilt = true;
     }
     uploadMode(o);
@@ -171,8 +171,8 @@ bool ImpostorPass::stale(const GpuScene& scene, int resolution) const {
 
 void ImpostorPass::uploadMode(const RendererOptions& o) {
     GpuImpostorHeader h{};
-    h.cubeMapBaseline = o.impostorCubeMapBaseline ? 1 : 0;
-    h.refinementSteps = o.impostorRefineSteps;
+    h.cubeMapBaseline = o.impostor.cubeMapBaseline ? 1 : 0;
+    h.refinementSteps = o.impostor.refineSteps;
     h.objectCount = stats_.objects;
     h.coarseSamples = kCoarseSamples;
     h.cubeResolution = float(builtResolution_);

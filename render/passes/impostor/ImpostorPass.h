@@ -14,7 +14,7 @@
 // Everything is built once (the frame it happens, the report says "build ...", with its GPU time
 // in the pass timer) and cached while nothing moves; it is rebuilt in the frame after objects
 // moved (GpuScene::generation(), "rebuild (objects moved)") or when
-// RendererOptions::impostorResolution changes. Refinement steps and
+// RendererOptions::impostor.resolution changes. Refinement steps and
 // the baseline switch are per-frame uniforms (no rebuild). World = glTF frame (metres, +Y up).
 #include <string>
 #include <vector>

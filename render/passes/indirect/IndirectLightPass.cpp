@@ -25,9 +25,9 @@ void IndirectLightPass::setup(PassBuilder& b) const {
 }
 
 PassDecision IndirectLightPass::decide(const FrameContext& ctx) const {
-    const int k = std::max(1, ctx.options.interleave);
+    const int k = std::max(1, ctx.options.indirect.interleave);
     return {true, "interleaved " + std::to_string(k) + "x" + std::to_string(k) + ": " +
-                      std::to_string((ctx.options.vplCount + k * k - 1) / (k * k)) +
+                      std::to_string((ctx.options.vpl.count + k * k - 1) / (k * k)) +
                       " VPLs per pixel, at 1/" + std::to_string(ctx.gatherScale()) + " resolution"};
 }
 
@@ -52,7 +52,7 @@ void IndirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     ctx.emptyVao.bind();
     // One draw per VPL group into its tile: the group is uniform over the draw, so every pixel
     // walks the same VPL list (uniform loads; on llvmpipe divergent SSBO gathers are far slower).
-    const int k = std::max(1, ctx.options.interleave);
+    const int k = std::max(1, ctx.options.indirect.interleave);
     const int tw = rv.width() / k, th = rv.height() / k;
     const GLint locGroup = program_.uniformLocation("group");
     const GLint locTile = program_.uniformLocation("tileOrigin");

@@ -15,14 +15,14 @@ void IsmPass::setup(PassBuilder& b) const {
 }
 
 PassDecision IsmPass::decide(const FrameContext& ctx) const {
-    return {true, std::to_string(ctx.options.vplCount) + " VPLs x " +
-                      std::to_string(ctx.options.ismPointsPerVpl) + " points" +
+    return {true, std::to_string(ctx.options.vpl.count) + " VPLs x " +
+                      std::to_string(ctx.options.ism.pointsPerVpl) + " points" +
                       (ctx.plan.needRealOnlyIsm ? ", plus a real-only atlas"
                                                 : ", no virtual points: one atlas")};
 }
 
 void IsmPass::resize(const FrameContext& ctx) {
-    const int size = ismTilesPerRow(ctx.options.vplCount) * ctx.options.ismTileSize;
+    const int size = ismTilesPerRow(ctx.options.vpl.count) * ctx.options.ism.tileSize;
     if (size == allocatedSize_) return;
     all_ = gl::Texture::create2D("ism atlas", size, size, GL_R32UI);
     real_ = gl::Texture::create2D("ism atlas real-only", size, size, GL_R32UI);
@@ -45,10 +45,10 @@ void IsmPass::execute(FrameContext& ctx, PassResources& res) {
     glBindImageTexture(kImageIsmReal, real_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glUniform1i(program_.uniformLocation("pointCount"), ctx.scene.surfacePointCount());
     glUniform1i(program_.uniformLocation("writeReal"), ctx.plan.needRealOnlyIsm ? 1 : 0);
-    const float perVpl = float(std::max(1, ctx.options.ismPointsPerVpl));
+    const float perVpl = float(std::max(1, ctx.options.ism.pointsPerVpl));
     glUniform1f(program_.uniformLocation("pointRadius"),
                 std::sqrt(ctx.scene.surfaceArea() / (3.14159265f * perVpl)));
-    const long long invocations = (long long)ctx.options.vplCount * ctx.options.ismPointsPerVpl;
+    const long long invocations = (long long)ctx.options.vpl.count * ctx.options.ism.pointsPerVpl;
     glDispatchCompute(GLuint((invocations + 63) / 64), 1, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     res.publish(kImperfectShadowMaps, all_);

@@ -54,17 +54,17 @@ PassDecision RoughRefractionPass::decide(const FrameContext& ctx) const {
         return {false,
                 fmt::format("no rough glass (roughness above {})", Material::kMirrorMaxRoughness)};
     const RendererOptions& o = ctx.options;
-    if (o.roughRefraction == RoughRefractionMethod::Filter)
+    if (o.rough.method == RoughRefractionMethod::Filter)
         return {false, "rough glass by the fuzzy pass's image-space filter (rough_method=filter)"};
-    if (o.roughRefraction == RoughRefractionMethod::Gsr)
+    if (o.rough.method == RoughRefractionMethod::Gsr)
         return {true, fmt::format("{} rough glass: GSR, {} hemisphere subdivisions, {} mip levels",
-                                  glass, o.gsrSubdivisions, o.roughMipLevels)};
-    return {true, fmt::format("{} rough glass: LEAN, {} mip levels", glass, o.roughMipLevels)};
+                                  glass, o.rough.gsrSubdivisions, o.rough.mipLevels)};
+    return {true, fmt::format("{} rough glass: LEAN, {} mip levels", glass, o.rough.mipLevels)};
 }
 
 void RoughRefractionPass::resize(const FrameContext& ctx) {
     const int w = ctx.canvasWidth(), h = ctx.canvasHeight();
-    const int levels = std::min(ctx.options.roughMipLevels, fullChain(w, h));
+    const int levels = std::min(ctx.options.rough.mipLevels, fullChain(w, h));
     if (w == width_ && h == height_ && levels == levels_) return;
     width_ = w;
     height_ = h;
@@ -123,7 +123,7 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     // the box-filtered levels.
     chainsFbo_.bind();
     ctx.beginFullscreen(prefilter_, w, h);
-    glUniform1f(locPrefilterEpsilon_, ctx.options.backProjectionEpsilon);
+    glUniform1f(locPrefilterEpsilon_, ctx.options.specular.backProjectionEpsilon);
     const std::vector<glm::ivec4> rect{ctx.specularScissor};
     ctx.clearForRects(rect, chainsDrawn_, 0, kChains);
     ctx.drawFullscreenTriangleIn(rect);
@@ -139,8 +139,8 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     }
     outFbo_.bind();
     ctx.beginFullscreen(refraction_, w, h);
-    glUniform1i(locMethod_, ctx.options.roughRefraction == RoughRefractionMethod::Gsr ? 1 : 0);
-    glUniform1i(locSubdivisions_, ctx.options.gsrSubdivisions);
+    glUniform1i(locMethod_, ctx.options.rough.method == RoughRefractionMethod::Gsr ? 1 : 0);
+    glUniform1i(locSubdivisions_, ctx.options.rough.gsrSubdivisions);
     const CameraIntrinsics& K = ctx.projection.camera;
     glUniform1f(locFocal_, float(0.5 * (K.fx + K.fy)));
     glUniform1f(locMaxLevel_, float(levels_ - 1));

@@ -58,7 +58,7 @@ PassDecision ShadowPass::decide(const FrameContext& ctx) const {
 }
 
 void ShadowPass::resize(const FrameContext& ctx) {
-    const int layers = std::max(1, ctx.plan.shadowLayers), s = ctx.options.shadowMapSize;
+    const int layers = std::max(1, ctx.plan.shadowLayers), s = ctx.options.shadow.mapSize;
     if (layers == allocatedLayers_ && s == allocatedSize_) return;
     distance_ = gl::Texture::create2DArray("shadow distance", s, s, layers, GL_R32F);
     distanceReal_ = gl::Texture::create2DArray("shadow distance real-only", s, s, layers, GL_R32F);

@@ -104,7 +104,8 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         const gl::Program& program = programs_[mode];
         ctx.beginFullscreen(program, ctx.canvasWidth(), ctx.canvasHeight());
         if (mode == 1)
-            glUniform1i(program.uniformLocation("marchSteps"), ctx.options.refractionMarchSteps);
+            glUniform1i(program.uniformLocation("marchSteps"),
+                        ctx.options.specular.refractionMarchSteps);
         // Only specular pixels pass the early depth test (the triangle lies at depth 0.5).
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_GREATER);

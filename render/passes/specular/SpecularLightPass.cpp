@@ -41,7 +41,7 @@ namespace {
 // half-resolution variant has no history: its hits are shaded per 2x2 block and upsampled, and
 // the history test needs each pixel's own hits.
 float specularBlend(const FrameContext& ctx) {
-    return ctx.options.specularTemporal && !ctx.options.specularHalfResolution
+    return ctx.options.specular.temporal && !ctx.options.specular.halfResolution
                ? ctx.options.temporalBlend
                : 0.0f;
 }
@@ -53,7 +53,7 @@ SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOption
     if (sceneCanGather_)
         gather_ = makeVariant("specular light (caustic gather)",
                               scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-    if (options.specularHalfResolution) {
+    if (options.specular.halfResolution) {
         const std::string half = scene.lightingDefines() + "#define MIRAGE_SPECULAR_HALF 1\n";
         halfPlain_ = makeVariant("specular light (half resolution)", half);
         if (sceneCanGather_)
@@ -85,13 +85,13 @@ void SpecularLightPass::setup(PassBuilder& b) const {
 }
 
 PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
-    const bool vpls = ctx.options.specularVpls && ctx.plan.needVpls;
+    const bool vpls = ctx.options.specular.vpls && ctx.plan.needVpls;
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
                       (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
                       (vpls ? " + VPLs" : "") +
                       (PhotonGridPass::gatherDecision(ctx).run ? " + caustic photons" : "") +
                       " at the reflected/refracted hits" +
-                      (ctx.options.specularHalfResolution ? ", half resolution" : "") + ", " +
+                      (ctx.options.specular.halfResolution ? ", half resolution" : "") + ", " +
                       history_.note(ctx, specularBlend(ctx))};
 }
 
@@ -121,7 +121,7 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
         drawn_[i].markAll();
     }
     history_.drop();  // new buffers hold no history
-    if (!ctx.options.specularHalfResolution) return;
+    if (!ctx.options.specular.halfResolution) return;
     halfWidth_ = (w + 1) / 2;
     halfHeight_ = (h + 1) / 2;
     const int hw = halfWidth_, hh = halfHeight_;
@@ -183,7 +183,7 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
         glBindTextureUnit(GLuint(kUnitSpecResolveHalfFirst + i), half[i]->id());
     glBindTextureUnit(kUnitSpecResolveSlot, res.texture(kGBufferEmissive).id());
     glUniform1i(resolve_.uniformLocation("geometryTest"),
-                ctx.options.specularUpsampleGeometry ? 1 : 0);
+                ctx.options.specular.upsampleGeometry ? 1 : 0);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
@@ -193,10 +193,10 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
 void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
                                     const Variant& v) const {
     if (v.cellSize >= 0) glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
-    if (v.gatherCap >= 0) glUniform1ui(v.gatherCap, GLuint(ctx.options.causticGatherCap));
-    const bool vpls = ctx.options.specularVpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
+    if (v.gatherCap >= 0) glUniform1ui(v.gatherCap, GLuint(ctx.options.caustic.gatherCap));
+    const bool vpls = ctx.options.specular.vpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
     glUniform1i(v.useVpls, vpls ? 1 : 0);
-    glUniform1i(v.vplStride, ctx.options.specularVplStride);
+    glUniform1i(v.vplStride, ctx.options.specular.vplStride);
     if (v.historyWeight >= 0) {
         const float blend = specularBlend(ctx);
         glUniform1f(v.historyWeight, history_.usable(ctx, blend) ? blend : 0.0f);
@@ -224,7 +224,7 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
                       res.textureOr(kShadowGlass, ctx.noGlassTexture()).id());
     glBindTextureUnit(kUnitSpecLightGlassReal,
                       res.textureOr(kShadowGlassReal, ctx.noGlassTexture()).id());
-    const bool vpls = ctx.options.specularVpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
+    const bool vpls = ctx.options.specular.vpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
     if (vpls) {
         vplTexels_.attachBuffer(res.buffer(kVpls), GL_RGBA32F);
         glBindTextureUnit(kUnitSpecLightVpls, vplTexels_.id());
@@ -250,7 +250,7 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecLightHistoryR, r_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryRRefl, rRefl_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryHits, hits_[read].id());
-    if (ctx.options.specularHalfResolution && halfPlain_.program.id() != 0) {
+    if (ctx.options.specular.halfResolution && halfPlain_.program.id() != 0) {
         shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, write);
     } else {
         const Variant& v = gather ? gather_ : plain_;

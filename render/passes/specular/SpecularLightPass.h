@@ -5,9 +5,9 @@
 // modelled look up the environment map into L_env (specular_light.frag). In frames with a
 // world-space photon grid (PhotonGridPass) the hits also gather the caustic photons around them
 // (a shader variant: without a grid the frame pays nothing for it). L'_rv, L'_r and the
-// reflection's share are smoothed over time (RendererOptions::specularTemporal): they and the
+// reflection's share are smoothed over time (RendererOptions::specular.temporal): they and the
 // hits they were lit at ping-pong, this frame's result being the next frame's history (not in the
-// half-resolution variant, RendererOptions::specularHalfResolution: its hits are shaded per 2x2
+// half-resolution variant, RendererOptions::specular.halfResolution: its hits are shaded per 2x2
 // block, and the history test needs each pixel's own hits).
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"
@@ -56,7 +56,7 @@ private:
     gl::Texture vplTexels_ = gl::Texture::createBufferView("VPL texels (specular light)");
     TemporalHistory history_;
     int width_ = 0, height_ = 0;
-    // RendererOptions::specularHalfResolution: the half-resolution variants (built on first use),
+    // RendererOptions::specular.halfResolution: the half-resolution variants (built on first use),
     // the upsample, the half-size specular-pixel mask and hit radiance.
     bool sceneCanGather_ = false;
     Variant halfPlain_, halfGather_;

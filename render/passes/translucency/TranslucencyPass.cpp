@@ -30,8 +30,8 @@ static_assert(sizeof(ObjectHeader) == 80);
 
 TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
                                    const RendererOptions& options) {
-    if (!options.translucency) {
-        why_ = "translucency off (RendererOptions::translucency)";
+    if (!options.translucency.enabled) {
+        why_ = "translucency off (RendererOptions::translucency.enabled)";
         return;
     }
     std::vector<translucency::TranslucentObject> objects = translucency::translucentObjects(scene);
@@ -48,8 +48,8 @@ TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
     if (objects.size() > size_t(kMaxObjects)) objects.resize(size_t(kMaxObjects));
 
     translucency::VnmSettings settings;
-    settings.resolution = options.vnmResolution;
-    settings.cacheDir = options.vnmCacheDir;
+    settings.resolution = options.translucency.vnmResolution;
+    settings.cacheDir = options.translucency.vnmCacheDir;
     std::vector<ObjectHeader> headers;
     std::vector<int32_t> numbers;
     std::vector<glm::vec4> voxels;

@@ -22,14 +22,14 @@ PassDecision VplPass::decide(const FrameContext& ctx) const {
     if (!ctx.plan.needVpls) return {false, ctx.plan.vplReason};
     std::string reason = ctx.plan.vplReason;
     if (ctx.plan.causticLayers > 0)
-        reason += ctx.options.reflectedRefractedVpls
+        reason += ctx.options.vpl.throughSpecular
                       ? "; VPLs on mirror / glass follow the reflected / refracted photons"
                       : "; reflected / refracted VPLs off";
     return {true, reason};
 }
 
 void VplPass::resize(const FrameContext& ctx) {
-    const int n = std::max(1, ctx.options.vplCount);
+    const int n = std::max(1, ctx.options.vpl.count);
     if (n == allocated_) return;
     vpls_ = gl::Buffer("vpls", size_t(n) * sizeof(GpuVpl));
     allocated_ = n;
@@ -42,7 +42,7 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitVplRsmFlux, res.texture(kRsmFlux).id());
     glBindTextureUnit(kUnitVplRsmNormal, res.texture(kRsmNormal).id());
     glBindTextureUnit(kUnitVplRsmPosition, res.texture(kRsmPosition).id());
-    const bool follow = ctx.options.reflectedRefractedVpls && res.has(kPhotonHitRefl);
+    const bool follow = ctx.options.vpl.throughSpecular && res.has(kPhotonHitRefl);
     const Resource photons[6] = {kPhotonHitRefl, kPhotonPowerRefl, kPhotonSurfaceRefl,
                                  kPhotonHitRefr, kPhotonPowerRefr, kPhotonSurfaceRefr};
     const int units[6] = {kUnitVplPhotonHitRefl,     kUnitVplPhotonPowerRefl,
@@ -65,8 +65,8 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     glUniformMatrix4fv(program_.uniformLocation("causticViewProj"), kMaxLights, GL_FALSE,
                        &causticViewProj[0][0][0]);
     glUniform1fv(program_.uniformLocation("causticTanHalf"), kMaxLights, causticTanHalf);
-    glUniform1i(program_.uniformLocation("photonMapSize"), ctx.options.causticMapSize);
-    glDispatchCompute(GLuint((ctx.options.vplCount + 63) / 64), 1, 1);
+    glUniform1i(program_.uniformLocation("photonMapSize"), ctx.options.caustic.mapSize);
+    glDispatchCompute(GLuint((ctx.options.vpl.count + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(kVpls, vpls_);
 }

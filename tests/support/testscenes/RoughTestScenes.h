@@ -91,7 +91,7 @@ inline RoughReference roughReference(const RoughTestScene& s, int spp = 64, int 
 inline render::RendererOptions roughSingleFrame() {
     render::RendererOptions o;
     o.temporalBlend = 0.0f;
-    o.caustics = false;
+    o.caustic.enabled = false;
     return o;
 }
 

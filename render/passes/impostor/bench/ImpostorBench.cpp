@@ -57,9 +57,9 @@ Fixture& fixture(bool nearSphere) {
 void BM_Trace(benchmark::State& state) {
     Fixture& f = fixture(state.range(3) != 0);
     render::RendererOptions o;
-    o.impostorResolution = int(state.range(0));
-    o.impostorRefineSteps = int(state.range(1));
-    o.impostorCubeMapBaseline = state.range(2) != 0;
+    o.impostor.resolution = int(state.range(0));
+    o.impostor.refineSteps = int(state.range(1));
+    o.impostor.cubeMapBaseline = state.range(2) != 0;
     render::ImpostorPass pass;
     pass.update(*f.gpu, o);
     double ms = 0.0;

@@ -1,0 +1,53 @@
+#pragma once
+// Options of the caustics (render/passes/caustic, docs/caustics.md).
+#include "render/PassOptions.h"
+
+namespace mirage::render {
+
+struct CausticOptions {
+    // Caustics from spot lights (Knecht 2013 Sec. 4.2, 5.2): photon G-buffers of mapSize^2 texels
+    // per spot light whose cone holds a mirror or glass object (the frustum fitted to the
+    // objects' bounding sphere), splatted as quads whose world radius is quadScale x the spacing
+    // of neighbouring photons on the receiver (Wyman 2008).
+    bool enabled = true;
+    int mapSize = 256;
+    float quadScale = 1.5f;
+    // Caustics seen in reflections and refractions: the photons sorted into a world-space hashed
+    // grid (PhotonGridPass) and gathered at every reflected / refracted hit by the specular light
+    // pass, with each photon's kernel radius (quadScale photon spacings, widened to 1.5 of the
+    // hit's pixel footprints) at most gatherRadius metres, or up to twice that where the pixels
+    // are coarser (the grid's cells are twice it: the gather's cost grows with it). false: those
+    // hits get no caustic.
+    bool gather = true;
+    float gatherRadius = 0.01f;
+    // Photons the gather reads per grid bucket (0: all). A focused caustic puts tens of thousands
+    // of photons into one cell, and every hit near it would read them all (a glass sphere alone
+    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read with a
+    // stride (every s-th photon from a per-pixel offset) and what is read is weighted by
+    // count / read, so the estimate keeps its expectation and gains noise only where photons
+    // are dense. Off by default: which photons a stride reads depends on the order the grid's
+    // scatter put them in, which atomics on a multithreaded rasteriser (llvmpipe) vary from run to
+    // run, so a capped frame is not reproducible (measured: up to 0.4 % of the peak between two
+    // renderers of the same frame); replays and sharded runs are expected to be.
+    int gatherCap = 0;
+    // Temporal smoothing of the caustic buffer (Knecht 2013 end of Sec. 4.2; caustic_resolve.frag):
+    // this frame's caustic irradiance blended with last frame's, reprojected by the receiver's
+    // world position and rejected where the surface there is at another distance, with the GI
+    // filter's reset rules (render/TemporalHistory.h). A tracked camera jitters every frame,
+    // which moves the photon footprints over the pixels: without it the caustic shimmers. false:
+    // every frame's caustic stands alone.
+    bool temporal = true;
+
+    void validate() const {
+        checkOption(mapSize >= 16 && mapSize <= 2048 && mapSize % 8 == 0, "caustic.mapSize",
+                    "a multiple of 8 in 16..2048 texels", mapSize);
+        checkOption(quadScale >= 0.25f && quadScale <= 8.0f, "caustic.quadScale",
+                    "in [0.25, 8] (photon spacings)", quadScale);
+        checkOption(gatherRadius >= 0.001f && gatherRadius <= 0.5f, "caustic.gatherRadius",
+                    "in [0.001, 0.5] (metres)", gatherRadius);
+        checkOption(gatherCap >= 0 && gatherCap <= (1 << 20), "caustic.gatherCap",
+                    "0 (all photons) or 1..1048576 photons per bucket", gatherCap);
+    }
+};
+
+}  // namespace mirage::render

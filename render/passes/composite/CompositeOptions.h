@@ -1,0 +1,29 @@
+#pragma once
+// Options of the differential composite (render/passes/composite, docs/realtime-renderer.md).
+#include "render/PassOptions.h"
+
+namespace mirage::render {
+
+struct CompositeOptions {
+    float exposure = 1.0f;      // rendered linear radiance -> camera linear units
+    float alphaMax = 8.0f;      // cap of alpha = CI / L_r
+    float alphaFadeLr = 0.02f;  // where L_r (linear) is below this, alpha fades to 1
+    // Where the lens remap is the identity (no distortion, a canvas of the camera's size) the
+    // composite reads each canvas buffer at its own pixel (CompositePass::isIdentityRemap).
+    // false: it reads through the remap table there too (tests compare the two).
+    bool identityRemap = true;
+    // false: the composite is the footage unchanged, as if no virtual object existed (the live
+    // view's "hide" key; the bench's `virtual=off` sanity point, which must score as the footage).
+    bool showVirtual = true;
+
+    void validate() const {
+        checkOption(exposure > 0.0f && exposure < 1e6f, "composite.exposure",
+                    "a positive number below 1e6", exposure);
+        checkOption(alphaMax >= 1.0f && alphaMax <= 1e3f, "composite.alphaMax", "in [1, 1000]",
+                    alphaMax);
+        checkOption(alphaFadeLr >= 0.0f && alphaFadeLr <= 1.0f, "composite.alphaFadeLr",
+                    "in [0, 1]", alphaFadeLr);
+    }
+};
+
+}  // namespace mirage::render

@@ -1,0 +1,22 @@
+#pragma once
+// Options of the direct-light pass (render/passes/direct).
+#include "render/PassOptions.h"
+
+namespace mirage::render {
+
+struct DirectOptions {
+    // false (the default): `direct` (with the GI upsample) and the composite's diffuse variant skip
+    // the pixels that show a mirror or glass object (their light comes from the specular passes;
+    // FrameContext::drawFullscreenTriangleOutsideSpecular). true: they shade them too (tests
+    // compare the two).
+    bool onSpecularPixels = false;
+    // true: in frames with VPL light the pass also writes the direct light alone (DirectRv /
+    // DirectR; two more canvas targets), besides the GI solutions LRv / LR it sums with the
+    // upsampled indirect light. false (the default): DirectRv / DirectR exist only in frames
+    // without VPL light, where they are LRv / LR.
+    bool keepDirectLight = false;
+
+    void validate() const {}
+};
+
+}  // namespace mirage::render

@@ -1,0 +1,20 @@
+#pragma once
+// Options of the virtual point lights (render/passes/vpl, docs/realtime-renderer.md).
+#include "render/PassOptions.h"
+
+namespace mirage::render {
+
+struct VplOptions {
+    int count = 256;  // total VPLs per frame, split over the lights with RSMs
+    // A VPL whose reflective-shadow-map sample lands on a mirror or glass continues to the
+    // reflected or refracted photon's receiver (Knecht 2013 Sec. 5.2), for spot lights with
+    // photon G-buffers (caustics on); false: it stays on the mirror / glass, which scatters no
+    // diffuse light (the VPL is dark).
+    bool throughSpecular = true;
+
+    void validate() const {
+        checkOption(count >= 0 && count <= 16384, "vpl.count", "0..16384", count);
+    }
+};
+
+}  // namespace mirage::render
