@@ -84,6 +84,16 @@ const char* roughRefractionMethodName(RoughRefractionMethod m) {
     return "?";
 }
 
+const char* shadowFilterName(ShadowFilter f) {
+    switch (f) {
+        case ShadowFilter::Bilinear:
+            return "off";
+        case ShadowFilter::Pcf:
+            return "pcf";
+    }
+    return "?";
+}
+
 int ismTilesPerRow(int vplCount) {
     return std::max(1, int(std::ceil(std::sqrt(double(std::max(vplCount, 1))))));
 }

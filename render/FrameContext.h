@@ -38,6 +38,13 @@ struct DrawnRects {
     std::vector<glm::ivec4> rects;
 };
 
+// How the shadow maps are looked up (lighting.glsl; docs/realtime-renderer.md, "Shadow edges").
+enum class ShadowFilter {
+    Bilinear,  // the 2x2 texels around the lookup, bilinear weights: 1-texel stair steps
+    Pcf,       // 4x4 texels, a 2-texel box over the bilinear test: straight edges stay straight
+};
+const char* shadowFilterName(ShadowFilter f);  // "off" (bilinear), "pcf"
+
 struct RendererOptions {
     int vplCount = 256;          // total VPLs per frame, split over the lights with RSMs
     int shadowMapSize = 512;     // texels per side of each shadow / RSM layer
@@ -50,7 +57,15 @@ struct RendererOptions {
     int indirectScale = 0;
     float vplDistanceClamp = 0.1f;  // metres: VPL distance below this is clamped (no spikes)
     float shadowBias = 0.001f;      // metres: constant depth bias of the shadow-map test
-                                    // (lighting.glsl adds 1.5 texels' footprint / cos)
+                                    // (lighting.glsl adds the filter's reach in texel footprints
+                                    // / cos: 1.5 bilinear, 2.5 PCF)
+    // The shadow-map lookup: PCF over 4x4 texels (a point or spot light's hard shadow edge
+    // without the texel grid's stair steps) or the 2x2 bilinear lookup alone. Bilinear by
+    // default: at 512 texels a texel spans more than a pixel of the tabletop's shadow, and PCF's
+    // 2-texel ramp is then further from the reference's hard edge than the stair steps are (its
+    // penumbra error is halved only with shadowMapSize 2048; docs/realtime-renderer.md,
+    // "Shadow edges").
+    ShadowFilter shadowFilter = ShadowFilter::Bilinear;
     // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
     // and where switched on below the caustic buffer and the specular-hit light L'. Each frame
     // keeps (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend)
@@ -89,14 +104,14 @@ struct RendererOptions {
     float causticGatherRadius = 0.01f;
     // Photons the gather reads per grid bucket (0: all). A focused caustic puts tens of thousands
     // of photons into one cell, and every hit near it would read them all (a glass sphere alone
-    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read with a
-    // stride (every s-th photon from a per-pixel offset) and what is read is weighted
-    // by count / read, so the estimate keeps its expectation and gains noise only where photons
-    // are dense. Off by default: which photons a stride reads depends on the order the grid's
-    // scatter put them in, which atomics on a multithreaded rasteriser (llvmpipe) vary from run to
-    // run, so a capped frame is not reproducible (measured: up to 0.4 % of the peak between two
-    // renderers of the same frame); replays and sharded runs are expected to be.
-    int causticGatherCap = 0;
+    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read by its
+    // finest stratified subsample of the photon map (every 2nd, 4th, 8th or 16th texel per axis:
+    // the grid stores each bucket's photons by that level) of at most cap photons, weighted by
+    // count / read and with kernels widened by the stride, so the estimate keeps its expectation.
+    // The photons read depend on their texels only, not on the order the grid's scatter stored
+    // them in (atomics on a multithreaded rasteriser vary it from run to run), so a capped frame
+    // is reproducible; hence on by default (docs/caustics.md, "The gather's cap").
+    int causticGatherCap = 64;
     // Temporal smoothing of the caustic buffer (Knecht 2013 end of Sec. 4.2; render/passes/caustic
     // caustic_resolve.frag): this frame's caustic irradiance blended with last frame's,
     // reprojected by the receiver's world position and rejected where the surface there is at

@@ -380,6 +380,8 @@ void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view
     f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
     f.vplDistanceClamp = options_.vplDistanceClamp;
     f.shadowBias = options_.shadowBias;
+    f.shadowFilter =
+        options_.shadowFilter == ShadowFilter::Pcf ? kShadowFilterPcf : kShadowFilterBilinear;
     f.temporalBlend = options_.temporalBlend;
     f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
     f.exposure = options_.exposure;

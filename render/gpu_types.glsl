@@ -18,8 +18,20 @@
 #endif
 
 const int kMaxLights = 8;
+// Shadow-map lookups (lighting.glsl, RendererOptions::shadowFilter): the 2x2 texels around the
+// lookup with bilinear weights (one textureGather), or percentage-closer filtering over 4x4
+// texels with the weights of a 2-texel box over that bilinear (four textureGathers).
+const int kShadowFilterBilinear = 0;
+const int kShadowFilterPcf = 1;
 // Hash cells of the world-space photon grid (a power of two; PhotonGridPass).
 const int kPhotonGridCells = 65536;
+// Nested subsets of the photon map within each grid bucket (PhotonGridPass, caustic.glsl
+// photonLevel): level l holds the photon texels on the lattice of stride 2^(levels - 1 - l) that
+// no coarser lattice holds, so that a capped gather reads whole levels, a set of photons fixed by
+// their texels and not by the order the grid's scatter stored them in.
+const int kPhotonGridLevels = 5;
+// Counters (and first indices) of the grid: one per bucket and level.
+const int kPhotonGridSlots = kPhotonGridCells * kPhotonGridLevels;
 const int kLightPoint = 0;
 const int kLightSpot = 1;
 const int kLightDirectional = 2;
@@ -77,7 +89,7 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
     float exposure;     // rendered linear radiance -> camera linear units
     float alphaMax;     // cap of alpha = CI / L_r
     float alphaFadeLr;  // L_r below which alpha fades to 1
-    float framePad0;    // std140: the block is a multiple of 16 bytes
+    int shadowFilter;   // kShadowFilterBilinear or kShadowFilterPcf (RendererOptions::shadowFilter)
 };
 
 // The environment light (kBindingEnvironment): written by the environment pass
