@@ -278,6 +278,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
                         "the scene has no mesh in its node tree: nothing to render or composite "
                         "(add the real surfaces' proxies and the virtual objects as meshes)");
     scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environmentLights);
+    scene_->setShadowPcf(options_.shadowFilter == ShadowFilter::Pcf);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 
@@ -380,8 +381,6 @@ void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view
     f.ismTilesPerRow = ismTilesPerRow(options_.vplCount);
     f.vplDistanceClamp = options_.vplDistanceClamp;
     f.shadowBias = options_.shadowBias;
-    f.shadowFilter =
-        options_.shadowFilter == ShadowFilter::Pcf ? kShadowFilterPcf : kShadowFilterBilinear;
     f.temporalBlend = options_.temporalBlend;
     f.ismPointsPerVpl = float(options_.ismPointsPerVpl);
     f.exposure = options_.exposure;

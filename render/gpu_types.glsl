@@ -18,11 +18,6 @@
 #endif
 
 const int kMaxLights = 8;
-// Shadow-map lookups (lighting.glsl, RendererOptions::shadowFilter): the 2x2 texels around the
-// lookup with bilinear weights (one textureGather), or percentage-closer filtering over 4x4
-// texels with the weights of a 2-texel box over that bilinear (four textureGathers).
-const int kShadowFilterBilinear = 0;
-const int kShadowFilterPcf = 1;
 // Hash cells of the world-space photon grid (a power of two; PhotonGridPass).
 const int kPhotonGridCells = 65536;
 // Nested subsets of the photon map within each grid bucket (PhotonGridPass, caustic.glsl
@@ -89,7 +84,7 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
     float exposure;     // rendered linear radiance -> camera linear units
     float alphaMax;     // cap of alpha = CI / L_r
     float alphaFadeLr;  // L_r below which alpha fades to 1
-    int shadowFilter;   // kShadowFilterBilinear or kShadowFilterPcf (RendererOptions::shadowFilter)
+    float framePad0;    // std140: the block is a multiple of 16 bytes
 };
 
 // The environment light (kBindingEnvironment): written by the environment pass

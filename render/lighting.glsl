@@ -58,7 +58,11 @@ bool shadowFootprint(int li, vec3 p, float NdotL, float mapSize, out int layer, 
     // the exact slope, tan = sqrt(1 - NdotL^2) / NdotL, so that the bias shifts the shadow of an
     // occluder standing on the receiver (a box's base) no more than needed.
     float c = max(NdotL, 0.2);
-    float slope = shadowFilter == kShadowFilterPcf ? sqrt(1.0 - c * c) / c : 1.0 / c;
+#ifdef MIRAGE_SHADOW_PCF
+    float slope = sqrt(1.0 - c * c) / c;
+#else
+    float slope = 1.0 / c;
+#endif
     bias = shadowBias + 1.5 * extent / mapSize * slope;
     // The gather footprint at t is texels floor(t * size - 0.5) + {0, 1}^2: w = (0,0), z = (1,0),
     // x = (0,1), y = (1,1); clamp-to-edge at the borders.
@@ -96,22 +100,24 @@ float shadowPcf(sampler2DArray map, vec3 tc, float ref, vec2 fr) {
 
 // Fraction of the light reaching p (0..1) in the all-occluder shadow atlas (x) and, when
 // `withReal`, in the real-occluder one (y; else y = x): the layer whose frustum holds p, 2x2
-// bilinear or 4x4 percentage-closer filtered (shadowFilter). Bias grows with the texel footprint
+// bilinear or, with MIRAGE_SHADOW_PCF (GpuScene::setShadowPcf), 4x4 percentage-closer
+// filtered. Bias grows with the texel footprint
 // and the slope. The layer search and footprint are shared and each atlas is read with
 // textureGather: on llvmpipe every texel read is costly, so this is ~2x cheaper than separate
 // lookups.
 vec2 shadowVisibilityAt(sampler2DArray allMap, sampler2DArray realMap, int layer, vec2 t, float d,
                         float bias, vec2 fr, bool withReal) {
-    if (shadowFilter == kShadowFilterPcf) {
-        vec3 tc = vec3(t, float(layer));
-        float pcfAll = shadowPcf(allMap, tc, d - bias, fr);
-        return vec2(pcfAll, withReal ? shadowPcf(realMap, tc, d - bias, fr) : pcfAll);
-    }
+#ifdef MIRAGE_SHADOW_PCF
+    vec3 tc = vec3(t, float(layer));
+    float pcfAll = shadowPcf(allMap, tc, d - bias, fr);
+    return vec2(pcfAll, withReal ? shadowPcf(realMap, tc, d - bias, fr) : pcfAll);
+#else
     vec4 a = step(vec4(d - bias), textureGather(allMap, vec3(t, float(layer)), 0));
     float visAll = bilinearGather(a, fr);
     if (!withReal) return vec2(visAll);
     vec4 r = step(vec4(d - bias), textureGather(realMap, vec3(t, float(layer)), 0));
     return vec2(visAll, bilinearGather(r, fr));
+#endif
 }
 
 vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
