@@ -647,6 +647,7 @@ std::string GpuScene::lightingDefines(bool withGlass) const {
     // Translucent objects use the glass atlases too (their light through them).
     if (withGlass && (hasTransmissive() || hasTranslucent()))
         defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
+    if (shadowPcf_) defines += "#define MIRAGE_SHADOW_PCF 1\n";
     return defines;
 }
 

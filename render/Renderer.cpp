@@ -278,6 +278,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
                         "the scene has no mesh in its node tree: nothing to render or composite "
                         "(add the real surfaces' proxies and the virtual objects as meshes)");
     scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environment.lights);
+    scene_->setShadowPcf(options_.shadow.filter == ShadowFilter::Pcf);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 

@@ -20,6 +20,13 @@
 const int kMaxLights = 8;
 // Hash cells of the world-space photon grid (a power of two; PhotonGridPass).
 const int kPhotonGridCells = 65536;
+// Nested subsets of the photon map within each grid bucket (PhotonGridPass, caustic.glsl
+// photonLevel): level l holds the photon texels on the lattice of stride 2^(levels - 1 - l) that
+// no coarser lattice holds, so that a capped gather reads whole levels, a set of photons fixed by
+// their texels and not by the order the grid's scatter stored them in.
+const int kPhotonGridLevels = 5;
+// Counters (and first indices) of the grid: one per bucket and level.
+const int kPhotonGridSlots = kPhotonGridCells * kPhotonGridLevels;
 const int kLightPoint = 0;
 const int kLightSpot = 1;
 const int kLightDirectional = 2;

@@ -52,7 +52,18 @@ bool shadowFootprint(int li, vec3 p, float NdotL, float mapSize, out int layer, 
     float tanOrExtent = lights[li].frustumSize;
     float extent = lights[li].type == LIGHT_DIRECTIONAL ? 2.0 * tanOrExtent
                                                         : 2.0 * tanOrExtent * d;
-    bias = shadowBias + 1.5 * extent / mapSize / max(NdotL, 0.2);
+    // On a slope the receiver's depth changes by a texel's extent x tan(angle to the light) per
+    // texel (at most extent / NdotL, which the bilinear lookup allows for, 1.5 texels' worth).
+    // The PCF's taps reach 2 texels, but those carry at most 1/16 of the weight: 1.5 texels of
+    // the exact slope, tan = sqrt(1 - NdotL^2) / NdotL, so that the bias shifts the shadow of an
+    // occluder standing on the receiver (a box's base) no more than needed.
+    float c = max(NdotL, 0.2);
+#ifdef MIRAGE_SHADOW_PCF
+    float slope = sqrt(1.0 - c * c) / c;
+#else
+    float slope = 1.0 / c;
+#endif
+    bias = shadowBias + 1.5 * extent / mapSize * slope;
     // The gather footprint at t is texels floor(t * size - 0.5) + {0, 1}^2: w = (0,0), z = (1,0),
     // x = (0,1), y = (1,1); clamp-to-edge at the borders.
     fr = fract(t * mapSize - 0.5);
@@ -61,18 +72,52 @@ bool shadowFootprint(int li, vec3 p, float NdotL, float mapSize, out int layer, 
 
 float bilinearGather(vec4 g, vec2 fr) { return mix(mix(g.w, g.z, fr.x), mix(g.x, g.y, fr.x), fr.y); }
 
+// A textureGather's four texels (x: (0,1), y: (1,1), z: (1,0), w: (0,0)) weighted by separable
+// per-texel weights wx (columns 0, 1) and wy (rows 0, 1).
+float weightedGather(vec4 g, vec2 wx, vec2 wy) {
+    return dot(g, vec4(wx.x * wy.y, wx.y * wy.y, wx.y * wy.x, wx.x * wy.x));
+}
+
+// Percentage-closer filtering over the 4x4 texels around the lookup (columns and rows -1..2 of
+// the bilinear footprint, fr its fraction): the visibility averaged over a 2-texel box around t
+// of the bilinearly interpolated depth test. Per axis the weights are that box convolved with
+// the bilinear hat at offsets -1 - fr, -fr, 1 - fr, 2 - fr: (1 - fr)^2 / 4, 1/2 - fr^2 / 4,
+// 1/2 - (1 - fr)^2 / 4, fr^2 / 4 (they sum to 1). Continuous in t with a continuous slope, so a
+// straight occluder edge leaves a straight ramp about 2 texels wide instead of the bilinear
+// lookup's 1-texel stair steps. Four textureGathers.
+float shadowPcf(sampler2DArray map, vec3 tc, float ref, vec2 fr) {
+    vec2 a = 1.0 - fr;
+    vec2 w0 = 0.25 * a * a, w1 = 0.5 - 0.25 * fr * fr, w2 = 0.5 - 0.25 * a * a, w3 = 0.25 * fr * fr;
+    vec4 lo = step(vec4(ref), textureGatherOffset(map, tc, ivec2(-1, -1), 0));
+    vec4 rx = step(vec4(ref), textureGatherOffset(map, tc, ivec2(1, -1), 0));
+    vec4 ry = step(vec4(ref), textureGatherOffset(map, tc, ivec2(-1, 1), 0));
+    vec4 hi = step(vec4(ref), textureGatherOffset(map, tc, ivec2(1, 1), 0));
+    return weightedGather(lo, vec2(w0.x, w1.x), vec2(w0.y, w1.y)) +
+           weightedGather(rx, vec2(w2.x, w3.x), vec2(w0.y, w1.y)) +
+           weightedGather(ry, vec2(w0.x, w1.x), vec2(w2.y, w3.y)) +
+           weightedGather(hi, vec2(w2.x, w3.x), vec2(w2.y, w3.y));
+}
+
 // Fraction of the light reaching p (0..1) in the all-occluder shadow atlas (x) and, when
 // `withReal`, in the real-occluder one (y; else y = x): the layer whose frustum holds p, 2x2
-// percentage-closer filtered. Bias grows with the texel footprint and the slope. The layer search
-// and footprint are shared and each atlas is read with one textureGather: on llvmpipe every
-// texel read is costly and both sides of a branch run, so this is ~2x cheaper than two lookups.
+// bilinear or, with MIRAGE_SHADOW_PCF (GpuScene::setShadowPcf), 4x4 percentage-closer
+// filtered. Bias grows with the texel footprint
+// and the slope. The layer search and footprint are shared and each atlas is read with
+// textureGather: on llvmpipe every texel read is costly, so this is ~2x cheaper than separate
+// lookups.
 vec2 shadowVisibilityAt(sampler2DArray allMap, sampler2DArray realMap, int layer, vec2 t, float d,
                         float bias, vec2 fr, bool withReal) {
+#ifdef MIRAGE_SHADOW_PCF
+    vec3 tc = vec3(t, float(layer));
+    float pcfAll = shadowPcf(allMap, tc, d - bias, fr);
+    return vec2(pcfAll, withReal ? shadowPcf(realMap, tc, d - bias, fr) : pcfAll);
+#else
     vec4 a = step(vec4(d - bias), textureGather(allMap, vec3(t, float(layer)), 0));
     float visAll = bilinearGather(a, fr);
     if (!withReal) return vec2(visAll);
     vec4 r = step(vec4(d - bias), textureGather(realMap, vec3(t, float(layer)), 0));
     return vec2(visAll, bilinearGather(r, fr));
+#endif
 }
 
 vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,

@@ -132,6 +132,29 @@ void frameKnobs(std::vector<BenchKnob>& knobs) {
                  c.options.syncPasses = parseOnOff("sync_passes", v);
              },
              [](const BenchConfig& c) { return onOff(c.options.syncPasses); }},
+            {"shadow_filter",
+             "pcf: shadow maps looked up with percentage-closer filtering over 4x4 texels "
+             "(straight shadow edges); off: the 2x2 bilinear lookup (1-texel stair steps)",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{shadowFilterName(RendererOptions{}.shadow.filter)};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 if (v != "off" && v != "pcf")
+                     throw Error(
+                         fmt::format("bench knob 'shadow_filter': '{}' is not off or pcf", v));
+                 c.options.shadow.filter = v == "pcf" ? ShadowFilter::Pcf : ShadowFilter::Bilinear;
+             },
+             [](const BenchConfig& c) {
+                 return std::string(shadowFilterName(c.options.shadow.filter));
+             }},
+            {"shadow_map", "texels per side of each shadow map and reflective shadow map layer",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{std::to_string(RendererOptions{}.shadow.mapSize)};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.shadow.mapSize = parseInt("shadow_map", v, 16, 4096);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.shadow.mapSize); }},
         });
 }
 
@@ -293,10 +316,13 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                  return fmt::format("{:g}", 100.0f * c.options.caustic.gatherRadius);
              }},
             {"caustic_gather_cap",
-             "photons the caustic gather reads per grid bucket, 0 = all (fuller buckets are read "
-             "with "
-             "a stride and weighted by count / read)",
-             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"0"}; },
+             "photons the caustic gather reads per grid bucket, 0 = all (a fuller bucket is read "
+             "by its finest stratified subsample of the photon map within the cap, weighted by "
+             "count / read)",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{
+                     std::to_string(RendererOptions{}.caustic.gatherCap)};
+             },
              [](BenchConfig& c, const std::string& v) {
                  char* end = nullptr;
                  const long q = std::strtol(v.c_str(), &end, 10);

@@ -22,14 +22,14 @@ struct CausticOptions {
     float gatherRadius = 0.01f;
     // Photons the gather reads per grid bucket (0: all). A focused caustic puts tens of thousands
     // of photons into one cell, and every hit near it would read them all (a glass sphere alone
-    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read with a
-    // stride (every s-th photon from a per-pixel offset) and what is read is weighted by
-    // count / read, so the estimate keeps its expectation and gains noise only where photons
-    // are dense. Off by default: which photons a stride reads depends on the order the grid's
-    // scatter put them in, which atomics on a multithreaded rasteriser (llvmpipe) vary from run to
-    // run, so a capped frame is not reproducible (measured: up to 0.4 % of the peak between two
-    // renderers of the same frame); replays and sharded runs are expected to be.
-    int gatherCap = 0;
+    // under a spot: the specular light pass 20x slower). Above the cap, a bucket is read by its
+    // finest stratified subsample of the photon map (every 2nd, 4th, 8th or 16th texel per axis:
+    // the grid stores each bucket's photons by that level) of at most cap photons, weighted by
+    // count / read and with kernels widened by the stride, so the estimate keeps its expectation.
+    // The photons read depend on their texels only, not on the order the grid's scatter stored
+    // them in (atomics on a multithreaded rasteriser vary it from run to run), so a capped frame
+    // is reproducible; hence on by default (docs/caustics.md, "The gather's cap").
+    int gatherCap = 64;
     // Temporal smoothing of the caustic buffer (Knecht 2013 end of Sec. 4.2; caustic_resolve.frag):
     // this frame's caustic irradiance blended with last frame's, reprojected by the receiver's
     // world position and rejected where the surface there is at another distance, with the GI

@@ -11,7 +11,7 @@ PhotonGridPass::PhotonGridPass()
     : count_(computeProgram("photon grid count", "passes/caustic/photon_grid_count.comp")),
       scan_(computeProgram("photon grid scan", "passes/caustic/photon_grid_scan.comp")),
       scatter_(computeProgram("photon grid scatter", "passes/caustic/photon_grid_scatter.comp")),
-      grid_("photon grid", (2 * size_t(kPhotonGridCells) + 1) * sizeof(GLuint)) {}
+      grid_("photon grid", (2 * size_t(kPhotonGridSlots) + 1) * sizeof(GLuint)) {}
 
 void PhotonGridPass::setup(PassBuilder& b) const {
     for (Resource r : {kPhotonHitRefl, kPhotonPowerRefl, kPhotonSurfaceRefl, kPhotonHitRefr,

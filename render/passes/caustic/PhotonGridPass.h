@@ -10,8 +10,9 @@
 namespace mirage::render {
 
 // A hashed uniform grid of the photons' receiver hits, for the caustics seen in reflections and
-// refractions. PhotonGrid: uint per hash cell (kPhotonGridCells counts, then kPhotonGridCells + 1
-// first indices); PhotonRecords: GpuPhoton per photon, sorted by cell.
+// refractions. PhotonGrid: uint per slot, a slot per hash cell and level of the photon map's
+// nested lattices (kPhotonGridSlots counts, then kPhotonGridSlots + 1 first indices);
+// PhotonRecords: GpuPhoton per photon, sorted by cell, then by level.
 inline constexpr Resource kPhotonGrid{"PhotonGrid"};
 inline constexpr Resource kPhotonRecords{"PhotonRecords"};
 

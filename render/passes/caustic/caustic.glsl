@@ -62,6 +62,22 @@ int photonBucket(ivec3 cell) {
 }
 int photonBucketAt(vec3 x, float cellSize) { return photonBucket(ivec3(floor(x / cellSize))); }
 
+// A photon's level within its bucket, from its photon-map texel t: the coarsest lattice of
+// stride 2^(kPhotonGridLevels - 1 - l) texels (16, 8, 4, 2, 1) that holds t. Levels 0..l of a
+// bucket together are its photons on the lattice of stride photonLevelStride(l): a stratified
+// subsample of the map (1/256, 1/64, 1/16, 1/4 of it, then all), fixed by the texels alone.
+int photonLevel(ivec2 t) {
+    for (int l = 0; l < kPhotonGridLevels - 1; ++l) {
+        int stride = 1 << (kPhotonGridLevels - 1 - l);
+        if (t.x % stride == 0 && t.y % stride == 0) return l;
+    }
+    return kPhotonGridLevels - 1;
+}
+float photonLevelStride(int level) { return float(1 << (kPhotonGridLevels - 1 - level)); }
+// The grid's counter (and first-index) slot of a bucket's level: a bucket's levels are adjacent,
+// so that its photons sit at [first[slot(b, 0)], first[slot(b + 1, 0)]) ordered by level.
+int photonSlot(int bucket, int level) { return bucket * kPhotonGridLevels + level; }
+
 #ifdef MIRAGE_CAUSTIC_GATHER
 // The photon gather (specular_light.frag's variant for frames with a photon grid): the caustic
 // irradiance at a reflected / refracted ray's hit, which the camera-space caustic buffer cannot
@@ -69,7 +85,7 @@ int photonBucketAt(vec3 x, float cellSize) { return photonBucket(ivec3(floor(x /
 layout(std430, binding = kBindingPhotonGrid) readonly buffer PhotonGridCells { uint photonGrid[]; };
 layout(std430, binding = kBindingPhotons) readonly buffer PhotonRecords { GpuPhoton photons[]; };
 uniform float photonCellSize;  // m: 2 x RendererOptions::causticGatherRadius
-uniform uint photonGatherCap;  // photons read per bucket, 0: all (RendererOptions::causticGatherCap)
+uniform uint photonGatherCap;  // photons read per bucket, 0: all (CausticOptions gather cap)
 
 // A gather point's footprint (m): the spacing of the neighbouring pixels' hits on its surface,
 // from the screen-space derivatives dx, dy of the hit position. Across a silhouette (another
@@ -115,30 +131,34 @@ void gatherCaustic(vec3 x, vec3 n, float footprint, out vec3 eRv, out vec3 eR) {
                 for (int j = 0; j < nVisited; ++j) seen = seen || visited[j] == b;
                 if (seen || nVisited >= 27) continue;
                 visited[nVisited++] = b;
-                uint first = photonGrid[kPhotonGridCells + b];
-                uint last = photonGrid[kPhotonGridCells + b + 1];
-                // A bucket fuller than the cap is read with a stride from an offset that varies
-                // by pixel and bucket (not by frame: a frame depends on its inputs only, so a
-                // frame after a history reset equals a fresh renderer's); what is read stands
-                // for the whole bucket (weight count / read). The scatter fills a bucket roughly
-                // in photon-map order, so a stride samples the bucket's whole footprint of the
-                // map rather than one corner of it.
-                uint count = last - first, stride = 1u;
+                // A bucket fuller than the cap is read by its finest prefix of levels (a
+                // stratified subsample of the photon map: every 2nd, 4th, 8th or 16th texel per
+                // axis) of at most cap photons; if that prefix is empty (the bucket's photons lie
+                // off the coarse lattices), the coarsest non-empty one. Which photons are read
+                // depends on their texels only, never on the order the scatter stored them in,
+                // so a capped frame is reproducible. What is read stands for the whole bucket
+                // (weight count / read), and each photon read for a stride x stride block of the
+                // map, so its kernel widens by the stride (its spacing to its read neighbours).
+                int s0 = photonSlot(b, 0);
+                uint first = photonGrid[kPhotonGridSlots + s0];
+                uint last = photonGrid[kPhotonGridSlots + s0 + kPhotonGridLevels];
+                uint count = last - first, end = last;
                 if (count == 0u) continue;
-                if (photonGatherCap > 0u && count > photonGatherCap)
-                    stride = (count + photonGatherCap - 1u) / photonGatherCap;
-                uint start = first;
-                if (stride > 1u) {
-                    uvec2 p = uvec2(gl_FragCoord.xy);
-                    uint seed = (p.x * 73856093u) ^ (p.y * 19349663u) ^ uint(b);
-                    seed = (seed ^ (seed >> 16)) * 0x45d9f3bu;
-                    start += (seed ^ (seed >> 16)) % stride;
+                float widen = 1.0;
+                if (photonGatherCap > 0u && count > photonGatherCap) {
+                    for (int l = kPhotonGridLevels - 2; l >= 0; --l) {
+                        uint e = photonGrid[kPhotonGridSlots + s0 + l + 1];
+                        if (e == first) break;  // this prefix and every coarser one empty
+                        end = e;
+                        widen = photonLevelStride(l);
+                        if (e - first <= photonGatherCap) break;
+                    }
                 }
-                float share = float(count) / float((last - start + stride - 1u) / stride);
+                float share = float(count) / float(end - first);
                 vec3 bucketRv = vec3(0.0), bucketR = vec3(0.0);
-                for (uint i = start; i < last; i += stride) {
+                for (uint i = first; i < end; ++i) {
                     vec3 d = x - photons[i].position;
-                    float r = min(max(photons[i].radius, 1.5 * footprint), reach);
+                    float r = min(max(widen * photons[i].radius, 1.5 * footprint), reach);
                     float d2 = dot(d, d), r2 = r * r;
                     if (d2 >= r2) continue;
                     vec3 np = unpackNormalOct(photons[i].normal);

@@ -30,7 +30,13 @@ layout(r32ui, binding = kImageCausticAccum) uniform uimage2DArray accum;
 uniform int mapSize;
 uniform float quadScale;   // kernel radius in photon spacings
 uniform float fixedScale;  // irradiance (W/m^2) -> integer units
-const int kMaxQuadPx = 8;  // kernel radius cap (pixels): bounds the cost of diffuse photons
+// Kernel radius cap (pixels): bounds the cost of photons spread wide (the ~4 % a glass reflects
+// spreads over the table, each photon's kernel would reach 8 px and more). 2 px: the glass-alone
+// frame's splat 3.7x cheaper than 8 px at the same error (docs/caustics.md, "Cost").
+const int kMaxQuadPx = 2;
+// The most pixels a kernel reaches from its centre: the cap, or the smallest kernel stretched on
+// a surface seen obliquely (0.75 px / cos, cos >= 0.2), whichever is larger.
+const int kMaxReachPx = 4;
 
 // Surface area (m^2) of canvas pixel px whose surface is x with normal n: the pixel's solid
 // angle cos^3 / (fx fy) times distance^2 / |cos| at the surface.
@@ -66,31 +72,35 @@ void main() {
     vec3 nc = texelFetch(gNormal, clamp(centre, ivec2(0), ivec2(canvas.xy) - 1), 0).xyz;
     float cosC = abs(dot(nc, normalize(cameraPos.xyz - hit.xyz)));
     float rMin = 0.75 * pixelWorld / clamp(cosC, 0.2, 1.0);
-    float r = clamp(quadScale * spacing, rMin, float(kMaxQuadPx) * pixelWorld);
-    int rPx = int(ceil(r / pixelWorld));
+    float r = clamp(quadScale * spacing, rMin, max(rMin, float(kMaxQuadPx) * pixelWorld));
+    int rPx = min(int(ceil(r / pixelWorld)), kMaxReachPx);
     ivec2 lo = max(centre - rPx, ivec2(0)), hi = min(centre + rPx, ivec2(canvas.xy) - 1);
     if (any(greaterThan(lo, hi))) return;
+    // The weights of the pixels reached, kept for the second loop (which then reads no G-buffer
+    // texel again): 0 where the pixel has no surface near the hit or is a specular pixel.
+    float weights[(2 * kMaxReachPx + 1) * (2 * kMaxReachPx + 1)];
+    int n = 0;
     float r2 = r * r, sumWA = 0.0;
     for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
+            float w = 0.0;
             vec4 g = texelFetch(gPosition, ivec2(x, y), 0);
-            if (int(g.w + 0.5) == ORIGIN_NONE) continue;
-            if (texelFetch(gEmissive, ivec2(x, y), 0).a > 0.5) continue;  // specular pixel
-            vec3 dv = g.xyz - hit.xyz;
-            float w = 1.0 - dot(dv, dv) / r2;
-            if (w <= 0.0) continue;
-            sumWA += w * pixelArea(g.xyz, texelFetch(gNormal, ivec2(x, y), 0).xyz, fx, fy);
+            // Not a specular pixel (mirror / glass: emissive a > 0.5), a surface near the hit.
+            if (int(g.w + 0.5) != ORIGIN_NONE && texelFetch(gEmissive, ivec2(x, y), 0).a <= 0.5) {
+                vec3 dv = g.xyz - hit.xyz;
+                w = max(1.0 - dot(dv, dv) / r2, 0.0);
+                if (w > 0.0)
+                    sumWA += w * pixelArea(g.xyz, texelFetch(gNormal, ivec2(x, y), 0).xyz, fx, fy);
+            }
+            weights[n++] = w;
         }
     if (!(sumWA > 0.0) || isinf(sumWA)) return;
     vec3 eRv = powerRv * (fixedScale / sumWA), eR = powerR * (fixedScale / sumWA);
     const float kMaxAdd = 268435456.0;  // 2^28: one photon can never wrap a counter
+    n = 0;
     for (int y = lo.y; y <= hi.y; ++y)
         for (int x = lo.x; x <= hi.x; ++x) {
-            vec4 g = texelFetch(gPosition, ivec2(x, y), 0);
-            if (int(g.w + 0.5) == ORIGIN_NONE) continue;
-            if (texelFetch(gEmissive, ivec2(x, y), 0).a > 0.5) continue;
-            vec3 dv = g.xyz - hit.xyz;
-            float w = 1.0 - dot(dv, dv) / r2;
+            float w = weights[n++];
             if (w <= 0.0) continue;
             uvec3 a = uvec3(min(eRv * w, vec3(kMaxAdd)) + 0.5);
             uvec3 b = uvec3(min(eR * w, vec3(kMaxAdd)) + 0.5);

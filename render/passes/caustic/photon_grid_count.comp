@@ -2,10 +2,10 @@
 #include "common.glsl"
 #include "passes/caustic/caustic.glsl"
 // World-space photon grid, step 1 of 3 (count, prefix sum, scatter): every photon of the photon
-// G-buffers counts itself into the hash bucket of the grid cell holding its receiver hit. One
-// invocation per photon texel; z = 2 x light layer + (0 reflected, 1 refracted). The counts
-// (grid[0 .. kPhotonGridCells - 1]) start at zero: cleared before the first build, and the
-// scatter step counts them back down to zero.
+// G-buffers counts itself into its slot: the hash bucket of the grid cell holding its receiver
+// hit, and its level in that bucket (photonLevel of its texel). One invocation per photon texel;
+// z = 2 x light layer + (0 reflected, 1 refracted). The counts (grid[0 .. kPhotonGridSlots - 1])
+// start at zero: cleared before the first build, and the scatter step counts them back down.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = kUnitGridReflHit) uniform sampler2DArray reflHit;
 layout(binding = kUnitGridReflPower) uniform sampler2DArray reflPower;
@@ -24,5 +24,5 @@ void main() {
     vec4 pw = refracted ? texelFetch(refrPower, tl, 0) : texelFetch(reflPower, tl, 0);
     vec3 powerRv, powerR;
     if (!photonPowers(hit, pw, powerRv, powerR)) return;
-    atomicAdd(grid[photonBucketAt(hit.xyz, cellSize)], 1u);
+    atomicAdd(grid[photonSlot(photonBucketAt(hit.xyz, cellSize), photonLevel(t))], 1u);
 }

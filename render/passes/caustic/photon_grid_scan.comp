@@ -1,13 +1,14 @@
 #version 450 core
 #include "common.glsl"
-// World-space photon grid, step 2 of 3: the exclusive prefix sum of the bucket counts, so that
-// bucket b's photons will sit at [first[b], first[b + 1]) of the photon records, with
-// first = grid[kPhotonGridCells ..] (kPhotonGridCells + 1 entries; the last is the total). One
-// work group: each invocation sums a run of buckets, one invocation scans the runs' totals.
+// World-space photon grid, step 2 of 3: the exclusive prefix sum of the slot counts (a slot per
+// bucket and level, photonSlot), so that slot s's photons will sit at [first[s], first[s + 1])
+// of the photon records, with first = grid[kPhotonGridSlots ..] (kPhotonGridSlots + 1 entries;
+// the last is the total). One work group: each invocation sums a run of slots, one invocation
+// scans the runs' totals.
 layout(local_size_x = 256) in;
 layout(std430, binding = kBindingPhotonGrid) buffer PhotonGridCells { uint grid[]; };
 shared uint runStart[256];
-const uint kRun = uint(kPhotonGridCells) / 256u;
+const uint kRun = uint(kPhotonGridSlots) / 256u;
 
 void main() {
     uint i = gl_LocalInvocationID.x;
@@ -23,14 +24,14 @@ void main() {
             runStart[j] = acc;
             acc += v;
         }
-        grid[2 * kPhotonGridCells] = acc;
+        grid[2 * kPhotonGridSlots] = acc;
     }
     memoryBarrierShared();
     barrier();
     uint acc = runStart[i];
     for (uint k = 0u; k < kRun; ++k) {
         uint b = i * kRun + k;
-        grid[uint(kPhotonGridCells) + b] = acc;
+        grid[uint(kPhotonGridSlots) + b] = acc;
         acc += grid[b];
     }
 }

@@ -2,8 +2,9 @@
 #include "common.glsl"
 #include "passes/caustic/caustic.glsl"
 // World-space photon grid, step 3 of 3: every photon writes its record (receiver hit, kernel
-// radius, powers for L_rv and L_r, receiver normal) into its bucket's range, taking a slot by
-// counting the bucket's count back down to zero (ready for the next build). One invocation per
+// radius, powers for L_rv and L_r, receiver normal) into its slot's range (its bucket's, at its
+// level), taking a place by counting the slot's count back down to zero (ready for the next
+// build). The order within a slot varies with the atomics; the gather reads whole slots. One invocation per
 // photon texel, as photon_grid_count.comp (the same photons: photonPowers decides for both).
 //
 // Kernel radius: causticQuadScale x the photon's spacing to its neighbours on the receiver (the
@@ -38,9 +39,9 @@ void main() {
     uvec4 sf = refracted ? texelFetch(refrSurface, tl, 0) : texelFetch(reflSurface, tl, 0);
     vec3 n = vec3(unpackHalf2x16(sf.x), unpackHalf2x16(sf.y).x);
     n = dot(n, n) > 1e-12 ? normalize(n) : vec3(0.0, 1.0, 0.0);
-    int b = photonBucketAt(hit.xyz, cellSize);
-    uint slot = atomicAdd(grid[b], 0xFFFFFFFFu) - 1u;  // counts down: 0 .. count - 1
-    uint index = grid[uint(kPhotonGridCells) + uint(b)] + slot;
+    int s = photonSlot(photonBucketAt(hit.xyz, cellSize), photonLevel(t));
+    uint place = atomicAdd(grid[s], 0xFFFFFFFFu) - 1u;  // counts down: 0 .. count - 1
+    uint index = grid[uint(kPhotonGridSlots) + uint(s)] + place;
     if (index >= capacity) return;
     GpuPhoton p;
     p.position = hit.xyz;

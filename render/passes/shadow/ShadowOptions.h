@@ -4,10 +4,25 @@
 
 namespace mirage::render {
 
+// How the shadow maps are looked up (lighting.glsl; docs/realtime-renderer.md, "Shadow edges").
+enum class ShadowFilter {
+    Bilinear,  // the 2x2 texels around the lookup, bilinear weights: 1-texel stair steps
+    Pcf,       // 4x4 texels, a 2-texel box over the bilinear test: straight edges stay straight
+};
+const char* shadowFilterName(ShadowFilter f);  // "off" (bilinear), "pcf"
+
 struct ShadowOptions {
     int mapSize = 512;    // texels per side of each shadow / RSM layer
     float bias = 0.001f;  // metres: constant depth bias of the shadow-map test
-                          // (lighting.glsl adds 1.5 texels' footprint / cos)
+                          // (lighting.glsl adds the filter's reach in texel footprints / cos:
+                          // 1.5 bilinear, 2.5 PCF)
+    // The shadow-map lookup: PCF over 4x4 texels (a point or spot light's hard shadow edge
+    // without the texel grid's stair steps) or the 2x2 bilinear lookup alone. Bilinear by
+    // default: at 512 texels a texel spans more than a pixel of the tabletop's shadow, and PCF's
+    // 2-texel ramp is then further from the reference's hard edge than the stair steps are (its
+    // penumbra error is halved only with mapSize 2048; docs/realtime-renderer.md, "Shadow
+    // edges").
+    ShadowFilter filter = ShadowFilter::Bilinear;
     // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
     // false: glass is an opaque occluder, as mirrors are.
     bool glass = true;
