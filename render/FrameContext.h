@@ -200,6 +200,20 @@ struct RendererOptions {
     bool translucentShadows = true;
     int vnmResolution = 16;
     std::string vnmCacheDir;
+    // The voxel number map's approximations, each measured against the reference on the sample
+    // scene (docs/translucency.md "Error budget"). vnmDiffusionKernel: the kernel e^{-k tau},
+    // k = min(1, sqrt(3 (1 - albedo))) (false, the default: the seed's e^{-tau}). vnmMeshSurface:
+    // surface voxels' normals and areas from the mesh (false, the default: from the voxels'
+    // occupancy). translucentSmoothLookup: the smooth reconstruction, each voxel's near field
+    // normalised (SurfaceVoxel::nearScale) and a translucent pixel blending the surface voxels
+    // within 1.5 voxels (false: neither, the nearest voxel alone: the voxels' stripes).
+    // vnmMeasuredAlbedo: the kernel's total is the share of scattered light that leaves the object,
+    // measured by random walks through its voxels (false, the default: Hapke's albedo of a thick
+    // half-space, which a front-lit cube's reference bears out and the walks overshoot).
+    bool vnmDiffusionKernel = false;
+    bool vnmMeshSurface = false;
+    bool translucentSmoothLookup = true;
+    bool vnmMeasuredAlbedo = false;
 
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.
