@@ -30,6 +30,13 @@ bool parseOnOff(const std::string& knob, const std::string& v) {
     return v == "on";
 }
 
+// One of two named values: true for `yes`, false for `no`.
+bool parseChoice(const std::string& knob, const std::string& v, const char* yes, const char* no) {
+    if (v != yes && v != no)
+        throw Error(fmt::format("bench knob '{}': '{}' is not {} or {}", knob, v, yes, no));
+    return v == yes;
+}
+
 // "WxH" -> (W, H); "session" -> (0, 0).
 std::pair<int, int> parseResolution(const std::string& v) {
     if (v == "session") return {0, 0};
@@ -456,6 +463,52 @@ void translucencyKnobs(std::vector<BenchKnob>& knobs) {
              },
              [](const BenchConfig& c) {
                  return std::to_string(c.options.translucency.vnmResolution);
+             }},
+            {"vnm_kernel",
+             "how light spreads between a translucent object's surface voxels: diffusion "
+             "(e^{-k tau}, k = min(1, sqrt(3 (1 - albedo))) per channel) or extinction (the "
+             "seed's e^{-tau})",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"extinction"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.translucency.diffusionKernel =
+                     parseChoice("vnm_kernel", v, "diffusion", "extinction");
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.translucency.diffusionKernel ? "diffusion"
+                                                                           : "extinction");
+             }},
+            {"vnm_surface",
+             "where a surface voxel's normal and area come from: mesh (the object's triangles) "
+             "or occupancy (the empty voxels around it and its exposed faces)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"occupancy"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.translucency.meshSurface =
+                     parseChoice("vnm_surface", v, "mesh", "occupancy");
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.translucency.meshSurface ? "mesh" : "occupancy");
+             }},
+            {"vnm_albedo",
+             "the share of a translucent object's scattered light that leaves it: walks (measured "
+             "by random walks through its voxels) or hapke (a thick half-space's albedo)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"hapke"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.translucency.measuredAlbedo =
+                     parseChoice("vnm_albedo", v, "walks", "hapke");
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.translucency.measuredAlbedo ? "walks" : "hapke");
+             }},
+            {"vnm_lookup",
+             "a translucent pixel's radiance: smooth (each voxel's near field normalised, the "
+             "surface voxels within 1.5 voxels blended) or nearest (the nearest voxel alone)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"smooth"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.translucency.smoothLookup =
+                     parseChoice("vnm_lookup", v, "smooth", "nearest");
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.translucency.smoothLookup ? "smooth" : "nearest");
              }},
             {"moving_objects",
              "on: the virtual objects move before every frame (to 1 cm along +X and back), so "

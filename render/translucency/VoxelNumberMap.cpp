@@ -15,6 +15,7 @@
 #include "core/ParallelFor.h"
 #include "render/raytrace/Bsdf.h"
 #include "render/raytrace/Sampling.h"
+#include "render/translucency/ExitAlbedo.h"
 
 namespace mirage::translucency {
 namespace {
@@ -23,7 +24,7 @@ namespace fs = std::filesystem;
 using raytrace::kPi;
 
 constexpr uint32_t kCacheMagic = 0x314D4E56;  // "VNM1"
-constexpr uint32_t kCacheVersion = 2;
+constexpr uint32_t kCacheVersion = 3;
 
 int threadCount(int requested) {
     return requested > 0 ? requested : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -69,6 +70,14 @@ glm::vec3 effectiveAlbedo(const glm::vec3& albedo) {
     return out;
 }
 
+glm::vec3 kernelFalloff(const glm::vec3& albedo, VnmKernel kernel) {
+    if (kernel == VnmKernel::Extinction) return glm::vec3(1.0f);
+    glm::vec3 k;
+    for (int c = 0; c < 3; ++c)
+        k[c] = std::min(1.0f, std::sqrt(3.0f * (1.0f - std::clamp(albedo[c], 0.0f, 1.0f))));
+    return k;
+}
+
 glm::vec3 shadowExtinctionScale(const glm::vec3& albedo) {
     // The light removed from the shadow ray over tau, e^{-tau} aside, is scattered; a_eff of it
     // leaves the object (effectiveAlbedo), about half of that on the side away from the light,
@@ -112,10 +121,15 @@ std::vector<TranslucentObject> translucentObjects(const Scene& scene) {
     return out;
 }
 
-std::string VoxelNumberMap::cacheKey(const TranslucentObject& o, int resolution) {
+std::string VoxelNumberMap::cacheKey(const TranslucentObject& o, const VnmSettings& s) {
     Hasher h;
     h.value(kCacheVersion);
-    h.value(resolution);
+    h.value(s.resolution);
+    h.value(s.surface);
+    h.value(kernelFalloff(o.medium.albedo, s.kernel));
+    h.value(o.medium.albedo);
+    h.value(o.medium.ior);
+    h.value(s.albedoWalks);
     h.bytes(o.positions.data(), o.positions.size() * sizeof(glm::vec3));
     h.bytes(o.indices.data(), o.indices.size() * sizeof(uint32_t));
     h.value(o.medium.extinction);
@@ -161,6 +175,40 @@ int VoxelNumberMap::surfaceVoxelAt(const glm::vec3& p) const {
                 }
             }
     return best;
+}
+
+float VoxelNumberMap::filterWeight(float d) {
+    const float x = d / kFilterRadius;
+    return x < 1.0f ? (1.0f - x * x) * (1.0f - x * x) : 0.0f;
+}
+
+std::vector<VoxelWeight> VoxelNumberMap::reconstructionAt(const glm::vec3& p) const {
+    // Every centre within kFilterRadius (1.5) voxels of a point in cell c lies in c's 3x3x3.
+    const glm::vec3 g = (p - origin_) / voxelSize_;
+    const glm::ivec3 c = glm::ivec3(glm::floor(g));
+    std::vector<VoxelWeight> out;
+    float sum = 0.0f;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const glm::ivec3 q = c + glm::ivec3(dx, dy, dz);
+                if (glm::any(glm::lessThan(q, glm::ivec3(0))) ||
+                    glm::any(glm::greaterThanEqual(q, dims_)))
+                    continue;
+                const int n = number_[size_t(cellIndex(q))];
+                if (n < 0) continue;
+                const float w = filterWeight(glm::length(glm::vec3(q) + 0.5f - g));
+                if (w <= 0.0f) continue;
+                out.push_back({n, w});
+                sum += w;
+            }
+    if (sum > 0.0f) {
+        for (VoxelWeight& v : out) v.weight /= sum;
+        return out;
+    }
+    const int nearest = surfaceVoxelAt(p);
+    if (nearest >= 0) return {{nearest, 1.0f}};
+    return {};
 }
 
 // Cubic voxels over the bounding box with one empty voxel of margin (sets the grid); returns
@@ -353,8 +401,51 @@ void VoxelNumberMap::findSurface(const TranslucentObject& o, const VnmSettings& 
     for (const SurfaceVoxel& v : surface_) area_ += v.exterior ? v.area : 0.0f;
 }
 
+// Normals and areas from the mesh: each triangle cut into m^2 equal parts (edges of at most a
+// quarter voxel), each part's area and normal given to the surface voxel standing for its centre
+// (surfaceVoxelAt). A voxel that gets no part keeps its occupancy normal and stands for no area.
+// The triangle's normal is turned to agree with the occupancy normal (outward from the medium,
+// into a cavity on its walls), so the winding of the mesh does not matter.
+void VoxelNumberMap::meshSurface(const TranslucentObject& o) {
+    const size_t S = surface_.size();
+    std::vector<double> area(S, 0.0);
+    std::vector<glm::dvec3> normal(S, glm::dvec3(0.0));
+    const float step = 0.25f * voxelSize_;
+    for (size_t t = 0; t + 2 < o.indices.size(); t += 3) {
+        const glm::vec3 a = o.positions[o.indices[t]], b = o.positions[o.indices[t + 1]],
+                        c = o.positions[o.indices[t + 2]];
+        const glm::vec3 cr = glm::cross(b - a, c - a);
+        const float len = glm::length(cr);
+        if (!(len > 0.0f) || !std::isfinite(len)) continue;
+        const glm::vec3 n = cr / len;
+        const float longest =
+            std::max(glm::length(b - a), std::max(glm::length(c - a), glm::length(c - b)));
+        const int m = std::clamp(int(std::ceil(longest / step)), 1, 4096);
+        const double part = 0.5 * double(len) / double(m) / double(m);
+        auto add = [&](float u, float v) {
+            const glm::vec3 p = a + (u / float(m)) * (b - a) + (v / float(m)) * (c - a);
+            const int i = surfaceVoxelAt(p);
+            if (i < 0) return;
+            const float sgn = glm::dot(n, surface_[size_t(i)].normal) < 0.0f ? -1.0f : 1.0f;
+            area[size_t(i)] += part;
+            normal[size_t(i)] += part * glm::dvec3(sgn * n);
+        };
+        for (int i = 0; i < m; ++i)
+            for (int j = 0; i + j < m; ++j) {
+                add(float(i) + 1.0f / 3.0f, float(j) + 1.0f / 3.0f);
+                if (i + j + 2 <= m) add(float(i) + 2.0f / 3.0f, float(j) + 2.0f / 3.0f);
+            }
+    }
+    for (size_t i = 0; i < S; ++i) {
+        surface_[i].area = float(area[i]);
+        if (glm::length(normal[i]) > 0.0) surface_[i].normal = glm::vec3(glm::normalize(normal[i]));
+    }
+    area_ = 0.0f;
+    for (const SurfaceVoxel& v : surface_) area_ += v.exterior ? v.area : 0.0f;
+}
+
 // Optical thickness between every pair of surface voxels (3D DDA through the voxel
-// extinctions), and the kernel scales c_i = 1/W_i - 1/A.
+// extinctions).
 void VoxelNumberMap::opticalThickness(const std::vector<float>& sigma, int threads) {
     const float h = voxelSize_;
     const glm::ivec3 n = dims_;
@@ -402,13 +493,52 @@ void VoxelNumberMap::opticalThickness(const std::vector<float>& sigma, int threa
             tau_[j * S + size_t(i)] = v;
         }
     });
+}
+
+// The kernel scales c_i = (1 - T_i) / W_i per channel (VoxelNumberMap.h): what enters at i and
+// does not pass straight through leaves the outer surface in total, spread as e^{-k tau}.
+void VoxelNumberMap::kernelScales(const glm::vec3& k, int threads) {
+    falloff_ = k;
+    const size_t S = surface_.size();
     parallelFor(int(S), threadCount(threads), [&](int i) {
-        double W = 0.0;
-        for (size_t j = 0; j < S; ++j)
-            if (surface_[j].exterior) W += surface_[j].area * std::exp(-double(tau(i, int(j))));
-        surface_[size_t(i)].kernelScale =
-            W > 0 ? float(std::max(0.0, 1.0 / W - 1.0 / double(area_))) : 0.0f;
+        glm::dvec3 W(0.0);
+        double straight = 0.0;
+        for (size_t j = 0; j < S; ++j) {
+            if (!surface_[j].exterior) continue;
+            const double t = double(tau(i, int(j))), A = surface_[j].area;
+            straight += A * std::exp(-t);
+            W += A * glm::dvec3(std::exp(-k.x * t), std::exp(-k.y * t), std::exp(-k.z * t));
+        }
+        const double scattered = area_ > 0 ? std::max(0.0, 1.0 - straight / double(area_)) : 0.0;
+        glm::vec3 c(0.0f);
+        for (int ch = 0; ch < 3; ++ch) c[ch] = W[ch] > 0 ? float(scattered / W[ch]) : 0.0f;
+        surface_[size_t(i)].kernelScale = c;
     });
+    // Near-field densities D_o = sum over outer voxels i within kNearField of o of
+    // A_i e^{-k tau(i, o)} (green channel's k): on a flat face they should all be equal, but on
+    // a face the grid cuts at an angle the voxel centres step in and out of it and the areas
+    // step with them, so D_o (and with it the light leaving o) rises and falls in stripes.
+    // g_o = mean D / D_o takes that out (a normalised convolution of the near field).
+    const float reach = kNearField * voxelSize_;
+    std::vector<double> density(S, 0.0);
+    parallelFor(int(S), threadCount(threads), [&](int o) {
+        double D = 0.0;
+        for (size_t i = 0; i < S; ++i)
+            if (surface_[i].exterior &&
+                glm::length(surface_[i].position - surface_[size_t(o)].position) <= reach)
+                D += surface_[i].area * std::exp(-double(k.y) * double(tau(int(i), o)));
+        density[size_t(o)] = D;
+    });
+    double sum = 0.0, weight = 0.0;
+    for (size_t o = 0; o < S; ++o)
+        if (surface_[o].exterior && density[o] > 0) {
+            sum += surface_[o].area * density[o];
+            weight += surface_[o].area;
+        }
+    const double mean = weight > 0 ? sum / weight : 0.0;
+    for (size_t o = 0; o < S; ++o)
+        surface_[o].nearScale =
+            density[o] > 0 && mean > 0 ? float(std::clamp(mean / density[o], 0.25, 4.0)) : 1.0f;
 }
 
 VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettings& s) {
@@ -419,7 +549,7 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
         throw Error("voxel number map: translucent object '" + o.name + "' has no triangles");
     const auto start = std::chrono::steady_clock::now();
     VoxelNumberMap m;
-    const std::string key = cacheKey(o, s.resolution);
+    const std::string key = cacheKey(o, s);
     const fs::path cacheFile =
         s.cacheDir.empty() ? fs::path() : s.cacheDir / ("vnm-" + key + ".bin");
     if (!cacheFile.empty() && m.readCache(cacheFile)) {
@@ -430,8 +560,20 @@ VoxelNumberMap VoxelNumberMap::build(const TranslucentObject& o, const VnmSettin
     }
 
     const std::vector<uint8_t> inside = m.voxelise(o, s.resolution);
-    m.findSurface(o, s, inside, m.exteriorOf(inside));
-    m.opticalThickness(m.extinction(o, inside), s.threads);
+    const std::vector<uint8_t> exterior = m.exteriorOf(inside);
+    m.findSurface(o, s, inside, exterior);
+    if (s.surface == VnmSurface::Mesh) m.meshSurface(o);
+    const std::vector<float> sigma = m.extinction(o, inside);
+    m.opticalThickness(sigma, s.threads);
+    m.kernelScales(kernelFalloff(o.medium.albedo, s.kernel), s.threads);
+    // Random walks in voxel units: extinction per voxel edge.
+    std::vector<float> sigmaPerVoxel(sigma.size());
+    for (size_t i = 0; i < sigma.size(); ++i) sigmaPerVoxel[i] = sigma[i] * m.voxelSize_;
+    std::vector<WalkStart> starts;
+    for (const SurfaceVoxel& v : m.surface_)
+        if (v.exterior) starts.push_back({v.cell, v.normal, v.area});
+    m.exitAlbedo_ = measureExitAlbedo({m.dims_, &inside, &exterior, &sigmaPerVoxel}, starts,
+                                      o.medium.albedo, o.medium.ior, s.albedoWalks);
     m.seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!cacheFile.empty()) m.writeCache(cacheFile);
     return m;
@@ -448,6 +590,8 @@ bool VoxelNumberMap::readCache(const fs::path& file) {
     in.read(reinterpret_cast<char*>(&origin_), sizeof origin_);
     in.read(reinterpret_cast<char*>(&voxelSize_), sizeof voxelSize_);
     in.read(reinterpret_cast<char*>(&area_), sizeof area_);
+    in.read(reinterpret_cast<char*>(&falloff_), sizeof falloff_);
+    in.read(reinterpret_cast<char*>(&exitAlbedo_), sizeof exitAlbedo_);
     in.read(reinterpret_cast<char*>(&S), sizeof S);
     if (!in || magic != kCacheMagic || version != kCacheVersion ||
         glm::any(glm::lessThan(dims_, glm::ivec3(1))) ||
@@ -500,6 +644,8 @@ void VoxelNumberMap::writeCache(const fs::path& file) const {
         out.write(reinterpret_cast<const char*>(&origin_), sizeof origin_);
         out.write(reinterpret_cast<const char*>(&voxelSize_), sizeof voxelSize_);
         out.write(reinterpret_cast<const char*>(&area_), sizeof area_);
+        out.write(reinterpret_cast<const char*>(&falloff_), sizeof falloff_);
+        out.write(reinterpret_cast<const char*>(&exitAlbedo_), sizeof exitAlbedo_);
         out.write(reinterpret_cast<const char*>(&S), sizeof S);
         out.write(reinterpret_cast<const char*>(number_.data()),
                   std::streamsize(number_.size() * 4));
@@ -520,9 +666,15 @@ void VoxelNumberMap::writeCache(const fs::path& file) const {
 
 // ---- run time -----------------------------------------------------------------------------------
 
+glm::vec3 VnmShading::radianceScale(const VoxelNumberMap& map, const raytrace::Medium& medium,
+                                    bool measured) {
+    if (!measured) return effectiveAlbedo(medium.albedo) / kPi;
+    return map.exitAlbedo() / (kPi * hemisphericalTransmittance(medium.ior));
+}
+
 VnmShading::VnmShading(const VoxelNumberMap& map, const TranslucentObject& object,
-                       const raytrace::RayTracingScene& scene, int envSamples)
-    : map_(map), medium_(object.medium) {
+                       const raytrace::RayTracingScene& scene, int envSamples, bool measuredAlbedo)
+    : map_(map), medium_(object.medium), scale_(radianceScale(map, object.medium, measuredAlbedo)) {
     const auto& sv = map.surface();
     E_.assign(sv.size(), glm::vec3(0.0f));
     const float offset = map.voxelSize();
@@ -572,18 +724,37 @@ VnmShading::VnmShading(const VoxelNumberMap& map, const TranslucentObject& objec
     }
 }
 
-glm::vec3 VnmShading::scattered(const glm::vec3& p, const glm::vec3& wOut) const {
-    const int out = map_.surfaceVoxelAt(p);
-    if (out < 0) return glm::vec3(0.0f);
+glm::vec3 VnmShading::voxelRadiance(int out) const {
     const auto& sv = map_.surface();
-    glm::vec3 sum(0.0f);
+    const glm::vec3 k = map_.falloff();
+    const float reach = VoxelNumberMap::kNearField * map_.voxelSize();
+    glm::vec3 near(0.0f), far(0.0f);
     for (size_t i = 0; i < sv.size(); ++i) {
         if (E_[i] == glm::vec3(0.0f) || !sv[i].exterior) continue;
-        sum += E_[i] * (sv[i].area * sv[i].kernelScale * std::exp(-map_.tau(int(i), out)));
+        const float t = map_.tau(int(i), out);
+        const glm::vec3 c =
+            E_[i] * (sv[i].area * sv[i].kernelScale *
+                     glm::vec3(std::exp(-k.x * t), std::exp(-k.y * t), std::exp(-k.z * t)));
+        (glm::length(sv[i].position - sv[size_t(out)].position) <= reach ? near : far) += c;
     }
-    const float cosOut = std::abs(glm::dot(sv[size_t(out)].normal, wOut));
-    return sum * effectiveAlbedo(medium_.albedo) *
-           (boundaryTransmittance(medium_.ior, cosOut) / kPi);
+    return (far + sv[size_t(out)].nearScale * near) * scale_;
+}
+
+glm::vec3 VnmShading::scattered(const glm::vec3& p, const glm::vec3& wOut, bool smooth) const {
+    std::vector<VoxelWeight> weights;
+    if (smooth) {
+        weights = map_.reconstructionAt(p);
+    } else if (const int out = map_.surfaceVoxelAt(p); out >= 0) {
+        weights = {{out, 1.0f}};
+    }
+    if (weights.empty()) return glm::vec3(0.0f);
+    glm::vec3 L(0.0f), n(0.0f);
+    for (const VoxelWeight& w : weights) {
+        L += w.weight * voxelRadiance(w.voxel);
+        n += w.weight * map_.surface()[size_t(w.voxel)].normal;
+    }
+    const float cosOut = glm::length(n) > 0 ? std::abs(glm::dot(glm::normalize(n), wOut)) : 1.0f;
+    return L * boundaryTransmittance(medium_.ior, cosOut);
 }
 
 VnmImage renderVnm(const VoxelNumberMap& map, const TranslucentObject& object,

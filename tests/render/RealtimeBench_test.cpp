@@ -187,20 +187,22 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     gl::Context context = gl::Context::headless();
     const std::vector<BenchConfig> grid = benchGrid(camera, true, {{"vpls", {"256"}}});
     ASSERT_EQ(grid.size(), 1u);
-    EXPECT_EQ(grid[0].label(),
-              "resolution=160x120 vpls=256 indirect_scale=auto static_reuse=on sync_passes=on "
-              "shadow_filter=off shadow_map=512 specular_trace=impostors impostor_resolution=256 "
-              "impostor_steps=2 "
-              "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
-                  std::string(RendererOptions{}.specular.halfResolution ? "half" : "full") +
-                  " virtual=on "
-                  "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
-                  "caustic_gather=on caustic_radius=1 caustic_gather_cap=64 caustic_temporal=on "
-                  "specular_temporal=on "
-                  "pose_jitter=0 "
-                  "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
-                  "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 moving_objects=off "
-                  "env_source=static env_resolution=512 env_lights=0");
+    EXPECT_EQ(
+        grid[0].label(),
+        "resolution=160x120 vpls=256 indirect_scale=auto static_reuse=on sync_passes=on "
+        "shadow_filter=off shadow_map=512 specular_trace=impostors impostor_resolution=256 "
+        "impostor_steps=2 "
+        "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
+            std::string(RendererOptions{}.specular.halfResolution ? "half" : "full") +
+            " virtual=on "
+            "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
+            "caustic_gather=on caustic_radius=1 caustic_gather_cap=64 caustic_temporal=on "
+            "specular_temporal=on "
+            "pose_jitter=0 "
+            "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
+            "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 vnm_kernel=extinction "
+            "vnm_surface=occupancy vnm_albedo=hapke vnm_lookup=smooth moving_objects=off "
+            "env_source=static env_resolution=512 env_lights=0");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";

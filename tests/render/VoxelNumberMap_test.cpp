@@ -115,30 +115,70 @@ TEST(VoxelNumberMap, LutLimitAndDiskCache) {
     EXPECT_TRUE(second.fromCache());
     ASSERT_EQ(second.surface().size(), first.surface().size());
     EXPECT_EQ(second.tau(3, 700), first.tau(3, 700));
-    EXPECT_EQ(second.surface()[5].kernelScale, first.surface()[5].kernelScale);
+    EXPECT_EQ(second.surface()[5].kernelScale.y, first.surface()[5].kernelScale.y);
+    EXPECT_EQ(second.falloff().x, first.falloff().x);
     // Another density (or mesh) is another key; a damaged cache file is recomputed.
     TranslucentObject denser = object;
     denser.medium.extinction *= 2.0f;
-    EXPECT_NE(VoxelNumberMap::cacheKey(denser, 12), VoxelNumberMap::cacheKey(object, 12));
-    EXPECT_NE(VoxelNumberMap::cacheKey(object, 16), VoxelNumberMap::cacheKey(object, 12));
+    EXPECT_NE(VoxelNumberMap::cacheKey(denser, settings),
+              VoxelNumberMap::cacheKey(object, settings));
+    VnmSettings finer = settings;
+    finer.resolution = 16;
+    EXPECT_NE(VoxelNumberMap::cacheKey(object, finer), VoxelNumberMap::cacheKey(object, settings));
+    // The kernel's falloff depends on the albedo, and the areas on the surface's source.
+    TranslucentObject whiter = object;
+    whiter.medium.albedo = glm::vec3(0.99f);
+    EXPECT_NE(VoxelNumberMap::cacheKey(whiter, settings),
+              VoxelNumberMap::cacheKey(object, settings));
+    VnmSettings mesh = settings;
+    mesh.surface = VnmSurface::Mesh;
+    EXPECT_NE(VoxelNumberMap::cacheKey(object, mesh), VoxelNumberMap::cacheKey(object, settings));
     const fs::path file =
-        settings.cacheDir / ("vnm-" + VoxelNumberMap::cacheKey(object, 12) + ".bin");
+        settings.cacheDir / ("vnm-" + VoxelNumberMap::cacheKey(object, settings) + ".bin");
     ASSERT_TRUE(fs::exists(file));
     fs::resize_file(file, fs::file_size(file) / 2);
     const VoxelNumberMap third = VoxelNumberMap::build(object, settings);
     EXPECT_FALSE(third.fromCache());
     EXPECT_EQ(third.tau(3, 700), first.tau(3, 700));
     // A header claiming ~10^6 surface voxels (a 2 TB LUT) is rejected by the file's size, not
-    // allocated. S is the 64-bit field after magic, version, dims, origin, voxel size and area.
+    // allocated. S is the 64-bit field after magic, version, dims, origin, voxel size, area, the
+    // kernel's falloff and the exit albedo.
     {
         std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
         const uint64_t huge = (uint64_t(1) << 20) - 1;
-        f.seekp(4 + 4 + 12 + 12 + 4 + 4);
+        f.seekp(4 + 4 + 12 + 12 + 4 + 4 + 12 + 12);
         f.write(reinterpret_cast<const char*>(&huge), sizeof huge);
     }
     const VoxelNumberMap fourth = VoxelNumberMap::build(object, settings);
     EXPECT_FALSE(fourth.fromCache());
     EXPECT_EQ(fourth.surface().size(), first.surface().size());
+}
+
+// The exit albedo by random walks (ExitAlbedo.h): a white medium loses nothing, so every walk
+// that scattered leaves (1 within the walks' noise, the boundary's reflections included); a
+// black one returns nothing; a finite cube loses less than Hapke's thick half-space, and the
+// thinner (sigma_t halved) the more leaves.
+TEST(VoxelNumberMap, ExitAlbedoByRandomWalks) {
+    const fs::path dir = mirage::test::outputDir("vnm_exit_albedo");
+    TranslucentSceneOptions o;
+    o.albedo = {1.0f, 0.8f, 0.0f};
+    VnmSettings settings;
+    settings.resolution = 12;
+    settings.threads = 2;
+    const VoxelNumberMap thick =
+        VoxelNumberMap::build(objectOf(translucentTestScene(o, dir)), settings);
+    const glm::vec3 a = thick.exitAlbedo();
+    EXPECT_NEAR(a.x, 1.0f, 0.02f);
+    EXPECT_EQ(a.z, 0.0f);
+    const float hapke = effectiveAlbedo(o.albedo).y;
+    EXPECT_GT(a.y, hapke) << "a 0.5 m cube of tau 4 keeps less than a half-space";
+    EXPECT_LT(a.y, 0.8f);
+    o.extinction *= 0.5f;
+    const VoxelNumberMap thin =
+        VoxelNumberMap::build(objectOf(translucentTestScene(o, dir)), settings);
+    EXPECT_GT(thin.exitAlbedo().y, a.y);
+    std::cout << "exit albedo (G, albedo 0.8): Hapke " << hapke << ", tau 4 across " << a.y
+              << ", tau 2 across " << thin.exitAlbedo().y << "\n";
 }
 
 struct Accuracy {

@@ -60,8 +60,22 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r) 
         TranslucentObjectGpu obj = translucentObjects[object];
         int base = 2 * obj.offsets.y;  // the object's slice: S for L_rv, then S for L_r
         float Ft = boundaryTransmittance(obj.params.x, abs(dot(n, v)));
-        rv = Ft * translucentL[base + voxel].rgb;
-        if (pReal) r = Ft * translucentL[base + obj.gridDims.w + voxel].rgb;
+        // The smooth lookup blends the voxels around p (no stripes where the grid cuts a face
+        // at an angle); without it, or with no voxel centre near, the nearest voxel alone.
+        int voxels[27];
+        float weights[27];
+        int count = obj.params.z > 0.5 ? translucentWeights(object, p, voxels, weights) : 0;
+        if (count == 0) {
+            count = 1;
+            voxels[0] = voxel;
+            weights[0] = 1.0;
+        }
+        for (int j = 0; j < count; ++j) {
+            rv += weights[j] * translucentL[base + voxels[j]].rgb;
+            if (pReal) r += weights[j] * translucentL[base + obj.gridDims.w + voxels[j]].rgb;
+        }
+        rv *= Ft;
+        r *= Ft;
         rv += Em.rgb;
         if (pReal) r += Em.rgb;
         return;

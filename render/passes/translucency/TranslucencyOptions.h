@@ -18,6 +18,20 @@ struct TranslucencyOptions {
     bool shadows = true;
     int vnmResolution = 16;
     std::string vnmCacheDir;
+    // The voxel number map's approximations, each measured against the reference on the sample
+    // scene (docs/translucency.md "Error budget"). diffusionKernel: the kernel e^{-k tau},
+    // k = min(1, sqrt(3 (1 - albedo))) (false, the default: the seed's e^{-tau}). meshSurface:
+    // surface voxels' normals and areas from the mesh (false, the default: from the voxels'
+    // occupancy). smoothLookup: the smooth reconstruction, each voxel's near field normalised
+    // (SurfaceVoxel::nearScale) and a translucent pixel blending the surface voxels within 1.5
+    // voxels (false: neither, the nearest voxel alone: the voxels' stripes). measuredAlbedo: the
+    // kernel's total is the share of scattered light that leaves the object, measured by random
+    // walks through its voxels (false, the default: Hapke's albedo of a thick half-space, which a
+    // front-lit cube's reference bears out and the walks overshoot).
+    bool diffusionKernel = false;
+    bool meshSurface = false;
+    bool smoothLookup = true;
+    bool measuredAlbedo = false;
 
     void validate() const {
         checkOption(vnmResolution >= 2 && vnmResolution <= 512, "translucency.vnmResolution",

@@ -16,15 +16,16 @@ namespace mirage::render {
 namespace {
 
 // One translucent object in the header of the grid buffer (translucency.glsl
-// TranslucentObjectGpu, std430): 5 vec4.
+// TranslucentObjectGpu, std430): 6 vec4.
 struct ObjectHeader {
     glm::vec4 gridOrigin;    // world corner of cell (0,0,0), voxel edge (m)
     glm::ivec4 gridDims;     // cells per axis, S
-    glm::vec4 params;        // ior, F_t over the cosine-weighted hemisphere, 0, 0
+    glm::vec4 params;        // ior, F_t over the cosine-weighted hemisphere, smooth lookup 1/0, 0
     glm::ivec4 offsets;      // first cell number, first surface voxel, first LUT entry, 0
     glm::vec4 albedoOverPi;  // a_eff / pi, 0
+    glm::vec4 falloff;       // k of the kernel e^{-k tau} per channel, 0
 };
-static_assert(sizeof(ObjectHeader) == 80);
+static_assert(sizeof(ObjectHeader) == 96);
 
 }  // namespace
 
@@ -50,6 +51,10 @@ TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
     translucency::VnmSettings settings;
     settings.resolution = options.translucency.vnmResolution;
     settings.cacheDir = options.translucency.vnmCacheDir;
+    settings.kernel = options.translucency.diffusionKernel ? translucency::VnmKernel::Diffusion
+                                                           : translucency::VnmKernel::Extinction;
+    settings.surface = options.translucency.meshSurface ? translucency::VnmSurface::Mesh
+                                                        : translucency::VnmSurface::Occupancy;
     std::vector<ObjectHeader> headers;
     std::vector<int32_t> numbers;
     std::vector<glm::vec4> voxels;
@@ -72,16 +77,21 @@ TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
         h.gridOrigin = glm::vec4(map.origin(), map.voxelSize());
         h.gridDims = glm::ivec4(map.dims(), int(S));
         h.params = glm::vec4(object.medium.ior,
-                             translucency::hemisphericalTransmittance(object.medium.ior), 0, 0);
+                             translucency::hemisphericalTransmittance(object.medium.ior),
+                             options.translucency.smoothLookup ? 1.0f : 0.0f, 0);
         h.offsets = glm::ivec4(int(numbers.size()), surfaceVoxels_, int(lut.size()), 0);
-        h.albedoOverPi =
-            glm::vec4(translucency::effectiveAlbedo(object.medium.albedo) / 3.14159265358979f, 0);
+        h.albedoOverPi = glm::vec4(translucency::VnmShading::radianceScale(
+                                       map, object.medium, options.translucency.measuredAlbedo),
+                                   0);
+        h.falloff = glm::vec4(map.falloff(), 0);
         headers.push_back(h);
         numbers.insert(numbers.end(), map.numbers().begin(), map.numbers().end());
         for (size_t i = 0; i < S; ++i) {
-            voxels.emplace_back(sv[i].position,
-                                sv[i].exterior ? sv[i].area * sv[i].kernelScale : 0.0f);
-            voxels.emplace_back(sv[i].normal, 0.0f);
+            voxels.emplace_back(sv[i].position, 0.0f);
+            voxels.emplace_back(sv[i].normal,
+                                options.translucency.smoothLookup ? sv[i].nearScale : 1.0f);
+            voxels.emplace_back(sv[i].exterior ? sv[i].area * sv[i].kernelScale : glm::vec3(0.0f),
+                                0.0f);
         }
         lut.insert(lut.end(), map.tauHalf().begin(), map.tauHalf().end());
         surfaceVoxels_ += int(S);

@@ -2,7 +2,7 @@
 // The voxel number map at run time (docs/translucency.md): for each of the scene's translucent
 // objects (up to kMaxObjects, each with its own map), the irradiance at its surface voxels from
 // every light (visibility from the shadow maps) and the environment (SH irradiance), then the
-// radiance leaving every surface voxel, L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-tau(i, o)}
+// radiance leaving every surface voxel, L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-k tau(i, o)}
 // (compute, two dispatches), for L_rv and L_r. The precomputation (surface voxels, tau LUT) is the
 // CPU VoxelNumberMap's, built (or read from its disk cache) when the renderer is created and
 // uploaded once. direct.frag shades the object's pixels from the result. Runs only when the scene
@@ -19,7 +19,7 @@ namespace mirage::render {
 
 // SSBOs of the first translucent object (docs/translucency.md). TranslucentGrid: header + the
 // voxel number of every grid cell (persistent, uploaded once); TranslucentRadiance: per surface
-// voxel the radiance (1/pi) a_eff sum E A c e^{-tau} leaving it before the exit F_t, S vec4 for
+// voxel the radiance (1/pi) a_eff sum E A c e^{-k tau} leaving it before the exit F_t, S vec4 for
 // L_rv then S vec4 for L_r.
 inline constexpr Resource kTranslucentGrid{"TranslucentGrid"};
 inline constexpr Resource kTranslucentRadiance{"TranslucentRadiance"};

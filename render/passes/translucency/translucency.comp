@@ -9,16 +9,18 @@
 //           irradiance at every outer surface voxel i; for L_rv every light with visibility
 //           through all occluders, for L_r only real lights with the real-only shadow maps and
 //           a real environment (DESIGN.md "Real and virtual");
-//  stage 1: per output voxel o, L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-tau(i, o)}, the
+//  stage 1: per output voxel o, L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-k tau(i, o)}, the
 //           radiance leaving o before the exit boundary's F_t (direct.frag applies it per pixel).
 layout(local_size_x = 64) in;
 
-// Per surface voxel (all objects' in order): (centre xyz world m, A_i c_i if on the outer
-// surface else 0),
-// (outward unit normal xyz, 0).
+const float kNearField = 2.01;  // VoxelNumberMap::kNearField (voxel edges)
+
+// Per surface voxel (all objects' in order): (centre xyz world m, 0), (outward unit normal xyz,
+// near-field scale g_o), (A_i c_i per channel if on the outer surface, else 0; 0).
 struct TranslucentVoxel {
-    vec4 positionWeight;
+    vec4 position;
     vec4 normal;
+    vec4 weight;
 };
 layout(std430, binding = kBindingTranslucentVoxels) readonly buffer Voxels {
     TranslucentVoxel voxels[];
@@ -46,8 +48,8 @@ float tau(int i, int o, int S, int lutFirst) {
 void irradiance(int i, int S, int v0, TranslucentObjectGpu obj) {
     TranslucentVoxel v = voxels[v0 + i];
     vec3 rv = vec3(0.0), r = vec3(0.0);
-    if (v.positionWeight.w > 0.0) {  // cavity walls receive no outside light
-        vec3 p = v.positionWeight.xyz;
+    if (any(greaterThan(v.weight.rgb, vec3(0.0)))) {  // cavity walls receive no outside light
+        vec3 p = v.position.xyz;
         vec3 N = v.normal.xyz;
         float ior = obj.params.x;
         // Visibility from just outside the voxel, along its normal (as the CPU code).
@@ -81,15 +83,27 @@ void irradiance(int i, int S, int v0, TranslucentObjectGpu obj) {
 void scatter(int o, int S, int v0, TranslucentObjectGpu obj) {
     vec3 rv = vec3(0.0), r = vec3(0.0);
     int lutFirst = obj.offsets.z;
+    vec3 falloff = obj.falloff.rgb;
+    // The near field (centres within kNearField voxel edges of o's) is scaled by g_o
+    // (VoxelNumberMap::kernelScales): no stripes where the grid cuts a face at an angle.
+    vec3 po = voxels[v0 + o].position.xyz;
+    float reach = kNearField * obj.gridOrigin.w;
+    vec3 nearRv = vec3(0.0), nearR = vec3(0.0);
     for (int i = 0; i < S; ++i) {
-        float w = voxels[v0 + i].positionWeight.w;
-        if (w <= 0.0) continue;
-        float k = w * exp(-tau(i, o, S, lutFirst));
-        rv += E[2 * v0 + i].rgb * k;
-        r += E[2 * v0 + S + i].rgb * k;
+        vec3 w = voxels[v0 + i].weight.rgb;
+        if (w == vec3(0.0)) continue;
+        vec3 k = w * exp(-falloff * tau(i, o, S, lutFirst));
+        if (distance(voxels[v0 + i].position.xyz, po) <= reach) {
+            nearRv += E[2 * v0 + i].rgb * k;
+            nearR += E[2 * v0 + S + i].rgb * k;
+        } else {
+            rv += E[2 * v0 + i].rgb * k;
+            r += E[2 * v0 + S + i].rgb * k;
+        }
     }
-    L[2 * v0 + o] = vec4(rv * obj.albedoOverPi.rgb, 0.0);
-    L[2 * v0 + S + o] = vec4(r * obj.albedoOverPi.rgb, 0.0);
+    float g = voxels[v0 + o].normal.w;
+    L[2 * v0 + o] = vec4((rv + g * nearRv) * obj.albedoOverPi.rgb, 0.0);
+    L[2 * v0 + S + o] = vec4((r + g * nearR) * obj.albedoOverPi.rgb, 0.0);
 }
 
 void main() {

@@ -9,16 +9,20 @@ const int kMaxTranslucentObjects = 8;
 
 // One object's map: gridOrigin.xyz = world corner of its cell (0,0,0), .w = voxel edge (m);
 // gridDims.xyz = cells per axis, .w = S (its surface voxels); params.x = the medium's index of
-// refraction, .y = F_t averaged over the cosine-weighted hemisphere; offsets.x = its first cell
+// refraction, .y = F_t averaged over the cosine-weighted hemisphere, .z = 1 for the smooth
+// lookup (translucentWeights), 0 for the nearest voxel alone; offsets.x = its first cell
 // in gridNumber, .y = its first surface voxel in the voxel, irradiance and radiance buffers
 // (which hold 2 entries per voxel: an object's S for L_rv, then its S for L_r, from 2 * .y on),
-// .z = its first entry in the tau LUT; albedoOverPi.rgb = a_eff / pi.
+// .z = its first entry in the tau LUT; albedoOverPi.rgb = VnmShading::radianceScale (the measured
+// exit albedo over pi F_t,hemisphere, or a_eff / pi); falloff.rgb = k of the
+// kernel e^{-k tau} (VoxelNumberMap::falloff).
 struct TranslucentObjectGpu {
     vec4 gridOrigin;
     ivec4 gridDims;
     vec4 params;
     ivec4 offsets;
     vec4 albedoOverPi;
+    vec4 falloff;
 };
 // objectCount.x objects; gridNumber: per cell (x fastest) the object's surface voxel or -1.
 layout(std430, binding = kBindingTranslucentGrid) readonly buffer TranslucentGridBlock {
@@ -73,6 +77,37 @@ int surfaceVoxelAt(int k, vec3 p, out float dist) {
                 }
             }
     return best;
+}
+
+// The smooth lookup (VoxelNumberMap::reconstructionAt): the surface voxels of object k whose
+// centres lie within kTranslucentFilterRadius voxel edges of world point p (all in the 3x3x3
+// cells around p's), weighted (1 - (d / r)^2)^2 and normalised; count = how many (0: none near).
+const float kTranslucentFilterRadius = 1.5;
+int translucentWeights(int k, vec3 p, out int voxel[27], out float weight[27]) {
+    TranslucentObjectGpu o = translucentObjects[k];
+    vec3 g = (p - o.gridOrigin.xyz) / o.gridOrigin.w;
+    ivec3 c = ivec3(floor(g));
+    ivec3 dims = o.gridDims.xyz;
+    int first = o.offsets.x;
+    int count = 0;
+    float sum = 0.0;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                ivec3 q = c + ivec3(dx, dy, dz);
+                if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, dims))) continue;
+                int n = gridNumber[first + (q.z * dims.y + q.y) * dims.x + q.x];
+                if (n < 0) continue;
+                float x = length(vec3(q) + 0.5 - g) / kTranslucentFilterRadius;
+                if (x >= 1.0) continue;
+                float w = (1.0 - x * x) * (1.0 - x * x);
+                voxel[count] = n;
+                weight[count] = w;
+                sum += w;
+                ++count;
+            }
+    for (int j = 0; j < count; ++j) weight[j] /= sum;
+    return count;
 }
 
 // The translucent object and surface voxel standing for world point p: the object whose map has

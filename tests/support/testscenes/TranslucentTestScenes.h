@@ -69,6 +69,9 @@ struct TranslucentSceneOptions {
     bool cavityInScene = true;    // false: the cube without its cavity (the "cavity ignored" case)
     Origin objectOrigin = Origin::Virtual;  // the cube
     Origin lightOrigin = Origin::Real;
+    // The cube turned about +Y (degrees): its faces then cut the world-aligned voxel grid of the
+    // voxel number map at an angle, as the sample scene's jade cube does.
+    float yawDegrees = 0.0f;
 };
 
 // A translucent cube [-0.25, 0.25]^3 (one mesh: the box, and for the cavity variant the inward
@@ -103,7 +106,9 @@ inline Scene translucentTestScene(const TranslucentSceneOptions& o,
     Node n;
     n.name = "translucent";
     n.mesh = 0;
-    mirage::test::addRootNode(s, std::move(n), glm::dmat4(1.0), o.objectOrigin);
+    const glm::dmat4 turn =
+        glm::rotate(glm::dmat4(1.0), glm::radians(double(o.yawDegrees)), glm::dvec3(0, 1, 0));
+    mirage::test::addRootNode(s, std::move(n), turn, o.objectOrigin);
     Light l;
     l.type = Light::Type::Point;
     l.intensity = o.lightIntensity;
