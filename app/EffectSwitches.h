@@ -16,22 +16,31 @@
 namespace mirage::app {
 
 struct EffectSwitch {
-    const char* name;   // as the bench knob
-    const char* label;  // as the HUD shows it
-    bool render::RendererOptions::*member;
+    const char* name;                         // as the bench knob
+    const char* label;                        // as the HUD shows it
+    bool& (*flag)(render::RendererOptions&);  // the option it switches
 };
 
+// `mirage live` and `mirage replay` start with every effect on, including exposure matching,
+// which the renderer's defaults leave off (a fixed exposure: the renderer as a model, for tests).
 inline constexpr EffectSwitch kEffectSwitches[] = {
-    {"caustics", "caustics", &render::RendererOptions::caustics},
-    {"caustic_temporal", "caustic smoothing", &render::RendererOptions::causticTemporal},
+    {"caustics", "caustics", [](render::RendererOptions& o) -> bool& { return o.caustics; }},
+    {"caustic_temporal", "caustic smoothing",
+     [](render::RendererOptions& o) -> bool& { return o.causticTemporal; }},
     {"specular_temporal", "mirror/glass light smoothing",
-     &render::RendererOptions::specularTemporal},
-    {"glass_shadows", "shadows through glass", &render::RendererOptions::glassShadows},
+     [](render::RendererOptions& o) -> bool& { return o.specularTemporal; }},
+    {"glass_shadows", "shadows through glass",
+     [](render::RendererOptions& o) -> bool& { return o.glassShadows; }},
     {"refl_refr_vpls", "VPLs through mirror/glass",
-     &render::RendererOptions::reflectedRefractedVpls},
-    {"specular_vpls", "VPLs in reflections", &render::RendererOptions::specularVpls},
-    {"fuzzy", "fuzzy reflections", &render::RendererOptions::fuzzyReflections},
-    {"translucency", "translucency", &render::RendererOptions::translucency},
+     [](render::RendererOptions& o) -> bool& { return o.reflectedRefractedVpls; }},
+    {"specular_vpls", "VPLs in reflections",
+     [](render::RendererOptions& o) -> bool& { return o.specularVpls; }},
+    {"fuzzy", "fuzzy reflections",
+     [](render::RendererOptions& o) -> bool& { return o.fuzzyReflections; }},
+    {"translucency", "translucency",
+     [](render::RendererOptions& o) -> bool& { return o.translucency; }},
+    {"exposure_match", "exposure matching",
+     [](render::RendererOptions& o) -> bool& { return o.exposureMatch.enabled; }},
 };
 
 inline std::string effectSwitchNames() {
@@ -66,7 +75,7 @@ inline void switchEffectsOff(const std::vector<std::string>& names,
         if (!e)
             throw Error(fmt::format("--off: '{}' is not an effect; the effects are: {}", n,
                                     effectSwitchNames()));
-        options.*e->member = false;
+        e->flag(options) = false;
     }
 }
 

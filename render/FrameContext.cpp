@@ -70,6 +70,9 @@ void RendererOptions::validate() const {
         environmentLightMapWidth % 2 != 0)
         fail("environmentLightMapWidth must be even, 16..2048 texels, got " +
              std::to_string(environmentLightMapWidth));
+    if (!(exposure >= 1e-4f && exposure <= 1e4f))
+        fail("exposure must be in [1e-4, 1e4], got " + std::to_string(exposure));
+    exposureMatch.validate();
 }
 
 const char* roughRefractionMethodName(RoughRefractionMethod m) {
@@ -95,6 +98,7 @@ FrameContext::FrameContext(const GpuScene& s, const CameraProjection& p, const R
       frameUbo("frame ubo", sizeof(GpuFrame)),
       lightUbo("light ubo", sizeof(GpuLightBlock)),
       emptyVao("empty vao") {
+    exposure.gain = glm::dvec3(double(o.exposure));  // the prior, until a frame says otherwise
     black_ = gl::Texture::create2D("black 1x1", 1, 1, GL_RGBA16F);
     const float zero[4] = {0, 0, 0, 0};
     black_.upload(GL_RGBA, GL_FLOAT, zero);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "render/GpuScene.h"
 #include "render/GpuTypes.h"
 #include "render/Resource.h"
+#include "render/passes/exposure/ExposureMatchOptions.h"
 
 namespace mirage::render {
 
@@ -56,7 +58,10 @@ struct RendererOptions {
     // keeps (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend)
     // frames. 0 .. 0.98.
     float temporalBlend = 0.8f;
-    float exposure = 1.0f;               // rendered linear radiance -> camera linear units
+    // Rendered linear radiance -> camera linear units: the gain of every frame, or with
+    // exposureMatch.enabled the prior of the per-frame estimate (docs/camera-matching.md).
+    float exposure = 1.0f;
+    ExposureMatchOptions exposureMatch;  // render/passes/exposure
     float alphaMax = 8.0f;               // cap of alpha = CI / L_r
     float alphaFadeLr = 0.02f;           // where L_r (linear) is below this, alpha fades to 1
     float nearM = 0.01f, farM = 100.0f;  // camera clip planes (metres)
@@ -293,6 +298,11 @@ public:
     bool historyValid = false;
     std::string historyResetReason;
     EnvironmentInput environment;
+    // The gain from rendered radiance to camera units in force this frame (frame.exposure), with
+    // where it came from: the exposure pass's estimate, or RendererOptions::exposure.
+    ExposureState exposure;
+    // The camera's own exposure report (time x gain, any unit; Renderer::setReportedExposure).
+    std::optional<double> reportedExposure;
     // What the camera-independent passes' output depends on besides the static scene: the light
     // matrices and parameters and the frame plan (Renderer sets it before every frame; equal keys
     // mean equal shadow maps).

@@ -175,9 +175,9 @@ HudRequests LiveWindow::drawHud(const HudStatus& s, LiveControls& controls, int 
     // the pass table above says why they did not run).
     if (ImGui::CollapsingHeader("effects")) {
         for (const EffectSwitch& e : kEffectSwitches) {
-            bool on = controls.effects.*e.member;
+            bool on = e.flag(controls.effects);
             if (ImGui::Checkbox(e.label, &on)) {
-                controls.effects.*e.member = on;
+                e.flag(controls.effects) = on;
                 req.rebuild = true;
                 spdlog::info("live: {} {}", e.name, on ? "on" : "off");
             }

@@ -171,7 +171,8 @@ void ReplaySession::createRenderer() {
                                                       : gl::Context::headless(copt));
     render::RendererOptions ropt;
     ropt.vplCount = a.vpls;
-    ropt.exposure = a.exposure;
+    ropt.exposure = a.exposure;  // the prior of the per-frame exposure estimate
+    ropt.exposureMatch.enabled = true;
     switchEffectsOff(a.effectsOff, ropt);
     if (a.estimateLights) {
         // As many as light estimation reports, within the renderer's light budget.
