@@ -24,6 +24,7 @@
 #include "render/evaluation/RealtimeBench.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/raytrace/GroundTruthComposite.h"
+#include "render/raytrace/SyntheticFootage.h"
 #include "render/raytrace/SyntheticSession.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
@@ -151,6 +152,27 @@ TEST(ExposureTracker, BadSettingsAreRefused) {
     EXPECT_THROW(ExposureTracker(glm::dvec3(1.0), s), Error);
     EXPECT_THROW(ExposureTracker(glm::dvec3(0.0)), Error);
     EXPECT_THROW(ExposureTracker(glm::dvec3(NAN)), Error);
+}
+
+TEST(SyntheticSensor, ExposureStepAndWhiteBalanceDriftAreWhereTheyAreSaidToBe) {
+    raytrace::SensorOptions s;
+    s.exposure = 0.8f;
+    s.exposureStep = 0.25;
+    s.whiteBalanceDrift = {1.4, 1.0, 0.6};
+    EXPECT_NEAR(raytrace::exposureAt(s, 0.49, 1.0), 0.8, 1e-7);
+    EXPECT_NEAR(raytrace::exposureAt(s, 0.5, 1.0), 0.8 * 0.25, 1e-7);  // a step between frames
+    EXPECT_EQ(raytrace::whiteBalanceAt(s, 0.0, 2.0), glm::dvec3(1.0));
+    EXPECT_NEAR(raytrace::whiteBalanceAt(s, 1.0, 2.0).r, 1.2, 1e-12);
+    EXPECT_NEAR(raytrace::whiteBalanceAt(s, 2.0, 2.0).b, 0.6, 1e-12);
+    // The sensor applies the gains per channel (R, G, B of the linear image; BGR out).
+    const cv::Mat grey(2, 2, CV_32FC3, cv::Scalar(0.2, 0.2, 0.2));
+    const cv::Mat bgr =
+        raytrace::applySensor(grey, raytrace::SensorOptions{}, 1.0, 1, {2.0, 1.0, 0.5});
+    const cv::Mat back = srgbBgr8ToLinearRgb(bgr);
+    const cv::Vec3f p = back.at<cv::Vec3f>(0, 0);
+    EXPECT_NEAR(p[0], 0.4, 0.01);
+    EXPECT_NEAR(p[1], 0.2, 0.01);
+    EXPECT_NEAR(p[2], 0.1, 0.01);
 }
 
 // ---- the exposure pass in the renderer ---------------------------------------------------------
