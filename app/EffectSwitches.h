@@ -21,6 +21,8 @@ struct EffectSwitch {
     bool& (*flag)(render::RendererOptions&);  // the option that switches it, in its pass's struct
 };
 
+// `mirage live` and `mirage replay` start with every effect on, including exposure matching,
+// which the renderer's defaults leave off (a fixed exposure: the renderer as a model, for tests).
 inline constexpr EffectSwitch kEffectSwitches[] = {
     {"caustics", "caustics", [](render::RendererOptions& o) -> bool& { return o.caustic.enabled; }},
     {"caustic_temporal", "caustic smoothing",
@@ -37,6 +39,8 @@ inline constexpr EffectSwitch kEffectSwitches[] = {
      [](render::RendererOptions& o) -> bool& { return o.fuzzy.enabled; }},
     {"translucency", "translucency",
      [](render::RendererOptions& o) -> bool& { return o.translucency.enabled; }},
+    {"exposure_match", "exposure matching",
+     [](render::RendererOptions& o) -> bool& { return o.exposureMatch.enabled; }},
 };
 
 inline std::string effectSwitchNames() {

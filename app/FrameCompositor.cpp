@@ -24,6 +24,8 @@ CompositedFrame FrameCompositor::composite(const cv::Mat& bgr, PoseRow pose, boo
         for (const auto& p : rep.passes) out.passMs[p.name] = p.gpuMs;
         out.gpuMs = rep.totalGpuMs;
         out.report = &rep;
+        out.exposureGain = renderer_.exposure().gain;
+        out.exposureSource = render::exposureSourceName(renderer_.exposure().source);
         const auto t2 = Clock::now();
         out.image = renderer_.compositeSrgb();
         out.readbackMs = msSince(t2);

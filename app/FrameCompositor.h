@@ -27,6 +27,10 @@ struct CompositedFrame {
     // for a lost frame (no image to composite into).
     cv::Mat image;
     const render::FrameReport* report = nullptr;  // the renderer's report, when it rendered
+    // The gain from rendered radiance to camera units the frame was composited with (R, G, B)
+    // and where it came from (render::exposureSourceName; empty when nothing was rendered).
+    glm::dvec3 exposureGain{0.0};
+    std::string exposureSource;
 };
 
 class FrameCompositor {

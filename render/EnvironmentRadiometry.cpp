@@ -14,14 +14,12 @@
 namespace mirage::render {
 namespace {
 
-// 8-bit codes that are neither dark (quantisation dominates) nor near clipping.
-constexpr int kLowCode = 16, kHighCode = 239;
 constexpr double kMaxRelativeVariation = 0.10;  // of a pixel's neighbourhood (edges are unusable)
 constexpr float kFar = 1e6f;                    // metres: "leaves the modelled scene"
 
 bool wellExposed(const cv::Vec3b& v) {
     for (int c = 0; c < 3; ++c)
-        if (v[c] < kLowCode || v[c] > kHighCode) return false;
+        if (!wellExposedCode(v[c])) return false;
     return true;
 }
 
@@ -46,12 +44,6 @@ bool smooth(const double* lum, int n) {
     for (int i = 0; i < n; ++i)
         if (std::abs(lum[i] - mean) > kMaxRelativeVariation * mean) return false;
     return mean > 0;
-}
-
-double quantile(std::vector<double> v, double q) {
-    const size_t k = std::min(v.size() - 1, size_t(q * double(v.size() - 1) + 0.5));
-    std::nth_element(v.begin(), v.begin() + long(k), v.end());
-    return v[k];
 }
 
 }  // namespace
@@ -133,8 +125,7 @@ int EnvironmentRadiometryEstimator::addFrame(const cv::Mat& mainBgr, const Pose&
             }
             if (!ok || !smooth(lum4, 4)) continue;
             const glm::dvec3 mainValue = linear(mainBgr.at<cv::Vec3b>(y, x));
-            ratios_.push_back(mainValue / envValue);
-            ++added;
+            if (ratios_.add(mainValue, envValue)) ++added;
         }
     if (added > 0) ++frames_;
     return added;
@@ -142,7 +133,7 @@ int EnvironmentRadiometryEstimator::addFrame(const cv::Mat& mainBgr, const Pose&
 
 RadiometryEstimate EnvironmentRadiometryEstimator::estimate(int minSamples) const {
     RadiometryEstimate r;
-    r.samples = int(ratios_.size());
+    r.samples = ratios_.size();
     r.frames = frames_;
     if (r.samples < std::max(minSamples, 1)) {
         r.whyNot = fmt::format(
@@ -154,16 +145,9 @@ RadiometryEstimate EnvironmentRadiometryEstimator::estimate(int minSamples) cons
             r.samples, minSamples);
         return r;
     }
-    glm::dvec3 ratio, spread;
-    for (int c = 0; c < 3; ++c) {
-        std::vector<double> v;
-        v.reserve(ratios_.size());
-        for (const glm::dvec3& s : ratios_) v.push_back(s[c]);
-        ratio[c] = quantile(v, 0.5);
-        spread[c] = 0.5 * (quantile(v, 0.75) - quantile(v, 0.25)) / ratio[c];
-    }
-    r.ratio = ratio;
-    r.spread = spread;
+    const std::optional<RatioStatistics> stats = ratios_.statistics(minSamples);
+    r.ratio = stats->ratio;
+    r.spread = stats->spread;
     return r;
 }
 

@@ -10,10 +10,12 @@
 // between the cameras), so per channel
 //     ratio = main linear value / environment linear value
 // is radiometry_to_main. Pairs are kept only where both are well exposed (every 8-bit channel,
-// and every bilinear tap of the environment pixel, within [16, 239]: not dark, not clipped) and
+// and every bilinear tap of the environment pixel, within the well-exposed codes of
+// render/RadiometricRatio.h: not dark, not clipped) and
 // smooth (the main pixel's 3 x 3 neighbourhood and the environment pixel's taps within 10 % of
 // their mean luminance: an edge moves with a small pose error or with parallax). The estimate is
-// the per-channel median of the kept ratios over all frames added.
+// the per-channel median of the kept ratios over all frames added: the same estimator
+// (RadiometricRatio) as the main camera's per-frame exposure against the rendered real surfaces.
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,6 +28,7 @@
 #include "core/math/Pose.h"
 #include "core/scene/Scene.h"
 #include "render/EnvironmentCamera.h"
+#include "render/RadiometricRatio.h"
 
 namespace mirage::raytrace {
 class EmbreeDevice;
@@ -71,7 +74,7 @@ private:
     EnvironmentCameraSetup env_;
     std::unique_ptr<raytrace::EmbreeDevice> device_;
     std::unique_ptr<raytrace::RayTracingScene> real_;
-    std::vector<glm::dvec3> ratios_;
+    RadiometricRatio ratios_;
     int frames_ = 0, stride_ = 2;
 };
 

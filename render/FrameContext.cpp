@@ -22,6 +22,7 @@ void RendererOptions::validate() const {
     environment.validate();
     translucency.validate();
     composite.validate();
+    exposureMatch.validate();
     checkOption(temporalBlend >= 0.0f && temporalBlend <= 0.98f, "temporalBlend",
                 "in [0, 0.98] (the history's weight)", temporalBlend);
     checkOption(clip.nearM > 0.0f && clip.farM > clip.nearM, "clip", "0 < nearM < farM (metres)",
@@ -39,6 +40,8 @@ FrameContext::FrameContext(const GpuScene& s, const CameraProjection& p, const R
       frameUbo("frame ubo", sizeof(GpuFrame)),
       lightUbo("light ubo", sizeof(GpuLightBlock)),
       emptyVao("empty vao") {
+    exposure.gain =
+        glm::dvec3(double(o.composite.exposure));  // the prior, until a frame says otherwise
     black_ = gl::Texture::create2D("black 1x1", 1, 1, GL_RGBA16F);
     const float zero[4] = {0, 0, 0, 0};
     black_.upload(GL_RGBA, GL_FLOAT, zero);

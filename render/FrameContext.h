@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "render/passes/composite/CompositeOptions.h"
 #include "render/passes/direct/DirectOptions.h"
 #include "render/passes/environment/EnvironmentOptions.h"
+#include "render/passes/exposure/ExposureMatchOptions.h"
 #include "render/passes/fuzzy/FuzzyOptions.h"
 #include "render/passes/impostor/ImpostorOptions.h"
 #include "render/passes/indirect/IndirectOptions.h"
@@ -65,6 +67,7 @@ struct RendererOptions {
     EnvironmentOptions environment;
     TranslucencyOptions translucency;
     CompositeOptions composite;
+    ExposureMatchOptions exposureMatch;  // render/passes/exposure
 
     // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
     // and where switched on the caustic buffer and the specular-hit light L'. Each frame keeps
@@ -169,6 +172,11 @@ public:
     bool historyValid = false;
     std::string historyResetReason;
     EnvironmentInput environment;
+    // The gain from rendered radiance to camera units in force this frame (frame.exposure), with
+    // where it came from: the exposure pass's estimate, or RendererOptions::composite.exposure.
+    ExposureState exposure;
+    // The camera's own exposure report (time x gain, any unit; Renderer::setReportedExposure).
+    std::optional<double> reportedExposure;
     // What the camera-independent passes' output depends on besides the static scene: the light
     // matrices and parameters and the frame plan (Renderer sets it before every frame; equal keys
     // mean equal shadow maps).

@@ -22,11 +22,12 @@ static_assert(offsetof(GpuLight, range) == 6 * 64 + 12 && offsetof(GpuLight, typ
 static_assert(offsetof(GpuLight, frustumSize) == 6 * 64 + 44);
 static_assert(offsetof(GpuLight, cosOuter) == 6 * 64 + 3 * 16);
 static_assert(offsetof(GpuLight, firstShadowLayer) == 6 * 64 + 4 * 16);
-static_assert(sizeof(GpuFrame) == 4 * 64 + 3 * 16 + 3 * 16 + 16);
+static_assert(sizeof(GpuFrame) == 4 * 64 + 3 * 16 + 3 * 16 + 2 * 16);
 static_assert(offsetof(GpuFrame, lightCount) == 4 * 64 + 3 * 16);
 static_assert(offsetof(GpuFrame, envOrigin) == 4 * 64 + 4 * 16);
 static_assert(offsetof(GpuFrame, vplDistanceClamp) == 4 * 64 + 5 * 16);
 static_assert(offsetof(GpuFrame, exposure) == 4 * 64 + 6 * 16);
+static_assert(offsetof(GpuFrame, alphaMax) == 4 * 64 + 6 * 16 + 12);  // std140: after a vec3
 static_assert(sizeof(GpuEnvironment) == 10 * 16);
 static_assert(offsetof(GpuEnvironment, envRotation) == 9 * 16);
 static_assert(sizeof(GpuLightBlock) == kMaxLights * sizeof(GpuLight));

@@ -17,6 +17,7 @@
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/environment/EnvironmentPass.h"
+#include "render/passes/exposure/ExposurePass.h"
 #include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
@@ -301,6 +302,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<GiFilterPass>(options_.indirect.interleave));
     g.addPass(std::make_unique<DirectLightPass>(*scene_));  // + the upsampled indirect light
     g.addPass(std::make_unique<CausticPass>());
+    g.addPass(std::make_unique<ExposurePass>());  // L_r complete; before any pass using exposure
     g.addPass(std::make_unique<BackFacePass>());
     g.addPass(std::make_unique<SpecularGBufferPass>());
     g.addPass(std::make_unique<PhotonGridPass>());  // caustics at the reflected/refracted hits
@@ -383,7 +385,14 @@ void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view
     f.shadowBias = options_.shadow.bias;
     f.temporalBlend = options_.temporalBlend;
     f.ismPointsPerVpl = float(options_.ism.pointsPerVpl);
-    f.exposure = options_.composite.exposure;
+    // The exposure pass (when on) replaces it after measuring this frame; until then, and in
+    // passes before it, the last frame's estimate (the prior before the first).
+    if (!options_.exposureMatch.enabled) {
+        c.exposure = ExposureState{};
+        c.exposure.gain = glm::dvec3(double(options_.composite.exposure));
+        c.exposure.note = "fixed exposure (matching off)";
+    }
+    f.exposure = glm::vec3(c.exposure.gain);
     f.alphaMax = options_.composite.alphaMax;
     f.alphaFadeLr = options_.composite.alphaFadeLr;
     c.frameUbo.upload(&f, sizeof(GpuFrame));

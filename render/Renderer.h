@@ -103,6 +103,13 @@ public:
 
     const CameraProjection& projection() const { return projection_; }
     const FramePlan& plan() const { return ctx_->plan; }
+    // The gain from rendered radiance to camera units this frame, per channel, and where it came
+    // from (the per-frame estimate with RendererOptions::exposureMatch, else the fixed exposure).
+    const ExposureState& exposure() const { return ctx_->exposure; }
+    // The camera's own report of its exposure (exposure time x gain, any unit: only its changes
+    // count) for the next render() calls, where the camera or the session gives one (nullopt:
+    // none): the prior of the per-frame estimate for changes (render/ExposureTracker.h).
+    void setReportedExposure(std::optional<double> exposure) { ctx_->reportedExposure = exposure; }
     // This frame's canvas rectangles of the specular / glass objects (FrameContext).
     const std::vector<glm::ivec4>& specularRects() const { return ctx_->specularRects; }
     const std::vector<glm::ivec4>& refractiveRects() const { return ctx_->refractiveRects; }

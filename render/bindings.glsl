@@ -183,6 +183,14 @@ const int kUnitCompositeFuzzyRRefl = 20;
 const int kUnitCompositeFuzzyLenv = 21;
 const int kUnitCompositeFuzzyVideo = 22;
 
+// passes/exposure: exposure_samples.frag
+const int kUnitExposureCamera = 0;  // the camera frame (sRGB8, sampled linear)
+const int kUnitExposureLR = 1;
+const int kUnitExposureCausticR = 2;  // black without caustics
+const int kUnitExposurePosition = 3;  // w = origin
+const int kUnitExposureEmissive = 4;  // a = specular slot + 1
+const int kUnitExposureCanvasToCamera = 5;
+
 // passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
 const int kUnitFuzzyPosition = 0;
 const int kUnitFuzzyEmissive = 1;

@@ -81,10 +81,14 @@ MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {
                              // the texel footprint)
     float temporalBlend;     // history weight of the VPL lighting (0 = off)
     float ismPointsPerVpl;
-    float exposure;     // rendered linear radiance -> camera linear units
+    // Rendered linear radiance -> camera linear units, per channel (R, G, B): the exposure and
+    // white balance (RendererOptions::composite.exposure, or this frame's estimate: passes/exposure).
+    vec3 exposure;
     float alphaMax;     // cap of alpha = CI / L_r
     float alphaFadeLr;  // L_r below which alpha fades to 1
     float framePad0;    // std140: the block is a multiple of 16 bytes
+    float framePad1;
+    float framePad2;
 };
 
 // The environment light (kBindingEnvironment): written by the environment pass

@@ -34,7 +34,8 @@ namespace fs = std::filesystem;
 struct SynthArgs {
     std::string scene, output, board, shard, frames;
     bool force = false, noEnv = false;
-    std::vector<double> envWhiteBalance;  // --env-white-balance R,G,B (empty: 1,1,1)
+    std::vector<double> envWhiteBalance;    // --env-white-balance R,G,B (empty: 1,1,1)
+    std::vector<double> whiteBalanceDrift;  // --white-balance-drift R,G,B (empty: none)
     raytrace::SyntheticSessionOptions o;
 };
 
@@ -122,6 +123,9 @@ void run(SynthArgs a) {
         a.o.envWhiteBalance = glm::vec3(float(a.envWhiteBalance[0]), float(a.envWhiteBalance[1]),
                                         float(a.envWhiteBalance[2]));
     }
+    if (!a.whiteBalanceDrift.empty())
+        a.o.sensor.whiteBalanceDrift =
+            glm::dvec3(a.whiteBalanceDrift[0], a.whiteBalanceDrift[1], a.whiteBalanceDrift[2]);
     // The scene's path as given (made absolute): ground_truth.json names it for `mirage bench`.
     a.o.sceneName = fs::absolute(a.scene).lexically_normal().string();
 
@@ -205,6 +209,17 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
         ->check(finiteIn(0, 1e6, true));
     cmd->add_flag("--exposure-change", a->o.sensor.exposureChange,
                   "Auto-exposure step (x0.55) at 60 % of the footage");
+    cmd->add_option("--exposure-step", a->o.sensor.exposureStep,
+                    "Sudden exposure step: the exposure is multiplied by this from 50 % of the "
+                    "footage on, between two frames (1 = none)")
+        ->capture_default_str()
+        ->check(finiteIn(0, 1e3, true));
+    cmd->add_option("--white-balance-drift", a->whiteBalanceDrift,
+                    "Main camera's white balance drifts linearly from 1,1,1 at the first frame "
+                    "to these gains R,G,B at the last")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(finiteIn(NumberRange{0, 1e3, true, true}));
     cmd->add_option("--vignette", a->o.sensor.vignette, "Corner darkening (0 = none)")
         ->capture_default_str()
         ->check(finiteIn(0, 1));

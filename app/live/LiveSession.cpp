@@ -134,6 +134,7 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     copt.title = "mirage live";
     context_ = std::make_unique<gl::Context>(a.headless ? gl::Context::headless(copt)
                                                         : gl::Context::window(copt));
+    settings.effects.exposureMatch.enabled = true;  // the camera's exposure changes on its own
     switchEffectsOff(a.effectsOff, settings.effects);
     settings.vpls = a.vpls;
     settings.exposure = a.exposure;

@@ -135,6 +135,11 @@ HudRequests LiveWindow::drawHud(const HudStatus& s, LiveControls& controls, int 
     if (s.last && !s.last->pose.reason.empty())
         ImGui::TextWrapped("%s", s.last->pose.reason.c_str());
     ImGui::TextWrapped("exposure: %s", s.exposureText.c_str());
+    // The gain the last frame was composited with (docs/camera-matching.md): R, G, B and whether
+    // it was measured, a step, held or the prior.
+    if (s.last && !s.last->exposureSource.empty())
+        ImGui::Text("exposure gain: %.3f %.3f %.3f (%s)", s.last->exposureGain.r,
+                    s.last->exposureGain.g, s.last->exposureGain.b, s.last->exposureSource.c_str());
     if (!s.environmentText.empty())
         ImGui::TextWrapped("environment: %s", s.environmentText.c_str());
     for (const auto& w : s.exposureWarnings) ImGui::TextColored(amber, "%s", w.c_str());

@@ -21,7 +21,8 @@ void ReplayOutputs::open(double fps, int jpegQuality, const std::vector<std::str
     if (!csv_) throw FileError(csvPath_.string(), "cannot create the timing CSV");
     csv_ << "frame,t,state,reason,decode_ms,tracking_ms";
     for (const std::string& p : passes_) csv_ << "," << p << "_ms";
-    csv_ << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz,environment\n";
+    csv_ << ",gpu_ms,readback_ms,encode_ms,frame_ms,tx,ty,tz,qw,qx,qy,qz,exposure_r,exposure_g,"
+            "exposure_b,exposure_source,environment\n";
 }
 
 bool ReplayOutputs::writeImage(int index, const cv::Mat& image, double t) {
@@ -55,6 +56,11 @@ void ReplayOutputs::writeRow(int index, double t, const CompositedFrame& cf,
     } else {
         csv_ << ",,,,,,,";
     }
+    if (cf.exposureSource.empty())
+        csv_ << ",,,,";
+    else
+        csv_ << "," << cf.exposureGain.r << "," << cf.exposureGain.g << "," << cf.exposureGain.b
+             << "," << cf.exposureSource;
     csv_ << "," << environment << "\n";
     csv_.flush();
     ++rows_;

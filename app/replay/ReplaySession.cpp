@@ -171,7 +171,8 @@ void ReplaySession::createRenderer() {
                                                       : gl::Context::headless(copt));
     render::RendererOptions ropt;
     ropt.vpl.count = a.vpls;
-    ropt.composite.exposure = a.exposure;
+    ropt.composite.exposure = a.exposure;  // the prior of the per-frame estimate
+    ropt.exposureMatch.enabled = true;
     switchEffectsOff(a.effectsOff, ropt);
     if (a.estimateLights) {
         // As many as light estimation reports, within the renderer's light budget.

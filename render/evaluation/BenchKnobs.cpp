@@ -564,6 +564,21 @@ void environmentKnobs(std::vector<BenchKnob>& knobs) {
         });
 }
 
+// Matching the camera (docs/camera-matching.md). Off by default, so that the default grid is the
+// renderer as a model (a fixed exposure, as before); `mirage replay` and `mirage live` switch it
+// on. Sweep with --knob exposure_match=off,on on a session whose exposure or white balance moves.
+void cameraKnobs(std::vector<BenchKnob>& knobs) {
+    knobs.push_back(
+        {"exposure_match",
+         "on: the exposure and white balance estimated every frame from the footage against the "
+         "rendered real surfaces, applied to what the renderer adds; off: the fixed --exposure",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.exposureMatch.enabled = parseOnOff("exposure_match", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.exposureMatch.enabled); }});
+}
+
 }  // namespace
 
 // The knobs, one group per effect, in the grid's (and the report's) column order.
@@ -576,6 +591,7 @@ const std::vector<BenchKnob>& benchKnobs() {
         roughKnobs(k);
         translucencyKnobs(k);
         environmentKnobs(k);
+        cameraKnobs(k);
         return k;
     }();
     return knobs;

@@ -117,11 +117,17 @@ double exposureAt(const SensorOptions& s, double t, double duration) {
         double u = std::clamp((t - start) / ramp, 0.0, 1.0);
         e *= 1.0 - 0.45 * (0.5 - 0.5 * std::cos(M_PI * u));
     }
+    if (t >= 0.5 * duration) e *= s.exposureStep;
     return e;
 }
 
+glm::dvec3 whiteBalanceAt(const SensorOptions& s, double t, double duration) {
+    const double u = duration > 0.0 ? std::clamp(t / duration, 0.0, 1.0) : 0.0;
+    return glm::dvec3(1.0) + u * (s.whiteBalanceDrift - glm::dvec3(1.0));
+}
+
 cv::Mat applySensor(const cv::Mat& linearRgb, const SensorOptions& s, double exposure,
-                    uint64_t seed) {
+                    uint64_t seed, const glm::dvec3& whiteBalance) {
     if (linearRgb.type() != CV_32FC3)
         throw Error("applySensor: expects linear RGB float (CV_32FC3)");
     cv::Mat img = linearRgb.clone();
@@ -133,7 +139,7 @@ cv::Mat applySensor(const cv::Mat& linearRgb, const SensorOptions& s, double exp
             float gain = float(exposure * (1.0 - s.vignette * r2));
             auto& p = img.at<cv::Vec3f>(y, x);
             for (int k = 0; k < 3; ++k) {
-                float v = std::max(0.0f, p[k] * gain);
+                float v = std::max(0.0f, p[k] * gain * float(whiteBalance[k]));
                 if (s.noise > 0) {
                     // Poisson-Gaussian sensor noise: shot noise grows with the signal, read noise
                     // does not.

@@ -51,15 +51,27 @@ struct SensorOptions {
     float exposure = 1.0f;  // multiplies linear radiance before encoding
     bool exposureChange =
         false;  // auto-exposure step: x0.55 over 0.25 s, starting at 60 % of the duration
+    // A sudden exposure step: from 50 % of the duration on, the exposure is multiplied by this
+    // (1 = none), between two frames.
+    double exposureStep = 1.0;
+    // White-balance drift of the main camera: per-channel gains (R, G, B) that grow linearly
+    // from 1 at the first frame to these at the last ((1, 1, 1) = none), as an automatic white
+    // balance wandering over a shot.
+    glm::dvec3 whiteBalanceDrift{1.0};
     double vignette = 0.0;  // relative darkening at the image corners (0 = none, 0.3 typical)
     double noise = 0.0;     // read-noise sigma in linear units at exposure 1; shot noise
                             // sigma = sqrt(noise * value) (0 = none)
 };
 
+// The exposure at time t (seconds) of footage `duration` long: the base exposure with the
+// exposure change and the exposure step.
 double exposureAt(const SensorOptions& s, double t, double duration);
-// Linear RGB float (CV_32FC3) -> 8-bit BGR sRGB as a camera would deliver: vignette, exposure,
-// noise (seeded: same seed = same noise), clamp, sRGB encoding.
+// The white balance's gains (R, G, B) at time t: 1 at t = 0, whiteBalanceDrift at t = duration.
+glm::dvec3 whiteBalanceAt(const SensorOptions& s, double t, double duration);
+// Linear RGB float (CV_32FC3) -> 8-bit BGR sRGB as a camera would deliver: vignette, exposure and
+// white balance (per-channel gains R, G, B), noise (seeded: same seed = same noise), clamp, sRGB
+// encoding.
 cv::Mat applySensor(const cv::Mat& linearRgb, const SensorOptions& s, double exposure,
-                    uint64_t seed);
+                    uint64_t seed, const glm::dvec3& whiteBalance = glm::dvec3(1.0));
 
 }  // namespace mirage::raytrace

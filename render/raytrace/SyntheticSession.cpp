@@ -151,8 +151,10 @@ public:
         if (a_.envRotationDegPerSecond != 0) setEnvironmentRotation(t);
         const LinearFrame real = renderSubset(*realScene_, f, t);
         const double exposure = exposureAt(a_.sensor, t, duration_);
+        const glm::dvec3 whiteBalance = whiteBalanceAt(a_.sensor, t, duration_);
         const uint64_t noiseSeed = a_.seed * 31 + uint64_t(f);
-        out.images.push_back(applySensor(real.radiance, a_.sensor, exposure, noiseSeed));
+        out.images.push_back(
+            applySensor(real.radiance, a_.sensor, exposure, noiseSeed, whiteBalance));
         out.times.push_back(t);
         if (a_.environmentCamera) {
             const cv::Mat envLinear =
@@ -176,7 +178,8 @@ public:
             // show.
             const LinearFrame mixed = renderSubset(*mixedScene_, f, t);
             render::GroundTruthFrame g;
-            g.compositeSrgb = applySensor(mixed.radiance, a_.sensor, exposure, noiseSeed);
+            g.compositeSrgb =
+                applySensor(mixed.radiance, a_.sensor, exposure, noiseSeed, whiteBalance);
             g.influence = render::influenceMask(real.radiance, mixed.radiance, mixed.coverage,
                                                 exposure, a_.influenceThreshold);
             out.composite = std::move(g);
@@ -276,13 +279,19 @@ std::string syntheticFingerprint(const SyntheticSessionOptions& a, uint64_t scen
     const std::string all = fmt::format(
         "{}x{} hfov {:.17g} fps {:.17g} s {:.17g} spp {} seed {} shutter {:.17g} sub {} env {} "
         "{} {:.17g} seq {} gt {} thr {:.17g} sensor {:.17g} {} {:.17g} {:.17g} path {:.17g} "
-        "{:.17g} {:.17g} {:.17g} envcam {:.9g} {:.9g} {:.9g} {:.9g} {:.17g} scene {} board {}",
+        "{:.17g} {:.17g} {:.17g} envcam {:.9g} {:.9g} {:.9g} {:.9g} {:.17g} scene {} board {}{}",
         a.width, a.height, a.hfovDeg, a.fps, a.seconds, a.samplesPerPixel, a.seed, a.shutter,
         a.blurSubframes, a.environmentCamera, a.envSize, a.envFovDeg, a.imageSequence,
         a.groundTruthComposite, a.influenceThreshold, a.sensor.exposure, a.sensor.exposureChange,
         a.sensor.vignette, a.sensor.noise, a.path.radius, a.path.height, a.path.panDeg,
         a.path.shakeTranslation, a.envExposure, a.envWhiteBalance.r, a.envWhiteBalance.g,
-        a.envWhiteBalance.b, a.envRotationDegPerSecond, hex64(sceneBytes), hex64(boardBytes));
+        a.envWhiteBalance.b, a.envRotationDegPerSecond, hex64(sceneBytes), hex64(boardBytes),
+        // Only when used: sessions made before these options keep their fingerprint.
+        a.sensor.exposureStep == 1.0 && a.sensor.whiteBalanceDrift == glm::dvec3(1.0)
+            ? std::string()
+            : fmt::format(" step {:.17g} wb {:.17g} {:.17g} {:.17g}", a.sensor.exposureStep,
+                          a.sensor.whiteBalanceDrift.r, a.sensor.whiteBalanceDrift.g,
+                          a.sensor.whiteBalanceDrift.b));
     return hex64(fingerprint64(all));
 }
 

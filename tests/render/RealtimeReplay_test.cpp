@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -159,6 +160,26 @@ TEST(RealtimeReplay, WritesPlayableVideoAndTimingCsv) {
         EXPECT_LT(std::stod(fields[size_t(gpuCol)]), 10000.0) << row;
     }
     EXPECT_NE(rows[2].find("lost"), std::string::npos);
+    // The exposure gain of every rendered frame (estimated per frame by default,
+    // docs/camera-matching.md); none for the lost frame, which was not rendered.
+    const auto sourceCol =
+        std::find(columns.begin(), columns.end(), "exposure_source") - columns.begin();
+    const auto gainCol = std::find(columns.begin(), columns.end(), "exposure_g") - columns.begin();
+    ASSERT_LT(size_t(sourceCol), columns.size());
+    ASSERT_LT(size_t(gainCol), columns.size());
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const std::vector<std::string> fields = splitCsvLine(rows[i]);
+        const std::string& source = fields[size_t(sourceCol)];
+        if (i == 2) {
+            EXPECT_TRUE(source.empty()) << rows[i];
+            continue;
+        }
+        EXPECT_TRUE(source == "prior" || source == "measured" || source == "step" ||
+                    source == "held")
+            << rows[i];
+        const double g = std::stod(fields[size_t(gainCol)]);
+        EXPECT_TRUE(std::isfinite(g) && g > 0.0) << rows[i];
+    }
 }
 
 // Ctrl-C (SIGINT) mid-replay leaves a playable MKV holding every finished frame, and a CSV row

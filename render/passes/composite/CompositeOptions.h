@@ -5,7 +5,10 @@
 namespace mirage::render {
 
 struct CompositeOptions {
-    float exposure = 1.0f;      // rendered linear radiance -> camera linear units
+    // Rendered linear radiance -> camera linear units: the gain of every frame, or with
+    // RendererOptions::exposureMatch.enabled the prior of the per-frame estimate
+    // (docs/camera-matching.md).
+    float exposure = 1.0f;
     float alphaMax = 8.0f;      // cap of alpha = CI / L_r
     float alphaFadeLr = 0.02f;  // where L_r (linear) is below this, alpha fades to 1
     // Where the lens remap is the identity (no distortion, a canvas of the camera's size) the
@@ -17,8 +20,8 @@ struct CompositeOptions {
     bool showVirtual = true;
 
     void validate() const {
-        checkOption(exposure > 0.0f && exposure < 1e6f, "composite.exposure",
-                    "a positive number below 1e6", exposure);
+        checkOption(exposure >= 1e-4f && exposure <= 1e4f, "composite.exposure", "in [1e-4, 1e4]",
+                    exposure);
         checkOption(alphaMax >= 1.0f && alphaMax <= 1e3f, "composite.alphaMax", "in [1, 1000]",
                     alphaMax);
         checkOption(alphaFadeLr >= 0.0f && alphaFadeLr <= 1.0f, "composite.alphaFadeLr",

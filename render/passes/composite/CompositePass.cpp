@@ -7,6 +7,7 @@
 #include "render/FrameImports.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/exposure/ExposurePass.h"
 #include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
@@ -72,6 +73,9 @@ void CompositePass::setup(PassBuilder& b) const {
         b.readOptional(r);
     // Rough metals and glass: the filtered video term, when the fuzzy or rough pass ran.
     b.readOptional(kFilteredVideo);
+    // The per-frame exposure (passes/exposure): its gain reaches this pass through the frame
+    // block; the read keeps the exposure pass in the frame when it is switched on.
+    b.readOptional(kExposureSamples);
     b.create(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
     b.create(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
 }

@@ -76,7 +76,7 @@ vec3 guardedAlpha(vec3 ci, vec3 r) {
 
 // Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci.
 vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
-    float ex = exposure;
+    vec3 ex = exposure;
     vec4 fuzzyBp = fuzzyOn != 0 ? texelFetch(fuzzyVideo, cpi, 0) : vec4(0.0);
     bool fuzzy = fuzzyBp.a > 0.5;
     vec3 rv = max((fuzzy ? texelFetch(fuzzyRv, cpi, 0) : texelFetch(specRv, cpi, 0)).rgb,

@@ -25,7 +25,7 @@ void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     outVideo = vec4(0.0);
     if (roughSlot(texelFetch(gEmissive, px, 0).a) < 0) return;
-    float ex = exposure;
+    vec3 ex = exposure;
     vec3 r = max(texelFetch(specR, px, 0).rgb, vec3(0.0)) * ex;
     vec3 rRefl = clamp(texelFetch(specRRefl, px, 0).rgb * ex, vec3(0.0), r);
     vec3 c = vec3(0.0);

@@ -58,7 +58,7 @@ void main() {
     outR = vec4(texelFetch(specR, px, 0).rgb, 1.0);
     outRRefl = vec4(texelFetch(specRRefl, px, 0).rgb, 1.0);
     outEnv = vec4(texelFetch(lEnv, px, 0).rgb, 1.0);
-    float ex = exposure;  // as fuzzy_resolve.frag / composite.frag's compositeSpecular
+    vec3 ex = exposure;  // as fuzzy_resolve.frag / composite.frag's compositeSpecular
     vec3 r = max(outR.rgb, vec3(0.0)) * ex;
     vec3 rRefl = clamp(outRRefl.rgb * ex, vec3(0.0), r);
     vec3 ciBp = vec3(0.0);
