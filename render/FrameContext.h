@@ -51,6 +51,19 @@ struct DrawnRects {
     std::vector<glm::ivec4> rects;
 };
 
+// How the frame graph runs the passes (for every scene; tests and benchmarks change them).
+struct FrameGraphOptions {
+    // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
+    // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
+    bool reuseStaticPasses = true;
+    bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
+    // glFinish around every pass, each timed by the wall clock between the two (PassReport::gpuMs).
+    // llvmpipe defers rasterisation until a later sync (a compute dispatch that reads the result,
+    // a readback), so without this a pass's time can show up in the next pass's timer query, and
+    // its queries miss compute dispatches. For benchmarks.
+    bool syncPasses = false;
+};
+
 // Every pass's options, one member per pass folder that has any (each struct, its defaults and its
 // validation live in that folder), plus the few that steer the whole frame.
 struct RendererOptions {
@@ -74,16 +87,8 @@ struct RendererOptions {
     // (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend) frames.
     // 0 .. 0.98.
     float temporalBlend = 0.8f;
-    ClipRange clip;  // the camera's near and far planes
-    // Reuse the camera-independent passes' output (shadow maps, RSMs, VPLs, ISMs) while the
-    // frame plan is unchanged, instead of re-rendering it every frame (false: always re-run).
-    bool reuseStaticPasses = true;
-    bool cullPasses = true;  // run only the passes the scene needs (false: run all; tests)
-    // glFinish around every pass, each timed by the wall clock between the two (PassReport::gpuMs).
-    // llvmpipe defers rasterisation until a later sync (a compute dispatch that reads the result,
-    // a readback), so without this a pass's time can show up in the next pass's timer query, and
-    // its queries miss compute dispatches. For benchmarks.
-    bool syncPasses = false;
+    ClipRange clip;           // the camera's near and far planes
+    FrameGraphOptions graph;  // how the frame graph runs the passes
 
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.

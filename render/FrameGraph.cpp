@@ -427,7 +427,7 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
             rep.reason = "reused: " + rep.reason;
             continue;
         }
-        if (p.cameraIndependent() && o.reuseStaticPasses && staticOutputValid_[i]) {
+        if (p.cameraIndependent() && o.graph.reuseStaticPasses && staticOutputValid_[i]) {
             for (const auto& [value, slot] : published_[i]) current_[size_t(value)] = slot;
             rep.reused = true;
             rep.reason = "reused: scene, lights and plan unchanged (" + rep.reason + ")";
@@ -440,7 +440,7 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
             if (poolOf_[size_t(node.writeValues[k])] >= 0)
                 view.publish(node.writes[k].id,
                              pool_[size_t(poolOf_[size_t(node.writeValues[k])])].texture);
-        if (o.syncPasses) {
+        if (o.graph.syncPasses) {
             // The pass alone between two glFinish: its time is the wall time between them. On
             // llvmpipe that is what the pass costs, and GL_TIME_ELAPSED is not: it reads ~0 for
             // compute dispatches and has returned a timestamp (7e7 "ms") after them.
@@ -461,7 +461,7 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
     for (size_t i = 0; i < nodes_.size(); ++i) {
         if (!report_.passes[i].ran) continue;
         double ms = syncedMs_[i];
-        if (!o.syncPasses) {
+        if (!o.graph.syncPasses) {
             // GPU time of the pass's commands, overlapping its neighbours'. No pass can take
             // longer than the frame so far (the result is in): a value beyond that is a broken
             // query result, reported as 0 rather than as a figure.

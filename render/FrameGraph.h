@@ -35,8 +35,8 @@ struct PassReport {
     bool ran = false;
     bool reused = false;  // not run: the output of an earlier frame was reused (still valid)
     std::string reason;
-    // The pass's time (0 when skipped), ms: with RendererOptions::syncPasses the wall time from
-    // a glFinish before it to one after it (its whole cost on a software rasteriser, compute
+    // The pass's time (0 when skipped), ms: with RendererOptions::graph.syncPasses the wall time
+    // from a glFinish before it to one after it (its whole cost on a software rasteriser, compute
     // dispatches included); otherwise its GL_TIME_ELAPSED, overlapping the other passes' work.
     double gpuMs = 0.0;
 };

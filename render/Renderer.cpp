@@ -240,7 +240,7 @@ void planVpls(const RendererOptions& o, bool anyCaster, bool anyReachesVirtual, 
         plan.vplReason = "VPL count is 0";
     } else if (!anyCaster) {
         plan.vplReason = "no light reaches any geometry";
-    } else if (!o.cullPasses) {
+    } else if (!o.graph.cullPasses) {
         plan.needVpls = true;
         plan.vplReason = "pass culling off";
     } else if (anyReachesVirtual) {

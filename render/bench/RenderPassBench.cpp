@@ -78,9 +78,9 @@ void BM_Frame(benchmark::State& state) {
     const int w = int(state.range(0)), h = int(state.range(1));
     render::RendererOptions opt;
     opt.vpl.count = int(state.range(2));
-    opt.syncPasses = true;
+    opt.graph.syncPasses = true;
     opt.indirect.scale =
-        int(state.range(4));  // per-pass attribution (see RendererOptions::syncPasses)
+        int(state.range(4));  // per-pass attribution (see RendererOptions::graph.syncPasses)
     opt.specular.vplStride = int(state.range(6));
     Scene scene = benchScene(int(state.range(3)), int(state.range(5)));
     CameraIntrinsics cam;
@@ -170,7 +170,7 @@ void BM_SpecularImpostorCurve(benchmark::State& state) {
     context();
     const SpecularReference& ref = specularReference();
     render::RendererOptions opt;
-    opt.syncPasses = true;
+    opt.graph.syncPasses = true;
     opt.temporalBlend = 0.0f;
     opt.impostor.resolution = int(state.range(0));
     opt.impostor.refineSteps = int(state.range(1));
@@ -207,7 +207,7 @@ void curveArgs(benchmark::internal::Benchmark* b) {
 void BM_Translucency(benchmark::State& state) {
     context();
     render::RendererOptions opt;
-    opt.syncPasses = true;
+    opt.graph.syncPasses = true;
     opt.translucency.vnmResolution = int(state.range(0));
     const std::filesystem::path dir =
         std::filesystem::temp_directory_path() / "mirage_bench_translucency";

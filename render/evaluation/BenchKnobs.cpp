@@ -127,18 +127,18 @@ void frameKnobs(std::vector<BenchKnob>& knobs) {
              "unchanged; off: re-run them every frame",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.reuseStaticPasses = parseOnOff("static_reuse", v);
+                 c.options.graph.reuseStaticPasses = parseOnOff("static_reuse", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.reuseStaticPasses); }},
+             [](const BenchConfig& c) { return onOff(c.options.graph.reuseStaticPasses); }},
             {"sync_passes",
              "on: glFinish around every pass so each pass's GPU ms is its own (llvmpipe defers "
              "work); "
              "off: as mirage replay runs, passes overlap and only the wall ms is meaningful",
              [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
              [](BenchConfig& c, const std::string& v) {
-                 c.options.syncPasses = parseOnOff("sync_passes", v);
+                 c.options.graph.syncPasses = parseOnOff("sync_passes", v);
              },
-             [](const BenchConfig& c) { return onOff(c.options.syncPasses); }},
+             [](const BenchConfig& c) { return onOff(c.options.graph.syncPasses); }},
             {"shadow_filter",
              "pcf: shadow maps looked up with percentage-closer filtering over 4x4 texels "
              "(straight shadow edges); off: the 2x2 bilinear lookup (1-texel stair steps)",
@@ -599,7 +599,7 @@ const std::vector<BenchKnob>& benchKnobs() {
 
 BenchConfig benchDefaultConfig() {
     BenchConfig c;
-    c.options.syncPasses = true;  // per-pass attribution of GPU time (see RendererOptions)
+    c.options.graph.syncPasses = true;  // per-pass attribution of GPU time (see RendererOptions)
     return c;
 }
 

@@ -3,7 +3,8 @@
 // of a synthetic session at the ground-truth poses, for a grid of knobs, each configuration judged
 // against the reference renderer's ground-truth composite (GroundTruthComposite.h) by PSNR/SSIM
 // over the whole frame and over the pixels the virtual objects influence, and timed per pass with
-// RendererOptions::syncPasses (each pass alone between two glFinish, timed by the wall clock).
+// RendererOptions::graph.syncPasses (each pass alone between two glFinish, timed by the wall
+// clock).
 //
 // Knobs are a list (benchKnobs()), not loops: a new knob (impostor resolution, refinement steps,
 // caustic map size, ...) is one entry there, and the grid, CSV and table pick it up.

@@ -400,9 +400,9 @@ TEST_F(FrameGraphTest, SynchronisedPassTimeIsTheWholePass) {
     add(g, {.name = "slow", .writes = {kComposite}, .cpuMs = 40});
     g.markOutput(kComposite);
     g.compile();
-    options_.syncPasses = true;
+    options_.graph.syncPasses = true;
     const double synced = g.execute(*ctx_, "").passes[0].gpuMs;
-    options_.syncPasses = false;
+    options_.graph.syncPasses = false;
     const double timed = g.execute(*ctx_, "").passes[0].gpuMs;
     std::cout << "a pass sleeping 40 ms: " << synced << " ms synchronised, " << timed
               << " ms by GL_TIME_ELAPSED\n";

@@ -315,7 +315,7 @@ TEST(RealtimeBench, GridIsTheProductOfTheKnobsAndRejectsBadValues) {
     CameraIntrinsics cam = test::smallCamera(1024, 768);
     const auto full = benchGrid(cam, false, {});
     EXPECT_EQ(full.size(), 3u * 3u * 3u);  // 1024x768, 640x480, 320x240 x 64/256/1024 x auto/2/1
-    for (const auto& c : full) EXPECT_TRUE(c.options.syncPasses);
+    for (const auto& c : full) EXPECT_TRUE(c.options.graph.syncPasses);
     const auto quick = benchGrid(cam, true, {});
     ASSERT_EQ(quick.size(), 2u);
     EXPECT_EQ(quick[0].width, 640);

@@ -309,7 +309,7 @@ TEST_F(RealtimeRenderer, RealOnlySceneCompositeEqualsFootage) {
     int red = addMaterial(s.scene, {0.8f, 0.1f, 0.1f});
     addBox(s.scene, "real box", {-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f}, red, Origin::Real);
     RendererOptions opt;
-    opt.cullPasses = false;
+    opt.graph.cullPasses = false;
     opt.vpl.count = 64;
     Renderer r(s.scene, s.cam, opt);
     cv::Mat footage(s.cam.height, s.cam.width, CV_8UC3);
@@ -419,7 +419,7 @@ TEST_F(RealtimeRenderer, CameraIndependentPassesAreReusedAcrossFrames) {
     EXPECT_TRUE(rep.ran("indirect"));
     EXPECT_NE(rep.summary().find("reused"), std::string::npos);
 
-    opt.reuseStaticPasses = false;
+    opt.graph.reuseStaticPasses = false;
     Renderer fresh(s.scene, s.cam, opt);
     fresh.render({s.pose, footage, true});
     const FrameReport& again = fresh.render({second, footage, true});

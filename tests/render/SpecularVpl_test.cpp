@@ -126,7 +126,7 @@ TEST(SpecularVpl, MirrorVplsCarryTheReflectedFluxToTheWall) {
     const cv::Mat black(72, 96, CV_8UC3, cv::Scalar::all(0));
     // The yardstick: the same light on the bare floor (albedo 0.7, as the wall).
     RendererOptions all;
-    all.cullPasses = false;  // no virtual object: VPLs only when every pass runs
+    all.graph.cullPasses = false;  // no virtual object: VPLs only when every pass runs
     const Frame bare = renderRealtime(makeRelay({false}), black, all);
     const Frame on = renderRealtime(makeRelay(), black);
     RendererOptions offOpt;
@@ -155,7 +155,7 @@ TEST(SpecularVpl, GlassGrazingAndEscapingPhotonsStayFiniteAndConserveEnergy) {
     gl::Context context = gl::Context::headless();
     const cv::Mat black(72, 96, CV_8UC3, cv::Scalar::all(0));
     RendererOptions all;
-    all.cullPasses = false;
+    all.graph.cullPasses = false;
     struct Case {
         const char* name;
         RelayOptions options;

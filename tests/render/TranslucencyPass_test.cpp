@@ -243,8 +243,8 @@ TEST_F(TranslucencyPass, ReusedWhileNothingChangesAndRerunWhenTheEnvironmentDoes
     EXPECT_TRUE(fifth.ran("translucency")) << fifth.summary();
     EXPECT_NEAR(objectMean(r.readBuffer(kDirectRv)), mean1, 0.02 * mean1);
 
-    // Reuse off (RendererOptions::reuseStaticPasses): every frame dispatches.
-    opt.reuseStaticPasses = false;
+    // Reuse off (RendererOptions::graph.reuseStaticPasses): every frame dispatches.
+    opt.graph.reuseStaticPasses = false;
     Renderer always(scene, cam.intrinsics, opt);
     always.render({cam.T_world_camera, cv::Mat(), true});
     EXPECT_TRUE(always.render({cam.T_world_camera, cv::Mat(), false}).ran("translucency"));

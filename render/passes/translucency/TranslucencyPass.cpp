@@ -143,7 +143,7 @@ std::string TranslucencyPass::inputKey(const FrameContext& ctx) const {
 }
 
 bool TranslucencyPass::upToDate(const FrameContext& ctx) const {
-    return ctx.options.reuseStaticPasses && !doneKey_.empty() && doneKey_ == inputKey(ctx);
+    return ctx.options.graph.reuseStaticPasses && !doneKey_.empty() && doneKey_ == inputKey(ctx);
 }
 
 void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
