@@ -335,15 +335,9 @@ std::vector<TagDetection> PredictedTagFinder::find(const cv::Mat& grey,
     return findImpl(grey, T_world_camera_estimated, nullptr, searchPx, &known, statsOut);
 }
 
-std::vector<TagDetection> PredictedTagFinder::findImpl(
+std::vector<PredictedTagFinder::Candidate> PredictedTagFinder::predictCandidates(
     const cv::Mat& grey, const Pose& T_world_camera_predicted, const Pose* T_world_camera_previous,
-    double searchPx, const std::vector<TagDetection>* known, PredictedTagStats* statsOut) const {
-    std::vector<TagDetection> out;
-    PredictedTagStats stats;
-    if (grey.empty() || grey.type() != CV_8UC1) {
-        if (statsOut) *statsOut = stats;
-        return out;
-    }
+    double searchPx) const {
     const Pose T_cw = T_world_camera_predicted.inverse();
     // Without a previous pose the corners "moved" by nothing and the radius is searchPx.
     const Pose T_cw_prev =
@@ -352,11 +346,6 @@ std::vector<TagDetection> PredictedTagFinder::findImpl(
     // Centres of the quiet-zone ring's cells lie this many cells outside the corners (+ some for
     // the diagonal and bilinear sampling): they and the edge search must stay inside the image.
     const double ringCells = 0.5 * (totalWidth_ - widthAtBorder_) - 0.25;
-    struct Candidate {
-        const TagModel* model;
-        std::array<glm::dvec2, 4> pred;
-        double search, minSide;
-    };
     std::vector<Candidate> candidates;
     for (const TagModel& m : tags_) {
         // Facing the camera: the tag's +Z points away from a viewer who reads it.
@@ -410,9 +399,23 @@ std::vector<TagDetection> PredictedTagFinder::findImpl(
             inside = inside && p.x >= margin && p.y >= margin && p.x <= grey.cols - 1 - margin &&
                      p.y <= grey.rows - 1 - margin;
         if (!inside) continue;
-        ++stats.predicted;
         candidates.push_back({&m, pred, search, minSide});
     }
+    return candidates;
+}
+
+std::vector<TagDetection> PredictedTagFinder::findImpl(
+    const cv::Mat& grey, const Pose& T_world_camera_predicted, const Pose* T_world_camera_previous,
+    double searchPx, const std::vector<TagDetection>* known, PredictedTagStats* statsOut) const {
+    std::vector<TagDetection> out;
+    PredictedTagStats stats;
+    if (grey.empty() || grey.type() != CV_8UC1) {
+        if (statsOut) *statsOut = stats;
+        return out;
+    }
+    std::vector<Candidate> candidates =
+        predictCandidates(grey, T_world_camera_predicted, T_world_camera_previous, searchPx);
+    stats.predicted = int(candidates.size());
 
     // Largest tags first (widest search, most reliable); the offsets between predicted and found
     // corners of the tags verified so far correct the predictions of the next ones (a 2D

@@ -113,6 +113,20 @@ private:
                                        const std::vector<TagDetection>* known,
                                        PredictedTagStats* stats) const;
     enum class Outcome { Verified, EdgeFailed, RefineFailed, DecodeFailed };
+    // A board tag predicted in view: its corners (pixels), edge search radius (pixels) and
+    // shortest side (pixels).
+    struct Candidate {
+        const TagModel* model;
+        std::array<glm::dvec2, 4> pred;
+        double search, minSide;
+    };
+    // The board tags that face the camera at the predicted pose, large enough to verify and with
+    // their quiet zone and search inside the image. Without a previous pose every search radius
+    // is searchPx; with one it grows with the corners' motion since it.
+    std::vector<Candidate> predictCandidates(const cv::Mat& grey,
+                                             const Pose& T_world_camera_predicted,
+                                             const Pose* T_world_camera_previous,
+                                             double searchPx) const;
     // Steps 1-3 for one tag from its predicted corners `pred` (pixels) with edge search radius
     // `search` (pixels, before the cap of searchMaxCells); t = the verified detection.
     Outcome follow(const cv::Mat& grey, const TagModel& m, const std::array<glm::dvec2, 4>& pred,
