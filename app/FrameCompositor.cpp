@@ -14,13 +14,14 @@ double msSince(Clock::time_point t0) {
 
 FrameCompositor::FrameCompositor(render::Renderer& renderer) : renderer_(renderer) {}
 
-CompositedFrame FrameCompositor::composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual) {
+CompositedFrame FrameCompositor::composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual,
+                                           double time) {
     CompositedFrame out;
     out.pose = std::move(pose);
     const PoseRow& pr = out.pose;
     if (pr.pose && renderVirtual && !bgr.empty()) {
         const render::FrameReport& rep =
-            renderer_.render({*pr.pose, bgr, /*resetHistory=*/lastLost_});
+            renderer_.render({*pr.pose, bgr, /*resetHistory=*/lastLost_, time});
         for (const auto& p : rep.passes) out.passMs[p.name] = p.gpuMs;
         out.gpuMs = rep.totalGpuMs;
         out.report = &rep;

@@ -3,6 +3,7 @@
 // live): the virtual objects rendered from the frame's decided pose (app/PoseStage.h),
 // composited into the frame, read back. One implementation, so that a live session and the
 // replay of its recording make the same images from the same frames and poses.
+#include <limits>
 #include <map>
 #include <string>
 
@@ -41,7 +42,10 @@ public:
     // `renderVirtual`) the renderer renders and composites; without one, or with
     // `renderVirtual` false, the footage passes through (the pose is still reported) and the
     // temporal history is reset on the next rendered frame.
-    CompositedFrame composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual = true);
+    // `time`: the frame's time in seconds on the footage's clock (the motion blur's frame
+    // interval; NaN = unknown, no motion blur).
+    CompositedFrame composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual = true,
+                              double time = std::numeric_limits<double>::quiet_NaN());
 
     // Blits the last composite into the current context's default framebuffer (w x h pixels,
     // flipped to the window's bottom-up rows).

@@ -26,6 +26,7 @@
 #include "render/passes/impostor/ImpostorOptions.h"
 #include "render/passes/indirect/IndirectOptions.h"
 #include "render/passes/ism/IsmOptions.h"
+#include "render/passes/motionblur/MotionBlurOptions.h"
 #include "render/passes/rough/RoughOptions.h"
 #include "render/passes/shadow/ShadowOptions.h"
 #include "render/passes/specular/SpecularOptions.h"
@@ -81,6 +82,7 @@ struct RendererOptions {
     TranslucencyOptions translucency;
     CompositeOptions composite;
     ExposureMatchOptions exposureMatch;  // render/passes/exposure
+    MotionBlurOptions motionBlur;        // render/passes/motionblur
 
     // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
     // and where switched on the caustic buffer and the specular-hit light L'. Each frame keeps
@@ -167,6 +169,15 @@ public:
     const RendererOptions& options;
 
     Pose T_world_camera;  // OpenCV camera axes
+    // The frame's time (seconds on the footage's clock; FrameInput::time), NaN when unknown.
+    double time = 0.0;
+    // The camera of the frame rendered before this one (the motion blur's velocity); none in the
+    // renderer's first frame.
+    struct PreviousCamera {
+        glm::mat4 viewProj{1.0f};  // world -> GL clip
+        double time = 0.0;         // seconds (NaN: unknown)
+    };
+    std::optional<PreviousCamera> previous;
     FramePlan plan;
     GpuFrame frame{};  // uploaded to the FrameBlock UBO before the passes run
     GpuLightBlock lightBlock{};

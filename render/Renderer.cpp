@@ -24,6 +24,7 @@
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
+#include "render/passes/motionblur/MotionBlurPass.h"
 #include "render/passes/rough/RoughRefractionPass.h"
 #include "render/passes/shadow/ShadowPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
@@ -310,6 +311,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<FuzzyReflectionPass>());
     g.addPass(std::make_unique<RoughRefractionPass>());
     g.addPass(std::make_unique<CompositePass>());
+    g.addPass(std::make_unique<MotionBlurPass>());  // what the renderer added, over the exposure
     g.markOutput(kComposite);
     g.markOutput(kCompositeSrgb);
     g.compile();
@@ -397,8 +399,13 @@ void Renderer::writeFrameUniforms(const FrameInput& input, const glm::mat4& view
     f.alphaFadeLr = options_.composite.alphaFadeLr;
     c.frameUbo.upload(&f, sizeof(GpuFrame));
     c.lightUbo.upload(&c.lightBlock, sizeof(GpuLightBlock));
+    if (c.frameIndex > 0)
+        c.previous = FrameContext::PreviousCamera{prevViewProj_, prevTime_};
+    else
+        c.previous.reset();
     prevViewProj_ = viewProj;
     prevCameraPos_ = camPos;
+    prevTime_ = input.time;
 }
 
 void Renderer::planFrame(const FrameInput& input) {
@@ -410,6 +417,7 @@ void Renderer::planFrame(const FrameInput& input) {
 
     // Camera.
     c.T_world_camera = input.T_world_camera;
+    c.time = input.time;
     const glm::mat4 view(input.T_world_camera.inverse().matrix());
     const glm::mat4 proj = projection_.projectionMatrix(options_.clip.nearM, options_.clip.farM);
     const glm::mat4 viewProj = proj * view;

@@ -7,6 +7,7 @@
 // the frame needs, times each (PassReport::gpuMs) and reports which ran and why
 // (`mirage info --passes SCENE` prints it, docs/realtime-renderer.md draws it). Needs a current
 // GL 4.5 context (core/gl/Context.h).
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,6 +33,10 @@ struct FrameInput {
     Pose T_world_camera;        // camera pose (OpenCV camera axes), world = glTF frame
     cv::Mat cameraImage;        // 8-bit BGR, sRGB-encoded, camera size; empty = black footage
     bool resetHistory = false;  // a cut, a seek or tracking loss: drop temporal history
+    // Seconds on the footage's clock (frames.csv's t_main; live: the capture time). The motion
+    // blur scales the motion since the last rendered frame by shutter / (time - its time); NaN
+    // (unknown) leaves the frame unblurred.
+    double time = std::numeric_limits<double>::quiet_NaN();
 };
 
 class Renderer {
@@ -142,6 +147,7 @@ private:
     uint64_t envLightsGeneration_ = UINT64_MAX;  // the environment generation they were found in
     glm::mat4 prevViewProj_{1.0f};
     glm::vec3 prevCameraPos_{0.0f};
+    double prevTime_ = 0.0;      // the last rendered frame's FrameInput::time
     bool objectsMoved_ = false;  // updateTransforms moved something since the last render()
 };
 

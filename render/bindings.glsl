@@ -191,6 +191,15 @@ const int kUnitExposurePosition = 3;  // w = origin
 const int kUnitExposureEmissive = 4;  // a = specular slot + 1
 const int kUnitExposureCanvasToCamera = 5;
 
+// passes/motionblur: motion_velocity.frag, motion_tiles.frag, motion_neighbours.frag,
+// motion_gather.frag
+const int kUnitMotionPosition = 0;   // the G-buffer position (canvas), w = origin
+const int kUnitMotionRemap = 1;      // camera pixel -> canvas pixel (lens distortion)
+const int kUnitMotionVelocity = 2;   // MotionVelocity: rg half motion (px), b depth (m)
+const int kUnitMotionTiles = 3;      // tile / neighbourhood maxima
+const int kUnitMotionComposite = 4;  // the composite (linear, a = coverage)
+const int kUnitMotionFootage = 5;    // CompositeFootage: rgb footage part, a = layer
+
 // passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
 const int kUnitFuzzyPosition = 0;
 const int kUnitFuzzyEmissive = 1;

@@ -87,6 +87,10 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
         ->check(wholeIn(0, 16384));
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
+    cmd->add_option("--shutter", args->shutter,
+                    "The webcam's exposure time in seconds for the motion blur of what the "
+                    "renderer adds (0 = off; default: the locked --camera-exposure, else off)")
+        ->check(finiteIn(0, 10));
     cmd->add_flag("--force", args->force, "Replace an existing CSV beside the output");
     cmd->add_option("--screenshot", args->screenshot,
                     "Window: save a PNG of the window after --screenshot-after frames, then exit")

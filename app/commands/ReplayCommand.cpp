@@ -75,6 +75,11 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
         ->check(shardSpecCheck());
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
+    cmd->add_option("--shutter", args->shutter,
+                    "The camera's exposure time in seconds for the motion blur of what the "
+                    "renderer adds (0 = off; default: the session's, session.json "
+                    "cameras[0].shutter)")
+        ->check(finiteIn(0, 10));
     cmd->add_option("--static-env", args->staticEnv,
                     "Light with this equirectangular image (.exr/.hdr/.pfm, linear) instead of "
                     "the session's environment camera")

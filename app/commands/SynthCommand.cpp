@@ -36,6 +36,7 @@ struct SynthArgs {
     bool force = false, noEnv = false;
     std::vector<double> envWhiteBalance;    // --env-white-balance R,G,B (empty: 1,1,1)
     std::vector<double> whiteBalanceDrift;  // --white-balance-drift R,G,B (empty: none)
+    double panFraction = -1.0;              // --pan-fraction (negative: the path's default)
     raytrace::SyntheticSessionOptions o;
 };
 
@@ -126,6 +127,12 @@ void run(SynthArgs a) {
     if (!a.whiteBalanceDrift.empty())
         a.o.sensor.whiteBalanceDrift =
             glm::dvec3(a.whiteBalanceDrift[0], a.whiteBalanceDrift[1], a.whiteBalanceDrift[2]);
+    if (a.panFraction >= 0) {
+        // The orbit and the hand-held hold share the rest in their default proportion (5 : 3).
+        const double rest = 1.0 - a.panFraction;
+        a.o.path.orbitFraction = rest * 0.625;
+        a.o.path.shakeFraction = rest * 0.375;
+    }
     // The scene's path as given (made absolute): ground_truth.json names it for `mirage bench`.
     a.o.sceneName = fs::absolute(a.scene).lexically_normal().string();
 
@@ -201,6 +208,10 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
     cmd->add_option("--pan-deg", a->o.path.panDeg, "Yaw of the final fast pan (degrees)")
         ->capture_default_str()
         ->check(finiteIn(-3600, 3600));
+    cmd->add_option("--pan-fraction", a->panFraction,
+                    "Share of the footage the final fast pan takes (0..1; default 0.2; 1: the "
+                    "whole clip is the pan, for strong motion blur with --shutter)")
+        ->check(finiteIn(0, 1));
     cmd->add_option("--shake-mm", a->o.path.shakeTranslation, "Hand-held shake amplitude (metres)")
         ->capture_default_str()
         ->check(finiteIn(0, 1));

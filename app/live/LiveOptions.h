@@ -1,5 +1,6 @@
 #pragma once
 // What `mirage live` is asked to do (its command-line options, docs/live.md).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,9 @@ struct LiveOptions {
     int maxFrames = -1;
     int vpls = 256;
     float exposure = 1.0f;
+    // The webcam's exposure time for the motion blur, seconds (--shutter; 0 = off); unset: the
+    // locked --camera-exposure, else off.
+    std::optional<double> shutter;
     int jpegQuality = 92;
     bool headless = false;
     bool boardOnly = false;  // no natural features (extended tracking off)

@@ -73,8 +73,9 @@ void LiveRenderStage::rebuild() {
     ++builds_;
 }
 
-CompositedFrame LiveRenderStage::composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual) {
-    return compositor_->composite(bgr, std::move(pose), renderVirtual);
+CompositedFrame LiveRenderStage::composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual,
+                                           double seconds) {
+    return compositor_->composite(bgr, std::move(pose), renderVirtual, seconds);
 }
 
 std::string LiveRenderStage::updateEnvironment(const cv::Mat& bgr, double seconds) {

@@ -3,6 +3,7 @@
 // per-frame compositing shared with replay (app/FrameCompositor.h), the environment camera's
 // frames as they arrive, and the renderer built anew when the quality, the effects or a
 // placement that cannot move in place change. Needs a current GL 4.5 context.
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -60,7 +61,9 @@ public:
                     const render::EnvironmentCameraSetup* environment);
 
     // Renders and composites one frame with its decided pose (FrameCompositor::composite).
-    CompositedFrame composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual);
+    // `seconds`: the frame's capture time (the motion blur's frame interval).
+    CompositedFrame composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual,
+                              double seconds = std::numeric_limits<double>::quiet_NaN());
 
     // A new environment frame lights the scene from the next render on. Returns the problem
     // when the renderer refuses it (wrong size), "" otherwise.

@@ -21,6 +21,25 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The webcam's exposure time for the motion blur: --shutter, else the locked --camera-exposure
+// (V4L2 units of 100 us); otherwise the motion blur is off, and the log says so.
+double liveShutterSeconds(const LiveOptions& a) {
+    if (a.shutter) {
+        spdlog::info("live: motion blur {} (--shutter {} s)", *a.shutter > 0 ? "on" : "off",
+                     *a.shutter);
+        return *a.shutter;
+    }
+    if (a.exposureLock.exposure) {
+        const double s = double(*a.exposureLock.exposure) * 1e-4;
+        spdlog::info("live: motion blur on (--camera-exposure: {} s)", s);
+        return s;
+    }
+    spdlog::info(
+        "live: motion blur off: no shutter time known; pass --shutter SECONDS (or lock the "
+        "webcam's exposure with --camera-exposure)");
+    return 0.0;
+}
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -138,6 +157,7 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     switchEffectsOff(a.effectsOff, settings.effects);
     settings.vpls = a.vpls;
     settings.exposure = a.exposure;
+    settings.effects.motionBlur.shutterSeconds = liveShutterSeconds(a);
     settings.keepDirectLight = !a.headless;
     controls_.preset = settings.preset;
     controls_.effects = settings.effects;
@@ -246,7 +266,8 @@ void LiveSession::process(LiveFrame& frame) {
     const auto t0 = Clock::now();
     PoseRow pose = track_->decide(f.bgr, f.captureSeconds, f.problem, std::nullopt);
     const double trackingMs = msSince(t0);
-    CompositedFrame cf = render_->composite(f.bgr, std::move(pose), !controls_.hideVirtual);
+    CompositedFrame cf =
+        render_->composite(f.bgr, std::move(pose), !controls_.hideVirtual, f.captureSeconds);
     cf.trackingMs = trackingMs;
     cf.trackingMode = track_->lastMode();
     if (f.bgr.empty()) spdlog::warn("live: {}", cf.pose.reason);

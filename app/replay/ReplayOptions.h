@@ -1,5 +1,6 @@
 #pragma once
 // What `mirage replay` is asked to do (its command-line options, docs/replay.md).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@ struct ReplayOptions {
     // range or shard. 8: the seam measured in docs/scale.md.
     int warmup = 8;
     float exposure = 1.0f;
+    // The camera's exposure time for the motion blur, seconds (--shutter; 0 = off); unset: the
+    // session's (session.json cameras[0].shutter), else off.
+    std::optional<double> shutter;
     int jpegQuality = 92;
     bool window = false;
     bool verbose = false;

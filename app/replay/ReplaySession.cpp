@@ -24,6 +24,26 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The main camera's exposure time for the motion blur: --shutter, else the session's; without
+// either the motion blur is off, and the log says so.
+double replayShutterSeconds(const ReplayOptions& a, const Session& s) {
+    if (a.shutter) {
+        spdlog::info("replay: motion blur {} (--shutter {} s)", *a.shutter > 0 ? "on" : "off",
+                     *a.shutter);
+        return *a.shutter;
+    }
+    const std::optional<double> fromSession = s.cameras.front().shutter;
+    if (!fromSession) {
+        spdlog::info(
+            "replay: motion blur off: the session states no shutter time (session.json "
+            "cameras[0].shutter); pass --shutter SECONDS to blur what the renderer adds");
+        return 0.0;
+    }
+    spdlog::info("replay: motion blur {} (the session's shutter: {} s)",
+                 *fromSession > 0 ? "on" : "off", *fromSession);
+    return *fromSession;
+}
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -174,6 +194,7 @@ void ReplaySession::createRenderer() {
     ropt.composite.exposure = a.exposure;  // the prior of the per-frame estimate
     ropt.exposureMatch.enabled = true;
     switchEffectsOff(a.effectsOff, ropt);
+    ropt.motionBlur.shutterSeconds = replayShutterSeconds(a, session_);
     if (a.estimateLights) {
         // As many as light estimation reports, within the renderer's light budget.
         const int room = render::kMaxLights - int(scene_.lightInstances().size());
@@ -247,7 +268,7 @@ bool ReplaySession::step(int pos, bool emit) {
     const auto t1 = Clock::now();
     PoseRow pose = track_->decide(bgr, t, problem, poses_->given(rec, bgr));
     const double trackingMs = msSince(t1);
-    CompositedFrame cf = compositor_->composite(bgr, std::move(pose));
+    CompositedFrame cf = compositor_->composite(bgr, std::move(pose), true, t);
     cf.trackingMs = trackingMs;
     if (bgr.empty()) spdlog::warn("replay: {}", cf.pose.reason);
     logLights(rec.index, cf);

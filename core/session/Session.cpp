@@ -47,6 +47,7 @@ void writeSessionJson(const Session& s) {
     for (const auto& c : s.cameras) {
         json cj{{"name", c.name}, {"video", c.video}, {"role", c.role}};
         if (!c.calibration.empty()) cj["calibration"] = c.calibration;
+        if (c.shutter) cj["shutter"] = *c.shutter;
         cams.push_back(cj);
     }
     j["cameras"] = cams;
@@ -141,6 +142,14 @@ void readCameras(const JsonReader& r, const json& j, Session& s) {
         c.role = r.string(cj, "role", f + ".role", false, i == 0 ? "main" : "environment");
         if (c.role != "main" && c.role != "environment")
             r.fail(f + ".role", "must be 'main' or 'environment', got '" + c.role + "'");
+        if (cj.contains("shutter")) {
+            const json& sh = cj["shutter"];
+            if (!sh.is_number() || !std::isfinite(sh.get<double>()) || sh.get<double>() < 0 ||
+                sh.get<double>() > 10)
+                r.fail(f + ".shutter",
+                       "expected the exposure time in seconds (0..10; 0 = no motion blur)");
+            c.shutter = sh.get<double>();
+        }
         if (i > 0 && c.role == "main")
             r.fail(f + ".role",
                    "is 'main', but cameras[0] is the main camera and a session has one; mark "

@@ -31,6 +31,10 @@ struct SessionCamera {
     std::string video;        // file (.mkv) or folder of images, relative to the session folder
     std::string calibration;  // OpenCV YAML, relative to the session folder; may be empty
     std::string role;         // "main" or "environment"
+    // The exposure time per frame (seconds the shutter is open), when the camera or the
+    // synthesiser reported it; 0 = an instantaneous shutter (no motion blur). session.json's
+    // optional cameras[].shutter.
+    std::optional<double> shutter = std::nullopt;
 };
 
 struct FrameRecord {

@@ -577,6 +577,14 @@ void cameraKnobs(std::vector<BenchKnob>& knobs) {
              c.options.exposureMatch.enabled = parseOnOff("exposure_match", v);
          },
          [](const BenchConfig& c) { return onOff(c.options.exposureMatch.enabled); }});
+    knobs.push_back(
+        {"motion_blur",
+         "on: what the renderer adds is blurred along its screen motion over the session's "
+         "shutter time (velocity buffer + McGuire et al. 2012's reconstruction filter); off: it "
+         "is drawn as a pinhole camera with an instantaneous shutter would",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
+         [](BenchConfig& c, const std::string& v) { c.motionBlur = parseOnOff("motion_blur", v); },
+         [](const BenchConfig& c) { return onOff(c.motionBlur); }});
 }
 
 }  // namespace

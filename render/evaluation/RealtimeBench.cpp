@@ -113,6 +113,10 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
         bf.footage = bgr.clone();
         bf.truth = gt->compositeSrgb;
         bf.influence = gt->influence;
+        bf.time = rec.timestamps.empty()
+                      ? double(rec.index) / session.fps
+                      : rec.timestamps.at(size_t(session.cameraIndex(main->name)));
+        bf.shutter = main->shutter;
         frames.push_back(std::move(bf));
         if (envSource && !envBgr.empty()) {
             frames.back().environment = envBgr.clone();
@@ -137,7 +141,17 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
     const int h = config.height > 0 ? config.height : sessionCamera.height;
     const std::vector<BenchFrame> frames = scaleFrames(allFrames, w, h);
     const CameraIntrinsics cam = scaleIntrinsics(sessionCamera, w, h);
-    Renderer renderer(scene, cam, config.options);
+    RendererOptions options = config.options;
+    if (config.motionBlur) {
+        const std::optional<double> shutter = allFrames.front().shutter;
+        if (!shutter || !(*shutter > 0.0))
+            throw Error(
+                "bench: knob motion_blur=on needs a session that states a shutter time "
+                "(session.json "
+                "cameras[0].shutter > 0, as `mirage synth --shutter S` writes it)");
+        options.motionBlur.shutterSeconds = *shutter;
+    }
+    Renderer renderer(scene, cam, options);
     if (config.environmentCamera) {
         renderer.setEnvironmentCamera(*environment);
         renderer.updateEnvironment(frames.front().environment, frames.front().environmentTime - 1);
@@ -186,7 +200,8 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
                     ? jitteredPose(f.T_world_camera, config.poseJitterMm, 0.1 * config.poseJitterMm,
                                    uint64_t(rep) * 100003u + i)
                     : f.T_world_camera;
-            const FrameReport& report = renderer.render({pose, f.footage, /*resetHistory=*/i == 0});
+            const FrameReport& report =
+                renderer.render({pose, f.footage, /*resetHistory=*/i == 0, f.time});
             const cv::Mat composite = renderer.compositeSrgb();
             const double wallMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)

@@ -10,6 +10,7 @@
 // caustic map size, ...) is one entry there, and the grid, CSV and table pick it up.
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct BenchConfig {
     // and repeat. The ground truth stays at the exact pose, so the noise costs error in itself;
     // what it shows is what shimmers (temporal smoothing on / off).
     double poseJitterMm = 0.0;
+    // Motion blur of what the renderer adds (knob motion_blur=on): the shutter is the session's
+    // (BenchFrame::shutter); a session that states none is refused.
+    bool motionBlur = false;
     std::string label() const;  // "vpls=256 indirect_scale=2 ..."
 };
 
@@ -82,6 +86,10 @@ struct BenchFrame {
     cv::Mat influence;    // CV_8U, nonzero = influenced by the virtual objects
     cv::Mat environment;  // the environment camera's frame of this row (8-bit BGR sRGB), if any
     double environmentTime = 0.0;  // its time (seconds, the environment camera's clock)
+    double time = 0.0;             // the main camera's time of the frame (seconds, frames.csv)
+    // The main camera's exposure time (seconds; session.json cameras[].shutter), if the session
+    // states it: the motion blur's shutter (knob motion_blur=on).
+    std::optional<double> shutter;
 };
 
 // The main camera's frames of `session` that have a ground-truth pose and a ground-truth

@@ -64,7 +64,8 @@ public:
 
         meta_.fps = a_.fps;
         const std::string ext = a_.imageSequence ? "" : ".mkv";
-        meta_.cameras.push_back({"main", "main" + ext, "main.yaml", "main"});
+        // The main camera's exposure time: the open fraction of the frame interval.
+        meta_.cameras.push_back({"main", "main" + ext, "main.yaml", "main", a_.shutter / a_.fps});
         if (a_.environmentCamera)
             meta_.cameras.push_back({"env", "env" + ext, "env.yaml", "environment"});
         meta_.board = a_.boardFile.empty() ? "" : "board.json";
@@ -347,7 +348,8 @@ nlohmann::json writeSyntheticShard(const Scene& scene, const fs::path& dir,
         cameras.push_back({{"name", c.name},
                            {"video", c.video},
                            {"calibration", c.calibration},
-                           {"role", c.role}});
+                           {"role", c.role},
+                           {"shutter", c.shutter ? nlohmann::json(*c.shutter) : nlohmann::json()}});
     return {{"fps", a.fps},
             {"frames_total", run.frames()},
             {"cameras", cameras},
@@ -369,7 +371,10 @@ void mergeSyntheticShards(const ShardSet& set, const fs::path& out, const SynthP
         for (const auto& c : p.at("cameras"))
             meta.cameras.push_back(
                 {c.at("name").get<std::string>(), c.at("video").get<std::string>(),
-                 c.at("calibration").get<std::string>(), c.at("role").get<std::string>()});
+                 c.at("calibration").get<std::string>(), c.at("role").get<std::string>(),
+                 c.contains("shutter") && c.at("shutter").is_number()
+                     ? std::optional<double>(c.at("shutter").get<double>())
+                     : std::nullopt});
         meta.board = p.at("board").get<std::string>();
         meta.createdBy = p.at("created_by").get<std::string>();
         // The run's creation time: its earliest shard's.

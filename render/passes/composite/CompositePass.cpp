@@ -78,6 +78,7 @@ void CompositePass::setup(PassBuilder& b) const {
     b.readOptional(kExposureSamples);
     b.create(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
     b.create(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
+    b.create(kCompositeFootage, {GL_RGBA16F, SizeRule::Camera, Storage::PassOwned});
 }
 
 PassDecision CompositePass::decide(const FrameContext&) const {
@@ -109,12 +110,17 @@ void CompositePass::resize(const FrameContext& ctx) {
         canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
         canvasToCameraTable_ = std::move(table);
     }
+    footage_ = gl::Texture::create2D("composite footage", w, h, GL_RGBA16F);
     fbo_ = gl::Framebuffer("composite fbo");
     fbo_.attachColor(0, linear_);
     fbo_.attachColor(1, srgb_);
+    // The footage target only while the motion blur reads it (the options are the renderer's
+    // for its whole life): otherwise the shader's third output goes nowhere.
+    const bool footage = ctx.options.motionBlur.enabled();
+    if (footage) fbo_.attachColor(2, footage_);
     mask_ = gl::Texture::create2D("composite specular mask", w, h, GL_DEPTH_COMPONENT32F);
     fbo_.attachDepth(mask_);
-    fbo_.finalize(2);
+    fbo_.finalize(footage ? 3 : 2);
     maskFbo_ = gl::Framebuffer("composite specular mask fbo");
     maskFbo_.attachDepth(mask_);
     maskFbo_.finalize(0);
@@ -246,6 +252,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     glDisable(GL_FRAMEBUFFER_SRGB);
     res.publish(kComposite, linear_);
     res.publish(kCompositeSrgb, srgb_);
+    res.publish(kCompositeFootage, footage_);
 }
 
 }  // namespace mirage::render

@@ -8,6 +8,9 @@ namespace mirage::render {
 // The output (camera image size): linear RGBA32F, a = coverage; the same, sRGB8.
 inline constexpr Resource kComposite{"Composite"};
 inline constexpr Resource kCompositeSrgb{"CompositeSrgb"};
+// Camera size, RGBA16F: the footage part of each composite pixel and its layer (composite.frag's
+// outFootage), for the motion blur; written only while RendererOptions::motionBlur is on.
+inline constexpr Resource kCompositeFootage{"CompositeFootage"};
 
 class CompositePass final : public RenderPass {
 public:
@@ -35,7 +38,7 @@ private:
     gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
     bool programsBuilt_ = false, identityRemap_ = false;  // the variants built, and which
     bool remapIsIdentity_ = false;  // isIdentityRemap of the camera the tables were built for
-    gl::Texture linear_, srgb_, remap_;
+    gl::Texture linear_, srgb_, remap_, footage_;
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
     gl::Texture canvasToCamera_;

@@ -65,6 +65,12 @@ uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showV
 uniform int withCaustics;    // 1: a caustic pass ran (else causticRv / causticR are not read)
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
+// The part of outLinear that is footage, and the pixel's layer, for the motion blur
+// (render/passes/motionblur): the footage is already blurred by the camera and must not be blurred
+// again within its layer. rgb camera linear; a = 0: a real or empty pixel (rgb = CI), 1: a virtual
+// pixel (rgb = 0), 2 + slot: a mirror / glass pixel (rgb = the back-projected video CI_bp).
+// Attached only while the motion blur is on.
+layout(location = 2) out vec4 outFootage;
 
 #ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 // alpha for L = CI + alpha dL, guarded where the rendered real radiance is near 0.
@@ -74,8 +80,9 @@ vec3 guardedAlpha(vec3 ci, vec3 r) {
     return mix(vec3(1.0), ratio, t);
 }
 
-// Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci.
-vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
+// Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci; `footage` receives the part
+// of the result that is video (CI, or the back-projected CI_bp); wholeCi: it is CI (all real).
+vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out bool wholeCi) {
     vec3 ex = exposure;
     vec4 fuzzyBp = fuzzyOn != 0 ? texelFetch(fuzzyVideo, cpi, 0) : vec4(0.0);
     bool fuzzy = fuzzyBp.a > 0.5;
@@ -91,6 +98,8 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
     bool envReal = envOrigin == ORIGIN_REAL;
     bool allReal = pReal;
     vec3 ciBp = vec3(0.0);
+    footage = vec3(0.0);
+    wholeCi = false;
     for (int k = 0; k < 2; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, cpi, 0) : texelFetch(refrPosition, cpi, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, cpi, 0) : texelFetch(refrWeight, cpi, 0)).rgb;
@@ -111,13 +120,19 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal) {
         vec3 c;
         if (backProject(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, c)) {
             ciBp += w * c;
+            footage += w * c;
         } else {
             ciBp += k == 0 ? rRefl : max(r - rRefl, vec3(0.0));  // rendered real share
         }
     }
     if (fuzzy) ciBp = max(fuzzyBp.rgb, vec3(0.0));  // the neighbours' resolved CI_bp, filtered
+    if (fuzzy) footage = ciBp;
     vec3 dL = rv - r;  // Eq. 6
-    if (allReal) return ci + guardedAlpha(ci, r + (envReal ? env : vec3(0.0))) * dL;
+    if (allReal) {
+        footage = ci;
+        wholeCi = true;
+        return ci + guardedAlpha(ci, r + (envReal ? env : vec3(0.0))) * dL;
+    }
     return env + ciBp + guardedAlpha(ciBp, r) * dL;
 }
 #endif
@@ -134,6 +149,8 @@ void main() {
 #endif
     vec3 result = ci;
     float coverage = 0.0;
+    vec3 footage = ci;
+    float layer = 0.0;
     if (canvasPx.x > -1000.0 && showVirtual != 0) {
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
 #if defined(MIRAGE_IDENTITY_REMAP) && defined(MIRAGE_DIFFUSE_ONLY)
@@ -157,13 +174,17 @@ void main() {
 #ifndef MIRAGE_DIFFUSE_ONLY
         int slot = int(texelFetch(gEmissive, cpi, 0).a + 0.5) - 1;
         if (slot >= 0 && origin != ORIGIN_NONE) {
-            result = compositeSpecular(cpi, ci, origin == ORIGIN_REAL);
+            bool wholeCi;
+            result = compositeSpecular(cpi, ci, origin == ORIGIN_REAL, footage, wholeCi);
             coverage = origin == ORIGIN_VIRTUAL ? 1.0 : 0.5;
+            layer = wholeCi ? 0.0 : float(2 + slot);
         } else
 #endif
         if (origin == ORIGIN_VIRTUAL) {
             result = rv;
             coverage = 1.0;
+            footage = vec3(0.0);
+            layer = 1.0;
         } else {
             vec3 t = smoothstep(vec3(0.0), vec3(alphaFadeLr), r);
             vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(alphaMax));
@@ -176,4 +197,5 @@ void main() {
     result = max(result, vec3(0.0));
     outLinear = vec4(result, coverage);
     outSrgb = vec4(clamp(result, 0.0, 1.0), 1.0);
+    outFootage = vec4(allFinite(footage) ? max(footage, vec3(0.0)) : vec3(0.0), layer);
 }
