@@ -191,6 +191,10 @@ const int kUnitExposurePosition = 3;  // w = origin
 const int kUnitExposureEmissive = 4;  // a = specular slot + 1
 const int kUnitExposureCanvasToCamera = 5;
 
+// passes/aa: antialias.frag
+const int kUnitAntialiasComposite = 0;  // the composite, linear RGBA32F (bilinear sampler)
+const int kUnitAntialiasCamera = 1;     // the camera frame (sRGB8, sampled linear, bilinear)
+
 // passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
 const int kUnitFuzzyPosition = 0;
 const int kUnitFuzzyEmissive = 1;

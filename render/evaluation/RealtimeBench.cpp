@@ -46,6 +46,7 @@ std::vector<BenchFrame> scaleFrames(const std::vector<BenchFrame>& frames, int w
     for (const auto& f : frames) {
         if (width <= 0 || (f.footage.cols == width && f.footage.rows == height)) {
             out.push_back(f);
+            out.back().edges = edgePixels(f.footage, f.truth, f.influence);
             continue;
         }
         BenchFrame s = f;
@@ -61,6 +62,7 @@ std::vector<BenchFrame> scaleFrames(const std::vector<BenchFrame>& frames, int w
         touched.convertTo(m, CV_32F, 1.0 / 255.0);
         cv::resize(m, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
         s.influence = small > 0.0f;
+        s.edges = edgePixels(s.footage, s.truth, s.influence);
         out.push_back(std::move(s));
     }
     return out;
@@ -136,7 +138,23 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
     const int w = config.width > 0 ? config.width : sessionCamera.width;
     const int h = config.height > 0 ? config.height : sessionCamera.height;
     const std::vector<BenchFrame> frames = scaleFrames(allFrames, w, h);
-    const CameraIntrinsics cam = scaleIntrinsics(sessionCamera, w, h);
+    const int ss = std::max(1, config.supersample);
+    const CameraIntrinsics cam = scaleIntrinsics(sessionCamera, w * ss, h * ss);
+    // The footage the renderer composites into: each pixel replicated ss x ss times.
+    std::vector<cv::Mat> footage;
+    for (const BenchFrame& f : frames) {
+        footage.push_back(f.footage);
+        if (ss > 1)
+            cv::resize(f.footage, footage.back(), cv::Size(w * ss, h * ss), 0, 0,
+                       cv::INTER_NEAREST);
+    }
+    // The judged composite: the renderer's own, or its supersampled linear one averaged down.
+    const auto judged = [&](const Renderer& r) {
+        if (ss == 1) return r.compositeSrgb();
+        cv::Mat small;
+        cv::resize(r.compositeLinear(), small, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+        return linearRgbToSrgbBgr8(small);
+    };
     Renderer renderer(scene, cam, config.options);
     if (config.environmentCamera) {
         renderer.setEnvironmentCamera(*environment);
@@ -158,7 +176,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
         renderer.updateTransforms(scene);
     }
     // Warm-up: shader compilation and first allocations stay out of the timings.
-    renderer.render({frames.front().T_world_camera, frames.front().footage, true});
+    renderer.render({frames.front().T_world_camera, footage.front(), true});
 
     BenchResult result;
     result.passOrder = renderer.passNames();
@@ -186,8 +204,9 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
                     ? jitteredPose(f.T_world_camera, config.poseJitterMm, 0.1 * config.poseJitterMm,
                                    uint64_t(rep) * 100003u + i)
                     : f.T_world_camera;
-            const FrameReport& report = renderer.render({pose, f.footage, /*resetHistory=*/i == 0});
-            const cv::Mat composite = renderer.compositeSrgb();
+            const FrameReport& report =
+                renderer.render({pose, footage[i], /*resetHistory=*/i == 0});
+            const cv::Mat composite = judged(renderer);
             const double wallMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
@@ -198,7 +217,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
             for (const auto& p : report.passes)
                 if (p.ran) fr.passMs[p.name] = p.gpuMs;
             CompositeErrorAccumulator one;
-            one.add(composite, f.truth, f.influence);
+            one.add(composite, f.truth, f.influence, f.edges);
             fr.error = one.result();
             acc.merge(one);
             if (i == 0) {
@@ -244,7 +263,7 @@ BenchResult footageBaseline(const std::vector<BenchFrame>& allFrames, int width,
         BenchFrameResult fr;
         fr.index = f.index;
         CompositeErrorAccumulator one;
-        one.add(f.footage, f.truth, f.influence);
+        one.add(f.footage, f.truth, f.influence, f.edges);
         fr.error = one.result();
         acc.merge(one);
         if (result.frames.empty()) {
