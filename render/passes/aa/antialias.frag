@@ -10,9 +10,10 @@
 // composite's perceptual luma (sqrt of linear luminance, clamped to 0..1), so a virtual
 // silhouette and a shadow's edge are found as the camera would show them; the search along the
 // edge for its two ends turns a stair step into the ramp a box-filtered pixel would see.
-// Pixels with no changed pixel (|D| > changeEpsilon) in their 3x3 neighbourhood are written
-// with the composite's value unchanged: where the renderer changed nothing the footage stays
-// bit for bit.
+// Pixels where neither they nor their 4 neighbours were changed (|D| > changeEpsilon) are
+// written with the composite's value unchanged: where the renderer changed nothing the footage
+// stays bit for bit. Most pixels stop after the 5 reads of the contrast test (on llvmpipe every
+// read counts).
 in vec2 uv;
 layout(binding = kUnitAntialiasComposite) uniform sampler2D compositeImage;  // linear, a = coverage
 layout(binding = kUnitAntialiasCamera) uniform sampler2D cameraImage;       // sRGB8, samples linear
@@ -38,22 +39,15 @@ float lumaAt(ivec2 p) {
 float lumaAtPos(vec2 pos, vec2 rcpSize) {
     return lumaOf(textureLod(compositeImage, pos * rcpSize, 0.0).rgb);
 }
-bool changedAt(ivec2 p) {
-    vec3 d = abs(texelFetch(compositeImage, p, 0).rgb - texelFetch(cameraImage, p, 0).rgb);
+bool changed(vec3 composite, vec3 camera) {
+    vec3 d = abs(composite - camera);
     return max(d.r, max(d.g, d.b)) > changeEpsilon;
 }
 
-// The edge-directed offset (pixels, along `across`) of pixel px; 0 where no edge is found.
-vec2 edgeOffset(ivec2 px, ivec2 hi, vec2 rcpSize) {
-    float lM = lumaAt(px);
-    float lN = lumaAt(clamp(px + ivec2(0, -1), ivec2(0), hi));
-    float lS = lumaAt(clamp(px + ivec2(0, 1), ivec2(0), hi));
-    float lW = lumaAt(clamp(px + ivec2(-1, 0), ivec2(0), hi));
-    float lE = lumaAt(clamp(px + ivec2(1, 0), ivec2(0), hi));
-    float maxL = max(max(max(lN, lS), max(lW, lE)), lM);
-    float minL = min(min(min(lN, lS), min(lW, lE)), lM);
-    float range = maxL - minL;
-    if (range < max(edgeThresholdMin, maxL * edgeThreshold)) return vec2(0.0);
+// The edge-directed offset (pixels, along one axis) of pixel px, whose luma and that of its 4
+// neighbours are lM, lN (y - 1), lS, lW (x - 1), lE and span `range`.
+vec2 edgeOffset(ivec2 px, ivec2 hi, vec2 rcpSize, float lM, float lN, float lS, float lW,
+                float lE, float range) {
     float lNW = lumaAt(clamp(px + ivec2(-1, -1), ivec2(0), hi));
     float lNE = lumaAt(clamp(px + ivec2(1, -1), ivec2(0), hi));
     float lSW = lumaAt(clamp(px + ivec2(-1, 1), ivec2(0), hi));
@@ -112,22 +106,35 @@ void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     ivec2 size = textureSize(compositeImage, 0);
     ivec2 hi = size - 1;
-    vec4 here = texelFetch(compositeImage, px, 0);
-    outLinear = here;
-    outSrgb = vec4(clamp(here.rgb, 0.0, 1.0), 1.0);
+    // The pixel and its 4 neighbours: the filter reads no other pixel's contribution (its offset
+    // runs along one axis, by at most 1 pixel).
+    ivec2 q[5] = ivec2[](px, clamp(px + ivec2(0, -1), ivec2(0), hi),
+                         clamp(px + ivec2(0, 1), ivec2(0), hi),
+                         clamp(px + ivec2(-1, 0), ivec2(0), hi),
+                         clamp(px + ivec2(1, 0), ivec2(0), hi));
+    vec4 c[5];
+    float l[5];
+    for (int i = 0; i < 5; ++i) {
+        c[i] = texelFetch(compositeImage, q[i], 0);
+        l[i] = lumaOf(c[i].rgb);
+    }
+    outLinear = c[0];
+    outSrgb = vec4(clamp(c[0].rgb, 0.0, 1.0), 1.0);
+    float maxL = max(max(max(l[1], l[2]), max(l[3], l[4])), l[0]);
+    float minL = min(min(min(l[1], l[2]), min(l[3], l[4])), l[0]);
+    float range = maxL - minL;
+    if (range < max(edgeThresholdMin, maxL * edgeThreshold)) return;  // no edge
     bool near = false;
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-            near = near || changedAt(clamp(px + ivec2(dx, dy), ivec2(0), hi));
-    if (!near) return;
+    for (int i = 0; i < 5; ++i) near = near || changed(c[i].rgb, texelFetch(cameraImage, q[i], 0).rgb);
+    if (!near) return;  // the footage's own edge: left as it is
     vec2 rcpSize = 1.0 / vec2(size);
-    vec2 offset = edgeOffset(px, hi, rcpSize);
+    vec2 offset = edgeOffset(px, hi, rcpSize, l[0], l[1], l[2], l[3], l[4], range);
     if (offset == vec2(0.0)) return;
     vec2 pos = (vec2(px) + 0.5 + offset) * rcpSize;
     vec3 delta = textureLod(compositeImage, pos, 0.0).rgb - textureLod(cameraImage, pos, 0.0).rgb;
     vec3 result = texelFetch(cameraImage, px, 0).rgb + delta;
     if (!allFinite(result)) return;
     result = max(result, vec3(0.0));
-    outLinear = vec4(result, here.a);
+    outLinear = vec4(result, c[0].a);
     outSrgb = vec4(clamp(result, 0.0, 1.0), 1.0);
 }
