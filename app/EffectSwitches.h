@@ -41,6 +41,7 @@ inline constexpr EffectSwitch kEffectSwitches[] = {
      [](render::RendererOptions& o) -> bool& { return o.translucency.enabled; }},
     {"exposure_match", "exposure matching",
      [](render::RendererOptions& o) -> bool& { return o.exposureMatch.enabled; }},
+    {"aa", "anti-aliasing", [](render::RendererOptions& o) -> bool& { return o.aa.enabled; }},
 };
 
 inline std::string effectSwitchNames() {

@@ -17,6 +17,7 @@
 #include "render/GpuScene.h"
 #include "render/GpuTypes.h"
 #include "render/Resource.h"
+#include "render/passes/aa/AntialiasOptions.h"
 #include "render/passes/caustic/CausticOptions.h"
 #include "render/passes/composite/CompositeOptions.h"
 #include "render/passes/direct/DirectOptions.h"
@@ -83,6 +84,7 @@ struct RendererOptions {
     CompositeOptions composite;
     ExposureMatchOptions exposureMatch;  // render/passes/exposure
     MotionBlurOptions motionBlur;        // render/passes/motionblur
+    AntialiasOptions aa;                 // render/passes/aa
 
     // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
     // and where switched on the caustic buffer and the specular-hit light L'. Each frame keeps

@@ -10,6 +10,7 @@
 
 #include "core/Error.h"
 #include "render/FrameImports.h"
+#include "render/passes/aa/AntialiasPass.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
@@ -311,6 +312,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<FuzzyReflectionPass>());
     g.addPass(std::make_unique<RoughRefractionPass>());
     g.addPass(std::make_unique<CompositePass>());
+    g.addPass(std::make_unique<AntialiasPass>());   // the renderer's edges, after the composite
     g.addPass(std::make_unique<MotionBlurPass>());  // what the renderer added, over the exposure
     g.markOutput(kComposite);
     g.markOutput(kCompositeSrgb);

@@ -200,6 +200,10 @@ const int kUnitMotionTiles = 3;      // tile / neighbourhood maxima
 const int kUnitMotionComposite = 4;  // the composite (linear, a = coverage)
 const int kUnitMotionFootage = 5;    // CompositeFootage: rgb footage part, a = layer
 
+// passes/aa: antialias.frag
+const int kUnitAntialiasComposite = 0;  // the composite, linear RGBA32F (bilinear sampler)
+const int kUnitAntialiasCamera = 1;     // the camera frame (sRGB8, sampled linear, bilinear)
+
 // passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
 const int kUnitFuzzyPosition = 0;
 const int kUnitFuzzyEmissive = 1;

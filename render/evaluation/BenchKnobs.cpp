@@ -585,6 +585,27 @@ void cameraKnobs(std::vector<BenchKnob>& knobs) {
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
          [](BenchConfig& c, const std::string& v) { c.motionBlur = parseOnOff("motion_blur", v); },
          [](const BenchConfig& c) { return onOff(c.motionBlur); }});
+    knobs.push_back(
+        {"aa",
+         "anti-aliasing of what the renderer adds: morphological (the aa pass, an edge-directed "
+         "filter of the renderer's contribution), ssaa2 (the renderer at 2x2 the resolution, "
+         "averaged down: a measured alternative), off",
+         [](const CameraIntrinsics&, bool) {
+             return std::vector<std::string>{RendererOptions{}.aa.enabled ? "morphological"
+                                                                          : "off"};
+         },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "off" && v != "morphological" && v != "ssaa2")
+                 throw Error(
+                     fmt::format("bench knob 'aa': '{}' is not off, morphological or ssaa2", v));
+             c.supersample = v == "ssaa2" ? 2 : 1;
+             c.options.aa.enabled = v == "morphological";
+         },
+         [](const BenchConfig& c) {
+             return c.supersample == 2
+                        ? std::string("ssaa2")
+                        : std::string(c.options.aa.enabled ? "morphological" : "off");
+         }});
 }
 
 }  // namespace

@@ -68,7 +68,7 @@ void writeBenchCsv(const std::string& path, const std::vector<BenchResult>& resu
     out << ",width,height,frames";
     for (const auto& p : passes) out << "," << p << "_ms";
     out << ",gpu_ms,wall_ms,psnr_frame_db,ssim_frame,psnr_influenced_db,ssim_influenced,"
-           "influenced_px\n";
+           "influenced_px,psnr_edges_db,edge_px\n";
     for (const auto& r : results) {
         out << '"' << (r.baseline ? "footage (no virtual objects)" : r.config.label()) << '"' << ","
             << (r.baseline ? 1 : 0);
@@ -81,7 +81,8 @@ void writeBenchCsv(const std::string& path, const std::vector<BenchResult>& resu
         out << "," << (r.baseline ? "" : num(r.medianGpuMs, 3)) << ","
             << (r.baseline ? "" : num(r.medianWallMs, 3)) << "," << num(r.error.psnrFrame, 3) << ","
             << num(r.error.ssimFrame, 5) << "," << num(r.error.psnrInfluenced, 3) << ","
-            << num(r.error.ssimInfluenced, 5) << "," << num(r.error.influencedPixels, 0) << "\n";
+            << num(r.error.ssimInfluenced, 5) << "," << num(r.error.influencedPixels, 0) << ","
+            << num(r.error.psnrEdges, 3) << "," << num(r.error.edgePixels, 0) << "\n";
     }
     if (!out) throw FileError(path, "write failed");
 }
@@ -92,7 +93,7 @@ void writeBenchFramesCsv(const std::string& path, const std::vector<BenchResult>
     out << "config,frame";
     for (const auto& p : passes) out << "," << p << "_ms";
     out << ",gpu_ms,wall_ms,psnr_frame_db,ssim_frame,psnr_influenced_db,ssim_influenced,"
-           "influenced_px\n";
+           "influenced_px,psnr_edges_db,edge_px\n";
     for (const auto& r : results)
         for (const auto& f : r.frames) {
             out << '"' << (r.baseline ? "footage (no virtual objects)" : r.config.label()) << '"'
@@ -104,7 +105,8 @@ void writeBenchFramesCsv(const std::string& path, const std::vector<BenchResult>
             out << "," << num(f.gpuMs, 3) << "," << num(f.wallMs, 3) << ","
                 << num(f.error.psnrFrame, 3) << "," << num(f.error.ssimFrame, 5) << ","
                 << num(f.error.psnrInfluenced, 3) << "," << num(f.error.ssimInfluenced, 5) << ","
-                << num(f.error.influencedPixels, 0) << "\n";
+                << num(f.error.influencedPixels, 0) << "," << num(f.error.psnrEdges, 3) << ","
+                << num(f.error.edgePixels, 0) << "\n";
         }
     if (!out) throw FileError(path, "write failed");
 }
@@ -118,9 +120,10 @@ void writeBenchMarkdown(const std::string& path, const std::vector<BenchResult>&
     out << "|";
     for (const auto& k : knobs) out << " " << k << " |";
     for (const auto& p : passes) out << " " << p << " |";
-    out << " **GPU ms** | frames/s | wall ms | PSNR dB | SSIM | PSNR infl. dB | SSIM infl. |\n|";
+    out << " **GPU ms** | frames/s | wall ms | PSNR dB | SSIM | PSNR infl. dB | SSIM infl. | "
+           "PSNR edges dB |\n|";
     for (size_t i = 0; i < knobs.size(); ++i) out << "---|";
-    for (size_t i = 0; i < passes.size() + 7; ++i) out << "---:|";
+    for (size_t i = 0; i < passes.size() + 8; ++i) out << "---:|";
     out << "\n";
     for (const auto& r : results) {
         out << "|";
@@ -140,7 +143,8 @@ void writeBenchMarkdown(const std::string& path, const std::vector<BenchResult>&
                 << num(r.medianGpuMs > 0 ? 1000.0 / r.medianGpuMs : 0.0, 1) << " | "
                 << num(r.medianWallMs, 1) << " |";
         out << " " << num(r.error.psnrFrame, 2) << " | " << num(r.error.ssimFrame, 4) << " | "
-            << num(r.error.psnrInfluenced, 2) << " | " << num(r.error.ssimInfluenced, 4) << " |\n";
+            << num(r.error.psnrInfluenced, 2) << " | " << num(r.error.ssimInfluenced, 4) << " | "
+            << num(r.error.psnrEdges, 2) << " |\n";
     }
     if (!out) throw FileError(path, "write failed");
 }
@@ -162,8 +166,9 @@ double number(const nlohmann::json& j) {
 }
 
 nlohmann::json errorJson(const CompositeError& e) {
-    return {number(e.psnrFrame), number(e.ssimFrame), number(e.psnrInfluenced),
-            number(e.ssimInfluenced), number(e.influencedPixels)};
+    return {number(e.psnrFrame),      number(e.ssimFrame),        number(e.psnrInfluenced),
+            number(e.ssimInfluenced), number(e.influencedPixels), number(e.psnrEdges),
+            number(e.edgePixels)};
 }
 
 CompositeError errorFromJson(const nlohmann::json& j) {
@@ -173,6 +178,10 @@ CompositeError errorFromJson(const nlohmann::json& j) {
     e.psnrInfluenced = number(j.at(2));
     e.ssimInfluenced = number(j.at(3));
     e.influencedPixels = number(j.at(4));
+    if (j.size() > 6) {  // results written before the edge figure have five entries
+        e.psnrEdges = number(j.at(5));
+        e.edgePixels = number(j.at(6));
+    }
     return e;
 }
 

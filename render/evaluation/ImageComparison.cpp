@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Error.h"
+#include "core/image/ImageIO.h"
 
 namespace mirage::render {
 void ErrorAccumulator::add(const cv::Mat& got, const cv::Mat& truth, double peak,
@@ -36,8 +37,22 @@ double ErrorAccumulator::meanSsim() const {
     return pixels > 0 ? ssimSum / pixels : std::nan("");
 }
 
+cv::Mat edgePixels(const cv::Mat& footageSrgb8, const cv::Mat& truthSrgb8, const cv::Mat& influence,
+                   double threshold) {
+    checkComparable(footageSrgb8, truthSrgb8, influence);
+    cv::Mat change = srgbBgr8ToLinearRgb(truthSrgb8) - srgbBgr8ToLinearRgb(footageSrgb8);
+    cv::Mat luma;  // linear RGB -> Rec. 709 luminance
+    cv::transform(change, luma, cv::Matx13f(0.2126f, 0.7152f, 0.0722f));
+    cv::Mat hi, lo;
+    const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+    cv::dilate(luma, hi, k);
+    cv::erode(luma, lo, k);
+    cv::Mat edges = (hi - lo) > threshold;
+    return edges & (influence > 0);
+}
+
 void CompositeErrorAccumulator::add(const cv::Mat& gotSrgb8, const cv::Mat& truthSrgb8,
-                                    const cv::Mat& influence) {
+                                    const cv::Mat& influence, const cv::Mat& edgeMask) {
     if (gotSrgb8.type() != CV_8UC3)
         throw Error("composite comparison: expects 8-bit BGR (sRGB) images");
     checkComparable(gotSrgb8, truthSrgb8, influence);
@@ -52,11 +67,19 @@ void CompositeErrorAccumulator::add(const cv::Mat& gotSrgb8, const cv::Mat& trut
     influenced.squaredError += cv::sum(se.clone().setTo(0, off))[0];
     influenced.ssimSum += cv::sum(s.clone().setTo(0, off))[0];
     influenced.pixels += cv::countNonZero(influence);
+    edges.channels = 3;
+    if (!edgeMask.empty()) {
+        checkComparable(gotSrgb8, truthSrgb8, edgeMask);
+        edges.squaredError += cv::sum(se.clone().setTo(0, edgeMask == 0))[0];
+        edges.ssimSum += cv::sum(s.clone().setTo(0, edgeMask == 0))[0];
+        edges.pixels += cv::countNonZero(edgeMask);
+    }
 }
 
 void CompositeErrorAccumulator::merge(const CompositeErrorAccumulator& other) {
-    for (auto [mine, theirs] :
-         {std::pair{&frame, &other.frame}, {&influenced, &other.influenced}}) {
+    for (auto [mine, theirs] : {std::pair{&frame, &other.frame},
+                                {&influenced, &other.influenced},
+                                {&edges, &other.edges}}) {
         mine->squaredError += theirs->squaredError;
         mine->ssimSum += theirs->ssimSum;
         mine->pixels += theirs->pixels;
@@ -71,6 +94,8 @@ CompositeError CompositeErrorAccumulator::result() const {
     e.psnrInfluenced = influenced.psnrDb();
     e.ssimInfluenced = influenced.meanSsim();
     e.influencedPixels = influenced.pixels;
+    e.psnrEdges = edges.psnrDb();
+    e.edgePixels = edges.pixels;
     return e;
 }
 

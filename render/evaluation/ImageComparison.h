@@ -35,13 +35,25 @@ struct CompositeError {
     double psnrInfluenced = std::numeric_limits<double>::quiet_NaN();
     double ssimInfluenced = std::numeric_limits<double>::quiet_NaN();
     double influencedPixels = 0;  // summed over frames
+    // Over the edge pixels of what the virtual objects change (edgePixels): their silhouettes
+    // and their shadows' edges, where aliasing shows (docs/camera-matching.md, "Anti-aliasing").
+    double psnrEdges = std::numeric_limits<double>::quiet_NaN();
+    double edgePixels = 0;  // summed over frames
 };
 
+// The edge pixels of the virtual objects' contribution, from the ground truth alone (so every
+// configuration is judged over the same pixels): influenced pixels where the ground truth's
+// change to the footage (truth - footage, linear luminance) varies by more than `threshold`
+// (linear camera units) within the pixel's 3x3 neighbourhood. CV_8U 255 / 0.
+cv::Mat edgePixels(const cv::Mat& footageSrgb8, const cv::Mat& truthSrgb8, const cv::Mat& influence,
+                   double threshold = 0.05);
+
 struct CompositeErrorAccumulator {
-    ErrorAccumulator frame, influenced;
+    ErrorAccumulator frame, influenced, edges;
     // got, truth: 8-bit BGR sRGB of equal size; influence: CV_8U (nonzero = the virtual objects
-    // change the pixel), same size.
-    void add(const cv::Mat& gotSrgb8, const cv::Mat& truthSrgb8, const cv::Mat& influence);
+    // change the pixel), same size; edges: CV_8U (edgePixels), same size, or empty (none counted).
+    void add(const cv::Mat& gotSrgb8, const cv::Mat& truthSrgb8, const cv::Mat& influence,
+             const cv::Mat& edges = {});
     void merge(const CompositeErrorAccumulator& other);  // adds another's sums (frames pooled)
     CompositeError result() const;
 };

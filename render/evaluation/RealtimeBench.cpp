@@ -46,6 +46,7 @@ std::vector<BenchFrame> scaleFrames(const std::vector<BenchFrame>& frames, int w
     for (const auto& f : frames) {
         if (width <= 0 || (f.footage.cols == width && f.footage.rows == height)) {
             out.push_back(f);
+            out.back().edges = edgePixels(f.footage, f.truth, f.influence);
             continue;
         }
         BenchFrame s = f;
@@ -61,6 +62,7 @@ std::vector<BenchFrame> scaleFrames(const std::vector<BenchFrame>& frames, int w
         touched.convertTo(m, CV_32F, 1.0 / 255.0);
         cv::resize(m, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
         s.influence = small > 0.0f;
+        s.edges = edgePixels(s.footage, s.truth, s.influence);
         out.push_back(std::move(s));
     }
     return out;
@@ -140,15 +142,30 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
     const int w = config.width > 0 ? config.width : sessionCamera.width;
     const int h = config.height > 0 ? config.height : sessionCamera.height;
     const std::vector<BenchFrame> frames = scaleFrames(allFrames, w, h);
-    const CameraIntrinsics cam = scaleIntrinsics(sessionCamera, w, h);
+    const int ss = std::max(1, config.supersample);
+    const CameraIntrinsics cam = scaleIntrinsics(sessionCamera, w * ss, h * ss);
+    // The footage the renderer composites into: each pixel replicated ss x ss times.
+    std::vector<cv::Mat> footage;
+    for (const BenchFrame& f : frames) {
+        footage.push_back(f.footage);
+        if (ss > 1)
+            cv::resize(f.footage, footage.back(), cv::Size(w * ss, h * ss), 0, 0,
+                       cv::INTER_NEAREST);
+    }
+    // The judged composite: the renderer's own, or its supersampled linear one averaged down.
+    const auto judged = [&](const Renderer& r) {
+        if (ss == 1) return r.compositeSrgb();
+        cv::Mat small;
+        cv::resize(r.compositeLinear(), small, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+        return linearRgbToSrgbBgr8(small);
+    };
     RendererOptions options = config.options;
     if (config.motionBlur) {
         const std::optional<double> shutter = allFrames.front().shutter;
         if (!shutter || !(*shutter > 0.0))
             throw Error(
                 "bench: knob motion_blur=on needs a session that states a shutter time "
-                "(session.json "
-                "cameras[0].shutter > 0, as `mirage synth --shutter S` writes it)");
+                "(session.json cameras[0].shutter > 0, as `mirage synth --shutter S` writes it)");
         options.motionBlur.shutterSeconds = *shutter;
     }
     Renderer renderer(scene, cam, options);
@@ -172,7 +189,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
         renderer.updateTransforms(scene);
     }
     // Warm-up: shader compilation and first allocations stay out of the timings.
-    renderer.render({frames.front().T_world_camera, frames.front().footage, true});
+    renderer.render({frames.front().T_world_camera, footage.front(), true});
 
     BenchResult result;
     result.passOrder = renderer.passNames();
@@ -201,8 +218,8 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
                                    uint64_t(rep) * 100003u + i)
                     : f.T_world_camera;
             const FrameReport& report =
-                renderer.render({pose, f.footage, /*resetHistory=*/i == 0, f.time});
-            const cv::Mat composite = renderer.compositeSrgb();
+                renderer.render({pose, footage[i], /*resetHistory=*/i == 0, f.time});
+            const cv::Mat composite = judged(renderer);
             const double wallMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
@@ -213,7 +230,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
             for (const auto& p : report.passes)
                 if (p.ran) fr.passMs[p.name] = p.gpuMs;
             CompositeErrorAccumulator one;
-            one.add(composite, f.truth, f.influence);
+            one.add(composite, f.truth, f.influence, f.edges);
             fr.error = one.result();
             acc.merge(one);
             if (i == 0) {
@@ -259,7 +276,7 @@ BenchResult footageBaseline(const std::vector<BenchFrame>& allFrames, int width,
         BenchFrameResult fr;
         fr.index = f.index;
         CompositeErrorAccumulator one;
-        one.add(f.footage, f.truth, f.influence);
+        one.add(f.footage, f.truth, f.influence, f.edges);
         fr.error = one.result();
         acc.merge(one);
         if (result.frames.empty()) {

@@ -49,6 +49,12 @@ struct BenchConfig {
     // Motion blur of what the renderer adds (knob motion_blur=on): the shutter is the session's
     // (BenchFrame::shutter); a session that states none is refused.
     bool motionBlur = false;
+    // Supersampling of the renderer's layer (knob aa=ssaa2): the renderer runs at this many
+    // times the width and height, over the footage enlarged by pixel replication (each footage
+    // pixel stays one value in linear light), and its linear composite is box-averaged back to
+    // the judging size, then sRGB-encoded. 1: none. A measured alternative to the aa pass
+    // (docs/camera-matching.md, "Anti-aliasing"), not a renderer mode.
+    int supersample = 1;
     std::string label() const;  // "vpls=256 indirect_scale=2 ..."
 };
 
@@ -84,6 +90,7 @@ struct BenchFrame {
     cv::Mat footage;      // 8-bit BGR sRGB, as the session stores it
     cv::Mat truth;        // ground-truth composite, 8-bit BGR sRGB
     cv::Mat influence;    // CV_8U, nonzero = influenced by the virtual objects
+    cv::Mat edges;        // CV_8U: edgePixels(footage, truth, influence) at the judging size
     cv::Mat environment;  // the environment camera's frame of this row (8-bit BGR sRGB), if any
     double environmentTime = 0.0;  // its time (seconds, the environment camera's clock)
     double time = 0.0;             // the main camera's time of the frame (seconds, frames.csv)
