@@ -182,7 +182,8 @@ void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predi
                                  options_.kltLevels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
         back = prev;
         cv::calcOpticalFlowPyrLK(pyramid, pyramid_, next, back, statusBack, err, cv::Size(win, win),
-                                 options_.kltLevels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+                                 std::clamp(options_.backwardLevels, 0, options_.kltLevels), term,
+                                 cv::OPTFLOW_USE_INITIAL_FLOW);
         std::vector<Track> kept;
         const float border = 2.0f;
         for (size_t i = 0; i < tracks_.size(); ++i) {

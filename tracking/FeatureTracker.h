@@ -36,6 +36,11 @@ struct FeatureTrackingOptions {
     int kltLevels = 4;
     // A track whose backward track misses its start by more than this is dropped (pixels).
     double forwardBackwardMaxPx = 0.5;
+    // Pyramid levels above the full image searched by the backward track. It starts where the
+    // forward track began, so a track that held comes back without the coarse levels; one that
+    // slid is still rejected when it does not come back within forwardBackwardMaxPx. Fewer
+    // levels than kltLevels make the check cheaper.
+    int backwardLevels = 1;
     // Feature position noise (pixels, per coordinate) and of the tag corners used with them.
     double featureSigmaPx = 0.35;
     double tagCornerSigmaPx = 0.3;

@@ -243,7 +243,8 @@ BENCHMARK(BM_MirageTrackTextured)
 // textured video (grey, 640x480) with the true pose as the board's (1 sigma 0.05 deg, 0.5 mm):
 // track (pyramid, KLT forwards and backwards), learn (landmarks refined, new corners detected
 // when due), and with estimate 1 also the pose from the landmarks every frame (what a frame
-// without the board pays). Counters: tracked features and landmark inliers per frame (means).
+// without the board pays); backward: the pyramid levels of the backward check (1 the default,
+// 4 = all, as before). Counters: tracked features and landmark inliers per frame (means).
 void BM_FeatureTracking(benchmark::State& state) {
     const BoardFrames& f = texturedVideo(int(state.range(0)));
     std::vector<cv::Mat> grey(f.images.size());
@@ -253,7 +254,9 @@ void BM_FeatureTracking(benchmark::State& state) {
         else
             grey[v] = f.images[v];
     }
-    FeatureTracker features(f.board, f.camera);
+    FeatureTrackingOptions options;
+    options.backwardLevels = int(state.range(2));
+    FeatureTracker features(f.board, f.camera, options);
     const double rotVar = std::pow(glm::radians(0.05), 2) / 3, posVar = std::pow(5e-4, 2) / 3;
     auto boardPose = [&](size_t v) {
         PoseEstimate e;
@@ -279,9 +282,10 @@ void BM_FeatureTracking(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FeatureTracking)
-    ->ArgNames({"width", "estimate"})
-    ->Args({640, 0})
-    ->Args({640, 1})
+    ->ArgNames({"width", "estimate", "backward"})
+    ->Args({640, 0, 1})
+    ->Args({640, 1, 1})
+    ->Args({640, 0, 4})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
