@@ -126,6 +126,8 @@ FeatureTracker::FeatureTracker(Board board, CameraIntrinsics camera, FeatureTrac
 
 void FeatureTracker::reset() {
     pyramid_.clear();
+    previousGrey_.release();
+    deferred_.reset();
     tracks_.clear();
     map_.clear();
     framesSinceDetect_ = 0;
@@ -144,9 +146,18 @@ void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predi
     stats_ = {};
     const auto t0 = std::chrono::steady_clock::now();
     const int win = std::max(9, int(std::lround(options_.kltWindowPx * scale_))) | 1;
+    // The previous frame's detection, deferred until a frame follows it within the gap.
+    if (deferred_ && predicted && !previousGrey_.empty()) {
+        detect(previousGrey_, deferred_->pose, deferred_->derived, deferred_->boardPixels);
+        framesSinceDetect_ = 0;
+    }
+    deferred_.reset();
+    if (!tracks_.empty() && pyramid_.empty() && !previousGrey_.empty())
+        cv::buildOpticalFlowPyramid(previousGrey_, pyramid_, cv::Size(win, win),
+                                    options_.kltLevels);
     std::vector<cv::Mat> pyramid;
-    cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(win, win), options_.kltLevels);
     if (!pyramid_.empty() && !tracks_.empty()) {
+        cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(win, win), options_.kltLevels);
         std::vector<cv::Point2f> prev, next, back;
         for (const auto& t : tracks_) prev.push_back(t.px);
         // Where the predicted pose puts each landmark starts its search (a fast pan moves the
@@ -171,7 +182,8 @@ void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predi
                                  options_.kltLevels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
         back = prev;
         cv::calcOpticalFlowPyrLK(pyramid, pyramid_, next, back, statusBack, err, cv::Size(win, win),
-                                 options_.kltLevels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+                                 std::clamp(options_.backwardLevels, 0, options_.kltLevels), term,
+                                 cv::OPTFLOW_USE_INITIAL_FLOW);
         std::vector<Track> kept;
         const float border = 2.0f;
         for (size_t i = 0; i < tracks_.size(); ++i) {
@@ -191,7 +203,12 @@ void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predi
             if (t.landmark >= 0) map_.remove(t.landmark);
         tracks_.clear();
     }
+    // Without tracks no pyramid was built; the image is kept for a deferred detection.
     pyramid_ = std::move(pyramid);
+    if (pyramid_.empty())
+        grey.copyTo(previousGrey_);
+    else
+        previousGrey_.release();
     stats_.tracked = int(tracks_.size());
     stats_.trackMs = msSince(t0);
 }
@@ -249,7 +266,11 @@ void FeatureTracker::learn(const cv::Mat& grey, const PoseEstimate& pose, bool f
     if (options_.enabled && (fromBoard || options_.derivedLandmarks) &&
         (++framesSinceDetect_ >= options_.detectEvery ||
          double(tracks_.size()) < options_.refillFraction * maxFeatures)) {
-        detect(grey, pose, !fromBoard, boardPixels);
+        // Nothing was tracked into this frame: detect only if a next frame follows.
+        if (pyramid_.empty())
+            deferred_ = DeferredDetection{pose, !fromBoard, boardPixels};
+        else
+            detect(grey, pose, !fromBoard, boardPixels);
         framesSinceDetect_ = 0;
     }
     stats_.mapMs = msSince(t0);

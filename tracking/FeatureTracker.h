@@ -36,6 +36,11 @@ struct FeatureTrackingOptions {
     int kltLevels = 4;
     // A track whose backward track misses its start by more than this is dropped (pixels).
     double forwardBackwardMaxPx = 0.5;
+    // Pyramid levels above the full image searched by the backward track. It starts where the
+    // forward track began, so a track that held comes back without the coarse levels; one that
+    // slid is still rejected when it does not come back within forwardBackwardMaxPx. Fewer
+    // levels than kltLevels make the check cheaper.
+    int backwardLevels = 1;
     // Feature position noise (pixels, per coordinate) and of the tag corners used with them.
     double featureSigmaPx = 0.35;
     double tagCornerSigmaPx = 0.3;
@@ -88,12 +93,16 @@ public:
 
     // Follows the tracked features into the new frame (8-bit grey). Call once per frame first.
     // predicted: the frame's expected T_world_camera (motion model), where each landmark's
-    // search starts; without it the search starts at the feature's last position.
+    // search starts; without it the search starts at the feature's last position. The previous
+    // frame's deferred detection (see learn) runs first when `predicted` is given (the frames
+    // are a video), and is dropped otherwise.
     void track(const cv::Mat& grey, const std::optional<Pose>& predicted = std::nullopt);
     // The frame's pose is known (state ok): refine the landmarks, drop those that disagree, and
     // detect new features where there are none. fromBoard: the pose came from tags alone (else
     // from the landmarks; new landmarks are then `derived`). boardPixels: the board's image box
-    // under the pose (no features there: the tags are tracked on their own).
+    // under the pose (no features there: the tags are tracked on their own). A frame that had
+    // nothing to track (the first of a video, or an unrelated single frame) defers its detection
+    // to the next call of track: single frames do not pay for features no later frame follows.
     void learn(const cv::Mat& grey, const PoseEstimate& pose, bool fromBoard,
                const cv::Rect& boardPixels);
     // Pose from the tracked landmarks and the board tags among `tags`, starting near `predicted`
@@ -129,12 +138,20 @@ private:
     void judge(PoseEstimate& e, const FitQuality& q) const;
     void detect(const cv::Mat& grey, const PoseEstimate& pose, bool derived,
                 const cv::Rect& boardPixels);
+    // A detection left for the next frame (learn on a frame with nothing tracked).
+    struct DeferredDetection {
+        PoseEstimate pose;
+        bool derived = false;
+        cv::Rect boardPixels;
+    };
 
     Board board_;
     CameraIntrinsics camera_;
     FeatureTrackingOptions options_;
     PoseEstimatorOptions bounds_;
-    std::vector<cv::Mat> pyramid_;  // previous frame's
+    std::vector<cv::Mat> pyramid_;  // previous frame's (empty when it had nothing to track)
+    cv::Mat previousGrey_;          // previous frame's image, for a deferred detection
+    std::optional<DeferredDetection> deferred_;
     std::vector<Track> tracks_;
     LandmarkMap map_;
     int framesSinceDetect_ = 0;

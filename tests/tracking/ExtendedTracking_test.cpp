@@ -110,6 +110,33 @@ TEST(ExtendedTracking, MovingTexturedObjectOverHalfTheViewNeverGivesAWrongOkPose
     EXPECT_GT(r.ok, 0);
 }
 
+// A frame with nothing to track (an unrelated single frame, the first of a video) defers its
+// feature detection to the next frame: single frames pay nothing for features no frame follows,
+// while a video's second frame tracks the features of the first as before.
+TEST(ExtendedTracking, FeatureDetectionWaitsForAFollowingFrame) {
+    const auto& scene = tabletop();
+    const CameraIntrinsics cam = testing::pinholeCamera();
+    TexturedPlaneRenderer renderer(cam, 2);
+    Tracker tracker(scene.board(), cam, {});
+    ASSERT_NE(tracker.features(), nullptr);
+    const TrackedFrame first =
+        tracker.process(scene.render(renderer, orbitThenPan(0, kOrbitFrames, kPanFrames, 80.0)), 0);
+    ASSERT_EQ(first.estimate.state, TrackingState::Ok) << first.estimate.reason;
+    EXPECT_TRUE(tracker.features()->map().landmarks().empty());
+    // A frame 10 s later is unrelated: the deferred detection is dropped, nothing is tracked.
+    const TrackedFrame single = tracker.process(
+        scene.render(renderer, orbitThenPan(5, kOrbitFrames, kPanFrames, 80.0)), 10);
+    ASSERT_EQ(single.estimate.state, TrackingState::Ok) << single.estimate.reason;
+    EXPECT_EQ(single.features.tracked, 0);
+    EXPECT_TRUE(tracker.features()->map().landmarks().empty());
+    // The next frame of a video: the features of the previous frame are detected and tracked.
+    const TrackedFrame next = tracker.process(
+        scene.render(renderer, orbitThenPan(6, kOrbitFrames, kPanFrames, 80.0)), 10 + 1 / kFps);
+    ASSERT_EQ(next.estimate.state, TrackingState::Ok) << next.estimate.reason;
+    EXPECT_GE(next.features.tracked, 60);
+    EXPECT_GE(tracker.features()->map().landmarks().size(), 60u);
+}
+
 // A landmark seen from two places converges to the true point, with a covariance that covers the
 // error; one seen only from one place keeps an uncertain depth but the right direction.
 TEST(ExtendedTracking, LandmarkTriangulatesFromKnownPoses) {

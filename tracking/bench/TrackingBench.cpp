@@ -12,6 +12,7 @@
 #include <opencv2/aruco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "tracking/ArucoComparison.h"
 #include "tracking/Detector.h"
@@ -238,6 +239,56 @@ BENCHMARK(BM_MirageTrackTextured)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The natural features' own cost per frame, apart from the tags: FeatureTracker over the
+// textured video (grey, 640x480) with the true pose as the board's (1 sigma 0.05 deg, 0.5 mm):
+// track (pyramid, KLT forwards and backwards), learn (landmarks refined, new corners detected
+// when due), and with estimate 1 also the pose from the landmarks every frame (what a frame
+// without the board pays); backward: the pyramid levels of the backward check (1 the default,
+// 4 = all, as before). Counters: tracked features and landmark inliers per frame (means).
+void BM_FeatureTracking(benchmark::State& state) {
+    const BoardFrames& f = texturedVideo(int(state.range(0)));
+    std::vector<cv::Mat> grey(f.images.size());
+    for (size_t v = 0; v < f.images.size(); ++v) {
+        if (f.images[v].channels() == 3)
+            cv::cvtColor(f.images[v], grey[v], cv::COLOR_BGR2GRAY);
+        else
+            grey[v] = f.images[v];
+    }
+    FeatureTrackingOptions options;
+    options.backwardLevels = int(state.range(2));
+    FeatureTracker features(f.board, f.camera, options);
+    const double rotVar = std::pow(glm::radians(0.05), 2) / 3, posVar = std::pow(5e-4, 2) / 3;
+    auto boardPose = [&](size_t v) {
+        PoseEstimate e;
+        e.state = TrackingState::Ok;
+        e.pose = f.truth[v];
+        e.distanceM = glm::length(f.truth[v].translation);
+        for (int k = 0; k < 6; ++k) e.covariance[size_t(k * 7)] = k < 3 ? rotVar : posVar;
+        return e;
+    };
+    double tracked = 0, inliers = 0;
+    size_t i = 0, n = 0;
+    for (auto _ : state) {
+        const size_t v = i++ % f.images.size();
+        features.track(grey[v], f.truth[v]);
+        if (state.range(1) == 1) benchmark::DoNotOptimize(features.estimate(f.truth[v], {}));
+        features.learn(grey[v], boardPose(v), true, cv::Rect());
+        tracked += features.stats().tracked;
+        inliers += features.stats().inliers;
+        ++n;
+    }
+    state.counters["tracked"] = tracked / double(std::max<size_t>(1, n));
+    state.counters["inliers"] = inliers / double(std::max<size_t>(1, n));
+}
+
+BENCHMARK(BM_FeatureTracking)
+    ->ArgNames({"width", "estimate", "backward"})
+    ->Args({640, 0, 1})
+    ->Args({640, 1, 1})
+    ->Args({640, 0, 4})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 // ArUco per frame over the textured video of BM_MirageTrackTextured.
 void BM_ArucoTrackTextured(benchmark::State& state) {
     runAruco(state, texturedVideo(int(state.range(0))));
@@ -249,13 +300,13 @@ void BM_ArucoTrackTextured(benchmark::State& state) {
 // where the decimated search missed tags, the adaptive full-resolution pass), 5 = the default
 // with the full-resolution pass off (the default before it), 6-8 = the default with one of
 // libapriltag's knobs changed in the full-resolution pass: 6 quad_sigma 0.8, 7 decode_sharpening
-// 0.5, 8 refine_edges off; 3 = coarse-first as before the window (the whole grown region), 4 =
-// the default with decimation 1 for the small tags (libapriltag at full resolution in the
-// window), 1 = coarse-to-fine at the
-// fixed `coarse` decimation (libapriltag at that decimation, the other board tags found from that
-// pose at full resolution and verified; the previous default from 1000 px width), 0 = libapriltag's
-// search at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker); texture 1 = the search
-// starts in the textured region (default), 0 = full image.
+// 0.5, 8 refine_edges off; 9 = the default with natural features off (--board-only); 3 =
+// coarse-first as before the window (the whole grown region), 4 = the default with decimation 1 for
+// the small tags (libapriltag at full resolution in the window), 1 = coarse-to-fine at the fixed
+// `coarse` decimation (libapriltag at that decimation, the other board tags found from that pose at
+// full resolution and verified; the previous default from 1000 px width), 0 = libapriltag's search
+// at decimate 2 only (= BM_Mirage/decimate:2 inside the Tracker); texture 1 = the search starts in
+// the textured region (default), 0 = full image.
 void BM_MirageSingle(benchmark::State& state) {
     const BoardFrames& f = frames(int(state.range(0)));
     TrackerOptions opt;
@@ -266,6 +317,7 @@ void BM_MirageSingle(benchmark::State& state) {
     if (state.range(1) == 8) opt.fullResolutionRefineEdges = false;
     if (state.range(1) == 3) opt.coarseWindowFraction = 1.0;
     if (state.range(1) == 4) opt.coarseFirstDecimations = {4.0f, 3.0f, 1.0f};
+    opt.features.enabled = state.range(1) != 9;
     opt.coarseToFine = state.range(1) == 1;
     opt.coarseMinWidth = 0;  // mode 1 measured at 640x480 too
     opt.coarseDecimate = float(state.range(2));
@@ -426,6 +478,7 @@ BENCHMARK(BM_MirageSingle)
     ->Args({640, 6, 0, 1})
     ->Args({640, 7, 0, 1})
     ->Args({640, 8, 0, 1})
+    ->Args({640, 9, 0, 1})
     ->Args({640, 3, 0, 1})
     ->Args({640, 4, 0, 1})
     ->Args({640, 0, 0, 1})
