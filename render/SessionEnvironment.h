@@ -24,8 +24,8 @@ class SessionEnvironment {
 public:
     // The environment camera of `session` (read with SessionReadOptions::environmentOptional),
     // or nullopt with `whyNot` set when the session has none (whyNot empty) or it is unusable
-    // (whyNot names the file and the problem). `mainExposure`: RendererOptions::composite.exposure (scene
-    // radiance -> main camera units), so that gain = radiometry_to_main / mainExposure.
+    // (whyNot names the file and the problem). `mainExposure`: RendererOptions::composite.exposure
+    // (scene radiance -> main camera units), so that gain = radiometry_to_main / mainExposure.
     static std::optional<SessionEnvironment> open(const Session& session, float mainExposure,
                                                   std::string& whyNot);
 

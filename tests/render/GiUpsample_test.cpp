@@ -1,7 +1,7 @@
 // The direct-light pass upsamples the filtered indirect light (gifilter's GatherLight) and adds
 // it in the same full-screen pass: LRv / LR are direct + indirect light, DirectRv / DirectR the
-// direct light alone when RendererOptions::direct.keepDirectLight asks for it, and without VPL light
-// the GI solutions are the direct light.
+// direct light alone when RendererOptions::direct.keepDirectLight asks for it, and without VPL
+// light the GI solutions are the direct light.
 #include <gtest/gtest.h>
 
 #include <iostream>
