@@ -27,6 +27,7 @@
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
 #include "testscenes/RenderTestScenes.h"
+#include "testscenes/TurnedBoxScene.h"
 
 namespace mirage::render {
 namespace {
@@ -39,35 +40,11 @@ namespace {
 constexpr double kSilhouettePsnrFloor = 22.0;
 constexpr double kShadowSlackDb = 0.5;
 
-struct EdgeScene {
-    Scene scene;
-    CameraIntrinsics cam;
-    Pose pose;
-    glm::vec3 boxLo{-0.08f, 0.0f, -0.08f}, boxHi{0.08f, 0.12f, 0.08f};  // box frame (m)
-    glm::dmat4 boxWorld{1.0};  // box frame -> world: 30 degrees about +Y
-    glm::vec3 lightPos{0.6f, 0.5f, 0.3f};
-};
+using EdgeScene = test::TurnedBoxScene;
+using test::segmentHitsBox;
 
 EdgeScene makeScene() {
-    EdgeScene s;
-    const int table = test::addMaterial(s.scene, glm::vec3(0.7f));
-    const int dark = test::addMaterial(s.scene, glm::vec3(0.04f));
-    test::addFloor(s.scene, "table", 0.0f, 3.0f, table, Origin::Real);
-    test::addBox(s.scene, "box", s.boxLo, s.boxHi, dark, Origin::Virtual);
-    s.boxWorld = glm::rotate(glm::dmat4(1.0), glm::radians(30.0), glm::dvec3(0, 1, 0));
-    s.scene.nodes.back().local = s.scene.nodes.back().world = s.boxWorld;
-    test::addLight(s.scene, Light::Type::Spot, s.lightPos, -s.lightPos, 4.0f, Origin::Real, 0.6f,
-                   0.5f);
-    s.cam = test::smallCamera(240, 180, 360.0);
-    s.pose = test::lookAtPose({-0.40, 0.45, -0.30}, {-0.1, 0.0, -0.05});
-    return s;
-}
-
-bool segmentHitsBox(const EdgeScene& s, glm::dvec3 a, glm::dvec3 b) {
-    const glm::dmat4 inv = glm::inverse(s.boxWorld);
-    return test::segmentHitsBox(glm::dvec3(inv * glm::dvec4(a, 1.0)),
-                                glm::dvec3(inv * glm::dvec4(b, 1.0)), glm::dvec3(s.boxLo),
-                                glm::dvec3(s.boxHi));
+    return test::makeTurnedBoxScene();
 }
 
 struct EdgeMasks {

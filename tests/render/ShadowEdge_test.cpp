@@ -26,6 +26,7 @@
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
 #include "testscenes/RenderTestScenes.h"
+#include "testscenes/TurnedBoxScene.h"
 
 namespace mirage::render {
 namespace {
@@ -35,36 +36,11 @@ namespace {
 constexpr double kPenumbraPsnrFloor = 23.5;
 constexpr int kFineMap = 2048;  // shadow map texels per side where the filter is judged
 
-struct ShadowEdgeScene {
-    Scene scene;
-    CameraIntrinsics cam;
-    Pose pose;
-    glm::vec3 boxLo{-0.08f, 0.0f, -0.08f}, boxHi{0.08f, 0.12f, 0.08f};  // box frame (m)
-    glm::dmat4 boxWorld{1.0};  // box frame -> world: 30 degrees about +Y
-    glm::vec3 lightPos{0.6f, 0.5f, 0.3f};
-};
+using ShadowEdgeScene = test::TurnedBoxScene;
+using test::segmentHitsBox;
 
 ShadowEdgeScene makeScene() {
-    ShadowEdgeScene s;
-    const int table = test::addMaterial(s.scene, glm::vec3(0.7f));
-    const int dark = test::addMaterial(s.scene, glm::vec3(0.04f));
-    test::addFloor(s.scene, "table", 0.0f, 3.0f, table, Origin::Real);
-    test::addBox(s.scene, "box", s.boxLo, s.boxHi, dark, Origin::Virtual);
-    s.boxWorld = glm::rotate(glm::dmat4(1.0), glm::radians(30.0), glm::dvec3(0, 1, 0));
-    s.scene.nodes.back().local = s.scene.nodes.back().world = s.boxWorld;
-    test::addLight(s.scene, Light::Type::Spot, s.lightPos, -s.lightPos, 4.0f, Origin::Real, 0.6f,
-                   0.5f);
-    s.cam = test::smallCamera(240, 180, 360.0);
-    s.pose = test::lookAtPose({-0.40, 0.45, -0.30}, {-0.1, 0.0, -0.05});
-    return s;
-}
-
-// Does the world segment a-b cross the (turned) box?
-bool segmentHitsBox(const ShadowEdgeScene& s, glm::dvec3 a, glm::dvec3 b) {
-    const glm::dmat4 inv = glm::inverse(s.boxWorld);
-    return test::segmentHitsBox(glm::dvec3(inv * glm::dvec4(a, 1.0)),
-                                glm::dvec3(inv * glm::dvec4(b, 1.0)), glm::dvec3(s.boxLo),
-                                glm::dvec3(s.boxHi));
+    return test::makeTurnedBoxScene();
 }
 
 // The penumbra pixels: table pixels (their centre's ray meets the table before the box) within
