@@ -29,21 +29,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A real table under a real spot light, a virtual box on it.
 Scene tableScene() {
-    Scene s;
-    const int table = test::addMaterial(s, glm::vec3(0.7f));
-    const int boxMat = test::addMaterial(s, glm::vec3(0.8f, 0.3f, 0.2f));
-    test::addFloor(s, "table", 0.0f, 4.0f, table, Origin::Real);
-    test::addBox(s, "virtual box", {-0.2f, 0.0f, -0.2f}, {0.2f, 0.4f, 0.2f}, boxMat,
-                 Origin::Virtual);
-    const glm::vec3 lightPos{1.2f, 2.0f, 0.0f};
-    const glm::vec3 axis = glm::normalize(glm::vec3(-0.6f, 0.0f, 0.0f) - lightPos);
-    test::addLight(s, Light::Type::Spot, lightPos, axis, 8.0f, Origin::Real, 1.0f, 0.9f);
-    return s;
+    return test::spotLitTableWithVirtualBox();
 }
-
-const Pose kOverview = test::lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
+const Pose kOverview = test::spotLitTableOverview();
 
 RendererOptions blurring(double shutter) {
     RendererOptions o;

@@ -160,4 +160,21 @@ inline CameraIntrinsics smallCamera(int w = 160, int h = 120, double f = 130.0) 
     return c;
 }
 
+// A real table (4 m) under a real spot light, a virtual box (40 cm) on it, and the pose that
+// overlooks them: the exposure-matching and motion-blur tests' scene.
+inline Scene spotLitTableWithVirtualBox() {
+    Scene s;
+    const int table = addMaterial(s, glm::vec3(0.7f));
+    const int boxMat = addMaterial(s, glm::vec3(0.8f, 0.3f, 0.2f));
+    addFloor(s, "table", 0.0f, 4.0f, table, Origin::Real);
+    addBox(s, "virtual box", {-0.2f, 0.0f, -0.2f}, {0.2f, 0.4f, 0.2f}, boxMat, Origin::Virtual);
+    const glm::vec3 lightPos{1.2f, 2.0f, 0.0f};
+    const glm::vec3 axis = glm::normalize(glm::vec3(-0.6f, 0.0f, 0.0f) - lightPos);
+    addLight(s, Light::Type::Spot, lightPos, axis, 8.0f, Origin::Real, 1.0f, 0.9f);
+    return s;
+}
+inline Pose spotLitTableOverview() {
+    return lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
+}
+
 }  // namespace mirage::test
