@@ -21,6 +21,7 @@
 #include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
+#include "render/passes/grain/GrainPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
@@ -310,6 +311,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<FuzzyReflectionPass>());
     g.addPass(std::make_unique<RoughRefractionPass>());
     g.addPass(std::make_unique<CompositePass>());
+    g.addPass(std::make_unique<GrainPass>());  // last: the sensor adds its noise last
     g.markOutput(kComposite);
     g.markOutput(kCompositeSrgb);
     g.compile();
