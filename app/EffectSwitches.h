@@ -21,8 +21,9 @@ struct EffectSwitch {
     bool& (*flag)(render::RendererOptions&);  // the option that switches it, in its pass's struct
 };
 
-// `mirage live` and `mirage replay` start with every effect on, including exposure matching,
-// which the renderer's defaults leave off (a fixed exposure: the renderer as a model, for tests).
+// `mirage live` and `mirage replay` start with every effect on, including exposure, noise and
+// vignetting matching, which the renderer's defaults leave off (a fixed exposure: the renderer as a
+// model, for tests).
 inline constexpr EffectSwitch kEffectSwitches[] = {
     {"caustics", "caustics", [](render::RendererOptions& o) -> bool& { return o.caustic.enabled; }},
     {"caustic_temporal", "caustic smoothing",
@@ -42,6 +43,10 @@ inline constexpr EffectSwitch kEffectSwitches[] = {
     {"exposure_match", "exposure matching",
      [](render::RendererOptions& o) -> bool& { return o.exposureMatch.enabled; }},
     {"aa", "anti-aliasing", [](render::RendererOptions& o) -> bool& { return o.aa.enabled; }},
+    {"noise_match", "noise matching",
+     [](render::RendererOptions& o) -> bool& { return o.grain.noise.enabled; }},
+    {"vignette_match", "vignetting matching",
+     [](render::RendererOptions& o) -> bool& { return o.grain.vignette.enabled; }},
 };
 
 inline std::string effectSwitchNames() {

@@ -24,6 +24,7 @@
 #include "render/passes/environment/EnvironmentOptions.h"
 #include "render/passes/exposure/ExposureMatchOptions.h"
 #include "render/passes/fuzzy/FuzzyOptions.h"
+#include "render/passes/grain/GrainOptions.h"
 #include "render/passes/impostor/ImpostorOptions.h"
 #include "render/passes/indirect/IndirectOptions.h"
 #include "render/passes/ism/IsmOptions.h"
@@ -85,6 +86,7 @@ struct RendererOptions {
     ExposureMatchOptions exposureMatch;  // render/passes/exposure
     MotionBlurOptions motionBlur;        // render/passes/motionblur
     AntialiasOptions aa;                 // render/passes/aa
+    GrainOptions grain;                  // render/passes/grain: noise and vignetting
 
     // History weight of every temporally smoothed buffer (0 = off): the VPL lighting (gifilter),
     // and where switched on the caustic buffer and the specular-hit light L'. Each frame keeps
@@ -195,6 +197,13 @@ public:
     ExposureState exposure;
     // The camera's own exposure report (time x gain, any unit; Renderer::setReportedExposure).
     std::optional<double> reportedExposure;
+    // The footage's noise and vignetting as estimated over the frames so far (the grain pass),
+    // and the vignetting in force (RendererOptions::grain.vignette.profile, else the estimate;
+    // none before the first): the exposure pass divides its blocks by it, so that the gain is
+    // the one at the principal point.
+    GrainEstimates grainEstimates;
+    std::optional<VignetteProfile> vignette;
+    std::string vignetteNote = "none yet (no profile given, nothing estimated)";
     // What the camera-independent passes' output depends on besides the static scene: the light
     // matrices and parameters and the frame plan (Renderer sets it before every frame; equal keys
     // mean equal shadow maps).

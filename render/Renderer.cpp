@@ -22,6 +22,7 @@
 #include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
+#include "render/passes/grain/GrainPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
@@ -314,6 +315,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.addPass(std::make_unique<CompositePass>());
     g.addPass(std::make_unique<AntialiasPass>());   // the renderer's edges, after the composite
     g.addPass(std::make_unique<MotionBlurPass>());  // what the renderer added, over the exposure
+    g.addPass(std::make_unique<GrainPass>());       // last: the sensor adds its noise last
     g.markOutput(kComposite);
     g.markOutput(kCompositeSrgb);
     g.compile();

@@ -115,6 +115,12 @@ public:
     // count) for the next render() calls, where the camera or the session gives one (nullopt:
     // none): the prior of the per-frame estimate for changes (render/ExposureTracker.h).
     void setReportedExposure(std::optional<double> exposure) { ctx_->reportedExposure = exposure; }
+    // The footage's noise and vignetting estimated so far (RendererOptions::grain), each with a
+    // note saying what was used; and the vignetting applied to the virtual pixels (none before
+    // one is given or estimated: vignettingNote says so).
+    const GrainEstimates& grainEstimates() const { return ctx_->grainEstimates; }
+    const std::optional<VignetteProfile>& vignetting() const { return ctx_->vignette; }
+    const std::string& vignettingNote() const { return ctx_->vignetteNote; }
     // This frame's canvas rectangles of the specular / glass objects (FrameContext).
     const std::vector<glm::ivec4>& specularRects() const { return ctx_->specularRects; }
     const std::vector<glm::ivec4>& refractiveRects() const { return ctx_->refractiveRects; }

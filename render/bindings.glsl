@@ -204,6 +204,15 @@ const int kUnitMotionFootage = 5;    // CompositeFootage: rgb footage part, a = 
 const int kUnitAntialiasComposite = 0;  // the composite, linear RGBA32F (bilinear sampler)
 const int kUnitAntialiasCamera = 1;     // the camera frame (sRGB8, sampled linear, bilinear)
 
+// passes/grain: grain_samples.frag, grain_apply.frag
+const int kUnitGrainCamera = 0;  // the camera frame (sRGB8, sampled linear)
+const int kUnitGrainLR = 1;
+const int kUnitGrainCausticR = 2;  // black without caustics
+const int kUnitGrainPosition = 3;  // w = origin
+const int kUnitGrainEmissive = 4;  // a = specular slot + 1
+const int kUnitGrainCanvasToCamera = 5;
+const int kUnitGrainComposite = 6;  // the composite (linear, a = coverage)
+
 // passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
 const int kUnitFuzzyPosition = 0;
 const int kUnitFuzzyEmissive = 1;

@@ -154,6 +154,8 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     context_ = std::make_unique<gl::Context>(a.headless ? gl::Context::headless(copt)
                                                         : gl::Context::window(copt));
     settings.effects.exposureMatch.enabled = true;  // the camera's exposure changes on its own
+    settings.effects.grain.noise.enabled = true;    // and it is a noisy, vignetting webcam
+    settings.effects.grain.vignette.enabled = true;
     switchEffectsOff(a.effectsOff, settings.effects);
     settings.vpls = a.vpls;
     settings.exposure = a.exposure;

@@ -193,6 +193,8 @@ void ReplaySession::createRenderer() {
     ropt.vpl.count = a.vpls;
     ropt.composite.exposure = a.exposure;  // the prior of the per-frame estimate
     ropt.exposureMatch.enabled = true;
+    ropt.grain.noise.enabled = true;
+    ropt.grain.vignette.enabled = true;
     switchEffectsOff(a.effectsOff, ropt);
     ropt.motionBlur.shutterSeconds = replayShutterSeconds(a, session_);
     if (a.estimateLights) {
@@ -309,6 +311,17 @@ int ReplaySession::run() {
     // CSV); an interruption still exits non-zero so that scripts do not take it for a full run.
     outputs_->finish();
     restoreStopSignals();
+    if (renderer_) {
+        // What the camera matching used, so that a composite without noise or vignetting says
+        // why (docs/camera-matching.md).
+        const render::GrainOptions& g = renderer_->options().grain;
+        const std::string noise = renderer_->grainEstimates().noiseNote;
+        spdlog::info("replay: camera noise: {}; vignetting: {}",
+                     !g.noise.enabled ? "off"
+                     : noise.empty()  ? "not measured"
+                                      : noise,
+                     g.vignette.enabled ? renderer_->vignettingNote() : "off");
+    }
     summary_.rows = outputs_->rowsWritten();
     summary_.images = outputs_->imagesWritten();
     summary_.interrupted = stopRequested();

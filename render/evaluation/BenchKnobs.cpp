@@ -606,6 +606,24 @@ void cameraKnobs(std::vector<BenchKnob>& knobs) {
                         ? std::string("ssaa2")
                         : std::string(c.options.aa.enabled ? "morphological" : "off");
          }});
+    knobs.push_back(
+        {"noise_match",
+         "on: the footage's noise (its level per intensity, estimated every frame) added to the "
+         "pixels the renderer changed; off: they stay clean",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.grain.noise.enabled = parseOnOff("noise_match", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.grain.noise.enabled); }});
+    knobs.push_back(
+        {"vignette_match",
+         "on: the camera's vignetting (estimated from the footage over frames) applied to the "
+         "virtual pixels; off: none",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
+         [](BenchConfig& c, const std::string& v) {
+             c.options.grain.vignette.enabled = parseOnOff("vignette_match", v);
+         },
+         [](const BenchConfig& c) { return onOff(c.options.grain.vignette.enabled); }});
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -13,6 +14,7 @@
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
+#include "render/passes/grain/CameraGrain.h"
 
 namespace mirage::render {
 namespace {
@@ -79,6 +81,16 @@ void ExposurePass::resize(const FrameContext& ctx) {
     canvasToCamera_ = gl::Texture::create2D("exposure canvas to camera", cw, ch, GL_RG32F);
     canvasToCamera_.setFilter(GL_NEAREST, GL_NEAREST);
     canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
+    blockR2_.assign(size_t(grid_.columns) * size_t(grid_.rows), -1.0f);
+    for (int by = 0; by < grid_.rows; ++by)
+        for (int bx = 0; bx < grid_.columns; ++bx) {
+            const int x = std::min(cw - 1, bx * grid_.block + grid_.block / 2);
+            const int y = std::min(ch - 1, by * grid_.block + grid_.block / 2);
+            const glm::vec2 q = table[size_t(y) * size_t(cw) + size_t(x)];
+            if (q.x > -1000.0f)
+                blockR2_[size_t(by) * size_t(grid_.columns) + size_t(bx)] =
+                    vignetteRadius2(ctx.projection.camera, q);
+        }
     footageRead_.assign(size_t(grid_.columns) * size_t(grid_.rows) * 4, 0.0f);
     renderedRead_.assign(footageRead_.size(), 0.0f);
 }
@@ -107,6 +119,13 @@ void ExposurePass::execute(FrameContext& ctx, PassResources& res) {
     glGetTextureImage(rendered_.id(), 0, GL_RGBA, GL_FLOAT, bytes, renderedRead_.data());
     RadiometricRatio ratios;
     int real = 0, badlyExposed = 0, noisy = 0;
+    // With the vignetting matched, the gain is the one at the principal point (the grain pass
+    // darkens the virtual pixels towards the corners): each block's footage over V there.
+    const VignetteMatchOptions& vo = ctx.options.grain.vignette;
+    const bool devignette = vo.enabled && (vo.profile || ctx.vignette);
+    const VignetteProfile vignette = !devignette  ? VignetteProfile{}
+                                     : vo.profile ? *vo.profile
+                                                  : *ctx.vignette;
     for (size_t i = 0; i + 3 < footageRead_.size(); i += 4) {
         if (footageRead_[i + 3] < 0.5f) continue;
         ++real;
@@ -120,7 +139,9 @@ void ExposurePass::execute(FrameContext& ctx, PassResources& res) {
             ++noisy;
             continue;
         }
-        ratios.add(measured, expected);
+        const float r2 = blockR2_[i / 4];
+        const double v = devignette && r2 >= 0.0f ? double(vignette.gain(r2)) : 1.0;
+        ratios.add(measured / std::max(v, 1e-3), expected);
     }
     const std::string why = fmt::format(
         "{} of {} sample blocks show unhidden real surfaces, smooth in the model and unclipped "

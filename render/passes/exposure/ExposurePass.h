@@ -46,6 +46,9 @@ private:
     gl::Framebuffer fbo_;
     int canvasW_ = 0, canvasH_ = 0;
     std::vector<float> footageRead_, renderedRead_;  // readback storage (allocated in resize)
+    // Each block centre's squared normalised radius in the camera image (vignetteRadius2; -1
+    // where no camera pixel sees it): the blocks are divided by the vignetting in force.
+    std::vector<float> blockR2_;
     ExposureTracker tracker_;
     bool trackerConfigured_ = false;
 };

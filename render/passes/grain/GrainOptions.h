@@ -1,0 +1,47 @@
+#pragma once
+// Options of the grain pass (render/passes/grain, docs/camera-matching.md): the footage's noise
+// added to the pixels the renderer changed, and the camera's vignetting applied to the virtual
+// objects' pixels, both estimated from the footage (or the vignetting given).
+#include <cstdint>
+#include <optional>
+
+#include "render/passes/grain/CameraGrain.h"
+
+namespace mirage::render {
+
+struct NoiseMatchOptions {
+    // Off: the renderer's pixels stay clean (the renderer as a model; tests). `mirage replay`
+    // and `mirage live` switch it on by default.
+    bool enabled = false;
+    // Sample blocks an intensity level needs for its noise level to be measured (the others
+    // follow the Poisson-Gaussian line through the measured ones).
+    int minBlocksPerLevel = 6;
+    // Mixed with the renderer's frame count into each frame's noise: the same seed and frame
+    // give the same noise (replays and tests reproduce).
+    uint32_t seed = 1;
+};
+
+struct VignetteMatchOptions {
+    bool enabled = false;  // off: the virtual pixels are not darkened; on in replay and live
+    // The camera's vignetting, when known (the calibration's, or the user's): used as it is,
+    // nothing is estimated. Not set: estimated from the footage.
+    std::optional<VignetteProfile> profile;
+    // A frame's fit needs this many usable sample blocks, reaching this normalised radius.
+    int minBlocks = 150;
+    float minRadius = 0.6f;
+};
+
+struct GrainOptions {
+    NoiseMatchOptions noise;
+    VignetteMatchOptions vignette;
+    // The sample blocks (as the exposure pass's: sampleColumns across the canvas) and the
+    // smoothness of L_r a block needs (max / min luminance of its taps).
+    int sampleColumns = 80;
+    float maxBlockVariation = 1.25f;
+    // Weight of the earlier frames in the noise and vignetting estimates (0: each frame's own).
+    float history = 0.8f;
+    // Throws mirage::Error naming the first field out of range.
+    void validate() const;
+};
+
+}  // namespace mirage::render
