@@ -28,7 +28,7 @@ CompositedFrame FrameCompositor::composite(const cv::Mat& bgr, PoseRow pose, boo
         out.exposureGain = renderer_.exposure().gain;
         out.exposureSource = render::exposureSourceName(renderer_.exposure().source);
         const auto t2 = Clock::now();
-        out.image = renderer_.compositeSrgb();
+        out.image = renderer_.compositeCameraCoded();
         out.readbackMs = msSince(t2);
     } else {
         out.image = bgr;  // tracking lost (or virtual objects hidden): the footage passes through

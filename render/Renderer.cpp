@@ -288,7 +288,9 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
 
     // The frame, in order. Passes know each other only through the resources they declare.
     FrameGraph& g = graph_;
-    g.importTexture(kCameraImage, GL_SRGB8_ALPHA8, SizeRule::Camera, "camera frame");
+    const GLenum cameraFormat =
+        options_.composite.cameraResponse.isSrgb() ? GL_SRGB8_ALPHA8 : GL_RGBA16F;
+    g.importTexture(kCameraImage, cameraFormat, SizeRule::Camera, "camera frame");
     g.importTexture(kSceneEnvironmentMap, GL_RGBA16F, SizeRule::Scene, "scene environment");
     g.importTexture(kEnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene,
                     "environment camera frame");
@@ -320,8 +322,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.markOutput(kCompositeSrgb);
     g.compile();
 
-    cameraImage_ =
-        gl::Texture::create2D("camera image", camera.width, camera.height, GL_SRGB8_ALPHA8);
+    cameraImage_ = gl::Texture::create2D("camera image", camera.width, camera.height, cameraFormat);
     cameraImage_.setFilter(GL_NEAREST, GL_NEAREST);
     uploadCameraImage(cv::Mat());
     g.setImport(kCameraImage, cameraImage_);
@@ -346,7 +347,21 @@ void Renderer::uploadCameraImage(const cv::Mat& bgr) {
         cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
     }
     if (!rgba.isContinuous()) rgba = rgba.clone();
-    cameraImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+    const CameraResponse& response = options_.composite.cameraResponse;
+    if (response.isSrgb()) {  // the sRGB texture decodes
+        cameraImage_.upload(GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+        return;
+    }
+    // Linearised here with the camera's own response, into the half-float texture.
+    cv::Mat linear(rgba.size(), CV_32FC4);
+    for (int y = 0; y < rgba.rows; ++y) {
+        const cv::Vec4b* in = rgba.ptr<cv::Vec4b>(y);
+        cv::Vec4f* out = linear.ptr<cv::Vec4f>(y);
+        for (int x = 0; x < rgba.cols; ++x)
+            out[x] = {response.linear(0, in[x][0]), response.linear(1, in[x][1]),
+                      response.linear(2, in[x][2]), 1.0f};
+    }
+    cameraImage_.upload(GL_RGBA, GL_FLOAT, linear.data);
 }
 
 // The frame's uniform blocks (GpuFrame, the lights) and its history rule.
@@ -661,6 +676,21 @@ cv::Mat Renderer::compositeSrgb() const {
     auto px = t.read<unsigned char>(GL_RGBA, GL_UNSIGNED_BYTE, 4);
     cv::Mat rgba(t.height(), t.width(), CV_8UC4, px.data()), bgr;
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+    return bgr;
+}
+
+cv::Mat Renderer::compositeCameraCoded() const {
+    const CameraResponse& response = options_.composite.cameraResponse;
+    if (response.isSrgb()) return compositeSrgb();
+    // From the linear composite: through 8-bit sRGB codes the darkest codes would merge.
+    const cv::Mat linear = compositeLinear();
+    cv::Mat bgr(linear.size(), CV_8UC3);
+    for (int y = 0; y < linear.rows; ++y)
+        for (int x = 0; x < linear.cols; ++x) {
+            const cv::Vec3f& p = linear.at<cv::Vec3f>(y, x);
+            cv::Vec3b& q = bgr.at<cv::Vec3b>(y, x);
+            for (int k = 0; k < 3; ++k) q[2 - k] = uint8_t(response.code(k, p[k]));
+        }
     return bgr;
 }
 

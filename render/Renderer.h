@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera/CameraModel.h"
+#include "core/camera/CameraResponse.h"
 #include "core/gl/Objects.h"
 #include "core/math/Pose.h"
 #include "core/scene/Scene.h"
@@ -89,6 +90,12 @@ public:
     // BGR (CV_8UC3) / coverage (CV_8U: 0 empty, 1 real, 2 virtual).
     cv::Mat compositeLinear() const;
     cv::Mat compositeSrgb() const;
+    // The composite in the main camera's own codes (its response, setCameraResponse): what a
+    // recording or a window shows beside the camera's footage. compositeSrgb() for an sRGB camera.
+    cv::Mat compositeCameraCoded() const;
+
+    // The main camera's response (RendererOptions::composite.cameraResponse).
+    const CameraResponse& cameraResponse() const { return options_.composite.cameraResponse; }
     cv::Mat coverage() const;
     // Any canvas-size linear buffer of this frame (LRv, LR, DirectRv, ...) as CV_32FC3 RGB,
     // top row first; a depth buffer (SpecularMask) as CV_32FC1. Throws mirage::Error if the frame

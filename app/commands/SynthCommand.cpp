@@ -124,6 +124,11 @@ void run(SynthArgs a) {
         a.o.envWhiteBalance = glm::vec3(float(a.envWhiteBalance[0]), float(a.envWhiteBalance[1]),
                                         float(a.envWhiteBalance[2]));
     }
+    if (a.o.sensor.responseGamma != 0.0 && a.o.sensor.responseGamma < 1.0)
+        throw Error(
+            fmt::format("mirage synth: --response-gamma {} is neither 0 (sRGB) nor in "
+                        "[1, 4]",
+                        a.o.sensor.responseGamma));
     if (!a.whiteBalanceDrift.empty())
         a.o.sensor.whiteBalanceDrift =
             glm::dvec3(a.whiteBalanceDrift[0], a.whiteBalanceDrift[1], a.whiteBalanceDrift[2]);
@@ -231,6 +236,11 @@ const CommandRegistrar reg("synth", [](CLI::App& parent) {
         ->delimiter(',')
         ->expected(3)
         ->check(finiteIn(NumberRange{0, 1e3, true, true}));
+    cmd->add_option("--response-gamma", a->o.sensor.responseGamma,
+                    "Main camera's response: 0 = sRGB; G in [1, 4] = codes of value^(1/G) "
+                    "(written to main.yaml as its `response`)")
+        ->capture_default_str()
+        ->check(finiteIn(0, 4));
     cmd->add_option("--vignette", a->o.sensor.vignette, "Corner darkening (0 = none)")
         ->capture_default_str()
         ->check(finiteIn(0, 1));

@@ -11,6 +11,7 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
+#include "core/camera/CameraResponse.h"
 #include "core/capture/CaptureFormat.h"
 #include "core/scene/ScenePlacement.h"
 #include "render/LightEstimation.h"
@@ -156,6 +157,7 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     settings.effects.exposureMatch.enabled = true;  // the camera's exposure changes on its own
     settings.effects.grain.noise.enabled = true;    // and it is a noisy, vignetting webcam
     settings.effects.grain.vignette.enabled = true;
+    settings.effects.composite.cameraResponse = cameraResponseOrSrgb(calibrationPath_);
     switchEffectsOff(a.effectsOff, settings.effects);
     settings.vpls = a.vpls;
     settings.exposure = a.exposure;

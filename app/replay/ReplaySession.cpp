@@ -13,6 +13,7 @@
 #include "app/commands/ShardMerge.h"
 #include "core/Error.h"
 #include "core/Log.h"
+#include "core/camera/CameraResponse.h"
 #include "core/image/ImageIO.h"
 #include "core/scene/ScenePlacement.h"
 #include "core/session/SessionReadOptions.h"
@@ -207,6 +208,7 @@ void ReplaySession::createRenderer() {
                 a.scene, render::kMaxLights));
         ropt.environment.lights = std::min(render::LightEstimationOptions{}.maxLights, room);
     }
+    ropt.composite.cameraResponse = cameraResponseOrSrgb(session_.path(main_->calibration));
     renderer_ = std::make_unique<render::Renderer>(scene_, calibration_.intrinsics, ropt);
     compositor_ = std::make_unique<FrameCompositor>(*renderer_);
     // The environment camera, unless --static-env overrides it.

@@ -624,6 +624,20 @@ void cameraKnobs(std::vector<BenchKnob>& knobs) {
              c.options.grain.vignette.enabled = parseOnOff("vignette_match", v);
          },
          [](const BenchConfig& c) { return onOff(c.options.grain.vignette.enabled); }});
+    knobs.push_back(
+        {"camera_response",
+         "session: the footage linearised with the main camera's response from its calibration "
+         "(`response`; sRGB when it states none) and the composite encoded with it; srgb: the "
+         "footage taken as sRGB whatever the calibration says (what a camera without a measured "
+         "response gets)",
+         [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"session"}; },
+         [](BenchConfig& c, const std::string& v) {
+             if (v != "session" && v != "srgb")
+                 throw Error(
+                     fmt::format("bench knob 'camera_response': '{}' is not session or srgb", v));
+             c.sessionResponse = v == "session";
+         },
+         [](const BenchConfig& c) { return std::string(c.sessionResponse ? "session" : "srgb"); }});
 }
 
 }  // namespace

@@ -85,6 +85,10 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
             envSource = openCameraFrames(session, c.name);
             envIndex = session.cameraIndex(c.name);
         }
+    const CameraResponse response =
+        main->calibration.empty()
+            ? CameraResponse::srgb()
+            : loadCameraResponse(session.path(main->calibration)).value_or(CameraResponse::srgb());
     cv::Mat bgr, envBgr;
     int missing = 0;
     for (size_t i = 0; i < session.frames.size(); ++i) {
@@ -119,6 +123,7 @@ std::vector<BenchFrame> loadBenchFrames(const Session& session, const GroundTrut
                       ? double(rec.index) / session.fps
                       : rec.timestamps.at(size_t(session.cameraIndex(main->name)));
         bf.shutter = main->shutter;
+        bf.response = response;
         frames.push_back(std::move(bf));
         if (envSource && !envBgr.empty()) {
             frames.back().environment = envBgr.clone();
@@ -154,10 +159,17 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
     }
     // The judged composite: the renderer's own, or its supersampled linear one averaged down.
     const auto judged = [&](const Renderer& r) {
-        if (ss == 1) return r.compositeSrgb();
+        if (ss == 1) return r.compositeCameraCoded();
         cv::Mat small;
         cv::resize(r.compositeLinear(), small, cv::Size(w, h), 0, 0, cv::INTER_AREA);
-        return linearRgbToSrgbBgr8(small);
+        if (r.cameraResponse().isSrgb()) return linearRgbToSrgbBgr8(small);
+        cv::Mat bgr(small.size(), CV_8UC3);
+        for (int y = 0; y < small.rows; ++y)
+            for (int x = 0; x < small.cols; ++x)
+                for (int k = 0; k < 3; ++k)
+                    bgr.at<cv::Vec3b>(y, x)[2 - k] =
+                        uint8_t(r.cameraResponse().code(k, small.at<cv::Vec3f>(y, x)[k]));
+        return bgr;
     };
     RendererOptions options = config.options;
     if (config.motionBlur) {
@@ -168,6 +180,7 @@ BenchResult runBenchConfig(const Scene& scene, const CameraIntrinsics& sessionCa
                 "(session.json cameras[0].shutter > 0, as `mirage synth --shutter S` writes it)");
         options.motionBlur.shutterSeconds = *shutter;
     }
+    if (config.sessionResponse) options.composite.cameraResponse = frames.front().response;
     Renderer renderer(scene, cam, options);
     if (config.environmentCamera) {
         renderer.setEnvironmentCamera(*environment);

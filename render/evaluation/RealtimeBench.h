@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera/CameraModel.h"
+#include "core/camera/CameraResponse.h"
 #include "core/math/Pose.h"
 #include "core/scene/Scene.h"
 #include "core/session/Session.h"
@@ -55,6 +56,10 @@ struct BenchConfig {
     // the judging size, then sRGB-encoded. 1: none. A measured alternative to the aa pass
     // (docs/camera-matching.md, "Anti-aliasing"), not a renderer mode.
     int supersample = 1;
+    // Linearise the footage with the session's camera response (knob camera_response=session),
+    // or take it as sRGB whatever the calibration says (camera_response=srgb: the assumption a
+    // camera without a measured response gets).
+    bool sessionResponse = true;
     std::string label() const;  // "vpls=256 indirect_scale=2 ..."
 };
 
@@ -97,6 +102,9 @@ struct BenchFrame {
     // The main camera's exposure time (seconds; session.json cameras[].shutter), if the session
     // states it: the motion blur's shutter (knob motion_blur=on).
     std::optional<double> shutter;
+    // The main camera's response (its calibration's `response`; sRGB when it states none):
+    // footage and truth stay in the camera's codes and the composite is judged in them.
+    CameraResponse response;
 };
 
 // The main camera's frames of `session` that have a ground-truth pose and a ground-truth

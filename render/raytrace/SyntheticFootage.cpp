@@ -5,6 +5,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/Error.h"
+#include "core/camera/CameraResponse.h"
 #include "core/image/ImageIO.h"
 #include "render/raytrace/Sampling.h"
 
@@ -151,6 +152,19 @@ cv::Mat applySensor(const cv::Mat& linearRgb, const SensorOptions& s, double exp
                 p[k] = v;
             }
         }
+    }
+    if (s.responseGamma > 0.0) {
+        // The camera's own response: sRGB codes of the same light, re-coded with the gamma.
+        const CameraResponse response = CameraResponse::gamma(s.responseGamma);
+        cv::Mat bgr(img.rows, img.cols, CV_8UC3);
+        for (int y = 0; y < img.rows; ++y)
+            for (int x = 0; x < img.cols; ++x) {
+                const cv::Vec3f& p = img.at<cv::Vec3f>(y, x);
+                for (int k = 0; k < 3; ++k)
+                    bgr.at<cv::Vec3b>(y, x)[2 - k] = uint8_t(
+                        response.code(k, std::clamp(std::isnan(p[k]) ? 0.0f : p[k], 0.0f, 1.0f)));
+            }
+        return bgr;
     }
     return linearRgbToSrgbBgr8(img, 1.0f);
 }

@@ -61,6 +61,9 @@ struct SensorOptions {
     double vignette = 0.0;  // relative darkening at the image corners (0 = none, 0.3 typical)
     double noise = 0.0;     // read-noise sigma in linear units at exposure 1; shot noise
                             // sigma = sqrt(noise * value) (0 = none)
+    // The main camera's response: 0 = sRGB encoding; else code = 255 * value^(1 / gamma), a
+    // camera whose response is not sRGB (the session's calibration states it).
+    double responseGamma = 0.0;
 };
 
 // The exposure at time t (seconds) of footage `duration` long: the base exposure with the
@@ -70,7 +73,7 @@ double exposureAt(const SensorOptions& s, double t, double duration);
 glm::dvec3 whiteBalanceAt(const SensorOptions& s, double t, double duration);
 // Linear RGB float (CV_32FC3) -> 8-bit BGR sRGB as a camera would deliver: vignette, exposure and
 // white balance (per-channel gains R, G, B), noise (seeded: same seed = same noise), clamp, sRGB
-// encoding.
+// encoding (or the gamma response of `s.responseGamma`).
 cv::Mat applySensor(const cv::Mat& linearRgb, const SensorOptions& s, double exposure,
                     uint64_t seed, const glm::dvec3& whiteBalance = glm::dvec3(1.0));
 

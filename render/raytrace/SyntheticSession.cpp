@@ -15,6 +15,7 @@
 #include "core/Log.h"
 #include "core/Timestamp.h"
 #include "core/camera/CalibrationFile.h"
+#include "core/camera/CameraResponse.h"
 #include "core/camera/Radiometry.h"
 #include "core/image/ImageIO.h"
 #include "core/session/Session.h"
@@ -120,6 +121,8 @@ public:
         mainCal.intrinsics = mainK_;
         mainCal.avgReprojectionError = 0.0;  // exact by construction
         saveCalibration(dir / "main.yaml", mainCal);
+        if (a_.sensor.responseGamma > 0.0)
+            saveCameraResponse(dir / "main.yaml", CameraResponse::gamma(a_.sensor.responseGamma));
         if (a_.environmentCamera) {
             CameraCalibration envCal;
             envCal.intrinsics = envK_;
@@ -166,8 +169,10 @@ public:
                 envLinear,
                 cv::Scalar(a_.envWhiteBalance.r, a_.envWhiteBalance.g, a_.envWhiteBalance.b),
                 balanced);
+            SensorOptions envSensor = a_.sensor;
+            envSensor.responseGamma = 0.0;  // the environment camera's response stays sRGB
             out.images.push_back(
-                applySensor(balanced, a_.sensor, a_.envExposure, a_.seed * 37 + uint64_t(f)));
+                applySensor(balanced, envSensor, a_.envExposure, a_.seed * 37 + uint64_t(f)));
             out.times.push_back(t);
         }
         if (a_.groundTruthComposite) {
@@ -280,7 +285,7 @@ std::string syntheticFingerprint(const SyntheticSessionOptions& a, uint64_t scen
     const std::string all = fmt::format(
         "{}x{} hfov {:.17g} fps {:.17g} s {:.17g} spp {} seed {} shutter {:.17g} sub {} env {} "
         "{} {:.17g} seq {} gt {} thr {:.17g} sensor {:.17g} {} {:.17g} {:.17g} path {:.17g} "
-        "{:.17g} {:.17g} {:.17g} envcam {:.9g} {:.9g} {:.9g} {:.9g} {:.17g} scene {} board {}{}",
+        "{:.17g} {:.17g} {:.17g} envcam {:.9g} {:.9g} {:.9g} {:.9g} {:.17g} scene {} board {}{}{}",
         a.width, a.height, a.hfovDeg, a.fps, a.seconds, a.samplesPerPixel, a.seed, a.shutter,
         a.blurSubframes, a.environmentCamera, a.envSize, a.envFovDeg, a.imageSequence,
         a.groundTruthComposite, a.influenceThreshold, a.sensor.exposure, a.sensor.exposureChange,
@@ -292,7 +297,9 @@ std::string syntheticFingerprint(const SyntheticSessionOptions& a, uint64_t scen
             ? std::string()
             : fmt::format(" step {:.17g} wb {:.17g} {:.17g} {:.17g}", a.sensor.exposureStep,
                           a.sensor.whiteBalanceDrift.r, a.sensor.whiteBalanceDrift.g,
-                          a.sensor.whiteBalanceDrift.b));
+                          a.sensor.whiteBalanceDrift.b),
+        a.sensor.responseGamma == 0.0 ? std::string()
+                                      : fmt::format(" response {:.17g}", a.sensor.responseGamma));
     return hex64(fingerprint64(all));
 }
 

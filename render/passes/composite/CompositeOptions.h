@@ -1,5 +1,6 @@
 #pragma once
 // Options of the differential composite (render/passes/composite, docs/realtime-renderer.md).
+#include "core/camera/CameraResponse.h"
 #include "render/PassOptions.h"
 
 namespace mirage::render {
@@ -18,6 +19,12 @@ struct CompositeOptions {
     // false: the composite is the footage unchanged, as if no virtual object existed (the live
     // view's "hide" key; the bench's `virtual=off` sanity point, which must score as the footage).
     bool showVirtual = true;
+    // The main camera's response (docs/camera-matching.md, "Camera response"): the footage is
+    // linearised with it and Renderer::compositeCameraCoded() encodes with it. sRGB: the camera
+    // frame is an sRGB texture, decoded by the sampler; another response: the frame is
+    // linearised on upload into a half-float texture (8-bit sRGB codes would merge the darkest
+    // codes of a gamma-2.6 camera).
+    CameraResponse cameraResponse;
 
     void validate() const {
         checkOption(exposure >= 1e-4f && exposure <= 1e4f, "composite.exposure", "in [1e-4, 1e4]",
