@@ -20,6 +20,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -218,6 +219,22 @@ protected:
         const auto frames = sessionFrames(dataDir() / "sessions" / "sample");
         ASSERT_FALSE(frames.empty());
         ASSERT_TRUE(cv::imwrite((dir_ / "one_frame" / "000000.png").string(), frames.front()));
+        // An exposure bracket (response): four pictures of a still ramp over three decades of
+        // light, each twice the exposure of the one before, from a gamma-2.2 camera.
+        fs::create_directories(dir_ / "bracket");
+        std::ofstream exposures(dir_ / "bracket" / "exposures.csv");
+        exposures << "file,exposure_seconds\n";
+        for (int i = 0; i < 4; ++i) {
+            cv::Mat img(48, 64, CV_8UC3);
+            for (int p = 0; p < img.rows * img.cols; ++p) {
+                const double light = std::pow(10.0, -3.0 + 3.0 * p / (img.rows * img.cols - 1));
+                const double v = 255.0 * std::pow(std::min(1.0, light * (1 << i)), 1.0 / 2.2);
+                img.at<cv::Vec3b>(p / img.cols, p % img.cols) = cv::Vec3b::all(uint8_t(v));
+            }
+            const std::string name = "b" + std::to_string(i) + ".png";
+            ASSERT_TRUE(cv::imwrite((dir_ / "bracket" / name).string(), img));
+            exposures << name << "," << (1 << i) << "\n";
+        }
         // One shard of a tiny render, kept by every merge (--keep-shards).
         const auto shard =
             runMirage({"render", scene, "--camera", "main", "-o", (dir_ / "merged.png").string(),
@@ -283,6 +300,7 @@ protected:
             {"calibrate",
              {{{"--write-synthetic", (out / "syn").string()}, {"--synthetic-views", "3"}}}},
             {"info", {{}}},
+            {"response", {{{"bracket", (dir_ / "bracket").string()}}}},
             {"merge",
              {{{"output", (dir_ / "merged.png").string()},
                {"--keep-shards", ""},
