@@ -29,9 +29,10 @@ struct StereoOptions {
     int smoothness = 96;  // SGBM's P2 per channel and window pixel (P1 is 8)
     // Partners per frame: each frame is matched with up to this many others, the baselines
     // nearest preferredBaselineM, then the ones nearest 1.5x and 2x it (more depth maps of the
-    // same surface from different baselines: their errors differ, fusion averages them).
-    int partnersPerFrame = 2;
-    int maxPairs = 48;  // depth maps computed (spread over the frames)
+    // same surface from different baselines). One by default: on the tabletop two help at
+    // 320x240 and hurt at 640x480 (docs/results.md, "Reconstructed proxies").
+    int partnersPerFrame = 1;
+    int maxPairs = 24;  // depth maps computed (spread over the frames)
     // A depth is kept when this many other depth maps see the same point (within agreementM
     // plus agreementDepthFraction of the depth, metres); 0 keeps every match.
     int minAgreeingMaps = 2;
