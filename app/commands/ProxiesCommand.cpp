@@ -47,6 +47,7 @@ struct ProxiesArgs {
     double minParallaxDeg = rc::FootageCheckOptions{}.minParallaxDeg;
     int minFrames = rc::FootageCheckOptions{}.minFrames;
     int triangleBudget = rc::GeometryOptions{}.triangleBudgetPerObject;
+    rc::StereoOptions stereo;
 };
 
 // The board's plane with the extent of its tags and page (what is known to lie flat).
@@ -246,6 +247,7 @@ void runProxies(const ProxiesArgs& a) {
     options.check.minFrames = a.minFrames;
     options.check.minParallaxDeg = a.minParallaxDeg;
     options.geometry.triangleBudgetPerObject = a.triangleBudget;
+    options.stereo = a.stereo;
     TerminalProgress bar("proxies");
     const rc::Reconstruction r =
         rc::reconstruct(footage, environment, options, [&](const std::string& stage, int d, int n) {
@@ -303,6 +305,33 @@ const CommandRegistrar registrar("proxies", [](CLI::App& parent) {
     cmd->add_option("--triangles", a->triangleBudget, "Triangle budget per object")
         ->capture_default_str()
         ->check(wholeIn(12, 1000000));
+    cmd->add_option("--stereo-partners", a->stereo.partnersPerFrame,
+                    "Stereo partners per frame (depth maps of each frame at different baselines)")
+        ->capture_default_str()
+        ->check(wholeIn(1, 8));
+    cmd->add_option("--stereo-baseline", a->stereo.preferredBaselineM,
+                    "Preferred stereo baseline (metres, within 0.035-0.14)")
+        ->capture_default_str()
+        ->check(finiteIn(0.035, 0.14));
+    cmd->add_option("--stereo-pairs", a->stereo.maxPairs, "Depth maps computed at most")
+        ->capture_default_str()
+        ->check(wholeIn(1, 10000));
+    cmd->add_option("--stereo-smoothness", a->stereo.smoothness,
+                    "SGBM's penalty for a depth jump (P2 per channel and window pixel; P1 is 8)")
+        ->capture_default_str()
+        ->check(wholeIn(9, 10000));
+    cmd->add_option("--stereo-uniqueness", a->stereo.uniquenessRatio,
+                    "SGBM's margin (percent) by which the best match must beat the second")
+        ->capture_default_str()
+        ->check(wholeIn(0, 100));
+    cmd->add_option("--agreeing-maps", a->stereo.minAgreeingMaps,
+                    "Other depth maps that must agree with a depth to keep it (0: keep all)")
+        ->capture_default_str()
+        ->check(wholeIn(0, 64));
+    cmd->add_option("--agreement", a->stereo.agreementDepthFraction,
+                    "Depth agreement tolerance as a share of the depth (plus 6 mm)")
+        ->capture_default_str()
+        ->check(finiteIn(0, 0.5));
     cmd->add_option("--truth", a->truth,
                     "The scene a synthetic session was made from: compare the rebuilt scene "
                     "with it (report and console)")

@@ -128,10 +128,11 @@ DepthView matchPair(const Footage& footage, const PosedFrame& left, const PosedF
 }
 
 // Geometric consistency between the depth maps: a depth is kept only when at least `minAgree`
-// other maps see the same point within `tolerance` (metres, plus 2 % of the depth) where it
-// projects into them. One pair's wrong match (a plain face, repeated texture) seldom agrees with
-// another pair's; surfaces seen by several pairs do.
-void keepConsistentDepth(std::vector<DepthView>& views, int minAgree, double tolerance) {
+// other maps see the same point within `tolerance` (metres, plus `depthFraction` of the depth)
+// where it projects into them. One pair's wrong match (a plain face, repeated texture) seldom
+// agrees with another pair's; surfaces seen by several pairs do.
+void keepConsistentDepth(std::vector<DepthView>& views, int minAgree, double tolerance,
+                         double depthFraction) {
     std::vector<cv::Mat> kept;
     for (size_t i = 0; i < views.size(); ++i) {
         const DepthView& v = views[i];
@@ -153,7 +154,7 @@ void keepConsistentDepth(std::vector<DepthView>& views, int minAgree, double tol
                     const int r = int(std::lround(w.fy * c.y / c.z + w.cy));
                     if (u < 0 || r < 0 || u >= w.depth.cols || r >= w.depth.rows) continue;
                     const float zw = w.depth.at<float>(r, u);
-                    if (zw > 0 && std::abs(zw - c.z) < tolerance + 0.02 * c.z) ++agree;
+                    if (zw > 0 && std::abs(zw - c.z) < tolerance + depthFraction * c.z) ++agree;
                 }
                 if (agree < minAgree)
                     z = 0;
@@ -171,21 +172,29 @@ void keepConsistentDepth(std::vector<DepthView>& views, int minAgree, double tol
 std::vector<std::pair<int, int>> chooseStereoPairs(const Footage& footage, const StereoOptions& o) {
     std::vector<std::pair<int, int>> pairs;
     const int n = int(footage.frames.size());
+    const int partners = std::max(1, o.partnersPerFrame);
     for (int i = 0; i < n; ++i) {
-        int best = -1;
-        double bestScore = 1e9;
+        std::vector<std::pair<double, int>> candidates;  // (baseline, frame)
         for (int j = 0; j < n; ++j) {
             if (j == i) continue;
             const double b =
                 partnerBaseline(footage.frames[size_t(i)], footage.frames[size_t(j)], o);
-            if (b < 0) continue;
-            const double score = std::abs(b - o.preferredBaselineM);
-            if (score < bestScore) bestScore = score, best = j;
+            if (b >= 0) candidates.emplace_back(b, j);
         }
-        if (best < 0) continue;
-        const bool repeated =
-            std::find(pairs.begin(), pairs.end(), std::make_pair(best, i)) != pairs.end();
-        if (!repeated) pairs.emplace_back(i, best);
+        // The k-th partner is the candidate nearest (1 + k/2) x the preferred baseline.
+        for (int k = 0; k < partners && !candidates.empty(); ++k) {
+            const double wanted = o.preferredBaselineM * (1.0 + 0.5 * k);
+            auto best = std::min_element(
+                candidates.begin(), candidates.end(), [&](const auto& a, const auto& b) {
+                    return std::abs(a.first - wanted) < std::abs(b.first - wanted);
+                });
+            const int j = best->second;
+            candidates.erase(best);
+            const bool repeated =
+                std::find(pairs.begin(), pairs.end(), std::make_pair(j, i)) != pairs.end() ||
+                std::find(pairs.begin(), pairs.end(), std::make_pair(i, j)) != pairs.end();
+            if (!repeated) pairs.emplace_back(i, j);
+        }
     }
     if (int(pairs.size()) > o.maxPairs) {  // spread the kept pairs over the footage
         std::vector<std::pair<int, int>> kept;
@@ -214,7 +223,8 @@ std::vector<DepthView> computeDepthViews(const Footage& footage, const StereoOpt
         if (v.validFraction > 0) views.push_back(std::move(v));
         if (progress) progress(++done, int(pairs.size()));
     }
-    if (o.minAgreeingMaps > 0) keepConsistentDepth(views, o.minAgreeingMaps, o.agreementM);
+    if (o.minAgreeingMaps > 0)
+        keepConsistentDepth(views, o.minAgreeingMaps, o.agreementM, o.agreementDepthFraction);
     return views;
 }
 

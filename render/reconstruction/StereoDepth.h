@@ -27,11 +27,17 @@ struct StereoOptions {
     // lower keeps more of the plain faces, higher drops more wrong matches.
     int uniquenessRatio = 1;
     int smoothness = 96;  // SGBM's P2 per channel and window pixel (P1 is 8)
-    int maxPairs = 24;    // depth maps computed (spread over the frames)
+    // Partners per frame: each frame is matched with up to this many others, the baselines
+    // nearest preferredBaselineM, then the ones nearest 1.5x and 2x it (more depth maps of the
+    // same surface from different baselines). One by default: on the tabletop two help at
+    // 320x240 and hurt at 640x480 (docs/results.md, "Reconstructed proxies").
+    int partnersPerFrame = 1;
+    int maxPairs = 24;  // depth maps computed (spread over the frames)
     // A depth is kept when this many other depth maps see the same point (within agreementM
-    // plus 2 % of the depth, metres); 0 keeps every match.
+    // plus agreementDepthFraction of the depth, metres); 0 keeps every match.
     int minAgreeingMaps = 2;
     double agreementM = 0.006;
+    double agreementDepthFraction = 0.02;
 };
 
 // A depth map in a rectified camera: pinhole, no distortion.
@@ -45,7 +51,7 @@ struct DepthView {
     double validFraction = 0;  // of the pixels
 };
 
-// Pairs frames (every frame at most once as the left image) and computes their depth maps.
+// Pairs frames (every pair at most once) and computes their depth maps.
 // `progress` is called after each pair (done, total).
 std::vector<DepthView> computeDepthViews(const Footage& footage, const StereoOptions& options = {},
                                          const std::function<void(int, int)>& progress = {});

@@ -2,9 +2,11 @@
 // the bundled tabletop's real geometry (depth maps ray cast along `mirage synth`'s orbit), and a
 // table lit by a known spot light. Fast: no reference rendering (the stereo step on rendered
 // footage is measured by `mirage proxies --truth`, docs/results.md).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -244,6 +246,36 @@ TEST(FootageCheck, TooFewFramesAreRefusedAndAnOrbitIsAccepted) {
     const FootageCheck c = checkFootage(footageAt(poses));
     EXPECT_FALSE(c.ok);
     EXPECT_NE(c.problem.find("only 5 tracked frame"), std::string::npos) << c.problem;
+}
+
+TEST(StereoPairs, EachFrameGetsPartnersAtDifferentBaselines) {
+    raytrace::CameraPathOptions path;  // `mirage synth`'s 6 s path: its orbit at 4 frames/s
+    path.duration = 6.0;
+    std::vector<Pose> poses;
+    for (int k = 0; k < 12; ++k) poses.push_back(raytrace::cameraPathPose(path, 0.25 * k));
+    const Footage f = footageAt(poses);
+    StereoOptions o;
+    o.partnersPerFrame = 1;
+    const auto single = chooseStereoPairs(f, o);
+    o.partnersPerFrame = 2;
+    const auto pairs = chooseStereoPairs(f, o);
+    // About twice the depth maps, never the same two frames twice (either order).
+    EXPECT_GE(pairs.size(), single.size() * 3 / 2);
+    std::set<std::pair<int, int>> seen;
+    for (auto [a, b] : pairs) EXPECT_TRUE(seen.insert({std::min(a, b), std::max(a, b)}).second);
+    // A frame in the middle of the orbit is matched at two different baselines.
+    std::vector<double> baselines;
+    for (auto [a, b] : pairs)
+        if (a == 6 || b == 6)
+            baselines.push_back(
+                glm::length(poses[size_t(a)].translation - poses[size_t(b)].translation));
+    ASSERT_GE(baselines.size(), 2u);
+    std::sort(baselines.begin(), baselines.end());
+    EXPECT_GT(baselines.back() - baselines.front(), 0.01);
+    for (double b : baselines) {
+        EXPECT_GE(b, o.minBaselineM);
+        EXPECT_LE(b, o.maxBaselineM);
+    }
 }
 
 }  // namespace
