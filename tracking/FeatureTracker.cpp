@@ -68,22 +68,64 @@ bool pointResiduals(const CameraIntrinsics& cam, const Pose& T, const std::vecto
     return true;
 }
 
-lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<PosePoint>& pts) {
+lm::Problem poseProblem(const CameraIntrinsics& cam, const std::vector<PosePoint>& pts,
+                        const CentrePrior& prior) {
     lm::Problem p;
     p.parameters = 6;
-    p.residuals = [&cam, &pts](const std::vector<double>& x, std::vector<double>& r) {
-        return pointResiduals(cam, poseOfState(x), pts, r, nullptr);
+    p.residuals = [&cam, &pts, &prior](const std::vector<double>& x, std::vector<double>& r) {
+        const Pose T = poseOfState(x);
+        if (!pointResiduals(cam, T, pts, r, nullptr)) return false;
+        if (prior.active) {
+            const glm::dvec3 rc = prior.W * (T.translation - prior.centre);
+            r.insert(r.end(), {rc.x, rc.y, rc.z});
+        }
+        return true;
     };
-    p.jacobian = [&cam, &pts](const std::vector<double>& x, lm::JacobianSink& sink) {
+    p.jacobian = [&cam, &pts, &prior](const std::vector<double>& x, lm::JacobianSink& sink) {
         std::vector<double> r, J;
         pointResiduals(cam, poseOfState(x), pts, r, &J);
         static const std::vector<int> kColumns = {0, 1, 2, 3, 4, 5};
         sink.add(0, J.size() / 6, kColumns, J.data());
+        if (prior.active) {
+            // The step moves the centre by dx[3..5] (perturbed): dr/dc = W.
+            static const std::vector<int> kCentre = {3, 4, 5};
+            double Jc[9];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) Jc[i * 3 + j] = prior.W[j][i];
+            sink.add(pts.size() * 2, 3, kCentre, Jc);
+        }
     };
     p.retract = [](std::vector<double>& x, const std::vector<double>& dx) {
         x = poseState(perturbed(poseOfState(x), dx.data()));
     };
     return p;
+}
+
+// L^-1 of the Cholesky factor of a symmetric positive 3x3 matrix (glm, column-major); false when
+// the matrix is not positive definite.
+bool inverseCholesky(const glm::dmat3& S, glm::dmat3& W) {
+    double L[3][3] = {};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j <= i; ++j) {
+            double v = S[j][i];
+            for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
+            if (i == j) {
+                if (!(v > 0)) return false;
+                L[i][i] = std::sqrt(v);
+            } else {
+                L[i][j] = v / L[j][j];
+            }
+        }
+    double Li[3][3] = {};  // forward substitution of L Li = I
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 3; ++i) {
+            double v = i == c ? 1.0 : 0.0;
+            for (int k = 0; k < i; ++k) v -= L[i][k] * Li[k][c];
+            Li[i][c] = v / L[i][i];
+        }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) W[j][i] = Li[i][j];
+    return true;
 }
 
 // Inverse square root of a symmetric positive 2x2 matrix (the whitening of a residual).
@@ -133,6 +175,7 @@ void FeatureTracker::reset() {
     framesSinceDetect_ = 0;
     mapCovariance_ = {};
     derivedCovariance_ = {};
+    lastPoseCovariance_.reset();
 }
 
 std::vector<cv::Point2f> FeatureTracker::trackedPixels() const {
@@ -218,6 +261,8 @@ void FeatureTracker::learn(const cv::Mat& grey, const PoseEstimate& pose, bool f
     if (!pose.pose) return;
     const auto t0 = std::chrono::steady_clock::now();
     const Pose& T = *pose.pose;
+    lastPoseCovariance_ = pose.covariance;
+    lastCentre_ = T.translation;
     const double rotSigma = glm::radians(pose.sigmaRotDeg());
     const double f = 0.5 * (camera_.fx + camera_.fy);
     if (fromBoard) {
@@ -357,9 +402,10 @@ double chi2At(const CameraIntrinsics& cam, const Pose& T, const PosePoint& p) {
 
 }  // namespace
 
-PoseEstimate FeatureTracker::estimate(const Pose& predicted,
-                                      const std::vector<TagDetection>& tags) {
+PoseEstimate FeatureTracker::estimate(const Pose& predicted, const std::vector<TagDetection>& tags,
+                                      double sinceLastPoseS, const glm::dvec3& velocity) {
     const auto t0 = std::chrono::steady_clock::now();
+    const CentrePrior prior = centrePrior(sinceLastPoseS, velocity);
     PoseEstimate e;
     e.state = TrackingState::Lost;
     const std::vector<Correspondence> corr = correspondences(predicted);
@@ -408,7 +454,7 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
         for (size_t i : inliers) pts.push_back(corr[i].point);
         pts.insert(pts.end(), tagPoints.begin(), tagPoints.end());
         if (pts.size() < 4) break;
-        const lm::Problem problem = poseProblem(camera_, pts);
+        const lm::Problem problem = poseProblem(camera_, pts, prior);
         report = lm::solve(problem, x, o);
         inliers = inliersAt(poseOfState(x));
     }
@@ -425,7 +471,7 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
     }
     e.pose = T;
     e.tagsUsed = tagIds;
-    const lm::Problem problem = poseProblem(camera_, pts);
+    const lm::Problem problem = poseProblem(camera_, pts, prior);
     const lm::Covariance cov = lm::covariance(problem, x);
     std::vector<double> r;
     pointResiduals(camera_, T, pts, r, nullptr);
@@ -475,6 +521,22 @@ PoseEstimate FeatureTracker::estimate(const Pose& predicted,
     judge(e, {inliers.size(), corr.size(), tagIds.size(), whitenedRms, spread, cov.ok,
               report.converged() || report.stop == lm::Stop::MaxIterations});
     return e;
+}
+
+CentrePrior FeatureTracker::centrePrior(double sinceLastPoseS, const glm::dvec3& velocity) const {
+    CentrePrior prior;
+    if (!(options_.centreAccelSigma > 0) || !(sinceLastPoseS > 0) || !lastPoseCovariance_)
+        return prior;
+    // The last pose's centre moved by the board poses' velocity; its error: the last pose's
+    // plus an unmodelled acceleration over the gap (the second difference of the centre:
+    // a dt^2).
+    const double q = options_.centreAccelSigma * sinceLastPoseS * sinceLastPoseS;
+    glm::dmat3 S(q * q);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) S[j][i] += (*lastPoseCovariance_)[size_t((3 + i) * 6 + 3 + j)];
+    prior.active = inverseCholesky(S, prior.W);
+    prior.centre = lastCentre_ + velocity * sinceLastPoseS;
+    return prior;
 }
 
 std::optional<Pose> FeatureTracker::ransacStart(const std::vector<Correspondence>& corr) const {

@@ -68,9 +68,23 @@ struct FeatureTrackingOptions {
     double maxWhitenedRms = 1.6;
     // Features are tracked only this long after the last ok pose (seconds).
     double maxGapS = 0.5;
+    // The camera centre of a pose from features is held near the motion model's prediction:
+    // a prior with the last pose's covariance plus this unmodelled acceleration (m/s^2, per
+    // axis) over the time since that pose. A pan seen only through landmarks of unknown depth
+    // constrains the rotation, not the centre; the prior says how far a hand-held camera's
+    // centre can stray from its motion in that time. 0: no prior.
+    double centreAccelSigma = 0.5;
     // Landmarks may be created from poses of the features themselves (a pan into unseen parts
     // of the scene); their uncertainty includes that pose's.
     bool derivedLandmarks = true;
+};
+
+// A prior on the camera centre of a pose from features (world, metres): residual
+// W (c - centre) with W = L^-1 for the prior's covariance L L^T (unit covariance). Inactive: none.
+struct CentrePrior {
+    glm::dvec3 centre{0.0};
+    glm::dmat3 W{0.0};
+    bool active = false;
 };
 
 // How the frame's pose was made: tags alone, tags and features together, features alone.
@@ -106,9 +120,11 @@ public:
     void learn(const cv::Mat& grey, const PoseEstimate& pose, bool fromBoard,
                const cv::Rect& boardPixels);
     // Pose from the tracked landmarks and the board tags among `tags`, starting near `predicted`
-    // (T_world_camera). State ok only when the checks pass (see above); pose unset when none
-    // could be found.
-    PoseEstimate estimate(const Pose& predicted, const std::vector<TagDetection>& tags);
+    // (T_world_camera). The camera centre has a prior (options: centreAccelSigma): the last
+    // pose given to learn moved by `velocity` (world, m/s) over sinceLastPoseS seconds (<= 0: no
+    // prior). State ok only when the checks pass (see above); pose unset when none was found.
+    PoseEstimate estimate(const Pose& predicted, const std::vector<TagDetection>& tags,
+                          double sinceLastPoseS = 0, const glm::dvec3& velocity = glm::dvec3(0.0));
     // Forgets everything (the next frame starts without tracks).
     void reset();
 
@@ -124,6 +140,8 @@ private:
         int landmark = -1;
     };
     struct Correspondence;
+    // The prior on the camera centre (inactive without a last pose).
+    CentrePrior centrePrior(double sinceLastPoseS, const glm::dvec3& velocity) const;
     std::vector<Correspondence> correspondences(const Pose& at) const;
     // A start pose from PnP + RANSAC over the landmarks' point estimates (none: too few agree).
     std::optional<Pose> ransacStart(const std::vector<Correspondence>& corr) const;
@@ -160,7 +178,10 @@ private:
     std::array<double, 36> mapCovariance_{};
     // Covariance of the last pose from the landmarks (shared by the derived landmarks).
     std::array<double, 36> derivedCovariance_{};
-    double scale_ = 1.0;  // image width / 640
+    // Covariance of the last pose given to learn (the centre prior's starting error).
+    std::optional<std::array<double, 36>> lastPoseCovariance_;
+    glm::dvec3 lastCentre_{0.0};  // of the last pose given to learn (world, metres)
+    double scale_ = 1.0;          // image width / 640
     FeatureStats stats_;
 };
 

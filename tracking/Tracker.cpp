@@ -197,6 +197,12 @@ Tracker::Tracker(Board board, CameraIntrinsics camera, TrackerOptions options)
     largestTagOverDiameter_ = diameter > 0 ? largest / diameter : 0;
 }
 
+glm::dvec3 Tracker::boardVelocity() const {
+    if (boardCentres_.size() < 2) return glm::dvec3(0.0);
+    const double span = boardCentres_.back().first - boardCentres_.front().first;
+    return (boardCentres_.back().second - boardCentres_.front().second) / span;
+}
+
 Pose Tracker::predictPose(double t) const {
     Pose p = *lastOk_;
     const double span = lastOkT_ - previousOkT_;
@@ -620,7 +626,8 @@ void Tracker::extendWithFeatures(const cv::Mat& grey, double t, TrackedFrame& f)
         reanchorLeft_ = 0;
         if (lastMode_ != TrackingMode::Board && options_.reanchorFrames > 0 && lastOk_ &&
             t - lastOkT_ <= options_.features.maxGapS) {
-            const PoseEstimate drifted = features_->estimate(predictPose(t), {});
+            const PoseEstimate drifted =
+                features_->estimate(predictPose(t), {}, t - lastOkT_, boardVelocity());
             if (drifted.state == TrackingState::Ok) {
                 reanchorOffset_ = poseDifference(*f.estimate.pose, *drifted.pose);
                 reanchorLeft_ = options_.reanchorFrames;
@@ -628,7 +635,8 @@ void Tracker::extendWithFeatures(const cv::Mat& grey, double t, TrackedFrame& f)
         }
         features_->learn(grey, f.estimate, true, boardBox(*f.estimate.pose));
     } else if (lastOk_ && t >= lastOkT_ && t - lastOkT_ <= options_.features.maxGapS) {
-        PoseEstimate e = features_->estimate(predictPose(t), f.detections);
+        PoseEstimate e =
+            features_->estimate(predictPose(t), f.detections, t - lastOkT_, boardVelocity());
         if (e.state == TrackingState::Ok) {
             f.mode =
                 e.tagsUsed.empty() ? TrackingMode::FeaturesOnly : TrackingMode::BoardAndFeatures;
@@ -680,6 +688,12 @@ void Tracker::record(double t, TrackedFrame& f) {
         lastOk_ = f.estimate.pose;
         lastOkT_ = t;
         lastMode_ = f.mode;
+        if (f.mode == TrackingMode::Board) {
+            if (!boardCentres_.empty() && !(t > boardCentres_.back().first)) boardCentres_.clear();
+            boardCentres_.emplace_back(t, f.estimate.pose->translation);
+            while (t - boardCentres_.front().first > kBoardVelocityWindowS)
+                boardCentres_.pop_front();
+        }
         if (!options_.filterEnabled)
             f.filtered = *f.estimate.pose;
         else if (options_.filterKind == FilterKind::OneEuro)

@@ -2,6 +2,7 @@
 // Frame-by-frame camera tracking: detection, pose, state with a reason, temporal filtering.
 // One Tracker per video stream (it keeps the previous pose for the planar ambiguity and the
 // filter state). Frames are 8-bit BGR (sRGB-encoded, as cameras deliver them) or grey.
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -305,6 +306,14 @@ private:
     TrackingMode lastMode_ = TrackingMode::Board;  // of the last ok frame
     std::array<double, 6> reanchorOffset_{};       // board pose -> drifted pose (poseDifference)
     int reanchorLeft_ = 0;                         // frames of the blend still to come
+    // Times and camera centres (world, metres) of the ok poses from the board alone over the
+    // last kBoardVelocityWindowS: the velocity the prior on a pose from features moves the last
+    // centre by (poses from features would feed their own errors back into the velocity; a
+    // window of several board poses averages their noise).
+    static constexpr double kBoardVelocityWindowS = 0.25;
+    std::deque<std::pair<double, glm::dvec3>> boardCentres_;
+    // The board poses' velocity of the camera centre (m/s) over the window; zero without two.
+    glm::dvec3 boardVelocity() const;
 };
 
 }  // namespace mirage::tracking

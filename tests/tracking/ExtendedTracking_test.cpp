@@ -81,14 +81,15 @@ RunResult run(const TrackerOptions& options, double panDeg, bool lie) {
 }
 
 TEST(ExtendedTracking, PanAwayFromTheBoardKeepsTheRightPose) {
-    const RunResult r = run({}, 80.0, false);
-    // The path does take the board out of view for the last part of the pan.
-    EXPECT_GE(r.boardOutOfView, 6);
-    // Measured: 59 of 66 ok, 4 of the 7 frames without the board ok from features alone (the
-    // rest uncertain: the new landmarks of the pan have no depth yet, so the position's
-    // uncertainty grows past 0.5 % of the distance); the goal of 95 % is not reached yet.
-    EXPECT_GE(r.ok, 59) << r.ok << " of " << r.frames;
-    EXPECT_GE(r.featuresOnlyOk, 4);
+    const RunResult r = run({}, 100.0, false);
+    // The path takes the board out of view for at least the last eighth of the frames
+    // (measured: the last 13 of 66).
+    EXPECT_GE(8 * r.boardOutOfView, r.frames);
+    // At least 95 % of the frames ok (measured: 63 of 66, 10 of the 13 frames without the board
+    // ok from features alone; the last 3 uncertain as the centre's uncertainty passes 0.5 % of
+    // the distance). Without the prior on the camera centre (centreAccelSigma = 0): 52.
+    EXPECT_GE(100 * r.ok, 95 * r.frames) << r.ok << " of " << r.frames;
+    EXPECT_GE(r.featuresOnlyOk, 8);
     EXPECT_LE(r.medianRot(), 0.3);
     EXPECT_LE(r.medianPos(), 0.01);
     EXPECT_EQ(r.wrongOk, 0);
@@ -97,14 +98,14 @@ TEST(ExtendedTracking, PanAwayFromTheBoardKeepsTheRightPose) {
 TEST(ExtendedTracking, BoardOnlyLosesTheFramesWithoutTheBoard) {
     TrackerOptions o;
     o.features.enabled = false;
-    const RunResult r = run(o, 80.0, false);
+    const RunResult r = run(o, 100.0, false);
     EXPECT_LE(r.ok, r.frames - r.boardOutOfView);
     EXPECT_EQ(r.featuresOnlyOk, 0);
     EXPECT_EQ(r.wrongOk, 0);
 }
 
 TEST(ExtendedTracking, MovingTexturedObjectOverHalfTheViewNeverGivesAWrongOkPose) {
-    const RunResult r = run({}, 80.0, true);
+    const RunResult r = run({}, 100.0, true);
     EXPECT_EQ(r.wrongOk, 0);
     // The board's frames stay ok (the board is in the right half for most of the orbit).
     EXPECT_GT(r.ok, 0);
