@@ -12,7 +12,11 @@ enum class ShadowFilter {
 const char* shadowFilterName(ShadowFilter f);  // "off" (bilinear), "pcf"
 
 struct ShadowOptions {
-    int mapSize = 512;    // texels per side of each shadow / RSM layer
+    int mapSize = 512;  // texels per side of each shadow-map layer (occluder distance only)
+    // Texels per side of each reflective-shadow-map layer (what the VPLs are sampled from: flux,
+    // normal, position). Apart from mapSize so that a fine shadow map for sharp edges does not
+    // also raise the four-target RSM raster; equal to mapSize, both are written in one raster.
+    int rsmSize = 512;
     float bias = 0.001f;  // metres: constant depth bias of the shadow-map test
                           // (lighting.glsl adds the filter's reach in texel footprints / cos:
                           // 1.5 bilinear, 2.5 PCF)
@@ -29,6 +33,7 @@ struct ShadowOptions {
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 4096, "shadow.mapSize", "16..4096", mapSize);
+        checkOption(rsmSize >= 16 && rsmSize <= 4096, "shadow.rsmSize", "16..4096", rsmSize);
         checkOption(bias >= 0.0f && bias <= 1.0f, "shadow.bias", "in [0, 1] metres", bias);
     }
 };
