@@ -24,8 +24,8 @@ struct ShadowOptions {
     // without the texel grid's stair steps) or the 2x2 bilinear lookup alone. Bilinear by
     // default: at 512 texels a texel spans more than a pixel of the tabletop's shadow, and PCF's
     // 2-texel ramp is then further from the reference's hard edge than the stair steps are (its
-    // penumbra error is halved only with mapSize 2048; docs/realtime-renderer.md, "Shadow
-    // edges").
+    // penumbra error is halved only with mapSize 2048, which costs ~10x the shadow raster in
+    // every frame that re-renders the maps; docs/realtime-renderer.md, "Shadow edges").
     ShadowFilter filter = ShadowFilter::Bilinear;
     // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
     // false: glass is an opaque occluder, as mirrors are.
