@@ -32,7 +32,8 @@ bool expectedSize(SizeRule s, const FrameContext& c, int& w, int& h, int& layers
             return true;
         }
         case SizeRule::ShadowAtlas:
-            w = h = o.shadow.mapSize;
+        case SizeRule::RsmAtlas:
+            w = h = s == SizeRule::ShadowAtlas ? o.shadow.mapSize : o.shadow.rsmSize;
             layers = std::max(1, c.plan.shadowLayers);
             return true;
         case SizeRule::IsmAtlas:

@@ -32,6 +32,7 @@ enum class SizeRule {
     Gather,       // canvas / RendererOptions::indirect.scale per axis, rounded up
     GatherTiles,  // Gather rounded up to a multiple of the interleave K (deinterleaved tiles)
     ShadowAtlas,  // shadowMapSize^2, one layer per shadow layer of the frame plan
+    RsmAtlas,     // rsmSize^2, one layer per shadow layer of the frame plan
     IsmAtlas,     // tilesPerRow(vplCount) * ismTileSize, square
     Impostor,     // impostorResolution^2, layers per specular object / impostor
     CausticMap,   // causticMapSize^2, one layer per caustic spot light of the frame plan

@@ -154,7 +154,7 @@ void frameKnobs(std::vector<BenchKnob>& knobs) {
              [](const BenchConfig& c) {
                  return std::string(shadowFilterName(c.options.shadow.filter));
              }},
-            {"shadow_map", "texels per side of each shadow map and reflective shadow map layer",
+            {"shadow_map", "texels per side of each shadow-map layer (occluder distance)",
              [](const CameraIntrinsics&, bool) {
                  return std::vector<std::string>{std::to_string(RendererOptions{}.shadow.mapSize)};
              },
@@ -162,6 +162,16 @@ void frameKnobs(std::vector<BenchKnob>& knobs) {
                  c.options.shadow.mapSize = parseInt("shadow_map", v, 16, 4096);
              },
              [](const BenchConfig& c) { return std::to_string(c.options.shadow.mapSize); }},
+            {"shadow_rsm",
+             "texels per side of each reflective-shadow-map layer (the VPLs' source; its own "
+             "raster when it differs from shadow_map)",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{std::to_string(RendererOptions{}.shadow.rsmSize)};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.shadow.rsmSize = parseInt("shadow_rsm", v, 16, 4096);
+             },
+             [](const BenchConfig& c) { return std::to_string(c.options.shadow.rsmSize); }},
         });
 }
 

@@ -190,7 +190,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
     EXPECT_EQ(
         grid[0].label(),
         "resolution=160x120 vpls=256 indirect_scale=auto static_reuse=on sync_passes=on "
-        "shadow_filter=off shadow_map=512 specular_trace=impostors impostor_resolution=256 "
+        "shadow_filter=off shadow_map=512 shadow_rsm=512 specular_trace=impostors "
+        "impostor_resolution=256 "
         "impostor_steps=2 "
         "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
             std::string(RendererOptions{}.specular.halfResolution ? "half" : "full") +

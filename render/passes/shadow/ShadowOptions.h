@@ -12,7 +12,11 @@ enum class ShadowFilter {
 const char* shadowFilterName(ShadowFilter f);  // "off" (bilinear), "pcf"
 
 struct ShadowOptions {
-    int mapSize = 512;    // texels per side of each shadow / RSM layer
+    int mapSize = 512;  // texels per side of each shadow-map layer (occluder distance only)
+    // Texels per side of each reflective-shadow-map layer (what the VPLs are sampled from: flux,
+    // normal, position). Apart from mapSize so that a fine shadow map for sharp edges does not
+    // also raise the four-target RSM raster; equal to mapSize, both are written in one raster.
+    int rsmSize = 512;
     float bias = 0.001f;  // metres: constant depth bias of the shadow-map test
                           // (lighting.glsl adds the filter's reach in texel footprints / cos:
                           // 1.5 bilinear, 2.5 PCF)
@@ -20,8 +24,8 @@ struct ShadowOptions {
     // without the texel grid's stair steps) or the 2x2 bilinear lookup alone. Bilinear by
     // default: at 512 texels a texel spans more than a pixel of the tabletop's shadow, and PCF's
     // 2-texel ramp is then further from the reference's hard edge than the stair steps are (its
-    // penumbra error is halved only with mapSize 2048; docs/realtime-renderer.md, "Shadow
-    // edges").
+    // penumbra error is halved only with mapSize 2048, which costs ~10x the shadow raster in
+    // every frame that re-renders the maps; docs/realtime-renderer.md, "Shadow edges").
     ShadowFilter filter = ShadowFilter::Bilinear;
     // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
     // false: glass is an opaque occluder, as mirrors are.
@@ -29,6 +33,7 @@ struct ShadowOptions {
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 4096, "shadow.mapSize", "16..4096", mapSize);
+        checkOption(rsmSize >= 16 && rsmSize <= 4096, "shadow.rsmSize", "16..4096", rsmSize);
         checkOption(bias >= 0.0f && bias <= 1.0f, "shadow.bias", "in [0, 1] metres", bias);
     }
 };

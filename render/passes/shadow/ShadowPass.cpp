@@ -9,10 +9,12 @@ ShadowPass::ShadowPass()
       glassProgram_(rasterProgram("shadow glass", "passes/shadow/shadow.vert",
                                   "passes/shadow/shadow_glass.frag")),
       fbo_("shadow fbo"),
-      glassFbo_("shadow glass fbo") {
+      glassFbo_("shadow glass fbo"),
+      rsmFbo_("rsm fbo") {
     locViewProj_ = program_.uniformLocation("lightViewProj");
     locLight_ = program_.uniformLocation("lightIndex");
     locGlassLayer_ = program_.uniformLocation("glassLayer");
+    locGlassScale_ = program_.uniformLocation("glassTexelsPerTexel");
     locGlassViewProj_ = glassProgram_.uniformLocation("lightViewProj");
     locGlassLight_ = glassProgram_.uniformLocation("lightIndex");
     locTranslucent_ = glassProgram_.uniformLocation("translucent");
@@ -33,9 +35,9 @@ void ShadowPass::setup(PassBuilder& b) const {
              {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});  // only with glass in a cone
     b.create(kShadowGlassReal, {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});
     b.create(kRsmFlux,
-             {GL_RGBA16F, SizeRule::ShadowAtlas, Storage::PassOwned});  // only when VPLs are needed
-    b.create(kRsmNormal, {GL_RGBA16F, SizeRule::ShadowAtlas, Storage::PassOwned});
-    b.create(kRsmPosition, {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});
+             {GL_RGBA16F, SizeRule::RsmAtlas, Storage::PassOwned});  // only when VPLs are needed
+    b.create(kRsmNormal, {GL_RGBA16F, SizeRule::RsmAtlas, Storage::PassOwned});
+    b.create(kRsmPosition, {GL_RGBA32F, SizeRule::RsmAtlas, Storage::PassOwned});
 }
 
 PassDecision ShadowPass::decide(const FrameContext& ctx) const {
@@ -58,13 +60,14 @@ PassDecision ShadowPass::decide(const FrameContext& ctx) const {
 }
 
 void ShadowPass::resize(const FrameContext& ctx) {
-    const int layers = std::max(1, ctx.plan.shadowLayers), s = ctx.options.shadow.mapSize;
-    if (layers == allocatedLayers_ && s == allocatedSize_) return;
+    const int layers = std::max(1, ctx.plan.shadowLayers), s = ctx.options.shadow.mapSize,
+              r = ctx.options.shadow.rsmSize;
+    if (layers == allocatedLayers_ && s == allocatedSize_ && r == rsmSize_) return;
     distance_ = gl::Texture::create2DArray("shadow distance", s, s, layers, GL_R32F);
     distanceReal_ = gl::Texture::create2DArray("shadow distance real-only", s, s, layers, GL_R32F);
-    rsmFlux_ = gl::Texture::create2DArray("rsm flux", s, s, layers, GL_RGBA16F);
-    rsmNormal_ = gl::Texture::create2DArray("rsm normal", s, s, layers, GL_RGBA16F);
-    rsmPosition_ = gl::Texture::create2DArray("rsm position", s, s, layers, GL_RGBA32F);
+    rsmFlux_ = gl::Texture::create2DArray("rsm flux", r, r, layers, GL_RGBA16F);
+    rsmNormal_ = gl::Texture::create2DArray("rsm normal", r, r, layers, GL_RGBA16F);
+    rsmPosition_ = gl::Texture::create2DArray("rsm position", r, r, layers, GL_RGBA32F);
     for (gl::Texture* t : {&distance_, &distanceReal_, &rsmFlux_, &rsmNormal_, &rsmPosition_})
         t->setFilter(GL_NEAREST, GL_NEAREST);
     glass_ = gl::Texture::create2DArray("shadow glass", s, s, layers, GL_RGBA32F);
@@ -72,8 +75,11 @@ void ShadowPass::resize(const FrameContext& ctx) {
     glass_.setFilter(GL_NEAREST, GL_NEAREST);
     glassReal_.setFilter(GL_NEAREST, GL_NEAREST);
     depth_ = gl::Texture::create2D("shadow depth", s, s, GL_DEPTH_COMPONENT32F);
+    rsmDepth_ =
+        r == s ? gl::Texture() : gl::Texture::create2D("rsm depth", r, r, GL_DEPTH_COMPONENT32F);
     allocatedLayers_ = layers;
     allocatedSize_ = s;
+    rsmSize_ = r;
 }
 
 void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm) {
@@ -95,10 +101,40 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
     glClearBufferfv(GL_COLOR, 0, far);
     for (int i = 1; i < colorCount; ++i) glClearBufferfv(GL_COLOR, i, zero);
     glClearBufferfv(GL_DEPTH, 0, &one);
+    drawOccluders(ctx, light, layer, realOnly, rsm);
+}
+
+// The RSM layer alone at rsmSize (its own raster and depth buffer; the occluder distance is not
+// written: colour attachment 0 is left out of the draw buffers).
+void ShadowPass::renderRsmLayer(FrameContext& ctx, int light, int layer) {
+    const int atlasLayer = ctx.plan.lights[size_t(light)].firstLayer + layer;
+    rsmFbo_.attachColorLayer(1, rsmFlux_, atlasLayer);
+    rsmFbo_.attachColorLayer(2, rsmNormal_, atlasLayer);
+    rsmFbo_.attachColorLayer(3, rsmPosition_, atlasLayer);
+    rsmFbo_.attachDepth(rsmDepth_);
+    rsmFbo_.finalize(4);  // checks completeness; attachment 0 stays empty
+    const GLenum bufs[4] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                            GL_COLOR_ATTACHMENT3};
+    glNamedFramebufferDrawBuffers(rsmFbo_.id(), 4, bufs);
+    rsmFbo_.bind();
+    glViewport(0, 0, rsmSize_, rsmSize_);
+    const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
+    for (int i = 1; i < 4; ++i) glClearBufferfv(GL_COLOR, i, zero);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    drawOccluders(ctx, light, layer, false, true);
+    fbo_.bind();
+    glViewport(0, 0, allocatedSize_, allocatedSize_);
+}
+
+void ShadowPass::drawOccluders(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm) {
+    const LightPlan& lp = ctx.plan.lights[size_t(light)];
+    const int atlasLayer = lp.firstLayer + layer;
     const glm::mat4& vp = ctx.lightBlock.lights[light].viewProj[layer];
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
     glUniform1i(locLight_, light);
     glUniform1i(locGlassLayer_, rsm && lp.hasGlassLayer() ? atlasLayer : -1);
+    // The glass layer has the shadow map's texels; the RSM raster may be coarser or finer.
+    glUniform1f(locGlassScale_, float(allocatedSize_) / float(rsm ? rsmSize_ : allocatedSize_));
     glBindTextureUnit(kUnitShadowGlassLayer, glass_.id());
     for (const DrawItem& d : ctx.scene.draws()) {
         if (realOnly && d.origin != Origin::Real) continue;
@@ -184,7 +220,9 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
                 renderGlassLayer(ctx, int(i), layer, false);
                 if (lp.needsRealOnlyGlass) renderGlassLayer(ctx, int(i), layer, true);
             }
-            renderLayer(ctx, int(i), layer, false, ctx.plan.needVpls && lp.hasRsm);
+            const bool rsm = ctx.plan.needVpls && lp.hasRsm;
+            renderLayer(ctx, int(i), layer, false, rsm && !separateRsm());
+            if (rsm && separateRsm()) renderRsmLayer(ctx, int(i), layer);
             if (lp.needsRealOnlyMap) renderLayer(ctx, int(i), layer, true, false);
         }
     }

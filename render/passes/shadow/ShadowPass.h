@@ -4,7 +4,8 @@
 // Visibility is tested twice (DESIGN.md "Real and virtual"): against all occluders (for L_rv)
 // and against real occluders only (for L_r). The second map is rendered only for real lights
 // with a virtual caster in the cone; elsewhere it is the same as the first and aliases it.
-// When VPLs are needed the all-occluder pass also writes the reflective shadow maps.
+// When VPLs are needed the all-occluder pass also writes the reflective shadow maps; at their own
+// size (ShadowOptions::rsmSize) when it differs from the shadow map's, in a second raster.
 // Glass (DrawItem::transmissive) in a light's cone is left out of the occluder maps and drawn
 // into the glass atlases instead (shadow_glass.frag): the lookups colour the light behind it by
 // its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque. A
@@ -22,8 +23,8 @@ inline constexpr Resource kShadowMapsReal{"ShadowMapsReal"};
 // Beer-Lambert), a = nearest glass (m); and the same with real glass only.
 inline constexpr Resource kShadowGlass{"ShadowGlass"};
 inline constexpr Resource kShadowGlassReal{"ShadowGlassReal"};
-// Reflective shadow map: rgb reflected intensity, a = real; normal facing the light; xyz world
-// (m), w = 1 where covered.
+// Reflective shadow map (rsmSize^2 x layers): rgb reflected intensity, a = real; normal facing the
+// light; xyz world (m), w = 1 where covered.
 inline constexpr Resource kRsmFlux{"RsmFlux"};
 inline constexpr Resource kRsmNormal{"RsmNormal"};
 inline constexpr Resource kRsmPosition{"RsmPosition"};
@@ -40,16 +41,19 @@ public:
 
 private:
     void renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);
+    void renderRsmLayer(FrameContext& ctx, int light, int layer);
+    void drawOccluders(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);
+    bool separateRsm() const { return rsmSize_ != allocatedSize_; }
     void renderGlassLayer(FrameContext& ctx, int light, int layer, bool realOnly);
     void setMediumUniforms(const DrawItem& d, const GpuMedium* medium);
     gl::Program program_, glassProgram_;
-    gl::Texture distance_, distanceReal_, rsmFlux_, rsmNormal_, rsmPosition_, depth_;
+    gl::Texture distance_, distanceReal_, rsmFlux_, rsmNormal_, rsmPosition_, depth_, rsmDepth_;
     gl::Texture glass_, glassReal_;
-    gl::Framebuffer fbo_, glassFbo_;
-    int allocatedLayers_ = 0, allocatedSize_ = 0;
+    gl::Framebuffer fbo_, glassFbo_, rsmFbo_;
+    int allocatedLayers_ = 0, allocatedSize_ = 0, rsmSize_ = 0;
     MaterialDraw draw_{program_};  // after program_
     MaterialDraw glassDraw_{glassProgram_};
-    GLint locViewProj_ = -1, locLight_ = -1, locGlassLayer_ = -1;
+    GLint locViewProj_ = -1, locLight_ = -1, locGlassLayer_ = -1, locGlassScale_ = -1;
     GLint locGlassViewProj_ = -1, locGlassLight_ = -1;
     GLint locTranslucent_ = -1, locExtinction_ = -1, locShadowScale_ = -1, locIor_ = -1,
           locHasDensity_ = -1, locLocalFromWorld_ = -1, locDensityMin_ = -1, locDensityMax_ = -1,

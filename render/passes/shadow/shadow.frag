@@ -16,6 +16,7 @@ layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB tex
 // The glass layer of this light layer (shadow_glass.frag), rendered first; -1 = no glass.
 layout(binding = kUnitShadowGlassLayer) uniform sampler2DArray glassLayers;
 uniform int glassLayer;
+uniform float glassTexelsPerTexel;  // glass-layer texels per texel of this raster (RSM at rsmSize)
 layout(location = 0) out float outDistance;  // metres from the light (see lightDistance)
 layout(location = 1) out vec4 outFlux;       // rgb W/sr * albedo (W/m^2 * albedo for dir.), a = real
 layout(location = 2) out vec4 outNormal;     // xyz world normal facing the light, w = 1 on a
@@ -40,7 +41,7 @@ void main() {
     diffuseAlbedo *= 1.0 - clamp(m.transmission, 0.0, 1.0);
     vec3 flux = lights[li].radiantIntensity * atten * diffuseAlbedo;
     if (glassLayer >= 0) {  // behind glass the light arrives coloured by it
-        vec4 g = texelFetch(glassLayers, ivec3(ivec2(gl_FragCoord.xy), glassLayer), 0);
+        vec4 g = texelFetch(glassLayers, ivec3(ivec2(gl_FragCoord.xy * glassTexelsPerTexel), glassLayer), 0);
         if (outDistance > g.a + 1e-3) flux *= exp(min(g.rgb, vec3(0.0)));
     }
     outFlux = vec4(flux, origin == ORIGIN_REAL ? 1.0 : 0.0);
