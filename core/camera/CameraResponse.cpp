@@ -2,9 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <regex>
-#include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
@@ -12,8 +9,8 @@
 #include <opencv2/core.hpp>
 
 #include "core/Error.h"
+#include "core/camera/CalibrationKey.h"
 #include "core/image/ImageIO.h"
-#include "core/session/AtomicFile.h"
 
 namespace mirage {
 
@@ -178,16 +175,7 @@ void saveCameraResponse(const std::filesystem::path& file, const CameraResponse&
             break;
         }
     }
-    std::ifstream in(file);
-    if (!in) throw FileError(file.string(), "cannot read the calibration file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    // Drop an earlier value (one line, as written here), then append the key at the top level.
-    std::string text =
-        std::regex_replace(ss.str(), std::regex(std::string("\n") + kKey + ":[^\n]*"), "");
-    if (!text.empty() && text.back() != '\n') text += '\n';
-    text += fmt::format("{}: {}\n", kKey, value);
-    writeFileAtomically(file, text);
+    setCalibrationKey(file, kKey, value);
 }
 
 }  // namespace mirage

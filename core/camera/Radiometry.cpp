@@ -1,15 +1,12 @@
 #include "core/camera/Radiometry.h"
 
 #include <cmath>
-#include <fstream>
-#include <regex>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
 #include "core/Error.h"
-#include "core/session/AtomicFile.h"
+#include "core/camera/CalibrationKey.h"
 
 namespace mirage {
 
@@ -51,16 +48,7 @@ void saveRadiometryToMain(const std::filesystem::path& file, const glm::dvec3& r
     for (int i = 0; i < 3; ++i)
         if (!(std::isfinite(r[i]) && r[i] > 0))
             throw Error(fmt::format("{}: every gain must be finite and positive", kKey));
-    std::ifstream in(file);
-    if (!in) throw FileError(file.string(), "cannot read the calibration file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    // Drop an earlier value (one line, as written here), then append the key at the top level.
-    std::string text =
-        std::regex_replace(ss.str(), std::regex(std::string("\n") + kKey + ":[^\n]*"), "");
-    if (!text.empty() && text.back() != '\n') text += '\n';
-    text += fmt::format("{}: [ {:.17g}, {:.17g}, {:.17g} ]\n", kKey, r.x, r.y, r.z);
-    writeFileAtomically(file, text);
+    setCalibrationKey(file, kKey, fmt::format("[ {:.17g}, {:.17g}, {:.17g} ]", r.x, r.y, r.z));
 }
 
 }  // namespace mirage
