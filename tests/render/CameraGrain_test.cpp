@@ -25,6 +25,7 @@
 #include "render/raytrace/SyntheticSession.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
+#include "testscenes/SmallSyntheticSession.h"
 
 namespace mirage::render {
 namespace {
@@ -266,22 +267,7 @@ TEST(GrainPass, HardFootageAddsNothingWrongAndSaysWhy) {
 // ---- against ground truth ----------------------------------------------------------------------
 
 raytrace::SyntheticSessionOptions sessionOptions() {
-    raytrace::SyntheticSessionOptions o;
-    o.width = 160;
-    o.height = 120;
-    o.hfovDeg = 63.2;
-    o.fps = 6.0;
-    o.seconds = 1.0;  // 6 frames
-    o.samplesPerPixel = 32;
-    o.threads = 2;
-    o.seed = 11;
-    o.environmentCamera = false;
-    o.imageSequence = true;
-    o.groundTruthComposite = true;
-    o.path.radius = 2.5;
-    o.path.height = 2.5;
-    o.sceneName = "in-memory grain scene";
-    return o;
+    return test::smallSyntheticSession("in-memory grain scene", 32, 11);
 }
 
 // The noise's standard deviation in `bgr`'s green channel (linear) over the mask: the high-pass

@@ -17,6 +17,7 @@
 #include "render/raytrace/SyntheticSession.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
+#include "testscenes/SmallSyntheticSession.h"
 
 namespace mirage::render {
 namespace {
@@ -26,22 +27,11 @@ namespace fs = std::filesystem;
 TEST(CameraResponseGroundTruth, AGammaCameraIsCompositedInItsOwnCodes) {
     const Scene scene = test::spotLitTableWithVirtualBox();
     const fs::path dir = test::outputDirForThisTest("response_gamma");
-    raytrace::SyntheticSessionOptions o;
-    o.width = 160;
-    o.height = 120;
-    o.hfovDeg = 63.2;
+    // 4 frames of the small session, from a camera with a gamma-2.6 response.
+    raytrace::SyntheticSessionOptions o =
+        test::smallSyntheticSession("in-memory camera response scene", 16, 7);
     o.fps = 4.0;
-    o.seconds = 1.0;  // 4 frames
-    o.samplesPerPixel = 16;
-    o.threads = 2;
-    o.seed = 7;
-    o.environmentCamera = false;
-    o.imageSequence = true;
-    o.groundTruthComposite = true;
-    o.path.radius = 2.5;
-    o.path.height = 2.5;
     o.sensor.responseGamma = 2.6;
-    o.sceneName = "in-memory camera response scene";
     raytrace::writeSyntheticSession(scene, dir, o);
 
     const Session session = readSession(dir);

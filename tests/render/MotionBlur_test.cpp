@@ -23,6 +23,7 @@
 #include "render/raytrace/SyntheticSession.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
+#include "testscenes/SmallSyntheticSession.h"
 
 namespace mirage::render {
 namespace {
@@ -143,28 +144,15 @@ struct PanSession {
 const PanSession& fastPan() {
     static const PanSession s = [] {
         const fs::path dir = mirage::test::outputDirForThisTest("fast_pan_shutter");
-        raytrace::SyntheticSessionOptions o;
-        o.width = 160;
-        o.height = 120;
-        o.hfovDeg = 63.2;
-        o.fps = 6.0;
-        o.seconds = 1.0;  // 6 frames
-        o.samplesPerPixel = 16;
-        o.threads = 2;
-        o.seed = 5;
+        raytrace::SyntheticSessionOptions o =
+            test::smallSyntheticSession("in-memory motion blur scene", 16, 5);
         o.shutter = 0.5;
         o.blurSubframes = 6;
-        o.environmentCamera = false;
-        o.imageSequence = true;
-        o.groundTruthComposite = true;
-        o.path.radius = 2.5;
-        o.path.height = 2.5;
         o.path.orbitFraction = 0.0;  // the whole clip is the pan (mirage synth --pan-fraction 1)
         o.path.shakeFraction = 0.0;
         o.path.panDeg = 24.0;
         o.path.shakeTranslation = 0.0;
         o.path.shakeRotationDeg = 0.0;
-        o.sceneName = "in-memory motion blur scene";
         raytrace::writeSyntheticSession(tableScene(), dir, o);
         PanSession p;
         p.session = readSession(dir);
