@@ -81,18 +81,24 @@ void ExposurePass::resize(const FrameContext& ctx) {
     canvasToCamera_ = gl::Texture::create2D("exposure canvas to camera", cw, ch, GL_RG32F);
     canvasToCamera_.setFilter(GL_NEAREST, GL_NEAREST);
     canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
-    blockR2_.assign(size_t(grid_.columns) * size_t(grid_.rows), -1.0f);
-    for (int by = 0; by < grid_.rows; ++by)
-        for (int bx = 0; bx < grid_.columns; ++bx) {
-            const int x = std::min(cw - 1, bx * grid_.block + grid_.block / 2);
-            const int y = std::min(ch - 1, by * grid_.block + grid_.block / 2);
-            const glm::vec2 q = table[size_t(y) * size_t(cw) + size_t(x)];
-            if (q.x > -1000.0f)
-                blockR2_[size_t(by) * size_t(grid_.columns) + size_t(bx)] =
-                    vignetteRadius2(ctx.projection.camera, q);
-        }
+    blockR2_ = blockRadii2(grid_, cw, ch, table, ctx.projection.camera);
     footageRead_.assign(size_t(grid_.columns) * size_t(grid_.rows) * 4, 0.0f);
     renderedRead_.assign(footageRead_.size(), 0.0f);
+}
+
+std::vector<float> ExposurePass::blockRadii2(const Grid& grid, int cw, int ch,
+                                             const std::vector<glm::vec2>& table,
+                                             const CameraIntrinsics& camera) {
+    std::vector<float> r2(size_t(grid.columns) * size_t(grid.rows), -1.0f);
+    for (int by = 0; by < grid.rows; ++by)
+        for (int bx = 0; bx < grid.columns; ++bx) {
+            const int x = std::min(cw - 1, bx * grid.block + grid.block / 2);
+            const int y = std::min(ch - 1, by * grid.block + grid.block / 2);
+            const glm::vec2 q = table[size_t(y) * size_t(cw) + size_t(x)];
+            if (q.x > -1000.0f)
+                r2[size_t(by) * size_t(grid.columns) + size_t(bx)] = vignetteRadius2(camera, q);
+        }
+    return r2;
 }
 
 void ExposurePass::execute(FrameContext& ctx, PassResources& res) {

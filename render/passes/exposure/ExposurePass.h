@@ -38,6 +38,12 @@ public:
         int columns = 0, rows = 0, block = 1, taps = 1, stride = 1;
     };
     static Grid grid(int canvasWidth, int canvasHeight, int sampleColumns);
+    // Each block centre's squared normalised radius in the camera image (vignetteRadius2), -1
+    // where no camera pixel sees it; `canvasToCamera` is CameraProjection::canvasToCameraTable()
+    // of a canvas canvasWidth pixels wide. The exposure and grain passes share the blocks.
+    static std::vector<float> blockRadii2(const Grid& grid, int canvasWidth, int canvasHeight,
+                                          const std::vector<glm::vec2>& canvasToCamera,
+                                          const CameraIntrinsics& camera);
 
 private:
     gl::Program program_;

@@ -102,16 +102,7 @@ void GrainPass::resize(const FrameContext& ctx) {
     canvasToCamera_.upload(GL_RG, GL_FLOAT, table.data());
     // Each block's centre in the camera image (canvas rows are GL rows: row 0 at the bottom of
     // the canvas texture is the table's row 0, as the shaders read it).
-    blockR2_.assign(size_t(grid_.columns) * size_t(grid_.rows), -1.0f);
-    for (int by = 0; by < grid_.rows; ++by)
-        for (int bx = 0; bx < grid_.columns; ++bx) {
-            const int x = std::min(cw - 1, bx * grid_.block + grid_.block / 2);
-            const int y = std::min(ch - 1, by * grid_.block + grid_.block / 2);
-            const glm::vec2 q = table[size_t(y) * size_t(cw) + size_t(x)];
-            if (q.x > -1000.0f)
-                blockR2_[size_t(by) * size_t(grid_.columns) + size_t(bx)] =
-                    vignetteRadius2(p.camera, q);
-        }
+    blockR2_ = ExposurePass::blockRadii2(grid_, cw, ch, table, p.camera);
     footageRead_.assign(size_t(grid_.columns) * size_t(grid_.rows) * 4, 0.0f);
     renderedRead_.assign(footageRead_.size(), 0.0f);
     noiseRead_.assign(footageRead_.size(), 0.0f);
