@@ -619,12 +619,20 @@ void cameraKnobs(std::vector<BenchKnob>& knobs) {
     knobs.push_back(
         {"noise_match",
          "on: the footage's noise (its level per intensity, estimated every frame) added to the "
-         "pixels the renderer changed; off: they stay clean",
+         "pixels the renderer changed, drawn from the footage's own grain; synthesised: the same "
+         "level drawn as Gaussian noise from a seed; off: they stay clean",
          [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"off"}; },
          [](BenchConfig& c, const std::string& v) {
-             c.options.grain.noise.enabled = parseOnOff("noise_match", v);
+             if (v != "off" && v != "on" && v != "synthesised")
+                 throw Error(fmt::format(
+                     "bench knob 'noise_match': '{}' is not off, on or synthesised", v));
+             c.options.grain.noise.enabled = v != "off";
+             c.options.grain.noise.footageGrain = v == "on";
          },
-         [](const BenchConfig& c) { return onOff(c.options.grain.noise.enabled); }});
+         [](const BenchConfig& c) {
+             const auto& n = c.options.grain.noise;
+             return std::string(!n.enabled ? "off" : n.footageGrain ? "on" : "synthesised");
+         }});
     knobs.push_back(
         {"vignette_match",
          "on: the camera's vignetting (estimated from the footage over frames) applied to the "

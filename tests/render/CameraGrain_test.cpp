@@ -206,7 +206,11 @@ TEST(GrainPass, NoiseIsReproducibleForAFrameAndDiffersBetweenFrames) {
     const Scene scene = tableScene();
     const CameraIntrinsics camera = test::smallCamera();
     const cv::Mat footage = noisyFootage(scene, camera, kOverview, 1.0, 0.02, 5);
-    Renderer a(scene, camera, grainOn()), b(scene, camera, grainOn());
+    // The synthesised draw (from the seed and the frame): the footage's own grain changes with
+    // the footage, which is the same in both frames here.
+    RendererOptions synthesised = grainOn();
+    synthesised.grain.noise.footageGrain = false;
+    Renderer a(scene, camera, synthesised), b(scene, camera, synthesised);
     a.render({kOverview, footage, true});
     b.render({kOverview, footage, true});
     ASSERT_TRUE(a.lastReport().ran("grain")) << a.lastReport().summary();
@@ -262,6 +266,96 @@ TEST(GrainPass, HardFootageAddsNothingWrongAndSaysWhy) {
     EXPECT_NEAR(r.grainEstimates().noise()->variance[4].g / before, 1.0, 0.5)
         << r.grainEstimates().noiseNote;
     EXPECT_TRUE(cv::checkRange(r.compositeLinear()));
+}
+
+double noiseSigma(const cv::Mat& bgr, const cv::Mat& mask);
+
+// The high-pass residual I - box3(I) of a linear image's green channel (the noise and the finest
+// detail).
+cv::Mat highPassGreen(const cv::Mat& linearRgb) {
+    cv::Mat g, blurred;
+    cv::extractChannel(linearRgb, g, 1);
+    cv::blur(g, blurred, cv::Size(3, 3));
+    return g - blurred;
+}
+
+double correlation(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+    cv::Scalar ma, sa, mb, sb;
+    cv::meanStdDev(a, ma, sa, mask);
+    cv::meanStdDev(b, mb, sb, mask);
+    const cv::Mat da = a - ma[0], db = b - mb[0];
+    return cv::mean(da.mul(db), mask)[0] / std::max(sa[0] * sb[0], 1e-20);
+}
+
+TEST(GrainPass, FootageGrainIsTheFootagesOwnDrawAtTheVirtualPixels) {
+    gl::Context context = gl::Context::headless();
+    const Scene scene = tableScene();
+    const CameraIntrinsics camera = test::smallCamera();
+    // Footage of the table without the box (L_r is black on virtual pixels): the box out of
+    // view.
+    const cv::Mat footage =
+        noisyFootage(tableScene({50.0f, 0.0f, 50.0f}), camera, kOverview, 1.0, 0.02, 21);
+    const cv::Mat footageHp = highPassGreen(srgbBgr8ToLinearRgb(footage));
+    double corr[2] = {0, 0}, level[2] = {0, 0};
+    for (const bool own : {true, false}) {
+        RendererOptions o = grainOn();
+        o.grain.vignette.enabled = false;
+        o.grain.noise.footageGrain = own;
+        Renderer r(scene, camera, o);
+        r.render({kOverview, footage, true});  // the noise levels are measured in this frame
+        r.render({kOverview, footage, false});
+        cv::Mat virtualPx, inner;
+        virtualPx = r.coverage() == 2;
+        cv::erode(virtualPx, inner, cv::Mat::ones(5, 5, CV_8U));
+        ASSERT_GT(cv::countNonZero(inner), 200);
+        Renderer clean(scene, camera);
+        clean.render({kOverview, footage, true});
+        const cv::Mat added =
+            highPassGreen(r.compositeLinear()) - highPassGreen(clean.compositeLinear());
+        corr[own ? 0 : 1] = correlation(added, footageHp, inner);
+        cv::Scalar m, sdAdded, sdFootage;
+        cv::meanStdDev(added, m, sdAdded, inner);
+        cv::meanStdDev(footageHp, m, sdFootage, inner);
+        level[own ? 0 : 1] = sdAdded[0] / sdFootage[0];
+    }
+    std::cout << "footage grain: correlation with the footage's noise " << corr[0] << ", level "
+              << level[0] << "; synthesised: " << corr[1] << ", " << level[1] << "\n";
+    // The footage's own draw: what is added on the box is the noise the footage has there;
+    // a synthesised draw is not the footage's realisation. Both at the box's level.
+    EXPECT_GT(corr[0], 0.7);
+    EXPECT_LT(std::abs(corr[1]), 0.15);
+    EXPECT_NEAR(level[0] / level[1], 1.0, 0.25);
+}
+
+// A virtual mirror shows the real table: with the footage's grain matched, what it shows of the
+// footage is taken without its noise and the grain adds the mirror pixel's own, so the mirror is
+// as noisy as the footage; otherwise it carries the noise of the table pixel it shows plus its own.
+TEST(GrainPass, MirrorsShowTheFootageWithTheNoiseOfOnePixel) {
+    gl::Context context = gl::Context::headless();
+    Scene scene = tableScene();
+    const int mirror = test::addMaterial(scene, glm::vec3(0.95f), 0.0f, 1.0f);
+    test::addBox(scene, "virtual mirror", {-0.9f, 0.0f, -0.75f}, {0.9f, 1.2f, -0.7f}, mirror,
+                 Origin::Virtual);
+    const CameraIntrinsics camera = test::smallCamera();
+    Scene table = tableScene({50.0f, 0.0f, 50.0f});  // the footage: no box, no mirror
+    const cv::Mat footage = noisyFootage(table, camera, kOverview, 1.0, 0.02, 23);
+    double ratio[2] = {0, 0};
+    for (const bool own : {true, false}) {
+        RendererOptions o = grainOn();
+        o.grain.vignette.enabled = false;
+        o.grain.noise.footageGrain = own;
+        Renderer r(scene, camera, o);
+        r.render({kOverview, footage, true});
+        r.render({kOverview, footage, false});
+        ASSERT_TRUE(r.lastReport().ran("specgbuf")) << r.lastReport().summary();
+        const cv::Mat mirrorPx = r.coverage() == 2, table = r.coverage() == 1;
+        ASSERT_GT(cv::countNonZero(mirrorPx), 300);
+        ratio[own ? 0 : 1] = noiseSigma(r.compositeSrgb(), mirrorPx) / noiseSigma(footage, table);
+    }
+    std::cout << "mirror noise / table footage noise: footage grain " << ratio[0]
+              << ", synthesised " << ratio[1] << "\n";
+    EXPECT_NEAR(ratio[0], 0.95, 0.2);  // the mirror's reflectance scales the table's noise
+    EXPECT_GT(ratio[1], ratio[0] + 0.2);
 }
 
 // ---- against ground truth ----------------------------------------------------------------------

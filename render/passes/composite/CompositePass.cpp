@@ -42,6 +42,8 @@ void CompositePass::buildPrograms(bool identityRemap) {
     locShowVirtualNoCaustics_ = programDiffuseNoCaustics_.uniformLocation("showVirtual");
     locWithCaustics_ = program_.uniformLocation("withCaustics");
     locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
+    locDenoiseFootage_ = program_.uniformLocation("denoiseFootage");
+    locNoiseVariance_ = program_.uniformLocation("noiseVariance");
     identityRemap_ = identityRemap;
     programsBuilt_ = true;
 }
@@ -244,6 +246,15 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                                      : res.textureOr(kFilteredVideo, ctx.blackTexture()))
                                   .id());
         glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
+        // With the footage's own grain matched, what mirrors and glass show of the footage is
+        // taken without its noise: the grain pass adds the noise of the pixel it is seen at
+        // (else the pixel would carry the noise of two places). The noise levels are the
+        // earlier frames' (this frame's are measured after the composite); none on the first.
+        const NoiseMatchOptions& noise = ctx.options.grain.noise;
+        const auto& levels = ctx.grainEstimates.noise();
+        const bool denoise = noise.enabled && noise.footageGrain && levels.has_value();
+        glUniform1i(locDenoiseFootage_, denoise ? 1 : 0);
+        if (denoise) glUniform3fv(locNoiseVariance_, kNoiseLevels, &levels->variance[0].x);
         ctx.drawFullscreenTriangleIn(rects);  // the pixels the diffuse variant left
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_LESS);

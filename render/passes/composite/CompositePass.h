@@ -44,6 +44,7 @@ private:
     gl::Texture canvasToCamera_;
     std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
     GLint locEpsilon_ = -1, locFuzzyOn_ = -1;
+    GLint locDenoiseFootage_ = -1, locNoiseVariance_ = -1;    // of program_ (footage_noise.glsl)
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
     GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
     gl::Framebuffer fbo_;

@@ -1,6 +1,7 @@
 #version 450 core
 #include "common.glsl"
 #include "passes/specular/specular.glsl"
+#include "passes/grain/footage_noise.glsl"
 // Differential rendering (Knecht 2013 Eqs. 1-2), one output pixel per camera pixel:
 //   real or empty pixel:  L_final = CI + alpha * (L_rv - L_r),  alpha = CI / L_r per channel
 //   virtual pixel:        L_final = L_rv
@@ -63,6 +64,9 @@ uniform int fuzzyOn;         // 1 when the fuzzy pass ran this frame
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
 uniform int withCaustics;    // 1: a caustic pass ran (else causticRv / causticR are not read)
+// 1: the footage seen in mirrors and glass is taken without its noise (footage_noise.glsl): the
+// grain pass adds the noise of the pixel it is seen at (noiseVariance: the footage's levels).
+uniform int denoiseFootage;
 layout(location = 0) out vec4 outLinear;  // rgb linear; a = 0 empty, 0.5 real, 1 virtual
 layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB: encoded sRGB8
 // The part of outLinear that is footage, and the pixel's layer, for the motion blur
@@ -117,8 +121,10 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out boo
             allReal = false;
             continue;
         }
-        vec3 c;
-        if (backProject(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, c)) {
+        ivec2 bp;
+        if (backProjectPixel(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, bp)) {
+            vec3 c = texelFetch(cameraImage, bp, 0).rgb, spread;
+            if (denoiseFootage != 0) c = footageMean(cameraImage, bp, c, spread);
             ciBp += w * c;
             footage += w * c;
         } else {

@@ -16,6 +16,11 @@ struct NoiseMatchOptions {
     // Sample blocks an intensity level needs for its noise level to be measured (the others
     // follow the Poisson-Gaussian line through the measured ones).
     int minBlocksPerLevel = 6;
+    // The draw: the footage's own grain (each camera pixel's residual from an edge-preserving
+    // mean, so the added noise has the camera's texture and changes with its frames), or
+    // Gaussian noise synthesised from the seed (also where the footage's draw cannot be
+    // measured: at its edges and clipped pixels).
+    bool footageGrain = true;
     // Mixed with the renderer's frame count into each frame's noise: the same seed and frame
     // give the same noise (replays and tests reproduce).
     uint32_t seed = 1;

@@ -178,6 +178,7 @@ void GrainPass::apply(FrameContext& ctx, PassResources& res) {
             rho > 1e-4f ? (1.0f - std::sqrt(1.0f - 4.0f * rho * rho)) / (4.0f * rho) : 0.0f;
         glUniform1f(applyProgram_.uniformLocation("beta"), beta);
         glUniform1ui(applyProgram_.uniformLocation("seed"), mixSeed(o.noise.seed, ctx.frameIndex));
+        glUniform1i(applyProgram_.uniformLocation("footageGrain"), o.noise.footageGrain ? 1 : 0);
     }
     if (vignetteOn) {
         glUniform2f(applyProgram_.uniformLocation("vignetteK"), vignette.k1, vignette.k2);

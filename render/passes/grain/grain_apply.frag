@@ -1,18 +1,25 @@
 #version 450 core
 #include "common.glsl"
+#include "passes/grain/footage_noise.glsl"
 // The camera's vignetting and noise on the composite (passes/grain/GrainPass.h), per camera
 // pixel. Virtual pixels (coverage 1) are multiplied by V(r) = 1 + k1 r^2 + k2 r^4 (r from the
 // principal point, 1 at the farthest corner); real pixels carry it through the footage. Then the
 // noise: the footage's noise variance at the pixel's new value L (the noise-level function,
 // per channel) minus what the pixel carries already: nothing on virtual pixels, (L / CI)^2 times
 // the footage's at CI on real ones (the differential's L = CI + alpha dL is CI scaled where alpha
-// = CI / L_r), so an unchanged pixel gets none. Gaussian, from a hash of pixel, channel and the
-// frame's seed; correlated with the 4 neighbours' draws by beta when the footage's noise is.
+// = CI / L_r), so an unchanged pixel gets none. The draw n is the footage's own grain where it
+// can be measured (footageGrain): the camera pixel's residual from an edge-preserving 5x5 mean,
+// in units of its standard deviation, so what is added carries the camera's noise texture
+// (its spatial correlation, demosaicing, compression) and changes with every frame as the
+// footage's does; otherwise Gaussian, from a hash of pixel, channel and the frame's seed,
+// correlated with the 4 neighbours' draws by beta when the footage's noise is. With the
+// footage's draw, the standard deviation is added, not the variance: n already sits in the
+// pixel as k sigma(CI) n, and sigma(L) - k sigma(CI) makes it sigma(L) n.
 in vec2 uv;
 layout(binding = kUnitGrainComposite) uniform sampler2D composite;  // rgb linear, a = coverage
 layout(binding = kUnitGrainCamera) uniform sampler2D cameraImage;   // sRGB8: samples linear
 uniform int noiseOn, vignetteOn;
-uniform vec3 noiseVariance[8];  // per level (sRGB-encoded value (i + 0.5) / 8), linear units^2
+uniform int footageGrain;        // 1: n from the footage's residual (else synthesised)
 uniform float beta;             // neighbour weight of the correlated noise (0: white)
 uniform uint seed;              // the frame's
 uniform vec2 vignetteK;         // k1, k2
@@ -20,22 +27,6 @@ uniform vec2 principalPoint;    // camera pixels (OpenCV: x right, y down, top r
 uniform float invCornerR2;      // 1 / squared distance to the farthest corner
 layout(location = 0) out vec4 outLinear;  // rgb linear, a = coverage (unchanged)
 layout(location = 1) out vec4 outSrgb;    // through GL_FRAMEBUFFER_SRGB
-
-float encodeSrgb(float v) {
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-}
-
-vec3 varianceAt(vec3 v) {
-    vec3 out3;
-    for (int c = 0; c < 3; ++c) {
-        float s = encodeSrgb(clamp(v[c], 0.0, 1.0)) * 8.0 - 0.5;
-        int i0 = clamp(int(floor(s)), 0, 7);
-        int i1 = min(i0 + 1, 7);
-        float t = clamp(s - float(i0), 0.0, 1.0);
-        out3[c] = mix(noiseVariance[i0][c], noiseVariance[i1][c], t);
-    }
-    return out3;
-}
 
 uvec3 pcg3d(uvec3 v) {  // Jarzynski & Olano 2020, "Hash functions for GPU rendering"
     v = v * 1664525u + 1013904223u;
@@ -58,6 +49,20 @@ vec3 whiteNoise(ivec2 p) {
     return sqrt(-2.0 * log(u1)) * cos(6.28318530718 * u2);
 }
 
+// The footage's noise draw at camera pixel p, per channel, in standard deviations: the
+// residual of CI from its noise-free estimate (footage_noise.glsl) over the residual's standard
+// deviation. ok is false where the estimate is the centre alone (an edge or a clipped pixel on
+// every side) or the pixel is clipped: no residual to measure there.
+vec3 footageDraw(ivec2 p, vec3 ci, out bvec3 ok) {
+    vec3 spread;
+    vec3 residual = ci - footageMean(cameraImage, p, ci, spread);
+    // Clipped footage holds no noise to take (a dark object before a white wall needs its own).
+    ok = bvec3(vec3(greaterThan(spread, vec3(0.05))) * vec3(greaterThan(ci, vec3(kNoiseBlack))) *
+               vec3(lessThan(ci, vec3(kNoiseWhite))));
+    vec3 sigma = sqrt(max(noiseVarianceAt(ci), vec3(1e-12)));
+    return clamp(residual / (sigma * sqrt(max(spread, vec3(0.05)))), vec3(-4.0), vec3(4.0));
+}
+
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 c = texelFetch(composite, px, 0);
@@ -69,18 +74,26 @@ void main() {
         value *= max(1.0 + vignetteK.x * r2 + vignetteK.y * r2 * r2, 0.0);
     }
     if (noiseOn != 0) {
-        vec3 need = varianceAt(value);
-        if (!virtualPx) {
-            vec3 ci = texelFetch(cameraImage, px, 0).rgb;
-            vec3 k = value / max(ci, vec3(1e-4));
-            need -= k * k * varianceAt(ci);
-        }
+        vec3 ci = texelFetch(cameraImage, px, 0).rgb;
+        // What the pixel carries of the footage's noise already, scaled by k = L / CI.
+        vec3 k = virtualPx ? vec3(0.0) : value / max(ci, vec3(1e-4));
         vec3 n = whiteNoise(px);
         if (beta > 0.0)
             n = (n + beta * (whiteNoise(px + ivec2(1, 0)) + whiteNoise(px - ivec2(1, 0)) +
                              whiteNoise(px + ivec2(0, 1)) + whiteNoise(px - ivec2(0, 1)))) /
                 sqrt(1.0 + 4.0 * beta * beta);
-        value = max(value + sqrt(max(need, vec3(0.0))) * n, vec3(0.0));
+        vec3 need = noiseVarianceAt(value);
+        bvec3 own = bvec3(false);
+        vec3 draw = footageGrain != 0 ? footageDraw(px, ci, own) : vec3(0.0);
+        vec3 carriedVariance = k * k * noiseVarianceAt(ci);
+        for (int c = 0; c < 3; ++c) {
+            float carried = carriedVariance[c];
+            if (own[c])  // the same draw: standard deviations add
+                value[c] += (sqrt(need[c]) - sqrt(carried)) * draw[c];
+            else  // an independent draw: variances add
+                value[c] += sqrt(max(need[c] - carried, 0.0)) * n[c];
+        }
+        value = max(value, vec3(0.0));
     }
     outLinear = vec4(value, c.a);
     outSrgb = vec4(clamp(value, 0.0, 1.0), 1.0);

@@ -11,10 +11,15 @@
 // mirror or glass pixel). A sample Y contributes to pixel X
 //     C(Y)                    when X and Y lie in different layers (an object's silhouette: the
 //                             object smears over what is behind it, footage or not),
-//     C(Y) - F(Y) + F(X)      when they lie in the same layer (real surfaces: the differential
-//                             change is blurred, the footage of X is kept as the camera made it;
-//                             inside a mirror: its rendered light is blurred, the reflected
-//                             video is not blurred again).
+//     F(X) C(Y) / F(Y)        when both are real surfaces: the differential change is blurred,
+//                             the footage of X is kept as the camera made it. The change is a
+//                             ratio there (the composite's L = CI + alpha dL is CI times
+//                             L_rv / L_r), so the footage's noise at X is scaled as the change
+//                             scales the light; a difference would move Y's noise into X and keep
+//                             X's full noise in a shadow (where a darker pixel has less). Where
+//                             F(Y) is nearly black, the difference below stands in;
+//     C(Y) - F(Y) + F(X)      inside a mirror or glass (its rendered light is blurred, the
+//                             reflected video is not blurred again).
 // So a pixel whose neighbourhood the renderer did not change keeps its footage exactly, and a
 // still camera (no motion) leaves the composite unchanged.
 layout(binding = kUnitMotionVelocity) uniform sampler2D velocity;    // rg half motion, b depth
@@ -38,6 +43,10 @@ float cone(float distance, float halfLength) {
 float cylinder(float distance, float halfLength) {
     return 1.0 - smoothstep(0.95 * halfLength, 1.05 * halfLength, distance);
 }
+
+// Footage (linear) below which a real pixel's change is blurred as a difference: the ratio's
+// noise would grow without bound towards black.
+const float kRatioFloor = 0.02;
 
 void write(vec4 c) {
     outLinear = c;
@@ -78,7 +87,14 @@ void main() {
                   cylinder(distance, vYLength) * cylinder(distance, vXLength) * 2.0;
         vec4 fY = texelFetch(footage, Y, 0);
         vec3 cY = texelFetch(composite, Y, 0).rgb;
-        vec3 term = abs(fY.a - fX.a) < 0.5 ? cY - fY.rgb + fX.rgb : cY;
+        vec3 term = cY;
+        if (abs(fY.a - fX.a) < 0.5) {
+            term = cY - fY.rgb + fX.rgb;
+            if (fX.a < 0.5) {  // real surfaces: the ratio where the footage is not black
+                bvec3 lit = greaterThan(fY.rgb, vec3(kRatioFloor));
+                term = mix(term, fX.rgb * cY / max(fY.rgb, vec3(kRatioFloor)), vec3(lit));
+            }
+        }
         weight += a;
         sum += a * term;
     }

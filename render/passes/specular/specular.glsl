@@ -191,9 +191,10 @@ bool projectToCanvas(vec3 x, out vec2 canvasPx) {
 // distance within depthEpsilon * distance + 5 mm. canvasToCamera: canvas -> camera-image pixel
 // (lens distortion; not read under MIRAGE_IDENTITY_REMAP, where the canvas is the camera image);
 // cameraImage: sRGB8 texture, so `colour` is linear camera units.
-bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampler2D cameraImage,
-                 float depthEpsilon, out vec3 colour) {
-    colour = vec3(0.0);
+// backProjectPixel: the same test, giving the camera-image pixel instead of its colour.
+bool backProjectPixel(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera,
+                      sampler2D cameraImage, float depthEpsilon, out ivec2 pixel) {
+    pixel = ivec2(0);
     vec2 cp;
     if (!projectToCanvas(x, cp)) return false;
     ivec2 ci = ivec2(floor(cp + 0.5));
@@ -211,8 +212,16 @@ bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampl
     if (camPx.x < -0.5 || camPx.y < -0.5 || camPx.x > float(size.x) - 0.5 ||
         camPx.y > float(size.y) - 0.5)
         return false;  // outside the video's frustum
-    colour = texelFetch(cameraImage, clamp(ivec2(floor(camPx + 0.5)), ivec2(0), size - 1), 0).rgb;
+    pixel = clamp(ivec2(floor(camPx + 0.5)), ivec2(0), size - 1);
     return true;
+}
+
+bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampler2D cameraImage,
+                 float depthEpsilon, out vec3 colour) {
+    ivec2 pixel;
+    bool ok = backProjectPixel(x, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, pixel);
+    colour = ok ? texelFetch(cameraImage, pixel, 0).rgb : vec3(0.0);
+    return ok;
 }
 
 #endif
