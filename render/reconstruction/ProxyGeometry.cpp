@@ -332,10 +332,16 @@ void splitObjects(const TriangleMesh& mesh, const Footage& footage, const Geomet
         cv::connectedComponentsWithStats(f.height > 0, labels, stats, centroids, 8, CV_32S);
     const double cellArea = f.cell * f.cell;
     for (int label = 1; label < count; ++label) {
+        // Small pieces first, by their area alone (the carved raster holds many specks).
+        if (stats.at<int>(label, cv::CC_STAT_AREA) * cellArea < o.minObjectAreaM2) continue;
+        const int x0 = stats.at<int>(label, cv::CC_STAT_LEFT),
+                  y0 = stats.at<int>(label, cv::CC_STAT_TOP);
+        const int x1 = x0 + stats.at<int>(label, cv::CC_STAT_WIDTH);
+        const int y1 = y0 + stats.at<int>(label, cv::CC_STAT_HEIGHT);
         double top = 0;
         int observed = 0;
-        for (int y = 0; y < labels.rows; ++y)
-            for (int x = 0; x < labels.cols; ++x)
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x)
                 if (labels.at<int>(y, x) == label) {
                     top = std::max(top, double(f.height.at<float>(y, x)));
                     observed += f.observed.at<uchar>(y, x) ? 1 : 0;
