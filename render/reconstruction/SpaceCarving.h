@@ -3,23 +3,26 @@
 // "Space carving"). Real objects often have plain faces where photo-consistency stereo finds no
 // depth; but the table's plane and every camera pose are known, so each pixel can be asked
 // whether it shows the table where its ray meets the plane:
-//  1. the plane's appearance: every cell of the plane (cellM) is projected into every frame and
-//     its colour taken as the median over the frames (a diffuse table looks the same from
-//     every view; an object standing in front of a cell in a few views does not move the
-//     median). Cells whose median is not the table's (or the board's) colour are covered by
-//     something in most views: the footprints of objects, never seen, or whatever lies beyond
-//     the table's edge. The table is the connected region of table-coloured cells around the
-//     board, its enclosed holes are footprints;
+//  1. the plane's appearance: every cell of the plane (cellM) is projected into every frame.
+//     References: the chromaticity and brightness of the board's paper and of the table around
+//     the board (plain medians). A cell is the table's when enough frames see the table's
+//     chromaticity there; its colour is the median of those samples (a diffuse table looks the
+//     same from every view, spot pools and shadows included; a cell hidden behind an object in
+//     most frames still gets its colour from the few that see it). The table is the region of
+//     such cells holding most of the board; inside its convex hull the other cells are covered
+//     (footprints: every ray ending there passes through an object); outside it, off the table;
 //  2. each pixel is classed: its ray meets the plane in a table cell and its colour matches the
 //     cell's (the table is seen: nothing stands on that ray above the plane), or it does not
-//     (something above the plane), or its ray ends off the table (unknown: says nothing). Where
-//     the ray meets a covered cell, the pixel sees the table when its colour is the table's
-//     (the few frames that see behind an object);
+//     (something above the plane). A ray meeting a covered cell sees the table when the pixel
+//     has the table's chromaticity; a ray off the table sees past the objects when the pixel
+//     has the colour the frames commonly see through that cell (the floor), else says nothing;
 //  3. a voxel column over the plane is carved bottom-up: a voxel is empty when at least
 //     minPlaneVotes frames see the table through it, occupied when at least minObjectVotes
 //     frames (and minObjectShare of those deciding) see something above the plane there. A
 //     single frame never carves (a mistracked frame, noise), and nothing is made where the
 //     frames only see off the table.
+//  4. columns whose top fewer than minObjectVotes frames see (the ray to the camera passes under
+//     another column's top) are dropped: the hull's slope behind an object seen from one side.
 // The result is a height field over the plane (the top of each column's occupied run from the
 // table up): the visual hull against the table, exact for boxes and cylinders seen from all
 // sides, grown behind objects on their unseen sides. Units: metres, plane frame
