@@ -48,6 +48,8 @@ struct ProxiesArgs {
     int minFrames = rc::FootageCheckOptions{}.minFrames;
     int triangleBudget = rc::GeometryOptions{}.triangleBudgetPerObject;
     rc::StereoOptions stereo;
+    rc::CarvingOptions carving;
+    bool noCarving = false;
 };
 
 // The board's plane with the extent of its tags and page (what is known to lie flat).
@@ -248,6 +250,8 @@ void runProxies(const ProxiesArgs& a) {
     options.check.minParallaxDeg = a.minParallaxDeg;
     options.geometry.triangleBudgetPerObject = a.triangleBudget;
     options.stereo = a.stereo;
+    options.carving = a.carving;
+    options.carving.enabled = !a.noCarving;
     TerminalProgress bar("proxies");
     const rc::Reconstruction r =
         rc::reconstruct(footage, environment, options, [&](const std::string& stage, int d, int n) {
@@ -332,6 +336,17 @@ const CommandRegistrar registrar("proxies", [](CLI::App& parent) {
                     "Depth agreement tolerance as a share of the depth (plus 6 mm)")
         ->capture_default_str()
         ->check(finiteIn(0, 0.5));
+    cmd->add_flag("--no-carving", a->noCarving,
+                  "Objects from the fused stereo depth alone (no space carving against the table)");
+    cmd->add_option("--carving-frames", a->carving.maxFrames,
+                    "Frames the space carving uses at most (spread over the footage)")
+        ->capture_default_str()
+        ->check(wholeIn(2, 10000));
+    cmd->add_option("--carving-tolerance", a->carving.colourTolerance,
+                    "A pixel shows the table when its colour is within this share of the "
+                    "table's there")
+        ->capture_default_str()
+        ->check(finiteIn(0.01, 2));
     cmd->add_option("--truth", a->truth,
                     "The scene a synthetic session was made from: compare the rebuilt scene "
                     "with it (report and console)")

@@ -171,6 +171,7 @@ struct HeightField {
     double u0 = 0, v0 = 0, cell = 0.004;
 };
 
+// The fused surface more than planeBandM above the plane, as the highest point per cell.
 HeightField objectHeights(const TriangleMesh& mesh, const TableEstimate& t,
                           const GeometryOptions& o) {
     HeightField f;
@@ -188,6 +189,54 @@ HeightField objectHeights(const TriangleMesh& mesh, const TableEstimate& t,
         h = std::max(h, float(uvh.z));
     }
     f.observed = f.height > 0;
+    return f;
+}
+
+// The carved columns' heights (SpaceCarving.h) as the objects' height field.
+HeightField carvedHeights(const CarvedHeights& c) {
+    HeightField f;
+    f.cell = c.cell;
+    f.u0 = c.u0, f.v0 = c.v0;
+    f.height = c.height.clone();
+    f.observed = f.height > 0;
+    return f;
+}
+
+// Silhouettes leave the space over a plain top that every frame sees the top through (a wedge
+// rising towards the cameras, docs/reconstruction.md); the fused stereo surface has depth where
+// the footage has edges, such as a top's rims. Each carved object is cut at the 95th percentile
+// of the fused surface's heights over its footprint (plus a cell), where the fusion has at least
+// minFusedSamples points there.
+void capByFusedSurface(HeightField& f, const TriangleMesh& mesh, const BoardPlane& plane,
+                       const GeometryOptions& o) {
+    cv::Mat labels;
+    const int count = cv::connectedComponents(f.height > 0, labels, 8, CV_32S);
+    std::vector<std::vector<float>> heights{size_t(count)};
+    for (const auto& p : mesh.vertices_) {
+        const glm::dvec3 uvh = plane.toPlane({p.x(), p.y(), p.z()});
+        const int x = int(std::floor((uvh.x - f.u0) / f.cell));
+        const int y = int(std::floor((uvh.y - f.v0) / f.cell));
+        if (uvh.z < o.planeBandM || x < 0 || y < 0 || x >= labels.cols || y >= labels.rows)
+            continue;
+        heights[size_t(labels.at<int>(y, x))].push_back(float(uvh.z));
+    }
+    std::vector<float> cap(size_t(count), std::numeric_limits<float>::infinity());
+    for (int l = 1; l < count; ++l) {
+        auto& h = heights[size_t(l)];
+        if (int(h.size()) < o.minFusedSamples) continue;
+        auto at = h.begin() + long(0.95 * double(h.size() - 1));
+        std::nth_element(h.begin(), at, h.end());
+        cap[size_t(l)] = *at + float(f.cell);
+    }
+    for (int y = 0; y < labels.rows; ++y)
+        for (int x = 0; x < labels.cols; ++x) {
+            float& h = f.height.at<float>(y, x);
+            h = std::min(h, cap[size_t(labels.at<int>(y, x))]);
+        }
+}
+
+void closeHeightField(HeightField& f) {
+    const int rows = f.height.rows, cols = f.height.cols;
     // Close one-cell gaps between fused samples, then the holes inside each footprint (the
     // unseen underside of an overhang, a face the matcher left empty): the object stands there.
     cv::Mat occupied;
@@ -215,7 +264,6 @@ HeightField objectHeights(const TriangleMesh& mesh, const TableEstimate& t,
     cv::Mat smoothed;
     cv::medianBlur(f.height, smoothed, 3);
     smoothed.copyTo(f.height, occupied);
-    return f;
 }
 
 // A closed solid from the cells labelled `label`: a top quad per cell, walls down to the lower
@@ -275,17 +323,25 @@ void simplify(ProxyObject& obj, int budget) {
 }
 
 void splitObjects(const TriangleMesh& mesh, const Footage& footage, const GeometryOptions& o,
-                  FusedGeometry& out) {
-    const HeightField f = objectHeights(mesh, out.table, o);
+                  const CarvedHeights* carved, FusedGeometry& out) {
+    HeightField f = carved ? carvedHeights(*carved) : objectHeights(mesh, out.table, o);
+    if (carved) capByFusedSurface(f, mesh, footage.board, o);
+    closeHeightField(f);
     cv::Mat labels, stats, centroids;
     const int count =
         cv::connectedComponentsWithStats(f.height > 0, labels, stats, centroids, 8, CV_32S);
     const double cellArea = f.cell * f.cell;
     for (int label = 1; label < count; ++label) {
+        // Small pieces first, by their area alone (the carved raster holds many specks).
+        if (stats.at<int>(label, cv::CC_STAT_AREA) * cellArea < o.minObjectAreaM2) continue;
+        const int x0 = stats.at<int>(label, cv::CC_STAT_LEFT),
+                  y0 = stats.at<int>(label, cv::CC_STAT_TOP);
+        const int x1 = x0 + stats.at<int>(label, cv::CC_STAT_WIDTH);
+        const int y1 = y0 + stats.at<int>(label, cv::CC_STAT_HEIGHT);
         double top = 0;
         int observed = 0;
-        for (int y = 0; y < labels.rows; ++y)
-            for (int x = 0; x < labels.cols; ++x)
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x)
                 if (labels.at<int>(y, x) == label) {
                     top = std::max(top, double(f.height.at<float>(y, x)));
                     observed += f.observed.at<uchar>(y, x) ? 1 : 0;
@@ -331,11 +387,11 @@ void splitObjects(const TriangleMesh& mesh, const Footage& footage, const Geomet
 }  // namespace
 
 FusedGeometry reconstructGeometry(const Footage& footage, const std::vector<DepthView>& views,
-                                  const GeometryOptions& o) {
+                                  const GeometryOptions& o, const CarvedHeights* carved) {
     FusedGeometry out;
     const auto mesh = fuseDepth(views, footage.board, o, out);
     estimateTable(*mesh, footage, o, out);
-    splitObjects(*mesh, footage, o, out);
+    splitObjects(*mesh, footage, o, carved, out);
     return out;
 }
 

@@ -17,6 +17,7 @@
 #include <glm/glm.hpp>
 
 #include "render/reconstruction/Footage.h"
+#include "render/reconstruction/SpaceCarving.h"
 #include "render/reconstruction/StereoDepth.h"
 
 namespace mirage::reconstruction {
@@ -37,6 +38,9 @@ struct GeometryOptions {
     // imperfect shadow map: a few thousand triangles each keep those passes cheap).
     int triangleBudgetPerObject = 1500;
     int maxObjects = 16;
+    // Carved objects are cut at the fused surface's height where it has this many points over
+    // them (ProxyGeometry.cpp, capByFusedSurface).
+    int minFusedSamples = 20;
 };
 
 struct TableEstimate {
@@ -74,7 +78,11 @@ struct FusedGeometry {
     double tableCellM = 0.004;
 };
 
+// `carved`: the objects' heights from space carving (SpaceCarving.h) instead of the fused
+// surface's; the fusion still gives the table's extent, its colour and the objects' colour
+// samples.
 FusedGeometry reconstructGeometry(const Footage& footage, const std::vector<DepthView>& views,
-                                  const GeometryOptions& options = {});
+                                  const GeometryOptions& options = {},
+                                  const CarvedHeights* carved = nullptr);
 
 }  // namespace mirage::reconstruction

@@ -39,9 +39,17 @@ Reconstruction reconstruct(const Footage& footage, const std::optional<glm::dvec
             "3.5-14 cm between them, optical axes within 25 degrees); record again walking the "
             "camera slowly around the table, keeping the board in view");
     r.stereoSeconds = secondsSince(t0);
+    if (o.carving.enabled) {
+        t0 = Clock::now();
+        if (progress) progress("carving", 0, 1);
+        r.carving = carveAbovePlane(footage, o.carving);
+        if (progress) progress("carving", 1, 1);
+        r.carvingSeconds = secondsSince(t0);
+    }
     t0 = Clock::now();
     if (progress) progress("fusion", 0, 1);
-    r.geometry = reconstructGeometry(footage, views, o.geometry);
+    r.geometry =
+        reconstructGeometry(footage, views, o.geometry, o.carving.enabled ? &r.carving : nullptr);
     if (progress) progress("fusion", 1, 1);
     r.fusionSeconds = secondsSince(t0);
     t0 = Clock::now();
@@ -62,6 +70,18 @@ nlohmann::json reconstructionReport(const Reconstruction& r) {
                     {"median_distance_m", r.check.medianDistanceM},
                     {"depth_maps", r.depthMaps},
                     {"depth_valid_fraction", r.meanValidFraction}};
+    if (!r.carving.height.empty()) {
+        const PlaneAppearance& a = r.carving.plane;
+        j["carving"] = {{"frames", r.carving.framesUsed},
+                        {"occupied_columns", r.carving.occupiedColumns},
+                        {"table_cells", cv::countNonZero(a.kind == PlaneAppearance::Table)},
+                        {"covered_cells", cv::countNonZero(a.kind == PlaneAppearance::Covered)},
+                        {"cell_m", a.cell},
+                        {"table_chromaticity", {a.tableChroma[0], a.tableChroma[1]}},
+                        {"board_chromaticity", {a.boardChroma[0], a.boardChroma[1]}}};
+    } else {
+        j["carving"] = nullptr;
+    }
     j["fusion"] = {{"vertices", r.geometry.fusedVertices},
                    {"triangles", r.geometry.fusedTriangles},
                    {"dropped_components", r.geometry.droppedComponents}};
@@ -106,8 +126,10 @@ nlohmann::json reconstructionReport(const Reconstruction& r) {
         j["spot"] = nullptr;
     }
     j["notes"] = r.lighting.notes;
-    j["seconds"] = {
-        {"stereo", r.stereoSeconds}, {"fusion", r.fusionSeconds}, {"lights", r.lightSeconds}};
+    j["seconds"] = {{"stereo", r.stereoSeconds},
+                    {"carving", r.carvingSeconds},
+                    {"fusion", r.fusionSeconds},
+                    {"lights", r.lightSeconds}};
     return j;
 }
 
@@ -117,6 +139,9 @@ std::string reconstructionSummary(const Reconstruction& r) {
         "footage: {} tracked frames, parallax {:.1f} deg, {} depth maps ({:.0f} % of pixels with "
         "depth)\n",
         r.check.frames, r.check.parallaxDeg, r.depthMaps, 100 * r.meanValidFraction);
+    if (!r.carving.height.empty())
+        s += fmt::format("carving: {} frames, {} columns of {:.0f} mm occupied above the table\n",
+                         r.carving.framesUsed, r.carving.occupiedColumns, 1000 * r.carving.cell);
     s += fmt::format(
         "table: {:.2f} x {:.2f} m seen flat ({:.0f} % of it observed), plane RMS {:.1f} mm, "
         "albedo {:.2f} {:.2f} {:.2f}\n",

@@ -25,6 +25,7 @@ struct ReconstructionOptions {
     FootageCheckOptions check;
     StereoOptions stereo;
     GeometryOptions geometry;
+    CarvingOptions carving;  // carving.enabled = false: objects from the fused stereo alone
     LightFitOptions light;
 };
 
@@ -32,12 +33,13 @@ struct Reconstruction {
     FootageCheck check;
     int depthMaps = 0;
     double meanValidFraction = 0;  // of the depth maps' pixels
+    CarvedHeights carving;         // empty when carving is off
     FusedGeometry geometry;
     LightingEstimate lighting;
-    double stereoSeconds = 0, fusionSeconds = 0, lightSeconds = 0;  // wall clock
+    double stereoSeconds = 0, carvingSeconds = 0, fusionSeconds = 0, lightSeconds = 0;  // wall
 };
 
-// stage: "stereo", "fusion", "lights"; done/total within it.
+// stage: "stereo", "carving", "fusion", "lights"; done/total within it.
 using ReconstructionProgress = std::function<void(const std::string& stage, int done, int total)>;
 
 // Throws FootageRefused when checkFootage says no. `environment`: the environment camera's
