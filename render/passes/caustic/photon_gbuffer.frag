@@ -174,7 +174,11 @@ void main() {
                               travelled))
         return;
     SurroundingHit ht = traceSurroundings(slot, P2 + T2 * eps, T2);
-    outRefrHit = photonHit(ht, realVis, rough);
+    // The refracted photon leaves the glass beside it: a kernel wider than the smooth glass's 2
+    // px would pour the light of the pixels the glass hides into the few in view around its
+    // foot (0.746 against 0.709 of the smooth render's error over the rough tabletop's changed
+    // pixels), so it splats as a sharp photon does.
+    outRefrHit = photonHit(ht, realVis, false);
     outRefrPower = photonPower(power * refractionWeight(m, transWeight, F1, F2, travelled), vis.x);
     outRefrSurface = photonSurface(ht);
 }
