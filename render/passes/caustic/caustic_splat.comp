@@ -39,10 +39,9 @@ const int kMaxQuadPx = 2;
 const int kMaxReachPx = 4;
 // A photon scattered over a rough surface's lobe (photonFromRoughLobe) lands among neighbours
 // from elsewhere in the lobe: its spacing is the glow's, and its kernel may reach kRoughReachPx
-// so that the sparse photons of a wide glow overlap instead of speckling it. 4 px: 0.746 of the
-// smooth render's error over the rough tabletop's changed pixels (2 px: 0.728 but speckled, the
-// influenced pixels' error up; 8 px: 0.93, a photon near the image's edge puts its whole power
-// into the few pixels in view; docs/caustics.md, "Rough surfaces").
+// so that the sparse photons of a wide glow overlap instead of speckling it (8 px: a photon near
+// the image's edge puts its whole power into the few pixels in view; docs/caustics.md, "Rough
+// surfaces", has the measurements). Only reflected photons are marked (photon_gbuffer.frag).
 const int kRoughReachPx = 4;
 
 // Surface area (m^2) of canvas pixel px whose surface is x with normal n: the pixel's solid
