@@ -26,7 +26,7 @@
 namespace mirage::render {
 namespace {
 
-constexpr float kRoughness = 0.35f;  // the tabletop's rough sphere and mirror (bars/rough)
+constexpr float kRoughness = 0.35f;  // as tabletop_rough35.gltf's sphere and mirror
 
 // A virtual rough sphere (r = 10 cm) on the real table, the real spot light above and to the
 // right of the camera so that its highlight lands on the sphere's upper right.
