@@ -183,11 +183,12 @@ void lightVisibility(sampler2DArray allMap, sampler2DArray realMap MIRAGE_GLASS_
 #endif
 }
 
-// Lambert diffuse + GGX specular (Smith-Schlick G, Schlick F, F0 = 0.04 for dielectrics), glTF
-// metallic-roughness. Returns BRDF * cos (the factor multiplying incident irradiance).
-vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+// The GGX specular lobe alone (Smith-Schlick G, Schlick F from F0) times cos: the glossy
+// highlight of a punctual light, also on rough mirrors, metals and glass (direct.frag).
+vec3 ggxSpecularCos(vec3 n, vec3 v, vec3 l, vec3 F0, float roughness, out vec3 F) {
     float NdotL = max(dot(n, l), 0.0);
     float NdotV = max(dot(n, v), 1e-4);
+    F = F0;
     if (NdotL <= 0.0) return vec3(0.0);
     vec3 h = normalize(l + v);
     float NdotH = max(dot(n, h), 0.0), VdotH = max(dot(v, h), 0.0);
@@ -196,11 +197,19 @@ vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float rough
     float D = a2 / (PI * dd * dd);
     float k = a * 0.5;
     float G = (NdotL / (NdotL * (1.0 - k) + k)) * (NdotV / (NdotV * (1.0 - k) + k));
-    vec3 F0 = mix(vec3(0.04), baseColor, metallic);
-    vec3 F = F0 + (1.0 - F0) * pow(1.0 - VdotH, 5.0);
-    vec3 spec = D * G * F / (4.0 * NdotL * NdotV);
+    F = F0 + (1.0 - F0) * pow(1.0 - VdotH, 5.0);
+    return D * G * F / (4.0 * NdotL * NdotV) * NdotL;
+}
+
+// Lambert diffuse + GGX specular (Smith-Schlick G, Schlick F, F0 = 0.04 for dielectrics), glTF
+// metallic-roughness. Returns BRDF * cos (the factor multiplying incident irradiance).
+vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+    float NdotL = max(dot(n, l), 0.0);
+    if (NdotL <= 0.0) return vec3(0.0);
+    vec3 F;
+    vec3 spec = ggxSpecularCos(n, v, l, mix(vec3(0.04), baseColor, metallic), roughness, F);
     vec3 diffuse = (1.0 - F) * (1.0 - metallic) * baseColor / PI;
-    return (diffuse + spec) * NdotL;
+    return spec + diffuse * NdotL;
 }
 
 #endif

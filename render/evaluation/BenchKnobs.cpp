@@ -317,6 +317,23 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                  c.options.caustic.gather = parseOnOff("caustic_gather", v);
              },
              [](const BenchConfig& c) { return onOff(c.options.caustic.gather); }},
+            {"rough_highlight",
+             "on: rough mirrors, metals and glass show the punctual lights' GGX highlight; off: "
+             "their light comes from the mirror / refracted ray alone (no highlight)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.direct.roughHighlight = parseOnOff("rough_highlight", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.direct.roughHighlight); }},
+            {"rough_photons",
+             "on: photons leaving a rough mirror, metal or glass scatter over its GGX lobe (a "
+             "soft caustic, spread reflected / refracted VPLs); off: they follow the mirror / "
+             "Snell ray (a sharp caustic)",
+             [](const CameraIntrinsics&, bool) { return std::vector<std::string>{"on"}; },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.caustic.roughLobes = parseOnOff("rough_photons", v);
+             },
+             [](const BenchConfig& c) { return onOff(c.options.caustic.roughLobes); }},
             {"caustic_radius",
              "photon kernel radius cap of the caustic gather, in cm (0.1..50; grid cells are twice "
              "that)",

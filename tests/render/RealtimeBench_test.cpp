@@ -197,7 +197,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
             std::string(RendererOptions{}.specular.halfResolution ? "half" : "full") +
             " virtual=on "
             "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
-            "caustic_gather=on caustic_radius=1 caustic_gather_cap=64 caustic_temporal=on "
+            "caustic_gather=on rough_highlight=on rough_photons=on caustic_radius=1 "
+            "caustic_gather_cap=64 caustic_temporal=on "
             "specular_temporal=on "
             "pose_jitter=0 "
             "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "

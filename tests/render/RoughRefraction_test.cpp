@@ -114,7 +114,11 @@ TEST(RoughRefraction, RoughnessZeroLimitEqualsSmoothPathAndOnlyTheGlassChanges) 
     EXPECT_FALSE(a.report.ran("roughrefr"));
     EXPECT_NE(a.report.summary().find("no rough glass"), std::string::npos) << a.report.summary();
     for (RoughRefractionMethod m : {RoughRefractionMethod::Lean, RoughRefractionMethod::Gsr}) {
-        const RoughFrame b = test::renderRough(limit, footage, withMethod(m));
+        // Without the spot's GGX highlight (direct.roughHighlight): light that smooth glass
+        // reflects as a point the renderer cannot draw, not this pass's business.
+        RendererOptions o = withMethod(m);
+        o.direct.roughHighlight = false;
+        const RoughFrame b = test::renderRough(limit, footage, o);
         EXPECT_TRUE(b.report.ran("roughrefr")) << b.report.summary();
         EXPECT_EQ(cv::norm(a.linear, b.linear, cv::NORM_INF), 0.0) << roughRefractionMethodName(m);
     }

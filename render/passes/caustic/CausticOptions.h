@@ -37,6 +37,12 @@ struct CausticOptions {
     // which moves the photon footprints over the pixels: without it the caustic shimmers. false:
     // every frame's caustic stands alone.
     bool temporal = true;
+    // Photons leaving a rough mirror, rough metal or rough glass (roughness above 0.05) each take
+    // a microfacet normal sampled from the surface's GGX lobe (photon_gbuffer.frag), so the
+    // caustic and the reflected / refracted VPLs spread as the reference's microfacet BSDF
+    // spreads them (a rough mirror throws a soft glow, not its smooth twin's sharp patch;
+    // docs/caustics.md, "Rough surfaces"). false: every photon follows the mirror / Snell ray.
+    bool roughLobes = true;
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 2048 && mapSize % 8 == 0, "caustic.mapSize",

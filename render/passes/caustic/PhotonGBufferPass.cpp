@@ -121,6 +121,8 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(photonProgram_.uniformLocation("tanHalf"), lp.causticTanHalf);
         glUniform1i(photonProgram_.uniformLocation("marchSteps"),
                     ctx.options.specular.refractionMarchSteps);
+        glUniform1i(photonProgram_.uniformLocation("roughPhotons"),
+                    ctx.options.caustic.roughLobes ? 1 : 0);
         const GLint locPhotonSlot = photonProgram_.uniformLocation("specularSlot");
         for (size_t slot = 0; slot < spec.size(); ++slot) {
             glUniform1i(locPhotonSlot, int(slot));

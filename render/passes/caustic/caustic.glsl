@@ -6,8 +6,14 @@
 #ifndef MIRAGE_CAUSTIC_GLSL
 #define MIRAGE_CAUSTIC_GLSL
 
-// Photon hit texel: xyz world receiver hit, w = 4 x hit origin + real-path visibility.
+// Photon hit texel: xyz world receiver hit, w = 4 x hit origin + real-path visibility (0..1)
+// + 2 for a photon scattered over a rough surface's lobe (photon_gbuffer.frag).
 int photonHitOrigin(vec4 hit) { return int(floor((hit.w + 0.5) / 4.0)); }
+float photonRealVisibility(vec4 hit) {
+    float v = hit.w - 4.0 * float(photonHitOrigin(hit));
+    return v > 1.5 ? v - 2.0 : v;
+}
+bool photonFromRoughLobe(vec4 hit) { return hit.w - 4.0 * float(photonHitOrigin(hit)) > 1.5; }
 
 // A photon texel's powers for L_rv (power x visibility through all occluders) and for L_r (power
 // x real-path visibility: nonzero only when the light and the specular object are real). False
@@ -18,7 +24,7 @@ bool photonPowers(vec4 hit, vec4 power, out vec3 powerRv, out vec3 powerR) {
     powerR = vec3(0.0);
     int origin = photonHitOrigin(hit);
     if (origin == ORIGIN_NONE) return false;
-    float realVis = hit.w - 4.0 * float(origin);
+    float realVis = photonRealVisibility(hit);
     powerRv = power.rgb * power.a;
     powerR = power.rgb * realVis;
     return max(max(powerRv.r, powerRv.g), max(powerRv.b, max(powerR.r, max(powerR.g, powerR.b)))) >

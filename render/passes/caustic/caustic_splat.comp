@@ -37,6 +37,12 @@ const int kMaxQuadPx = 2;
 // The most pixels a kernel reaches from its centre: the cap, or the smallest kernel stretched on
 // a surface seen obliquely (0.75 px / cos, cos >= 0.2), whichever is larger.
 const int kMaxReachPx = 4;
+// A photon scattered over a rough surface's lobe (photonFromRoughLobe) lands among neighbours
+// from elsewhere in the lobe: its spacing is the glow's, and its kernel may reach kRoughReachPx
+// so that the sparse photons of a wide glow overlap instead of speckling it (8 px: a photon near
+// the image's edge puts its whole power into the few pixels in view; docs/caustics.md, "Rough
+// surfaces", has the measurements). Only reflected photons are marked (photon_gbuffer.frag).
+const int kRoughReachPx = 4;
 
 // Surface area (m^2) of canvas pixel px whose surface is x with normal n: the pixel's solid
 // angle cos^3 / (fx fy) times distance^2 / |cos| at the surface.
@@ -72,13 +78,15 @@ void main() {
     vec3 nc = texelFetch(gNormal, clamp(centre, ivec2(0), ivec2(canvas.xy) - 1), 0).xyz;
     float cosC = abs(dot(nc, normalize(cameraPos.xyz - hit.xyz)));
     float rMin = 0.75 * pixelWorld / clamp(cosC, 0.2, 1.0);
-    float r = clamp(quadScale * spacing, rMin, max(rMin, float(kMaxQuadPx) * pixelWorld));
-    int rPx = min(int(ceil(r / pixelWorld)), kMaxReachPx);
+    bool rough = photonFromRoughLobe(hit);
+    float capPx = rough ? float(kRoughReachPx) : float(kMaxQuadPx);
+    float r = clamp(quadScale * spacing, rMin, max(rMin, capPx * pixelWorld));
+    int rPx = min(int(ceil(r / pixelWorld)), rough ? kRoughReachPx : kMaxReachPx);
     ivec2 lo = max(centre - rPx, ivec2(0)), hi = min(centre + rPx, ivec2(canvas.xy) - 1);
     if (any(greaterThan(lo, hi))) return;
     // The weights of the pixels reached, kept for the second loop (which then reads no G-buffer
     // texel again): 0 where the pixel has no surface near the hit or is a specular pixel.
-    float weights[(2 * kMaxReachPx + 1) * (2 * kMaxReachPx + 1)];
+    float weights[(2 * kRoughReachPx + 1) * (2 * kRoughReachPx + 1)];
     int n = 0;
     float r2 = r * r, sumWA = 0.0;
     for (int y = lo.y; y <= hi.y; ++y)

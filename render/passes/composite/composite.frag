@@ -86,14 +86,22 @@ vec3 guardedAlpha(vec3 ci, vec3 r) {
 
 // Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci; `footage` receives the part
 // of the result that is video (CI, or the back-projected CI_bp); wholeCi: it is CI (all real).
+// A rough mirror / metal / glass pixel's punctual highlight (direct.frag's rough-highlight
+// variant, marked LR.a = 2) joins its specular light: L'_rv and L'_r, as the direct light routes it.
 vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out bool wholeCi) {
     vec3 ex = exposure;
     vec4 fuzzyBp = fuzzyOn != 0 ? texelFetch(fuzzyVideo, cpi, 0) : vec4(0.0);
     bool fuzzy = fuzzyBp.a > 0.5;
+    vec4 highlightR = texelFetch(lR, cpi, 0);
+    bool highlight = highlightR.a > 1.5;
     vec3 rv = max((fuzzy ? texelFetch(fuzzyRv, cpi, 0) : texelFetch(specRv, cpi, 0)).rgb,
                   vec3(0.0)) * ex;
     vec3 r = max((fuzzy ? texelFetch(fuzzyR, cpi, 0) : texelFetch(specR, cpi, 0)).rgb,
                  vec3(0.0)) * ex;
+    if (highlight) {
+        rv += max(texelFetch(lRv, cpi, 0).rgb, vec3(0.0)) * ex;
+        r += max(highlightR.rgb, vec3(0.0)) * ex;
+    }
     vec3 rRefl =
         clamp((fuzzy ? texelFetch(fuzzyRRefl, cpi, 0) : texelFetch(specRRefl, cpi, 0)).rgb * ex,
               vec3(0.0), r);

@@ -35,18 +35,45 @@ DirectLightPass::DirectLightPass(const GpuScene& scene)
     program(true, false, false);  // the variant of frames without VPLs, compiled up front
 }
 
-gl::Program& DirectLightPass::program(bool glass, bool indirect, bool keepDirect) {
+gl::Program& DirectLightPass::program(bool glass, bool indirect, bool keepDirect, bool highlight) {
     keepDirect = keepDirect && indirect;  // without indirect light LRv is the direct light
-    const auto key = std::make_tuple(glass, indirect, keepDirect);
+    const auto key = std::make_tuple(glass, indirect, keepDirect, highlight);
     if (auto it = programs_.find(key); it != programs_.end()) return it->second;
     std::string defines = glass ? sceneDefines_ : sceneDefinesNoGlass_;
-    if (indirect) defines += "#define MIRAGE_WITH_INDIRECT 1\n";
+    if (indirect && !highlight) defines += "#define MIRAGE_WITH_INDIRECT 1\n";
     if (keepDirect) defines += "#define MIRAGE_KEEP_DIRECT 1\n";
-    gl::Program p = fullscreenProgram(std::string("direct") + (glass ? "" : " (no glass shadows)") +
-                                          (indirect ? " + indirect" : "") +
-                                          (keepDirect ? " (direct kept)" : ""),
-                                      "passes/direct/direct.frag", defines);
+    if (highlight) defines += "#define MIRAGE_ROUGH_HIGHLIGHT 1\n";
+    gl::Program p = fullscreenProgram(
+        std::string("direct") + (highlight ? " rough highlight" : "") +
+            (glass ? "" : " (no glass shadows)") + (indirect && !highlight ? " + indirect" : "") +
+            (keepDirect ? " (direct kept)" : ""),
+        "passes/direct/direct.frag", defines);
     return programs_.emplace(key, std::move(p)).first->second;
+}
+
+// The punctual lights' glossy highlight on the rough mirror / metal / glass pixels (direct.frag's
+// MIRAGE_ROUGH_HIGHLIGHT variant) inside the specular rectangles: where the mask is attached
+// only its specular pixels (depth 0 < the triangle's 0.5), else every pixel the variant keeps.
+void DirectLightPass::drawRoughHighlight(FrameContext& ctx, gl::Program& prog, bool masked) {
+    prog.use();
+    glUniform1i(prog.uniformLocation("translucentOn"), 0);
+    if (masked) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+    }
+    glEnable(GL_SCISSOR_TEST);
+    for (const glm::ivec4& r : ctx.specularRects) {
+        if (r.z <= 0 || r.w <= 0) continue;
+        glScissor(r.x, r.y, r.z, r.w);
+        ctx.drawFullscreenTriangle();
+    }
+    glDisable(GL_SCISSOR_TEST);
+    if (masked) {
+        glDepthMask(GL_TRUE);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_DEPTH_TEST);
+    }
 }
 
 void DirectLightPass::setup(PassBuilder& b) const {
@@ -72,9 +99,14 @@ void DirectLightPass::setup(PassBuilder& b) const {
 }
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
+    const int rough = ctx.scene.roughReflectorCount() + ctx.scene.roughGlassCount();
     return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
                       (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
-                      (ctx.plan.needVpls ? " + the upsampled indirect light" : "")};
+                      (ctx.plan.needVpls ? " + the upsampled indirect light" : "") +
+                      (rough > 0 && ctx.options.direct.roughHighlight
+                           ? " + the lights' highlight on " + std::to_string(rough) +
+                                 " rough mirror / metal / glass object(s)"
+                           : "")};
 }
 
 void DirectLightPass::resize(const FrameContext& ctx) {
@@ -149,6 +181,11 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
         ctx.drawFullscreenTriangleOutsideSpecular(0, targets);
     else
         ctx.drawFullscreenTriangle();
+    const bool roughInView =
+        ctx.scene.roughReflectorCount() + ctx.scene.roughGlassCount() > 0 && res.has(kSpecularMask);
+    if (roughInView && ctx.options.direct.roughHighlight)
+        drawRoughHighlight(ctx, program(ctx.plan.glassShadows, indirect, keep, true),
+                           mask != nullptr);
     res.publish(kLRv, rv_);
     res.publish(kLR, r_);
     if (!indirect) {  // the GI solutions are the direct light

@@ -34,10 +34,11 @@ private:
     // The shader variant for (glass shadows, indirect light added, direct light kept apart),
     // compiled on first use: llvmpipe pays for a branch's texture reads even when no pixel takes
     // it, so each combination is its own program.
-    gl::Program& program(bool glass, bool indirect, bool keepDirect);
+    gl::Program& program(bool glass, bool indirect, bool keepDirect, bool highlight = false);
+    void drawRoughHighlight(FrameContext& ctx, gl::Program& prog, bool masked);
 
     std::string sceneDefines_, sceneDefinesNoGlass_;
-    std::map<std::tuple<bool, bool, bool>, gl::Program> programs_;
+    std::map<std::tuple<bool, bool, bool, bool>, gl::Program> programs_;
     gl::Texture rv_, r_, directRv_, directR_;
     gl::Framebuffer fbo_, keepFbo_;                   // LRv, LR; and + DirectRv, DirectR
     GLuint attachedMask_ = 0, keepAttachedMask_ = 0;  // SpecularMask attached as their depth

@@ -15,6 +15,12 @@ struct DirectOptions {
     // upsampled indirect light. false (the default): DirectRv / DirectR exist only in frames
     // without VPL light, where they are LRv / LR.
     bool keepDirectLight = false;
+    // true (the default): rough mirrors, metals and glass (roughness above 0.05) show the punctual
+    // lights' GGX highlight (direct.frag's MIRAGE_ROUGH_HIGHLIGHT variant over their pixels; the
+    // composite adds it to their specular light; docs/specular.md, "The glossy highlight").
+    // false: their light comes from the mirror / refracted ray alone, which never meets a
+    // punctual light (no highlight).
+    bool roughHighlight = true;
 
     void validate() const {}
 };

@@ -106,6 +106,54 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r) 
     if (pReal) r += e;
 }
 
+#ifdef MIRAGE_ROUGH_HIGHLIGHT
+// Variant for the pixels of rough mirrors, metals and glass (roughness above the mirror
+// threshold 0.05; the specular passes light them along the mirror / refracted ray, which never
+// meets a punctual light): the punctual lights' GGX highlight alone, F0 the metal's base colour or
+// 0.04 for glass, routed as the direct light (DESIGN.md "Real and virtual"). The composite adds it
+// to the specular pixel's L'_rv / L'_r after the fuzzy / rough filters (it is the lobe already).
+// Other pixels are left as the main draw wrote them. LR.a = 2 marks a highlight pixel.
+const float kRoughHighlightThreshold = 0.05;
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 P = texelFetch(gPosition, px, 0);
+    int origin = int(P.w + 0.5);
+    vec4 N = texelFetch(gNormal, px, 0);
+    if (origin == ORIGIN_NONE || texelFetch(gEmissive, px, 0).a < 0.5 ||
+        !(N.w > kRoughHighlightThreshold))
+        discard;
+    vec4 A = texelFetch(gAlbedo, px, 0);
+    vec3 v = normalize(cameraPos.xyz - P.xyz);
+    vec3 F0 = mix(vec3(0.04), A.rgb, clamp(A.a, 0.0, 1.0));
+    bool pReal = origin == ORIGIN_REAL;
+    vec3 rv = vec3(0.0), r = vec3(0.0);
+    for (int li = 0; li < lightCount; ++li) {
+        vec3 wi, E;
+        incidentLight(li, P.xyz, wi, E);
+        float NdotL = dot(N.xyz, wi);
+        if (NdotL <= 0.0) continue;
+        vec3 F;
+        vec3 c = ggxSpecularCos(N.xyz, v, wi, F0, N.w, F) * E;
+        vec3 visAll, visReal;
+#ifdef MIRAGE_GLASS_SHADOWS
+        lightVisibility(shadowAll, shadowReal, glassAll, glassReal, li, P.xyz, NdotL, visAll,
+                        visReal);
+#else
+        lightVisibility(shadowAll, shadowReal, li, P.xyz, NdotL, visAll, visReal);
+#endif
+        rv += c * visAll;
+        if (lights[li].isReal == 1 && pReal) r += c * visReal;
+    }
+    rv = allFinite(rv) ? rv : vec3(0.0);
+    r = allFinite(r) ? r : vec3(0.0);
+    outRv = vec4(rv, float(origin));
+    outR = vec4(r, 2.0);
+#ifdef MIRAGE_KEEP_DIRECT
+    outDirectRv = vec4(rv, 1.0);
+    outDirectR = vec4(r, 1.0);
+#endif
+}
+#else
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 P = texelFetch(gPosition, px, 0);
@@ -127,3 +175,4 @@ void main() {
     outDirectR = vec4(r, 1.0);
 #endif
 }
+#endif

@@ -79,6 +79,7 @@ void followSpecular(int li, int layer, vec3 p, float sampleSolidAngle, uint k, i
     float photonSolidAngle = texelTan * texelTan / pow(1.0 + t * t * dot(texelNdc, texelNdc), 1.5);
     int origin = int(floor(hit.w / 4.0));
     float realVis = hit.w - 4.0 * float(origin);
+    realVis = realVis > 1.5 ? realVis - 2.0 : realVis;  // + 2: scattered over a rough lobe
     v.position = hit.xyz;
     v.normal = normalize(n);
     v.isReal = origin == ORIGIN_REAL && realVis > 0.5 ? 1 : 0;
