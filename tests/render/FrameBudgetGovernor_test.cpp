@@ -103,7 +103,9 @@ TEST(FrameBudgetGovernor, HoldsTheBudgetWhenAnObjectComesIntoView) {
     int over = 0;
     for (int f = 30; f < 120; ++f) {
         if (frameMs[size_t(f)] > budget) ++over;
-        if (f >= 34) EXPECT_LE(frameMs[size_t(f)], budget) << "frame " << f;
+        if (f >= 34) {
+            EXPECT_LE(frameMs[size_t(f)], budget) << "frame " << f;
+        }
     }
     EXPECT_LE(over, 3);
     // The most accurate setting within the budget in this scene: half resolution, caustic
