@@ -10,6 +10,7 @@
 
 #include "core/Error.h"
 #include "render/FrameImports.h"
+#include "render/governor/GovernedKnobs.h"
 #include "render/passes/aa/AntialiasPass.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/caustic/CausticPass.h"
@@ -548,6 +549,13 @@ const FrameReport& Renderer::render(const FrameInput& input) {
     objectsMoved_ = false;
     ++c.frameIndex;
     return report;
+}
+
+void Renderer::setQuality(const RendererOptions& quality) {
+    RendererOptions next = options_;
+    copyGovernedOptions(quality, next);
+    next.validate();                      // throws before anything changed
+    copyGovernedOptions(next, options_);  // ctx_ holds a reference to options_
 }
 
 bool Renderer::updateTransforms(const Scene& scene) {

@@ -133,6 +133,12 @@ public:
     const std::vector<glm::ivec4>& refractiveRects() const { return ctx_->refractiveRects; }
     const GpuScene& gpuScene() const { return *scene_; }
     const RendererOptions& options() const { return options_; }
+    // Takes the options a frame-time governor may change between frames (render/governor/
+    // GovernedKnobs.h: specular resolution, VPL stride at the hits, refraction and impostor
+    // steps, caustic gather cap and refresh interval) from `quality`, from the next
+    // render() on; every other option stays as built. Throws mirage::Error (nothing changed) when
+    // they are out of range.
+    void setQuality(const RendererOptions& quality);
     const FrameReport& lastReport() const { return graph_.lastReport(); }
     // The passes in frame order (the columns of every per-pass table: replay CSV, bench).
     std::vector<std::string> passNames() const;

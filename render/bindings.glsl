@@ -101,6 +101,13 @@ const int kUnitSpecGbufBackPosition = 3;
 const int kUnitSpecGbufBackNormal = 4;
 const int kUnitSpecGbufMaterials = 5;      // samplerBuffer: GpuMaterial[] (common.glsl materialAt)
 const int kUnitSpecGbufSpecularDraws = 6;  // samplerBuffer: GpuSpecularDraw[] (specularDrawAt)
+// specular_trace_fill.frag (the half-resolution trace's fill, RendererOptions::specular.
+// halfResolutionTrace): the half-resolution GBuf_refl then GBuf_refr (5 targets each), and the
+// primary G-buffer's position, normal and emissive (a = specular slot + 1).
+const int kUnitSpecFillHalfFirst = 0;  // .. + 9
+const int kUnitSpecFillPosition = 10;
+const int kUnitSpecFillNormal = 11;
+const int kUnitSpecFillEmissive = 12;
 
 // specular_light.frag: GBuf_refl then GBuf_refr (position, normal, albedo, emissive, weight)
 const int kUnitSpecLightReflFirst = 0;  // .. + 4

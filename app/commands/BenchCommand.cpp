@@ -43,6 +43,7 @@
 #include "core/session/Session.h"
 #include "render/SessionEnvironment.h"
 #include "render/evaluation/RealtimeBench.h"
+#include "render/governor/FrameBudgetGovernor.h"
 #include "render/raytrace/GroundTruthComposite.h"
 
 namespace mirage::app {
@@ -56,7 +57,23 @@ struct BenchArgs {
     bool quick = false, listKnobs = false, noBaseline = false, images = false, force = false;
     int maxFrames = -1, start = 0, repeats = 1;
     float exposure = 1.0f;
+    double budgetMs = 0;  // > 0: the setting a frame-time governor holds there (budget.md)
 };
+
+// The rows' governed knobs, median wall ms and influenced PSNR as the governor's table.
+render::SpeedErrorTable speedErrorTable(const std::vector<render::BenchResult>& results) {
+    std::vector<render::SpeedErrorRow> rows;
+    for (const render::BenchResult& r : results) {
+        if (r.baseline) continue;
+        render::SpeedErrorRow row;
+        for (const auto& [name, value] : r.config.knobs)
+            if (render::isGovernedKnob(name)) row.setting[name] = value;
+        row.frameMs = r.medianWallMs;
+        row.psnrDb = r.error.psnrInfluenced;
+        rows.push_back(std::move(row));
+    }
+    return render::SpeedErrorTable(std::move(rows));
+}
 
 std::map<std::string, std::vector<std::string>> parseKnobs(const std::vector<std::string>& specs) {
     std::map<std::string, std::vector<std::string>> out;
@@ -309,6 +326,11 @@ void runBench(const BenchArgs& a) {
     framesOut->commit();
     mdOut->commit();
     if (a.images) writeBenchImages(out / "images", results);
+    if (a.budgetMs > 0) {
+        const std::string report = render::budgetReport(speedErrorTable(results), a.budgetMs);
+        std::ofstream(out / "budget.md") << report;
+        spdlog::info("bench: {}", report.substr(0, report.find("\n\nThe speed")));
+    }
     spdlog::info("bench: wrote {}, {}, {} (load average {} after)", (out / "bench.csv").string(),
                  (out / "bench_frames.csv").string(), (out / "bench.md").string(), loadAfter);
 }
@@ -334,6 +356,12 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
     cmd->add_option("--frames", a->maxFrames, "Use at most N frames")
         ->check(wholeIn(-1, 100000000));
     cmd->add_option("--start", a->start, "First frame")->check(wholeIn(0, 100000000));
+    cmd->add_option("--budget-ms", a->budgetMs,
+                    "Frame-time budget (ms): OUTDIR/budget.md says which setting of the grid a "
+                    "frame-time governor holds there (the most accurate within it on the "
+                    "speed-vs-error front of the grid's rows) and its error beside the most "
+                    "accurate setting's")
+        ->check(CLI::Range(0.0, 60000.0));
     cmd->add_option("--repeat", a->repeats, "Run the frame sequence R times (timings pooled)")
         ->capture_default_str()
         ->check(wholeIn(1, 10000));

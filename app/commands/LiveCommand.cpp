@@ -85,6 +85,16 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
         ->check(outputPath(OutputShape::Folder));
     cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
         ->check(wholeIn(0, 16384));
+    cmd->add_option("--budget-ms", args->budgetMs,
+                    "Frame-time budget of rendering and compositing in ms: each frame's quality "
+                    "(specular resolution, caustic refresh, ...) is chosen to meet it with the "
+                    "least error (default: the camera's frame interval; 0: off, full quality)")
+        ->check(finiteIn(0, 60000));
+    cmd->add_option("--budget-table", args->budgetTable,
+                    "The speed-vs-error table the budget chooses from: a `mirage bench` "
+                    "bench.csv (default: data/governor/tabletop_llvmpipe.csv, measured on "
+                    "llvmpipe, 2 cores)")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--exposure", args->exposure, "Rendered radiance -> camera linear units")
         ->check(finiteIn(0, 1e6, true));
     cmd->add_option("--shutter", args->shutter,

@@ -15,6 +15,11 @@ struct LiveOptions {
     int width = 640, height = 480;
     int maxFrames = -1;
     int vpls = 256;
+    // Frame-time budget of the render stage, ms (--budget-ms): -1 the camera's frame interval, 0
+    // off; and the speed-vs-error table it chooses from (--budget-table; empty: the table measured
+    // on llvmpipe, kDefaultBudgetTable).
+    double budgetMs = -1;
+    std::string budgetTable;
     float exposure = 1.0f;
     // The webcam's exposure time for the motion blur, seconds (--shutter; 0 = off); unset: the
     // locked --camera-exposure, else off.

@@ -1,7 +1,10 @@
 #include "app/live/LiveRenderStage.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+
+#include <spdlog/spdlog.h>
 
 #include "core/Error.h"
 #include "render/passes/direct/DirectLightPass.h"
@@ -47,6 +50,18 @@ LiveRenderStage::LiveRenderStage(const Scene& scene, const PlacementPlane& plane
       camera_(camera),
       settings_(std::move(settings)) {
     if (environment) environment_ = *environment;
+    if (settings_.budgetMs > 0) {
+        render::GovernorOptions g;
+        g.budgetMs = settings_.budgetMs;
+        governor_ = std::make_unique<render::FrameBudgetGovernor>(
+            render::SpeedErrorTable::readBenchCsv(!settings_.budgetTable.empty()
+                                                      ? settings_.budgetTable
+                                                      : std::string(MIRAGE_DEFAULT_DATA_DIR) +
+                                                            "/governor/tabletop_llvmpipe.csv"),
+            g);
+        spdlog::info("live: frame-time budget {:.1f} ms over {} quality settings; {}",
+                     settings_.budgetMs, governor_->ladder().size(), governor_->summary());
+    }
     rebuild();
 }
 
@@ -75,7 +90,19 @@ void LiveRenderStage::rebuild() {
 
 CompositedFrame LiveRenderStage::composite(const cv::Mat& bgr, PoseRow pose, bool renderVirtual,
                                            double seconds) {
-    return compositor_->composite(bgr, std::move(pose), renderVirtual, seconds);
+    if (!governor_) return compositor_->composite(bgr, std::move(pose), renderVirtual, seconds);
+    // The frame's quality is the governor's; its time, render + composite + readback (the stage
+    // the budget holds), is what the governor learns from.
+    render::RendererOptions quality = renderer_->options();
+    render::applyQualitySetting(governor_->setting(), quality);
+    renderer_->setQuality(quality);
+    const auto t0 = std::chrono::steady_clock::now();
+    CompositedFrame out = compositor_->composite(bgr, std::move(pose), renderVirtual, seconds);
+    if (out.report && governor_->observe(std::chrono::duration<double, std::milli>(
+                                             std::chrono::steady_clock::now() - t0)
+                                             .count()))
+        spdlog::info("live: {}", governor_->summary());
+    return out;
 }
 
 std::string LiveRenderStage::updateEnvironment(const cv::Mat& bgr, double seconds) {

@@ -15,6 +15,7 @@
 #include "core/scene/Scene.h"
 #include "core/scene/ScenePlacement.h"
 #include "render/Renderer.h"
+#include "render/governor/FrameBudgetGovernor.h"
 
 namespace mirage::app {
 
@@ -50,6 +51,11 @@ struct LiveRenderSettings {
     float exposure = 1.0f;
     int environmentLights = 0;
     bool keepDirectLight = false;
+    // The frame-time budget (ms) the governor holds by choosing each frame's quality
+    // (render/governor/; docs/live.md, "Frame-time budget"); 0: off, every frame at full quality.
+    double budgetMs = 0;
+    // The `mirage bench` bench.csv it chooses from; empty: data/governor/tabletop_llvmpipe.csv.
+    std::string budgetTable;
 };
 
 class LiveRenderStage {
@@ -88,6 +94,8 @@ public:
     cv::Mat view(int index) const;
     std::vector<std::string> passNames() const { return renderer_->passNames(); }
     render::Renderer& renderer() { return *renderer_; }
+    // The governor when a budget is set (null otherwise): what it chose and why.
+    const render::FrameBudgetGovernor* governor() const { return governor_.get(); }
 
 private:
     const Scene& scene_;
@@ -101,6 +109,7 @@ private:
     double envSeconds_ = 0;
     std::unique_ptr<render::Renderer> renderer_;
     std::unique_ptr<FrameCompositor> compositor_;
+    std::unique_ptr<render::FrameBudgetGovernor> governor_;
     int builds_ = 0;
 };
 

@@ -160,6 +160,8 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     settings.effects.composite.cameraResponse = cameraResponseOrSrgb(calibrationPath_);
     switchEffectsOff(a.effectsOff, settings.effects);
     settings.vpls = a.vpls;
+    settings.budgetMs = a.budgetMs >= 0 ? a.budgetMs : 1000.0 / camera_.fps;
+    settings.budgetTable = a.budgetTable;
     settings.exposure = a.exposure;
     settings.effects.motionBlur.shutterSeconds = liveShutterSeconds(a);
     settings.keepDirectLight = !a.headless;

@@ -232,6 +232,20 @@ void specularKnobs(std::vector<BenchKnob>& knobs) {
                  c.options.specular.vplStride = n;
              },
              [](const BenchConfig& c) { return std::to_string(c.options.specular.vplStride); }},
+            {"specular_trace_resolution",
+             "resolution of the reflected/refracted ray search (specgbuf): full (a ray pair per "
+             "specular pixel) or half (one per 2x2 block, filled by primary-surface geometry)",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{
+                     RendererOptions{}.specular.halfResolutionTrace ? "half" : "full"};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.specular.halfResolutionTrace =
+                     parseChoice("specular_trace_resolution", v, "half", "full");
+             },
+             [](const BenchConfig& c) {
+                 return std::string(c.options.specular.halfResolutionTrace ? "half" : "full");
+             }},
             {"specular_resolution",
              "resolution of the lighting at the reflected/refracted hits: full (every specular "
              "pixel) or half (one pixel per 2x2 block, upsampled by hit geometry)",
@@ -368,6 +382,19 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                  c.options.caustic.gatherCap = int(q);
              },
              [](const BenchConfig& c) { return std::to_string(c.options.caustic.gatherCap); }},
+            {"caustic_refresh",
+             "frames between two splats of the caustic photons (1..8); in the frames between, last "
+             "frame's caustic reprojected by the receivers' positions",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{
+                     std::to_string(RendererOptions{}.caustic.refreshInterval)};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 c.options.caustic.refreshInterval = parseInt("caustic_refresh", v, 1, 8);
+             },
+             [](const BenchConfig& c) {
+                 return std::to_string(c.options.caustic.refreshInterval);
+             }},
             {"caustic_temporal",
              "on: the caustic buffer smoothed over frames (reprojected history, the GI filter's "
              "reset rules); off: every frame's caustic stands alone",

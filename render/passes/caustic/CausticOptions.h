@@ -43,6 +43,14 @@ struct CausticOptions {
     // spreads them (a rough mirror throws a soft glow, not its smooth twin's sharp patch;
     // docs/caustics.md, "Rough surfaces"). false: every photon follows the mirror / Snell ray.
     bool roughLobes = true;
+    // Temporal reuse of the caustic buffer (docs/caustics.md, "Refreshing every N frames"): the
+    // photons are splatted in one frame of every refreshInterval; in the frames between, the
+    // caustic irradiance is last frame's, reprojected by the receiver's world position (a caustic
+    // lies on diffuse receivers: it does not depend on the view) with the smoothing's same-surface
+    // test. A receiver whose history is rejected (disoccluded) has no caustic until the next
+    // refresh; a frame that drops the history (first frame, cut, objects moved) splats. 1: every
+    // frame.
+    int refreshInterval = 1;
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 2048 && mapSize % 8 == 0, "caustic.mapSize",
@@ -53,6 +61,8 @@ struct CausticOptions {
                     "in [0.001, 0.5] (metres)", gatherRadius);
         checkOption(gatherCap >= 0 && gatherCap <= (1 << 20), "caustic.gatherCap",
                     "0 (all photons) or 1..1048576 photons per bucket", gatherCap);
+        checkOption(refreshInterval >= 1 && refreshInterval <= 8, "caustic.refreshInterval",
+                    "1..8 frames", refreshInterval);
     }
 };
 

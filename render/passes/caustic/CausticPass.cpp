@@ -30,8 +30,16 @@ void CausticPass::setup(PassBuilder& b) const {
     b.create(kCausticHistoryR, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
 }
 
+bool CausticPass::reusesHistory(const FrameContext& ctx) const {
+    const int interval = ctx.options.caustic.refreshInterval;
+    return interval > 1 && framesSinceSplat_ + 1 < interval && history_.usable(ctx, 1.0f);
+}
+
 PassDecision CausticPass::decide(const FrameContext& ctx) const {
     if (ctx.plan.causticLayers == 0) return {false, ctx.plan.causticReason};
+    if (reusesHistory(ctx))
+        return {true, "last frame's caustic reprojected (photons splatted every " +
+                          std::to_string(ctx.options.caustic.refreshInterval) + " frames)"};
     return {true, "photon quads of " + std::to_string(ctx.plan.causticLayers) +
                       " light(s) splatted (compute, atomics), " +
                       history_.note(ctx, causticBlend(ctx))};
@@ -65,12 +73,19 @@ void CausticPass::resize(const FrameContext& ctx) {
 }
 
 void CausticPass::execute(FrameContext& ctx, PassResources& res) {
-    const GLuint zero = 0;
-    glClearTexImage(accum_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     // Fixed point: 2^24 units = 64 x the brightest caustic light's irradiance at its objects, so
     // a counter wraps only past ~16,000 times that (a focus far beyond what a pixel can hold)
     // while ~4e-6 of it still counts.
     const float fixedScale = 16777216.0f / (64.0f * std::max(ctx.plan.causticIrradiance, 1e-6f));
+    const bool reuse = reusesHistory(ctx);
+    framesSinceSplat_ = reuse ? framesSinceSplat_ + 1 : 0;
+    if (!reuse) splat(ctx, res, fixedScale);
+    resolve(ctx, res, reuse ? 0.0f : 1.0f / fixedScale, reuse);
+}
+
+void CausticPass::splat(FrameContext& ctx, PassResources& res, float fixedScale) {
+    const GLuint zero = 0;
+    glClearTexImage(accum_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     splat_.use();
     ctx.bindFrameBlocks();
     glBindTextureUnit(kUnitSplatReflHit, res.texture(kPhotonHitRefl).id());
@@ -87,7 +102,11 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
     glUniform1f(splat_.uniformLocation("fixedScale"), fixedScale);
     glDispatchCompute(GLuint((s + 7) / 8), GLuint((s + 7) / 8), GLuint(2 * ctx.plan.causticLayers));
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+}
 
+// invFixedScale 0: the caustic buffer counts for nothing (a reuse frame: its counters are an
+// older frame's, in that frame's pixels); `reuse`: the history is taken whole where it passes.
+void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedScale, bool reuse) {
     const int write = history_.writeSlot(), read = history_.readSlot();
     fbo_[write].bind();
     ctx.beginFullscreen(resolve_, width_, height_);
@@ -97,8 +116,8 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitResolveEmissive, res.texture(kGBufferEmissive).id());
     glBindTextureUnit(kUnitResolveHistoryRv, historyRv_[read].id());
     glBindTextureUnit(kUnitResolveHistoryR, historyR_[read].id());
-    glUniform1f(resolve_.uniformLocation("invFixedScale"), 1.0f / fixedScale);
-    const float blend = causticBlend(ctx);
+    glUniform1f(resolve_.uniformLocation("invFixedScale"), invFixedScale);
+    const float blend = reuse ? 1.0f : causticBlend(ctx);
     glUniform1f(resolve_.uniformLocation("historyWeight"),
                 history_.usable(ctx, blend) ? blend : 0.0f);
     ctx.drawFullscreenTriangle();

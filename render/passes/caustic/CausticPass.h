@@ -31,6 +31,11 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
+    // This frame takes last frame's caustic instead of splatting (CausticOptions::refreshInterval).
+    bool reusesHistory(const FrameContext& ctx) const;
+    void splat(FrameContext& ctx, PassResources& res, float fixedScale);
+    void resolve(FrameContext& ctx, PassResources& res, float invFixedScale, bool reuse);
+
     gl::Program splat_, resolve_;
     gl::Texture accum_, rv_, r_;
     // Smoothed irradiance for L_rv / L_r, a = camera distance (m); [history_.writeSlot()] is
@@ -38,6 +43,7 @@ private:
     gl::Texture historyRv_[2], historyR_[2];
     gl::Framebuffer fbo_[2];
     TemporalHistory history_;
+    int framesSinceSplat_ = 0;  // frames since the photons were last splatted
     int width_ = 0, height_ = 0;
 };
 

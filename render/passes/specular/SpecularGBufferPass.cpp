@@ -78,6 +78,36 @@ void SpecularGBufferPass::resize(const FrameContext& ctx) {
     allocate(refl_, "GBuf_refl", w, h);
     allocate(refr_, "GBuf_refr", w, h);
     attachedMask_ = 0;
+    halfWidth_ = halfHeight_ = 0;  // the half-resolution buffers follow on first use
+}
+
+void SpecularGBufferPass::allocateHalfResolution() {
+    halfWidth_ = (width_ + 1) / 2;
+    halfHeight_ = (height_ + 1) / 2;
+    allocate(halfRefl_, "half GBuf_refl", halfWidth_, halfHeight_);
+    allocate(halfRefr_, "half GBuf_refr", halfWidth_, halfHeight_);
+    halfMask_ = gl::Texture::create2D("half specular block mask", halfWidth_, halfHeight_,
+                                      GL_DEPTH_COMPONENT32F);
+    halfMaskFbo_ = gl::Framebuffer("half specular block mask fbo");
+    halfMaskFbo_.attachDepth(halfMask_);
+    halfMaskFbo_.finalize(0);
+    halfMaskDrawn_.markAll();
+    for (SpecularHitBuffer* hits : {&halfRefl_, &halfRefr_}) {
+        hits->fbo.attachDepth(halfMask_);
+        hits->fbo.finalize(5);
+    }
+    if (halfPrograms_[0].id() != 0) return;
+    for (int mode = 0; mode < 2; ++mode) {
+        const std::string defines = "#define MIRAGE_SPECULAR_MODE " + std::to_string(mode) + "\n";
+        const std::string what = mode == 0 ? " (reflection)" : " (refraction)";
+        halfPrograms_[mode] = fullscreenProgram("specular gbuffer, half resolution" + what,
+                                                "passes/specular/specular_gbuffer.frag",
+                                                defines + "#define MIRAGE_SPECULAR_TRACE_HALF 1\n");
+        fillPrograms_[mode] = fullscreenProgram(
+            "specular gbuffer fill" + what, "passes/specular/specular_trace_fill.frag", defines);
+    }
+    halfMaskProgram_ = fullscreenProgram("specular half-resolution mask",
+                                         "passes/specular/specular_half_mask.frag");
 }
 
 void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
@@ -98,6 +128,20 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         }
         attachedMask_ = mask.id();
     }
+    if (ctx.options.specular.halfResolutionTrace)
+        traceHalfResolution(ctx, res);
+    else
+        traceFullResolution(ctx);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+    publish(res, refl_, kReflectionGBuffer, kReflectionNormal, kReflectionAlbedo,
+            kReflectionEmissive, kReflectionWeight);
+    publish(res, refr_, kRefractionGBuffer, kRefractionNormal, kRefractionAlbedo,
+            kRefractionEmissive, kRefractionWeight);
+}
+
+void SpecularGBufferPass::traceFullResolution(FrameContext& ctx) {
     for (int mode = 0; mode < 2; ++mode) {
         SpecularHitBuffer& hits = mode == 0 ? refl_ : refr_;
         hits.fbo.bind();
@@ -115,13 +159,69 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
         ctx.clearForRects(rects, hits.drawn, 0, 5);
         ctx.drawFullscreenTriangleIn(rects);
     }
+}
+
+namespace {
+// Canvas rectangles in half pixels (2x2 blocks), rounded outwards.
+std::vector<glm::ivec4> halfRects(const std::vector<glm::ivec4>& rects) {
+    std::vector<glm::ivec4> out;
+    for (const glm::ivec4& s : rects)
+        out.push_back(
+            {s.x / 2, s.y / 2, (s.x + s.z + 1) / 2 - s.x / 2, (s.y + s.w + 1) / 2 - s.y / 2});
+    return mergeOverlappingRects(std::move(out));
+}
+}  // namespace
+
+void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& res) {
+    if (halfWidth_ == 0) allocateHalfResolution();
+    // The blocks holding a specular pixel (depth 0; specular_half_mask.frag reads the flag from
+    // the primary G-buffer's emissive alpha, the specular slot + 1).
+    const std::vector<glm::ivec4> blocks = halfRects(ctx.specularRects);
+    halfMaskFbo_.bind();
+    ctx.beginFullscreen(halfMaskProgram_, halfWidth_, halfHeight_);
+    glBindTextureUnit(kUnitSpecLightReflFirst + 3, res.texture(kGBufferEmissive).id());
     glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_DEPTH_TEST);
-    publish(res, refl_, kReflectionGBuffer, kReflectionNormal, kReflectionAlbedo,
-            kReflectionEmissive, kReflectionWeight);
-    publish(res, refr_, kRefractionGBuffer, kRefractionNormal, kRefractionAlbedo,
-            kRefractionEmissive, kRefractionWeight);
+    ctx.clearForRects(blocks, halfMaskDrawn_, 0, 0, true);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    ctx.drawFullscreenTriangleIn(blocks);
+    // The trace's units again (the mask's shared one).
+    glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(kBackFacePosition).id());
+    for (int mode = 0; mode < 2; ++mode) {
+        SpecularHitBuffer& hits = mode == 0 ? halfRefl_ : halfRefr_;
+        hits.fbo.bind();
+        const gl::Program& program = halfPrograms_[mode];
+        ctx.beginFullscreen(program, halfWidth_, halfHeight_);
+        if (mode == 1)
+            glUniform1i(program.uniformLocation("marchSteps"),
+                        ctx.options.specular.refractionMarchSteps);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+        ctx.clearForRects(blocks, hits.drawn, 0, 5);
+        ctx.drawFullscreenTriangleIn(blocks);
+    }
+    // The fill, on the canvas's specular pixels.
+    const gl::Texture* half[10] = {&halfRefl_.position, &halfRefl_.normal, &halfRefl_.albedo,
+                                   &halfRefl_.emissive, &halfRefl_.weight, &halfRefr_.position,
+                                   &halfRefr_.normal,   &halfRefr_.albedo, &halfRefr_.emissive,
+                                   &halfRefr_.weight};
+    for (int mode = 0; mode < 2; ++mode) {
+        SpecularHitBuffer& hits = mode == 0 ? refl_ : refr_;
+        hits.fbo.bind();
+        ctx.beginFullscreen(fillPrograms_[mode], ctx.canvasWidth(), ctx.canvasHeight());
+        for (int i = 0; i < 10; ++i)
+            glBindTextureUnit(GLuint(kUnitSpecFillHalfFirst + i), half[i]->id());
+        glBindTextureUnit(kUnitSpecFillPosition, res.texture(kGBufferPosition).id());
+        glBindTextureUnit(kUnitSpecFillNormal, res.texture(kGBufferNormal).id());
+        glBindTextureUnit(kUnitSpecFillEmissive, res.texture(kGBufferEmissive).id());
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+        const std::vector<glm::ivec4>& rects = mode == 0 ? ctx.specularRects : ctx.refractiveRects;
+        ctx.clearForRects(rects, hits.drawn, 0, 5);
+        ctx.drawFullscreenTriangleIn(rects);
+    }
 }
 
 }  // namespace mirage::render

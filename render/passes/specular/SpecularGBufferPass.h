@@ -41,12 +41,26 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
+    // One ray pair per pixel into refl_ / refr_, or (halfResolutionTrace) per 2x2 block into the
+    // half-size buffers, then filled into refl_ / refr_.
+    void traceFullResolution(FrameContext& ctx);
+    void traceHalfResolution(FrameContext& ctx, PassResources& res);
+    void allocateHalfResolution();
+
     ImpostorPass::TableViews impostorTables_;  // trace.glsl's tables, bound every frame
     SceneTableViews sceneTables_;              // materials and specular draws, likewise
     gl::Program programs_[2];  // [0] reflection, [1] refraction (MIRAGE_SPECULAR_MODE)
     GLuint attachedMask_ = 0;  // the SpecularMask texture attached as both hit buffers' depth
     SpecularHitBuffer refl_, refr_;
     int width_ = 0, height_ = 0;
+    // RendererOptions::specular.halfResolutionTrace (built and allocated on first use): the
+    // half-resolution trace's programs, its fill's, the half-size hits and specular-block mask.
+    gl::Program halfPrograms_[2], fillPrograms_[2], halfMaskProgram_;
+    SpecularHitBuffer halfRefl_, halfRefr_;
+    gl::Texture halfMask_;
+    gl::Framebuffer halfMaskFbo_;
+    DrawnRects halfMaskDrawn_;
+    int halfWidth_ = 0, halfHeight_ = 0;
 };
 
 }  // namespace mirage::render

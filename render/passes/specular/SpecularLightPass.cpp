@@ -53,17 +53,21 @@ SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOption
     if (sceneCanGather_)
         gather_ = makeVariant("specular light (caustic gather)",
                               scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-    if (options.specular.halfResolution) {
-        const std::string half = scene.lightingDefines() + "#define MIRAGE_SPECULAR_HALF 1\n";
-        halfPlain_ = makeVariant("specular light (half resolution)", half);
-        if (sceneCanGather_)
-            halfGather_ = makeVariant("specular light (half resolution, caustic gather)",
-                                      half + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-        resolve_ =
-            fullscreenProgram("specular light upsample", "passes/specular/specular_resolve.frag");
-        halfMaskProgram_ = fullscreenProgram("specular half-resolution mask",
-                                             "passes/specular/specular_half_mask.frag");
-    }
+    if (options.specular.halfResolution) buildHalfResolution(scene);
+}
+
+// The half-resolution variants, their upsample and mask (RendererOptions::specular.halfResolution,
+// which a frame-time governor may switch on while the renderer runs: built on first use).
+void SpecularLightPass::buildHalfResolution(const GpuScene& scene) {
+    const std::string half = scene.lightingDefines() + "#define MIRAGE_SPECULAR_HALF 1\n";
+    halfPlain_ = makeVariant("specular light (half resolution)", half);
+    if (sceneCanGather_)
+        halfGather_ = makeVariant("specular light (half resolution, caustic gather)",
+                                  half + "#define MIRAGE_CAUSTIC_GATHER 1\n");
+    resolve_ =
+        fullscreenProgram("specular light upsample", "passes/specular/specular_resolve.frag");
+    halfMaskProgram_ = fullscreenProgram("specular half-resolution mask",
+                                         "passes/specular/specular_half_mask.frag");
 }
 
 void SpecularLightPass::setup(PassBuilder& b) const {
@@ -120,8 +124,12 @@ void SpecularLightPass::resize(const FrameContext& ctx) {
         attachedMask_[i] = 0;  // execute() attaches the specular mask
         drawn_[i].markAll();
     }
-    history_.drop();  // new buffers hold no history
-    if (!ctx.options.specular.halfResolution) return;
+    history_.drop();               // new buffers hold no history
+    halfWidth_ = halfHeight_ = 0;  // the half-resolution targets follow on first use
+    if (ctx.options.specular.halfResolution) allocateHalfResolution(w, h);
+}
+
+void SpecularLightPass::allocateHalfResolution(int w, int h) {
     halfWidth_ = (w + 1) / 2;
     halfHeight_ = (h + 1) / 2;
     const int hw = halfWidth_, hh = halfHeight_;
@@ -250,7 +258,9 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecLightHistoryR, r_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryRRefl, rRefl_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryHits, hits_[read].id());
-    if (ctx.options.specular.halfResolution && halfPlain_.program.id() != 0) {
+    if (ctx.options.specular.halfResolution) {
+        if (halfPlain_.program.id() == 0) buildHalfResolution(ctx.scene);
+        if (halfWidth_ == 0) allocateHalfResolution(width_, height_);
         shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, write);
     } else {
         const Variant& v = gather ? gather_ : plain_;

@@ -26,6 +26,13 @@ struct SpecularOptions {
     // back by their own hit albedo, Fresnel weight and emission; L_env stays per pixel
     // (specular_resolve.frag, docs/specular.md "Cost"). false: every specular pixel is shaded.
     bool halfResolution = false;
+    // The reflected / refracted rays (specgbuf) traced at half the canvas resolution per axis: one
+    // ray pair per 2x2 block, from the block's first specular pixel, then every specular pixel
+    // takes the hits of the block around it whose primary surface matches its own best (same
+    // object, tangent plane, normal: specular_trace_fill.frag), so an object's edge keeps its
+    // pixels. The ray search is a quarter of the work; the hits are 2x2 blocks. false: a ray pair
+    // per pixel.
+    bool halfResolutionTrace = false;
     // Tests only: false drops the upsample's geometry test (plain bilinear weights; halos at
     // depth steps in the reflections).
     bool upsampleGeometry = true;

@@ -63,8 +63,30 @@ void writeHit(SurroundingHit h, vec3 dir, vec3 weight, float inside) {
                      isnan(inside) || isinf(inside) ? 0.0 : inside);
 }
 
+#ifdef MIRAGE_SPECULAR_TRACE_HALF
+// Half-resolution trace (RendererOptions::specular.halfResolutionTrace): this fragment is a 2x2
+// block of the canvas, traced from its representative, the block's first specular pixel (x then
+// y), as specular_trace_fill.frag finds it again; -1 when the block has none.
+ivec2 blockRepresentative(ivec2 block) {
+    ivec2 size = textureSize(gEmissive, 0);
+    for (int i = 0; i < 4; ++i) {
+        ivec2 c = 2 * block + ivec2(i & 1, i >> 1);
+        if (all(lessThan(c, size)) && texelFetch(gEmissive, c, 0).a >= 0.5) return c;
+    }
+    return ivec2(-1);
+}
+#endif
+
 void main() {
+#ifdef MIRAGE_SPECULAR_TRACE_HALF
+    ivec2 px = blockRepresentative(ivec2(gl_FragCoord.xy));
+    if (px.x < 0) {
+        outPosition = outNormal = outAlbedo = outEmissive = outWeight = vec4(0.0);
+        return;
+    }
+#else
     ivec2 px = ivec2(gl_FragCoord.xy);
+#endif
     outPosition = vec4(0.0);
     outNormal = vec4(0.0);
     outAlbedo = vec4(0.0);
