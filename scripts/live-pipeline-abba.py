@@ -29,7 +29,7 @@ MODES = {"serial": ["--no-pipeline", "--no-predict"], "pipelined": []}
 def summarise(csv_path, log):
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))[1:]
-    num = lambda r, k: float(r[k]) if r[k] != "" else 0.0
+    num = lambda r, k: float(r[k]) if r.get(k, "") != "" else 0.0
     displayed = [num(r, "t") + num(r, "latency_ms") / 1e3 for r in rows]
     lat = [num(r, "latency_ms") for r in rows]
     pred = [num(r, "predict_ms") for r in rows]

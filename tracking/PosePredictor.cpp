@@ -66,10 +66,13 @@ void PosePredictor::update(const Pose& pose, double t) {
         reset();
         return;
     }
-    if (last_ && t > lastT_ && t - lastT_ <= options_.maxGapS)
-        velocity_ = velocityBetween(*last_, pose, t - lastT_);
-    else
-        velocity_.reset();
+    velocity_.reset();
+    if (last_ && t > lastT_ && t - lastT_ <= options_.maxGapS) {
+        const PoseVelocity v = velocityBetween(*last_, pose, t - lastT_);
+        const double speed = glm::length(pose.translation - last_->translation) / (t - lastT_);
+        if (speed <= options_.maxSpeedMps && glm::length(v.angular) <= options_.maxTurnRadps)
+            velocity_ = v;
+    }
     last_ = pose;
     lastT_ = t;
 }

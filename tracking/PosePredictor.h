@@ -35,6 +35,11 @@ struct PosePredictorOptions {
     // Predictions are made at most this far past the last pose (seconds): a horizon beyond
     // it is cut to it (a hand's motion does not stay constant for longer).
     double maxAheadS = 0.5;
+    // Two poses implying a faster motion give no velocity (m/s of the camera centre, rad/s of
+    // turn): a jump, not a motion (a tracking glitch, a recorded stand-in starting again), whose
+    // extrapolation would throw the pose far off.
+    double maxSpeedMps = 3.0;
+    double maxTurnRadps = 6.0;
 };
 
 class PosePredictor {
@@ -42,7 +47,8 @@ public:
     explicit PosePredictor(PosePredictorOptions options = {}) : options_(options) {}
 
     // A pose measured at time `t` (seconds, increasing). A non-increasing time, a gap longer
-    // than maxGapS or a non-finite pose starts again from this pose (no velocity yet).
+    // than maxGapS, a jump (faster than maxSpeedMps or maxTurnRadps) or a non-finite pose starts
+    // again from this pose (no velocity yet).
     void update(const Pose& T_world_camera, double t);
     // Forgets every pose (tracking was lost: the next pose starts afresh).
     void reset();

@@ -142,6 +142,11 @@ TEST(PosePredictor, NoVelocityWhereItCannotBeKnownAndABoundedHorizon) {
     EXPECT_FALSE(p.predict(0.9)) << "a non-finite pose was kept";
     p.update(orbit(0.85, 1.0), 0.85);
     p.update(orbit(0.9, 1.0), 0.9);
+    ASSERT_TRUE(p.velocity());
+    // A jump (the orbit half way round in 0.1 s: 10 m/s) gives no velocity.
+    p.update(orbit(3.1, 1.0), 1.0);
+    EXPECT_FALSE(p.velocity()) << "a jump gave a velocity";
+    p.update(orbit(0.9, 1.0), 1.1);
     p.reset();
     EXPECT_FALSE(p.velocity());
     EXPECT_FALSE(p.predict(1.0));
