@@ -20,19 +20,21 @@ public:
     // `groundTruth[i]`: T_world_camera of the stand-in's frame i (nullopt where unknown);
     // `releaseSeconds[i]`: when the stand-in releases frame i, relative to frame 0 (seconds).
     // A looped stand-in's frame counter k is frame k mod the frame count. `camera`: the main
-    // camera, for the image offset of the world origin.
+    // camera, for the image offset of points around the world origin.
     DisplayPoseError(std::vector<std::optional<Pose>> groundTruth,
                      std::vector<double> releaseSeconds, CameraIntrinsics camera);
 
     struct Sample {
-        double shownPx = 0, trackedPx = 0;  // image offset of the world origin, pixels
+        // Mean image offset of four points 10 cm around the world origin on its XZ plane (the
+        // board's, where the objects stand), pixels.
+        double shownPx = 0, trackedPx = 0;
         double shownMm = 0, trackedMm = 0;  // distance of the camera centre, millimetres
     };
     // Frame `sequence` (the camera's counter), captured at `captureSeconds` and displayed at
     // `displaySeconds` (steady clock), shown with `shown` and tracked as `tracked`
     // (T_world_camera). nullopt (and not counted) where the ground truth at the display time is
     // unknown: past the stand-in's last frame (a looped one starts again), a frame without
-    // ground truth, or the world origin behind a camera.
+    // ground truth, or a point behind a camera.
     std::optional<Sample> add(int64_t sequence, double captureSeconds, double displaySeconds,
                               const Pose& shown, const Pose& tracked);
 
