@@ -347,7 +347,7 @@ void LiveSession::process(TrackedLiveFrame& tracked, double takenAt) {
     // The pose at the time the frame is expected on display, not at its capture.
     PoseRow shown = tracked.pose;
     double predictMs = std::numeric_limits<double>::quiet_NaN();
-    if (!options_.noPredict && tracked.motion && shown.pose) {
+    if (!options_.noPredict && tracked.motion && tracked.motion->velocity() && shown.pose) {
         const double displayAt = schedule_.expectedDisplay(takenAt);
         predictMs = tracked.motion->horizon(displayAt) * 1e3;
         shown.pose = tracked.motion->predict(displayAt);
