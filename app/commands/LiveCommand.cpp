@@ -65,6 +65,12 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
     cmd->add_flag("--camera-loop", args->loop,
                   "Play a stand-in session or video again from the start when it ends");
     cmd->add_flag("--headless", args->headless, "No window (EGL): for tests and benchmarks");
+    cmd->add_flag("--no-pipeline", args->noPipeline,
+                  "Track each frame on the GL thread before rendering it, instead of tracking the "
+                  "next frame on a thread of its own while the frame before renders");
+    cmd->add_flag("--no-predict", args->noPredict,
+                  "Render with the pose as tracked at capture, instead of the pose predicted to "
+                  "the frame's display time");
     cmd->add_flag("--board-only", args->boardOnly,
                   "Track the board's tags only, no natural features (docs/tracking.md)");
     cmd->add_option("--frames", args->maxFrames, "Stop after N processed frames")

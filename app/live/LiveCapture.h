@@ -3,6 +3,7 @@
 // latest-frame hand-off (core/capture/LatestFrameCapture.h), and for each main frame the
 // environment frame nearest to it in time. Capture never waits for processing: frames that
 // arrive while the loop is busy replace each other in the slot and are counted as dropped.
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
@@ -40,7 +41,8 @@ public:
 
     bool ended() const { return main_.ended(); }
     // The environment camera ended (its last frame keeps lighting); the reason, once.
-    bool environmentEnded() const { return envEnded_; }
+    // Read by the GL thread while next() runs on the tracking worker's.
+    bool environmentEnded() const { return envEnded_.load(); }
     bool hasEnvironment() const { return env_.has_value(); }
     // The camera is unplugged or stalled and is being reopened; the reason.
     bool lost() const { return main_.state() == LatestFrameCapture::State::Lost; }
@@ -55,7 +57,7 @@ private:
     double envHalfPeriodS_ = 0;
     cv::Mat envLatest_;  // the environment's newest frame as delivered, and its time
     double envLatestS_ = 0;
-    bool envEnded_ = false;
+    std::atomic<bool> envEnded_{false};
 };
 
 }  // namespace mirage::app

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <functional>
@@ -109,6 +110,28 @@ std::string timestampName(const char* prefix, const char* ext) {
     return std::string(prefix) + buf + ext;
 }
 
+namespace {
+
+// When a session stand-in releases each frame (CameraInput::releaseSeconds): its own times
+// relative to its first, or i / fps when paced at a rate (or when a time is missing). No ground
+// truth at all: none.
+void releaseTimes(CameraInput& in) {
+    if (std::none_of(in.groundTruth.begin(), in.groundTruth.end(),
+                     [](const std::optional<Pose>& p) { return p.has_value(); })) {
+        in.groundTruth.clear();
+        in.releaseSeconds.clear();
+        return;
+    }
+    const bool own = in.pacing.paceBySourceTime &&
+                     std::all_of(in.releaseSeconds.begin(), in.releaseSeconds.end(),
+                                 [](double t) { return std::isfinite(t); });
+    const double t0 = in.releaseSeconds.empty() ? 0.0 : in.releaseSeconds.front();
+    for (size_t i = 0; i < in.releaseSeconds.size(); ++i)
+        in.releaseSeconds[i] = own ? in.releaseSeconds[i] - t0 : double(i) / in.fps;
+}
+
+}  // namespace
+
 CameraInput openCamera(const LiveOptions& a) {
     CameraInput in;
     std::string device = a.camera;
@@ -160,6 +183,12 @@ CameraInput openCamera(const LiveOptions& a) {
         in.inputs = sessionInputs(s);
         in.description = "session " + a.camera + " (camera '" + main->name + "')";
         in.pacing.paceBySourceTime = true;  // the session's own frame times
+        const size_t column = size_t(main - s.cameras.data());
+        for (const FrameRecord& r : s.frames) {
+            in.groundTruth.push_back(r.groundTruth);
+            in.releaseSeconds.push_back(column < r.timestamps.size() ? r.timestamps[column]
+                                                                     : std::nan(""));
+        }
     } else {
         in.source = openFrames(p);
         in.inputs = {p};
@@ -187,6 +216,7 @@ CameraInput openCamera(const LiveOptions& a) {
         in.source = std::make_unique<LoopingSource>(std::move(in.source), reopen);
         in.description += ", looped";
     }
+    releaseTimes(in);
     return in;
 }
 

@@ -5,11 +5,13 @@
 // camera with its calibration as the renderer's environment camera.
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/live/LiveOptions.h"
 #include "core/capture/LatestFrameCapture.h"
+#include "core/math/Pose.h"
 #include "core/session/FrameSource.h"
 #include "render/Renderer.h"
 
@@ -27,6 +29,11 @@ struct CameraInput {
     std::vector<std::string> exposureWarnings;
     std::string calibrationHint, boardHint;  // where a webcam's defaults were looked for
     std::vector<std::filesystem::path> inputs;
+    // A recorded session standing in with ground-truth poses: frame i's T_world_camera
+    // (nullopt where unknown) and when the stand-in releases it, seconds after frame 0 (its
+    // own times, or i / fps when paced at a rate). Empty otherwise.
+    std::vector<std::optional<Pose>> groundTruth;
+    std::vector<double> releaseSeconds;
 };
 
 // The environment camera of a live session: its frames (a capture thread of its own, paced as

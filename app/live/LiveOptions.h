@@ -38,6 +38,10 @@ struct LiveOptions {
     // environment camera, and its calibration (intrinsics, extrinsics, radiometry_to_main).
     std::string envCamera, envCalibration;
     bool estimateLights = false;  // place the environment camera's dominant lights
+    // By default the next frame is tracked on a thread of its own while the GL thread renders,
+    // and rendered with the pose predicted to its display time (docs/live.md, "How it runs").
+    bool noPipeline = false;  // track, then render, one after the other on the GL thread
+    bool noPredict = false;   // render with the pose as tracked at capture
 };
 
 }  // namespace mirage::app

@@ -34,7 +34,7 @@ void LiveOutputs::open(double fps, int jpegQuality, const std::vector<std::strin
     if (!csv_) throw FileError(csvPath_.string(), "cannot create the timing CSV");
     csv_ << "frame,t,state,reason,camera_frame,dropped,driver_dropped,env_age_ms,tracking_ms";
     for (const std::string& p : passes_) csv_ << "," << p << "_ms";
-    csv_ << ",gpu_ms,readback_ms,frame_ms,latency_ms,tx,ty,tz,qw,qx,qy,qz\n";
+    csv_ << ",gpu_ms,readback_ms,frame_ms,latency_ms,handoff_ms,predict_ms,tx,ty,tz,qw,qx,qy,qz\n";
 }
 
 void LiveOutputs::writeImage(int frame, const cv::Mat& image, double t) {
@@ -47,7 +47,8 @@ void LiveOutputs::writeImage(int frame, const cv::Mat& image, double t) {
 }
 
 void LiveOutputs::writeRow(int frame, const CapturedFrame& f, double envAgeMs,
-                           const CompositedFrame& cf, double frameMs, double latencyMs) {
+                           const CompositedFrame& cf, double frameMs, double latencyMs,
+                           const LivePipelineTimes& pipeline) {
     if (!csv_.is_open()) return;
     csv_ << frame << "," << exactDecimal(f.captureSeconds) << "," << csvField(cf.pose.state) << ","
          << csvField(cf.pose.reason) << "," << f.sequence << "," << f.droppedBefore << ","
@@ -58,7 +59,9 @@ void LiveOutputs::writeRow(int frame, const CapturedFrame& f, double envAgeMs,
         auto it = cf.passMs.find(p);
         csv_ << "," << (it == cf.passMs.end() ? 0.0 : it->second);
     }
-    csv_ << "," << cf.gpuMs << "," << cf.readbackMs << "," << frameMs << "," << latencyMs;
+    csv_ << "," << cf.gpuMs << "," << cf.readbackMs << "," << frameMs << "," << latencyMs << ","
+         << pipeline.handoffMs << ",";
+    if (std::isfinite(pipeline.predictMs)) csv_ << pipeline.predictMs;
     if (cf.pose.pose) {
         const Pose& p = *cf.pose.pose;
         for (double v : {p.translation.x, p.translation.y, p.translation.z, p.rotation.w,

@@ -183,11 +183,14 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
                  a.headless ? "headless" : "window", width, height, boardPath_.string());
     if (!a.headless)
         window_ = std::make_unique<LiveWindow>(*context_, calibration_.intrinsics, plane);
+    if (!camera_.groundTruth.empty())
+        displayError_.emplace(camera_.groundTruth, camera_.releaseSeconds, calibration_.intrinsics);
 }
 
 LiveSession::~LiveSession() {
     // Left by an error: the recording is closed (every frame in it stays playable); the -o
     // outputs, not finished, leave nothing (their temporary files are removed).
+    if (worker_) worker_->stop();  // first: its step reads the capture
     if (capture_) capture_->stop();
     try {
         if (recorder_) recorder_->stop();
@@ -199,17 +202,41 @@ LiveSession::~LiveSession() {
 
 int LiveSession::run() {
     capture_ = std::make_unique<LiveCapture>(camera_, environment_ ? &*environment_ : nullptr);
+    worker_ = std::make_unique<TrackingWorker>(
+        [this](TrackedLiveFrame& out, double timeout) { return trackNext(out, timeout); },
+        !options_.noPipeline);
+    spdlog::info(
+        "live: {}; the pose rendered is {}",
+        worker_->threaded()
+            ? "pipelined (the next frame is tracked on its own thread while this one "
+              "renders)"
+            : "serial (each frame tracked, then rendered)",
+        options_.noPredict ? "the tracked one (not predicted)" : "predicted to the display time");
     const auto tStart = Clock::now();
     lastFrameAt_ = Clock::now();
     while (!stopRequested() && (options_.maxFrames < 0 || processed_ < options_.maxFrames)) {
-        LiveFrame f;
+        TrackedLiveFrame f;
         bool got = false;
+        double takenAt = 0;
         if (!controls_.paused) {
+            if (!requested_) {
+                // The first frame, or the first after a pause or a rebuild: a frame tracked
+                // meanwhile is too old to show; the newest camera frame now.
+                worker_->discard();
+                worker_->request(steadySeconds());
+                requested_ = true;
+            }
             // The window redraws at most about every 15 ms while it waits for a frame (a frame
             // that arrives ends the wait at once), so the HUD stays responsive without spinning.
-            got = capture_->next(f, options_.headless ? 0.1 : 0.015);
-            if (!got && capture_->ended()) break;
+            const TrackingWorker::Result r = worker_->take(f, options_.headless ? 0.1 : 0.015);
+            if (r == TrackingWorker::Result::Ended) break;
+            got = r == TrackingWorker::Result::Frame;
+            takenAt = steadySeconds();
+            // The next frame, tracked while this one renders, ready when the GL thread is.
+            const bool last = options_.maxFrames >= 0 && processed_ + 1 >= options_.maxFrames;
+            if (got && !last) worker_->request(schedule_.nextTrackingStart(takenAt));
         } else {
+            requested_ = false;
             std::this_thread::sleep_for(std::chrono::milliseconds(15));
         }
         const bool lost = capture_->lost();
@@ -218,26 +245,49 @@ int LiveSession::run() {
                          capture_->lostReason());
         if (!lost && reportedLost_) spdlog::info("live: camera back");
         reportedLost_ = lost;
-        if (got) process(f);
+        if (got) process(f, takenAt);
         if (window_ && !present()) break;
+        if (got) schedule_.addBusy(steadySeconds() - takenAt);
     }
+    worker_->stop();
     const std::string captureError = capture_->stop();
     const double seconds = msSince(tStart) * 1e-3;
     finish();
-    const LatestFrameCapture& c = capture_->main();
-    spdlog::info(
-        "live: {} frames in {:.1f} s ({:.1f} frames/s); camera delivered {}, dropped {} while "
-        "processing was busy (the driver dropped {}); median capture-to-display latency {:.0f} "
-        "ms; camera reconnected {} times",
-        processed_, seconds, processed_ / std::max(seconds, 1e-9), c.delivered(), c.dropped(),
-        c.deviceDropped(), median(latencies_), c.reconnections());
+    report(seconds);
     if (!captureError.empty()) throw Error("mirage live: " + captureError);
     return stopRequested() ? 128 + stopSignal() : 0;
+}
+
+void LiveSession::report(double seconds) const {
+    const LatestFrameCapture& c = capture_->main();
+    const int64_t stale = worker_->staleDropped();
+    std::vector<double> intervals, behind;
+    for (size_t k = 1; k < displayedAt_.size(); ++k)
+        intervals.push_back((displayedAt_[k] - displayedAt_[k - 1]) * 1e3);
+    for (size_t k = 0; k < latencies_.size(); ++k) behind.push_back(latencies_[k] - predictMs_[k]);
+    const double latency = median(latencies_), interval = median(intervals);
+    spdlog::info(
+        "live: {} frames in {:.1f} s ({:.1f} frames/s, {}); camera delivered {}, dropped {} while "
+        "processing was busy ({} of them tracked, then replaced by a newer frame before "
+        "rendering; the driver dropped {}); camera reconnected {} times",
+        processed_, seconds, processed_ / std::max(seconds, 1e-9),
+        worker_->threaded() ? "pipelined" : "serial", c.delivered(), c.dropped() + stale, stale,
+        c.deviceDropped(), c.reconnections());
+    spdlog::info(
+        "live: median capture-to-display latency {:.0f} ms, median frame interval {:.0f} ms "
+        "(latency {:.2f}x the interval); without prediction the pose shown is {:.0f} ms old at "
+        "display, with prediction (median {:.0f} ms ahead) {:.0f} ms{}",
+        latency, interval, interval > 0 ? latency / interval : 0.0, latency, median(predictMs_),
+        median(behind), options_.noPredict ? " (--no-predict: not used)" : "");
+    if (displayError_ && displayError_->frames() > 0)
+        spdlog::info("live: pose at display time against the stand-in's ground truth: {}",
+                     displayError_->summary());
 }
 
 void LiveSession::finish() {
     if (finished_) return;
     finished_ = true;
+    if (worker_) worker_->stop();
     if (capture_) capture_->stop();
     if (outputs_) outputs_->finish();
     if (recorder_) recorder_->stop();
@@ -258,8 +308,14 @@ void LiveSession::updateEnvironment(const LiveFrame& f) {
                     : std::numeric_limits<double>::quiet_NaN();
 }
 
-void LiveSession::process(LiveFrame& frame) {
-    const CapturedFrame& f = frame.main;
+TrackingWorker::Result LiveSession::trackNext(TrackedLiveFrame& out, double timeoutSeconds) {
+    if (restartTracking_.exchange(false)) {
+        track_->restart();
+        predictor_.reset();
+    }
+    if (!capture_->next(out.frame, timeoutSeconds))
+        return capture_->ended() ? TrackingWorker::Result::Ended : TrackingWorker::Result::Timeout;
+    const CapturedFrame& f = out.frame.main;
     const int width = calibration_.intrinsics.width, height = calibration_.intrinsics.height;
     if (!f.bgr.empty() && (f.bgr.cols != width || f.bgr.rows != height))
         throw Error(fmt::format(
@@ -267,15 +323,41 @@ void LiveSession::process(LiveFrame& frame) {
             "the calibration of this camera at this size (or ask the camera for {}x{})",
             camera_.description, f.bgr.cols, f.bgr.rows, calibrationPath_.string(), width, height,
             width, height));
+    const auto t0 = Clock::now();
+    out.pose = track_->decide(f.bgr, f.captureSeconds, f.problem, std::nullopt);
+    out.trackingMs = msSince(t0);
+    out.trackingMode = track_->lastMode();
+    // The motion for the prediction: from tracked poses only (a held pose is already old and
+    // is shown as it is; a lost frame ends the motion).
+    if (out.pose.state == "ok" && out.pose.pose) {
+        predictor_.update(*out.pose.pose, f.captureSeconds);
+        out.motion = predictor_;
+    } else if (!out.pose.pose) {
+        predictor_.reset();
+    }
+    out.trackedSeconds = steadySeconds();
+    return TrackingWorker::Result::Frame;
+}
+
+void LiveSession::process(TrackedLiveFrame& tracked, double takenAt) {
+    LiveFrame& frame = tracked.frame;
+    const CapturedFrame& f = frame.main;
     envAgeMs_ = std::numeric_limits<double>::quiet_NaN();
     updateEnvironment(frame);
     const auto t0 = Clock::now();
-    PoseRow pose = track_->decide(f.bgr, f.captureSeconds, f.problem, std::nullopt);
-    const double trackingMs = msSince(t0);
+    schedule_.addTracking(tracked.trackingMs * 1e-3);
+    // The pose at the time the frame is expected on display, not at its capture.
+    PoseRow shown = tracked.pose;
+    double predictMs = std::numeric_limits<double>::quiet_NaN();
+    if (!options_.noPredict && tracked.motion && tracked.motion->velocity() && shown.pose) {
+        const double displayAt = schedule_.expectedDisplay(takenAt);
+        predictMs = tracked.motion->horizon(displayAt) * 1e3;
+        shown.pose = tracked.motion->predict(displayAt);
+    }
     CompositedFrame cf =
-        render_->composite(f.bgr, std::move(pose), !controls_.hideVirtual, f.captureSeconds);
-    cf.trackingMs = trackingMs;
-    cf.trackingMode = track_->lastMode();
+        render_->composite(f.bgr, std::move(shown), !controls_.hideVirtual, f.captureSeconds);
+    cf.trackingMs = tracked.trackingMs;
+    cf.trackingMode = tracked.trackingMode;
     if (f.bgr.empty()) spdlog::warn("live: {}", cf.pose.reason);
     if (!cf.image.empty()) {
         outputs_->writeImage(processed_, cf.image, f.captureSeconds);
@@ -294,11 +376,25 @@ void LiveSession::process(LiveFrame& frame) {
     }
     // Written (headless) or uploaded for display: the end of the capture-to-display latency
     // (the window's swap follows).
-    const double latencyMs = (steadySeconds() - f.captureSeconds) * 1e3;
+    const double displayedAt = steadySeconds();
+    const double latencyMs = (displayedAt - f.captureSeconds) * 1e3;
+    schedule_.addDisplayDelay(displayedAt - takenAt);
     latencies_.push_back(latencyMs);
+    predictMs_.push_back(std::isfinite(predictMs) ? predictMs : 0.0);
+    displayedAt_.push_back(displayedAt);
     lastLatencyMs_ = latencyMs;
+    lastPredictMs_ = predictMs;
+    if (displayError_ && cf.pose.pose && tracked.pose.pose)
+        displayError_->add(f.sequence, f.captureSeconds, displayedAt, *cf.pose.pose,
+                           *tracked.pose.pose);
     recorder_->append(f.bgr, f.captureSeconds, cf.pose, frame.envBgr, frame.envSeconds);
-    outputs_->writeRow(processed_, f, envAgeMs_, cf, msSince(t0), latencyMs);
+    // The GL thread's time for the frame: tracking too when it ran here (serial).
+    const double frameMs = msSince(t0) + (worker_->threaded() ? 0.0 : tracked.trackingMs);
+    LivePipelineTimes times;
+    times.handoffMs =
+        worker_->threaded() ? std::max(0.0, takenAt - tracked.trackedSeconds) * 1e3 : 0;
+    times.predictMs = predictMs;
+    outputs_->writeRow(processed_, f, envAgeMs_, cf, frameMs, latencyMs, times);
     const double dt = msSince(lastFrameAt_) * 1e-3;
     lastFrameAt_ = Clock::now();
     if (processed_ > 0 && dt > 0) fpsEma_ = fpsEma_ == 0 ? 1 / dt : 0.8 * fpsEma_ + 0.2 / dt;
@@ -321,6 +417,8 @@ bool LiveSession::present() {
     if (capture_->lost()) s.lostReason = capture_->lostReason();
     s.fps = fpsEma_;
     s.latencyMs = lastLatencyMs_;
+    s.predictMs = lastPredictMs_;
+    s.pipelined = worker_->threaded();
     s.dropped = static_cast<long long>(capture_->main().dropped());
     s.driverDropped = static_cast<long long>(capture_->main().deviceDropped());
     s.last = &last_;
@@ -384,7 +482,10 @@ bool LiveSession::present() {
     }
     if (rebuild) {
         render_->rebuild();
-        track_->restart();
+        // On the worker's thread before its next frame; the frame it tracked during the
+        // rebuild is too old to show: the next is asked for now.
+        restartTracking_ = true;
+        requested_ = false;
         last_.report = nullptr;
     }
     return !closed;

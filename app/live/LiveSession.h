@@ -2,7 +2,10 @@
 // `mirage live` as a loop of stages (docs/live.md), each a member that can be built and tested
 // alone:
 //   capture  (LiveCapture)      the cameras' threads, newest frame, environment frame nearest
-//   track    (PoseStage)        the pose decision of the frame (shared with replay)
+//   track    (TrackingWorker + PoseStage)  the pose decision of the frame (shared with replay),
+//                               on a thread of its own that tracks the next frame while the GL
+//                               thread renders this one (PipelineSchedule times it); the pose
+//                               rendered is predicted to the display time (PosePredictor)
 //   render + composite (LiveRenderStage)  the renderer for the scene as placed, rebuilt on
 //                               quality/effect/placement changes (FrameCompositor, as replay)
 //   present  (LiveWindow)       the window with the HUD; absent headless
@@ -11,14 +14,17 @@
 // The session checks every input and output before any work, and on every way out (the frame
 // limit, the end of a stand-in, SIGINT/SIGTERM, the window closed, an error) closes its outputs
 // and recordings so that each is complete and playable, or is not left at all.
+#include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "app/PoseStage.h"
+#include "app/live/DisplayPoseError.h"
 #include "app/live/LiveCapture.h"
 #include "app/live/LiveInputs.h"
 #include "app/live/LiveOptions.h"
@@ -26,10 +32,13 @@
 #include "app/live/LiveRecorder.h"
 #include "app/live/LiveRenderStage.h"
 #include "app/live/LiveWindow.h"
+#include "app/live/PipelineSchedule.h"
 #include "app/live/PlacementEditor.h"
+#include "app/live/TrackingWorker.h"
 #include "core/camera/CalibrationFile.h"
 #include "core/gl/Context.h"
 #include "core/scene/Scene.h"
+#include "tracking/PosePredictor.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::app {
@@ -50,8 +59,14 @@ public:
     int run();
 
 private:
-    // One processed frame: track, render, composite, present (upload), write and record.
-    void process(LiveFrame& frame);
+    // The tracking worker's step (on its thread when pipelined): the next camera frame, its
+    // pose decision and the camera's motion for the prediction.
+    TrackingWorker::Result trackNext(TrackedLiveFrame& out, double timeoutSeconds);
+    // One tracked frame, taken by the GL thread at `takenAt` (steady seconds): predict the pose
+    // to the display time, render, composite, present (upload), write and record.
+    void process(TrackedLiveFrame& frame, double takenAt);
+    // The run's report: frames/s, drops, latency with and without prediction.
+    void report(double seconds) const;
     // Takes the environment frame that came with `frame` into the renderer.
     void updateEnvironment(const LiveFrame& frame);
     // One window frame and what the user asked for in it. Returns false when the window closes.
@@ -74,7 +89,14 @@ private:
     std::unique_ptr<LiveRecorder> recorder_;
     std::unique_ptr<LiveWindow> window_;  // null headless
     std::unique_ptr<LiveCapture> capture_;
+    std::unique_ptr<TrackingWorker> worker_;
     std::vector<std::string> passes_;
+
+    // Tracking worker's thread only (the GL thread's while the worker is not threaded).
+    tracking::PosePredictor predictor_;
+    // Set by the GL thread when a new renderer starts its history again; the worker forgets
+    // the held pose before its next frame.
+    std::atomic<bool> restartTracking_{false};
 
     // Loop state.
     LiveControls controls_;
@@ -82,7 +104,13 @@ private:
     CompositedFrame last_;  // the last processed frame (no image), for the HUD
     std::string viewProblem_, envProblem_;
     double envAgeMs_ = 0;
-    std::vector<double> latencies_;
+    PipelineSchedule schedule_;
+    bool requested_ = false;  // the worker was asked for the next frame
+    // Per processed frame: capture-to-display latency, the prediction's horizon (0: not
+    // predicted), the display time (steady seconds).
+    std::vector<double> latencies_, predictMs_, displayedAt_;
+    std::optional<DisplayPoseError> displayError_;  // a stand-in with ground truth
+    double lastPredictMs_ = std::numeric_limits<double>::quiet_NaN();
     int processed_ = 0;
     bool reportedLost_ = false, finished_ = false;
     double fpsEma_ = 0, lastLatencyMs_ = 0;

@@ -121,7 +121,14 @@ HudRequests LiveWindow::drawHud(const HudStatus& s, LiveControls& controls, int 
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
     const ImVec4 red(1, 0.4f, 0.4f, 1), green(0.4f, 1, 0.4f, 1), amber(1, 0.85f, 0.3f, 1);
     if (!s.lostReason.empty()) ImGui::TextColored(red, "CAMERA LOST: %s", s.lostReason.c_str());
-    ImGui::Text("%.1f frames/s | latency %.0f ms", s.fps, s.latencyMs);
+    ImGui::Text("%.1f frames/s | latency %.0f ms (%s)", s.fps, s.latencyMs,
+                s.pipelined ? "pipelined" : "serial");
+    // Capture-to-display latency with prediction: how far the pose shown lags the display.
+    if (std::isfinite(s.predictMs))
+        ImGui::Text("pose predicted %.0f ms ahead: %.0f ms behind", s.predictMs,
+                    s.latencyMs - s.predictMs);
+    else
+        ImGui::Text("pose not predicted: %.0f ms behind", s.latencyMs);
     ImGui::Text("dropped %lld (driver %lld)", s.dropped, s.driverDropped);
     const std::string st = s.last ? s.last->pose.state : std::string();
     const std::string mode =

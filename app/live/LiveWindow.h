@@ -34,6 +34,10 @@ struct LiveControls {
 struct HudStatus {
     std::string lostReason;  // non-empty: the camera is lost
     double fps = 0, latencyMs = 0;
+    // How far ahead of its capture the last frame's pose was predicted (to its display time),
+    // ms; NaN: not predicted (shown as tracked). Tracking on its own thread (pipelined) or not.
+    double predictMs = 0;
+    bool pipelined = false;
     long long dropped = 0, driverDropped = 0;
     const CompositedFrame* last = nullptr;  // the last processed frame (pose, pass report)
     std::string exposureText;

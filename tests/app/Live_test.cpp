@@ -202,6 +202,51 @@ TEST(LiveHeadless, CompositesEqualReplayOfTheSameFramesAndPoses) {
     EXPECT_EQ(caught, showing);
 }
 
+// The loop both ways: pipelined with prediction (the default) and serial without
+// (--no-pipeline --no-predict). Serial, the tracked frame never waits and no pose is predicted;
+// pipelined, the frames after the first two (a velocity needs two tracked poses) are rendered
+// with the pose predicted ahead of their capture, and the log says which loop ran.
+TEST(LiveHeadless, PipelinedPredictsAndSerialDoesNot) {
+    const fs::path dir = outputDir("live_pipeline");
+    for (const bool serial : {false, true}) {
+        const fs::path out = dir / (serial ? "serial" : "pipelined");
+        std::vector<std::string> args = {"live",
+                                         "--camera",
+                                         sampleSession().string(),
+                                         "--scene",
+                                         diffuseScene(),
+                                         "--headless",
+                                         "--camera-fps",
+                                         "15",
+                                         "--frames",
+                                         "4",
+                                         "-o",
+                                         out.string()};
+        if (serial) args.insert(args.end(), {"--no-pipeline", "--no-predict"});
+        auto live = runMirage(args);
+        ASSERT_EQ(live.exitCode, 0) << live.output;
+        EXPECT_NE(live.output.find(serial ? "serial" : "pipelined"), std::string::npos)
+            << live.output;
+        const CsvTable csv = readCsvTable(out / "frames.csv");
+        ASSERT_EQ(csv.rows.size(), 4u);
+        int predicted = 0;
+        for (size_t k = 0; k < csv.rows.size(); ++k) {
+            const std::string ahead = csv.field(k, "predict_ms");
+            if (serial) {
+                EXPECT_EQ(ahead, "") << "frame " << k;
+                EXPECT_EQ(std::stod(csv.field(k, "handoff_ms")), 0.0);
+            } else if (k >= 2 && csv.field(k, "state") == "ok") {
+                ASSERT_NE(ahead, "") << "frame " << k << " was not predicted";
+                EXPECT_GT(std::stod(ahead), 0.0);
+                ++predicted;
+            }
+        }
+        if (!serial) {
+            EXPECT_GE(predicted, 1);
+        }
+    }
+}
+
 // The footage as recorded (main.mkv, JPEG) against the frames the stand-in delivered.
 TEST(LiveRecording, ReplayOfTheRecordingReproducesTheLiveComposite) {
     const fs::path dir = outputDir("live_record");
