@@ -182,6 +182,30 @@ std::optional<render::SessionEnvironment> benchEnvironment(
     return env;
 }
 
+// The head of bench.md: the command, the session, the machine and what the figures are.
+std::string benchPreamble(const BenchArgs& a, const std::vector<render::BenchFrame>& frames,
+                          const CameraIntrinsics& camera, const std::string& scenePath,
+                          const gl::Context& ctx, const std::string& startedAt,
+                          const std::string& loadBefore, const std::string& loadAfter) {
+    double influenced = 0;
+    for (const auto& f : frames) influenced += cv::countNonZero(f.influence);
+    return fmt::format(
+        "# mirage bench\n\n"
+        "- command: `{}`\n"
+        "- session: {} ({} frame(s), {}x{}), scene: {}\n"
+        "- machine: {} CPU ({} cores), GL renderer {} ({}), started {}, load average (1/5/15 min) "
+        "{} before, {} after\n"
+        "- times: medians over frames (x{} repeats) of ms per pass: with `syncPasses` the wall "
+        "time between a glFinish before and after each pass, else GL timer queries; wall ms = "
+        "render() + composite readback on the CPU\n"
+        "- errors: 8-bit sRGB composite vs the ground-truth composite, pooled over frames; "
+        "\"infl.\" = pixels the virtual objects influence ({} pixel(s) in all at the session's "
+        "size)\n",
+        commandLine(a), a.session, frames.size(), camera.width, camera.height, scenePath,
+        cpuModel(), std::max(1u, std::thread::hardware_concurrency()), ctx.rendererName(),
+        ctx.versionString(), startedAt, loadBefore, loadAfter, a.repeats, influenced);
+}
+
 void runBench(const BenchArgs& a) {
     if (a.listKnobs) {
         for (const auto& k : render::benchKnobs())
@@ -278,27 +302,8 @@ void runBench(const BenchArgs& a) {
             results.push_back(render::footageBaseline(frames, it->first, it->second));
     const std::string loadAfter = loadAverage();
 
-    const std::string preamble = fmt::format(
-        "# mirage bench\n\n"
-        "- command: `{}`\n"
-        "- session: {} ({} frame(s), {}x{}), scene: {}\n"
-        "- machine: {} CPU ({} cores), GL renderer {} ({}), started {}, load average (1/5/15 min) "
-        "{} "
-        "before, {} after\n"
-        "- times: medians over frames (x{} repeats) of ms per pass: with `syncPasses` the wall "
-        "time "
-        "between a glFinish before and after each pass, else GL timer queries; wall ms = render() "
-        "+ composite readback on the CPU\n"
-        "- errors: 8-bit sRGB composite vs the ground-truth composite, pooled over frames; "
-        "\"infl.\" = pixels the virtual objects influence ({} pixel(s) in all at the session's "
-        "size)\n",
-        commandLine(a), a.session, frames.size(), calib.intrinsics.width, calib.intrinsics.height,
-        scenePath, cpuModel(), std::max(1u, std::thread::hardware_concurrency()),
-        ctx.rendererName(), ctx.versionString(), startedAt, loadBefore, loadAfter, a.repeats, [&] {
-            double n = 0;
-            for (const auto& f : frames) n += cv::countNonZero(f.influence);
-            return n;
-        }());
+    const std::string preamble = benchPreamble(a, frames, calib.intrinsics, scenePath, ctx,
+                                               startedAt, loadBefore, loadAfter);
     if (split) {
         BenchShard bs;
         bs.shard = shard;
@@ -361,7 +366,7 @@ const CommandRegistrar reg("bench", [](CLI::App& parent) {
                     "frame-time governor holds there (the most accurate within it on the "
                     "speed-vs-error front of the grid's rows) and its error beside the most "
                     "accurate setting's")
-        ->check(CLI::Range(0.0, 60000.0));
+        ->check(finiteIn(0, 60000));
     cmd->add_option("--repeat", a->repeats, "Run the frame sequence R times (timings pooled)")
         ->capture_default_str()
         ->check(wholeIn(1, 10000));

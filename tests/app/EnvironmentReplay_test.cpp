@@ -396,9 +396,15 @@ TEST(LiveEnvironment, EnvironmentCameraLightsEveryFrameNearestInTime) {
     const CommandResult synth = runMirage(synthArgs);
     ASSERT_EQ(synth.exitCode, 0) << synth.output;
     auto live = [&](const std::string& name, bool env) {
-        std::vector<std::string> args = {"live",  "--camera",           s.string(), "--scene",
-                                         scene(), "--headless",         "--frames", "3",
-                                         "-o",    (dir / name).string()};
+        // At full quality (no frame-time budget) and with the pose as tracked (no prediction to
+        // the display time), serial: each live frame must equal its replay.
+        std::vector<std::string> args = {"live",         "--camera",
+                                         s.string(),     "--scene",
+                                         scene(),        "--headless",
+                                         "--frames",     "3",
+                                         "--budget-ms",  "0",
+                                         "--no-predict", "--no-pipeline",
+                                         "-o",           (dir / name).string()};
         if (env)
             args.insert(args.end(),
                         {"--env-camera", s.string(), "--record", (dir / "rec").string()});

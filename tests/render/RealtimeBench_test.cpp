@@ -193,12 +193,13 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
         "shadow_filter=off shadow_map=512 shadow_rsm=512 specular_trace=impostors "
         "impostor_resolution=256 "
         "impostor_steps=2 "
-        "refraction_steps=16 specular_vpl_stride=16 specular_resolution=" +
+        "refraction_steps=16 specular_vpl_stride=16 specular_trace_resolution=full "
+        "specular_resolution=" +
             std::string(RendererOptions{}.specular.halfResolution ? "half" : "full") +
             " virtual=on "
             "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
             "caustic_gather=on rough_highlight=on rough_photons=on caustic_radius=1 "
-            "caustic_gather_cap=64 caustic_temporal=on "
+            "caustic_gather_cap=64 caustic_refresh=1 caustic_temporal=on "
             "specular_temporal=on "
             "pose_jitter=0 "
             "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
