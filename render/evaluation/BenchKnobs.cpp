@@ -411,6 +411,24 @@ void causticKnobs(std::vector<BenchKnob>& knobs) {
                  c.options.specular.temporal = parseOnOff("specular_temporal", v);
              },
              [](const BenchConfig& c) { return onOff(c.options.specular.temporal); }},
+            {"specular_refresh",
+             "frames over which the reflected / refracted hits' light is refreshed (1, 2 or 4): "
+             "each frame shades one phase of 8x8-pixel tiles, the others take last frame's light "
+             "where it was lit at this frame's hits",
+             [](const CameraIntrinsics&, bool) {
+                 return std::vector<std::string>{
+                     std::to_string(RendererOptions{}.specular.refreshInterval)};
+             },
+             [](BenchConfig& c, const std::string& v) {
+                 const int n = parseInt("specular_refresh", v, 1, 4);
+                 if (n == 3)
+                     throw Error(
+                         fmt::format("bench knob 'specular_refresh': '{}' is not 1, 2 or 4", v));
+                 c.options.specular.refreshInterval = n;
+             },
+             [](const BenchConfig& c) {
+                 return std::to_string(c.options.specular.refreshInterval);
+             }},
             {"pose_jitter",
              "tracking-like noise on every frame's pose: mm of translation (1 sigma per axis) and "
              "a tenth of that in degrees of rotation (0..10; 0: the exact ground-truth pose)",

@@ -81,6 +81,17 @@ const std::vector<GovernedKnob>& knobs() {
          [](const RendererOptions& f, RendererOptions& t) {
              t.caustic.gatherCap = f.caustic.gatherCap;
          }},
+        {"specular_refresh",
+         [](RendererOptions& o, const std::string& v) {
+             const int n = parseRange("specular_refresh", v, 1, 4);
+             if (n == 3)
+                 throw Error(
+                     fmt::format("quality knob 'specular_refresh': '{}' is not 1, 2 or 4", v));
+             o.specular.refreshInterval = n;
+         },
+         [](const RendererOptions& f, RendererOptions& t) {
+             t.specular.refreshInterval = f.specular.refreshInterval;
+         }},
         {"caustic_refresh",
          [](RendererOptions& o, const std::string& v) {
              o.caustic.refreshInterval = parseRange("caustic_refresh", v, 1, 8);

@@ -166,6 +166,60 @@ TEST_F(GovernedQuality, HalfResolutionTraceAgainstTheReference) {
     EXPECT_LT(unrefined, full - 1.5) << "must-fail: a worse trace is caught by the same bar";
 }
 
+// The hit light refreshed over 4 frames (SpecularOptions::refreshInterval) on a camera orbiting
+// 1 degree a frame, then resting: every frame after the first says it refreshed a quarter of the
+// tiles; the glass sphere's pixels against the reference as with every pixel shaded (within
+// 0.1 dB), and against the renderer shading every pixel in every frame. The must-fail: a frame of
+// the orbit taken for the next, as a reuse without the hit test would, is far from it by the
+// same bar. After an object
+// moved, nothing is reused.
+TEST_F(GovernedQuality, SpecularRefreshOnAMovingCameraAgainstTheReference) {
+    test::CausticScene s = test::makeCausticScene({});
+    s.cam = test::smallCamera(256, 192, 300.0);
+    const int frames = 8;
+    auto poseAt = [](int k) { return orbit(std::min(k, 5) * 1.0); };  // frames 5-7 at rest
+    s.pose = poseAt(frames - 1);
+    const test::CausticReferenceRender ref = test::renderCausticReference(s, 16, 25);
+    const cv::Mat sphere = test::sphereMask(test::sphereView(s), 0.98);
+    ASSERT_GT(cv::countNonZero(sphere), 300);
+    Renderer every(s.scene, s.cam, options());
+    Renderer reusing(s.scene, s.cam, options({{"specular_refresh", "4"}}));
+    cv::Mat before, lastMove;  // the frames before and after the last step of the orbit
+    double worst = 1e9;
+    for (int k = 0; k < frames; ++k) {
+        if (k == 5) before = every.compositeSrgb().clone();
+        every.render({poseAt(k), ref.footage, k == 0});
+        if (k == 5) lastMove = every.compositeSrgb().clone();
+        const FrameReport& rep = reusing.render({poseAt(k), ref.footage, k == 0});
+        const bool reused =
+            passReason(rep, "speclight").find("1/4 of the tiles refreshed") != std::string::npos;
+        EXPECT_EQ(reused, k > 0) << "frame " << k << ": " << passReason(rep, "speclight");
+        worst = std::min(worst,
+                         test::psnr(reusing.compositeSrgb(), every.compositeSrgb(), 255.0, sphere));
+    }
+    const double full = test::psnr(every.compositeSrgb(), ref.compositeSrgb, 255.0, sphere);
+    const double reuse = test::psnr(reusing.compositeSrgb(), ref.compositeSrgb, 255.0, sphere);
+    const double stale = test::psnr(before, lastMove, 255.0, sphere);
+    std::cout << "[ specular refresh ] glass sphere, " << cv::countNonZero(sphere)
+              << " px against the reference: every pixel every frame " << full
+              << " dB, a quarter of the tiles per frame " << reuse
+              << " dB; against every pixel shaded, worst frame " << worst
+              << " dB; a frame of the orbit against the one before (must-fail) " << stale
+              << " dB\n";
+    EXPECT_GT(reuse, full - 0.1);
+    EXPECT_GT(worst, 45.0);
+    EXPECT_LT(stale, 45.0) << "must-fail: a stale frame is caught by the same bar";
+
+    Scene moved = s.scene;
+    ScenePlacement placement;
+    placement.moveU = 0.03;
+    ASSERT_GT(applyPlacement(moved, placement, PlacementPlane{}), 0);
+    ASSERT_TRUE(reusing.updateTransforms(moved));
+    const FrameReport& rep = reusing.render({s.pose, ref.footage, false});
+    EXPECT_NE(passReason(rep, "speclight").find("every pixel refreshed"), std::string::npos)
+        << passReason(rep, "speclight");
+}
+
 // Renderer::setQuality between frames gives the frames of a renderer built with those options
 // (the half-resolution programs and targets are made on first use), and back.
 TEST_F(GovernedQuality, SetQualityEqualsARendererBuiltWithIt) {

@@ -33,6 +33,8 @@ SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
     v.cellSize = v.program.uniformLocation("photonCellSize");
     v.gatherCap = v.program.uniformLocation("photonGatherCap");
     v.historyWeight = v.program.uniformLocation("historyWeight");
+    v.refreshInterval = v.program.uniformLocation("refreshInterval");
+    v.refreshPhase = v.program.uniformLocation("refreshPhase");
     return v;
 }
 
@@ -44,6 +46,12 @@ float specularBlend(const FrameContext& ctx) {
     return ctx.options.specular.temporal && !ctx.options.specular.halfResolution
                ? ctx.options.temporalBlend
                : 0.0f;
+}
+// The frames over which every hit's light is refreshed this frame (SpecularOptions::
+// refreshInterval), 1 where the history cannot stand in for it.
+int specularRefresh(const FrameContext& ctx, const TemporalHistory& history) {
+    const int n = ctx.options.specular.refreshInterval;
+    return n > 1 && !ctx.options.specular.halfResolution && history.usable(ctx, 1.0f) ? n : 1;
 }
 }  // namespace
 
@@ -95,8 +103,16 @@ PassDecision SpecularLightPass::decide(const FrameContext& ctx) const {
                       (vpls ? " + VPLs" : "") +
                       (PhotonGridPass::gatherDecision(ctx).run ? " + caustic photons" : "") +
                       " at the reflected/refracted hits" +
-                      (ctx.options.specular.halfResolution ? ", half resolution" : "") + ", " +
-                      history_.note(ctx, specularBlend(ctx))};
+                      (ctx.options.specular.halfResolution ? ", half resolution" : "") +
+                      refreshNote(ctx) + ", " + history_.note(ctx, specularBlend(ctx))};
+}
+
+std::string SpecularLightPass::refreshNote(const FrameContext& ctx) const {
+    const int asked = ctx.options.specular.refreshInterval, n = specularRefresh(ctx, history_);
+    if (asked <= 1) return "";
+    if (n > 1) return ", 1/" + std::to_string(n) + " of the tiles refreshed (the rest reused)";
+    return ctx.options.specular.halfResolution ? ""
+                                               : ", every pixel refreshed (no history to reuse)";
 }
 
 void SpecularLightPass::resize(const FrameContext& ctx) {
@@ -208,6 +224,11 @@ void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources
     if (v.historyWeight >= 0) {
         const float blend = specularBlend(ctx);
         glUniform1f(v.historyWeight, history_.usable(ctx, blend) ? blend : 0.0f);
+    }
+    if (v.refreshInterval >= 0) {
+        const int n = specularRefresh(ctx, history_);
+        glUniform1i(v.refreshInterval, n);
+        glUniform1i(v.refreshPhase, int(ctx.frameIndex % n));
     }
 }
 

@@ -38,10 +38,12 @@ private:
     struct Variant {
         gl::Program program;
         GLint useVpls = -1, vplStride = -1, cellSize = -1, gatherCap = -1, historyWeight = -1;
+        GLint refreshInterval = -1, refreshPhase = -1;
     };
     static Variant makeVariant(const char* label, const std::string& defines);
     void buildHalfResolution(const GpuScene& scene);
     void allocateHalfResolution(int w, int h);
+    std::string refreshNote(const FrameContext& ctx) const;
     void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
     void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v, int write);
     // Clears fbo_[write] (bound) where the last draws into its textures and this one's cover,

@@ -33,6 +33,13 @@ struct SpecularOptions {
     // pixels. The ray search is a quarter of the work; the hits are 2x2 blocks. false: a ray pair
     // per pixel.
     bool halfResolutionTrace = false;
+    // Temporal reuse of the hit light: 1 shades every specular pixel every frame; 2 or 4 shade the
+    // 8x8-pixel tiles of one phase of N per frame, and the other tiles' pixels take last frame's
+    // light where it was lit at this frame's hits, within 0.5 mm (specular_light.frag); a pixel whose history
+    // does not hold (disocclusion, the hits moved) is shaded. Every pixel every frame where the
+    // history is reset (first frame, a cut, tracking lost, an object or light moved) and in the
+    // half-resolution variant (its hits are per 2x2 block).
+    int refreshInterval = 1;
     // Tests only: false drops the upsample's geometry test (plain bilinear weights; halos at
     // depth steps in the reflections).
     bool upsampleGeometry = true;
@@ -45,6 +52,8 @@ struct SpecularOptions {
                     "specular.refractionMarchSteps", "2..128", refractionMarchSteps);
         checkOption(vplStride == 1 || vplStride == 4 || vplStride == 16, "specular.vplStride",
                     "1, 4 or 16", vplStride);
+        checkOption(refreshInterval == 1 || refreshInterval == 2 || refreshInterval == 4,
+                    "specular.refreshInterval", "1, 2 or 4 frames", refreshInterval);
         checkOption(backProjectionEpsilon > 0.0f && backProjectionEpsilon <= 1.0f,
                     "specular.backProjectionEpsilon", "in (0, 1] (relative depth tolerance)",
                     backProjectionEpsilon);

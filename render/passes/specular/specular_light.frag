@@ -61,6 +61,15 @@ layout(location = 2) out vec4 outRefrRv;  // refracted hit, L_rv
 layout(location = 3) out vec4 outRefrR;   // refracted hit, L_r
 #else
 uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
+// Temporal reuse (SpecularOptions::refreshInterval): 1 shades every specular pixel. N = 2 or 4:
+// only the 8x8-pixel tiles of this frame's phase (of N, in a 2x2-tile pattern) are shaded; a pixel
+// of the other tiles takes its history as it is where the history holds this frame's hits (the
+// light at a hit does not depend on where it is seen from; the Fresnel weight changes little over
+// the frames a tile waits) and is shaded where it does not (a disocclusion, a hit that moved
+// more than 0.5 mm: sameHitForReuse). Tiles of
+// 8x8 so that a SIMD group of llvmpipe (and a GPU's warp) skips the shading as a whole.
+uniform int refreshInterval;  // 1, 2 or 4; 1 also where the history cannot be used this frame
+uniform int refreshPhase;     // this frame's tiles: frame index mod refreshInterval
 // Last frame's smoothed L'_rv (a = the specular surface's camera distance, m; 0: no specular
 // pixel), L'_r and the reflection's share of L'_r, and the hits they were lit at: the reflected
 // ray's in historyHits.xyz, the refracted ray's in (historyHits.w, historyR.a, historyRRefl.a)
@@ -110,6 +119,24 @@ void quadAverage(inout vec4 irrRv, inout vec4 irrR, vec3 hit, int origin, float 
         irrRv = vec4(sumRv.rgb / wsum, 1.0);
         irrR = vec4(sumR.rgb / wsum, 1.0);
     }
+}
+
+// A history hit may stand in for this frame's light without shading: the same hit within 0.5 mm
+// (both rays hit nothing: both kNoHit). Stricter than sameHit, which only lets the history into
+// a blend: taken as it is at sameHit's tolerance, the light of a reflected edge or texture a few
+// millimetres away cost 0.6 dB over the influenced pixels on an orbiting camera (docs/specular.md).
+bool sameHitForReuse(vec3 stored, vec3 current) {
+    return distance(stored, current) < 0.0005;
+}
+
+// The tile of pixel px is shaded this frame (see refreshInterval).
+bool tileRefreshedNow(ivec2 px) {
+    if (refreshInterval <= 1) return true;
+    ivec2 tile = px >> 3;
+    // 2x2 tiles cover the phases of 4 in the order 0 3 / 2 1 (each phase's tiles spread evenly);
+    // 2 phases take the diagonals of the same pattern.
+    int order = (tile.x & 1) == 0 ? ((tile.y & 1) == 0 ? 0 : 2) : ((tile.y & 1) == 0 ? 3 : 1);
+    return order % refreshInterval == refreshPhase;
 }
 
 // A history hit (world, m) is this frame's hit: both rays hit nothing, or both hit within
@@ -271,11 +298,42 @@ void main() {
     outRRefl = vec4(0.0);
     outEnv = vec4(0.0);
     outHits = vec4(0.0);
-    // No early return before the quad average below: its derivatives need every lane's values.
+    // No early return before the quad decisions below: their derivatives need every lane's values.
     bool specularPixel = texelFetch(reflEmissive, px, 0).a >= 0.5;
-    vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
     vec3 surface = texelFetch(gPosition, px, 0).xyz;
-    vec3 hit[2] = vec3[2](vec3(kNoHit), vec3(kNoHit));  // per ray (world, m)
+    float toSurface = distance(surface, cameraPos.xyz);
+    // This frame's hits first (per ray, world, m): the history test needs them before the shading.
+    vec3 hit[2] = vec3[2](vec3(kNoHit), vec3(kNoHit));
+    for (int k = 0; k < 2 && specularPixel; ++k) {
+        vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
+        vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
+        if (!all(lessThanEqual(w, vec3(0.0))) && int(P.w + 0.5) != ORIGIN_NONE) hit[k] = P.xyz;
+    }
+    // Last frame's smoothed values at this pixel's surface; they hold where the surface and both
+    // rays' hits are this frame's.
+    vec4 hRv = vec4(0.0), hR = vec4(0.0), hRRefl = vec4(0.0);
+    bool historyHolds = false, reuseHolds = false;
+    vec2 puv;
+    if (specularPixel && (historyWeight > 0.0 || refreshInterval > 1) &&
+        reprojectToPreviousFrame(surface, puv)) {
+        hRv = texture(historyRv, puv);
+        hR = texture(historyR, puv);
+        hRRefl = texture(historyRRefl, puv);
+        vec4 hHits = texture(historyHits, puv);
+        historyHolds = historyIsSameSurface(hRv.a, surface) &&
+                       sameHit(hHits.xyz, hit[0], toSurface + distance(surface, hit[0])) &&
+                       sameHit(vec3(hHits.w, hR.a, hRRefl.a), hit[1],
+                               toSurface + distance(surface, hit[1])) &&
+                       allFinite(hRv.rgb) && allFinite(hR.rgb) && allFinite(hRRefl.rgb);
+        reuseHolds = historyHolds && sameHitForReuse(hHits.xyz, hit[0]) &&
+                     sameHitForReuse(vec3(hHits.w, hR.a, hRRefl.a), hit[1]);
+    }
+    // Shaded unless its tile waits this frame and the history holds, decided per 2x2 quad so that
+    // the quad average's derivatives see all four lanes shaded or none.
+    vec4 need = vec4(specularPixel && !(reuseHolds && !tileRefreshedNow(px)) ? 1.0 : 0.0);
+    bool shade = max(max(need.x, quadSwapX(need).x),
+                     max(quadSwapY(need).x, quadSwapX(quadSwapY(need)).x)) > 0.5;
+    vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
     // Per ray: the VPL irradiance at its hit (w: 1 if the ray has one), and what turns it into
     // this pixel's radiance (Fresnel weight x albedo (1 - metallic) / pi).
     vec4 vplRv[2] = vec4[2](vec4(0.0), vec4(0.0)), vplR[2] = vec4[2](vec4(0.0), vec4(0.0));
@@ -286,17 +344,17 @@ void main() {
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;
         int origin = int(P.w + 0.5);
-        if (origin != ORIGIN_NONE) hit[k] = P.xyz;
         if (origin == ORIGIN_NONE) {
             if (dot(P.xyz, P.xyz) > 0.25) env += w * environmentRadiance(envMap, P.xyz);
             continue;
         }
+        if (!shade) continue;  // the history's light is taken below
         vec4 N = k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0);
         vec4 A = k == 0 ? texelFetch(reflAlbedo, px, 0) : texelFetch(refrAlbedo, px, 0);
         vec3 e = (k == 0 ? texelFetch(reflEmissive, px, 0) : texelFetch(refrEmissive, px, 0)).rgb;
         // Viewed from the specular surface point p (for the refracted ray the exit point lies
         // on the same object; its glossy highlights are approximate).
-        vec3 v = normalize(texelFetch(gPosition, px, 0).xyz - P.xyz);
+        vec3 v = normalize(surface - P.xyz);
         if (!allFinite(v)) v = N.xyz;
         vec3 hrv, hr, irrRv, irrR;
         // Interleaved VPL subsets: a 2x2 (stride 4) or 4x4 (16) pixel tile covers every VPL.
@@ -320,36 +378,32 @@ void main() {
         r += w * hr;
         if (k == 0) rRefl = w * hr;
     }
-    float toSurface = distance(surface, cameraPos.xyz);
-    for (int k = 0; k < 2; ++k) {
-        if (vplStride > 1)  // uniform: the quad's lanes all take it
-            quadAverage(vplRv[k], vplR[k], hit[k], hitOrigin[k],
-                        toSurface + distance(surface, hit[k]));
-        rv += vplToRadiance[k] * vplRv[k].rgb;
-        r += vplToRadiance[k] * vplR[k].rgb;
-        if (k == 0) rRefl += vplToRadiance[k] * vplR[k].rgb;
+    if (shade) {  // the same in all lanes of the quad
+        for (int k = 0; k < 2; ++k) {
+            if (vplStride > 1)  // uniform: the quad's lanes all take it
+                quadAverage(vplRv[k], vplR[k], hit[k], hitOrigin[k],
+                            toSurface + distance(surface, hit[k]));
+            rv += vplToRadiance[k] * vplRv[k].rgb;
+            r += vplToRadiance[k] * vplR[k].rgb;
+            if (k == 0) rRefl += vplToRadiance[k] * vplR[k].rgb;
+        }
     }
     if (!specularPixel) return;
-    rv = allFinite(rv) ? rv : vec3(0.0);
-    r = allFinite(r) ? r : vec3(0.0);
-    rRefl = allFinite(rRefl) ? rRefl : vec3(0.0);
-    vec2 puv;
-    if (historyWeight > 0.0 && reprojectToPreviousFrame(surface, puv)) {
-        vec4 hRv = texture(historyRv, puv);
-        vec4 hR = texture(historyR, puv);
-        vec4 hRRefl = texture(historyRRefl, puv);
-        vec4 hHits = texture(historyHits, puv);
-        if (historyIsSameSurface(hRv.a, surface) &&
-            sameHit(hHits.xyz, hit[0], toSurface + distance(surface, hit[0])) &&
-            sameHit(vec3(hHits.w, hR.a, hRRefl.a), hit[1],
-                    toSurface + distance(surface, hit[1])) &&
-            allFinite(hRv.rgb) && allFinite(hR.rgb) && allFinite(hRRefl.rgb)) {
+    if (!shade) {
+        rv = max(hRv.rgb, vec3(0.0));
+        r = max(hR.rgb, vec3(0.0));
+        rRefl = max(hRRefl.rgb, vec3(0.0));
+    } else {
+        rv = allFinite(rv) ? rv : vec3(0.0);
+        r = allFinite(r) ? r : vec3(0.0);
+        rRefl = allFinite(rRefl) ? rRefl : vec3(0.0);
+        if (historyWeight > 0.0 && historyHolds) {
             rv = mix(rv, max(hRv.rgb, vec3(0.0)), historyWeight);
             r = mix(r, max(hR.rgb, vec3(0.0)), historyWeight);
             rRefl = mix(rRefl, max(hRRefl.rgb, vec3(0.0)), historyWeight);
         }
     }
-    outRv = vec4(rv, distance(surface, cameraPos.xyz));
+    outRv = vec4(rv, toSurface);
     outR = vec4(r, hit[1].y);
     outRRefl = vec4(rRefl, hit[1].z);
     outHits = vec4(hit[0], hit[1].x);
