@@ -425,6 +425,7 @@ bool LiveSession::present() {
     s.exposureText = camera_.exposureText;
     s.exposureWarnings = camera_.exposureWarnings;
     s.environmentText = environmentText();
+    if (const render::FrameBudgetGovernor* g = render_->governor()) s.budgetText = g->summary();
     s.viewProblem = viewProblem_;
     if (recorder_->recording())
         s.recordingText =

@@ -149,6 +149,7 @@ HudRequests LiveWindow::drawHud(const HudStatus& s, LiveControls& controls, int 
                     s.last->exposureGain.g, s.last->exposureGain.b, s.last->exposureSource.c_str());
     if (!s.environmentText.empty())
         ImGui::TextWrapped("environment: %s", s.environmentText.c_str());
+    if (!s.budgetText.empty()) ImGui::TextWrapped("budget: %s", s.budgetText.c_str());
     for (const auto& w : s.exposureWarnings) ImGui::TextColored(amber, "%s", w.c_str());
     ImGui::PopTextWrapPos();
     ImGui::Separator();

@@ -43,6 +43,8 @@ struct HudStatus {
     std::string exposureText;
     std::vector<std::string> exposureWarnings;
     std::string environmentText;  // empty: no environment camera
+    // The frame-time governor's choice and why (FrameBudgetGovernor::summary); empty: no budget.
+    std::string budgetText;
     std::string viewProblem;
     std::string recordingText;  // empty: not recording
     ScenePlacement placement;

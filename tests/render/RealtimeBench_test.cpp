@@ -200,7 +200,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
             "caustics=on glass_shadows=on refl_refr_vpls=on caustic_map=256 caustic_quad=1.5 "
             "caustic_gather=on rough_highlight=on rough_photons=on caustic_radius=1 "
             "caustic_gather_cap=64 caustic_refresh=1 caustic_temporal=on "
-            "specular_temporal=on "
+            "specular_temporal=on specular_refresh=1 "
             "pose_jitter=0 "
             "fuzzy=on fuzzy_cone=20 fuzzy_taps=12 rough_method=lean gsr_subdivisions=4 "
             "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 vnm_kernel=extinction "

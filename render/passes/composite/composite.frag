@@ -132,7 +132,7 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out boo
         ivec2 bp;
         if (backProjectPixel(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, bp)) {
             vec3 c = texelFetch(cameraImage, bp, 0).rgb, spread;
-            if (denoiseFootage != 0) c = footageMean(cameraImage, bp, c, spread);
+            if (denoiseFootage != 0) c = footageMean(cameraImage, bp, c, noiseVarianceAt(c), spread);
             ciBp += w * c;
             footage += w * c;
         } else {

@@ -33,14 +33,15 @@ vec3 noiseVarianceAt(vec3 v) {
 // footage's texture survives; its noise is averaged over the pixels like the centre).
 // spread: the variance of ci minus that mean in units of the pixel's noise variance,
 // (1 - w0)^2 + the other weights' squares (w normalised; w0 the centre's). Per channel.
-vec3 footageMean(sampler2D image, ivec2 p, vec3 ci, out vec3 spread) {
+// varianceCi: noiseVarianceAt(ci), which the callers need as well.
+vec3 footageMean(sampler2D image, ivec2 p, vec3 ci, vec3 varianceCi, out vec3 spread) {
     ivec2 size = textureSize(image, 0);
-    vec3 sigma = sqrt(max(noiseVarianceAt(ci), vec3(1e-12)));
+    vec3 invTwoSigma = 0.5 / sqrt(max(varianceCi, vec3(1e-12)));
     vec3 wSum = vec3(0.0), wMean = vec3(0.0), w2 = vec3(0.0);
     for (int dy = -2; dy <= 2; ++dy)
         for (int dx = -2; dx <= 2; ++dx) {
             vec3 cq = texelFetch(image, clamp(p + ivec2(dx, dy), ivec2(0), size - 1), 0).rgb;
-            vec3 d = (cq - ci) / (2.0 * sigma);
+            vec3 d = (cq - ci) * invTwoSigma;
             vec3 w = exp(-0.5 * d * d);
             wSum += w;
             wMean += w * cq;

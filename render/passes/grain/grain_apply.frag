@@ -53,13 +53,14 @@ vec3 whiteNoise(ivec2 p) {
 // residual of CI from its noise-free estimate (footage_noise.glsl) over the residual's standard
 // deviation. ok is false where the estimate is the centre alone (an edge or a clipped pixel on
 // every side) or the pixel is clipped: no residual to measure there.
-vec3 footageDraw(ivec2 p, vec3 ci, out bvec3 ok) {
+// varianceCi: noiseVarianceAt(ci).
+vec3 footageDraw(ivec2 p, vec3 ci, vec3 varianceCi, out bvec3 ok) {
     vec3 spread;
-    vec3 residual = ci - footageMean(cameraImage, p, ci, spread);
+    vec3 residual = ci - footageMean(cameraImage, p, ci, varianceCi, spread);
     // Clipped footage holds no noise to take (a dark object before a white wall needs its own).
     ok = bvec3(vec3(greaterThan(spread, vec3(0.05))) * vec3(greaterThan(ci, vec3(kNoiseBlack))) *
                vec3(lessThan(ci, vec3(kNoiseWhite))));
-    vec3 sigma = sqrt(max(noiseVarianceAt(ci), vec3(1e-12)));
+    vec3 sigma = sqrt(max(varianceCi, vec3(1e-12)));
     return clamp(residual / (sigma * sqrt(max(spread, vec3(0.05)))), vec3(-4.0), vec3(4.0));
 }
 
@@ -73,8 +74,12 @@ void main() {
         float r2 = dot(d, d) * invCornerR2;
         value *= max(1.0 + vignetteK.x * r2 + vignetteK.y * r2 * r2, 0.0);
     }
-    if (noiseOn != 0) {
-        vec3 ci = texelFetch(cameraImage, px, 0).rgb;
+    vec3 ci = texelFetch(cameraImage, px, 0).rgb;
+    // A real pixel the renderer left as the footage already carries the footage's noise: nothing
+    // to add (need = carried below), so skip the draw (most of a frame outside the virtual
+    // objects' influence; the draw's 5x5 mean is most of this pass's time).
+    bool unchanged = !virtualPx && all(lessThanEqual(abs(value - ci), vec3(1e-6)));
+    if (noiseOn != 0 && !unchanged) {
         // What the pixel carries of the footage's noise already, scaled by k = L / CI.
         vec3 k = virtualPx ? vec3(0.0) : value / max(ci, vec3(1e-4));
         vec3 n = whiteNoise(px);
@@ -83,9 +88,10 @@ void main() {
                              whiteNoise(px + ivec2(0, 1)) + whiteNoise(px - ivec2(0, 1)))) /
                 sqrt(1.0 + 4.0 * beta * beta);
         vec3 need = noiseVarianceAt(value);
+        vec3 varianceCi = noiseVarianceAt(ci);
         bvec3 own = bvec3(false);
-        vec3 draw = footageGrain != 0 ? footageDraw(px, ci, own) : vec3(0.0);
-        vec3 carriedVariance = k * k * noiseVarianceAt(ci);
+        vec3 draw = footageGrain != 0 ? footageDraw(px, ci, varianceCi, own) : vec3(0.0);
+        vec3 carriedVariance = k * k * varianceCi;
         for (int c = 0; c < 3; ++c) {
             float carried = carriedVariance[c];
             if (own[c])  // the same draw: standard deviations add
