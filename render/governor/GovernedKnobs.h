@@ -2,9 +2,10 @@
 // The renderer options a frame-time governor may change from one frame to the next without
 // building a new renderer: each changes only what a pass reads when it executes (a uniform, a
 // shader variant built on first use, how often a pass refreshes), never a texture's size or the
-// renderer's plan of lights and VPLs. They carry the names of their `mirage bench` knobs
-// (docs/bench.md), so a speed-vs-error table written by `mirage bench` is read by the governor
-// column for column.
+// renderer's plan of lights and VPLs. They are the pass knobs that declare themselves governed
+// (render/PassKnob.h), set and read through those knobs, so they carry the names of their
+// `mirage bench` knobs (docs/bench.md) and a speed-vs-error table written by `mirage bench` is
+// read by the governor column for column.
 #include <map>
 #include <string>
 #include <vector>
@@ -17,7 +18,7 @@ namespace mirage::render {
 // "half"). A knob left out keeps the value the renderer was built with.
 using QualitySetting = std::map<std::string, std::string>;
 
-// The knobs the governor may set, in the order reports list them.
+// The knobs the governor may set, in the order reports list them (registration order).
 const std::vector<std::string>& governedKnobNames();
 bool isGovernedKnob(const std::string& name);
 

@@ -1,0 +1,40 @@
+// The shadow pass's knobs (render/PassKnob.h).
+#include <fmt/format.h>
+
+#include "render/PassKnob.h"
+
+namespace mirage::render {
+
+std::vector<PassKnob> shadowKnobs() {
+    std::vector<PassKnob> k{
+        PassKnob{"shadow_filter",
+                 "pcf: shadow maps looked up with percentage-closer filtering over 4x4 texels "
+                 "(straight shadow edges); off: the 2x2 bilinear lookup (1-texel stair steps)",
+                 {},
+                 {},
+                 [](RendererOptions& o, const std::string& v) {
+                     o.shadow.filter = parseKnobChoice("shadow_filter", v, {"off", "pcf"}) == 1
+                                           ? ShadowFilter::Pcf
+                                           : ShadowFilter::Bilinear;
+                 },
+                 [](const RendererOptions& o) {
+                     return std::string(shadowFilterName(o.shadow.filter));
+                 }},
+        intKnob(
+            "shadow_map", "texels per side of each shadow-map layer (occluder distance)",
+            [](RendererOptions& o) -> int& { return o.shadow.mapSize; }, 16, 4096),
+        intKnob(
+            "shadow_rsm",
+            "texels per side of each reflective-shadow-map layer (the VPLs' source; its own "
+            "raster when it differs from shadow_map)",
+            [](RendererOptions& o) -> int& { return o.shadow.rsmSize; }, 16, 4096),
+        onOffKnob(
+            "glass_shadows",
+            "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
+            "off: glass is opaque there",
+            [](RendererOptions& o) -> bool& { return o.shadow.glass; }, {"on"}),
+    };
+    return k;
+}
+
+}  // namespace mirage::render
