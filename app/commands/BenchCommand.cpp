@@ -15,6 +15,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -332,8 +333,15 @@ void runBench(const BenchArgs& a) {
     mdOut->commit();
     if (a.images) writeBenchImages(out / "images", results);
     if (a.budgetMs > 0) {
-        const std::string report = render::budgetReport(speedErrorTable(results), a.budgetMs);
-        std::ofstream(out / "budget.md") << report;
+        const render::SpeedErrorTable table = speedErrorTable(results);
+        double footage = std::numeric_limits<double>::quiet_NaN();
+        for (const render::BenchResult& r : results)
+            if (r.baseline) footage = r.error.psnrInfluenced;
+        std::ofstream(out / "budget.svg") << render::budgetPlotSvg(table, a.budgetMs, footage);
+        const std::string report = render::budgetReport(table, a.budgetMs);
+        std::ofstream(out / "budget.md")
+            << report << "\n![the settings' speed against error, the front the governor follows "
+            << "and its choice at this budget](budget.svg)\n";
         spdlog::info("bench: {}", report.substr(0, report.find("\n\nThe speed")));
     }
     spdlog::info("bench: wrote {}, {}, {} (load average {} after)", (out / "bench.csv").string(),

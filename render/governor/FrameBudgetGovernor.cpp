@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include <fmt/format.h>
 
 #include "core/Error.h"
+#include "core/plot/SvgPlot.h"
 
 namespace mirage::render {
 
@@ -137,6 +139,36 @@ std::string budgetReport(const SpeedErrorTable& table, double budgetMs) {
         s += fmt::format("| {} | {:.1f} | {:.2f} |\n", describeQualitySetting(r.setting), r.frameMs,
                          r.psnrDb);
     return s;
+}
+
+std::string budgetPlotSvg(const SpeedErrorTable& table, double budgetMs, double footagePsnrDb) {
+    const BudgetChoice c = chooseWithinBudget(table, budgetMs);
+    const std::vector<SpeedErrorRow>& rows = table.rows();
+    std::set<std::string> varying;  // knobs whose value is not the same in every row
+    for (const SpeedErrorRow& r : rows)
+        for (const auto& [name, value] : r.setting) {
+            const auto it = rows.front().setting.find(name);
+            if (it == rows.front().setting.end() || it->second != value) varying.insert(name);
+        }
+    plot::ScatterPlot p;
+    p.title =
+        fmt::format("Speed against error; ringed: the governor's choice at {:.1f} ms", budgetMs);
+    p.xLabel = "ms per frame (median wall)";
+    p.yLabel = "PSNR over influenced pixels (dB)";
+    for (const SpeedErrorRow& r : rows) {
+        std::string label;
+        for (const std::string& name : varying) {
+            const auto it = r.setting.find(name);
+            if (it != r.setting.end())
+                label += (label.empty() ? "" : " ") + name + "=" + it->second;
+        }
+        const bool chosen = r.setting == c.chosen.setting && r.frameMs == c.chosen.frameMs;
+        p.points.push_back({r.frameMs, r.psnrDb, label, chosen, false});
+    }
+    p.hasBaseline = std::isfinite(footagePsnrDb);
+    p.baselineY = footagePsnrDb;
+    p.baselineLabel = "footage only";
+    return plot::svgScatter(p);
 }
 
 std::string FrameBudgetGovernor::summary() const {

@@ -46,6 +46,12 @@ struct BudgetChoice {
 };
 BudgetChoice chooseWithinBudget(const SpeedErrorTable& table, double budgetMs);
 std::string budgetReport(const SpeedErrorTable& table, double budgetMs);
+// The same as a picture (SVG, frame time against PSNR): every row of the table as a point, the
+// Pareto front as the step line the governor's choice follows as the budget grows (at any
+// budget it holds the front's most accurate setting within it), the setting it holds at this
+// budget ringed, and `footagePsnrDb` (the footage alone; NaN: none) as a dashed baseline. Points
+// are labelled by the knobs whose values differ between rows.
+std::string budgetPlotSvg(const SpeedErrorTable& table, double budgetMs, double footagePsnrDb);
 
 class FrameBudgetGovernor {
 public:

@@ -71,6 +71,28 @@ TEST(FrameBudgetGovernor, ChoosesOnlyFromTheParetoFront) {
         }
 }
 
+// The picture of budget.md: a point per row, the setting held at the budget ringed (the most
+// accurate of the front within it: half resolution refreshed every 2nd frame at 200 ms), the
+// footage's baseline, labels of the knobs that vary. The must-fail: at another budget another
+// point is ringed.
+TEST(FrameBudgetGovernor, BudgetPlotRingsTheChoiceAmongEveryRow) {
+    const std::string svg = budgetPlotSvg(glassTable(), 200.0, 18.4);
+    auto count = [&](const std::string& s, const std::string& what) {
+        size_t n = 0;
+        for (size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+        return n;
+    };
+    EXPECT_EQ(count(svg, "class=\"point\""), glassTable().rows().size());
+    EXPECT_EQ(count(svg, "class=\"default\""), 1u);
+    EXPECT_NE(svg.find("footage only"), std::string::npos);
+    EXPECT_NE(svg.find("caustic_refresh=2 specular_resolution=half"), std::string::npos)
+        << "labels name the knobs that vary";
+    // The ringed point is the 190 ms row: the same SVG with the budget at 170 ms rings 160 ms.
+    const std::string other = budgetPlotSvg(glassTable(), 170.0, 18.4);
+    EXPECT_NE(svg, other) << "must-fail: the ring moves with the budget";
+    EXPECT_EQ(count(other, "class=\"default\""), 1u);
+}
+
 TEST(FrameBudgetGovernor, DominatedRowsAreRecognised) {
     // The must-fail side of the test above: a dominated setting is caught by the same check.
     const SpeedErrorTable table = glassTable();
