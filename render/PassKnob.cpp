@@ -90,6 +90,24 @@ PassKnob intKnob(std::string name, std::string help, int& (*field)(RendererOptio
             }};
 }
 
+PassKnob intChoiceKnob(std::string name, std::string help, int& (*field)(RendererOptions&),
+                       std::vector<int> values, std::vector<std::string> full) {
+    const std::string n = name;
+    std::vector<std::string> spelled;
+    for (int v : values) spelled.push_back(std::to_string(v));
+    return {std::move(name),
+            std::move(help),
+            std::move(full),
+            {},
+            [n, field, values, spelled](RendererOptions& o, const std::string& v) {
+                field(o) = values[parseKnobChoice(n, v, spelled)];
+            },
+            [field](const RendererOptions& o) {
+                RendererOptions copy = o;
+                return std::to_string(field(copy));
+            }};
+}
+
 PassKnob governedKnob(PassKnob k) {
     k.governed = true;
     return k;

@@ -53,6 +53,9 @@ PassKnob onOffKnob(std::string name, std::string help, bool& (*field)(RendererOp
                    std::vector<std::string> full = {});
 PassKnob intKnob(std::string name, std::string help, int& (*field)(RendererOptions&), int lo,
                  int hi, std::vector<std::string> full = {}, std::vector<std::string> quick = {});
+// An int that takes only the listed values (e.g. 1, 4 or 16).
+PassKnob intChoiceKnob(std::string name, std::string help, int& (*field)(RendererOptions&),
+                       std::vector<int> values, std::vector<std::string> full = {});
 // `k` with governed = true.
 PassKnob governedKnob(PassKnob k);
 // A bool spelled by two names: `yes` sets it, `no` clears it.
