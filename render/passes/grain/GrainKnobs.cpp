@@ -1,6 +1,4 @@
 // The grain pass's knobs: noise and vignetting matching (render/PassKnob.h).
-#include <fmt/format.h>
-
 #include "render/PassKnob.h"
 
 namespace mirage::render {

@@ -1,7 +1,5 @@
 // The impostor pass's knobs (render/PassKnob.h); the refinement steps (a loop count of the trace)
 // the frame-time governor may set between frames.
-#include <fmt/format.h>
-
 #include "render/PassKnob.h"
 
 namespace mirage::render {

@@ -1,8 +1,6 @@
 // The rough-refraction pass's knobs (render/PassKnob.h).
 #include <array>
 
-#include <fmt/format.h>
-
 #include "render/PassKnob.h"
 
 namespace mirage::render {

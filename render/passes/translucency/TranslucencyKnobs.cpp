@@ -1,6 +1,4 @@
 // The translucency pass's knobs (render/PassKnob.h).
-#include <fmt/format.h>
-
 #include "render/PassKnob.h"
 
 namespace mirage::render {
