@@ -8,7 +8,9 @@
 // reflection's share are smoothed over time (RendererOptions::specular.temporal): they and the
 // hits they were lit at ping-pong, this frame's result being the next frame's history (not in the
 // half-resolution variant, RendererOptions::specular.halfResolution: its hits are shaded per 2x2
-// block, and the history test needs each pixel's own hits).
+// block, and the history test needs each pixel's own hits). With specular.refreshInterval N > 1
+// only one phase of N of the 8x8-pixel tiles is shaded per frame; the other tiles' pixels take
+// their history as it is where it was lit at this frame's hits (specular_light.frag).
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"
 
