@@ -28,8 +28,7 @@ void RendererOptions::validate() const {
     grain.validate();
     checkOption(temporalBlend >= 0.0f && temporalBlend <= 0.98f, "temporalBlend",
                 "in [0, 0.98] (the history's weight)", temporalBlend);
-    checkOption(clip.nearM > 0.0f && clip.farM > clip.nearM, "clip", "0 < nearM < farM (metres)",
-                clip.farM);
+    passes.validate();
 }
 
 int ismTilesPerRow(int vplCount) {

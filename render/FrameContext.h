@@ -16,6 +16,7 @@
 #include "render/CameraProjection.h"
 #include "render/GpuScene.h"
 #include "render/GpuTypes.h"
+#include "render/PassOptionSet.h"
 #include "render/Resource.h"
 #include "render/passes/aa/AntialiasOptions.h"
 #include "render/passes/caustic/CausticOptions.h"
@@ -36,12 +37,6 @@
 #include "render/passes/vpl/VplOptions.h"
 
 namespace mirage::render {
-
-// The camera's clip planes, metres from the camera.
-struct ClipRange {
-    float nearM = 0.01f;
-    float farM = 100.0f;
-};
 
 // The rectangles (GL window x, y, width, height) that draws into a set of textures last covered.
 // Clearing those and the next draw's rectangles before that draw keeps the textures at their
@@ -93,8 +88,10 @@ struct RendererOptions {
     // (1 - temporalBlend) of its own value: an exponential average over ~1 / (1 - blend) frames.
     // 0 .. 0.98.
     float temporalBlend = 0.8f;
-    ClipRange clip;           // the camera's near and far planes
     FrameGraphOptions graph;  // how the frame graph runs the passes
+    // The options of every pass registered after the members above, each struct in its pass's
+    // folder (render/PassOptionSet.h): adding a pass adds no member here.
+    PassOptionSet passes;
 
     // Throws mirage::Error naming the first option out of range and its valid range. The
     // Renderer calls it once, before anything is allocated.

@@ -729,6 +729,11 @@ bool PassResources::has(Resource r) const {
     return v >= 0 && bool(graph_.current_[size_t(v)]);
 }
 
+bool PassResources::hasTexture(Resource r) const {
+    const int v = graph_.resolvedReads_[node_][size_t(declaredRead(r))];
+    return v >= 0 && graph_.current_[size_t(v)].texture != nullptr;
+}
+
 const gl::Texture& PassResources::textureOr(Resource r, const gl::Texture& fallback) const {
     return has(r) ? texture(r) : fallback;
 }

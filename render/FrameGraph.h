@@ -75,6 +75,8 @@ public:
     // A transient texture whose memory a later resource reused in the frame is gone: texture()
     // throws mirage::Error naming it (as when the frame did not write it).
     bool has(Resource r) const;
+    // ... and is a texture (not a buffer): for a pass whose reads an option names.
+    bool hasTexture(Resource r) const;
     const gl::Texture& texture(Resource r) const;
     const gl::Buffer& buffer(Resource r) const;
 
@@ -186,6 +188,8 @@ public:
     const gl::Buffer& buffer(Resource r) const;
     // A declared read (typically optional) is available this frame.
     bool has(Resource r) const;
+    // ... and is a texture (not a buffer): for a pass whose reads an option names.
+    bool hasTexture(Resource r) const;
     // A declared optional read, or `fallback` when it is not available this frame.
     const gl::Texture& textureOr(Resource r, const gl::Texture& fallback) const;
     // A declared write: checked against the declared format and size rule (MR_CHECK).

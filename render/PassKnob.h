@@ -3,7 +3,8 @@
 // the pass's options struct as `mirage bench --knob`, the governor and the docs spell it
 // ("caustic_map=512"), says which values it takes, and sets and reads it on RendererOptions.
 // A pass folder declares its knobs beside its options (render/passes/<pass>/<Pass>Knobs.cpp);
-// passKnobs() collects them, one line per pass (render/PassKnobs.cpp).
+// passKnobs() collects them from the pass list (render/PassList.cpp: one line per pass names its
+// factory and its knobs).
 #include <functional>
 #include <string>
 #include <vector>
@@ -30,7 +31,7 @@ struct PassKnob {
     std::vector<std::string> sweep(bool quickGrid) const;
 };
 
-// Every pass's knobs, in registration order (render/PassKnobs.cpp); names are unique.
+// Every pass's knobs, in the pass list's order (render/PassList.cpp); names are unique.
 const std::vector<PassKnob>& passKnobs();
 // The knob named `name`, or nullptr.
 const PassKnob* findPassKnob(const std::string& name);

@@ -92,6 +92,11 @@ public:
     // is still the newest version, i.e. no pass modified the resource since `h` was returned.
     TextureHandle read(TextureHandle h);
 
+    // An import or an earlier pass (or this one) declares the resource: a pass whose reads are
+    // chosen at run time (an option naming a resource) checks them with this. Always true for
+    // a recording builder (nothing to check against).
+    bool declared(Resource r) const { return !graph_ || newestVersion(r) >= 0; }
+
     const std::vector<ResourceWrite>& writes() const { return writes_; }
     const std::vector<ResourceRead>& reads() const { return reads_; }
 

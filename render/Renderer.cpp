@@ -10,33 +10,19 @@
 
 #include "core/Error.h"
 #include "render/FrameImports.h"
+#include "render/PassRegistry.h"
 #include "render/governor/GovernedKnobs.h"
-#include "render/passes/aa/AntialiasPass.h"
-#include "render/passes/backface/BackFacePass.h"
-#include "render/passes/caustic/CausticPass.h"
-#include "render/passes/caustic/PhotonGBufferPass.h"
-#include "render/passes/caustic/PhotonGridPass.h"
 #include "render/passes/composite/CompositePass.h"
-#include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/environment/EnvironmentPass.h"
-#include "render/passes/exposure/ExposurePass.h"
-#include "render/passes/fuzzy/FuzzyReflectionPass.h"
-#include "render/passes/gbuffer/GBufferPass.h"
-#include "render/passes/gifilter/GiFilterPass.h"
-#include "render/passes/grain/GrainPass.h"
-#include "render/passes/impostor/ImpostorPass.h"
-#include "render/passes/indirect/IndirectLightPass.h"
 #include "render/passes/ism/IsmPass.h"
-#include "render/passes/motionblur/MotionBlurPass.h"
-#include "render/passes/rough/RoughRefractionPass.h"
-#include "render/passes/shadow/ShadowPass.h"
-#include "render/passes/specular/SpecularGBufferPass.h"
-#include "render/passes/specular/SpecularLightPass.h"
-#include "render/passes/translucency/TranslucencyPass.h"
 #include "render/passes/vpl/VplPass.h"
 
 namespace mirage::render {
 namespace {
+
+// The camera's clip planes, metres from the camera: a tabletop at 1 cm, a room's far wall well
+// inside 100 m (the depth buffer is 32-bit float).
+constexpr float kNearM = 0.01f, kFarM = 100.0f;
 
 // Does the sphere touch the light's cone of influence (spot cone, range)?
 bool inLightCone(const SceneLight& l, const BoundingSphere& s) {
@@ -287,7 +273,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 
-    // The frame, in order. Passes know each other only through the resources they declare.
+    // The frame, in order (render/PassList.cpp).
     FrameGraph& g = graph_;
     const GLenum cameraFormat =
         options_.composite.cameraResponse.isSrgb() ? GL_SRGB8_ALPHA8 : GL_RGBA16F;
@@ -295,30 +281,8 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
     g.importTexture(kSceneEnvironmentMap, GL_RGBA16F, SizeRule::Scene, "scene environment");
     g.importTexture(kEnvironmentCamera, GL_SRGB8_ALPHA8, SizeRule::Scene,
                     "environment camera frame");
-    g.addPass(std::make_unique<EnvironmentPass>());
-    g.addPass(std::make_unique<GBufferPass>(GBufferPass::MaterialMaps{
-        scene_->hasBaseColorTextures(), scene_->hasMetallicRoughnessTextures()}));
-    g.addPass(std::make_unique<ShadowPass>());
-    g.addPass(std::make_unique<ImpostorPass>());
-    g.addPass(std::make_unique<PhotonGBufferPass>(*scene_));  // before vpl: VPLs follow photons
-    g.addPass(std::make_unique<VplPass>());
-    g.addPass(std::make_unique<IsmPass>());
-    g.addPass(std::make_unique<TranslucencyPass>(scene, *scene_, options_));
-    g.addPass(std::make_unique<IndirectLightPass>());
-    g.addPass(std::make_unique<GiFilterPass>(options_.indirect.interleave));
-    g.addPass(std::make_unique<DirectLightPass>(*scene_));  // + the upsampled indirect light
-    g.addPass(std::make_unique<CausticPass>());
-    g.addPass(std::make_unique<ExposurePass>());  // L_r complete; before any pass using exposure
-    g.addPass(std::make_unique<BackFacePass>());
-    g.addPass(std::make_unique<SpecularGBufferPass>());
-    g.addPass(std::make_unique<PhotonGridPass>());  // caustics at the reflected/refracted hits
-    g.addPass(std::make_unique<SpecularLightPass>(*scene_, options_));
-    g.addPass(std::make_unique<FuzzyReflectionPass>());
-    g.addPass(std::make_unique<RoughRefractionPass>());
-    g.addPass(std::make_unique<CompositePass>());
-    g.addPass(std::make_unique<AntialiasPass>());   // the renderer's edges, after the composite
-    g.addPass(std::make_unique<MotionBlurPass>());  // what the renderer added, over the exposure
-    g.addPass(std::make_unique<GrainPass>());       // last: the sensor adds its noise last
+    const PassInit init{scene, *scene_, options_};
+    for (const RegisteredPass& p : registeredPasses()) g.addPass(p.make(init));
     g.markOutput(kComposite);
     g.markOutput(kCompositeSrgb);
     g.compile();
@@ -439,7 +403,7 @@ void Renderer::planFrame(const FrameInput& input) {
     c.T_world_camera = input.T_world_camera;
     c.time = input.time;
     const glm::mat4 view(input.T_world_camera.inverse().matrix());
-    const glm::mat4 proj = projection_.projectionMatrix(options_.clip.nearM, options_.clip.farM);
+    const glm::mat4 proj = projection_.projectionMatrix(kNearM, kFarM);
     const glm::mat4 viewProj = proj * view;
 
     bool virtualInView = false;

@@ -10,6 +10,7 @@
 // live poses (core/capture/LiveRecording.h).
 #include "app/Command.h"
 #include "app/EffectSwitches.h"
+#include "app/KnobSettings.h"
 #include "app/NumberChecks.h"
 #include "app/PathChecks.h"
 #include "app/live/LiveInputs.h"
@@ -85,6 +86,10 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
                         effectSwitchNames())
         ->delimiter(',')
         ->check(effectSwitchName());
+    cmd->add_option("--set", args->knobSettings,
+                    "Set a pass knob, KNOB=VALUE (repeatable; the knobs and their values: "
+                    "`mirage bench --list-knobs`), e.g. --set caustic_map=512")
+        ->check(knobSetting());
     cmd->add_option("--record", args->record,
                     "Record the session (the camera's frames and the live poses) into this new "
                     "folder; replay it with `mirage replay`")

@@ -27,6 +27,7 @@
 // directional lights (render/EnvironmentLights.h); --report-lights only logs them.
 #include "app/Command.h"
 #include "app/EffectSwitches.h"
+#include "app/KnobSettings.h"
 #include "app/NumberChecks.h"
 #include "app/PathChecks.h"
 #include "app/ShardOptions.h"
@@ -89,6 +90,10 @@ const CommandRegistrar reg("replay", [](CLI::App& parent) {
                         effectSwitchNames())
         ->delimiter(',')
         ->check(effectSwitchName());
+    cmd->add_option("--set", args->knobSettings,
+                    "Set a pass knob, KNOB=VALUE (repeatable; the knobs and their values: "
+                    "`mirage bench --list-knobs`), e.g. --set caustic_map=512")
+        ->check(knobSetting());
     cmd->add_flag("--estimate-lights", args->estimateLights,
                   "Find the dominant lights of the environment camera's frames and place them as "
                   "shadow-casting real directional lights (their regions taken out of the "

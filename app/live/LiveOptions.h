@@ -10,8 +10,9 @@ namespace mirage::app {
 
 struct LiveOptions {
     std::string camera, scene, calibration, board, output, record;
-    std::vector<std::string> effectsOff;  // bench knob names of effects switched off
-    double cameraFps = 0;                 // 0: the stand-in's own rate
+    std::vector<std::string> effectsOff;    // bench knob names of effects switched off
+    std::vector<std::string> knobSettings;  // --set KNOB=VALUE, applied after effectsOff
+    double cameraFps = 0;                   // 0: the stand-in's own rate
     int width = 640, height = 480;
     int maxFrames = -1;
     int vpls = 256;

@@ -8,6 +8,7 @@
 #include "app/BoardPlane.h"
 #include "app/EffectSwitches.h"
 #include "app/InputChecks.h"
+#include "app/KnobSettings.h"
 #include "core/Error.h"
 #include "core/Log.h"
 #include "core/OutputFile.h"
@@ -159,6 +160,7 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     settings.effects.grain.vignette.enabled = true;
     settings.effects.composite.cameraResponse = cameraResponseOrSrgb(calibrationPath_);
     switchEffectsOff(a.effectsOff, settings.effects);
+    applyKnobSettings(a.knobSettings, settings.effects);
     settings.vpls = a.vpls;
     settings.budgetMs = a.budgetMs >= 0 ? a.budgetMs : 1000.0 / camera_.fps;
     settings.budgetTable = a.budgetTable;

@@ -8,7 +8,8 @@ namespace mirage::app {
 
 struct ReplayOptions {
     std::string session, scene, output, poses, shard, placement, staticEnv;
-    std::vector<std::string> effectsOff;  // bench knob names of effects switched off
+    std::vector<std::string> effectsOff;    // bench knob names of effects switched off
+    std::vector<std::string> knobSettings;  // --set KNOB=VALUE, applied after effectsOff
     int vpls = 256;
     int maxFrames = -1;
     int start = 0;

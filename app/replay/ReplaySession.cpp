@@ -9,6 +9,7 @@
 #include "app/BoardPlane.h"
 #include "app/EffectSwitches.h"
 #include "app/InputChecks.h"
+#include "app/KnobSettings.h"
 #include "app/OutputKind.h"
 #include "app/commands/ShardMerge.h"
 #include "core/Error.h"
@@ -197,6 +198,7 @@ void ReplaySession::createRenderer() {
     ropt.grain.noise.enabled = true;
     ropt.grain.vignette.enabled = true;
     switchEffectsOff(a.effectsOff, ropt);
+    applyKnobSettings(a.knobSettings, ropt);
     ropt.motionBlur.shutterSeconds = replayShutterSeconds(a, session_);
     if (a.estimateLights) {
         // As many as light estimation reports, within the renderer's light budget.

@@ -29,7 +29,7 @@ void applyQualitySetting(const QualitySetting& setting, RendererOptions& options
 // Copies the governed knobs' options from `from` into `to`, leaving every other option of `to`.
 void copyGovernedOptions(const RendererOptions& from, RendererOptions& to);
 
-// "specular_resolution=half caustic_refresh=2" (knobs in governedKnobNames() order; "defaults"
+// "caustic_refresh=2 specular_resolution=half" (knobs in governedKnobNames() order; "defaults"
 // for an empty setting).
 std::string describeQualitySetting(const QualitySetting& setting);
 

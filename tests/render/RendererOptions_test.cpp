@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -76,6 +77,38 @@ TEST(RendererOptions, AutomaticGatherScaleFollowsTheCanvasWidth) {
     o.indirect.scale = 2;
     EXPECT_EQ(o.indirect.gatherScale(640), 2);
     EXPECT_EQ(o.indirect.gatherScale(160), 2);
+}
+
+}  // namespace
+}  // namespace mirage::render
+
+namespace mirage::render {
+namespace {
+
+// An options struct as a pass folder would declare it (render/PassOptionSet.h).
+struct ProbeOptions {
+    int taps = 4;
+    void validate() const { checkOption(taps >= 1 && taps <= 8, "probe.taps", "1..8", taps); }
+};
+
+// A pass's options in the per-pass set: defaults until set, copied with RendererOptions (two
+// renderers never share them), and validated with the rest; the must-fail: a bad value set.
+TEST(RendererOptions, PassOptionSetHoldsEachPassOwnOptions) {
+    RendererOptions a;
+    EXPECT_EQ(std::as_const(a).passes.get<ProbeOptions>().taps, 4);
+    a.passes.get<ProbeOptions>().taps = 6;
+    RendererOptions b = a;
+    b.passes.get<ProbeOptions>().taps = 2;
+    EXPECT_EQ(std::as_const(a).passes.get<ProbeOptions>().taps, 6);
+    EXPECT_EQ(std::as_const(b).passes.get<ProbeOptions>().taps, 2);
+    EXPECT_NO_THROW(a.validate());
+    a.passes.get<ProbeOptions>().taps = 9;
+    try {
+        a.validate();
+        ADD_FAILURE() << "taps 9 was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("probe.taps"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
+#include "render/PassRegistry.h"
 #include "render/passes/composite/CompositePass.h"
 
 namespace mirage::render {
@@ -64,6 +65,11 @@ void AntialiasPass::execute(FrameContext& ctx, PassResources& res) {
     glDisable(GL_FRAMEBUFFER_SRGB);
     res.publish(kComposite, linear_);
     res.publish(kCompositeSrgb, srgb_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeAntialiasPass(const PassInit&) {
+    return std::make_unique<AntialiasPass>();
 }
 
 }  // namespace mirage::render

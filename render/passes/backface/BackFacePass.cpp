@@ -1,6 +1,7 @@
 #include "render/passes/backface/BackFacePass.h"
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 
 namespace mirage::render {
 
@@ -72,6 +73,11 @@ void BackFacePass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kBackFacePosition, position_);
     res.publish(kBackFaceNormal, normal_);
     glDisable(GL_DEPTH_TEST);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeBackFacePass(const PassInit&) {
+    return std::make_unique<BackFacePass>();
 }
 
 }  // namespace mirage::render

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 
@@ -126,6 +127,11 @@ void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedS
     res.publish(kCausticHistoryR, historyR_[write]);
     res.publish(kCausticRv, rv_);
     res.publish(kCausticR, r_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeCausticPass(const PassInit&) {
+    return std::make_unique<CausticPass>();
 }
 
 }  // namespace mirage::render

@@ -1,6 +1,7 @@
 #include "render/passes/caustic/PhotonGBufferPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/impostor/ImpostorPass.h"
 #include "render/passes/shadow/ShadowPass.h"
 
@@ -136,6 +137,11 @@ void PhotonGBufferPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kPhotonPowerRefr, refrPower_);
     res.publish(kPhotonSurfaceRefl, reflSurface_);
     res.publish(kPhotonSurfaceRefr, refrSurface_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makePhotonGBufferPass(const PassInit& init) {
+    return std::make_unique<PhotonGBufferPass>(init.gpuScene);
 }
 
 }  // namespace mirage::render

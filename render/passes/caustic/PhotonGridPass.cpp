@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
 
 namespace mirage::render {
@@ -89,6 +90,11 @@ void PhotonGridPass::execute(FrameContext& ctx, PassResources& res) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(kPhotonGrid, grid_);
     res.publish(kPhotonRecords, records_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makePhotonGridPass(const PassInit&) {
+    return std::make_unique<PhotonGridPass>();
 }
 
 }  // namespace mirage::render

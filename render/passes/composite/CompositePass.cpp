@@ -5,6 +5,7 @@
 
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
+#include "render/PassRegistry.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/exposure/ExposurePass.h"
@@ -264,6 +265,11 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kComposite, linear_);
     res.publish(kCompositeSrgb, srgb_);
     res.publish(kCompositeFootage, footage_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeCompositePass(const PassInit&) {
+    return std::make_unique<CompositePass>();
 }
 
 }  // namespace mirage::render

@@ -1,6 +1,7 @@
 #include "render/passes/direct/DirectLightPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
@@ -195,6 +196,11 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
         res.publish(kDirectRv, directRv_);
         res.publish(kDirectR, directR_);
     }
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeDirectLightPass(const PassInit& init) {
+    return std::make_unique<DirectLightPass>(init.gpuScene);
 }
 
 }  // namespace mirage::render

@@ -9,6 +9,7 @@
 #include "core/Error.h"
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
+#include "render/PassRegistry.h"
 
 namespace mirage::render {
 namespace {
@@ -138,6 +139,11 @@ void EnvironmentPass::executeLive(FrameContext& ctx, PassResources& res) {
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_UNIFORM_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     res.publish(kEnvironmentMap, map_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeEnvironmentPass(const PassInit&) {
+    return std::make_unique<EnvironmentPass>();
 }
 
 }  // namespace mirage::render

@@ -10,6 +10,7 @@
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
 #include "render/PassOptions.h"
+#include "render/PassRegistry.h"
 #include "render/RadiometricRatio.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/direct/DirectLightPass.h"
@@ -160,6 +161,11 @@ void ExposurePass::execute(FrameContext& ctx, PassResources& res) {
     ctx.frameUbo.upload(&ctx.frame.exposure, sizeof(ctx.frame.exposure),
                         offsetof(GpuFrame, exposure));
     res.publish(kExposureSamples, footage_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeExposurePass(const PassInit&) {
+    return std::make_unique<ExposurePass>();
 }
 
 }  // namespace mirage::render

@@ -6,6 +6,7 @@
 
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
+#include "render/PassRegistry.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
 #include "render/passes/specular/SpecularLightPass.h"
@@ -142,6 +143,11 @@ void FuzzyReflectionPass::execute(FrameContext& ctx, PassResources& res) {
     }
     for (int i = 0; i < 4; ++i) res.publish(kFiltered[i], out_[i]);
     res.publish(kFilteredVideo, out_[4]);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeFuzzyReflectionPass(const PassInit&) {
+    return std::make_unique<FuzzyReflectionPass>();
 }
 
 }  // namespace mirage::render

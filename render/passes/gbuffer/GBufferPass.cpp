@@ -3,6 +3,7 @@
 #include <string>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 namespace mirage::render {
 
 GBufferPass::GBufferPass(MaterialMaps maps)
@@ -136,6 +137,12 @@ void GBufferPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kGBufferNormal, normal_);
     res.publish(kGBufferAlbedo, albedo_);
     res.publish(kGBufferEmissive, emissive_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeGBufferPass(const PassInit& init) {
+    return std::make_unique<GBufferPass>(GBufferPass::MaterialMaps{
+        init.gpuScene.hasBaseColorTextures(), init.gpuScene.hasMetallicRoughnessTextures()});
 }
 
 }  // namespace mirage::render

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
 
@@ -72,6 +73,11 @@ void GiFilterPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kGiHistoryRv, lowRv_[write]);
     res.publish(kGiHistoryR, lowR_[write]);
     res.publish(kGatherLight, gatherLight_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeGiFilterPass(const PassInit& init) {
+    return std::make_unique<GiFilterPass>(init.options.indirect.interleave);
 }
 
 }  // namespace mirage::render

@@ -9,6 +9,7 @@
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
 #include "render/PassOptions.h"
+#include "render/PassRegistry.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/direct/DirectLightPass.h"
@@ -213,6 +214,11 @@ void GrainPass::execute(FrameContext& ctx, PassResources& res) {
         }
     }
     apply(ctx, res);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeGrainPass(const PassInit&) {
+    return std::make_unique<GrainPass>();
 }
 
 }  // namespace mirage::render

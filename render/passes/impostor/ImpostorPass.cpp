@@ -11,6 +11,7 @@
 #include "core/Error.h"
 #include "core/Log.h"
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/impostor/ImpostorTypes.h"
 
 namespace mirage::render {
@@ -563,6 +564,11 @@ std::vector<ImpostorHit> ImpostorPass::trace(const std::vector<ImpostorRay>& ray
         h.metallic = q.emissiveMetal.w;
     }
     return hits;
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeImpostorPass(const PassInit&) {
+    return std::make_unique<ImpostorPass>();
 }
 
 }  // namespace mirage::render

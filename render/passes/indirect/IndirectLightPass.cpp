@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/ism/IsmPass.h"
 #include "render/passes/vpl/VplPass.h"
@@ -63,6 +64,11 @@ void IndirectLightPass::execute(FrameContext& ctx, PassResources& res) {
             glUniform2i(locTile, gx * tw, gy * th);
             glDrawArrays(GL_TRIANGLES, 0, 3);
         }
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeIndirectLightPass(const PassInit&) {
+    return std::make_unique<IndirectLightPass>();
 }
 
 }  // namespace mirage::render

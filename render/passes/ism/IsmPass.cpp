@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/vpl/VplPass.h"
 namespace mirage::render {
 
@@ -53,6 +54,11 @@ void IsmPass::execute(FrameContext& ctx, PassResources& res) {
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     res.publish(kImperfectShadowMaps, all_);
     res.publish(kImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? real_ : all_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeIsmPass(const PassInit&) {
+    return std::make_unique<IsmPass>();
 }
 
 }  // namespace mirage::render

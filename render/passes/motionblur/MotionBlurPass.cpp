@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/composite/CompositePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 
@@ -149,6 +150,11 @@ void MotionBlurPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kMotionVelocity, velocity_);
     res.publish(kComposite, linear_);
     res.publish(kCompositeSrgb, srgb_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeMotionBlurPass(const PassInit&) {
+    return std::make_unique<MotionBlurPass>();
 }
 
 }  // namespace mirage::render

@@ -6,6 +6,7 @@
 
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
+#include "render/PassRegistry.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
@@ -148,6 +149,11 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     ctx.drawFullscreenTriangleIn(rect);
     for (int i = 0; i < 4; ++i) res.publish(kFiltered[i], out_[i]);
     res.publish(kFilteredVideo, out_[4]);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeRoughRefractionPass(const PassInit&) {
+    return std::make_unique<RoughRefractionPass>();
 }
 
 }  // namespace mirage::render

@@ -1,6 +1,7 @@
 #include "render/passes/shadow/ShadowPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/translucency/VoxelNumberMap.h"
 namespace mirage::render {
 
@@ -238,6 +239,11 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
         res.publish(kRsmNormal, rsmNormal_);
         res.publish(kRsmPosition, rsmPosition_);
     }
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeShadowPass(const PassInit&) {
+    return std::make_unique<ShadowPass>();
 }
 
 }  // namespace mirage::render

@@ -3,6 +3,7 @@
 #include <array>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/backface/BackFacePass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/impostor/ImpostorPass.h"
@@ -222,6 +223,11 @@ void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& 
         ctx.clearForRects(rects, hits.drawn, 0, 5);
         ctx.drawFullscreenTriangleIn(rects);
     }
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeSpecularGBufferPass(const PassInit&) {
+    return std::make_unique<SpecularGBufferPass>();
 }
 
 }  // namespace mirage::render

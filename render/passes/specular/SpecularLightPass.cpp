@@ -3,6 +3,7 @@
 #include <array>
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/caustic/PhotonGridPass.h"
 #include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
@@ -304,6 +305,11 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kSpecularRReflection, rRefl_[write]);
     res.publish(kLenv, env_[write]);
     history_.written(ctx);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeSpecularLightPass(const PassInit& init) {
+    return std::make_unique<SpecularLightPass>(init.gpuScene, init.options);
 }
 
 }  // namespace mirage::render

@@ -7,6 +7,7 @@
 
 #include "core/Error.h"
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/shadow/ShadowPass.h"
 #include "render/translucency/VoxelNumberMap.h"
@@ -178,6 +179,11 @@ void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
     res.publish(kTranslucentGrid, grid_);
     res.publish(kTranslucentRadiance, radiance_);
     doneKey_ = inputKey(ctx);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeTranslucencyPass(const PassInit& init) {
+    return std::make_unique<TranslucencyPass>(init.scene, init.gpuScene, init.options);
 }
 
 }  // namespace mirage::render

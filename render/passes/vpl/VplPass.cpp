@@ -1,6 +1,7 @@
 #include "render/passes/vpl/VplPass.h"
 
 #include "render/FrameGraph.h"
+#include "render/PassRegistry.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
 #include "render/passes/shadow/ShadowPass.h"
 namespace mirage::render {
@@ -69,6 +70,11 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
     glDispatchCompute(GLuint((ctx.options.vpl.count + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(kVpls, vpls_);
+}
+
+// Registered in render/PassList.cpp.
+std::unique_ptr<RenderPass> makeVplPass(const PassInit&) {
+    return std::make_unique<VplPass>();
 }
 
 }  // namespace mirage::render
