@@ -34,6 +34,7 @@
     X(makeAntialiasPass, antialiasKnobs) /* the renderer's edges, after the composite */  \
     X(makeMotionBlurPass, noKnobs)       /* what the renderer added, over the exposure */ \
     X(makeGrainPass, grainKnobs)         /* the sensor adds its noise last */             \
+    X(makeResourceViewPass, viewKnobs)   /* in place of the composite, when asked for */  \
     /* (the list's end: every pass's line ends in a backslash) */
 
 namespace mirage::render {

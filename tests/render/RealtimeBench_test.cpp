@@ -206,7 +206,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
             "lean_mip_levels=8 translucent_shadows=on vnm_resolution=16 vnm_kernel=extinction "
             "vnm_surface=occupancy vnm_albedo=hapke vnm_lookup=smooth moving_objects=off "
             "env_source=static env_resolution=512 env_lights=0 exposure_match=off "
-            "motion_blur=off aa=off noise_match=off vignette_match=off camera_response=session");
+            "motion_blur=off aa=off noise_match=off vignette_match=off camera_response=session "
+            "view=off");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";
