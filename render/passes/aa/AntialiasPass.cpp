@@ -6,6 +6,7 @@
 #include "render/FrameImports.h"
 #include "render/PassRegistry.h"
 #include "render/passes/composite/CompositePass.h"
+#include "render/passes/composite/CompositeVersion.h"
 
 namespace mirage::render {
 
@@ -21,8 +22,7 @@ AntialiasPass::AntialiasPass()
 
 void AntialiasPass::setup(PassBuilder& b) const {
     b.read(kCameraImage);
-    b.modify(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
-    b.modify(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
+    CompositeVersion::declare(b);
 }
 
 PassDecision AntialiasPass::decide(const FrameContext& ctx) const {
@@ -36,18 +36,12 @@ PassDecision AntialiasPass::decide(const FrameContext& ctx) const {
 
 void AntialiasPass::resize(const FrameContext& ctx) {
     const int w = ctx.projection.camera.width, h = ctx.projection.camera.height;
-    if (linear_.width() == w && linear_.height() == h) return;
-    linear_ = gl::Texture::create2D("antialiased composite linear", w, h, GL_RGBA32F);
-    srgb_ = gl::Texture::create2D("antialiased composite srgb", w, h, GL_SRGB8_ALPHA8);
-    fbo_ = gl::Framebuffer("antialias fbo");
-    fbo_.attachColor(0, linear_);
-    fbo_.attachColor(1, srgb_);
-    fbo_.finalize(2);
+    output_.resize(w, h);
 }
 
 void AntialiasPass::execute(FrameContext& ctx, PassResources& res) {
     const AntialiasOptions& o = ctx.options.aa;
-    fbo_.bind();
+    output_.bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
     ctx.beginFullscreen(program_, ctx.projection.camera.width, ctx.projection.camera.height);
     glUniform1f(locEdgeThreshold_, o.edgeThreshold);
@@ -63,8 +57,7 @@ void AntialiasPass::execute(FrameContext& ctx, PassResources& res) {
     glBindSampler(kUnitAntialiasComposite, 0);
     glBindSampler(kUnitAntialiasCamera, 0);
     glDisable(GL_FRAMEBUFFER_SRGB);
-    res.publish(kComposite, linear_);
-    res.publish(kCompositeSrgb, srgb_);
+    output_.publish(res);
 }
 
 // Registered in render/PassList.cpp.

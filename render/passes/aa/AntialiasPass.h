@@ -7,6 +7,7 @@
 // validation and back-projection see the same buffers as without it, and lens distortion has
 // already been applied.
 #include "render/RenderPass.h"
+#include "render/passes/composite/CompositeVersion.h"
 
 namespace mirage::render {
 
@@ -22,8 +23,7 @@ public:
 private:
     gl::Program program_;
     gl::Sampler bilinear_;  // the filter reads both images between pixel centres
-    gl::Texture linear_, srgb_;
-    gl::Framebuffer fbo_;
+    CompositeVersion output_{"antialiased composite"};
     GLint locEdgeThreshold_ = -1, locEdgeThresholdMin_ = -1, locSubpixel_ = -1;
     GLint locChangeEpsilon_ = -1, locSearchSteps_ = -1;
 };

@@ -12,6 +12,7 @@
 #include "render/PassRegistry.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/composite/CompositePass.h"
+#include "render/passes/composite/CompositeVersion.h"
 #include "render/passes/direct/DirectLightPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 
@@ -59,8 +60,7 @@ void GrainPass::setup(PassBuilder& b) const {
     b.read(kGBufferPosition);
     b.read(kGBufferEmissive);
     b.readOptional(kCausticR);
-    b.modify(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
-    b.modify(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
+    CompositeVersion::declare(b);
 }
 
 PassDecision GrainPass::decide(const FrameContext& ctx) const {
@@ -75,16 +75,7 @@ PassDecision GrainPass::decide(const FrameContext& ctx) const {
 void GrainPass::resize(const FrameContext& ctx) {
     const CameraProjection& p = ctx.projection;
     const int cw = ctx.canvasWidth(), ch = ctx.canvasHeight();
-    if (p.camera.width != cameraW_ || p.camera.height != cameraH_) {
-        cameraW_ = p.camera.width;
-        cameraH_ = p.camera.height;
-        linear_ = gl::Texture::create2D("grain linear", cameraW_, cameraH_, GL_RGBA32F);
-        srgb_ = gl::Texture::create2D("grain srgb", cameraW_, cameraH_, GL_SRGB8_ALPHA8);
-        applyFbo_ = gl::Framebuffer("grain apply fbo");
-        applyFbo_.attachColor(0, linear_);
-        applyFbo_.attachColor(1, srgb_);
-        applyFbo_.finalize(2);
-    }
+    output_.resize(p.camera.width, p.camera.height);
     if (cw == canvasW_ && ch == canvasH_) return;
     canvasW_ = cw;
     canvasH_ = ch;
@@ -160,7 +151,7 @@ void GrainPass::estimate(FrameContext& ctx) {
 void GrainPass::apply(FrameContext& ctx, PassResources& res) {
     const GrainOptions& o = ctx.options.grain;
     const CameraIntrinsics& cam = ctx.projection.camera;
-    applyFbo_.bind();
+    output_.bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
     ctx.beginFullscreen(applyProgram_, cam.width, cam.height);
     const bool noise = o.noise.enabled && ctx.grainEstimates.noise().has_value();
@@ -193,8 +184,7 @@ void GrainPass::apply(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitGrainCamera, res.texture(kCameraImage).id());
     ctx.drawFullscreenTriangle();
     glDisable(GL_FRAMEBUFFER_SRGB);
-    res.publish(kComposite, linear_);
-    res.publish(kCompositeSrgb, srgb_);
+    output_.publish(res);
 }
 
 void GrainPass::execute(FrameContext& ctx, PassResources& res) {

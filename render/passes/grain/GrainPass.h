@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "render/RenderPass.h"
+#include "render/passes/composite/CompositeVersion.h"
 #include "render/passes/exposure/ExposurePass.h"
 
 namespace mirage::render {
@@ -38,9 +39,8 @@ private:
     ExposurePass::Grid grid_;
     gl::Texture footage_, rendered_, noise_, canvasToCamera_;
     gl::Framebuffer samplesFbo_;
-    gl::Texture linear_, srgb_;
-    gl::Framebuffer applyFbo_;
-    int canvasW_ = 0, canvasH_ = 0, cameraW_ = 0, cameraH_ = 0;
+    CompositeVersion output_{"grain"};
+    int canvasW_ = 0, canvasH_ = 0;
     std::vector<float> footageRead_, renderedRead_, noiseRead_;
     std::vector<float> blockR2_;  // each block centre's squared normalised radius (camera image)
 };

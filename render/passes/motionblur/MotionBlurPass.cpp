@@ -20,8 +20,7 @@ void MotionBlurPass::setup(PassBuilder& b) const {
     b.read(kGBufferPosition);
     b.read(kCompositeFootage);
     b.create(kMotionVelocity, {GL_RGBA16F, SizeRule::Camera, Storage::PassOwned});
-    b.modify(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
-    b.modify(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
+    CompositeVersion::declare(b);
 }
 
 std::optional<double> MotionBlurPass::exposureScale(const FrameContext& ctx, std::string* why) {
@@ -85,8 +84,6 @@ void MotionBlurPass::resize(const FrameContext& ctx) {
     const int tw = (w + k - 1) / k, th = (h + k - 1) / k;
     tiles_ = gl::Texture::create2D("motion tile max", tw, th, GL_RGBA16F);
     neighbours_ = gl::Texture::create2D("motion neighbour max", tw, th, GL_RGBA16F);
-    linear_ = gl::Texture::create2D("motion blurred composite", w, h, GL_RGBA32F);
-    srgb_ = gl::Texture::create2D("motion blurred composite srgb", w, h, GL_SRGB8_ALPHA8);
     velocityFbo_ = gl::Framebuffer("motion velocity fbo");
     velocityFbo_.attachColor(0, velocity_);
     velocityFbo_.finalize(1);
@@ -96,10 +93,7 @@ void MotionBlurPass::resize(const FrameContext& ctx) {
     neighboursFbo_ = gl::Framebuffer("motion neighbours fbo");
     neighboursFbo_.attachColor(0, neighbours_);
     neighboursFbo_.finalize(1);
-    outputFbo_ = gl::Framebuffer("motion blur output fbo");
-    outputFbo_.attachColor(0, linear_);
-    outputFbo_.attachColor(1, srgb_);
-    outputFbo_.finalize(2);
+    output_.resize(w, h);
 }
 
 void MotionBlurPass::execute(FrameContext& ctx, PassResources& res) {
@@ -134,7 +128,7 @@ void MotionBlurPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitMotionTiles, tiles_.id());
     ctx.drawFullscreenTriangle();
 
-    outputFbo_.bind();
+    output_.bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
     ctx.beginFullscreen(gatherProgram_, width_, height_);
     glUniform1i(locGatherTileSize_, o.tileSize);
@@ -148,8 +142,7 @@ void MotionBlurPass::execute(FrameContext& ctx, PassResources& res) {
     glDisable(GL_FRAMEBUFFER_SRGB);
 
     res.publish(kMotionVelocity, velocity_);
-    res.publish(kComposite, linear_);
-    res.publish(kCompositeSrgb, srgb_);
+    output_.publish(res);
 }
 
 // Registered in render/PassList.cpp.

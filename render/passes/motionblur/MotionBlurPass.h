@@ -20,6 +20,7 @@
 #include <string>
 
 #include "render/RenderPass.h"
+#include "render/passes/composite/CompositeVersion.h"
 
 namespace mirage::render {
 
@@ -46,8 +47,9 @@ private:
           locMaxHalfLength_ = -1;
     GLint locTileSize_ = -1, locChangeEpsilon_ = -1;
     GLint locGatherTileSize_ = -1, locSamples_ = -1, locSoftDepth_ = -1;
-    gl::Texture remap_, velocity_, tiles_, neighbours_, linear_, srgb_;
-    gl::Framebuffer velocityFbo_, tilesFbo_, neighboursFbo_, outputFbo_;
+    gl::Texture remap_, velocity_, tiles_, neighbours_;
+    gl::Framebuffer velocityFbo_, tilesFbo_, neighboursFbo_;
+    CompositeVersion output_{"motion blurred composite"};
     int width_ = 0, height_ = 0, tileSize_ = 0;
 };
 

@@ -67,8 +67,7 @@ ResourceViewPass::ResourceViewPass(const ViewOptions& options)
 }
 
 void ResourceViewPass::setup(PassBuilder& b) const {
-    b.modify(kComposite, {GL_RGBA32F, SizeRule::Camera, Storage::PassOwned});
-    b.modify(kCompositeSrgb, {GL_SRGB8_ALPHA8, SizeRule::Camera, Storage::PassOwned});
+    CompositeVersion::declare(b);
     if (resourceName_.empty()) return;
     const Resource shown{resourceName_.c_str()};
     if (shown == kComposite || shown == kCompositeSrgb)
@@ -90,14 +89,7 @@ PassDecision ResourceViewPass::decide(const FrameContext&) const {
 }
 
 void ResourceViewPass::resize(const FrameContext& ctx) {
-    const int w = ctx.projection.camera.width, h = ctx.projection.camera.height;
-    if (linear_.width() == w && linear_.height() == h) return;
-    linear_ = gl::Texture::create2D("view linear", w, h, GL_RGBA32F);
-    srgb_ = gl::Texture::create2D("view srgb", w, h, GL_SRGB8_ALPHA8);
-    fbo_ = gl::Framebuffer("view fbo");
-    fbo_.attachColor(0, linear_);
-    fbo_.attachColor(1, srgb_);
-    fbo_.finalize(2);
+    output_.resize(ctx.projection.camera.width, ctx.projection.camera.height);
 }
 
 void ResourceViewPass::execute(FrameContext& ctx, PassResources& res) {
@@ -118,7 +110,7 @@ void ResourceViewPass::execute(FrameContext& ctx, PassResources& res) {
                         isIntegerFormat(t.format()) ? "an integer texture"
                                                     : "neither a 2D texture nor an array"));
     const gl::Program& program = target == GL_TEXTURE_2D_ARRAY ? arrayProgram_ : flatProgram_;
-    fbo_.bind();
+    output_.bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
     ctx.beginFullscreen(program, ctx.projection.camera.width, ctx.projection.camera.height);
     glUniform1f(program.uniformLocation("scale"), options_.scale);
@@ -129,8 +121,7 @@ void ResourceViewPass::execute(FrameContext& ctx, PassResources& res) {
     ctx.drawFullscreenTriangle();
     glBindSampler(kUnitViewSource, 0);
     glDisable(GL_FRAMEBUFFER_SRGB);
-    res.publish(kComposite, linear_);
-    res.publish(kCompositeSrgb, srgb_);
+    output_.publish(res);
 }
 
 // Registered in render/PassList.cpp.

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "render/RenderPass.h"
+#include "render/passes/composite/CompositeVersion.h"
 #include "render/passes/view/ViewOptions.h"
 
 namespace mirage::render {
@@ -31,8 +32,7 @@ private:
     std::string resourceName_;  // the storage of the Resource the graph keeps (its name pointer)
     gl::Program flatProgram_, arrayProgram_;
     gl::Sampler nearest_;
-    gl::Texture linear_, srgb_;
-    gl::Framebuffer fbo_;
+    CompositeVersion output_{"view"};
 };
 
 }  // namespace mirage::render
