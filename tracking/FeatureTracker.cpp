@@ -185,6 +185,34 @@ std::vector<cv::Point2f> FeatureTracker::trackedPixels() const {
     return out;
 }
 
+std::vector<uchar> FeatureTracker::trackForwardBackward(const std::vector<cv::Mat>& from,
+                                                        const std::vector<cv::Mat>& to, int win,
+                                                        int levels,
+                                                        const std::vector<cv::Point2f>& prev,
+                                                        std::vector<cv::Point2f>& next) const {
+    std::vector<uchar> status, statusBack;
+    const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                options_.kltMaxIterations, options_.kltEpsilonPx);
+    // No error output: OpenCV then skips a pass over each window at the finest level.
+    cv::calcOpticalFlowPyrLK(from, to, prev, next, status, cv::noArray(), cv::Size(win, win),
+                             levels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+    std::vector<cv::Point2f> back = prev;
+    cv::calcOpticalFlowPyrLK(to, from, next, back, statusBack, cv::noArray(), cv::Size(win, win),
+                             std::clamp(options_.backwardLevels, 0, options_.kltLevels), term,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    const int cols = to.front().cols, rows = to.front().rows;
+    const float border = 2.0f;
+    std::vector<uchar> good(prev.size(), 0);
+    for (size_t i = 0; i < prev.size(); ++i) {
+        const bool inside = next[i].x >= border && next[i].y >= border &&
+                            next[i].x < float(cols) - border && next[i].y < float(rows) - border;
+        const double fb = cv::norm(back[i] - prev[i]);
+        good[i] = status[i] && statusBack[i] && inside &&
+                  fb <= options_.forwardBackwardMaxPx * std::max(1.0, scale_);
+    }
+    return good;
+}
+
 void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predicted) {
     stats_ = {};
     const auto t0 = std::chrono::steady_clock::now();
@@ -201,7 +229,7 @@ void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predi
     std::vector<cv::Mat> pyramid;
     if (!pyramid_.empty() && !tracks_.empty()) {
         cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(win, win), options_.kltLevels);
-        std::vector<cv::Point2f> prev, next, back;
+        std::vector<cv::Point2f> prev, next;
         for (const auto& t : tracks_) prev.push_back(t.px);
         // Where the predicted pose puts each landmark starts its search (a fast pan moves the
         // image by more than the pyramid reaches from the old position).
@@ -218,24 +246,36 @@ void FeatureTracker::track(const cv::Mat& grey, const std::optional<Pose>& predi
                     next[i] = cv::Point2f(float(px->x), float(px->y));
             }
         }
-        std::vector<uchar> status, statusBack;
-        std::vector<float> err;
-        const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
-        cv::calcOpticalFlowPyrLK(pyramid_, pyramid, prev, next, status, err, cv::Size(win, win),
-                                 options_.kltLevels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
-        back = prev;
-        cv::calcOpticalFlowPyrLK(pyramid, pyramid_, next, back, statusBack, err, cv::Size(win, win),
-                                 std::clamp(options_.backwardLevels, 0, options_.kltLevels), term,
-                                 cv::OPTFLOW_USE_INITIAL_FLOW);
+        // The predicted start is usually within a few pixels: a first pass over the lower
+        // levels only; the tracks it loses (a motion the prediction missed) search again over
+        // every level from the same start.
+        std::vector<cv::Point2f> start = next;
+        const int levels = options_.kltLevels;
+        const int first = predicted && options_.kltFirstLevels > 0
+                              ? std::min(options_.kltFirstLevels, levels)
+                              : levels;
+        std::vector<uchar> good = trackForwardBackward(pyramid_, pyramid, win, first, prev, next);
+        if (first < levels) {
+            std::vector<size_t> again;
+            std::vector<cv::Point2f> prevAgain, nextAgain;
+            for (size_t i = 0; i < good.size(); ++i)
+                if (!good[i]) {
+                    again.push_back(i);
+                    prevAgain.push_back(prev[i]);
+                    nextAgain.push_back(start[i]);
+                }
+            if (!again.empty()) {
+                const std::vector<uchar> goodAgain =
+                    trackForwardBackward(pyramid_, pyramid, win, levels, prevAgain, nextAgain);
+                for (size_t k = 0; k < again.size(); ++k) {
+                    good[again[k]] = goodAgain[k];
+                    next[again[k]] = nextAgain[k];
+                }
+            }
+        }
         std::vector<Track> kept;
-        const float border = 2.0f;
         for (size_t i = 0; i < tracks_.size(); ++i) {
-            const bool inside = next[i].x >= border && next[i].y >= border &&
-                                next[i].x < float(grey.cols) - border &&
-                                next[i].y < float(grey.rows) - border;
-            const double fb = cv::norm(back[i] - prev[i]);
-            if (status[i] && statusBack[i] && inside &&
-                fb <= options_.forwardBackwardMaxPx * std::max(1.0, scale_))
+            if (good[i])
                 kept.push_back({next[i], tracks_[i].landmark});
             else if (tracks_[i].landmark >= 0)
                 map_.remove(tracks_[i].landmark);  // the map holds only what is tracked

@@ -34,6 +34,14 @@ struct FeatureTrackingOptions {
     double cornerQuality = 0.01;  // cv::goodFeaturesToTrack qualityLevel
     int kltWindowPx = 21;         // at 640 pixels of width
     int kltLevels = 4;
+    // KLT's stop per pyramid level: this many iterations, or a step below kltEpsilonPx (pixels
+    // of that level).
+    int kltMaxIterations = 20;
+    double kltEpsilonPx = 0.03;
+    // With a predicted pose the forward track first searches the pyramid levels up to this one
+    // only (the prediction is usually a few pixels off); the tracks that pass lose nothing, the
+    // others are tracked again over all kltLevels from the same start. 0: all levels at once.
+    int kltFirstLevels = 2;
     // A track whose backward track misses its start by more than this is dropped (pixels).
     double forwardBackwardMaxPx = 0.5;
     // Pyramid levels above the full image searched by the backward track. It starts where the
@@ -140,6 +148,12 @@ private:
         int landmark = -1;
     };
     struct Correspondence;
+    // KLT from `from` to `to` (pyramids) over `levels` levels, starting at `next` (in: the
+    // start, out: the result), checked backwards; per point whether the track holds.
+    std::vector<uchar> trackForwardBackward(const std::vector<cv::Mat>& from,
+                                            const std::vector<cv::Mat>& to, int win, int levels,
+                                            const std::vector<cv::Point2f>& prev,
+                                            std::vector<cv::Point2f>& next) const;
     // The prior on the camera centre (inactive without a last pose).
     CentrePrior centrePrior(double sinceLastPoseS, const glm::dvec3& velocity) const;
     std::vector<Correspondence> correspondences(const Pose& at) const;

@@ -273,6 +273,8 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
         o.fullResolutionRetry = false;
         // Refined by coarseToFine, in one or two passes.
         o.refineCorners = false;
+        o.minClusterPixels = options_.coarseMinClusterPixels;
+        o.maxCornerCandidates = options_.coarseMaxCornerCandidates;
         coarseDetectors_.emplace_back(decimate, std::make_unique<Detector>(o));
         coarseDetector = coarseDetectors_.back().second.get();
     }
@@ -348,6 +350,19 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
     return true;
 }
 
+Detector& Tracker::fullResolutionDetector() {
+    if (!fullResolutionDetector_) {
+        DetectorOptions o = options_.detector;
+        o.decimate = 1.0f;
+        o.fullResolutionRetry = false;
+        o.blurSigma = options_.fullResolutionBlurSigma;
+        o.decodeSharpening = options_.fullResolutionSharpening;
+        o.refineEdges = options_.fullResolutionRefineEdges;
+        fullResolutionDetector_ = std::make_unique<Detector>(o);
+    }
+    return *fullResolutionDetector_;
+}
+
 void Tracker::searchTags(const cv::Mat& grey, const cv::Rect& region,
                          const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f) {
     f.fullResolutionRegion = cv::Rect();
@@ -382,17 +397,8 @@ void Tracker::searchTags(const cv::Mat& grey, const cv::Rect& region,
             again = m.region;
         }
         if (!again.empty()) {
-            if (!fullResolutionDetector_) {
-                DetectorOptions o = options_.detector;
-                o.decimate = 1.0f;
-                o.fullResolutionRetry = false;
-                o.blurSigma = options_.fullResolutionBlurSigma;
-                o.decodeSharpening = options_.fullResolutionSharpening;
-                o.refineEdges = options_.fullResolutionRefineEdges;
-                fullResolutionDetector_ = std::make_unique<Detector>(o);
-            }
             f.fullResolutionRegion = again;
-            for (auto& d : fullResolutionDetector_->detect(grey, again)) {
+            for (auto& d : fullResolutionDetector().detect(grey, again)) {
                 // Board tags the decimated search missed join the frame's (a tag id seen twice
                 // would be dropped by the estimator).
                 if (!estimator_.board().find(d.id)) continue;

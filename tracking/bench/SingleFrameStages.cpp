@@ -74,12 +74,20 @@ int main(int argc, char** argv) {
     std::map<std::string, double> stageMs;  // per view, summed over views
 
     double t = 0, sumFrame = 0, sumRefine = 0, sumPose = 0, sumApril = 0;
-    std::printf("view | frame ms | path | tags | state | refine ms | pose ms | apriltag d2 ms\n");
+    std::printf(
+        "view | frame ms | path | tags | state | refine ms | pose ms | apriltag d2 ms | tracker "
+        "detect / pose / features wall ms | side est px\n");
     for (size_t v = 0; v < f.images.size(); ++v) {
         const cv::Mat& grey = f.images[v];
         TrackedFrame r;
         double c0 = cpuMs();
-        for (int i = 0; i < reps; ++i) r = tracker.process(grey, t += 10.0);
+        double detectMs = 0, trackerPoseMs = 0, featureMs = 0;
+        for (int i = 0; i < reps; ++i) {
+            r = tracker.process(grey, t += 10.0);
+            detectMs += r.detectMs / reps;
+            trackerPoseMs += r.poseMs / reps;
+            featureMs += r.featureMs / reps;
+        }
         const double frameMs = (cpuMs() - c0) / reps;
 
         c0 = cpuMs();
@@ -116,8 +124,9 @@ int main(int argc, char** argv) {
 
         char path[96];
         if (r.coarseTried)
-            std::snprintf(path, sizeof path, "coarse d%.0f %s", double(r.coarseFirstDecimate),
-                          r.coarseUsed ? "used" : "fell back");
+            std::snprintf(path, sizeof path, "coarse d%.0f %s (%d tags, %d/%d verified)",
+                          double(r.coarseFirstDecimate), r.coarseUsed ? "used" : "fell back",
+                          r.coarseTags, r.prediction.verified, r.prediction.predicted);
         else
             std::snprintf(path, sizeof path, "search%s", r.fullFrameRetry ? " + full retry" : "");
         if (!r.fullResolutionRegion.empty()) {
@@ -130,9 +139,11 @@ int main(int argc, char** argv) {
             std::snprintf(path + len, sizeof path - len, " + finder %d",
                           r.fullResolutionFinderFound);
         }
-        std::printf("%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f\n", v, frameMs, path,
-                    r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
-                    trackingStateName(r.estimate.state), refineMs, poseMs, aprilMs);
+        std::printf(
+            "%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f | %.2f / %.2f / %.2f | %.0f\n", v,
+            frameMs, path, r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
+            trackingStateName(r.estimate.state), refineMs, poseMs, aprilMs, detectMs, trackerPoseMs,
+            featureMs, r.coarseFirstSidePx);
         sumFrame += frameMs;
         sumRefine += refineMs;
         sumPose += poseMs;

@@ -244,7 +244,9 @@ BENCHMARK(BM_MirageTrackTextured)
 // track (pyramid, KLT forwards and backwards), learn (landmarks refined, new corners detected
 // when due), and with estimate 1 also the pose from the landmarks every frame (what a frame
 // without the board pays); backward: the pyramid levels of the backward check (1 the default,
-// 4 = all, as before). Counters: tracked features and landmark inliers per frame (means).
+// 4 = all, as before); eps_centipx: KLT's stop step in hundredths of a pixel (3 the default, 1
+// before); first: the levels of the first forward pass (2 the default, 0 = all at once as before).
+// Counters: tracked features and landmark inliers per frame (means).
 void BM_FeatureTracking(benchmark::State& state) {
     const BoardFrames& f = texturedVideo(int(state.range(0)));
     std::vector<cv::Mat> grey(f.images.size());
@@ -256,6 +258,8 @@ void BM_FeatureTracking(benchmark::State& state) {
     }
     FeatureTrackingOptions options;
     options.backwardLevels = int(state.range(2));
+    options.kltEpsilonPx = 0.01 * double(state.range(3));
+    options.kltFirstLevels = int(state.range(4));
     FeatureTracker features(f.board, f.camera, options);
     const double rotVar = std::pow(glm::radians(0.05), 2) / 3, posVar = std::pow(5e-4, 2) / 3;
     auto boardPose = [&](size_t v) {
@@ -282,10 +286,13 @@ void BM_FeatureTracking(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FeatureTracking)
-    ->ArgNames({"width", "estimate", "backward"})
-    ->Args({640, 0, 1})
-    ->Args({640, 1, 1})
-    ->Args({640, 0, 4})
+    ->ArgNames({"width", "estimate", "backward", "eps_centipx", "first"})
+    ->Args({640, 0, 1, 3, 2})
+    ->Args({640, 1, 1, 3, 2})
+    ->Args({640, 0, 1, 3, 0})
+    ->Args({640, 0, 1, 1, 0})
+    ->Args({640, 1, 1, 1, 0})
+    ->Args({640, 0, 4, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -300,7 +307,9 @@ void BM_ArucoTrackTextured(benchmark::State& state) {
 // where the decimated search missed tags, the adaptive full-resolution pass), 5 = the default
 // with the full-resolution pass off (the default before it), 6-8 = the default with one of
 // libapriltag's knobs changed in the full-resolution pass: 6 quad_sigma 0.8, 7 decode_sharpening
-// 0.5, 8 refine_edges off; 9 = the default with natural features off (--board-only); 3 =
+// 0.5, 8 refine_edges off; 9 = the default with natural features off (--board-only); 10 = the
+// default with libapriltag's quad-fitting defaults in the coarse search (min_cluster_pixels 5,
+// max_nmaxima 10; before); 3 =
 // coarse-first as before the window (the whole grown region), 4 = the default with decimation 1 for
 // the small tags (libapriltag at full resolution in the window), 1 = coarse-to-fine at the fixed
 // `coarse` decimation (libapriltag at that decimation, the other board tags found from that pose at
@@ -315,6 +324,10 @@ void BM_MirageSingle(benchmark::State& state) {
     if (state.range(1) == 6) opt.fullResolutionBlurSigma = 0.8f;
     if (state.range(1) == 7) opt.fullResolutionSharpening = 0.5;
     if (state.range(1) == 8) opt.fullResolutionRefineEdges = false;
+    if (state.range(1) == 10) {
+        opt.coarseMinClusterPixels = 5;
+        opt.coarseMaxCornerCandidates = 10;
+    }
     if (state.range(1) == 3) opt.coarseWindowFraction = 1.0;
     if (state.range(1) == 4) opt.coarseFirstDecimations = {4.0f, 3.0f, 1.0f};
     opt.features.enabled = state.range(1) != 9;
@@ -479,6 +492,7 @@ BENCHMARK(BM_MirageSingle)
     ->Args({640, 7, 0, 1})
     ->Args({640, 8, 0, 1})
     ->Args({640, 9, 0, 1})
+    ->Args({640, 10, 0, 1})
     ->Args({640, 3, 0, 1})
     ->Args({640, 4, 0, 1})
     ->Args({640, 0, 0, 1})
