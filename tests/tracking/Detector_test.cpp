@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 
@@ -107,28 +108,41 @@ TEST(Detector, NoiseFrameGivesNoTags) {
     EXPECT_TRUE(d.detect(noise).empty());
 }
 
-// A rendered board at a known pose: every tag found, corners in the documented order and at the
-// projected board corners (OpenCV pixel convention) to a small fraction of a pixel.
-TEST(Detector, CornersMatchBoardGeometryAndOrder) {
-    const Board board = BoardLayout().makeBoard();
-    const BoardRaster tex = renderBoard(board, 12000, false);
+// A rendered board at a known pose: the camera 0.35 m above the board, looking down and slightly
+// forward (-Z), tilted by 25 deg and rolled by 0.3 rad so that no edge is aligned with the pixel
+// grid.
+struct TiltedBoardView {
+    Board board = BoardLayout().makeBoard();
     CameraIntrinsics cam;
-    cam.width = 640;
-    cam.height = 480;
-    cam.fx = cam.fy = 600;
-    cam.cx = 319.5;
-    cam.cy = 239.5;
-    // Camera 0.35 m above the board, looking down and slightly forward (-Z), tilted by 25 deg.
-    const double tilt = glm::radians(25.0);
-    const glm::dvec3 eye(0.02, 0.32, 0.15);
-    const glm::dvec3 fwd = glm::normalize(glm::dvec3(0, -std::cos(tilt), -std::sin(tilt)));
-    // Rolled by 0.3 rad so that no edge is aligned with the pixel grid.
-    const double roll = 0.3;
-    const glm::dvec3 right0(1, 0, 0);
-    const glm::dvec3 right = std::cos(roll) * right0 + std::sin(roll) * glm::cross(fwd, right0);
-    const glm::dvec3 down = glm::cross(fwd, right);
-    const Pose T_world_camera = Pose::fromRotationTranslation(glm::dmat3(right, down, fwd), eye);
-    const cv::Mat img = renderSyntheticBoardView(board, tex, cam, T_world_camera);
+    Pose T_world_camera;
+    cv::Mat image;
+    TiltedBoardView() {
+        const BoardRaster tex = renderBoard(board, 12000, false);
+        cam.width = 640;
+        cam.height = 480;
+        cam.fx = cam.fy = 600;
+        cam.cx = 319.5;
+        cam.cy = 239.5;
+        const double tilt = glm::radians(25.0);
+        const glm::dvec3 eye(0.02, 0.32, 0.15);
+        const glm::dvec3 fwd = glm::normalize(glm::dvec3(0, -std::cos(tilt), -std::sin(tilt)));
+        const double roll = 0.3;
+        const glm::dvec3 right0(1, 0, 0);
+        const glm::dvec3 right = std::cos(roll) * right0 + std::sin(roll) * glm::cross(fwd, right0);
+        const glm::dvec3 down = glm::cross(fwd, right);
+        T_world_camera = Pose::fromRotationTranslation(glm::dmat3(right, down, fwd), eye);
+        image = renderSyntheticBoardView(board, tex, cam, T_world_camera);
+    }
+};
+
+// Every tag found, corners in the documented order and at the projected board corners (OpenCV
+// pixel convention) to a small fraction of a pixel.
+TEST(Detector, CornersMatchBoardGeometryAndOrder) {
+    const TiltedBoardView view;
+    const Board& board = view.board;
+    const CameraIntrinsics& cam = view.cam;
+    const Pose& T_world_camera = view.T_world_camera;
+    const cv::Mat& img = view.image;
     cv::imwrite((test::outputDir("detector_synthetic") / "view.png").string(), img);
     for (float decimate : {1.0f, 2.0f}) {
         DetectorOptions opt;
@@ -156,6 +170,39 @@ TEST(Detector, CornersMatchBoardGeometryAndOrder) {
         EXPECT_LT(sum / n, 0.05) << "decimate " << decimate;
         EXPECT_LT(worst, 0.12) << "decimate " << decimate;
     }
+}
+
+// libapriltag's quad-fitting knobs (the coarse search skips small edge clusters and tries fewer
+// corner candidates): at decimation 4 the coarse settings find the 4 largest tags of the view (the
+// coarse pose's) and nearly all others found with libapriltag's defaults (measured: 22 of 23).
+// Must fail: clusters larger than any tag's edge leave nothing to fit.
+TEST(Detector, QuadFittingKnobsReachLibapriltag) {
+    const TiltedBoardView view;
+    DetectorOptions defaults;
+    defaults.decimate = 4.0f;
+    std::vector<TagDetection> reference = Detector(defaults).detect(view.image);
+    ASSERT_GE(reference.size(), 8u);
+    DetectorOptions coarse = defaults;
+    coarse.minClusterPixels = 30;
+    coarse.maxCornerCandidates = 6;
+    const std::vector<TagDetection> found = Detector(coarse).detect(view.image);
+    EXPECT_GE(found.size(), reference.size() - reference.size() / 10);
+    auto side = [](const TagDetection& d) { return glm::length(d.corners[1] - d.corners[0]); };
+    std::sort(reference.begin(), reference.end(),
+              [&](const TagDetection& a, const TagDetection& b) { return side(a) > side(b); });
+    for (size_t i = 0; i < 4; ++i)
+        EXPECT_TRUE(std::any_of(found.begin(), found.end(),
+                                [&](const TagDetection& d) { return d.id == reference[i].id; }))
+            << "tag " << reference[i].id << " (" << side(reference[i]) << " px)";
+    DetectorOptions tooLarge = defaults;
+    tooLarge.minClusterPixels = 100000;
+    EXPECT_TRUE(Detector(tooLarge).detect(view.image).empty());
+    DetectorOptions bad = defaults;
+    bad.maxCornerCandidates = 3;
+    EXPECT_THROW(Detector{bad}, Error);
+    bad = defaults;
+    bad.minClusterPixels = 0;
+    EXPECT_THROW(Detector{bad}, Error);
 }
 
 }  // namespace
