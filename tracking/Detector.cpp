@@ -178,9 +178,6 @@ Detector::Detector(const DetectorOptions& options)
     if (!(options.decimate >= 1.0f)) throw Error("detector: decimate must be >= 1");
     if (!(options.blurSigma >= 0.0f)) throw Error("detector: blur sigma must be >= 0");
     if (options.threads < 1) throw Error("detector: threads must be >= 1");
-    if (options.minClusterPixels < 1) throw Error("detector: min cluster pixels must be >= 1");
-    if (options.maxCornerCandidates < 4)
-        throw Error("detector: max corner candidates must be >= 4 (a quad has 4 corners)");
     if (options.maxHammingCorrected < 0 || options.maxHammingCorrected > 3)
         throw Error("detector: max corrected bits must be 0..3");
     detector_ = apriltag_detector_create();
@@ -191,8 +188,6 @@ Detector::Detector(const DetectorOptions& options)
     detector_->refine_edges = options.refineEdges;
     detector_->decode_sharpening = options.decodeSharpening;
     detector_->nthreads = options.threads;
-    detector_->qtp.min_cluster_pixels = options.minClusterPixels;
-    detector_->qtp.max_nmaxima = options.maxCornerCandidates;
 }
 
 Detector::~Detector() {

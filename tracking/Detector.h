@@ -45,16 +45,6 @@ struct DetectorOptions {
     // Detections with a decision margin below this are dropped (libapriltag's quality measure of
     // the bit decoding; real tags are typically > 30, noise-born false detections < 20).
     float minDecisionMargin = 20.0f;
-    // libapriltag's qtp.min_cluster_pixels: edge clusters with fewer pixels (of the decimated
-    // image) are not fitted as quads. A tag's border edge gives about 4 x its side (decimated
-    // pixels), so a search that only wants tags of at least S pixels may skip clusters well
-    // under 4 S: texture and noise make many small clusters, and fitting quads to them is
-    // libapriltag's largest stage. libapriltag default: 5.
-    int minClusterPixels = 5;
-    // libapriltag's qtp.max_nmaxima: the corner candidates per edge cluster from which the
-    // quad's 4 corners are chosen (all sets of 4 are tried). Fewer is faster; clean, sharp tags
-    // need few, blurred or steep ones more. libapriltag default: 10.
-    int maxCornerCandidates = 10;
 };
 
 struct TagDetection {

@@ -273,8 +273,6 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
         o.fullResolutionRetry = false;
         // Refined by coarseToFine, in one or two passes.
         o.refineCorners = false;
-        o.minClusterPixels = options_.coarseMinClusterPixels;
-        o.maxCornerCandidates = options_.coarseMaxCornerCandidates;
         coarseDetectors_.emplace_back(decimate, std::make_unique<Detector>(o));
         coarseDetector = coarseDetectors_.back().second.get();
     }

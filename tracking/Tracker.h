@@ -111,17 +111,6 @@ struct TrackerOptions {
     bool coarseFirst = true;
     std::vector<float> coarseFirstDecimations{4.0f, 3.0f};
     double coarseFirstMinSidePx = 15.0;
-    // The coarse search fits quads only to edge clusters of at least this many pixels of the
-    // decimated image (DetectorOptions::minClusterPixels; a tag of coarseFirstMinSidePx gives
-    // about 60): the small clusters of texture and of tags too small to use are skipped.
-    // 5 = libapriltag's default.
-    int coarseMinClusterPixels = 30;
-    // The coarse search only needs a few well-formed tags to settle a pose: libapriltag
-    // segments each edge cluster at this many corner candidates at most
-    // (DetectorOptions::maxCornerCandidates; its default 10 tries 210 corner sets per cluster,
-    // 6 tries 15). A tag it misses is the finder's, or the ordinary search's (libapriltag's
-    // defaults) when the coarse pose does not settle.
-    int coarseMaxCornerCandidates = 6;
     // The coarse-first search reads only a window about the textured region's centre, this
     // fraction of the region's width and height, grown by textureMarginPx (libapriltag's cost
     // follows the tag edges it reads; the coarse pose needs only a few tags, one large tag may

@@ -172,38 +172,5 @@ TEST(Detector, CornersMatchBoardGeometryAndOrder) {
     }
 }
 
-// libapriltag's quad-fitting knobs (the coarse search skips small edge clusters and tries fewer
-// corner candidates): at decimation 4 the coarse settings find the 4 largest tags of the view (the
-// coarse pose's) and nearly all others found with libapriltag's defaults (measured: 22 of 23).
-// Must fail: clusters larger than any tag's edge leave nothing to fit.
-TEST(Detector, QuadFittingKnobsReachLibapriltag) {
-    const TiltedBoardView view;
-    DetectorOptions defaults;
-    defaults.decimate = 4.0f;
-    std::vector<TagDetection> reference = Detector(defaults).detect(view.image);
-    ASSERT_GE(reference.size(), 8u);
-    DetectorOptions coarse = defaults;
-    coarse.minClusterPixels = 30;
-    coarse.maxCornerCandidates = 6;
-    const std::vector<TagDetection> found = Detector(coarse).detect(view.image);
-    EXPECT_GE(found.size(), reference.size() - reference.size() / 10);
-    auto side = [](const TagDetection& d) { return glm::length(d.corners[1] - d.corners[0]); };
-    std::sort(reference.begin(), reference.end(),
-              [&](const TagDetection& a, const TagDetection& b) { return side(a) > side(b); });
-    for (size_t i = 0; i < 4; ++i)
-        EXPECT_TRUE(std::any_of(found.begin(), found.end(),
-                                [&](const TagDetection& d) { return d.id == reference[i].id; }))
-            << "tag " << reference[i].id << " (" << side(reference[i]) << " px)";
-    DetectorOptions tooLarge = defaults;
-    tooLarge.minClusterPixels = 100000;
-    EXPECT_TRUE(Detector(tooLarge).detect(view.image).empty());
-    DetectorOptions bad = defaults;
-    bad.maxCornerCandidates = 3;
-    EXPECT_THROW(Detector{bad}, Error);
-    bad = defaults;
-    bad.minClusterPixels = 0;
-    EXPECT_THROW(Detector{bad}, Error);
-}
-
 }  // namespace
 }  // namespace mirage::tracking
