@@ -5,27 +5,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/math/Pose.h"
+
 namespace mirage::tracking {
 namespace {
 
 double alpha(double cutoffHz, double dt) {
     const double tau = 1.0 / (2.0 * M_PI * cutoffHz);
     return 1.0 / (1.0 + tau / dt);
-}
-
-// Rotation vector of a unit quaternion (shortest way: q and -q are the same rotation).
-glm::dvec3 logQuat(glm::dquat q) {
-    if (q.w < 0) q = -q;
-    const glm::dvec3 v(q.x, q.y, q.z);
-    const double s = glm::length(v);
-    if (s < 1e-12) return 2.0 * v;
-    return v * (2.0 * std::atan2(s, q.w) / s);
-}
-
-glm::dquat expRotation(const glm::dvec3& w) {
-    const double a = glm::length(w);
-    if (a < 1e-12) return glm::normalize(glm::dquat(1.0, 0.5 * w.x, 0.5 * w.y, 0.5 * w.z));
-    return glm::angleAxis(a, w / a);
 }
 
 bool usable(const PoseCovariance* c) {
@@ -50,11 +37,12 @@ Pose PoseFilter::update(const Pose& measured, double t, const PoseCovariance* co
     const double dt = t - s.t;
     // 1. Constant-velocity prediction.
     Pose pred = s.filtered;
-    pred.rotation = glm::normalize(expRotation(s.angularVelocity * dt) * s.filtered.rotation);
+    pred.rotation =
+        glm::normalize(rotationFromVector(s.angularVelocity * dt) * s.filtered.rotation);
     pred.translation += s.velocity * dt;
     // 2. Innovation in the estimator's perturbation convention (world-frame rotation vector,
     // camera-centre offset).
-    const glm::dvec3 eR = logQuat(measured.rotation * glm::conjugate(pred.rotation));
+    const glm::dvec3 eR = rotationVector(measured.rotation * glm::conjugate(pred.rotation));
     const glm::dvec3 eT = measured.translation - pred.translation;
     // 3. Normalised innovation with the measurement covariance (plus the floor on the diagonal).
     cv::Matx66d S = cv::Matx66d::zeros();
@@ -83,7 +71,7 @@ Pose PoseFilter::update(const Pose& measured, double t, const PoseCovariance* co
     const double a = options_.minGain + (1.0 - options_.minGain) * u * u * (3.0 - 2.0 * u);
     const double b = std::min(options_.maxVelocityGain, a * a / (2.0 - a));
     // 5. Correct pose and velocity.
-    s.filtered.rotation = glm::normalize(expRotation(a * eR) * pred.rotation);
+    s.filtered.rotation = glm::normalize(rotationFromVector(a * eR) * pred.rotation);
     s.filtered.translation = pred.translation + a * eT;
     s.angularVelocity += (b / dt) * eR;
     s.velocity += (b / dt) * eT;
@@ -100,7 +88,7 @@ Pose OneEuroPoseFilter::update(const Pose& measured, double t) {
     State& s = *state_;
     const double dt = t - s.t;
     const glm::dvec3 dT = measured.translation - s.filtered.translation;
-    const glm::dvec3 dR = logQuat(glm::conjugate(s.filtered.rotation) * measured.rotation);
+    const glm::dvec3 dR = rotationVector(glm::conjugate(s.filtered.rotation) * measured.rotation);
     const double aD = alpha(options_.derivativeCutoffHz, dt);
     // Low-pass the velocity vectors (as One Euro does per coordinate), then take their norms: at
     // rest the noise's velocities cancel instead of adding up as magnitudes would.
@@ -111,7 +99,7 @@ Pose OneEuroPoseFilter::update(const Pose& measured, double t) {
     const double aR =
         alpha(options_.minCutoffHz + options_.rotationBeta * glm::length(s.velocityR), dt);
     s.filtered.translation += aT * dT;
-    s.filtered.rotation = glm::normalize(s.filtered.rotation * expRotation(aR * dR));
+    s.filtered.rotation = glm::normalize(s.filtered.rotation * rotationFromVector(aR * dR));
     s.t = t;
     return s.filtered;
 }

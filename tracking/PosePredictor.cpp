@@ -3,27 +3,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/math/Pose.h"
+
 namespace mirage::tracking {
 namespace {
 
 glm::dmat3 skew(const glm::dvec3& w) {
     // Column-major: m[c][r].
     return glm::dmat3(0, w.z, -w.y, -w.z, 0, w.x, w.y, -w.x, 0);
-}
-
-// Rotation vector (axis x angle, radians) of a unit quaternion, the shorter way round.
-glm::dvec3 rotationVector(glm::dquat q) {
-    if (q.w < 0) q = -q;
-    const glm::dvec3 v(q.x, q.y, q.z);
-    const double s = glm::length(v);
-    if (s < 1e-12) return 2.0 * v;
-    return v * (2.0 * std::atan2(s, q.w) / s);
-}
-
-glm::dquat rotationFromVector(const glm::dvec3& w) {
-    const double a = glm::length(w);
-    if (a < 1e-12) return glm::normalize(glm::dquat(1.0, 0.5 * w.x, 0.5 * w.y, 0.5 * w.z));
-    return glm::angleAxis(a, w / a);
 }
 
 // The left Jacobian of SO(3), V(w) = I + (1 - cos a) / a^2 [w]x + (a - sin a) / a^3 [w]x^2: the

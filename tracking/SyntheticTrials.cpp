@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/image/ImageIO.h"
+#include "core/math/Pose.h"
 #include "tracking/SyntheticBoardView.h"
 
 namespace mirage::tracking {
@@ -32,14 +33,6 @@ cv::Mat lineKernel(double length, double angle) {
         k.at<float>(y0 + 1, x0 + 1) += fx * fy;
     }
     return k / cv::sum(k)[0];
-}
-
-glm::dvec3 rotationVector(const glm::dquat& q) {
-    glm::dquat u = q.w < 0 ? -q : q;
-    const glm::dvec3 v(u.x, u.y, u.z);
-    const double s = glm::length(v);
-    if (s < 1e-15) return 2.0 * v;
-    return (2.0 * std::atan2(s, u.w) / s) * v;
 }
 
 double mahalanobis2(const std::array<double, 36>& c, int offset, const glm::dvec3& e) {

@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/math/Pose.h"
 #include "tracking/TagFamily.h"
 
 namespace mirage::tracking {
@@ -19,11 +20,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 // The step d = (world-frame rotation vector, radians; camera-centre offset, metres) that takes
 // pose a to pose b (the pose estimator's perturbation convention).
 std::array<double, 6> poseDifference(const Pose& a, const Pose& b) {
-    glm::dquat q = b.rotation * glm::inverse(a.rotation);
-    if (q.w < 0) q = -q;
-    const double s = glm::length(glm::dvec3(q.x, q.y, q.z));
-    const double angle = 2.0 * std::atan2(s, q.w);
-    const glm::dvec3 w = s > 1e-15 ? glm::dvec3(q.x, q.y, q.z) * (angle / s) : glm::dvec3(0.0);
+    const glm::dvec3 w = rotationVector(b.rotation * glm::inverse(a.rotation));
     const glm::dvec3 c = b.translation - a.translation;
     return {w.x, w.y, w.z, c.x, c.y, c.z};
 }

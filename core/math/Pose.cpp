@@ -61,4 +61,19 @@ double rotationAngleBetween(const glm::dquat& a, const glm::dquat& b) {
     return 2.0 * std::acos(std::min(1.0, w));
 }
 
+glm::dvec3 rotationVector(glm::dquat q) {
+    if (q.w < 0) q = -q;
+    const glm::dvec3 v(q.x, q.y, q.z);
+    const double s = glm::length(v);
+    // Below 1e-12 (sin of half the angle) the first-order term, without dividing by s.
+    if (s < 1e-12) return 2.0 * v;
+    return v * (2.0 * std::atan2(s, q.w) / s);
+}
+
+glm::dquat rotationFromVector(const glm::dvec3& w) {
+    const double a = glm::length(w);
+    if (a < 1e-12) return glm::normalize(glm::dquat(1.0, 0.5 * w.x, 0.5 * w.y, 0.5 * w.z));
+    return glm::angleAxis(a, w / a);
+}
+
 }  // namespace mirage

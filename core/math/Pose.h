@@ -37,6 +37,12 @@ Pose cameraLookingAt(const glm::dvec3& eye, const glm::dvec3& target, const glm:
 // Angle of the rotation between a and b (radians, in [0, pi]).
 double rotationAngleBetween(const glm::dquat& a, const glm::dquat& b);
 
+// The rotation vector (axis x angle, radians) of a unit quaternion, the shorter way round (q and
+// -q are the same rotation): the logarithm of SO(3). Near identity it is 2 (x, y, z).
+glm::dvec3 rotationVector(glm::dquat q);
+// The unit quaternion of a rotation vector (axis x angle, radians): the exponential of SO(3).
+glm::dquat rotationFromVector(const glm::dvec3& w);
+
 // Rotation taking OpenCV camera axes to glTF camera axes (and back: it is its own inverse):
 // x stays, y and z flip. T_world_cvcam = T_world_gltfcam * kCvFromGltfCamera.
 inline const Pose kCvFromGltfCamera =

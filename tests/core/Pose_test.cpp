@@ -42,6 +42,22 @@ TEST(Pose, CvFromGltfCameraFlipsYZ) {
     EXPECT_NEAR(rotationAngleBetween(twice.rotation, Pose().rotation), 0.0, 1e-7);
 }
 
+TEST(Pose, RotationVectorAndBackIsTheSameRotation) {
+    // Small, ordinary and near-pi angles; q and -q give the same vector (the shorter way round).
+    for (double angle : {1e-14, 1e-6, 0.3, 2.0, 3.14159}) {
+        const glm::dvec3 axis = glm::normalize(glm::dvec3(0.2, -1.0, 0.4));
+        const glm::dquat q = glm::angleAxis(angle, axis);
+        const glm::dvec3 w = rotationVector(q);
+        EXPECT_NEAR(glm::length(w), angle, 1e-12 + 1e-9 * angle) << angle;
+        EXPECT_NEAR(glm::length(rotationVector(-q) - w), 0.0, 1e-12) << angle;
+        EXPECT_NEAR(rotationAngleBetween(rotationFromVector(w), q), 0.0, 1e-7) << angle;
+    }
+    EXPECT_EQ(rotationVector(glm::dquat(1, 0, 0, 0)), glm::dvec3(0));
+    // A rotation by more than pi comes back as the shorter rotation the other way.
+    const glm::dvec3 w = rotationVector(glm::angleAxis(4.0, glm::dvec3(0, 0, 1)));
+    EXPECT_NEAR(w.z, 4.0 - 2.0 * glm::pi<double>(), 1e-12);
+}
+
 TEST(Pose, NonFiniteDetected) {
     Pose p;
     p.translation.x = std::nan("");
