@@ -48,9 +48,9 @@ bool insideForBilinear(const cv::Mat& grey, const glm::dvec2& p) {
 }  // namespace
 
 // Sub-pixel edge refinement (see DetectorOptions::refineCorners). Leaves the corners unchanged if
-// any edge cannot be measured or a corner would move by more than 1.5 px.
+// any edge cannot be measured or a corner would move by more than maxMovePx.
 bool Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder,
-                             std::array<glm::dvec2, 4>& corners) {
+                             std::array<glm::dvec2, 4>& corners, double maxMovePx) {
     glm::dvec2 centroid(0.0);
     for (const auto& c : corners) centroid += 0.25 * c;
     std::array<ImageLine, 4> lines;
@@ -167,8 +167,19 @@ bool Detector::refineCorners(const cv::Mat& grey, int cellsAtBorder,
         // Corner k joins edge k-1 (corner k-1 -> k) and edge k (corner k -> k+1).
         if (!intersect(lines[size_t((k + 3) % 4)], lines[size_t(k)], refined[size_t(k)]))
             return false;
-        if (glm::length(refined[size_t(k)] - corners[size_t(k)]) > 1.5) return false;
+        if (glm::length(refined[size_t(k)] - corners[size_t(k)]) > maxMovePx) return false;
     }
+    corners = refined;
+    return true;
+}
+
+bool Detector::refineQuadCorners(const cv::Mat& grey, int cellsAtBorder,
+                                 std::array<glm::dvec2, 4>& corners, double startErrorPx) {
+    std::array<glm::dvec2, 4> refined = corners;
+    if (!refineCorners(grey, cellsAtBorder, refined, std::max(1.5, startErrorPx))) return false;
+    double moved = 0;
+    for (size_t k = 0; k < 4; ++k) moved = std::max(moved, glm::length(refined[k] - corners[k]));
+    if (moved > kSecondPassMovePx && !refineCorners(grey, cellsAtBorder, refined)) return false;
     corners = refined;
     return true;
 }
@@ -230,9 +241,10 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect&
     // A view of the region (rows keep the full image's stride): libapriltag reads only it.
     image_u8_t im{roi.width, roi.height, int(grey.step[0]), grey.ptr<uint8_t>(roi.y) + roi.x};
     zarray_t* dets = apriltag_detector_detect(detector_, &im);
+    float searchedDecimate = options_.decimate;
     if (zarray_size(dets) == 0 && options_.fullResolutionRetry && options_.decimate > 1.0f) {
         apriltag_detections_destroy(dets);
-        detector_->quad_decimate = 1.0f;
+        detector_->quad_decimate = searchedDecimate = 1.0f;
         dets = apriltag_detector_detect(detector_, &im);
         detector_->quad_decimate = options_.decimate;
     }
@@ -252,8 +264,11 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect&
         t.centre = glm::dvec2(d->c[0], d->c[1]) + shift;
         for (int k = 0; k < 4; ++k)
             t.corners[size_t(k)] = glm::dvec2(d->p[k][0], d->p[k][1]) + shift;
+        // libapriltag's corners are ~1 px off without its edge refinement (refine_edges), up to
+        // the decimation factor on a decimated search.
         if (options_.refineCorners)
-            t.refined = refineCorners(grey, family_->widthAtBorder(), t.corners);
+            t.refined = refineQuadCorners(grey, family_->widthAtBorder(), t.corners,
+                                          options_.refineEdges ? 1.5 : double(searchedDecimate));
         out.push_back(t);
     }
     apriltag_detections_destroy(dets);

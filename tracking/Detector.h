@@ -88,9 +88,19 @@ public:
     // corners in an 8-bit grey sRGB-encoded image, from corners within ~0.45 cell of the truth
     // (cellsAtBorder: TagFamily::widthAtBorder()). Returns false and leaves the corners unchanged
     // when an edge cannot be measured (occluded, damaged, next to dark surroundings) or a corner
-    // would move by more than 1.5 px. Also used by the tracking mode (PredictedTagFinder).
+    // would move by more than maxMovePx. Also used by the tracking mode (PredictedTagFinder).
     static bool refineCorners(const cv::Mat& grey, int cellsAtBorder,
-                              std::array<glm::dvec2, 4>& corners);
+                              std::array<glm::dvec2, 4>& corners, double maxMovePx = 1.5);
+    // The refinement of corners a quad search found to within startErrorPx (libapriltag's
+    // corners on an image decimated by d, without its own edge refinement, are up to ~d px off):
+    // a corner may move by up to max(1.5, startErrorPx), and a second pass runs when the first
+    // moved a corner by more than kSecondPassMovePx, because a pass that starts ~1 px off samples
+    // profiles skewed along the edges (measured: up to 0.47 px corner error left on a 31 px tag,
+    // 0.2 px after the second pass). After a small move a second pass changes little and costs as
+    // much. Returns false (corners unchanged) when a pass fails.
+    static bool refineQuadCorners(const cv::Mat& grey, int cellsAtBorder,
+                                  std::array<glm::dvec2, 4>& corners, double startErrorPx);
+    static constexpr double kSecondPassMovePx = 0.25;
 
 private:
     DetectorOptions options_;

@@ -254,9 +254,6 @@ std::optional<cv::Rect> Tracker::boardRegion(const Pose& T_world_camera, cv::Siz
     return cv::Rect(bx0, by0, bx1 - bx0, by1 - by0);
 }
 
-// Corner move (pixels) of the coarse tags' first refinement pass beyond which a second pass runs.
-constexpr double kCoarseSecondPassMovePx = 0.25;
-
 bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float decimate,
                            const std::optional<Pose>& prior, TrackedFrame& f) {
     f.coarseTried = true;
@@ -278,21 +275,13 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
     std::vector<TagDetection> coarse = coarseDetector->detect(grey, region);
     f.coarseTags = int(coarse.size());
     // Only tags whose corners mirage's refinement can measure at full resolution are used
-    // (libapriltag's corners on the decimated image are off by up to ~1 px); the finder tries the
-    // others. A second pass of the refinement when the first moved a corner by more than
-    // kCoarseSecondPassMovePx: a pass that starts from corners ~1 px off has its profiles along
-    // the edges skewed (measured: up to 0.47 px corner error left on a 31 px tag, 0.2 px after
-    // the second pass); after a small move a second pass changes little and costs as much
-    // (~0.4 ms for the 24 large tags of a near 640x480 view).
+    // (libapriltag's corners on the decimated image are off by up to ~1 px with its edge
+    // refinement, up to the decimation factor without); the finder tries the others.
+    const double startErrorPx = options_.detector.refineEdges ? 1.5 : double(decimate);
     std::erase_if(coarse, [&](TagDetection& d) {
-        const std::array<glm::dvec2, 4> before = d.corners;
-        if (!Detector::refineCorners(grey, coarseCellsAtBorder_, d.corners)) return true;
-        d.refined = true;
-        double moved = 0;
-        for (size_t k = 0; k < 4; ++k)
-            moved = std::max(moved, glm::length(d.corners[k] - before[k]));
-        return moved > kCoarseSecondPassMovePx &&
-               !Detector::refineCorners(grey, coarseCellsAtBorder_, d.corners);
+        d.refined =
+            Detector::refineQuadCorners(grey, coarseCellsAtBorder_, d.corners, startErrorPx);
+        return !d.refined;
     });
     f.detectMs += msSince(t0);
     if (coarse.empty()) return false;

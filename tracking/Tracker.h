@@ -24,7 +24,11 @@ namespace mirage::tracking {
 enum class FilterKind { Predictive, OneEuro };
 
 struct TrackerOptions {
-    DetectorOptions detector;
+    // libapriltag's own edge refinement (refine_edges) off: mirage refines every corner it uses
+    // anyway (Detector::refineQuadCorners, from the decimated search's error), and libapriltag's
+    // refinement of every candidate quad was ~0.15 ms of each search at 640x480 (docs/tracking.md,
+    // "libapriltag's edge refinement, left to mirage's").
+    DetectorOptions detector{.refineEdges = false};
     PoseEstimatorOptions pose;
     FilterKind filterKind = FilterKind::Predictive;
     PoseFilterOptions filter;

@@ -307,7 +307,9 @@ void BM_ArucoTrackTextured(benchmark::State& state) {
 // where the decimated search missed tags, the adaptive full-resolution pass), 5 = the default
 // with the full-resolution pass off (the default before it), 6-8 = the default with one of
 // libapriltag's knobs changed in the full-resolution pass: 6 quad_sigma 0.8, 7 decode_sharpening
-// 0.5, 8 refine_edges off; 9 = the default with natural features off (--board-only); 3 =
+// 0.5, 8 refine_edges off; 9 = the default with natural features off (--board-only); 10 = the
+// default with libapriltag's edge refinement on in the decimated searches (as before mirage's
+// refinement took the decimation's error alone); 3 =
 // coarse-first as before the window (the whole grown region), 4 = the default with decimation 1 for
 // the small tags (libapriltag at full resolution in the window), 1 = coarse-to-fine at the fixed
 // `coarse` decimation (libapriltag at that decimation, the other board tags found from that pose at
@@ -322,6 +324,7 @@ void BM_MirageSingle(benchmark::State& state) {
     if (state.range(1) == 6) opt.fullResolutionBlurSigma = 0.8f;
     if (state.range(1) == 7) opt.fullResolutionSharpening = 0.5;
     if (state.range(1) == 8) opt.fullResolutionRefineEdges = false;
+    if (state.range(1) == 10) opt.detector.refineEdges = true;
     if (state.range(1) == 3) opt.coarseWindowFraction = 1.0;
     if (state.range(1) == 4) opt.coarseFirstDecimations = {4.0f, 3.0f, 1.0f};
     opt.features.enabled = state.range(1) != 9;
@@ -486,6 +489,7 @@ BENCHMARK(BM_MirageSingle)
     ->Args({640, 7, 0, 1})
     ->Args({640, 8, 0, 1})
     ->Args({640, 9, 0, 1})
+    ->Args({640, 10, 0, 1})
     ->Args({640, 3, 0, 1})
     ->Args({640, 4, 0, 1})
     ->Args({640, 0, 0, 1})
