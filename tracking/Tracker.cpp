@@ -267,6 +267,7 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
         o.fullResolutionRetry = false;
         // Refined by coarseToFine, in one or two passes.
         o.refineCorners = false;
+        o.refineEdges = options_.coarseRefineEdges;
         coarseDetectors_.emplace_back(decimate, std::make_unique<Detector>(o));
         coarseDetector = coarseDetectors_.back().second.get();
     }
@@ -277,7 +278,7 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
     // Only tags whose corners mirage's refinement can measure at full resolution are used
     // (libapriltag's corners on the decimated image are off by up to ~1 px with its edge
     // refinement, up to the decimation factor without); the finder tries the others.
-    const double startErrorPx = options_.detector.refineEdges ? 1.5 : double(decimate);
+    const double startErrorPx = options_.coarseRefineEdges ? 1.5 : double(decimate);
     std::erase_if(coarse, [&](TagDetection& d) {
         d.refined =
             Detector::refineQuadCorners(grey, coarseCellsAtBorder_, d.corners, startErrorPx);

@@ -24,11 +24,7 @@ namespace mirage::tracking {
 enum class FilterKind { Predictive, OneEuro };
 
 struct TrackerOptions {
-    // libapriltag's own edge refinement (refine_edges) off: mirage refines every corner it uses
-    // anyway (Detector::refineQuadCorners, from the decimated search's error), and libapriltag's
-    // refinement of every candidate quad was ~0.15 ms of each search at 640x480 (docs/tracking.md,
-    // "libapriltag's edge refinement, left to mirage's").
-    DetectorOptions detector{.refineEdges = false};
+    DetectorOptions detector;
     PoseEstimatorOptions pose;
     FilterKind filterKind = FilterKind::Predictive;
     PoseFilterOptions filter;
@@ -101,6 +97,12 @@ struct TrackerOptions {
     float coarseDecimate = 4.0f;
     double coarseSearchPx = 4.0;
     int coarsePoseTags = 4;
+    // libapriltag's edge refinement (refine_edges) in the coarse search: off, mirage's corner
+    // refinement takes the decimation's error (Detector::refineQuadCorners). libapriltag refines
+    // every candidate quad, ~0.15 ms of each coarse search at 640x480 (docs/tracking.md,
+    // "libapriltag's edge refinement in the coarse search"). The ordinary search keeps it
+    // (detector.refineEdges): on blurred, compressed views its refined quads decode more tags.
+    bool coarseRefineEdges = false;
     // Coarse-first single frames (docs/tracking.md, "Single frames: coarse-first search"): in a
     // frame without a recent ok pose, the textured region's size says how large the board's
     // tags are in the image (the largest tag's side, estimated as the board's largest tag over

@@ -86,12 +86,17 @@ std::optional<glm::dvec2> CameraIntrinsics::projectWithJacobian(const glm::dvec3
         }
         return p0;
     }
-    const auto px = project(p);
-    if (!px) return std::nullopt;
+    // The projection of project() and distortNormalized(), written out so that the distortion
+    // terms serve the pixel and its derivatives (the pose solver's hot path).
+    if (!(p.z > 1e-12)) return std::nullopt;
     const double k1 = coeff(0), k2 = coeff(1), p1 = coeff(2), p2 = coeff(3), k3 = coeff(4);
-    const double iz = 1.0 / p.z, x = p.x * iz, y = p.y * iz;
+    // x, y divided as project() divides them: the same pixel to the last bit.
+    const double iz = 1.0 / p.z, x = p.x / p.z, y = p.y / p.z;
     const double r2 = x * x + y * y;
     const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const glm::dvec2 px{fx * (x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)) + cx,
+                        fy * (y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y) + cy};
+    if (!std::isfinite(px.x) || !std::isfinite(px.y)) return std::nullopt;
     const double dRadial = k1 + r2 * (2 * k2 + 3 * k3 * r2);  // d radial / d r2
     // Derivatives of the distorted point (u, v) by the normalised point (x, y).
     const double dudx = radial + 2 * x * x * dRadial + 2 * p1 * y + 6 * p2 * x;

@@ -78,6 +78,8 @@ int main(int argc, char** argv) {
     cv::setNumThreads(1);
     const std::vector<Method> methods{
         {"mirage (default)", [](TrackerOptions&) {}},
+        {"mirage, coarse search with libapriltag's edge refinement",
+         [](TrackerOptions& o) { o.coarseRefineEdges = true; }},
         {"mirage, full-resolution fallback off",
          [](TrackerOptions& o) { o.fullResolutionFallback = false; }},
         {"mirage, decimate 1",

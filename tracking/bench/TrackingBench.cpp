@@ -6,6 +6,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <memory>
 
@@ -308,7 +309,7 @@ void BM_ArucoTrackTextured(benchmark::State& state) {
 // with the full-resolution pass off (the default before it), 6-8 = the default with one of
 // libapriltag's knobs changed in the full-resolution pass: 6 quad_sigma 0.8, 7 decode_sharpening
 // 0.5, 8 refine_edges off; 9 = the default with natural features off (--board-only); 10 = the
-// default with libapriltag's edge refinement on in the decimated searches (as before mirage's
+// default with libapriltag's edge refinement on in the coarse search (as before mirage's
 // refinement took the decimation's error alone); 3 =
 // coarse-first as before the window (the whole grown region), 4 = the default with decimation 1 for
 // the small tags (libapriltag at full resolution in the window), 1 = coarse-to-fine at the fixed
@@ -324,7 +325,7 @@ void BM_MirageSingle(benchmark::State& state) {
     if (state.range(1) == 6) opt.fullResolutionBlurSigma = 0.8f;
     if (state.range(1) == 7) opt.fullResolutionSharpening = 0.5;
     if (state.range(1) == 8) opt.fullResolutionRefineEdges = false;
-    if (state.range(1) == 10) opt.detector.refineEdges = true;
+    if (state.range(1) == 10) opt.coarseRefineEdges = true;
     if (state.range(1) == 3) opt.coarseWindowFraction = 1.0;
     if (state.range(1) == 4) opt.coarseFirstDecimations = {4.0f, 3.0f, 1.0f};
     opt.features.enabled = state.range(1) != 9;
@@ -354,6 +355,62 @@ void BM_MirageSingle(benchmark::State& state) {
     // Frames with an adaptive full-resolution pass.
     state.counters["full_res_pass"] = fullResolution;
 }
+
+// mirage's default Tracker (mode 2 of BM_MirageSingle; mode 10 = libapriltag's edge refinement on
+// in the coarse search, as before) and ArUco (no corner refinement) on the same single frame, one
+// after the other in each iteration, the order swapped every iteration: on a shared machine whose
+// speed drifts by tens of percent within a minute, both see the same moments, so their ratio is
+// steadier than that of two separate rows. Counters: each one's wall ms per frame, `speedup` =
+// ArUco's time over mirage's (the bar: >= 2), and mirage's accuracy over one pass of the 16 views.
+void BM_SingleSideBySide(benchmark::State& state) {
+    const BoardFrames& f = frames(int(state.range(0)));
+    TrackerOptions opt;
+    opt.filterEnabled = false;
+    if (state.range(1) == 10) opt.coarseRefineEdges = true;
+    Tracker tracker(f.board, f.camera, opt);
+    ArucoBaseline aruco(cv::aruco::CORNER_REFINE_NONE);
+    double t = 0, mirageMs = 0, arucoMs = 0;
+    TrackingAccuracy acc;
+    for (size_t v = 0; v < f.images.size(); ++v) {
+        const TrackedFrame r = tracker.process(f.images[v], t += 10.0);
+        acc.addFrame(f, v, foundTags(r.detections), okPose(r.estimate));
+    }
+    size_t i = 0;
+    auto timeMirage = [&](const cv::Mat& image) {
+        const auto t0 = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(tracker.process(image, t += 10.0));
+        mirageMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                        .count();
+    };
+    auto timeAruco = [&](const cv::Mat& image) {
+        const auto t0 = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(aruco.process(f, image));
+        arucoMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                       .count();
+    };
+    for (auto _ : state) {
+        const cv::Mat& image = f.images[(i / 2) % f.images.size()];
+        if (i++ % 2 == 0) {
+            timeMirage(image);
+            timeAruco(image);
+        } else {
+            timeAruco(image);
+            timeMirage(image);
+        }
+    }
+    const double n = double(state.iterations());
+    state.counters["mirage_ms"] = mirageMs / n;
+    state.counters["aruco_ms"] = arucoMs / n;
+    state.counters["speedup"] = mirageMs > 0 ? arucoMs / mirageMs : 0.0;
+    report(state, acc);
+}
+
+BENCHMARK(BM_SingleSideBySide)
+    ->ArgNames({"width", "mode"})
+    ->Args({640, 2})
+    ->Args({640, 10})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Hard footage (hardBoardViews: far, steep, blurred, JPEG; 16 frames at 12 fps per seed, seeds
 // 1-3 one after the other), tracked in order by mirage's Tracker (Arg fallback: the adaptive
