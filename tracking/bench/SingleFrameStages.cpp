@@ -8,7 +8,7 @@
 // ordinary search the coarse-first path replaces.
 //
 //   tracking_single_stages [--width 640|1280] [--reps N] [--no-coarse-first]
-//                          [--no-full-resolution-fallback]
+//                          [--no-full-resolution-fallback] [--coarse-refine-edges]
 // The path says where adaptive detection added tags: "+ full res F/S" = libapriltag at full
 // resolution found F of the S missed board tags (S = 0: the whole region searched, no pose to
 // predict them), "+ finder N" = the finder found N where the frame's settled pose put them.
@@ -39,7 +39,7 @@ double cpuMs() {
 int main(int argc, char** argv) {
     using namespace mirage::tracking;
     int width = 640, reps = 20;
-    bool coarseFirst = true, fullResolutionFallback = true;
+    bool coarseFirst = true, fullResolutionFallback = true, coarseRefineEdges = false;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--width") && i + 1 < argc)
             width = std::atoi(argv[++i]);
@@ -49,10 +49,12 @@ int main(int argc, char** argv) {
             coarseFirst = false;
         else if (!std::strcmp(argv[i], "--no-full-resolution-fallback"))
             fullResolutionFallback = false;
+        else if (!std::strcmp(argv[i], "--coarse-refine-edges"))
+            coarseRefineEdges = true;
         else {
             std::fprintf(stderr,
                          "usage: %s [--width 640|1280] [--reps N] [--no-coarse-first] "
-                         "[--no-full-resolution-fallback]\n",
+                         "[--no-full-resolution-fallback] [--coarse-refine-edges]\n",
                          argv[0]);
             return 2;
         }
@@ -62,6 +64,7 @@ int main(int argc, char** argv) {
     opt.filterEnabled = false;
     opt.coarseFirst = coarseFirst;
     opt.fullResolutionFallback = fullResolutionFallback;
+    opt.coarseRefineEdges = coarseRefineEdges;
     Tracker tracker(f.board, f.camera, opt);
     PoseEstimator estimator(f.board, f.camera);
     const TagFamily family("tag36h11");
