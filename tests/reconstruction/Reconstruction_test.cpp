@@ -19,6 +19,7 @@
 #include "render/reconstruction/GeometryEvaluation.h"
 #include "render/reconstruction/ProxyReconstruction.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/FusedGeometryScene.h"
 
 namespace mirage::reconstruction {
 namespace {
@@ -77,33 +78,6 @@ std::vector<DepthView> exactViews(const Scene& scene, int count) {
     return views;
 }
 
-// The reconstructed geometry as an in-memory scene of real meshes (table top and objects).
-Scene asScene(const FusedGeometry& g, const std::string& leaveOut = "") {
-    Scene s;
-    auto add = [&](const std::string& name, std::vector<glm::vec3> pos, std::vector<uint32_t> idx) {
-        Mesh m;
-        m.name = name;
-        Primitive p;
-        p.positions = std::move(pos);
-        p.indices = std::move(idx);
-        m.primitives.push_back(std::move(p));
-        s.meshes.push_back(std::move(m));
-        Node n;
-        n.name = name;
-        n.mesh = int(s.meshes.size()) - 1;
-        n.origin = Origin::Real;
-        s.nodes.push_back(n);
-        s.roots.push_back(int(s.nodes.size()) - 1);
-    };
-    const TableEstimate& t = g.table;
-    auto at = [&](double u, double v) { return glm::vec3(t.plane.toWorld({u, v, 0})); };
-    add("table", {at(t.uMin, t.vMin), at(t.uMax, t.vMin), at(t.uMax, t.vMax), at(t.uMin, t.vMax)},
-        {0, 1, 2, 0, 2, 3});
-    for (const auto& o : g.objects)
-        if (o.name != leaveOut) add(o.name, o.positions, o.indices);
-    return s;
-}
-
 struct TabletopFixture : ::testing::Test {
     static const FusedGeometry& geometry() {
         static const FusedGeometry g = [] {
@@ -135,7 +109,8 @@ TEST_F(TabletopFixture, BookMugAndBlockAreRebuilt) {
                     o.centre.y, o.centre.z, o.sizeU, o.sizeV, o.heightM);
     ASSERT_EQ(g.objects.size(), 3u);
     for (const auto& o : g.objects) EXPECT_LE(o.indices.size() / 3, 1500u) << o.name;
-    const GeometryScore s = evaluateGeometry(tabletop(), asScene(g), tabletopPlane());
+    const GeometryScore s =
+        evaluateGeometry(tabletop(), test::fusedGeometryScene(g), tabletopPlane());
     ASSERT_EQ(s.objects.size(), 3u);
     for (const ObjectScore& o : s.objects) {
         EXPECT_GE(o.completeness, 0.8) << o.name;
@@ -155,7 +130,8 @@ TEST_F(TabletopFixture, AMissingObjectShowsAsALargeDistance) {
         if (const double d = glm::length(o.centre - glm::dvec3(0.33, 0, 0.2)); d < best)
             best = d, nearest = o.name;
     ASSERT_LT(best, 0.02);
-    const GeometryScore s = evaluateGeometry(tabletop(), asScene(g, nearest), tabletopPlane());
+    const GeometryScore s =
+        evaluateGeometry(tabletop(), test::fusedGeometryScene(g, nearest), tabletopPlane());
     for (const ObjectScore& o : s.objects)
         if (o.name == "block") {
             EXPECT_LT(o.completeness, 0.5);  // only its underside, on the table, is still near

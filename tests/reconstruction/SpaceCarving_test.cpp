@@ -20,6 +20,7 @@
 #include "render/reconstruction/GeometryEvaluation.h"
 #include "render/reconstruction/ProxyGeometry.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/FusedGeometryScene.h"
 
 namespace mirage::reconstruction {
 namespace {
@@ -123,31 +124,6 @@ std::vector<DepthView> depthAtEdges(const Scene& scene, const Footage& f) {
     return views;
 }
 
-Scene asScene(const FusedGeometry& g) {
-    Scene s;
-    auto add = [&](const std::string& name, std::vector<glm::vec3> pos, std::vector<uint32_t> idx) {
-        Mesh m;
-        m.name = name;
-        Primitive p;
-        p.positions = std::move(pos);
-        p.indices = std::move(idx);
-        m.primitives.push_back(std::move(p));
-        s.meshes.push_back(std::move(m));
-        Node n;
-        n.name = name;
-        n.mesh = int(s.meshes.size()) - 1;
-        n.origin = Origin::Real;
-        s.nodes.push_back(n);
-        s.roots.push_back(int(s.nodes.size()) - 1);
-    };
-    const TableEstimate& t = g.table;
-    auto at = [&](double u, double v) { return glm::vec3(t.plane.toWorld({u, v, 0})); };
-    add("table", {at(t.uMin, t.vMin), at(t.uMax, t.vMin), at(t.uMax, t.vMax), at(t.uMin, t.vMax)},
-        {0, 1, 2, 0, 2, 3});
-    for (const auto& o : g.objects) add(o.name, o.positions, o.indices);
-    return s;
-}
-
 struct Carved {
     FusedGeometry geometry;
     GeometryScore score;
@@ -157,7 +133,7 @@ Carved carveAndScore(const Scene& truth, const Footage& f, const CarvingOptions&
     const CarvedHeights carved = carveAbovePlane(f, o);
     Carved c;
     c.geometry = reconstructGeometry(f, depthAtEdges(truth, f), {}, o.enabled ? &carved : nullptr);
-    c.score = evaluateGeometry(truth, asScene(c.geometry), f.board);
+    c.score = evaluateGeometry(truth, test::fusedGeometryScene(c.geometry), f.board);
     for (const auto& s : c.score.objects)
         std::printf("%s: %.1f %% within 1 cm (mean %.1f mm, p95 %.1f mm)\n", s.name.c_str(),
                     100 * s.completeness, s.meanMm, s.p95Mm);
