@@ -4,19 +4,11 @@
 #include <functional>
 #include <random>
 
+#include "testscenes/NoisyPose.h"
 #include "tracking/PoseFilter.h"
 
 namespace mirage::tracking {
 namespace {
-
-Pose noisy(const Pose& p, std::mt19937& rng, double sigmaM, double sigmaRad) {
-    std::normal_distribution<double> n(0.0, 1.0);
-    Pose q = p;
-    q.translation += sigmaM * glm::dvec3(n(rng), n(rng), n(rng));
-    const glm::dvec3 w = sigmaRad * glm::dvec3(n(rng), n(rng), n(rng));
-    q.rotation = glm::normalize(glm::angleAxis(glm::length(w), glm::normalize(w)) * q.rotation);
-    return q;
-}
 
 // The measurement covariance the pose estimator would report for this noise (per-axis sigmas).
 PoseCovariance diagonalCovariance(double sigmaM, double sigmaRad) {
@@ -55,7 +47,7 @@ TEST(PoseFilter, RemovesJitterAtRest) {
     PoseFilter f;
     std::vector<Pose> raw, filtered, truths;
     for (int i = 0; i < 300; ++i) {
-        const Pose m = noisy(truth, rng, kSigmaM, kSigmaRad);
+        const Pose m = test::noisyPose(truth, rng, kSigmaM, kSigmaRad);
         const Pose o = f.update(m, i / 30.0, &cov);
         if (i >= 30) {  // after 1 s of settling
             raw.push_back(m);
@@ -106,7 +98,7 @@ PanError fastPan(const std::function<Pose(const Pose&, double, const PoseCovaria
         const double t = i / 30.0, s = progress(t);
         const Pose truth = Pose::fromRotationTranslation(
             glm::mat3_cast(glm::angleAxis(omega * s, glm::dvec3(0, 1, 0))), {speed * s, 0.3, 0.2});
-        const Pose m = noisy(truth, rng, kSigmaM, kSigmaRad);
+        const Pose m = test::noisyPose(truth, rng, kSigmaM, kSigmaRad);
         const Pose o = filter(m, t, cov);
         if (i >= 2) {
             out.worstM = std::max(out.worstM, glm::length(o.translation - truth.translation));

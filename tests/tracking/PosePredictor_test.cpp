@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "testscenes/NoisyPose.h"
 #include "tracking/PosePredictor.h"
 
 namespace mirage::tracking {
@@ -34,15 +35,6 @@ Pose pan(double t) {
 
 double translationError(const Pose& a, const Pose& b) {
     return glm::length(a.translation - b.translation);
-}
-
-Pose noisy(const Pose& p, std::mt19937& rng, double sigmaM, double sigmaRad) {
-    std::normal_distribution<double> n(0.0, 1.0);
-    Pose q = p;
-    q.translation += sigmaM * glm::dvec3(n(rng), n(rng), n(rng));
-    const glm::dvec3 w = sigmaRad * glm::dvec3(n(rng), n(rng), n(rng));
-    q.rotation = glm::normalize(glm::angleAxis(glm::length(w), glm::normalize(w)) * q.rotation);
-    return q;
 }
 
 double median(std::vector<double> v) {
@@ -92,7 +84,7 @@ TEST(PosePredictor, PredictionBeatsTheLastPoseOnNoisyConstantMotion) {
     std::vector<double> predictedM, lastM, predictedDeg, lastDeg;
     for (int i = 0; i < 60; ++i) {
         const double t = i / 30.0;
-        const Pose measured = noisy(pan(t), rng, sigmaM, sigmaRad);
+        const Pose measured = test::noisyPose(pan(t), rng, sigmaM, sigmaRad);
         p.update(measured, t);
         if (!p.velocity()) continue;
         const Pose truth = pan(t + ahead);
