@@ -26,6 +26,7 @@
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/RenderTestScenes.h"
 #include "testscenes/TurnedBoxScene.h"
 
@@ -96,18 +97,8 @@ struct Reference {
 };
 
 Reference reference(const EdgeScene& s) {
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 64;
-    st.threads = 2;
-    st.seed = 7;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    Reference r;
-    r.footage = linearRgbToSrgbBgr8(ref.realOnly);
-    r.composite =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), ref));
-    return r;
+    const test::ReferenceFrame f = test::renderReferenceFrame(s.scene, s.cam, s.pose, 64, 7);
+    return {f.footage, f.composite};
 }
 
 RendererOptions options(bool aa) {

@@ -19,6 +19,7 @@
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
+#include "testscenes/ReferenceFrame.h"
 
 namespace mirage::render {
 namespace {
@@ -31,19 +32,8 @@ struct Reference {
 };
 
 Reference referenceComposite(const test::CausticScene& s) {
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 32;
-    st.threads = 2;
-    st.seed = 5;
-    st.caustics = true;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-    Reference r;
-    r.footage = linearRgbToSrgbBgr8(ref.realOnly);
-    r.composite = raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), ref);
-    return r;
+    const test::ReferenceFrame f = test::renderReferenceFrame(s.scene, s.cam, s.pose, 32, 5);
+    return {f.footage, f.compositeLinear};
 }
 
 // Mean luminance (linear) over the glass's straight shadow in the reference composite, the

@@ -21,6 +21,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/RoughTestScenes.h"
 
 namespace mirage::render {
@@ -131,17 +132,10 @@ test::RoughTestScene makePanel() {
 TEST(RoughLight, RoughPanelCausticSpreadsAsTheReferenceAndSharpPhotonsFail) {
     gl::Context context = gl::Context::headless();
     test::RoughTestScene s = makePanel();
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 256;  // the glow reaches the table through the rough panel: noisy
-    st.threads = 2;
-    st.seed = 5;
-    st.caustics = true;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    const cv::Mat footage = linearRgbToSrgbBgr8(ref.realOnly);
-    const cv::Mat refSrgb =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(footage), ref));
+    // 256 passes: the glow reaches the table through the rough panel, noisy.
+    const test::ReferenceFrame ref = test::renderReferenceFrame(s.scene, s.cam, s.pose, 256, 5);
+    const cv::Mat& footage = ref.footage;
+    const cv::Mat& refSrgb = ref.composite;
     RendererOptions on = test::roughSingleFrame();
     on.caustic.enabled = true;
     const test::RoughFrame spread = test::renderRough(s, footage, on);

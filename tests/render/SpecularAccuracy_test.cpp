@@ -21,6 +21,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
@@ -38,18 +39,10 @@ struct Comparison {
 
 Comparison reference(const test::SpecularScene& s, int spp = 48) {
     Comparison c{s, {}, {}, test::sphereMask(s)};
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = spp;
-    st.threads = 2;
-    st.seed = 3;
-    st.caustics = true;  // photon map on: light through glass as it is (docs/caustics.md)
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-    c.footage = linearRgbToSrgbBgr8(ref.realOnly);
-    c.refSrgb =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(c.footage), ref));
+    // Photon map on: light through glass as it is (docs/caustics.md).
+    const test::ReferenceFrame f = test::renderReferenceFrame(s.scene, s.cam, s.pose, spp, 3, true);
+    c.footage = f.footage;
+    c.refSrgb = f.composite;
     return c;
 }
 

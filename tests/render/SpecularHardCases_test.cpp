@@ -22,6 +22,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
@@ -42,19 +43,8 @@ struct Reference {
 };
 Reference reference(const Scene& scene, const CameraIntrinsics& cam, const Pose& pose, int spp = 48,
                     bool caustics = false) {
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = spp;
-    st.threads = 2;
-    st.seed = 5;
-    st.caustics = caustics;
-    const auto ref = raytrace::renderDifferential(scene, device, {cam, pose}, st);
-    EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-    Reference out;
-    out.footage = linearRgbToSrgbBgr8(ref.realOnly);
-    out.composite =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(out.footage), ref));
-    return out;
+    const test::ReferenceFrame f = test::renderReferenceFrame(scene, cam, pose, spp, 5, caustics);
+    return {f.footage, f.composite};
 }
 
 RendererOptions singleFrame() {

@@ -22,6 +22,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
@@ -195,27 +196,20 @@ constexpr double kFloorLrvRatioTolerance = 0.25, kFloorLrvRatioOff = 0.5;
 TEST(SpecularVpl, FloorLitByTheMirrorsBounceMatchesReference) {
     gl::Context context = gl::Context::headless();
     const RelayScene s = makeRelay();
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 48;
-    st.threads = 2;
-    st.seed = 5;
-    st.caustics = true;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    const cv::Mat footage = linearRgbToSrgbBgr8(ref.realOnly);
-    const cv::Mat refComposite =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(footage), ref));
+    const test::ReferenceFrame ref = test::renderReferenceFrame(s.scene, s.cam, s.pose, 48, 5);
+    const cv::Mat& footage = ref.footage;
+    const cv::Mat& refComposite = ref.composite;
     const cv::Mat region = floorByTheWall(s);
     ASSERT_GT(cv::countNonZero(region), 200);
     const Frame on = renderRealtime(s, footage);
     RendererOptions offOpt;
     offOpt.vpl.throughSpecular = false;
     const Frame off = renderRealtime(s, footage, offOpt);
-    ASSERT_EQ(on.lrv.size(), ref.realAndVirtual.size());  // an undistorted camera: canvas = image
+    ASSERT_EQ(on.lrv.size(),
+              ref.images.realAndVirtual.size());  // an undistorted camera: canvas = image
     // L_rv there is the light the mirror throws onto the wall, bounced once (the light's cone
     // falls on the mirror alone): the reflected VPLs' work.
-    const double lrvRef = test::meanLuminance(ref.realAndVirtual, region);
+    const double lrvRef = test::meanLuminance(ref.images.realAndVirtual, region);
     const double ratioOn = test::meanLuminance(on.lrv, region) / lrvRef;
     const double ratioOff = test::meanLuminance(off.lrv, region) / lrvRef;
     const double psnrOn = test::psnr(on.composite, refComposite, 255.0, region);

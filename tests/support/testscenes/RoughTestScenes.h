@@ -13,6 +13,7 @@
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::test {
@@ -72,20 +73,9 @@ struct RoughReference {
 // The Embree differential reference (caustics off: the rough object's light on the table is not
 // judged by these tests).
 inline RoughReference roughReference(const RoughTestScene& s, int spp = 64, int seed = 5) {
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = spp;
-    st.threads = 2;
-    st.seed = uint64_t(seed);
-    st.caustics = false;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    EXPECT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-    RoughReference r;
-    r.footage = linearRgbToSrgbBgr8(ref.realOnly);
-    r.refSrgb =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), ref));
-    return r;
+    const ReferenceFrame f =
+        renderReferenceFrame(s.scene, s.cam, s.pose, spp, uint64_t(seed), false);
+    return {f.footage, f.composite};
 }
 
 inline render::RendererOptions roughSingleFrame() {
