@@ -3,6 +3,7 @@
 // and L_rv again with caustics off: the caustic tests judge the real-time caustic against their
 // difference.
 #include <cstdint>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
@@ -12,6 +13,7 @@
 #include "render/raytrace/DifferentialRendering.h"
 #include "render/raytrace/EmbreeDevice.h"
 #include "testscenes/CausticTestScenes.h"
+#include "testscenes/ReferenceFrame.h"
 
 namespace mirage::test {
 
@@ -35,21 +37,20 @@ inline cv::Mat linearLuminance(const cv::Mat& rgb) {
 
 inline CausticReferenceRender renderCausticReference(const CausticScene& s, int spp,
                                                      uint64_t seed) {
+    ReferenceFrame on = renderReferenceFrame(s.scene, s.cam, s.pose, spp, seed, true);
+    CausticReferenceRender r;
+    r.on = std::move(on.images);
+    r.footage = on.footage;
+    r.compositeSrgb = on.composite;
+    // L_rv again without the photon map, same passes and seed.
     const raytrace::EmbreeDevice device("threads=2");
     raytrace::RenderSettings st;
     st.samplesPerPixel = spp;
     st.threads = 2;
     st.seed = seed;
-    st.caustics = true;
-    CausticReferenceRender r;
-    r.on = raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    EXPECT_EQ(r.on.realStats.nonFiniteSamples + r.on.mixedStats.nonFiniteSamples, 0);
     st.caustics = false;
     const raytrace::RayTracingScene mixed(s.scene, raytrace::SceneSubset::All, device);
     const raytrace::RenderResult off = raytrace::render(mixed, {s.cam, s.pose}, st);
-    r.footage = linearRgbToSrgbBgr8(r.on.realOnly);
-    r.compositeSrgb =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(r.footage), r.on));
     r.caustic = cv::max(r.on.realAndVirtual - off.radiance, 0.0);
     cv::Mat yc = linearLuminance(r.caustic);
     const cv::Mat yon = linearLuminance(r.on.realAndVirtual);
