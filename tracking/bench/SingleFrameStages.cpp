@@ -21,6 +21,9 @@
 #include <map>
 #include <string>
 
+#include <opencv2/aruco.hpp>
+#include <opencv2/core/utility.hpp>
+
 #include "tracking/ArucoComparison.h"
 #include "tracking/TagFamily.h"
 #include "tracking/Tracker.h"
@@ -67,6 +70,8 @@ int main(int argc, char** argv) {
     opt.coarseRefineEdges = coarseRefineEdges;
     Tracker tracker(f.board, f.camera, opt);
     PoseEstimator estimator(f.board, f.camera);
+    cv::setNumThreads(1);
+    ArucoBaseline aruco(cv::aruco::CORNER_REFINE_NONE);
     const TagFamily family("tag36h11");
 
     apriltag_detector_t* td = apriltag_detector_create();
@@ -76,10 +81,12 @@ int main(int argc, char** argv) {
     td->nthreads = 1;
     std::map<std::string, double> stageMs;  // per view, summed over views
 
-    double t = 0, sumFrame = 0, sumRefine = 0, sumPose = 0, sumApril = 0;
+    double t = 0, sumFrame = 0, sumRefine = 0, sumPose = 0, sumApril = 0, sumAruco = 0,
+           sumMirageAgain = 0;
     std::printf(
         "view | frame ms | path | tags | state | refine ms | pose ms | apriltag d2 ms | tracker "
-        "detect / pose / features wall ms | side est px\n");
+        "detect / pose / features wall ms | side est px | ArUco / mirage CPU ms, alternating = "
+        "speedup\n");
     for (size_t v = 0; v < f.images.size(); ++v) {
         const cv::Mat& grey = f.images[v];
         TrackedFrame r;
@@ -124,6 +131,17 @@ int main(int argc, char** argv) {
             apriltag_detections_destroy(dets);
         }
         const double aprilMs = (cpuMs() - c0) / reps;
+        // ArUco on the same view, alternating with mirage so that both see the same moments of
+        // a machine whose speed drifts.
+        double arucoMs = 0, mirageAgainMs = 0;
+        for (int i = 0; i < reps; ++i) {
+            c0 = cpuMs();
+            aruco.process(f, grey);
+            arucoMs += (cpuMs() - c0) / reps;
+            c0 = cpuMs();
+            tracker.process(grey, t += 10.0);
+            mirageAgainMs += (cpuMs() - c0) / reps;
+        }
 
         char path[96];
         if (r.coarseTried)
@@ -143,18 +161,22 @@ int main(int argc, char** argv) {
                           r.fullResolutionFinderFound);
         }
         std::printf(
-            "%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f | %.2f / %.2f / %.2f | %.0f\n", v,
-            frameMs, path, r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
+            "%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f | %.2f / %.2f / %.2f | %.0f | "
+            "%.2f / %.2f = %.2f\n",
+            v, frameMs, path, r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
             trackingStateName(r.estimate.state), refineMs, poseMs, aprilMs, detectMs, trackerPoseMs,
-            featureMs, r.coarseFirstSidePx);
+            featureMs, r.coarseFirstSidePx, arucoMs, mirageAgainMs, arucoMs / mirageAgainMs);
         sumFrame += frameMs;
+        sumAruco += arucoMs;
+        sumMirageAgain += mirageAgainMs;
         sumRefine += refineMs;
         sumPose += poseMs;
         sumApril += aprilMs;
     }
     const double n = double(f.images.size());
-    std::printf("mean | %.2f | | | | %.3f | %.3f | %.2f\n", sumFrame / n, sumRefine / n,
-                sumPose / n, sumApril / n);
+    std::printf("mean | %.2f | | | | %.3f | %.3f | %.2f | | | %.2f / %.2f = %.2f\n", sumFrame / n,
+                sumRefine / n, sumPose / n, sumApril / n, sumAruco / n, sumMirageAgain / n,
+                sumAruco / sumMirageAgain);
     std::printf("libapriltag stages of the decimate-2 search (wall ms per view, mean):\n");
     for (const auto& [name, ms] : stageMs)
         if (ms / n >= 0.005) std::printf("  %-26s %.3f\n", name.c_str(), ms / n);
