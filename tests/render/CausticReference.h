@@ -44,13 +44,9 @@ inline CausticReferenceRender renderCausticReference(const CausticScene& s, int 
     r.compositeSrgb = on.composite;
     // L_rv again without the photon map, same passes and seed.
     const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = spp;
-    st.threads = 2;
-    st.seed = seed;
-    st.caustics = false;
     const raytrace::RayTracingScene mixed(s.scene, raytrace::SceneSubset::All, device);
-    const raytrace::RenderResult off = raytrace::render(mixed, {s.cam, s.pose}, st);
+    const raytrace::RenderResult off =
+        raytrace::render(mixed, {s.cam, s.pose}, referenceSettings(spp, seed, false));
     r.caustic = cv::max(r.on.realAndVirtual - off.radiance, 0.0);
     cv::Mat yc = linearLuminance(r.caustic);
     const cv::Mat yon = linearLuminance(r.on.realAndVirtual);

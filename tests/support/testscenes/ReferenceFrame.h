@@ -23,17 +23,23 @@ struct ReferenceFrame {
     cv::Mat composite;        // CV_8UC3 BGR, sRGB-encoded
 };
 
-// spp passes of the reference on two threads from `seed`; caustics = the photon map (on by
-// default, as in RenderSettings). A non-finite sample fails the calling test.
-inline ReferenceFrame renderReferenceFrame(const Scene& scene, const CameraIntrinsics& cam,
-                                           const Pose& T_world_camera, int spp, uint64_t seed,
-                                           bool caustics = true) {
-    const raytrace::EmbreeDevice device("threads=2");
+// The tests' reference settings: spp passes on two threads from `seed`; caustics = the photon map.
+inline raytrace::RenderSettings referenceSettings(int spp, uint64_t seed, bool caustics) {
     raytrace::RenderSettings st;
     st.samplesPerPixel = spp;
     st.threads = 2;
     st.seed = seed;
     st.caustics = caustics;
+    return st;
+}
+
+// The reference with referenceSettings (the photon map on by default, as in RenderSettings). A
+// non-finite sample fails the calling test.
+inline ReferenceFrame renderReferenceFrame(const Scene& scene, const CameraIntrinsics& cam,
+                                           const Pose& T_world_camera, int spp, uint64_t seed,
+                                           bool caustics = true) {
+    const raytrace::EmbreeDevice device("threads=2");
+    const raytrace::RenderSettings st = referenceSettings(spp, seed, caustics);
     ReferenceFrame r;
     r.images = raytrace::renderDifferential(scene, device, {cam, T_world_camera}, st);
     EXPECT_EQ(r.images.realStats.nonFiniteSamples + r.images.mixedStats.nonFiniteSamples, 0);
