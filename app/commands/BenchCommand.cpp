@@ -1,7 +1,7 @@
-// `mirage bench SESSION -o OUTDIR`: speed against error of the real-time renderer (DESIGN.md,
-// "Ground truth, and how every effect is judged"; docs/bench.md). Runs the renderer over the
-// frames of a synthetic session (made with `mirage synth --ground-truth-composite`) at the
-// ground-truth poses, for a grid of knobs (render/evaluation/RealtimeBench.h), and writes:
+// `mirage bench SESSION -o OUTDIR`: speed against error of the real-time renderer (docs/bench.md).
+// Runs the renderer over the frames of a synthetic session (made with `mirage synth
+// --ground-truth-composite`) at the ground-truth poses, for a grid of knobs
+// (render/evaluation/RealtimeBench.h), and writes:
 //   OUTDIR/bench.csv         one row per configuration: median GPU ms per pass and in total (with
 //                            syncPasses the wall time of each pass between two glFinish; else GL
 //                            timer queries), median wall ms, PSNR/SSIM over the whole

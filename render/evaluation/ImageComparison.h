@@ -1,8 +1,8 @@
 #pragma once
-// Image error figures for judging a composite against its ground truth (DESIGN.md, "Ground truth,
-// and how every effect is judged"): PSNR and SSIM over the whole frame and over a mask (the pixels
-// the virtual objects influence). Images are compared as the camera delivers them: 8-bit BGR,
-// sRGB-encoded (peak 255), so an error figure means the same as it would on real footage.
+// Image error figures for judging a composite against its ground truth (docs/bench.md): PSNR and
+// SSIM over the whole frame and over a mask (the pixels the virtual objects influence). Images are
+// compared as the camera delivers them: 8-bit BGR, sRGB-encoded (peak 255), so an error figure
+// means the same as it would on real footage.
 //
 // Figures over several frames are pooled (ErrorAccumulator): PSNR from the mean squared error of
 // all counted pixels of all frames, SSIM as the mean of the per-pixel SSIM map over them, so a

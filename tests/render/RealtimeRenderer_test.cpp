@@ -1,5 +1,6 @@
 // The real-time renderer on llvmpipe, against closed forms and the routing rules of differential
-// instant radiosity (DESIGN.md "Real and virtual"). Small images so the suite stays fast.
+// instant radiosity (docs/realtime-renderer.md "Real and virtual: routing"). Small images so the
+// suite stays fast.
 #include <gtest/gtest.h>
 
 #include <cmath>

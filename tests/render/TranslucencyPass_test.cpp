@@ -127,7 +127,8 @@ void expectAgreement(TranslucentShape shape, const std::string& name) {
     cv::minMaxLoc(cpu.radiance.reshape(1), nullptr, &peak);
     writeLinearRgb(dir / (name + "_cpu_realtime.png"), both, float(1.0 / peak));
     EXPECT_GT(db, kFloorDb) << name;
-    // The object is virtual: it adds nothing to L_r (DESIGN.md "Real and virtual").
+    // The object is virtual: it adds nothing to L_r (docs/realtime-renderer.md "Real and virtual:
+    // routing").
     cv::Mat rOverObject(rt.r.size(), rt.r.type(), cv::Scalar::all(0));
     rt.r.copyTo(rOverObject, cpu.mask);
     double maxR;

@@ -3,8 +3,8 @@
 #include "passes/caustic/caustic.glsl"
 // Caustic buffer (Knecht 2013 Sec. 5.2): every photon of the photon G-buffers is splatted as a
 // quad around its receiver hit, in camera space, into a fixed-point irradiance buffer with
-// integer atomics (on llvmpipe scattering is ~10x cheaper in compute than as GL_POINTS,
-// DESIGN.md). One invocation per photon texel; z = 2 x light layer + (0 reflected, 1 refracted).
+// integer atomics (on llvmpipe scattering is ~10x cheaper in compute than as GL_POINTS).
+// One invocation per photon texel; z = 2 x light layer + (0 reflected, 1 refracted).
 //
 // Quad size after Wyman 2008: the photon's footprint on the receiver is the spacing of its
 // neighbouring photons' hits (their divergence from the light through the object); the kernel

@@ -3,7 +3,7 @@
 #include "lighting.glsl"
 #include "passes/translucency/translucency.glsl"
 // Direct light, environment light and emission, routed into the two GI solutions
-// (DESIGN.md "Real and virtual"; Knecht 2010's decision flags):
+// (docs/realtime-renderer.md, "Real and virtual: routing"; Knecht 2010's decision flags):
 //   L_rv: every light, visibility against all occluders;
 //   L_r : only if the light and p are real, visibility against real occluders only.
 // The environment map is real (captured) unless the scene says otherwise; it is not shadowed.
@@ -110,8 +110,9 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r) 
 // Variant for the pixels of rough mirrors, metals and glass (roughness above the mirror
 // threshold 0.05; the specular passes light them along the mirror / refracted ray, which never
 // meets a punctual light): the punctual lights' GGX highlight alone, F0 the metal's base colour or
-// 0.04 for glass, routed as the direct light (DESIGN.md "Real and virtual"). The composite adds it
-// to the specular pixel's L'_rv / L'_r after the fuzzy / rough filters (it is the lobe already).
+// 0.04 for glass, routed as the direct light (docs/realtime-renderer.md, "Real and virtual:
+// routing"). The composite adds it to the specular pixel's L'_rv / L'_r after the fuzzy / rough
+// filters (it is the lobe already).
 // Other pixels are left as the main draw wrote them. LR.a = 2 marks a highlight pixel.
 const float kRoughHighlightThreshold = 0.05;
 void main() {

@@ -4,9 +4,10 @@
 // pixel q = (x, y) sums only VPLs i = g, g + K^2, ... with g = (x mod K) + K (y mod K), scaled by
 // K^2; the geometry-aware filter then recombines the K x K groups. The output is DEINTERLEAVED:
 // tile (x mod K, y mod K) of the target holds group g's pixels at (x / K, y / K), and each tile is
-// one draw with `group` uniform. Visibility from the imperfect
-// shadow maps. Routing (DESIGN.md): a VPL at q lights p in L_rv always; in L_r only if the light,
-// q and p are all real, with visibility against real points only. Diffuse receivers.
+// one draw with `group` uniform. Visibility from the imperfect shadow maps. Routing
+// (docs/realtime-renderer.md, "Real and virtual: routing"): a VPL at q lights p in L_rv always;
+// in L_r only if the light, q and p are all real, with visibility against real points only.
+// Diffuse receivers.
 in vec2 uv;
 layout(binding = kUnitIndirectVpls) uniform samplerBuffer vplTexels;  // GpuVpl[] (vplAt)
 layout(binding = kUnitIndirectPosition) uniform sampler2D gPosition;

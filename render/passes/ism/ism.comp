@@ -2,8 +2,8 @@
 #include "common.glsl"
 // Imperfect shadow maps (Ritschel et al. 2008): each VPL splats its own subset of the scene's
 // surface point pool into a small paraboloid depth tile around its normal. Scattering points is
-// an order of magnitude cheaper as compute + imageAtomicMin than as GL_POINTS on llvmpipe
-// (DESIGN.md timing table). Depth = distance to the VPL in metres, stored as float bits in r32ui
+// an order of magnitude cheaper as compute + imageAtomicMin than as GL_POINTS on llvmpipe.
+// Depth = distance to the VPL in metres, stored as float bits in r32ui
 // (positive floats order like unsigned ints). The real-only atlas gets only the real points.
 layout(local_size_x = 64) in;
 layout(std430, binding = kBindingVpls) readonly buffer Vpls { GpuVpl vpls[]; };

@@ -1,14 +1,14 @@
 #pragma once
 // Shadow maps for every light with a caster in its cone (spot: 1 layer, point: 6 cube-face
 // layers, directional: 1 ortho layer), stored as occluder distance in an R32F array texture.
-// Visibility is tested twice (DESIGN.md "Real and virtual"): against all occluders (for L_rv)
-// and against real occluders only (for L_r). The second map is rendered only for real lights
-// with a virtual caster in the cone; elsewhere it is the same as the first and aliases it.
-// When VPLs are needed the all-occluder pass also writes the reflective shadow maps; at their own
-// size (ShadowOptions::rsmSize) when it differs from the shadow map's, in a second raster.
-// Glass (DrawItem::transmissive) in a light's cone is left out of the occluder maps and drawn
-// into the glass atlases instead (shadow_glass.frag): the lookups colour the light behind it by
-// its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque. A
+// Visibility is tested twice (docs/realtime-renderer.md "Real and virtual: routing"): against all
+// occluders (for L_rv) and against real occluders only (for L_r). The second map is rendered only
+// for real lights with a virtual caster in the cone; elsewhere it is the same as the first and
+// aliases it. When VPLs are needed the all-occluder pass also writes the reflective shadow maps; at
+// their own size (ShadowOptions::rsmSize) when it differs from the shadow map's, in a second
+// raster. Glass (DrawItem::transmissive) in a light's cone is left out of the occluder maps and
+// drawn into the glass atlases instead (shadow_glass.frag): the lookups colour the light behind it
+// by its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque. A
 // translucent object (DrawItem::translucent) goes into the same atlases for every light (caustic
 // lights too): its boundary's Fresnel and its medium's optical thickness along the light's ray.
 #include "render/RenderPass.h"

@@ -10,10 +10,11 @@
 //   L'_rv = sum_ls  eta1 L_refl(ls) + eta2 T L_refr(ls)                       (Eq. 3)
 //   L'_r  = sum_ls  eta1 L_refl(ls) real(ls, p_refl) + eta2 T L_refr(ls) real(ls, p_refr) (Eq. 4)
 //   real(ls, p) = r(ls) and r(p)                                              (Eq. 5)
-// with visibility against all occluders for L'_rv and real occluders only for L'_r (DESIGN.md
-// routing table). The Fresnel / transmittance weights (eta1, eta2 T) are pre-multiplied (Sec.
-// 5.1). A ray that hit nothing modelled writes the weighted environment radiance into L_env
-// instead (Sec. 4.1.3); L'_rv and L'_r stay untouched there. Linear radiance throughout.
+// with visibility against all occluders for L'_rv and real occluders only for L'_r
+// (docs/realtime-renderer.md, "Real and virtual: routing"). The Fresnel / transmittance weights
+// (eta1, eta2 T) are pre-multiplied (Sec. 5.1). A ray that hit nothing modelled writes the
+// weighted environment radiance into L_env instead (Sec. 4.1.3); L'_rv and L'_r stay untouched
+// there. Linear radiance throughout.
 // Variant MIRAGE_CAUSTIC_GATHER (frames with a world-space photon grid): each hit also gathers
 // the caustic photons around it (caustic.glsl gatherCaustic), routed as the camera's caustic.
 // Variant MIRAGE_SPECULAR_HALF (RendererOptions::specularHalfResolution): drawn at half the

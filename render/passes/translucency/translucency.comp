@@ -8,7 +8,7 @@
 //  stage 0: irradiance E_i = sum_lights F_t(cos) cos I vis + F_t-weighted environment
 //           irradiance at every outer surface voxel i; for L_rv every light with visibility
 //           through all occluders, for L_r only real lights with the real-only shadow maps and
-//           a real environment (DESIGN.md "Real and virtual");
+//           a real environment (docs/realtime-renderer.md "Real and virtual: routing");
 //  stage 1: per output voxel o, L_o = (1/pi) a_eff sum_i E_i A_i c_i e^{-k tau(i, o)}, the
 //           radiance leaving o before the exit boundary's F_t (direct.frag applies it per pixel).
 layout(local_size_x = 64) in;
