@@ -217,6 +217,21 @@ TEST(Detector, QuadCornersFromAnUnrefinedDecimatedSearch) {
     EXPECT_GE(keptQuad, int(0.8 * double(found.size())));
     EXPECT_LT(refinedWorst, 0.12);
     EXPECT_LT(keptSinglePass, keptQuad);
+
+    // The detector itself without libapriltag's refinement refines its tags the same way: as many
+    // tags marked refined as refineQuadCorners kept, at the same accuracy.
+    DetectorOptions refining = opt;
+    refining.refineCorners = true;
+    Detector refiningDetector(refining);
+    int refined = 0;
+    double detectorWorst = 0;
+    for (const auto& d : refiningDetector.detect(view.image)) {
+        if (!d.refined) continue;
+        ++refined;
+        detectorWorst = std::max(detectorWorst, worstError(d, d.corners));
+    }
+    EXPECT_EQ(refined, keptQuad);
+    EXPECT_LT(detectorWorst, 0.12);
 }
 
 }  // namespace

@@ -5,7 +5,9 @@
 // used, textured region), and the CPU time of mirage's own stages on that frame's tags (corner
 // refinement of every tag once, the pose estimate). Then libapriltag's own stage timer
 // (apriltag_detector_t::tp, wall time) of a decimate-2 search of each view's textured region: the
-// ordinary search the coarse-first path replaces.
+// ordinary search the coarse-first path replaces. The last column times OpenCV ArUco (no corner
+// refinement, one thread) and the tracker again, alternately on the same view, and gives their
+// ratio (the speedup; docs/tracking.md, "Single frames against ArUco, paired").
 //
 //   tracking_single_stages [--width 640|1280] [--reps N] [--no-coarse-first]
 //                          [--no-full-resolution-fallback] [--coarse-refine-edges]

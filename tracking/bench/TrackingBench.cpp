@@ -375,27 +375,25 @@ void BM_SingleSideBySide(benchmark::State& state) {
         const TrackedFrame r = tracker.process(f.images[v], t += 10.0);
         acc.addFrame(f, v, foundTags(r.detections), okPose(r.estimate));
     }
+    // Adds the wall time of run() (ms) to `sum`.
+    auto timed = [](double& sum, auto&& run) {
+        const auto t0 = std::chrono::steady_clock::now();
+        run();
+        sum += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                   .count();
+    };
     size_t i = 0;
-    auto timeMirage = [&](const cv::Mat& image) {
-        const auto t0 = std::chrono::steady_clock::now();
-        benchmark::DoNotOptimize(tracker.process(image, t += 10.0));
-        mirageMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                        .count();
-    };
-    auto timeAruco = [&](const cv::Mat& image) {
-        const auto t0 = std::chrono::steady_clock::now();
-        benchmark::DoNotOptimize(aruco.process(f, image));
-        arucoMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                       .count();
-    };
     for (auto _ : state) {
+        // Each view twice, once in each order.
         const cv::Mat& image = f.images[(i / 2) % f.images.size()];
+        auto runMirage = [&] { benchmark::DoNotOptimize(tracker.process(image, t += 10.0)); };
+        auto runAruco = [&] { benchmark::DoNotOptimize(aruco.process(f, image)); };
         if (i++ % 2 == 0) {
-            timeMirage(image);
-            timeAruco(image);
+            timed(mirageMs, runMirage);
+            timed(arucoMs, runAruco);
         } else {
-            timeAruco(image);
-            timeMirage(image);
+            timed(arucoMs, runAruco);
+            timed(mirageMs, runMirage);
         }
     }
     const double n = double(state.iterations());
