@@ -69,10 +69,24 @@ GpuSpecularDraw specularDrawAt(samplerBuffer texels, int i) {
     return d;
 }
 
+// LRv.a of a pixel = its origin + kSeeThroughScale x the share of the footage behind it that a
+// translucent object lets through (direct.frag, composite.frag): below 0.5, so the origin still
+// rounds out of it.
+const float kSeeThroughScale = 0.45;
+
 // Paraboloid coordinates (unit disc) of unit direction w around a VPL's normal (z axis).
 vec2 paraboloidUv(GpuVpl V, vec3 w) {
     vec3 b = cross(V.normal, V.tangent);
     return vec2(dot(w, V.tangent), dot(w, b)) / (1.0 + dot(w, V.normal));
+}
+
+// Distance (m) of the nearest splatted point in direction puv (paraboloidUv) from VPL vplIndex
+// in an imperfect shadow map atlas, +inf if none.
+float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
+    int tile = ismTileSize, perRow = ismTilesPerRow;
+    ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
+    ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
+    return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
 }
 
 // glTF KHR_lights_punctual spot cone and range window (the spec's recommended falloff).

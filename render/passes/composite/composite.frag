@@ -4,7 +4,8 @@
 #include "passes/grain/footage_noise.glsl"
 // Differential rendering (Knecht 2013 Eqs. 1-2), one output pixel per camera pixel:
 //   real or empty pixel:  L_final = CI + alpha * (L_rv - L_r),  alpha = CI / L_r per channel
-//   virtual pixel:        L_final = L_rv
+//   virtual pixel:        L_final = L_rv (+ s CI on a translucent object: the share s of what
+//                         lies behind it that it lets through, from LRv.a; direct.frag)
 // CI is the camera frame, sRGB-encoded 8-bit, linearised by the sRGB texture format (the camera
 // response is taken to be the sRGB curve). L_* are scaled by `exposure` into camera units first.
 // Guard where L_r is near 0 (a black surface, or light only the virtual light reaches): alpha
@@ -175,7 +176,8 @@ void main() {
         vec3 rv = lrv.rgb, r = texelFetch(lR, cpi, 0).rgb;
 #else
         int origin = int(texelFetch(gPosition, cpi, 0).w + 0.5);
-        vec3 rv = MIRAGE_CANVAS_AT(lRv).rgb, r = MIRAGE_CANVAS_AT(lR).rgb;
+        vec4 lrv = MIRAGE_CANVAS_AT(lRv);
+        vec3 rv = lrv.rgb, r = MIRAGE_CANVAS_AT(lR).rgb;
 #endif
 #ifndef MIRAGE_NO_CAUSTICS  // the variant for frames without a caustic pass never reads them
         if (withCaustics != 0) {
@@ -195,9 +197,13 @@ void main() {
         } else
 #endif
         if (origin == ORIGIN_VIRTUAL) {
-            result = rv;
+            // Straight through a translucent object (no refraction at its boundary) the ray
+            // meets what this camera pixel shows. Bilinear reads blend the code with a
+            // neighbour's origin at the silhouette: clamped.
+            float seeThrough = clamp((lrv.a - float(ORIGIN_VIRTUAL)) / kSeeThroughScale, 0.0, 1.0);
+            footage = seeThrough * ci;
+            result = rv + footage;
             coverage = 1.0;
-            footage = vec3(0.0);
             layer = 1.0;
         } else {
             vec3 t = smoothstep(vec3(0.0), vec3(alphaFadeLr), r);

@@ -89,6 +89,7 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.readOptional(kShadowGlassReal);
     b.readOptional(kTranslucentGrid);  // none: no translucent object (or its pass off)
     b.readOptional(kTranslucentRadiance);
+    b.readOptional(kTranslucentLut);
     b.readOptional(kSpecularMask);  // none: no mirror or glass object in view
     b.readOptional(kGatherLight);   // none: no VPL light this frame
     b.create(kLRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
@@ -163,14 +164,19 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitDirectGlassReal,
                       res.textureOr(kShadowGlassReal, ctx.noGlassTexture()).id());
     glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment, res.buffer(kEnvironmentLight).id());
-    const bool translucent = res.has(kTranslucentGrid) && res.has(kTranslucentRadiance);
+    const bool translucent =
+        res.has(kTranslucentGrid) && res.has(kTranslucentRadiance) && res.has(kTranslucentLut);
     if (translucent) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentGrid,
                          res.buffer(kTranslucentGrid).id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentRadiance,
                          res.buffer(kTranslucentRadiance).id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTranslucentLut,
+                         res.buffer(kTranslucentLut).id());
     }
     glUniform1i(prog.uniformLocation("translucentOn"), translucent ? 1 : 0);
+    glUniform1i(prog.uniformLocation("translucentSeeThrough"),
+                translucent && ctx.options.translucency.seeThrough ? 1 : 0);
     if (indirect) {
         glBindTextureUnit(kUnitDirectGatherLight, res.texture(kGatherLight).id());
         glUniform1i(prog.uniformLocation("gatherScale"), ctx.gatherScale());

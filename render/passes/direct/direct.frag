@@ -26,6 +26,10 @@ layout(std430, binding = kBindingTranslucentRadiance) readonly buffer Translucen
     vec4 translucentL[];
 };
 uniform int translucentOn;  // 1: the translucency pass ran this frame
+// 1: a translucent pixel also shows what lies behind its object through the chord the camera ray
+// crosses (TranslucencyOptions::seeThrough): the share F_t^2 e^{-tau} of the footage behind,
+// passed to the composite in LRv.a (as VnmShading's renderVnm adds the background).
+uniform int translucentSeeThrough;
 // Variant MIRAGE_WITH_INDIRECT (frames with VPL light): the outputs are the GI solutions, direct
 // plus the filtered indirect light upsampled to the pixel (gi_upsample.glsl); MIRAGE_KEEP_DIRECT
 // also writes the direct light alone (RendererOptions::keepDirectLight).
@@ -40,14 +44,17 @@ layout(location = 3) out vec4 outDirectR;
 #endif
 
 // Direct, environment and emitted light at the G-buffer pixel px (surface point P.xyz, origin
-// real or virtual), both GI solutions.
-void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r) {
+// real or virtual), both GI solutions; seeThrough = the share of what lies behind it that the
+// pixel lets through (a translucent object's, else 0).
+void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r,
+                 out float seeThrough) {
     vec3 p = P.xyz;
     vec3 n = N.xyz;
     vec4 A = texelFetch(gAlbedo, px, 0);
     vec3 v = normalize(cameraPos.xyz - p);
     rv = vec3(0.0);
     r = vec3(0.0);
+    seeThrough = 0.0;
     vec4 Em = texelFetch(gEmissive, px, 0);
     // A translucent pixel (gEmissive.a = -1) takes the light scattered through its object (the
     // one whose map has the nearest surface voxel) to that surface voxel, times F_t towards the
@@ -76,6 +83,12 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r) 
         }
         rv *= Ft;
         r *= Ft;
+        if (translucentSeeThrough == 1) {
+            // The background through the chord, both boundaries' F_t taken at the entry's
+            // angle (the exit's normal is not at hand here).
+            float a = translucentChordTransmittance(object, voxel, p, -v);
+            seeThrough = Ft * Ft * a;
+        }
         rv += Em.rgb;
         if (pReal) r += Em.rgb;
         return;
@@ -160,16 +173,18 @@ void main() {
     vec4 P = texelFetch(gPosition, px, 0);
     int origin = int(P.w + 0.5);
     vec3 rv = vec3(0.0), r = vec3(0.0), iRv = vec3(0.0), iR = vec3(0.0);
+    float seeThrough = 0.0;
     if (origin != ORIGIN_NONE) {
         vec4 N = texelFetch(gNormal, px, 0);
-        directLight(px, P, N, origin == ORIGIN_REAL, rv, r);
+        directLight(px, P, N, origin == ORIGIN_REAL, rv, r, seeThrough);
         rv = allFinite(rv) ? rv : vec3(0.0);
         r = allFinite(r) ? r : vec3(0.0);
 #ifdef MIRAGE_WITH_INDIRECT
         upsampleIndirect(px, textureSize(gPosition, 0), P.xyz, N.xyz, iRv, iR);
 #endif
     }
-    outRv = vec4(rv + iRv, float(origin));  // a: the origin, for the composite's diffuse variant
+    // a: the origin, for the composite's diffuse variant, + the see-through share (common.glsl)
+    outRv = vec4(rv + iRv, float(origin) + kSeeThroughScale * seeThrough);
     outR = vec4(r + iR, 1.0);
 #ifdef MIRAGE_KEEP_DIRECT
     outDirectRv = vec4(rv, 1.0);

@@ -21,13 +21,6 @@ uniform ivec2 tileOrigin;  // where this group's tile starts in the target
 layout(location = 0) out vec4 outRv;
 layout(location = 1) out vec4 outR;
 
-// Distance (m) of the nearest splatted point in direction w from the VPL, +inf if none.
-float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
-    int tile = ismTileSize, perRow = ismTilesPerRow;
-    ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
-    ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
-    return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
-}
 
 void main() {
     int K = max(interleave, 1);

@@ -148,13 +148,6 @@ bool sameHit(vec3 stored, vec3 current, float pathLength) {
 }
 #endif
 
-float ismDistance(usampler2D atlas, int vplIndex, vec2 puv) {
-    int tile = ismTileSize, perRow = ismTilesPerRow;
-    ivec2 texel = clamp(ivec2((puv * 0.5 + 0.5) * float(tile)), ivec2(0), ivec2(tile - 1));
-    ivec2 origin = ivec2(vplIndex % perRow, vplIndex / perRow) * tile;
-    return uintBitsToFloat(texelFetch(atlas, origin + texel, 0).r);
-}
-
 // Outgoing radiance of hit point x towards the specular surface (unit v), both GI solutions:
 // lights, environment and emission in rv / r; the irradiance (W/m^2) from the interleaved VPL
 // subset (x stride) in vplRv / vplR, which the caller turns into radiance (x albedo (1 -

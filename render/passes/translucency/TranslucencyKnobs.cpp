@@ -39,6 +39,10 @@ std::vector<PassKnob> translucencyKnobs() {
             "surface voxels within 1.5 voxels blended) or nearest (the nearest voxel alone)",
             [](RendererOptions& o) -> bool& { return o.translucency.smoothLookup; }, "smooth",
             "nearest", {"smooth"}),
+        onOffKnob("vnm_see_through",
+                  "on: a translucent pixel shows the footage behind its object through the chord "
+                  "the camera ray crosses (e^{-tau} from the voxel number map); off: it is opaque",
+                  [](RendererOptions& o) -> bool& { return o.translucency.seeThrough; }, {"on"}),
     };
     return k;
 }

@@ -32,6 +32,12 @@ struct TranslucencyOptions {
     bool meshSurface = false;
     bool smoothLookup = true;
     bool measuredAlbedo = false;
+    // A translucent pixel also lets through what lies behind its object along the camera ray:
+    // the chord's e^{-tau} (from the voxel number map's LUT) times F_t at both boundaries, of the
+    // footage at that pixel (the boundary does not bend the ray), beside its scattered light, as
+    // renderVnm adds the background (docs/translucency.md "See-through"). false: every
+    // translucent pixel is opaque (its scattered light only).
+    bool seeThrough = true;
 
     void validate() const {
         checkOption(vnmResolution >= 2 && vnmResolution <= 512, "translucency.vnmResolution",

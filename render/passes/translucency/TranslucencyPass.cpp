@@ -21,7 +21,8 @@ namespace {
 struct ObjectHeader {
     glm::vec4 gridOrigin;    // world corner of cell (0,0,0), voxel edge (m)
     glm::ivec4 gridDims;     // cells per axis, S
-    glm::vec4 params;        // ior, F_t over the cosine-weighted hemisphere, smooth lookup 1/0, 0
+    glm::vec4 params;        // ior, F_t over the cosine-weighted hemisphere, smooth lookup 1/0,
+                             // mean extinction at the surface voxels (1/m)
     glm::ivec4 offsets;      // first cell number, first surface voxel, first LUT entry, 0
     glm::vec4 albedoOverPi;  // a_eff / pi, 0
     glm::vec4 falloff;       // k of the kernel e^{-k tau} per channel, 0
@@ -77,9 +78,14 @@ TranslucencyPass::TranslucencyPass(const Scene& scene, const GpuScene& gpu,
         ObjectHeader h{};
         h.gridOrigin = glm::vec4(map.origin(), map.voxelSize());
         h.gridDims = glm::ivec4(map.dims(), int(S));
+        // The mean extinction at the surface voxels' centres: a chord too short to meet a
+        // second surface voxel crosses the medium there (translucency.glsl).
+        double surfaceSigma = 0;
+        for (const auto& v : sv) surfaceSigma += object.medium.sigmaT(v.position);
         h.params = glm::vec4(object.medium.ior,
                              translucency::hemisphericalTransmittance(object.medium.ior),
-                             options.translucency.smoothLookup ? 1.0f : 0.0f, 0);
+                             options.translucency.smoothLookup ? 1.0f : 0.0f,
+                             S ? float(surfaceSigma / double(S)) : 0.0f);
         h.offsets = glm::ivec4(int(numbers.size()), surfaceVoxels_, int(lut.size()), 0);
         h.albedoOverPi = glm::vec4(translucency::VnmShading::radianceScale(
                                        map, object.medium, options.translucency.measuredAlbedo),
@@ -128,6 +134,7 @@ void TranslucencyPass::setup(PassBuilder& b) const {
     b.readOptional(kShadowGlassReal);
     b.createBuffer(kTranslucentGrid, SizeRule::Scene, true);
     b.createBuffer(kTranslucentRadiance, SizeRule::Scene);
+    b.createBuffer(kTranslucentLut, SizeRule::Scene, true);
 }
 
 PassDecision TranslucencyPass::decide(const FrameContext& ctx) const {
@@ -178,6 +185,7 @@ void TranslucencyPass::execute(FrameContext& ctx, PassResources& res) {
     }
     res.publish(kTranslucentGrid, grid_);
     res.publish(kTranslucentRadiance, radiance_);
+    res.publish(kTranslucentLut, lut_);
     doneKey_ = inputKey(ctx);
 }
 

@@ -23,6 +23,9 @@ namespace mirage::render {
 // L_rv then S vec4 for L_r.
 inline constexpr Resource kTranslucentGrid{"TranslucentGrid"};
 inline constexpr Resource kTranslucentRadiance{"TranslucentRadiance"};
+// The optical thickness between every two surface voxels of each object (half floats; persistent,
+// uploaded once): the chord a camera ray crosses (direct.frag's see-through).
+inline constexpr Resource kTranslucentLut{"TranslucentLut"};
 
 class TranslucencyPass final : public RenderPass {
 public:

@@ -25,7 +25,6 @@ struct TranslucentVoxel {
 layout(std430, binding = kBindingTranslucentVoxels) readonly buffer Voxels {
     TranslucentVoxel voxels[];
 };
-layout(std430, binding = kBindingTranslucentLut) readonly buffer Lut { uint tauHalf[]; };
 layout(std430, binding = kBindingTranslucentIrradiance) buffer Irradiance { vec4 E[]; };
 layout(std430, binding = kBindingTranslucentRadiance) writeonly buffer Radiance { vec4 L[]; };
 layout(binding = kUnitTranslucencyShadowAll) uniform sampler2DArray shadowAll;
@@ -36,13 +35,6 @@ layout(binding = kUnitTranslucencyGlassReal) uniform sampler2DArray glassReal;
 #endif
 uniform int stage;
 uniform int objectIndex;
-
-// tau between the object's surface voxels i and o (local numbers); lutFirst = its first entry.
-float tau(int i, int o, int S, int lutFirst) {
-    uint k = uint(lutFirst) + uint(i) * uint(S) + uint(o);
-    vec2 h = unpackHalf2x16(tauHalf[k >> 1u]);
-    return (k & 1u) == 0u ? h.x : h.y;
-}
 
 // Surface voxel i of the object (local number); v0 = its first voxel in the buffers.
 void irradiance(int i, int S, int v0, TranslucentObjectGpu obj) {
@@ -92,7 +84,7 @@ void scatter(int o, int S, int v0, TranslucentObjectGpu obj) {
     for (int i = 0; i < S; ++i) {
         vec3 w = voxels[v0 + i].weight.rgb;
         if (w == vec3(0.0)) continue;
-        vec3 k = w * exp(-falloff * tau(i, o, S, lutFirst));
+        vec3 k = w * exp(-falloff * translucentTau(i, o, S, lutFirst));
         if (distance(voxels[v0 + i].position.xyz, po) <= reach) {
             nearRv += E[2 * v0 + i].rgb * k;
             nearR += E[2 * v0 + S + i].rgb * k;

@@ -10,7 +10,8 @@ const int kMaxTranslucentObjects = 8;
 // One object's map: gridOrigin.xyz = world corner of its cell (0,0,0), .w = voxel edge (m);
 // gridDims.xyz = cells per axis, .w = S (its surface voxels); params.x = the medium's index of
 // refraction, .y = F_t averaged over the cosine-weighted hemisphere, .z = 1 for the smooth
-// lookup (translucentWeights), 0 for the nearest voxel alone; offsets.x = its first cell
+// lookup (translucentWeights), 0 for the nearest voxel alone, .w = the mean extinction (1/m) at
+// its surface voxels' centres; offsets.x = its first cell
 // in gridNumber, .y = its first surface voxel in the voxel, irradiance and radiance buffers
 // (which hold 2 entries per voxel: an object's S for L_rv, then its S for L_r, from 2 * .y on),
 // .z = its first entry in the tau LUT; albedoOverPi.rgb = VnmShading::radianceScale (the measured
@@ -30,6 +31,19 @@ layout(std430, binding = kBindingTranslucentGrid) readonly buffer TranslucentGri
     TranslucentObjectGpu translucentObjects[kMaxTranslucentObjects];
     int gridNumber[];
 };
+
+// The optical thickness between every two surface voxels of each object, S x S half floats two per
+// uint from the object's offsets.z on (VoxelNumberMap::tauHalf).
+layout(std430, binding = kBindingTranslucentLut) readonly buffer TranslucentLutBlock {
+    uint tauHalf[];
+};
+
+// tau between surface voxels i and o of an object (local numbers; lutFirst = its offsets.z).
+float translucentTau(int i, int o, int S, int lutFirst) {
+    uint k = uint(lutFirst) + uint(i) * uint(S) + uint(o);
+    vec2 h = unpackHalf2x16(tauHalf[k >> 1u]);
+    return (k & 1u) == 0u ? h.x : h.y;
+}
 
 // F_t = 1 - Fresnel reflectance of a smooth dielectric boundary of index ior at |cos| = c
 // (render/raytrace/Bsdf.cpp fresnelDielectric, seen from outside).
@@ -108,6 +122,80 @@ int translucentWeights(int k, vec3 p, out int voxel[27], out float weight[27]) {
             }
     for (int j = 0; j < count; ++j) weight[j] /= sum;
     return count;
+}
+
+// Where a ray from grid point g (grid units) along unit direction dir leaves the last surface voxel
+// of object o it meets before it leaves the grid (a 3D DDA over the cells; grid units along dir
+// from g, 0 if it meets none), and that voxel (-1 if none) and its cell.
+float translucentLastSurfaceVoxel(TranslucentObjectGpu o, vec3 g, vec3 dir, out int voxel,
+                                  out ivec3 cell) {
+    ivec3 dims = o.gridDims.xyz;
+    ivec3 c = ivec3(floor(g));
+    ivec3 stepDir = ivec3(sign(dir));
+    vec3 inv = 1.0 / max(abs(dir), vec3(1e-9));
+    vec3 next = (vec3(c) + max(vec3(stepDir), vec3(0.0)) - g) / vec3(dir + vec3(1e-12));
+    vec3 tMax = mix(vec3(1e30), abs(next), vec3(notEqual(stepDir, ivec3(0))));
+    voxel = -1;
+    cell = c;
+    float tLeave = 0.0;
+    if (all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, dims))) {
+        voxel = gridNumber[o.offsets.x + (c.z * dims.y + c.y) * dims.x + c.x];
+        if (voxel >= 0) tLeave = min(tMax.x, min(tMax.y, tMax.z));
+    }
+    int steps = dims.x + dims.y + dims.z + 3;
+    for (int s = 0; s < steps; ++s) {
+        if (tMax.x <= tMax.y && tMax.x <= tMax.z) {
+            c.x += stepDir.x;
+            tMax.x += inv.x;
+        } else if (tMax.y <= tMax.z) {
+            c.y += stepDir.y;
+            tMax.y += inv.y;
+        } else {
+            c.z += stepDir.z;
+            tMax.z += inv.z;
+        }
+        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, dims))) break;
+        int n = gridNumber[o.offsets.x + (c.z * dims.y + c.y) * dims.x + c.x];
+        if (n >= 0) {
+            voxel = n;
+            cell = c;
+            tLeave = min(tMax.x, min(tMax.y, tMax.z));
+        }
+    }
+    return tLeave;
+}
+
+// e^{-tau} of the chord the camera ray (unit direction dir) crosses through object k from its
+// surface voxel `entry` at p (on the surface). The chord ends half a voxel before the far side
+// of the last surface voxel the ray meets (surface voxels' centres lie inside the surface),
+// averaged over the ray and four parallel rays half a voxel beside it (one ray alone steps with
+// the voxels' staircase). Its extinction is the LUT's tau from the entry voxel to that last one
+// over the distance from p to its centre (the mean along the way: cavities and the air of
+// concave parts count as nothing), or the object's mean extinction at its surface voxels
+// (params.w) when the ray meets no other surface voxel (near the silhouette).
+float translucentChordTransmittance(int k, int entry, vec3 p, vec3 dir) {
+    TranslucentObjectGpu o = translucentObjects[k];
+    vec3 g = (p - o.gridOrigin.xyz) / o.gridOrigin.w;  // grid units
+    int exitVoxel;
+    ivec3 exitCell;
+    float tLeave = translucentLastSurfaceVoxel(o, g, dir, exitVoxel, exitCell);
+    float sigma = o.params.w;
+    if (exitVoxel >= 0 && exitVoxel != entry) {
+        vec3 centre = o.gridOrigin.xyz + (vec3(exitCell) + 0.5) * o.gridOrigin.w;
+        sigma = translucentTau(entry, exitVoxel, o.gridDims.w, o.offsets.z) /
+                max(distance(centre, p), 0.5 * o.gridOrigin.w);
+    }
+    vec3 u = normalize(cross(dir, abs(dir.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
+    vec3 w = cross(dir, u);
+    const vec2 kBeside[4] = vec2[4](vec2(0.5, 0.0), vec2(-0.5, 0.0), vec2(0.0, 0.5), vec2(0.0, -0.5));
+    float sum = exp(-sigma * max(tLeave - 0.5, 0.0) * o.gridOrigin.w);
+    for (int j = 0; j < 4; ++j) {
+        int v;
+        ivec3 cl;
+        float t = translucentLastSurfaceVoxel(o, g + kBeside[j].x * u + kBeside[j].y * w, dir, v, cl);
+        sum += exp(-sigma * max(t - 0.5, 0.0) * o.gridOrigin.w);
+    }
+    return sum / 5.0;
 }
 
 // The translucent object and surface voxel standing for world point p: the object whose map has
