@@ -165,6 +165,9 @@ float translucentLastSurfaceVoxel(TranslucentObjectGpu o, vec3 g, vec3 dir, out 
     return tLeave;
 }
 
+// How far (voxel edges) before the ray leaves the last surface voxel the chord ends (below).
+const float kChordEndVoxels = 0.5;
+
 // e^{-tau} of the chord the camera ray (unit direction dir) crosses through object k from its
 // surface voxel `entry` at p (on the surface). The chord ends half a voxel before the far side
 // of the last surface voxel the ray meets (surface voxels' centres lie inside the surface),
@@ -188,12 +191,12 @@ float translucentChordTransmittance(int k, int entry, vec3 p, vec3 dir) {
     vec3 u = normalize(cross(dir, abs(dir.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)));
     vec3 w = cross(dir, u);
     const vec2 kBeside[4] = vec2[4](vec2(0.5, 0.0), vec2(-0.5, 0.0), vec2(0.0, 0.5), vec2(0.0, -0.5));
-    float sum = exp(-sigma * max(tLeave - 0.5, 0.0) * o.gridOrigin.w);
+    float sum = exp(-sigma * max(tLeave - kChordEndVoxels, 0.0) * o.gridOrigin.w);
     for (int j = 0; j < 4; ++j) {
         int v;
         ivec3 cl;
         float t = translucentLastSurfaceVoxel(o, g + kBeside[j].x * u + kBeside[j].y * w, dir, v, cl);
-        sum += exp(-sigma * max(t - 0.5, 0.0) * o.gridOrigin.w);
+        sum += exp(-sigma * max(t - kChordEndVoxels, 0.0) * o.gridOrigin.w);
     }
     return sum / 5.0;
 }
