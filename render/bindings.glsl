@@ -189,6 +189,7 @@ const int kUnitCompositeFuzzyR = 19;
 const int kUnitCompositeFuzzyRRefl = 20;
 const int kUnitCompositeFuzzyLenv = 21;
 const int kUnitCompositeFuzzyVideo = 22;
+const int kUnitCompositeNormal = 23;  // the G-buffer normal (translucent pixels' reflection)
 
 // passes/exposure: exposure_samples.frag
 const int kUnitExposureCamera = 0;  // the camera frame (sRGB8, sampled linear)

@@ -1,13 +1,21 @@
-// A translucent object lets through what lies behind it (docs/translucency.md "See-through"),
-// against the Embree reference: an optically thin virtual cube (tau 1.5 across, turned 15 degrees
+// A translucent object's boundary against the Embree reference: what it lets through and what it
+// reflects (docs/translucency.md "See-through", "Reflection").
+//
+// See-through: an optically thin virtual cube (tau 1.5 across, turned 15 degrees
 // about +Y) in front of a real red wall, both lit by a real point light in front, composited into
 // the reference's footage of the real scene. Compared over the cube's pixels: with the see-through
 // the wall shows through the chord each camera ray crosses; without it (every translucent pixel
 // opaque, its scattered light only) the cube misses the floor. A thick cube (tau 28 across) lets
 // through only the short chords at its silhouette: inside them the two must agree, and over the
 // whole cube the see-through must not be worse.
+//
+// Reflection: a thick, dark cube (tau 28 across, albedo 0.3, IOR 1.5) on a lit real floor, seen
+// from low and to the side, so that two of its faces are seen at 55-70 degrees and mirror the
+// floor and the wall. Without the reflection those faces are their scattered light only, darker
+// than the reference.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -32,14 +40,22 @@ namespace fs = std::filesystem;
 class TranslucentSeeThrough : public test::HeadlessGlSuite {};
 
 // Measured on llvmpipe, 64 x 64 pixels, 16 voxels per side, the reference at 48 spp (seed 5),
-// 2026-12-05: the thin cube 23.1 dB with the see-through, 19.0 dB without; the thick cube 23.1
-// against 22.5 dB (its silhouette), its pixels 3 or more inside the silhouette within 0.1 codes.
+// 2026-12-06 (with the boundary's reflection): the thin cube 23.4 dB with the see-through, 19.3 dB
+// without; the thick cube 23.4 against 22.8 dB (its silhouette), its pixels 3 or more inside the
+// silhouette within 0.1 codes. The dark cube's 4 x 4 block means: 25.4 dB with the reflection,
+// 24.4 dB without.
 constexpr double kThinFloorDb = 21.0;
 constexpr double kThickInsideCodes = 1.0;  // mean |on - off| inside the thick cube, 8-bit codes
+constexpr double kReflectionFloorDb = 24.9;
 
 raytrace::RenderCamera cubeCamera() {
     // Focal length 120 px: the cube spans about 40 of the 64 pixels, the wall the rest.
     return lookAtCamera(64, 64, 120.0, {0.35, 0.3, 1.4}, {0, 0, 0});
+}
+
+raytrace::RenderCamera grazingCamera() {
+    // Above and to the right: the side faces at 55-70 degrees mirror the floor beside the cube.
+    return lookAtCamera(64, 64, 90.0, {0.95, 0.8, 0.75}, {0, -0.1, 0});
 }
 
 Scene seeThroughScene(float extinction, const fs::path& dir) {
@@ -55,28 +71,53 @@ Scene seeThroughScene(float extinction, const fs::path& dir) {
     return s;
 }
 
+Scene reflectionScene(const fs::path& dir) {
+    TranslucentSceneOptions o;
+    o.extinction = 56.0f;
+    o.albedo = {0.3f, 0.3f, 0.3f};
+    o.ior = 1.5f;
+    o.lightPosition = {0.2f, 1.2f, 1.0f};  // above, in front
+    o.lightIntensity = 4.0f;
+    o.environment = 0.15f;
+    o.yawDegrees = 15.0f;
+    Scene s = translucentTestScene(o, dir);
+    // The base colour carries the VPLs' indirect light into a translucent pixel: dark, as the
+    // medium that scatters little.
+    s.materials[0].baseColor = glm::vec4(0.05f, 0.05f, 0.05f, 1.0f);
+    addObject(s, "wall", boxPrimitive({-2.0f, -0.29f, -0.84f}, {2.0f, 2.0f, -0.8f}),
+              lambert({0.8f, 0.25f, 0.2f}), glm::dmat4(1.0), Origin::Real);
+    addObject(s, "floor", boxPrimitive({-2.0f, -0.29f, -0.8f}, {2.0f, -0.25f, 2.0f}),
+              lambert({0.7f, 0.7f, 0.6f}), glm::dmat4(1.0), Origin::Real);
+    return s;
+}
+
 struct Composite {
     cv::Mat srgb;  // CV_8UC3 BGR
     cv::Mat cube;  // CV_8U: pixels whose first hit is the cube
 };
 
-Composite renderRealtime(const Scene& scene, const cv::Mat& footage, bool seeThrough) {
-    const raytrace::RenderCamera cam = cubeCamera();
+Composite renderRealtime(const Scene& scene, const raytrace::RenderCamera& cam,
+                         const cv::Mat& footage, const TranslucencyOptions& translucency) {
     RendererOptions opt;
+    opt.translucency = translucency;
     opt.translucency.vnmResolution = 16;
-    opt.translucency.seeThrough = seeThrough;
     Renderer r(scene, cam.intrinsics, opt);
     const FrameReport& rep = r.render({cam.T_world_camera, footage, true});
     EXPECT_TRUE(rep.ran("translucency")) << rep.summary();
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
     Composite c;
     c.srgb = r.compositeSrgb();
+    // The cube's pixels: G-buffer positions inside the cube (turned 15 degrees about +Y).
     const cv::Mat position = r.readBuffer(kGBufferPosition);
+    const glm::dmat4 fromWorld =
+        glm::rotate(glm::dmat4(1.0), glm::radians(-15.0), glm::dvec3(0, 1, 0));
     c.cube = cv::Mat(position.size(), CV_8U, cv::Scalar(0));
     for (int y = 0; y < position.rows; ++y)
         for (int x = 0; x < position.cols; ++x) {
-            const cv::Vec3f p = position.at<cv::Vec3f>(y, x);
-            if (cv::norm(p) > 0.0 && cv::norm(p) < 0.5) c.cube.at<uint8_t>(y, x) = 255;
+            const cv::Vec3f w = position.at<cv::Vec3f>(y, x);
+            const glm::dvec3 q = glm::dvec3(fromWorld * glm::dvec4(w[0], w[1], w[2], 1.0));
+            const double inside = std::max({std::abs(q.x), std::abs(q.y), std::abs(q.z)});
+            if (cv::norm(w) > 0.0 && inside < 0.252) c.cube.at<uint8_t>(y, x) = 255;
         }
     return c;
 }
@@ -92,8 +133,10 @@ Judged judge(float extinction, const std::string& name) {
     const raytrace::RenderCamera cam = cubeCamera();
     const test::ReferenceFrame ref =
         test::renderReferenceFrame(scene, cam.intrinsics, cam.T_world_camera, 48, 5, false);
-    const Composite on = renderRealtime(scene, ref.footage, true);
-    const Composite off = renderRealtime(scene, ref.footage, false);
+    TranslucencyOptions withSeeThrough, opaque;
+    opaque.seeThrough = false;
+    const Composite on = renderRealtime(scene, cam, ref.footage, withSeeThrough);
+    const Composite off = renderRealtime(scene, cam, ref.footage, opaque);
     EXPECT_GT(cv::countNonZero(on.cube), 600) << name;
     Judged j{test::psnr(on.srgb, ref.composite, 255.0, on.cube),
              test::psnr(off.srgb, ref.composite, 255.0, on.cube), 0.0};
@@ -130,6 +173,44 @@ TEST_F(TranslucentSeeThrough, ThickCubeLetsThroughOnlyAtItsSilhouette) {
     EXPECT_LT(thick.insideCodes, kThickInsideCodes);
     const Judged& thin = thinCube();
     EXPECT_GT(thin.insideCodes, 10 * kThickInsideCodes) << "the check can fail: a thin cube";
+}
+
+TEST_F(TranslucentSeeThrough, GrazingFacesReflectTheFloorLikeTheReference) {
+    const fs::path dir = mirage::test::outputDir("translucent_reflection");
+    const Scene scene = reflectionScene(dir);
+    const raytrace::RenderCamera cam = grazingCamera();
+    const test::ReferenceFrame ref =
+        test::renderReferenceFrame(scene, cam.intrinsics, cam.T_world_camera, 48, 5, false);
+    TranslucencyOptions reflecting, matte;
+    matte.surfaceReflection = false;
+    const Composite on = renderRealtime(scene, cam, ref.footage, reflecting);
+    const Composite off = renderRealtime(scene, cam, ref.footage, matte);
+    ASSERT_GT(cv::countNonZero(on.cube), 600);
+    // Judged on 4 x 4 block means (blocks wholly on the cube): the reference's noise (a dark
+    // medium at 48 spp) averaged out, the faces' levels kept.
+    auto blocks = [](const cv::Mat& m) {
+        cv::Mat f, out;
+        m.convertTo(f, CV_32F);
+        cv::resize(f, out, {}, 0.25, 0.25, cv::INTER_AREA);
+        return out;
+    };
+    cv::Mat blockMask;
+    cv::resize(on.cube, blockMask, {}, 0.25, 0.25, cv::INTER_AREA);
+    blockMask = blockMask > 254;
+    const double psnrOn = test::psnr(blocks(on.srgb), blocks(ref.composite), 255.0, blockMask);
+    const double psnrOff = test::psnr(blocks(off.srgb), blocks(ref.composite), 255.0, blockMask);
+    const cv::Scalar meanRef = cv::mean(ref.composite, on.cube),
+                     meanOn = cv::mean(on.srgb, on.cube), meanOff = cv::mean(off.srgb, on.cube);
+    std::cout << "[ reflection ] " << cv::countNonZero(blockMask) << " blocks; PSNR over them "
+              << psnrOn << " dB with the reflection, " << psnrOff
+              << " dB without; mean code (B G R) reference " << meanRef << ", with " << meanOn
+              << ", without " << meanOff << "\n";
+    cv::Mat row;
+    cv::hconcat(std::vector<cv::Mat>{ref.footage, ref.composite, on.srgb, off.srgb}, row);
+    cv::resize(row, row, {}, 4, 4, cv::INTER_NEAREST);
+    writeBgr8(dir / "footage_reference_on_off.png", row);
+    EXPECT_GT(psnrOn, kReflectionFloorDb);
+    EXPECT_LT(psnrOff, kReflectionFloorDb) << "the must-fail: no reflection";
 }
 
 }  // namespace

@@ -9,8 +9,9 @@
 // refinement, one thread) and the tracker again, alternately on the same view, and gives their
 // ratio (the speedup; docs/tracking.md, "Single frames against ArUco, paired").
 //
-//   tracking_single_stages [--width 640|1280] [--reps N] [--no-coarse-first]
+//   tracking_single_stages [--width 640|1280] [--reps N] [--view V] [--no-coarse-first]
 //                          [--no-full-resolution-fallback] [--coarse-refine-edges]
+// --view V measures view V alone (to profile one slow view with perf).
 // The path says where adaptive detection added tags: "+ full res F/S" = libapriltag at full
 // resolution found F of the S missed board tags (S = 0: the whole region searched, no pose to
 // predict them), "+ finder N" = the finder found N where the frame's settled pose put them.
@@ -43,13 +44,15 @@ double cpuMs() {
 
 int main(int argc, char** argv) {
     using namespace mirage::tracking;
-    int width = 640, reps = 20;
+    int width = 640, reps = 20, onlyView = -1;
     bool coarseFirst = true, fullResolutionFallback = true, coarseRefineEdges = false;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--width") && i + 1 < argc)
             width = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc)
             reps = std::max(1, std::atoi(argv[++i]));
+        else if (!std::strcmp(argv[i], "--view") && i + 1 < argc)
+            onlyView = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--no-coarse-first"))
             coarseFirst = false;
         else if (!std::strcmp(argv[i], "--no-full-resolution-fallback"))
@@ -58,7 +61,7 @@ int main(int argc, char** argv) {
             coarseRefineEdges = true;
         else {
             std::fprintf(stderr,
-                         "usage: %s [--width 640|1280] [--reps N] [--no-coarse-first] "
+                         "usage: %s [--width 640|1280] [--reps N] [--view V] [--no-coarse-first] "
                          "[--no-full-resolution-fallback] [--coarse-refine-edges]\n",
                          argv[0]);
             return 2;
@@ -90,6 +93,7 @@ int main(int argc, char** argv) {
         "detect / pose / features wall ms | side est px | ArUco / mirage CPU ms, alternating = "
         "speedup\n");
     for (size_t v = 0; v < f.images.size(); ++v) {
+        if (onlyView >= 0 && int(v) != onlyView) continue;
         const cv::Mat& grey = f.images[v];
         TrackedFrame r;
         double c0 = cpuMs();
@@ -175,7 +179,7 @@ int main(int argc, char** argv) {
         sumPose += poseMs;
         sumApril += aprilMs;
     }
-    const double n = double(f.images.size());
+    const double n = onlyView >= 0 ? 1.0 : double(f.images.size());
     std::printf("mean | %.2f | | | | %.3f | %.3f | %.2f | | | %.2f / %.2f = %.2f\n", sumFrame / n,
                 sumRefine / n, sumPose / n, sumApril / n, sumAruco / n, sumMirageAgain / n,
                 sumAruco / sumMirageAgain);

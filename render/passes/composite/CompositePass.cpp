@@ -13,6 +13,7 @@
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/specular/SpecularGBufferPass.h"
 #include "render/passes/specular/SpecularLightPass.h"
+#include "render/passes/translucency/TranslucencyPass.h"
 
 namespace mirage::render {
 namespace {
@@ -45,6 +46,9 @@ void CompositePass::buildPrograms(bool identityRemap) {
     locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
     locDenoiseFootage_ = program_.uniformLocation("denoiseFootage");
     locNoiseVariance_ = program_.uniformLocation("noiseVariance");
+    const gl::Program* variants[3] = {&program_, &programDiffuse_, &programDiffuseNoCaustics_};
+    for (int i = 0; i < 3; ++i)
+        locTranslucentReflection_[i] = variants[i]->uniformLocation("translucentReflection");
     identityRemap_ = identityRemap;
     programsBuilt_ = true;
 }
@@ -69,6 +73,9 @@ void CompositePass::setup(PassBuilder& b) const {
     b.read(kLRv);
     b.read(kLR);
     for (Resource r : {kCausticRv, kCausticR, kGBufferPosition}) b.readOptional(r);
+    // Translucent pixels' reflection (the mirror ray marched over the G-buffer): its normals
+    // and the IOR the emissive buffer's alpha holds.
+    for (Resource r : {kGBufferNormal, kTranslucentRadiance}) b.readOptional(r);
     // Mirror / glass pixels (Eqs. 6-11): only when the specular passes ran.
     for (Resource r :
          {kGBufferEmissive, kReflectionGBuffer, kRefractionGBuffer, kReflectionWeight,
@@ -190,15 +197,23 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // caustic pass the variant that never reads the caustic buffers: reading the black stand-in
     // costs as much as a real buffer on llvmpipe, even behind a uniform branch.
     const int withCaustics = res.has(kCausticRv) ? 1 : 0;
+    // A translucent object's boundary reflects (the translucency pass ran: the scene has one).
+    const int translucentReflection = ctx.options.translucency.surfaceReflection &&
+                                              res.has(kTranslucentRadiance) &&
+                                              res.has(kGBufferNormal)
+                                          ? 1
+                                          : 0;
     if (withCaustics) {
         ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
         glUniform1i(locShowVirtualDiffuse_, ctx.options.composite.showVirtual ? 1 : 0);
         glUniform1i(locWithCausticsDiffuse_, 1);
+        glUniform1i(locTranslucentReflection_[1], translucentReflection);
     } else {
         ctx.beginFullscreen(programDiffuseNoCaustics_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
         glUniform1i(locShowVirtualNoCaustics_, ctx.options.composite.showVirtual ? 1 : 0);
+        glUniform1i(locTranslucentReflection_[2], translucentReflection);
     }
     glBindTextureUnit(kUnitCompositeCamera, res.texture(kCameraImage).id());
     glBindTextureUnit(kUnitCompositeLRv, res.texture(kLRv).id());
@@ -208,8 +223,12 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitCompositePosition,
                       res.textureOr(kGBufferPosition, ctx.blackTexture()).id());
     glBindTextureUnit(kUnitCompositeRemap, remap_.id());
-    if (specular) {
+    glBindTextureUnit(kUnitCompositeNormal, res.textureOr(kGBufferNormal, ctx.blackTexture()).id());
+    if (specular || translucentReflection) {
         glBindTextureUnit(kUnitCompositeEmissive, res.texture(kGBufferEmissive).id());
+        glBindTextureUnit(kUnitCompositeCanvasToCamera, canvasToCamera_.id());
+    }
+    if (specular) {
         glBindTextureUnit(kUnitCompositeReflPosition, res.texture(kReflectionGBuffer).id());
         glBindTextureUnit(kUnitCompositeRefrPosition, res.texture(kRefractionGBuffer).id());
         glBindTextureUnit(kUnitCompositeReflWeight, res.texture(kReflectionWeight).id());
@@ -222,7 +241,9 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glBindTextureUnit(kUnitCompositeCanvasToCamera, canvasToCamera_.id());
     } else {
         for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
-            glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
+            if (!translucentReflection ||
+                (u != kUnitCompositeEmissive && u != kUnitCompositeCanvasToCamera))
+                glBindTextureUnit(GLuint(u), ctx.blackTexture().id());
     }
     if (!rects.empty() && !ctx.options.direct.onSpecularPixels) {
         glEnable(GL_DEPTH_TEST);
@@ -238,6 +259,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locEpsilon_, ctx.options.specular.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
+        glUniform1i(locTranslucentReflection_[0], translucentReflection);
         // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
         // the newest versions, as the sharp units.
         const bool fuzzy = res.has(kFilteredVideo);

@@ -47,6 +47,8 @@ private:
     GLint locDenoiseFootage_ = -1, locNoiseVariance_ = -1;    // of program_ (footage_noise.glsl)
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
     GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
+    // "translucentReflection" of program_, programDiffuse_, programDiffuseNoCaustics_.
+    GLint locTranslucentReflection_[3] = {-1, -1, -1};
     gl::Framebuffer fbo_;
     // composite_mask.frag: depth 0 on the camera pixels that see a mirror or glass pixel, 1
     // elsewhere; fbo_'s depth attachment, so the full variant shades only those pixels.

@@ -5,7 +5,8 @@
 // Differential rendering (Knecht 2013 Eqs. 1-2), one output pixel per camera pixel:
 //   real or empty pixel:  L_final = CI + alpha * (L_rv - L_r),  alpha = CI / L_r per channel
 //   virtual pixel:        L_final = L_rv (+ s CI on a translucent object: the share s of what
-//                         lies behind it that it lets through, from LRv.a; direct.frag)
+//                         lies behind it that it lets through, from LRv.a; direct.frag; + its
+//                         boundary's reflection, translucentReflection below)
 // CI is the camera frame, sRGB-encoded 8-bit, linearised by the sRGB texture format (the camera
 // response is taken to be the sRGB curve). L_* are scaled by `exposure` into camera units first.
 // Guard where L_r is near 0 (a black surface, or light only the virtual light reaches): alpha
@@ -61,6 +62,10 @@ layout(binding = kUnitCompositeFuzzyR) uniform sampler2D fuzzyR;    // filtered 
 layout(binding = kUnitCompositeFuzzyRRefl) uniform sampler2D fuzzyRRefl;
 layout(binding = kUnitCompositeFuzzyLenv) uniform sampler2D fuzzyLenv;
 layout(binding = kUnitCompositeFuzzyVideo) uniform sampler2D fuzzyVideo;  // rgb camera units, a = 1: fuzzy pixel
+layout(binding = kUnitCompositeNormal) uniform sampler2D gNormal;  // canvas, xyz facing the camera
+// 1: a translucent object's boundary reflects (TranslucencyOptions::surfaceReflection); reads
+// gPosition, gNormal, gEmissive and canvasToCamera.
+uniform int translucentReflection;
 uniform int fuzzyOn;         // 1 when the fuzzy pass ran this frame
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
@@ -77,13 +82,96 @@ layout(location = 1) out vec4 outSrgb;    // written through GL_FRAMEBUFFER_SRGB
 // Attached only while the motion blur is on.
 layout(location = 2) out vec4 outFootage;
 
-#ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 // alpha for L = CI + alpha dL, guarded where the rendered real radiance is near 0.
 vec3 guardedAlpha(vec3 ci, vec3 r) {
     vec3 t = smoothstep(vec3(0.0), vec3(alphaFadeLr), r);
     vec3 ratio = min(ci / max(r, vec3(1e-6)), vec3(alphaMax));
     return mix(vec3(1.0), ratio, t);
 }
+
+// The camera-image pixel that shows canvas pixel c (the lens map), false outside the image.
+bool cameraPixelOfCanvas(ivec2 c, out ivec2 camPx) {
+#ifdef MIRAGE_IDENTITY_REMAP
+    vec2 q = vec2(c);
+#else
+    vec2 q = texture(canvasToCamera, (vec2(c) + 0.5) * canvas.zw).xy;
+#endif
+    ivec2 size = textureSize(cameraImage, 0);
+    camPx = ivec2(floor(q + 0.5));
+    return q.x > -0.5 && q.y > -0.5 && q.x < float(size.x) - 0.5 && q.y < float(size.y) - 0.5;
+}
+
+// The mirror reflection on a translucent object's boundary at canvas pixel cpi (gEmissive.a =
+// -IOR): the share F_r = 1 - F_t (Fresnel, the smooth boundary the reference has) of the light
+// arriving along the mirror ray r. What r meets is found by marching it over the G-buffer's
+// nearest surfaces (screen space: the ray is taken to meet a surface where it passes behind it
+// by less than the step; bisection then refines the point). A real surface gives what its pixel
+// composites to (its footage plus alpha (L_rv - L_r)), a virtual one its L_rv; a ray that leaves
+// the canvas or meets nothing within kReflectionMaxM sees the environment (its SH irradiance
+// over pi: the environment as a matte surface facing r would average it). Returns the reflected
+// radiance in camera units; `footageShare` the part of it that is footage.
+const int kReflectionSteps = 32;
+const float kReflectionFirstM = 0.002;  // first step (metres)
+const float kReflectionGrowth = 1.2;    // step growth: 0.002 * 1.2^32 = 0.68 m at the last
+const int kReflectionBisections = 6;
+vec3 boundaryReflection(ivec2 cpi, float ior, out vec3 footageShare) {
+    footageShare = vec3(0.0);
+    vec3 p = texelFetch(gPosition, cpi, 0).xyz;
+    vec3 n = texelFetch(gNormal, cpi, 0).xyz;  // faces the camera (G-buffer convention)
+    vec3 v = cameraPos.xyz - p;
+    float vl = length(v);
+    if (vl < 1e-6 || !allFinite(n) || dot(n, n) < 0.25) return vec3(0.0);
+    v /= vl;
+    n = normalize(n);
+    float Fr = fresnelDielectric(clamp(dot(n, v), 1e-4, 1.0), max(ior, 1.0));
+    if (!(Fr > 0.0)) return vec3(0.0);
+    vec3 r = reflect(-v, n);
+    vec3 o = p + n * (1e-4 + 1e-4 * vl);  // off the surface (metres)
+    float t0 = 0.0, t = kReflectionFirstM;
+    ivec2 hit = ivec2(-1);
+    for (int i = 0; i < kReflectionSteps; ++i, t0 = t, t *= kReflectionGrowth) {
+        vec2 cp;
+        if (!projectToCanvas(o + t * r, cp)) break;
+        ivec2 c = ivec2(floor(cp + 0.5));
+        if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, ivec2(canvas.xy)))) break;
+        vec4 S = texelFetch(gPosition, c, 0);
+        if (int(S.w + 0.5) == ORIGIN_NONE) continue;
+        float behind = length(o + t * r - cameraPos.xyz) - length(S.xyz - cameraPos.xyz);
+        if (behind < 0.0 || behind > (t - t0) + 0.005) continue;  // in front, or far behind
+        // The surface lies between t0 and t along the ray: bisect to the crossing.
+        float lo = t0, hi = t;
+        hit = c;
+        for (int k = 0; k < kReflectionBisections; ++k) {
+            float m = 0.5 * (lo + hi);
+            if (!projectToCanvas(o + m * r, cp)) break;
+            ivec2 cm = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+            vec4 Sm = texelFetch(gPosition, cm, 0);
+            bool past = int(Sm.w + 0.5) != ORIGIN_NONE &&
+                        length(o + m * r - cameraPos.xyz) > length(Sm.xyz - cameraPos.xyz);
+            if (past) {
+                hi = m;
+                hit = cm;
+            } else {
+                lo = m;
+            }
+        }
+        break;
+    }
+    if (hit.x < 0) {
+        if (envOrigin == ORIGIN_NONE) return vec3(0.0);
+        return Fr * shIrradiance(r) / PI * exposure;
+    }
+    int origin = int(texelFetch(gPosition, hit, 0).w + 0.5);
+    vec3 rv = max(texelFetch(lRv, hit, 0).rgb, vec3(0.0)) * exposure;
+    vec3 rr = max(texelFetch(lR, hit, 0).rgb, vec3(0.0)) * exposure;
+    ivec2 camPx;
+    if (origin != ORIGIN_REAL || !cameraPixelOfCanvas(hit, camPx)) return Fr * rv;
+    vec3 c = texelFetch(cameraImage, camPx, 0).rgb;
+    footageShare = Fr * c;
+    return Fr * (c + guardedAlpha(c, rr) * (rv - rr));
+}
+
+#ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 
 // Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci; `footage` receives the part
 // of the result that is video (CI, or the back-projected CI_bp); wholeCi: it is CI (all real).
@@ -203,6 +291,14 @@ void main() {
             float seeThrough = clamp((lrv.a - float(ORIGIN_VIRTUAL)) / kSeeThroughScale, 0.0, 1.0);
             footage = seeThrough * ci;
             result = rv + footage;
+            if (translucentReflection != 0) {
+                float a = texelFetch(gEmissive, cpi, 0).a;
+                if (a < -0.5) {  // a translucent object: a = -IOR
+                    vec3 reflectedFootage;
+                    result += boundaryReflection(cpi, -a, reflectedFootage);
+                    footage += reflectedFootage;
+                }
+            }
             coverage = 1.0;
             layer = 1.0;
         } else {

@@ -56,7 +56,7 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r,
     r = vec3(0.0);
     seeThrough = 0.0;
     vec4 Em = texelFetch(gEmissive, px, 0);
-    // A translucent pixel (gEmissive.a = -1) takes the light scattered through its object (the
+    // A translucent pixel (gEmissive.a = -IOR <= -1) takes the light scattered through its object (the
     // one whose map has the nearest surface voxel) to that surface voxel, times F_t towards the
     // camera (VnmShading::scattered), instead of the surface BRDF: L_rv from all lights, L_r from
     // real lights with the real-only shadow maps (and nothing on a virtual object, as for any

@@ -9,7 +9,7 @@ in vec3 worldNormal;
 in vec2 uv;
 flat in vec4 materialBaseMetallic;
 flat in vec4 materialEmissiveRough;
-flat in int materialTranslucent;
+flat in float materialTranslucentIor;  // > 0: a participating medium, its boundary's IOR
 #ifdef MIRAGE_BASE_COLOR_MAPS
 layout(binding = kUnitBaseColorMap) uniform sampler2D baseColorMap;  // sRGB texture: samples are linear
 #endif
@@ -20,7 +20,8 @@ layout(location = 0) out vec4 gPosition;  // xyz world (m), w = origin
 layout(location = 1) out vec4 gNormal;    // xyz unit world normal (facing the camera), w = roughness
 layout(location = 2) out vec4 gAlbedo;    // rgb linear base colour, a = metallic
 layout(location = 3) out vec4 gEmissive;  // rgb linear emitted radiance, a = specular slot + 1
-                                          // (0: not a mirror / glass pixel; -1: translucent)
+                                          // (0: not a mirror / glass pixel); a translucent
+                                          // object: a = -IOR of its boundary (<= -1)
 layout(location = 4) out vec4 gRealSurface;  // = gPosition; GBufferPass masks it off for the
                                              // virtual draws (RealSurfaces)
 void main() {
@@ -46,5 +47,6 @@ void main() {
     gNormal = vec4(n, clamp(materialEmissiveRough.a * mr.g, 0.02, 1.0));
     gAlbedo = vec4(baseColor, clamp(materialBaseMetallic.a * mr.b, 0.0, 1.0));
     gEmissive = vec4(materialEmissiveRough.rgb,
-                     materialTranslucent == 1 ? -1.0 : float(specularSlot + 1));
+                     materialTranslucentIor > 0.0 ? -materialTranslucentIor
+                                                  : float(specularSlot + 1));
 }

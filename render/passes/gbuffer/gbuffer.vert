@@ -17,7 +17,7 @@ layout(std430, binding = kBindingMaterials) readonly buffer Materials { GpuMater
 uniform int materialIndex;
 flat out vec4 materialBaseMetallic;     // rgb linear base colour, a = metallic
 flat out vec4 materialEmissiveRough;    // rgb linear emitted radiance, a = roughness
-flat out int materialTranslucent;       // 1: a participating medium
+flat out float materialTranslucentIor;  // a participating medium's boundary IOR (>= 1), else 0
 #endif
 void main() {
     vec4 wp = model * vec4(inPosition, 1.0);
@@ -29,6 +29,6 @@ void main() {
     GpuMaterial m = materials[materialIndex];
     materialBaseMetallic = vec4(m.baseColor.rgb, m.metallic);
     materialEmissiveRough = vec4(m.emissive, m.roughness);
-    materialTranslucent = m.translucent;
+    materialTranslucentIor = m.translucent == 1 ? max(m.ior, 1.0) : 0.0;
 #endif
 }

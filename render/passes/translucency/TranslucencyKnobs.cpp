@@ -43,6 +43,12 @@ std::vector<PassKnob> translucencyKnobs() {
                   "on: a translucent pixel shows the footage behind its object through the chord "
                   "the camera ray crosses (e^{-tau} from the voxel number map); off: it is opaque",
                   [](RendererOptions& o) -> bool& { return o.translucency.seeThrough; }, {"on"}),
+        onOffKnob("vnm_reflection",
+                  "on: a translucent object's boundary reflects (Fresnel) what the mirror ray "
+                  "meets on screen (footage and differential light), else the environment; off: "
+                  "no reflection",
+                  [](RendererOptions& o) -> bool& { return o.translucency.surfaceReflection; },
+                  {"on"}),
     };
     return k;
 }

@@ -38,6 +38,12 @@ struct TranslucencyOptions {
     // renderVnm adds the background (docs/translucency.md "See-through"). false: every
     // translucent pixel is opaque (its scattered light only).
     bool seeThrough = true;
+    // A translucent object's boundary reflects the share F_r = 1 - F_t of the light arriving
+    // along the camera ray's mirror direction (smooth, as the reference's boundary): the surface
+    // the ray meets, found by marching it over the G-buffer (the footage of a real surface, with
+    // its differential light), else the environment (docs/translucency.md "Reflection"). false:
+    // no reflection (the scattered light and the see-through only).
+    bool surfaceReflection = true;
 
     void validate() const {
         checkOption(vnmResolution >= 2 && vnmResolution <= 512, "translucency.vnmResolution",
