@@ -23,11 +23,15 @@ constexpr Resource kSpecularBuffers[4] = {kSpecularRv, kSpecularR, kSpecularRRef
 static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
 }  // namespace
 
-void CompositePass::buildPrograms(bool identityRemap) {
+void CompositePass::buildPrograms(bool identityRemap, bool translucentReflection) {
     // Without lens distortion on a canvas of the camera's size the remap is the identity: the
     // variant reads each buffer at its own pixel instead of looking the position up and
-    // filtering (on llvmpipe a bilinear read costs four, and the table read one more).
-    const std::string identity = identityRemap ? "#define MIRAGE_IDENTITY_REMAP 1\n" : "";
+    // filtering (on llvmpipe a bilinear read costs four, and the table read one more). The
+    // translucent boundary's reflection is compiled in only where a scene has such an object
+    // (llvmpipe may pay for code behind a branch it does not take).
+    const std::string identity =
+        std::string(identityRemap ? "#define MIRAGE_IDENTITY_REMAP 1\n" : "") +
+        (translucentReflection ? "#define MIRAGE_TRANSLUCENT_REFLECTION 1\n" : "");
     program_ = fullscreenProgram("composite", "passes/composite/composite.frag", identity);
     programDiffuse_ =
         fullscreenProgram("composite (diffuse only)", "passes/composite/composite.frag",
@@ -46,10 +50,8 @@ void CompositePass::buildPrograms(bool identityRemap) {
     locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
     locDenoiseFootage_ = program_.uniformLocation("denoiseFootage");
     locNoiseVariance_ = program_.uniformLocation("noiseVariance");
-    const gl::Program* variants[3] = {&program_, &programDiffuse_, &programDiffuseNoCaustics_};
-    for (int i = 0; i < 3; ++i)
-        locTranslucentReflection_[i] = variants[i]->uniformLocation("translucentReflection");
     identityRemap_ = identityRemap;
+    translucentReflection_ = translucentReflection;
     programsBuilt_ = true;
 }
 
@@ -105,7 +107,12 @@ void CompositePass::resize(const FrameContext& ctx) {
                           canvasToCamera_.height() == p.canvasHeight;
     if (!sameSize) remapIsIdentity_ = isIdentityRemap(p);
     const bool identity = ctx.options.composite.identityRemap && remapIsIdentity_;
-    if (!programsBuilt_ || identity != identityRemap_) buildPrograms(identity);
+    bool translucent = false;
+    for (const DrawItem& d : ctx.scene.draws()) translucent = translucent || d.translucent;
+    const bool reflection = translucent && ctx.options.translucency.enabled &&
+                            ctx.options.translucency.surfaceReflection;
+    if (!programsBuilt_ || identity != identityRemap_ || reflection != translucentReflection_)
+        buildPrograms(identity, reflection);
     if (sameSize) return;
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
     srgb_ = gl::Texture::create2D("composite srgb", w, h, GL_SRGB8_ALPHA8);
@@ -197,23 +204,20 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // caustic pass the variant that never reads the caustic buffers: reading the black stand-in
     // costs as much as a real buffer on llvmpipe, even behind a uniform branch.
     const int withCaustics = res.has(kCausticRv) ? 1 : 0;
-    // A translucent object's boundary reflects (the translucency pass ran: the scene has one).
-    const int translucentReflection = ctx.options.translucency.surfaceReflection &&
-                                              res.has(kTranslucentRadiance) &&
-                                              res.has(kGBufferNormal)
-                                          ? 1
-                                          : 0;
+    // The variants with a translucent boundary's reflection read the G-buffer's normal and
+    // emissive buffers and the lens table (the frame's translucent pixels: the translucency pass
+    // ran; else the emissive buffer's black stand-in marks none).
+    const bool translucentReflection =
+        translucentReflection_ && res.has(kTranslucentRadiance) && res.has(kGBufferNormal);
     if (withCaustics) {
         ctx.beginFullscreen(programDiffuse_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
         glUniform1i(locShowVirtualDiffuse_, ctx.options.composite.showVirtual ? 1 : 0);
         glUniform1i(locWithCausticsDiffuse_, 1);
-        glUniform1i(locTranslucentReflection_[1], translucentReflection);
     } else {
         ctx.beginFullscreen(programDiffuseNoCaustics_, ctx.projection.camera.width,
                             ctx.projection.camera.height);
         glUniform1i(locShowVirtualNoCaustics_, ctx.options.composite.showVirtual ? 1 : 0);
-        glUniform1i(locTranslucentReflection_[2], translucentReflection);
     }
     glBindTextureUnit(kUnitCompositeCamera, res.texture(kCameraImage).id());
     glBindTextureUnit(kUnitCompositeLRv, res.texture(kLRv).id());
@@ -259,7 +263,6 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locEpsilon_, ctx.options.specular.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
-        glUniform1i(locTranslucentReflection_[0], translucentReflection);
         // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
         // the newest versions, as the sharp units.
         const bool fuzzy = res.has(kFilteredVideo);

@@ -29,7 +29,9 @@ private:
     // window rect): where the composite can meet a specular pixel. Empty for an empty rect.
     glm::ivec4 cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const;
     // The variants below, with MIRAGE_IDENTITY_REMAP when `identityRemap`.
-    void buildPrograms(bool identityRemap);
+    // translucentReflection: the variants with a translucent boundary's reflection
+    // (MIRAGE_TRANSLUCENT_REFLECTION), built only for scenes with a translucent object.
+    void buildPrograms(bool identityRemap, bool translucentReflection);
 
     // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
     // compositing code would cost every frame even behind a uniform that turns it off.
@@ -37,6 +39,7 @@ private:
     gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
     gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
     bool programsBuilt_ = false, identityRemap_ = false;  // the variants built, and which
+    bool translucentReflection_ = false;
     bool remapIsIdentity_ = false;  // isIdentityRemap of the camera the tables were built for
     gl::Texture linear_, srgb_, remap_, footage_;
     // Canvas size, RG32F: the camera-image pixel (OpenCV convention) that sees each canvas
@@ -47,8 +50,6 @@ private:
     GLint locDenoiseFootage_ = -1, locNoiseVariance_ = -1;    // of program_ (footage_noise.glsl)
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
     GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
-    // "translucentReflection" of program_, programDiffuse_, programDiffuseNoCaustics_.
-    GLint locTranslucentReflection_[3] = {-1, -1, -1};
     gl::Framebuffer fbo_;
     // composite_mask.frag: depth 0 on the camera pixels that see a mirror or glass pixel, 1
     // elsewhere; fbo_'s depth attachment, so the full variant shades only those pixels.

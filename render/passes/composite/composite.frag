@@ -63,9 +63,6 @@ layout(binding = kUnitCompositeFuzzyRRefl) uniform sampler2D fuzzyRRefl;
 layout(binding = kUnitCompositeFuzzyLenv) uniform sampler2D fuzzyLenv;
 layout(binding = kUnitCompositeFuzzyVideo) uniform sampler2D fuzzyVideo;  // rgb camera units, a = 1: fuzzy pixel
 layout(binding = kUnitCompositeNormal) uniform sampler2D gNormal;  // canvas, xyz facing the camera
-// 1: a translucent object's boundary reflects (TranslucencyOptions::surfaceReflection); reads
-// gPosition, gNormal, gEmissive and canvasToCamera.
-uniform int translucentReflection;
 uniform int fuzzyOn;         // 1 when the fuzzy pass ran this frame
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
@@ -110,6 +107,7 @@ bool cameraPixelOfCanvas(ivec2 c, out ivec2 camPx) {
 // the canvas or meets nothing within kReflectionMaxM sees the environment (its SH irradiance
 // over pi: the environment as a matte surface facing r would average it). Returns the reflected
 // radiance in camera units; `footageShare` the part of it that is footage.
+#ifdef MIRAGE_TRANSLUCENT_REFLECTION
 const int kReflectionSteps = 32;
 const float kReflectionFirstM = 0.002;  // first step (metres)
 const float kReflectionGrowth = 1.2;    // step growth: 0.002 * 1.2^32 = 0.68 m at the last
@@ -170,6 +168,7 @@ vec3 boundaryReflection(ivec2 cpi, float ior, out vec3 footageShare) {
     footageShare = Fr * c;
     return Fr * (c + guardedAlpha(c, rr) * (rv - rr));
 }
+#endif
 
 #ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 
@@ -291,14 +290,16 @@ void main() {
             float seeThrough = clamp((lrv.a - float(ORIGIN_VIRTUAL)) / kSeeThroughScale, 0.0, 1.0);
             footage = seeThrough * ci;
             result = rv + footage;
-            if (translucentReflection != 0) {
-                float a = texelFetch(gEmissive, cpi, 0).a;
-                if (a < -0.5) {  // a translucent object: a = -IOR
-                    vec3 reflectedFootage;
-                    result += boundaryReflection(cpi, -a, reflectedFootage);
-                    footage += reflectedFootage;
-                }
+#ifdef MIRAGE_TRANSLUCENT_REFLECTION  // the variants for scenes with a translucent object
+            // (TranslucencyOptions::surfaceReflection); they read gPosition, gNormal, gEmissive
+            // and canvasToCamera.
+            float a = texelFetch(gEmissive, cpi, 0).a;
+            if (a < -0.5) {  // a translucent object: a = -IOR
+                vec3 reflectedFootage;
+                result += boundaryReflection(cpi, -a, reflectedFootage);
+                footage += reflectedFootage;
             }
+#endif
             coverage = 1.0;
             layer = 1.0;
         } else {
