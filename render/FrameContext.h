@@ -215,6 +215,9 @@ public:
     // covered, masked or not). refractiveRects: the glass objects' only, all the refraction
     // search needs (a mirror's pixel refracts nothing). Both empty when none is in view.
     std::vector<glm::ivec4> specularRects, refractiveRects;
+    // Canvas pixels that can show a translucent object, per object, overlapping ones merged
+    // (empty when none is in view): the composite's translucent variant runs on these only.
+    std::vector<glm::ivec4> translucentRects;
 
     gl::Buffer frameUbo, lightUbo;
     gl::VertexArray emptyVao;  // for full-screen triangles

@@ -85,7 +85,7 @@ glm::ivec4 sphereRect(const BoundingSphere& b, const glm::mat4& view, const glm:
 }
 
 // FrameContext's specularScissor (the bounding rectangle of every specular draw's), its
-// specularRects and refractiveRects (the glass draws').
+// specularRects and refractiveRects (the glass draws'), and its translucentRects.
 void specularRectangles(const GpuScene& s, const glm::mat4& view, const glm::mat4& viewProj,
                         const CameraProjection& p, FrameContext& c) {
     std::vector<glm::ivec4> all, glass;
@@ -112,6 +112,13 @@ void specularRectangles(const GpuScene& s, const glm::mat4& view, const glm::mat
     }
     c.specularRects = mergeOverlappingRects(std::move(all));
     c.refractiveRects = mergeOverlappingRects(std::move(glass));
+    std::vector<glm::ivec4> translucent;
+    for (const DrawItem& d : s.draws()) {
+        if (!d.translucent) continue;
+        const glm::ivec4 r = sphereRect(d.bounds, view, viewProj, p);
+        if (r.z > 0 && r.w > 0) translucent.push_back(r);
+    }
+    c.translucentRects = mergeOverlappingRects(std::move(translucent));
 }
 
 // The smallest sphere holding both.

@@ -26,12 +26,8 @@ static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
 void CompositePass::buildPrograms(bool identityRemap, bool translucentReflection) {
     // Without lens distortion on a canvas of the camera's size the remap is the identity: the
     // variant reads each buffer at its own pixel instead of looking the position up and
-    // filtering (on llvmpipe a bilinear read costs four, and the table read one more). The
-    // translucent boundary's reflection is compiled in only where a scene has such an object
-    // (llvmpipe may pay for code behind a branch it does not take).
-    const std::string identity =
-        std::string(identityRemap ? "#define MIRAGE_IDENTITY_REMAP 1\n" : "") +
-        (translucentReflection ? "#define MIRAGE_TRANSLUCENT_REFLECTION 1\n" : "");
+    // filtering (on llvmpipe a bilinear read costs four, and the table read one more).
+    const std::string identity = identityRemap ? "#define MIRAGE_IDENTITY_REMAP 1\n" : "";
     program_ = fullscreenProgram("composite", "passes/composite/composite.frag", identity);
     programDiffuse_ =
         fullscreenProgram("composite (diffuse only)", "passes/composite/composite.frag",
@@ -39,6 +35,14 @@ void CompositePass::buildPrograms(bool identityRemap, bool translucentReflection
     programDiffuseNoCaustics_ = fullscreenProgram(
         "composite (diffuse only, no caustics)", "passes/composite/composite.frag",
         identity + "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_NO_CAUSTICS 1\n");
+    if (translucentReflection) {
+        programTranslucent_ = fullscreenProgram(
+            "composite (translucent pixels, with the boundary's reflection)",
+            "passes/composite/composite.frag",
+            identity + "#define MIRAGE_DIFFUSE_ONLY 1\n#define MIRAGE_TRANSLUCENT_REFLECTION 1\n");
+        locShowVirtualTranslucent_ = programTranslucent_.uniformLocation("showVirtual");
+        locWithCausticsTranslucent_ = programTranslucent_.uniformLocation("withCaustics");
+    }
     maskProgram_ = fullscreenProgram("composite specular mask",
                                      "passes/composite/composite_mask.frag", identity);
     locEpsilon_ = program_.uniformLocation("depthEpsilon");
@@ -285,6 +289,19 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_LESS);
         glDisable(GL_DEPTH_TEST);
+    }
+    if (translucentReflection && ctx.options.composite.showVirtual) {
+        // The translucent pixels again, with their boundary's reflection (the variant discards
+        // every other pixel, so mirror / glass pixels in the rectangles keep theirs).
+        std::vector<glm::ivec4> translucentRects;
+        for (const glm::ivec4& r : ctx.translucentRects)
+            translucentRects.push_back(cameraRect(ctx, r));
+        translucentRects = mergeOverlappingRects(std::move(translucentRects));
+        glDisable(GL_DEPTH_TEST);
+        programTranslucent_.use();
+        glUniform1i(locShowVirtualTranslucent_, 1);
+        glUniform1i(locWithCausticsTranslucent_, withCaustics);
+        ctx.drawFullscreenTriangleIn(translucentRects);
     }
     glDisable(GL_FRAMEBUFFER_SRGB);
     res.publish(kComposite, linear_);

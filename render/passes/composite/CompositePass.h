@@ -29,8 +29,8 @@ private:
     // window rect): where the composite can meet a specular pixel. Empty for an empty rect.
     glm::ivec4 cameraRect(const FrameContext& ctx, const glm::ivec4& canvasRect) const;
     // The variants below, with MIRAGE_IDENTITY_REMAP when `identityRemap`.
-    // translucentReflection: the variants with a translucent boundary's reflection
-    // (MIRAGE_TRANSLUCENT_REFLECTION), built only for scenes with a translucent object.
+    // translucentReflection: also the variant that composites a translucent object's pixels with
+    // its boundary's reflection (programTranslucent_), built only for scenes with one.
     void buildPrograms(bool identityRemap, bool translucentReflection);
 
     // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
@@ -38,6 +38,11 @@ private:
     gl::Program program_;                   // with Eqs. 6-11 for mirror / glass pixels
     gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
     gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
+    // MIRAGE_DIFFUSE_ONLY + MIRAGE_TRANSLUCENT_REFLECTION: over the translucent objects'
+    // rectangles, the translucent pixels again with their boundary's reflection (the others
+    // discarded). Apart so that no other pixel pays for the reflection's code on llvmpipe.
+    gl::Program programTranslucent_;
+    GLint locShowVirtualTranslucent_ = -1, locWithCausticsTranslucent_ = -1;
     bool programsBuilt_ = false, identityRemap_ = false;  // the variants built, and which
     bool translucentReflection_ = false;
     bool remapIsIdentity_ = false;  // isIdentityRemap of the camera the tables were built for

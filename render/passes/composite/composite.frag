@@ -253,6 +253,17 @@ void main() {
     float coverage = 0.0;
     vec3 footage = ci;
     float layer = 0.0;
+#ifdef MIRAGE_TRANSLUCENT_REFLECTION
+    // The variant that adds a translucent boundary's reflection (TranslucencyOptions::
+    // surfaceReflection) runs over the translucent objects' rectangles after the others and
+    // rewrites only their pixels (gEmissive.a = -IOR); it reads gPosition, gNormal, gEmissive and
+    // canvasToCamera.
+    float translucentIor = 0.0;
+    if (canvasPx.x > -1000.0)
+        translucentIor = -texelFetch(gEmissive, clamp(ivec2(floor(canvasPx + 0.5)), ivec2(0),
+                                                       ivec2(canvas.xy) - 1), 0).a;
+    if (!(translucentIor > 0.5)) discard;
+#endif
     if (canvasPx.x > -1000.0 && showVirtual != 0) {
         ivec2 cpi = ivec2(floor(canvasPx + 0.5));
 #if defined(MIRAGE_IDENTITY_REMAP) && defined(MIRAGE_DIFFUSE_ONLY)
@@ -290,15 +301,10 @@ void main() {
             float seeThrough = clamp((lrv.a - float(ORIGIN_VIRTUAL)) / kSeeThroughScale, 0.0, 1.0);
             footage = seeThrough * ci;
             result = rv + footage;
-#ifdef MIRAGE_TRANSLUCENT_REFLECTION  // the variants for scenes with a translucent object
-            // (TranslucencyOptions::surfaceReflection); they read gPosition, gNormal, gEmissive
-            // and canvasToCamera.
-            float a = texelFetch(gEmissive, cpi, 0).a;
-            if (a < -0.5) {  // a translucent object: a = -IOR
-                vec3 reflectedFootage;
-                result += boundaryReflection(cpi, -a, reflectedFootage);
-                footage += reflectedFootage;
-            }
+#ifdef MIRAGE_TRANSLUCENT_REFLECTION  // the translucent pixels' variant (CompositePass)
+            vec3 reflectedFootage;
+            result += boundaryReflection(cpi, translucentIor, reflectedFootage);
+            footage += reflectedFootage;
 #endif
             coverage = 1.0;
             layer = 1.0;
