@@ -71,11 +71,11 @@ Scene seeThroughScene(float extinction, const fs::path& dir) {
     return s;
 }
 
-Scene reflectionScene(const fs::path& dir) {
+Scene reflectionScene(const fs::path& dir, float ior = 1.5f) {
     TranslucentSceneOptions o;
     o.extinction = 56.0f;
     o.albedo = {0.3f, 0.3f, 0.3f};
-    o.ior = 1.5f;
+    o.ior = ior;
     o.lightPosition = {0.2f, 1.2f, 1.0f};  // above, in front
     o.lightIntensity = 4.0f;
     o.environment = 0.15f;
@@ -211,6 +211,32 @@ TEST_F(TranslucentSeeThrough, GrazingFacesReflectTheFloorLikeTheReference) {
     writeBgr8(dir / "footage_reference_on_off.png", row);
     EXPECT_GT(psnrOn, kReflectionFloorDb);
     EXPECT_LT(psnrOff, kReflectionFloorDb) << "the must-fail: no reflection";
+}
+
+TEST_F(TranslucentSeeThrough, ReflectionVanishesAsTheIorNearsOne) {
+    // IOR 1.001: F_r is at most ~1e-3 short of grazing, so the reflection must change the
+    // cube's pixels by well under a code; at IOR 1.5 the same view differs by several codes
+    // (the check can fail).
+    auto apart = [](float ior) {
+        const fs::path dir = mirage::test::outputDir("translucent_reflection_ior");
+        const Scene scene = reflectionScene(dir, ior);
+        const raytrace::RenderCamera cam = grazingCamera();
+        const cv::Mat footage(cam.intrinsics.height, cam.intrinsics.width, CV_8UC3,
+                              cv::Scalar(120, 130, 140));
+        TranslucencyOptions reflecting, matte;
+        matte.surfaceReflection = false;
+        const Composite on = renderRealtime(scene, cam, footage, reflecting);
+        const Composite off = renderRealtime(scene, cam, footage, matte);
+        cv::Mat diff;
+        cv::absdiff(on.srgb, off.srgb, diff);
+        const cv::Scalar d = cv::mean(diff, on.cube);
+        return (d[0] + d[1] + d[2]) / 3.0;
+    };
+    const double nearOne = apart(1.001f), glass = apart(1.5f);
+    std::cout << "[ reflection ] mean |with - without| over the cube: " << nearOne
+              << " codes at IOR 1.001, " << glass << " at IOR 1.5\n";
+    EXPECT_LT(nearOne, 0.5);
+    EXPECT_GT(glass, 2.0);
 }
 
 }  // namespace
