@@ -122,6 +122,22 @@ Composite renderRealtime(const Scene& scene, const raytrace::RenderCamera& cam,
     return c;
 }
 
+// The reference frame, and the real-time composites into its footage with the defaults (`on`)
+// and with `without` (`off`).
+struct OnOff {
+    test::ReferenceFrame ref;
+    Composite on, off;
+};
+
+OnOff renderOnOff(const Scene& scene, const raytrace::RenderCamera& cam,
+                  const TranslucencyOptions& without) {
+    OnOff r;
+    r.ref = test::renderReferenceFrame(scene, cam.intrinsics, cam.T_world_camera, 48, 5, false);
+    r.on = renderRealtime(scene, cam, r.ref.footage, TranslucencyOptions{});
+    r.off = renderRealtime(scene, cam, r.ref.footage, without);
+    return r;
+}
+
 struct Judged {
     double on = 0, off = 0;
     double insideCodes = 0;  // mean |on - off| (8-bit codes) 3 or more pixels inside the cube
@@ -130,13 +146,9 @@ struct Judged {
 Judged judge(float extinction, const std::string& name) {
     const fs::path dir = mirage::test::outputDir("translucent_see_through_" + name);
     const Scene scene = seeThroughScene(extinction, dir);
-    const raytrace::RenderCamera cam = cubeCamera();
-    const test::ReferenceFrame ref =
-        test::renderReferenceFrame(scene, cam.intrinsics, cam.T_world_camera, 48, 5, false);
-    TranslucencyOptions withSeeThrough, opaque;
+    TranslucencyOptions opaque;
     opaque.seeThrough = false;
-    const Composite on = renderRealtime(scene, cam, ref.footage, withSeeThrough);
-    const Composite off = renderRealtime(scene, cam, ref.footage, opaque);
+    const auto [ref, on, off] = renderOnOff(scene, cubeCamera(), opaque);
     EXPECT_GT(cv::countNonZero(on.cube), 600) << name;
     Judged j{test::psnr(on.srgb, ref.composite, 255.0, on.cube),
              test::psnr(off.srgb, ref.composite, 255.0, on.cube), 0.0};
@@ -178,13 +190,9 @@ TEST_F(TranslucentSeeThrough, ThickCubeLetsThroughOnlyAtItsSilhouette) {
 TEST_F(TranslucentSeeThrough, GrazingFacesReflectTheFloorLikeTheReference) {
     const fs::path dir = mirage::test::outputDir("translucent_reflection");
     const Scene scene = reflectionScene(dir);
-    const raytrace::RenderCamera cam = grazingCamera();
-    const test::ReferenceFrame ref =
-        test::renderReferenceFrame(scene, cam.intrinsics, cam.T_world_camera, 48, 5, false);
-    TranslucencyOptions reflecting, matte;
+    TranslucencyOptions matte;
     matte.surfaceReflection = false;
-    const Composite on = renderRealtime(scene, cam, ref.footage, reflecting);
-    const Composite off = renderRealtime(scene, cam, ref.footage, matte);
+    const auto [ref, on, off] = renderOnOff(scene, grazingCamera(), matte);
     ASSERT_GT(cv::countNonZero(on.cube), 600);
     // Judged on 4 x 4 block means (blocks wholly on the cube): the reference's noise (a dark
     // medium at 48 spp) averaged out, the faces' levels kept.
