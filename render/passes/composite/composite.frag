@@ -6,7 +6,7 @@
 //   real or empty pixel:  L_final = CI + alpha * (L_rv - L_r),  alpha = CI / L_r per channel
 //   virtual pixel:        L_final = L_rv (+ s CI on a translucent object: the share s of what
 //                         lies behind it that it lets through, from LRv.a; direct.frag; + its
-//                         boundary's reflection, translucentReflection below)
+//                         boundary's reflection, boundaryReflection below)
 // CI is the camera frame, sRGB-encoded 8-bit, linearised by the sRGB texture format (the camera
 // response is taken to be the sRGB curve). L_* are scaled by `exposure` into camera units first.
 // Guard where L_r is near 0 (a black surface, or light only the virtual light reaches): alpha
@@ -103,10 +103,11 @@ bool cameraPixelOfCanvas(ivec2 c, out ivec2 camPx) {
 // arriving along the mirror ray r. What r meets is found by marching it over the G-buffer's
 // nearest surfaces (screen space: the ray is taken to meet a surface where it passes behind it
 // by less than the step; bisection then refines the point). A real surface gives what its pixel
-// composites to (its footage plus alpha (L_rv - L_r)), a virtual one its L_rv; a ray that leaves
-// the canvas or meets nothing within kReflectionMaxM sees the environment (its SH irradiance
-// over pi: the environment as a matte surface facing r would average it). Returns the reflected
-// radiance in camera units; `footageShare` the part of it that is footage.
+// composites to (its footage plus alpha (L_rv - L_r), caustics included), a virtual one its
+// L_rv; a ray that leaves the canvas or meets nothing within the march (0.68 m) sees the
+// environment (its SH irradiance over pi: the environment as a matte surface facing r would
+// average it). Returns the reflected radiance in camera units; `footageShare` the part of it
+// that is footage.
 #ifdef MIRAGE_TRANSLUCENT_REFLECTION
 const int kReflectionSteps = 32;
 const float kReflectionFirstM = 0.002;  // first step (metres)
@@ -160,8 +161,15 @@ vec3 boundaryReflection(ivec2 cpi, float ior, out vec3 footageShare) {
         return Fr * shIrradiance(r) / PI * exposure;
     }
     int origin = int(texelFetch(gPosition, hit, 0).w + 0.5);
-    vec3 rv = max(texelFetch(lRv, hit, 0).rgb, vec3(0.0)) * exposure;
-    vec3 rr = max(texelFetch(lR, hit, 0).rgb, vec3(0.0)) * exposure;
+    vec3 rv = texelFetch(lRv, hit, 0).rgb, rr = texelFetch(lR, hit, 0).rgb;
+#ifndef MIRAGE_NO_CAUSTICS
+    if (withCaustics != 0) {
+        rv += texelFetch(causticRv, hit, 0).rgb;
+        rr += texelFetch(causticR, hit, 0).rgb;
+    }
+#endif
+    rv = max(rv, vec3(0.0)) * exposure;
+    rr = max(rr, vec3(0.0)) * exposure;
     ivec2 camPx;
     if (origin != ORIGIN_REAL || !cameraPixelOfCanvas(hit, camPx)) return Fr * rv;
     vec3 c = texelFetch(cameraImage, camPx, 0).rgb;
