@@ -12,6 +12,7 @@
 #include "render/Renderer.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/view/ViewOptions.h"
+#include "tests/support/TestSupport.h"
 #include "testscenes/TurnedBoxScene.h"
 
 namespace mirage::render {
@@ -21,12 +22,6 @@ RendererOptions withView(const std::string& value) {
     RendererOptions o;
     findPassKnob("view")->apply(o, value);
     return o;
-}
-
-// Mean absolute difference over the pixels and channels.
-double meanAbsDiff(const cv::Mat& a, const cv::Mat& b) {
-    const cv::Scalar d = cv::mean(cv::abs(a - b));
-    return (d[0] + d[1] + d[2]) / 3.0;
 }
 
 TEST(ResourceView, ShowsTheResourceInPlaceOfTheComposite) {
@@ -40,12 +35,13 @@ TEST(ResourceView, ShowsTheResourceInPlaceOfTheComposite) {
     Renderer viewed(s.scene, s.cam, withView("GBufferAlbedo"));
     viewed.render({s.pose, cv::Mat(), true});
     // Albedos are 0.04 (the box) and 0.7 (the table); the view reads them nearest, unscaled.
-    EXPECT_LT(meanAbsDiff(viewed.compositeLinear(), albedo), 1e-3);
-    EXPECT_GT(meanAbsDiff(plain.compositeLinear(), albedo), 0.05) << "must-fail: not the view";
+    EXPECT_LT(test::meanAbsDiff(viewed.compositeLinear(), albedo), 1e-3);
+    EXPECT_GT(test::meanAbsDiff(plain.compositeLinear(), albedo), 0.05)
+        << "must-fail: not the view";
 
     Renderer scaled(s.scene, s.cam, withView("GBufferAlbedo*0.5"));
     scaled.render({s.pose, cv::Mat(), true});
-    EXPECT_LT(meanAbsDiff(scaled.compositeLinear(), albedo * 0.5), 1e-3);
+    EXPECT_LT(test::meanAbsDiff(scaled.compositeLinear(), albedo * 0.5), 1e-3);
 }
 
 TEST(ResourceView, OffLeavesTheFrameAsRendered) {
@@ -55,7 +51,7 @@ TEST(ResourceView, OffLeavesTheFrameAsRendered) {
     plain.render({s.pose, cv::Mat(), true});
     Renderer off(s.scene, s.cam, withView("off"));
     off.render({s.pose, cv::Mat(), true});
-    EXPECT_LT(meanAbsDiff(off.compositeLinear(), plain.compositeLinear()), 1e-6);
+    EXPECT_LT(test::meanAbsDiff(off.compositeLinear(), plain.compositeLinear()), 1e-6);
 }
 
 TEST(ResourceView, TheKnobReadsBackAndRefusesBadValues) {

@@ -189,14 +189,6 @@ StepPixels specularAtHitSteps(const Comparison& c, const test::SpecularScene& s,
     return out;
 }
 
-// Mean absolute difference (linear radiance, all channels) over a mask.
-double meanAbsDiff(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-    cv::Mat d;
-    cv::absdiff(a, b, d);
-    const cv::Scalar m = cv::mean(d, mask);
-    return (m[0] + m[1] + m[2]) / 3.0;
-}
-
 // Half-resolution specular lighting (RendererOptions::specular.halfResolution) against the
 // reference over the glass and the mirror sphere: within the floors, and within 0.5 dB of the
 // full-resolution render over the glass sphere (2.5 dB over the small mirror sphere, see below).
@@ -234,8 +226,8 @@ TEST(SpecularAccuracy, HalfResolutionLightingKeepsTheFloorsAndNeedsItsGeometryTe
     const StepPixels withGeometry = specularAtHitSteps(c, s, half);
     const StepPixels bilinear = specularAtHitSteps(c, s, plain);
     ASSERT_GT(cv::countNonZero(full.mask), 20);
-    const double errGeometry = meanAbsDiff(withGeometry.specRv, full.specRv, full.mask);
-    const double errBilinear = meanAbsDiff(bilinear.specRv, full.specRv, full.mask);
+    const double errGeometry = test::meanAbsDiff(withGeometry.specRv, full.specRv, full.mask);
+    const double errBilinear = test::meanAbsDiff(bilinear.specRv, full.specRv, full.mask);
     std::cout << "[ specular ] half resolution at " << cv::countNonZero(full.mask)
               << " hit-step pixels: mean |L'_rv - full| " << errGeometry
               << " with the geometry test, " << errBilinear << " without\n";

@@ -138,14 +138,6 @@ OnOff renderOnOff(const Scene& scene, const raytrace::RenderCamera& cam,
     return r;
 }
 
-// Mean |a - b| over `mask`, in 8-bit codes averaged over the three channels.
-double codesApart(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-    cv::Mat diff;
-    cv::absdiff(a, b, diff);
-    const cv::Scalar d = cv::mean(diff, mask);
-    return (d[0] + d[1] + d[2]) / 3.0;
-}
-
 struct Judged {
     double on = 0, off = 0;
     double insideCodes = 0;  // mean |on - off| (8-bit codes) 3 or more pixels inside the cube
@@ -162,7 +154,7 @@ Judged judge(float extinction, const std::string& name) {
              test::psnr(off.srgb, ref.composite, 255.0, on.cube), 0.0};
     cv::Mat inside;
     cv::erode(on.cube, inside, cv::Mat::ones(7, 7, CV_8U));
-    j.insideCodes = codesApart(on.srgb, off.srgb, inside);
+    j.insideCodes = test::meanAbsDiff(on.srgb, off.srgb, inside);
     std::cout << "[ see-through ] " << name << ": PSNR over the cube " << j.on
               << " dB with the see-through, " << j.off << " dB opaque; inside the silhouette "
               << j.insideCodes << " codes apart\n";
@@ -241,7 +233,7 @@ TEST_F(TranslucentSeeThrough, ReflectionVanishesAsTheIorNearsOne) {
         matte.surfaceReflection = false;
         const Composite on = renderRealtime(scene, cam, footage, reflecting);
         const Composite off = renderRealtime(scene, cam, footage, matte);
-        return codesApart(on.srgb, off.srgb, on.cube);
+        return test::meanAbsDiff(on.srgb, off.srgb, on.cube);
     };
     const double nearOne = apart(1.001f), glass = apart(1.5f);
     std::cout << "[ reflection ] mean |with - without| over the cube: " << nearOne

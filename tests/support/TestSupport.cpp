@@ -53,6 +53,14 @@ double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask
     return mirage::ssim(a, b, peak, mask);
 }
 
+double meanAbsDiff(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+    CV_Assert(a.size() == b.size() && a.type() == b.type() && a.channels() >= 3);
+    cv::Mat d;
+    cv::absdiff(a, b, d);
+    const cv::Scalar m = cv::mean(d, mask);
+    return (m[0] + m[1] + m[2]) / 3.0;
+}
+
 double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q) {
     CV_Assert(a.size() == b.size() && a.type() == b.type());
     cv::Mat fa, fb, d;

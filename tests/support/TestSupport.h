@@ -25,6 +25,9 @@ double psnr(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask
 // Mean Rec. 709 luminance of a linear RGB (channel order R, G, B) image over `mask`.
 double meanLuminance(const cv::Mat& linearRgb, const cv::Mat& mask = cv::Mat());
 double ssim(const cv::Mat& a, const cv::Mat& b, double peak, const cv::Mat& mask = cv::Mat());
+// Mean |a - b| over the pixels (all, or where mask != 0) and the first three channels, in the
+// images' units (8-bit codes, linear radiance). Equal size and type.
+double meanAbsDiff(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask = cv::Mat());
 // The q-quantile (0..1) of the per-pixel absolute difference (max over channels).
 double percentileAbsDiff(const cv::Mat& a, const cv::Mat& b, double q);
 // PSNR (dB, 8-bit peak) of the part of two composites' difference that their footage's difference
