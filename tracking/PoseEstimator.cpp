@@ -473,16 +473,44 @@ struct Refined {
     std::vector<const Observation*> inliers;
 };
 
+// The refinements (without covariance) of one estimate, by start pose and tag set: the ambiguity
+// test (step 5) refines from candidates that step 4 often refined already on the same tags, and
+// a refinement is a pure function of those, so the earlier result is the answer. Each costs
+// several evaluations of every corner's projection and Jacobian.
+class RefinementMemo {
+public:
+    Fit refine(const CameraIntrinsics& camera, const Pose& start,
+               const std::vector<const Observation*>& use) {
+        for (const auto& e : entries_)
+            if (e.use == use && sameBits(e.start, start)) return e.fit;
+        Fit f = mirage::tracking::refine(camera, start, use, false);
+        entries_.push_back({start, use, f});
+        return f;
+    }
+
+private:
+    static bool sameBits(const Pose& a, const Pose& b) {
+        return a.translation == b.translation && a.rotation == b.rotation;
+    }
+    struct Entry {
+        Pose start;
+        std::vector<const Observation*> use;
+        Fit fit;
+    };
+    std::vector<Entry> entries_;
+};
+
 // Refinement from `start` on the tags near it, then up to 3 rounds of dropping tags whose RMS
 // exceeds max(outlierTagRmsPx, 4 x the median) and refining again.
 Refined refineWithRejection(const CameraIntrinsics& camera, const PoseEstimatorOptions& options,
-                            const std::vector<Observation>& obs, const Pose& start) {
+                            const std::vector<Observation>& obs, const Pose& start,
+                            RefinementMemo& memo) {
     Refined best;
     std::vector<const Observation*> use;
     for (const auto& o : obs)
         if (tagRms(camera, start, o) < 4 * inlierThreshold(options, o)) use.push_back(&o);
     if (use.empty()) return best;
-    Fit f = refine(camera, start, use, false);
+    Fit f = memo.refine(camera, start, use);
     for (int round = 0; round < 3 && f.ok; ++round) {
         std::vector<double> rmsPerTag;
         for (const auto& o : obs) rmsPerTag.push_back(tagRms(camera, f.pose, o));
@@ -498,7 +526,7 @@ Refined refineWithRejection(const CameraIntrinsics& camera, const PoseEstimatorO
         if (next.empty()) break;
         if (next == use) break;
         use = next;
-        f = refine(camera, f.pose, use, false);
+        f = memo.refine(camera, f.pose, use);
     }
     best.fit = f;
     best.inliers = use;
@@ -510,7 +538,8 @@ Refined refineWithRejection(const CameraIntrinsics& camera, const PoseEstimatorO
 std::vector<Refined> refineCandidates(const CameraIntrinsics& camera,
                                       const PoseEstimatorOptions& options,
                                       const std::vector<Scored>& scored,
-                                      const std::vector<Observation>& obs, double sceneScale) {
+                                      const std::vector<Observation>& obs, double sceneScale,
+                                      RefinementMemo& memo) {
     std::vector<Refined> refined;
     int refinements = 0;
     for (size_t i = 0; i < scored.size() && refined.size() < 3 && refinements < 4; ++i) {
@@ -525,7 +554,7 @@ std::vector<Refined> refineCandidates(const CameraIntrinsics& camera,
             dup = dup || samePose(r.fit.pose, scored[i].pose, sceneScale, 5.0, 0.05);
         if (dup) continue;
         ++refinements;
-        Refined r = refineWithRejection(camera, options, obs, scored[i].pose);
+        Refined r = refineWithRejection(camera, options, obs, scored[i].pose, memo);
         if (!r.fit.ok) continue;
         bool dupAfter = false;
         for (const auto& q : refined)
@@ -549,11 +578,11 @@ struct Alternative {
 // may not have made it into the refined set.
 Alternative bestAlternative(const CameraIntrinsics& camera, const PoseEstimatorOptions& options,
                             const std::vector<Refined>& refined, const std::vector<Scored>& scored,
-                            const Pose& chosen, double sceneScale) {
+                            const Pose& chosen, double sceneScale, RefinementMemo& memo) {
     const std::vector<const Observation*>& inliers = refined[0].inliers;
     Alternative alt;
     auto consider = [&](const Pose& start) {
-        const Fit f = refine(camera, start, inliers, false);
+        const Fit f = memo.refine(camera, start, inliers);
         if (!f.ok || samePose(f.pose, chosen, sceneScale)) return;
         if (alt.rmsPx < 0 || f.rms < alt.rmsPx) {
             alt.rmsPx = f.rms;
@@ -647,8 +676,9 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
         sceneScale =
             std::max(sceneScale, glm::length(c.translation - obs[0].T_world_tag.translation));
 
+    RefinementMemo memo;
     const std::vector<Refined> refined =
-        refineCandidates(camera_, options_, scored, obs, sceneScale);
+        refineCandidates(camera_, options_, scored, obs, sceneScale, memo);
     if (refined.empty()) {
         out.state = TrackingState::Lost;
         out.reason = "pose refinement failed";
@@ -673,7 +703,7 @@ PoseEstimate PoseEstimator::estimate(const std::vector<TagDetection>& detections
     }
 
     const Alternative alt =
-        bestAlternative(camera_, options_, refined, scored, finalFit.pose, sceneScale);
+        bestAlternative(camera_, options_, refined, scored, finalFit.pose, sceneScale, memo);
     out.alternativeRmsPx = alt.rmsPx;
 
     // Step 6. The state: lost if the tags disagree or the fit is poor; ok if the alternative is
