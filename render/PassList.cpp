@@ -17,7 +17,7 @@
     X(makeImpostorPass, impostorKnobs)                                                    \
     X(makePhotonGBufferPass, noKnobs) /* before vpl: VPLs follow photons */               \
     X(makeVplPass, vplKnobs)                                                              \
-    X(makeIsmPass, noKnobs)                                                               \
+    X(makeIsmPass, ismKnobs)                                                              \
     X(makeTranslucencyPass, translucencyKnobs)                                            \
     X(makeIndirectLightPass, indirectKnobs)                                               \
     X(makeGiFilterPass, noKnobs)                                                          \

@@ -76,6 +76,9 @@ const int kUnitVplPhotonSurfaceRefr = 8;
 // ism.comp (image units)
 const int kImageIsmAll = 0;
 const int kImageIsmReal = 1;
+// ism_pullpush.comp: an atlas (kImageIsmAll's unit) and two levels of the hole-filling pyramid.
+const int kImageIsmPyramidSrc = 1;
+const int kImageIsmPyramidDst = 2;
 
 // indirect.frag
 const int kUnitIndirectPosition = 0;

@@ -7,7 +7,15 @@
 #include "render/passes/vpl/VplPass.h"
 namespace mirage::render {
 
-IsmPass::IsmPass() : program_(computeProgram("ism", "passes/ism/ism.comp")) {}
+IsmPass::IsmPass()
+    : program_(computeProgram("ism", "passes/ism/ism.comp")),
+      pullPush_(computeProgram("ism pull-push", "passes/ism/ism_pullpush.comp")) {}
+
+int IsmPass::pullPushLevels(int tileSize) {
+    int levels = 0;
+    while ((tileSize >> levels) % 2 == 0 && (tileSize >> (levels + 1)) >= 4) ++levels;
+    return levels;
+}
 
 void IsmPass::setup(PassBuilder& b) const {
     b.read(kVpls);
@@ -16,14 +24,26 @@ void IsmPass::setup(PassBuilder& b) const {
 }
 
 PassDecision IsmPass::decide(const FrameContext& ctx) const {
-    return {true, std::to_string(ctx.options.vpl.count) + " VPLs x " +
-                      std::to_string(ctx.options.ism.pointsPerVpl) + " points" +
-                      (ctx.plan.needRealOnlyIsm ? ", plus a real-only atlas"
-                                                : ", no virtual points: one atlas")};
+    return {true,
+            std::to_string(ctx.options.vpl.count) + " VPLs x " +
+                std::to_string(ctx.options.ism.pointsPerVpl) + " points" +
+                (ctx.plan.needRealOnlyIsm ? ", plus a real-only atlas"
+                                          : ", no virtual points: one atlas") +
+                (ctx.options.ism.pullPush && pullPushLevels(ctx.options.ism.tileSize) > 0
+                     ? ", gaps filled by pull-push (" +
+                           std::to_string(pullPushLevels(ctx.options.ism.tileSize)) + " levels)"
+                     : "")};
 }
 
 void IsmPass::resize(const FrameContext& ctx) {
     const int size = ismTilesPerRow(ctx.options.vpl.count) * ctx.options.ism.tileSize;
+    const int levels = ctx.options.ism.pullPush ? pullPushLevels(ctx.options.ism.tileSize) : 0;
+    if (levels != allocatedLevels_ || size != allocatedSize_) {
+        pyramid_ = levels > 0 ? gl::Texture::create2D("ism pull-push pyramid", size / 2, size / 2,
+                                                      GL_RG32F, levels)
+                              : gl::Texture();
+        allocatedLevels_ = levels;
+    }
     if (size == allocatedSize_) return;
     all_ = gl::Texture::create2D("ism atlas", size, size, GL_R32UI);
     real_ = gl::Texture::create2D("ism atlas real-only", size, size, GL_R32UI);
@@ -52,8 +72,41 @@ void IsmPass::execute(FrameContext& ctx, PassResources& res) {
     const long long invocations = (long long)ctx.options.vpl.count * ctx.options.ism.pointsPerVpl;
     glDispatchCompute(GLuint((invocations + 63) / 64), 1, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    if (allocatedLevels_ > 0) {
+        pullPush(ctx, all_);
+        if (ctx.plan.needRealOnlyIsm) pullPush(ctx, real_);
+    }
     res.publish(kImperfectShadowMaps, all_);
     res.publish(kImperfectShadowMapsReal, ctx.plan.needRealOnlyIsm ? real_ : all_);
+}
+
+void IsmPass::pullPush(const FrameContext& ctx, const gl::Texture& atlas) {
+    pullPush_.use();
+    ctx.bindFrameBlocks();
+    const GLint locMode = pullPush_.uniformLocation("mode");
+    const GLint locSize = pullPush_.uniformLocation("levelSize");
+    glUniform1f(pullPush_.uniformLocation("minCoverage"), ctx.options.ism.pullPushCoverage);
+    glBindImageTexture(kImageIsmAll, atlas.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    // One dispatch per level; each reads what the one before wrote.
+    auto run = [&](int mode, int srcMip, int dstMip, int level) {
+        const int n = allocatedSize_ >> level;
+        if (srcMip >= 0)
+            glBindImageTexture(kImageIsmPyramidSrc, pyramid_.id(), srcMip, GL_FALSE, 0,
+                               GL_READ_ONLY, GL_RG32F);
+        if (dstMip >= 0)
+            glBindImageTexture(kImageIsmPyramidDst, pyramid_.id(), dstMip, GL_FALSE, 0,
+                               GL_READ_WRITE, GL_RG32F);
+        glUniform1i(locMode, mode);
+        glUniform2i(locSize, n, n);
+        glDispatchCompute(GLuint((n + 7) / 8), GLuint((n + 7) / 8), 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    };
+    // Pyramid level L (L >= 1) is mip L - 1.
+    run(0, -1, 0, 1);
+    for (int level = 2; level <= allocatedLevels_; ++level) run(1, level - 2, level - 1, level);
+    for (int level = allocatedLevels_ - 1; level >= 1; --level) run(2, level, level - 1, level);
+    run(3, 0, -1, 0);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 }
 
 // Registered in render/PassList.cpp.

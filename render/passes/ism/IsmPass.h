@@ -21,10 +21,20 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
     bool cameraIndependent() const override { return true; }
 
+    // Levels of the pull-push pyramid above the atlas for tiles of `tileSize` texels: halvings
+    // while the level's tiles stay even and at least 4 texels wide (64: 4 levels, to 4x4).
+    static int pullPushLevels(int tileSize);
+
 private:
-    gl::Program program_;
+    // Fills the gaps of one atlas (ism_pullpush.comp): pull into pyramid_, push back.
+    void pullPush(const FrameContext& ctx, const gl::Texture& atlas);
+
+    gl::Program program_, pullPush_;
     gl::Texture all_, real_;
-    int allocatedSize_ = 0;
+    // Depth and coverage (RG32F) of the pull-push pyramid: mip level L - 1 holds level L
+    // (half the atlas's size at mip 0).
+    gl::Texture pyramid_;
+    int allocatedSize_ = 0, allocatedLevels_ = 0;
 };
 
 }  // namespace mirage::render
