@@ -428,7 +428,8 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
             rep.reason = "reused: " + rep.reason;
             continue;
         }
-        if (p.cameraIndependent() && o.graph.reuseStaticPasses && staticOutputValid_[i]) {
+        if (p.cameraIndependent() && o.graph.reuseStaticPasses && staticOutputValid_[i] &&
+            p.staticThisFrame(ctx)) {
             for (const auto& [value, slot] : published_[i]) current_[size_t(value)] = slot;
             rep.reused = true;
             rep.reason = "reused: scene, lights and plan unchanged (" + rep.reason + ")";

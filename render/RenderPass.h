@@ -128,6 +128,11 @@ public:
     // VPLs, imperfect shadow maps. Scenes are static, so while the plan is unchanged the graph
     // reuses their last output (republishing what they published) instead of re-running them.
     virtual bool cameraIndependent() const { return false; }
+    // A camera-independent pass whose output changes from frame to frame by choice (the VPLs'
+    // per-frame rotation) returns false here for that frame, and so does every camera-
+    // independent pass that reads its output: the graph then runs them although the plan is
+    // unchanged.
+    virtual bool staticThisFrame(const FrameContext& /*ctx*/) const { return true; }
 
     // True when the pass's persistent output from its last run is still what this frame needs
     // (the pass knows its own input generation: the environment pass's "no new environment

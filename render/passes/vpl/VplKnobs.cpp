@@ -12,6 +12,11 @@ std::vector<PassKnob> vplKnobs() {
                   "on: a VPL on a mirror or glass follows the reflected / refracted photon to its "
                   "receiver (spot lights with caustics); off: it stays dark on the object",
                   [](RendererOptions& o) -> bool& { return o.vpl.throughSpecular; }, {"on"}),
+        onOffKnob("vpl_rotate",
+                  "on: each frame's VPLs from the Hammersley set shifted by a per-frame offset "
+                  "(averaged by the GI filter's temporal smoothing; VPLs and ISMs redone every "
+                  "frame); off: the same VPLs every frame",
+                  [](RendererOptions& o) -> bool& { return o.vpl.temporalRotation; }),
     };
     return k;
 }

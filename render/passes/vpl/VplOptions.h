@@ -11,6 +11,12 @@ struct VplOptions {
     // photon G-buffers (caustics on); false: it stays on the mirror / glass, which scatters no
     // diffuse light (the VPL is dark).
     bool throughSpecular = true;
+    // Each frame's VPLs from the same Hammersley set shifted by a per-frame offset (a Cranley-
+    // Patterson rotation along the R2 sequence of the frame index), so that the GI filter's
+    // temporal smoothing averages several VPL sets where the camera holds still; the VPLs and
+    // the imperfect shadow maps are then placed every frame instead of being reused while the
+    // scene is static. false: the same VPLs every frame (no VPL flicker).
+    bool temporalRotation = false;
 
     void validate() const {
         checkOption(count >= 0 && count <= 16384, "vpl.count", "0..16384", count);

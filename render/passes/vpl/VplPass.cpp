@@ -1,5 +1,7 @@
 #include "render/passes/vpl/VplPass.h"
 
+#include <cmath>
+
 #include "render/FrameGraph.h"
 #include "render/PassRegistry.h"
 #include "render/passes/caustic/PhotonGBufferPass.h"
@@ -19,6 +21,18 @@ void VplPass::setup(PassBuilder& b) const {
     b.createBuffer(kVpls, SizeRule::Vpl);
 }
 
+glm::vec2 vplSampleOffset(int frame) {
+    // The R2 sequence (Roberts 2018): the plastic number's powers, offsets that fill the unit
+    // square evenly for any number of consecutive frames.
+    constexpr double g = 1.32471795724474602596;
+    const double n = double(frame);
+    return {float(std::fmod(n / g, 1.0)), float(std::fmod(n / (g * g), 1.0))};
+}
+
+bool VplPass::staticThisFrame(const FrameContext& ctx) const {
+    return !ctx.options.vpl.temporalRotation;
+}
+
 PassDecision VplPass::decide(const FrameContext& ctx) const {
     if (!ctx.plan.needVpls) return {false, ctx.plan.vplReason};
     std::string reason = ctx.plan.vplReason;
@@ -26,6 +40,7 @@ PassDecision VplPass::decide(const FrameContext& ctx) const {
         reason += ctx.options.vpl.throughSpecular
                       ? "; VPLs on mirror / glass follow the reflected / refracted photons"
                       : "; reflected / refracted VPLs off";
+    if (ctx.options.vpl.temporalRotation) reason += "; the Hammersley set rotated every frame";
     return {true, reason};
 }
 
@@ -67,6 +82,8 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
                        &causticViewProj[0][0][0]);
     glUniform1fv(program_.uniformLocation("causticTanHalf"), kMaxLights, causticTanHalf);
     glUniform1i(program_.uniformLocation("photonMapSize"), ctx.options.caustic.mapSize);
+    glUniform2fv(program_.uniformLocation("sampleOffset"), 1,
+                 &vplSampleOffset(ctx.options.vpl.temporalRotation ? ctx.frameIndex : 0)[0]);
     glDispatchCompute(GLuint((ctx.options.vpl.count + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(kVpls, vpls_);

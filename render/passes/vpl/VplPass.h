@@ -7,6 +7,10 @@ namespace mirage::render {
 // SSBO of GpuVpl (vplCount entries).
 inline constexpr Resource kVpls{"Vpls"};
 
+// Frame `frame`'s offset of the VPLs' Hammersley set in the RSM image square (each axis in
+// [0, 1); frame 0: none), VplOptions::temporalRotation.
+glm::vec2 vplSampleOffset(int frame);
+
 class VplPass final : public RenderPass {
 public:
     VplPass();
@@ -16,6 +20,7 @@ public:
     void resize(const FrameContext& ctx) override;
     void execute(FrameContext& ctx, PassResources& res) override;
     bool cameraIndependent() const override { return true; }
+    bool staticThisFrame(const FrameContext& ctx) const override;
 
 private:
     gl::Program program_;

@@ -3,7 +3,7 @@
 // Places VPLs by sampling the reflective shadow maps (Keller's instant radiosity with Dachsbacher
 // & Stamminger's RSMs): one invocation per VPL. Each light owns a contiguous VPL range; a light's
 // samples form a Hammersley set over its layers' image squares (the same every frame, so a static
-// scene has no VPL flicker). A VPL's flux is the RSM's reflected intensity times the solid angle
+// scene has no VPL flicker, unless VplOptions::temporalRotation shifts it every frame). A VPL's flux is the RSM's reflected intensity times the solid angle
 // its sample stands for.
 //
 // Reflected and refracted VPLs (Knecht 2013 Sec. 5.2): a sample on a mirror or glass of a spot
@@ -27,6 +27,9 @@ layout(binding = kUnitVplPhotonSurfaceRefr) uniform usampler2DArray photonSurfac
 uniform mat4 causticViewProj[MAX_LIGHTS];  // world -> clip of each light's photon frustum
 uniform float causticTanHalf[MAX_LIGHTS];  // tan of that frustum's half angle
 uniform int photonMapSize;                 // photon G-buffer texels per side
+// Added to every sample's image-square position, modulo 1 (VplOptions::temporalRotation; 0: the
+// same set every frame).
+uniform vec2 sampleOffset;
 
 float radicalInverse2(uint bits) {
     bits = (bits << 16u) | (bits >> 16u);
@@ -111,7 +114,8 @@ void main() {
         int perLayer = max(r.y / layers, 1);
         int k = local / layers;
         if (k >= perLayer) break;  // remainder of a count not divisible by the layers
-        vec2 uv = vec2((float(k) + 0.5) / float(perLayer), radicalInverse2(uint(k)));
+        vec2 uv = fract(vec2((float(k) + 0.5) / float(perLayer), radicalInverse2(uint(k))) +
+                        sampleOffset);
         vec3 tc = vec3(uv, float(lights[li].firstShadowLayer + layer));
         vec4 pos = textureLod(rsmPosition, tc, 0.0);
         if (pos.w < 0.5) break;  // the sample sees no geometry
