@@ -15,7 +15,9 @@ struct VplOptions {
     // Patterson rotation along the R2 sequence of the frame index), so that the GI filter's
     // temporal smoothing averages several VPL sets where the camera holds still; the VPLs and
     // the imperfect shadow maps are then placed every frame instead of being reused while the
-    // scene is static. false: the same VPLs every frame (no VPL flicker).
+    // scene is static. The Halton choice between a reflected and a refracted photon moves along
+    // its sequence too (each taken about every second frame, as Knecht 2013 Sec. 5.2 has it).
+    // false: the same VPLs every frame (no VPL flicker).
     bool temporalRotation = false;
 
     void validate() const {

@@ -82,8 +82,9 @@ void VplPass::execute(FrameContext& ctx, PassResources& res) {
                        &causticViewProj[0][0][0]);
     glUniform1fv(program_.uniformLocation("causticTanHalf"), kMaxLights, causticTanHalf);
     glUniform1i(program_.uniformLocation("photonMapSize"), ctx.options.caustic.mapSize);
-    glUniform2fv(program_.uniformLocation("sampleOffset"), 1,
-                 &vplSampleOffset(ctx.options.vpl.temporalRotation ? ctx.frameIndex : 0)[0]);
+    const int frame = ctx.options.vpl.temporalRotation ? ctx.frameIndex : 0;
+    glUniform2fv(program_.uniformLocation("sampleOffset"), 1, &vplSampleOffset(frame)[0]);
+    glUniform1i(program_.uniformLocation("haltonFrame"), frame);
     glDispatchCompute(GLuint((ctx.options.vpl.count + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     res.publish(kVpls, vpls_);

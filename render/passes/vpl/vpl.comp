@@ -8,7 +8,8 @@
 //
 // Reflected and refracted VPLs (Knecht 2013 Sec. 5.2): a sample on a mirror or glass of a spot
 // light with photon G-buffers continues to the receiver of that point's reflected or refracted
-// photon. When both exist a Halton (base 3) choice takes one and doubles its power. Its flux is
+// photon. When both exist a Halton (base 3) choice takes one and doubles its power (the same
+// choice every frame, unless VplOptions::temporalRotation moves it along the sequence). Its flux is
 // the photon's power (W, visibility included) scaled from the photon texel's solid angle to the
 // sample's, times the receiver's diffuse albedo: so caustics emit coloured indirect light.
 layout(local_size_x = 64) in;
@@ -30,6 +31,7 @@ uniform int photonMapSize;                 // photon G-buffer texels per side
 // Added to every sample's image-square position, modulo 1 (VplOptions::temporalRotation; 0: the
 // same set every frame).
 uniform vec2 sampleOffset;
+uniform int haltonFrame;  // the frame index with VplOptions::temporalRotation, else 0
 
 float radicalInverse2(uint bits) {
     bits = (bits << 16u) | (bits >> 16u);
@@ -67,7 +69,9 @@ void followSpecular(int li, int layer, vec3 p, float sampleSolidAngle, uint k, i
     bool hasL = hitL.w >= 1.0 && dot(powL.rgb, vec3(1.0)) * powL.a > 0.0;
     bool hasT = hitT.w >= 1.0 && dot(powT.rgb, vec3(1.0)) * powT.a > 0.0;
     if (!hasL && !hasT) return;
-    bool takeL = hasL && (!hasT || radicalInverse3(k + 1u) < 0.5);
+    // With the per-frame rotation the choice moves along the Halton sequence frame by frame, so
+    // each sample takes either photon about every second frame (Knecht 2013 Sec. 5.2).
+    bool takeL = hasL && (!hasT || radicalInverse3(k + 1u + uint(haltonFrame)) < 0.5);
     float pick = hasL && hasT ? 2.0 : 1.0;  // the other photon's share, carried by this one
     vec4 hit = takeL ? hitL : hitT;
     vec4 pw = takeL ? powL : powT;
