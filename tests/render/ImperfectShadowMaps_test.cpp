@@ -25,25 +25,6 @@ class ImperfectShadowMaps : public test::HeadlessGlSuite {};
 
 constexpr glm::dvec3 kPlateLo{-0.88, 0.25, -0.6}, kPlateHi{-0.2, 0.3, 0.6};
 
-// Does the segment a -> b pass through the box (slab test, ends excluded by 1 mm)?
-bool segmentHitsBox(glm::dvec3 a, glm::dvec3 b, glm::dvec3 lo, glm::dvec3 hi) {
-    const glm::dvec3 d = b - a;
-    const double len = glm::length(d);
-    double t0 = 1e-3 / len, t1 = 1.0 - 1e-3 / len;
-    for (int k = 0; k < 3; ++k) {
-        if (std::abs(d[k]) < 1e-12) {
-            if (a[k] < lo[k] || a[k] > hi[k]) return false;
-            continue;
-        }
-        double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-        if (t0 > t1) return false;
-    }
-    return true;
-}
-
 struct VisibilityErrors {
     int occluded = 0, leaks = 0;        // exactly occluded pairs; of those, the ISM sees through
     int visible = 0, falseShadows = 0;  // exactly visible pairs; of those, the ISM occludes
@@ -91,7 +72,7 @@ VisibilityErrors measure(const IsmOptions& ism) {
                     glm::clamp(glm::ivec2((puv * 0.5 + 0.5) * double(tile)), 0, tile - 1);
                 const float depth = atlas.at<float>(origin.y + texel.y, origin.x + texel.x);
                 const bool ismVisible = dist - (0.02 + 0.03 * dist) <= double(depth);
-                if (segmentHitsBox(q, p, kPlateLo, kPlateHi)) {
+                if (test::segmentHitsBox(q, p, kPlateLo, kPlateHi)) {
                     ++e.occluded;
                     e.leaks += ismVisible;
                     e.leaksThroughEmpty += ismVisible && std::isinf(depth);

@@ -55,32 +55,8 @@ glm::dvec3 brdfCos(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::dvec3 base, do
     return ((1.0 - F) * (1 - metallic) * base / M_PI + D * G * F / (4 * NL * NV)) * NL;
 }
 
-// World point on the plane y = 0 seen by pixel (x, y) of a pinhole camera, if any.
-std::optional<glm::dvec3> floorHit(const CameraIntrinsics& cam, const Pose& T_world_camera, int x,
-                                   int y) {
-    auto ray = cam.unproject(glm::dvec2(x, y));
-    if (!ray) return std::nullopt;
-    const glm::dvec3 d = T_world_camera.rotationMatrix() * *ray;
-    const glm::dvec3 o = T_world_camera.translation;
-    if (d.y >= -1e-9) return std::nullopt;
-    return o + d * (-o.y / d.y);
-}
-
-// Does the segment a -> b pass through the axis-aligned box [lo, hi] (slab test)?
-bool segmentHitsBox(glm::dvec3 a, glm::dvec3 b, glm::dvec3 lo, glm::dvec3 hi) {
-    const glm::dvec3 d = b - a;
-    double t0 = 0, t1 = 1;
-    for (int i = 0; i < 3; ++i) {
-        if (std::abs(d[i]) < 1e-12) {
-            if (a[i] < lo[i] || a[i] > hi[i]) return false;
-            continue;
-        }
-        const double u = (lo[i] - a[i]) / d[i], v = (hi[i] - a[i]) / d[i];
-        t0 = std::max(t0, std::min(u, v));
-        t1 = std::min(t1, std::max(u, v));
-    }
-    return t0 <= t1;
-}
+using test::floorHit;
+using test::segmentHitsBox;
 
 bool allFinite(const cv::Mat& m) {
     return cv::checkRange(m, true, nullptr, -1e30, 1e30);

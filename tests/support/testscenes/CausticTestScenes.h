@@ -96,24 +96,6 @@ inline bool segmentNearPoint(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, double r)
     return glm::length(a + t * ab - c) < r;
 }
 
-// Does the segment a -> b cross the box [lo, hi] (slab test)?
-inline bool segmentHitsBox(glm::dvec3 a, glm::dvec3 b, glm::dvec3 lo, glm::dvec3 hi) {
-    double t0 = 0.0, t1 = 1.0;
-    const glm::dvec3 d = b - a;
-    for (int k = 0; k < 3; ++k) {
-        if (std::abs(d[k]) < 1e-12) {
-            if (a[k] < lo[k] || a[k] > hi[k]) return false;
-            continue;
-        }
-        double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-        if (t0 > t1) return false;
-    }
-    return true;
-}
-
 // Table pixels (y = 0 plane) whose straight line to the light passes through the glass shrunk
 // by `inner` about its centre (1 = the geometric shadow), not covered by the glass in the camera
 // (the sphere plus 1.5 px; the box's projection plus a 1 cm margin). CV_8U 255 / 0.

@@ -1,7 +1,9 @@
 #pragma once
 // Scenes built in code for the real-time renderer tests (small, analytic). World = glTF frame
 // (metres, +Y up); camera poses are T_world_camera with OpenCV axes.
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -175,6 +177,33 @@ inline Scene spotLitTableWithVirtualBox() {
 }
 inline Pose spotLitTableOverview() {
     return lookAtPose({0, 2.5, 2.5}, {0, 0, 0});
+}
+
+// World point on the plane y = 0 seen by pixel (x, y) of a pinhole camera, if any.
+inline std::optional<glm::dvec3> floorHit(const CameraIntrinsics& cam, const Pose& T_world_camera,
+                                          int x, int y) {
+    auto ray = cam.unproject(glm::dvec2(x, y));
+    if (!ray) return std::nullopt;
+    const glm::dvec3 d = T_world_camera.rotationMatrix() * *ray;
+    const glm::dvec3 o = T_world_camera.translation;
+    if (d.y >= -1e-9) return std::nullopt;
+    return o + d * (-o.y / d.y);
+}
+
+// Does the segment a -> b pass through the axis-aligned box [lo, hi] (slab test)?
+inline bool segmentHitsBox(glm::dvec3 a, glm::dvec3 b, glm::dvec3 lo, glm::dvec3 hi) {
+    const glm::dvec3 d = b - a;
+    double t0 = 0, t1 = 1;
+    for (int i = 0; i < 3; ++i) {
+        if (std::abs(d[i]) < 1e-12) {
+            if (a[i] < lo[i] || a[i] > hi[i]) return false;
+            continue;
+        }
+        const double u = (lo[i] - a[i]) / d[i], v = (hi[i] - a[i]) / d[i];
+        t0 = std::max(t0, std::min(u, v));
+        t1 = std::min(t1, std::max(u, v));
+    }
+    return t0 <= t1;
 }
 
 }  // namespace mirage::test
