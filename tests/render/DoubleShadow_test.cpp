@@ -17,10 +17,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/gl/Context.h"
-#include "core/image/ImageIO.h"
 #include "render/Renderer.h"
-#include "render/raytrace/DifferentialRendering.h"
-#include "render/raytrace/EmbreeDevice.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
@@ -69,17 +67,10 @@ TEST(DoubleShadow, OverlapOfARealAndAVirtualShadowIsShadowedOnce) {
     const Scene scene = makeScene(true);
     const CameraIntrinsics cam = test::smallCamera(320, 240, 260.0);
     const Pose pose = test::lookAtPose({-0.2, 1.6, 1.6}, {-0.3, 0, 0});
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 64;
-    st.threads = 2;
-    st.seed = 7;
-    st.caustics = false;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(scene, device, {cam, pose}, st);
-    const cv::Mat footage = linearRgbToSrgbBgr8(ref.realOnly);
-    const cv::Mat truth =
-        linearRgbToSrgbBgr8(raytrace::compositeDifferential(srgbBgr8ToLinearRgb(footage), ref));
+    const test::ReferenceFrame ref =
+        test::renderReferenceFrame(scene, cam, pose, 64, 7, /*caustics=*/false);
+    const cv::Mat& footage = ref.footage;
+    const cv::Mat& truth = ref.composite;
 
     // Table pixels (not covered by a box) shadowed by both boxes, and by the virtual one only;
     // 2 px off every shadow edge (the shadow maps' texels place an edge to about a pixel).

@@ -17,8 +17,8 @@
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
 #include "render/raytrace/DifferentialRendering.h"
-#include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
@@ -85,31 +85,17 @@ TEST(RealtimeAccuracy, CompositeMatchesReferenceGroundTruth) {
     const AccuracyScene s = makeScene();
 
     // Ground truth: the reference renderer's L_r and L_rv (fixed seed; the plane and box are
-    // diffuse and the spot light is sampled directly, so a few passes converge).
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 64;
-    st.threads = 2;
-    st.seed = 7;
-    st.caustics = false;  // no specular objects: the photon map would add nothing
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    ASSERT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-
-    // Synthetic footage: L_r encoded like a camera frame (8-bit BGR sRGB); the reference composite
-    // uses the same quantised image (linear) as CI.
-    const cv::Mat footage = linearRgbToSrgbBgr8(ref.realOnly);
-    const cv::Mat refComposite = raytrace::compositeDifferential(srgbBgr8ToLinearRgb(footage), ref);
-    const cv::Mat refSrgb = linearRgbToSrgbBgr8(refComposite);
-
+    // diffuse and the spot light is sampled directly, so a few passes converge; no specular
+    // objects: the photon map would add nothing). The footage is L_r encoded like a camera frame
+    // (8-bit BGR sRGB); the reference composite uses the same quantised image (linear) as CI.
+    const test::ReferenceFrame reference =
+        test::renderReferenceFrame(s.scene, s.cam, s.pose, 64, 7, /*caustics=*/false);
+    const raytrace::DifferentialImages& ref = reference.images;
+    const cv::Mat& footage = reference.footage;
+    const cv::Mat& refSrgb = reference.composite;
     // Pixels the virtual box influences: its own coverage and where it changes the real world
     // (shadow, bounce) by more than 0.01 linear in some channel.
-    cv::Mat diff, diffMax;
-    cv::absdiff(ref.realAndVirtual, ref.realOnly, diff);
-    cv::Mat ch[3];
-    cv::split(diff, ch);
-    diffMax = cv::max(cv::max(ch[0], ch[1]), ch[2]);
-    const cv::Mat virtualMask = (diffMax > 0.01f) | (ref.virtualCoverage > 0.0f);
+    const cv::Mat virtualMask = test::influencedPixels(ref);
     ASSERT_GT(cv::countNonZero(virtualMask), 500);  // the box and its shadow are in view
 
     gl::Context context = gl::Context::headless();

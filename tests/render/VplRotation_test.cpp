@@ -16,12 +16,10 @@
 #include <opencv2/core.hpp>
 
 #include "core/gl/Context.h"
-#include "core/image/ImageIO.h"
 #include "render/Renderer.h"
 #include "render/passes/vpl/VplPass.h"
-#include "render/raytrace/DifferentialRendering.h"
-#include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/RenderTestScenes.h"
 
 namespace mirage::render {
@@ -46,22 +44,11 @@ const Reference& reference() {
         test::addLight(s.scene, Light::Type::Spot, light,
                        glm::normalize(glm::vec3(0.0f, 0.1f, 0.0f) - light), 8.0f, Origin::Real,
                        1.0f, 0.9f);
-        const raytrace::EmbreeDevice device("threads=2");
-        raytrace::RenderSettings st;
-        st.samplesPerPixel = 64;
-        st.threads = 2;
-        st.seed = 7;
-        st.caustics = false;
-        const raytrace::DifferentialImages ref =
-            raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-        s.footage = linearRgbToSrgbBgr8(ref.realOnly);
-        s.truthSrgb = linearRgbToSrgbBgr8(
-            raytrace::compositeDifferential(srgbBgr8ToLinearRgb(s.footage), ref));
-        cv::Mat diff, ch[3];
-        cv::absdiff(ref.realAndVirtual, ref.realOnly, diff);
-        cv::split(diff, ch);
-        s.influenced =
-            (cv::max(cv::max(ch[0], ch[1]), ch[2]) > 0.01f) | (ref.virtualCoverage > 0.0f);
+        const test::ReferenceFrame f = test::renderReferenceFrame(s.scene, s.cam, s.pose, 64, 7,
+                                                                  /*caustics=*/false);
+        s.footage = f.footage;
+        s.truthSrgb = f.composite;
+        s.influenced = test::influencedPixels(f.images);
         return s;
     }();
     return r;

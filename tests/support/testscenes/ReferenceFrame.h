@@ -49,4 +49,14 @@ inline ReferenceFrame renderReferenceFrame(const Scene& scene, const CameraIntri
     return r;
 }
 
+// CV_8U: the pixels the virtual objects influence, their coverage and where they change the
+// real world (shadow, bounce) by more than `threshold` (linear) in some channel.
+inline cv::Mat influencedPixels(const raytrace::DifferentialImages& images,
+                                float threshold = 0.01f) {
+    cv::Mat diff, ch[3];
+    cv::absdiff(images.realAndVirtual, images.realOnly, diff);
+    cv::split(diff, ch);
+    return (cv::max(cv::max(ch[0], ch[1]), ch[2]) > threshold) | (images.virtualCoverage > 0.0f);
+}
+
 }  // namespace mirage::test
