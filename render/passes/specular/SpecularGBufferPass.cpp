@@ -142,24 +142,30 @@ void SpecularGBufferPass::execute(FrameContext& ctx, PassResources& res) {
             kRefractionEmissive, kRefractionWeight);
 }
 
+namespace {
+// One trace (mode 0: the reflection, 1: the refraction) of `program` into `hits`, a width x
+// height target, over `rects`: only specular pixels pass the early depth test (the triangle lies
+// at depth 0.5 against the mask); the rest of the rectangles is cleared to 0 (no specular pixel,
+// or none that refracts).
+void trace(FrameContext& ctx, int mode, const gl::Program& program, SpecularHitBuffer& hits,
+           int width, int height, const std::vector<glm::ivec4>& rects) {
+    hits.fbo.bind();
+    ctx.beginFullscreen(program, width, height);
+    if (mode == 1)
+        glUniform1i(program.uniformLocation("marchSteps"),
+                    ctx.options.specular.refractionMarchSteps);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_FALSE);
+    ctx.clearForRects(rects, hits.drawn, 0, 5);
+    ctx.drawFullscreenTriangleIn(rects);
+}
+}  // namespace
+
 void SpecularGBufferPass::traceFullResolution(FrameContext& ctx) {
-    for (int mode = 0; mode < 2; ++mode) {
-        SpecularHitBuffer& hits = mode == 0 ? refl_ : refr_;
-        hits.fbo.bind();
-        const gl::Program& program = programs_[mode];
-        ctx.beginFullscreen(program, ctx.canvasWidth(), ctx.canvasHeight());
-        if (mode == 1)
-            glUniform1i(program.uniformLocation("marchSteps"),
-                        ctx.options.specular.refractionMarchSteps);
-        // Only specular pixels pass the early depth test (the triangle lies at depth 0.5).
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_GREATER);
-        glDepthMask(GL_FALSE);
-        // 0 elsewhere: no specular pixel, or (refraction) none that refracts.
-        const std::vector<glm::ivec4>& rects = mode == 0 ? ctx.specularRects : ctx.refractiveRects;
-        ctx.clearForRects(rects, hits.drawn, 0, 5);
-        ctx.drawFullscreenTriangleIn(rects);
-    }
+    for (int mode = 0; mode < 2; ++mode)
+        trace(ctx, mode, programs_[mode], mode == 0 ? refl_ : refr_, ctx.canvasWidth(),
+              ctx.canvasHeight(), mode == 0 ? ctx.specularRects : ctx.refractiveRects);
 }
 
 namespace {
@@ -188,20 +194,9 @@ void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& 
     ctx.drawFullscreenTriangleIn(blocks);
     // The trace's units again (the mask's shared one).
     glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(kBackFacePosition).id());
-    for (int mode = 0; mode < 2; ++mode) {
-        SpecularHitBuffer& hits = mode == 0 ? halfRefl_ : halfRefr_;
-        hits.fbo.bind();
-        const gl::Program& program = halfPrograms_[mode];
-        ctx.beginFullscreen(program, halfWidth_, halfHeight_);
-        if (mode == 1)
-            glUniform1i(program.uniformLocation("marchSteps"),
-                        ctx.options.specular.refractionMarchSteps);
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_GREATER);
-        glDepthMask(GL_FALSE);
-        ctx.clearForRects(blocks, hits.drawn, 0, 5);
-        ctx.drawFullscreenTriangleIn(blocks);
-    }
+    for (int mode = 0; mode < 2; ++mode)
+        trace(ctx, mode, halfPrograms_[mode], mode == 0 ? halfRefl_ : halfRefr_, halfWidth_,
+              halfHeight_, blocks);
     // The fill, on the canvas's specular pixels.
     const gl::Texture* half[10] = {&halfRefl_.position, &halfRefl_.normal, &halfRefl_.albedo,
                                    &halfRefl_.emissive, &halfRefl_.weight, &halfRefr_.position,
