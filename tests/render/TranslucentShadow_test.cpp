@@ -18,10 +18,9 @@
 #include "core/image/ImageIO.h"
 #include "render/Renderer.h"
 #include "render/passes/direct/DirectLightPass.h"
-#include "render/raytrace/DifferentialRendering.h"
-#include "render/raytrace/EmbreeDevice.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/CausticTestScenes.h"
+#include "testscenes/ReferenceFrame.h"
 #include "testscenes/TranslucentTestScenes.h"
 
 namespace mirage::render {
@@ -100,17 +99,11 @@ TEST(TranslucentShadow, VirtualCubeShadowIsLitAndTintedLikeTheReferenceAndOpaque
     const cv::Mat mask = test::straightShadowMask(s, 1.0);
     ASSERT_GT(cv::countNonZero(mask), 150);
 
-    const raytrace::EmbreeDevice device("threads=2");
-    raytrace::RenderSettings st;
-    st.samplesPerPixel = 48;
-    st.threads = 2;
-    st.seed = 5;
-    const raytrace::DifferentialImages ref =
-        raytrace::renderDifferential(s.scene, device, {s.cam, s.pose}, st);
-    ASSERT_EQ(ref.realStats.nonFiniteSamples + ref.mixedStats.nonFiniteSamples, 0);
-    const cv::Mat footage = linearRgbToSrgbBgr8(ref.realOnly);
+    const test::ReferenceFrame reference =
+        test::renderReferenceFrame(s.scene, s.cam, s.pose, 48, 5);
+    const cv::Mat& footage = reference.footage;
     const cv::Mat footageLinear = srgbBgr8ToLinearRgb(footage);
-    const cv::Mat refComposite = raytrace::compositeDifferential(footageLinear, ref);
+    const cv::Mat& refComposite = reference.compositeLinear;
 
     const Realtime on = renderRealtime(s, footage, true), off = renderRealtime(s, footage, false);
     const double yRef = test::meanLuminance(refComposite, mask),
@@ -141,8 +134,9 @@ TEST(TranslucentShadow, VirtualCubeShadowIsLitAndTintedLikeTheReferenceAndOpaque
     EXPECT_LT(psnrOff, kPsnrFloorDb);
     // Routing: a virtual cube leaves L_r unshadowed (the real-only maps hold no translucent
     // object): the real-time L_r over the shadow is the lit table of the reference's L_r.
-    EXPECT_NEAR(test::meanLuminance(on.lr, mask) / test::meanLuminance(ref.realOnly, mask), 1.0,
-                kLuminanceTolerance);
+    EXPECT_NEAR(
+        test::meanLuminance(on.lr, mask) / test::meanLuminance(reference.images.realOnly, mask),
+        1.0, kLuminanceTolerance);
 
     // The tint follows the albedo: a cool medium tints the shadow blue.
     ShadowSceneOptions cool;
