@@ -413,6 +413,9 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
     };
     const Clock::time_point frameStart = Clock::now();
     syncedMs_.assign(nodes_.size(), 0.0);
+    // Values a camera-independent pass wrote anew this frame (it ran instead of being reused): a
+    // camera-independent pass that reads one of them cannot reuse its output either.
+    std::vector<char> rewritten(values_.size(), 0);
     for (size_t i = 0; i < nodes_.size(); ++i) {
         Node& node = nodes_[i];
         RenderPass& p = *node.pass;
@@ -428,8 +431,11 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
             rep.reason = "reused: " + rep.reason;
             continue;
         }
+        const bool inputRewritten =
+            std::any_of(node.readValues.begin(), node.readValues.end(),
+                        [&](int v) { return v >= 0 && rewritten[size_t(v)]; });
         if (p.cameraIndependent() && o.graph.reuseStaticPasses && staticOutputValid_[i] &&
-            p.staticThisFrame(ctx)) {
+            p.staticThisFrame(ctx) && !inputRewritten) {
             for (const auto& [value, slot] : published_[i]) current_[size_t(value)] = slot;
             rep.reused = true;
             rep.reason = "reused: scene, lights and plan unchanged (" + rep.reason + ")";
@@ -457,6 +463,9 @@ const FrameReport& FrameGraph::execute(FrameContext& ctx, const std::string& sta
             timers_[i].end();
         }
         rep.ran = true;
+        if (p.cameraIndependent())
+            for (int v : node.writeValues)
+                if (v >= 0) rewritten[size_t(v)] = 1;
         staticOutputValid_[i] = p.cameraIndependent();
         outputHeld_[i] = true;
     }

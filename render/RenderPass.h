@@ -129,9 +129,8 @@ public:
     // reuses their last output (republishing what they published) instead of re-running them.
     virtual bool cameraIndependent() const { return false; }
     // A camera-independent pass whose output changes from frame to frame by choice (the VPLs'
-    // per-frame rotation) returns false here for that frame, and so does every camera-
-    // independent pass that reads its output: the graph then runs them although the plan is
-    // unchanged.
+    // per-frame rotation) returns false here for that frame: the graph then runs it although the
+    // plan is unchanged, and with it every camera-independent pass that reads its output.
     virtual bool staticThisFrame(const FrameContext& /*ctx*/) const { return true; }
 
     // True when the pass's persistent output from its last run is still what this frame needs

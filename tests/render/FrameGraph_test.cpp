@@ -22,6 +22,8 @@
 #include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/indirect/IndirectLightPass.h"
+#include "render/passes/ism/IsmPass.h"
+#include "render/passes/shadow/ShadowPass.h"
 #include "render/passes/specular/SpecularLightPass.h"
 #include "render/passes/vpl/VplPass.h"
 #include "testscenes/RenderTestScenes.h"
@@ -78,6 +80,8 @@ struct TestPassSpec {
     std::vector<Resource> publishExtra{};  // published in execute() without a declaration
     GLenum publishFormat = GL_RGBA16F;     // format of the published textures
     int cpuMs = 0;                         // execute() sleeps this long
+    bool cameraIndependent = false;        // RenderPass::cameraIndependent
+    bool staticEachFrame = true;           // RenderPass::staticThisFrame
 };
 
 class TestPass final : public RenderPass {
@@ -96,6 +100,8 @@ public:
             b.modify(r, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     }
     PassDecision decide(const FrameContext&) const override { return {s_.run, s_.reason}; }
+    bool cameraIndependent() const override { return s_.cameraIndependent; }
+    bool staticThisFrame(const FrameContext&) const override { return s_.staticEachFrame; }
     void resize(const FrameContext& ctx) override {
         if (!tex_.id()) {
             canvas_ = gl::Texture::create2D("test canvas", ctx.canvasWidth(), ctx.canvasHeight(),
@@ -293,6 +299,40 @@ TEST_F(FrameGraphTest, CullsFromTheOutputsAndSaysWhy) {
               (std::vector<std::string>{"off", "dependent", "unread", "used", "last"}));
     EXPECT_NE(g.describe().find("reads  Vpls"), std::string::npos) << g.describe();
     EXPECT_NE(g.dot().find("p0 -> p1 [label=\"Vpls\"]"), std::string::npos) << g.dot();
+}
+
+// Camera-independent passes are reused while the static key holds, except one that is not static
+// this frame (the VPLs rotated every frame) and every camera-independent pass that reads what it
+// wrote (the imperfect shadow maps of those VPLs); one that reads only reused outputs stays
+// reused.
+TEST_F(FrameGraphTest, ARerunCameraIndependentPassRerunsItsCameraIndependentReaders) {
+    for (bool sourceStatic : {true, false}) {
+        FrameGraph g;
+        TestPass& rsm = add(g, {.name = "rsm", .writes = {kRsmFlux}, .cameraIndependent = true});
+        TestPass& vpl = add(g, {.name = "vpl",
+                                .writes = {kVpls},
+                                .reads = {kRsmFlux},
+                                .cameraIndependent = true,
+                                .staticEachFrame = sourceStatic});
+        TestPass& ism = add(g, {.name = "ism",
+                                .writes = {kImperfectShadowMaps},
+                                .reads = {kVpls},
+                                .cameraIndependent = true});
+        TestPass& shadowed = add(g, {.name = "shadow user",
+                                     .writes = {kLenv},
+                                     .reads = {kRsmFlux},
+                                     .cameraIndependent = true});
+        TestPass& last = add(
+            g, {.name = "last", .writes = {kComposite}, .reads = {kImperfectShadowMaps, kLenv}});
+        g.markOutput(kComposite);
+        g.compile();
+        for (int frame = 0; frame < 3; ++frame) g.execute(*ctx_, "static");
+        EXPECT_EQ(rsm.runs, 1) << sourceStatic;
+        EXPECT_EQ(vpl.runs, sourceStatic ? 1 : 3);
+        EXPECT_EQ(ism.runs, sourceStatic ? 1 : 3) << "a reader of rewritten VPLs runs again";
+        EXPECT_EQ(shadowed.runs, 1) << sourceStatic;
+        EXPECT_EQ(last.runs, 3);
+    }
 }
 
 // Versioned writes: a pass that modifies a resource writes its next version; readers declared

@@ -35,10 +35,6 @@ PassDecision IsmPass::decide(const FrameContext& ctx) const {
                      : "")};
 }
 
-bool IsmPass::staticThisFrame(const FrameContext& ctx) const {
-    return !ctx.options.vpl.temporalRotation;
-}
-
 void IsmPass::resize(const FrameContext& ctx) {
     const int size = ismTilesPerRow(ctx.options.vpl.count) * ctx.options.ism.tileSize;
     const int levels = ctx.options.ism.pullPush ? pullPushLevels(ctx.options.ism.tileSize) : 0;

@@ -20,8 +20,6 @@ public:
     void resize(const FrameContext& ctx) override;
     void execute(FrameContext& ctx, PassResources& res) override;
     bool cameraIndependent() const override { return true; }
-    // Its points are splatted around the VPLs: new VPLs every frame, new maps.
-    bool staticThisFrame(const FrameContext& ctx) const override;
 
     // Levels of the pull-push pyramid above the atlas for tiles of `tileSize` texels: halvings
     // while the level's tiles stay even and at least 4 texels wide (64: 4 levels, to 4x4).
