@@ -10,7 +10,6 @@
 // docs/realtime-renderer.md, "VPLs rotated over frames", has the figures.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <cstdio>
 
 #include <opencv2/core.hpp>
@@ -54,17 +53,6 @@ const Reference& reference() {
     return r;
 }
 
-// PSNR (dB, 8-bit) of a against b over mask.
-double maskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
-    cv::Mat d;
-    cv::absdiff(a, b, d);
-    d.convertTo(d, CV_64FC3);
-    d = d.mul(d);
-    const cv::Scalar s = cv::sum(d.setTo(0, mask == 0));
-    const double mse = (s[0] + s[1] + s[2]) / (3.0 * cv::countNonZero(mask));
-    return 10.0 * std::log10(255.0 * 255.0 / std::max(mse, 1e-12));
-}
-
 struct Frames {
     cv::Mat first, last, beforeLast;
 };
@@ -99,8 +87,8 @@ TEST(VplRotation, RotatedVplsAverageTowardsTheReferenceAndFixedOnesFailTheFloor)
     ASSERT_GT(cv::countNonZero(ref.influenced), 500);
     for (int n : {16, 64, 256}) {
         const Frames fixed = render(false, kFrames, n), rotated = render(true, kFrames, n);
-        const double pFixed = maskedPsnr(fixed.last, ref.truthSrgb, ref.influenced);
-        const double pRotated = maskedPsnr(rotated.last, ref.truthSrgb, ref.influenced);
+        const double pFixed = test::psnr(fixed.last, ref.truthSrgb, 255.0, ref.influenced);
+        const double pRotated = test::psnr(rotated.last, ref.truthSrgb, 255.0, ref.influenced);
         const double change = test::meanAbsDiff(rotated.last, rotated.beforeLast, ref.influenced);
         std::printf(
             "%d VPLs, frame %d against the reference over %d px: fixed %.2f dB, rotated "
