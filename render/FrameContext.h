@@ -131,6 +131,19 @@ struct LightPlan {
     // optical thickness), whether or not the light has caustics.
     bool translucentTransmits = false;
     bool needsRealOnlyGlass = false;
+    // The virtual occluders get maps of their own, each fitted to a group of them
+    // (GpuLight::focusViewProj): a real light with real and virtual occluders in its cone whose
+    // virtual ones fill small parts of it. The shadow-map texels are then much finer where the
+    // virtual objects' shadows fall, which is what the differential (L_rv - L_r) shows:
+    // visibility through all occluders is the real map's times the virtual ones' (lighting.glsl).
+    // focusDraws[k]: the scene draws in focused map k (atlas layer firstFocusLayer + k).
+    std::vector<std::vector<int>> focusDraws;
+    // With focused maps: the virtual occluders in none of them (glass opaque to this light
+    // because its caustics carry the light through: its shadow's edge is where the photons take
+    // over, not a hard edge), drawn into the light's own layers of the all-occluder atlas.
+    std::vector<int> unfocusedDraws;
+    int firstFocusLayer = 0;
+    bool focusedVirtual() const { return !focusDraws.empty(); }
     // The light has glass atlases: glass or a translucent object transmits it.
     bool hasGlassLayer() const { return glassTransmits || translucentTransmits; }
     // Caustics: a spot light with a specular object in its cone gets photon G-buffers (layer
@@ -149,6 +162,7 @@ struct LightPlan {
 struct FramePlan {
     std::vector<LightPlan> lights;
     int shadowLayers = 0;
+    int focusLayers = 0;  // focused virtual-occluder maps, after shadowLayers in ShadowMaps
     bool needVpls = false;
     bool needRealOnlyShadows = false;
     bool glassShadows = false;  // some light's shadow maps have glass (ShadowGlass written)

@@ -36,6 +36,10 @@ bool expectedSize(SizeRule s, const FrameContext& c, int& w, int& h, int& layers
             w = h = s == SizeRule::ShadowAtlas ? o.shadow.mapSize : o.shadow.rsmSize;
             layers = std::max(1, c.plan.shadowLayers);
             return true;
+        case SizeRule::FocusedShadowAtlas:
+            w = h = o.shadow.mapSize;
+            layers = std::max(1, c.plan.shadowLayers) + c.plan.focusLayers;
+            return true;
         case SizeRule::IsmAtlas:
             w = h = ismTilesPerRow(o.vpl.count) * o.ism.tileSize;
             return true;

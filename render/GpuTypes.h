@@ -16,7 +16,9 @@ using mat4 = glm::mat4;
 
 #include "render/gpu_types.glsl"  // includes render/bindings.glsl
 
-static_assert(sizeof(GpuLight) == 6 * 64 + 6 * 16);
+static_assert(sizeof(GpuLight) == (6 + kMaxFocusMaps) * 64 + 7 * 16);
+static_assert(offsetof(GpuLight, focusFrustumSize) == 6 * 64 + 6 * 16);
+static_assert(offsetof(GpuLight, focusViewProj) == 6 * 64 + 7 * 16);
 static_assert(offsetof(GpuLight, glassShadow) == 6 * 64 + 5 * 16);
 static_assert(offsetof(GpuLight, range) == 6 * 64 + 12 && offsetof(GpuLight, type) == 6 * 64 + 28);
 static_assert(offsetof(GpuLight, frustumSize) == 6 * 64 + 44);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -229,6 +230,113 @@ void shadowMatrices(const SceneLight& l, const BoundingSphere& B, float R, GpuLi
     }
 }
 
+// A focused virtual-occluder map's frustum from light l around the spheres of a group of
+// virtual draws: spot and point lights, a square perspective frustum about the direction to the
+// group's merged bounds, wide enough for each member's bounding cone (size: tan of its half
+// angle); directional, an orthographic box around the merged bounds (size: its half extent, m).
+// False when a member's bounds hold the light (no frustum from inside).
+struct FocusFrustum {
+    std::vector<int> draws;
+    std::vector<BoundingSphere> spheres;
+    float size = 0.0f;
+    glm::mat4 viewProj{1.0f};
+};
+
+bool fitFocus(const SceneLight& l, FocusFrustum& f) {
+    BoundingSphere all = f.spheres.front();
+    for (const BoundingSphere& b : f.spheres) all = mergeSpheres(all, b);
+    const float radius = std::max(all.radius * 1.02f, 1e-3f);
+    if (l.type == kLightDirectional) {
+        const glm::vec3 eye = all.center - l.direction * (radius + 0.1f);
+        f.size = radius;
+        f.viewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 2.0f * radius + 0.2f) *
+                     glm::lookAt(eye, all.center, anyPerpendicular(l.direction));
+        return true;
+    }
+    const glm::vec3 toCentre = all.center - l.position;
+    const float dist = glm::length(toCentre);
+    if (dist <= radius) return false;
+    const glm::vec3 axis = toCentre / dist;
+    float half = 0.0f, nearest = dist - radius;
+    for (const BoundingSphere& b : f.spheres) {
+        const glm::vec3 v = b.center - l.position;
+        const float d = glm::length(v);
+        const float r = b.radius * 1.02f + 1e-3f;
+        if (d <= r) return false;
+        const float off = std::acos(std::clamp(glm::dot(v / d, axis), -1.0f, 1.0f));
+        half = std::max(half, off + std::asin(std::min(r / d, 1.0f)));
+        nearest = std::min(nearest, d - r);
+    }
+    if (half > 1.2f) return false;
+    f.size = std::tan(half);
+    f.viewProj =
+        glm::perspective(2.0f * half, 1.0f, std::max(nearest * 0.5f, 1e-3f), dist + radius * 1.5f) *
+        glm::lookAt(l.position, all.center, anyPerpendicular(axis));
+    return true;
+}
+
+// The virtual occluders' own shadow maps (LightPlan::focusDraws): the virtual draws that go into
+// the light's occluder maps (ShadowPass::drawOccluders' choice) but glass (opaque there only for
+// a light whose caustics carry the light through it; LightPlan::unfocusedDraws), grouped so that
+// each group's
+// frustum is small: every draw starts as its own group, and the two groups whose merged frustum
+// is smallest are merged while there are more than kMaxFocusMaps or the merge widens the larger
+// frustum by at most 25 % (one raster for neighbours). Used only where every frustum is at most
+// half the light's own (else one map of all occluders is nearly as fine).
+void planVirtualFocus(const SceneLight& l, const GpuScene& s, LightPlan& lp, GpuLight& g) {
+    std::vector<FocusFrustum> groups;
+    std::vector<int> unfocused;
+    for (size_t i = 0; i < s.draws().size(); ++i) {
+        const DrawItem& d = s.draws()[i];
+        if (d.origin != Origin::Virtual || !inLightCone(l, d.bounds)) continue;
+        if (lp.glassTransmits && d.transmissive) continue;  // in the glass layer instead
+        if (lp.translucentTransmits && d.translucent) continue;
+        if (d.transmissive) {  // opaque here only because the photons carry the light through
+            unfocused.push_back(int(i));
+            continue;
+        }
+        FocusFrustum f;
+        f.draws = {int(i)};
+        f.spheres = {d.bounds};
+        if (!fitFocus(l, f)) return;
+        groups.push_back(std::move(f));
+    }
+    while (groups.size() > 1) {
+        size_t bi = 0, bj = 0;
+        FocusFrustum best;
+        best.size = std::numeric_limits<float>::max();
+        for (size_t i = 0; i < groups.size(); ++i)
+            for (size_t j = i + 1; j < groups.size(); ++j) {
+                FocusFrustum m = groups[i];
+                m.draws.insert(m.draws.end(), groups[j].draws.begin(), groups[j].draws.end());
+                m.spheres.insert(m.spheres.end(), groups[j].spheres.begin(),
+                                 groups[j].spheres.end());
+                if (!fitFocus(l, m) || m.size >= best.size) continue;
+                best = std::move(m);
+                bi = i;
+                bj = j;
+            }
+        if (best.draws.empty()) break;  // no two groups fit one frustum
+        const bool cheap = best.size <= 1.25f * std::max(groups[bi].size, groups[bj].size);
+        if (groups.size() <= size_t(kMaxFocusMaps) && !cheap) break;
+        groups[bi] = std::move(best);
+        groups.erase(groups.begin() + std::ptrdiff_t(bj));
+    }
+    if (groups.empty() || groups.size() > size_t(kMaxFocusMaps)) return;
+    // frustumSize: the spot's tan(half angle), a cube face's tan(45 degrees) = 1, the
+    // directional box's half extent.
+    for (const FocusFrustum& f : groups)
+        if (f.size > 0.5f * g.frustumSize) return;
+    g.focusMaps = int(groups.size());
+    g.unfocusedVirtual = unfocused.empty() ? 0 : 1;
+    lp.unfocusedDraws = std::move(unfocused);
+    for (size_t k = 0; k < groups.size(); ++k) {
+        g.focusFrustumSize[int(k)] = groups[k].size;
+        g.focusViewProj[k] = groups[k].viewProj;
+        lp.focusDraws.push_back(groups[k].draws);
+    }
+}
+
 // VPLs: needed when the virtual objects change the indirect light that can be seen; split over
 // the lights with shadow maps (each gets a reflective shadow map).
 void planVpls(const RendererOptions& o, bool anyCaster, bool anyReachesVirtual, bool virtualInView,
@@ -445,6 +553,7 @@ void Renderer::planFrame(const FrameInput& input) {
 
         shadowMatrices(l, B, R, g, lp);
         if (!lp.castsShadow) lp.layers = 0;
+        if (options_.shadow.focus && lp.needsRealOnlyMap) planVirtualFocus(l, s, lp, g);
         lp.firstLayer = layer;
         layer += lp.layers;
         g.firstShadowLayer = lp.firstLayer;
@@ -458,6 +567,12 @@ void Renderer::planFrame(const FrameInput& input) {
         plan.lights.push_back(lp);
     }
     plan.shadowLayers = layer;
+    for (size_t i = 0; i < plan.lights.size(); ++i) {  // focused maps after the light layers
+        LightPlan& lp = plan.lights[i];
+        lp.firstFocusLayer = plan.shadowLayers + plan.focusLayers;
+        c.lightBlock.lights[i].firstFocusLayer = lp.firstFocusLayer;
+        plan.focusLayers += int(lp.focusDraws.size());
+    }
     if (plan.causticLayers > 0) {
         plan.causticReason = std::to_string(plan.causticLayers) +
                              " spot light(s) with a mirror or glass object in the cone";
@@ -482,17 +597,18 @@ std::string staticPlanKey(const FrameContext& c) {
     std::string key(reinterpret_cast<const char*>(&c.lightBlock), sizeof(GpuLightBlock));
     const FramePlan& p = c.plan;
     for (const LightPlan& l : p.lights)
-        key +=
-            fmt::format("|{}{}{}{}{}{}{} {} {} {} {}", int(l.castsShadow), int(l.needsRealOnlyMap),
-                        int(l.reachesVirtual), int(l.hasRsm), int(l.glassTransmits),
-                        int(l.translucentTransmits), int(l.needsRealOnlyGlass), l.firstLayer,
-                        l.layers, l.firstVpl, l.vplCount);
+        key += fmt::format("|{}{}{}{}{}{}{}{} {} {} {} {}", int(l.castsShadow),
+                           int(l.needsRealOnlyMap), int(l.reachesVirtual), int(l.hasRsm),
+                           int(l.glassTransmits), int(l.translucentTransmits),
+                           int(l.needsRealOnlyGlass),
+                           l.focusDraws.size() * 100 + l.unfocusedDraws.size(), l.firstLayer,
+                           l.layers, l.firstVpl, l.vplCount);
     for (const LightPlan& l : p.lights)
         key += fmt::format("|c{} {}", int(l.caustics), l.causticLayer) +
                std::string(reinterpret_cast<const char*>(&l.causticViewProj), sizeof(glm::mat4));
-    key +=
-        fmt::format("|{} {}{}{}{}{}", p.shadowLayers, int(p.needVpls), int(p.needRealOnlyShadows),
-                    int(p.needRealOnlyIsm), int(p.glassShadows), int(p.needRealOnlyGlass));
+    key += fmt::format("|{} {} {}{}{}{}{}", p.shadowLayers, p.focusLayers, int(p.needVpls),
+                       int(p.needRealOnlyShadows), int(p.needRealOnlyIsm), int(p.glassShadows),
+                       int(p.needRealOnlyGlass));
     return key;
 }
 

@@ -14,6 +14,8 @@ const char* sizeRuleName(SizeRule s) {
             return "canvas/scale, K tiles";
         case SizeRule::ShadowAtlas:
             return "shadow atlas";
+        case SizeRule::FocusedShadowAtlas:
+            return "shadow atlas + focused maps";
         case SizeRule::RsmAtlas:
             return "RSM atlas";
         case SizeRule::IsmAtlas:

@@ -32,12 +32,14 @@ enum class SizeRule {
     Gather,       // canvas / RendererOptions::indirect.scale per axis, rounded up
     GatherTiles,  // Gather rounded up to a multiple of the interleave K (deinterleaved tiles)
     ShadowAtlas,  // shadowMapSize^2, one layer per shadow layer of the frame plan
-    RsmAtlas,     // rsmSize^2, one layer per shadow layer of the frame plan
-    IsmAtlas,     // tilesPerRow(vplCount) * ismTileSize, square
-    Impostor,     // impostorResolution^2, layers per specular object / impostor
-    CausticMap,   // causticMapSize^2, one layer per caustic spot light of the frame plan
-    Vpl,          // buffer: vplCount entries
-    Scene,        // sized by the scene (imports, impostor tables)
+    // ShadowAtlas and then one layer per focused virtual-occluder map (FramePlan::focusLayers)
+    FocusedShadowAtlas,
+    RsmAtlas,    // rsmSize^2, one layer per shadow layer of the frame plan
+    IsmAtlas,    // tilesPerRow(vplCount) * ismTileSize, square
+    Impostor,    // impostorResolution^2, layers per specular object / impostor
+    CausticMap,  // causticMapSize^2, one layer per caustic spot light of the frame plan
+    Vpl,         // buffer: vplCount entries
+    Scene,       // sized by the scene (imports, impostor tables)
 };
 const char* sizeRuleName(SizeRule s);
 

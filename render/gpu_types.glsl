@@ -18,6 +18,7 @@
 #endif
 
 const int kMaxLights = 8;
+const int kMaxFocusMaps = 4;  // focused virtual-occluder maps per light (GpuLight::focusMaps)
 // Hash cells of the world-space photon grid (a power of two; PhotonGridPass).
 const int kPhotonGridCells = 65536;
 // Nested subsets of the photon map within each grid bucket (PhotonGridPass, caustic.glsl
@@ -55,9 +56,18 @@ struct GpuLight {
     int realOnlyMap;       // 1 if the real-only map differs from the all-occluder map
     int isReal;            // 1 if the light is real
     int glassShadow;       // 1 if glass transmits this light (its ShadowGlass layers are drawn)
-    int pad0;              // std140: the struct is a multiple of 16 bytes
-    int pad1;
-    int pad2;
+    // Focused virtual-occluder maps (ShadowPass): when > 0, the virtual occluders are in
+    // focusMaps maps of their own, each fitted to a group of them (all-occluder atlas layers
+    // firstFocusLayer.., rendered through focusViewProj[k]), and the light's layers of the
+    // real-only atlas hold the real ones.
+    int focusMaps;
+    int firstFocusLayer;
+    // 1 if some virtual occluders are in no focused map (glass that this light's caustics carry
+    // the light through): they are in the light's own layers of the all-occluder atlas.
+    int unfocusedVirtual;
+    // Per focused map: tan(half fov) (point, spot) or the orthographic half extent (m, dir.).
+    vec4 focusFrustumSize;
+    mat4 focusViewProj[kMaxFocusMaps];  // world -> clip of each focused map
 };
 
 MIRAGE_UNIFORM_BLOCK(FrameBlock, GpuFrame, kBindingFrame) {

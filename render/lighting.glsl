@@ -78,6 +78,34 @@ float weightedGather(vec4 g, vec2 wx, vec2 wy) {
     return dot(g, vec4(wx.x * wy.y, wx.y * wy.y, wx.y * wy.x, wx.x * wy.x));
 }
 
+// The hat (linear interpolation's kernel, support -1..1) integrated from -1 to v.
+float hatIntegral(float v) {
+    v = clamp(v, -1.0, 1.0);
+    return v < 0.0 ? 0.5 * (v + 1.0) * (v + 1.0) : 1.0 - 0.5 * (1.0 - v) * (1.0 - v);
+}
+
+// Per-axis weights of the 4 texels at offsets -1 - fr, -fr, 1 - fr, 2 - fr from the lookup for
+// a box of w texels (0 < w <= 2) convolved with the bilinear hat: the bilinear weights as w -> 0,
+// shadowPcf's at w = 2 (they sum to 1).
+vec4 boxHatWeights(float fr, float w) {
+    vec4 x = vec4(-1.0, 0.0, 1.0, 2.0) - fr;
+    float h = 0.5 * w;
+    vec4 wt;
+    for (int i = 0; i < 4; ++i) wt[i] = (hatIntegral(h - x[i]) - hatIntegral(-h - x[i])) / w;
+    return wt;
+}
+
+// Percentage-closer filtering over the 4x4 texels around the lookup with per-axis weights wx, wy
+// (texel columns and rows -1..2 of the bilinear footprint). Four textureGathers.
+float shadowPcfWeighted(sampler2DArray map, vec3 tc, float ref, vec4 wx, vec4 wy) {
+    vec4 lo = step(vec4(ref), textureGatherOffset(map, tc, ivec2(-1, -1), 0));
+    vec4 rx = step(vec4(ref), textureGatherOffset(map, tc, ivec2(1, -1), 0));
+    vec4 ry = step(vec4(ref), textureGatherOffset(map, tc, ivec2(-1, 1), 0));
+    vec4 hi = step(vec4(ref), textureGatherOffset(map, tc, ivec2(1, 1), 0));
+    return weightedGather(lo, wx.xy, wy.xy) + weightedGather(rx, wx.zw, wy.xy) +
+           weightedGather(ry, wx.xy, wy.zw) + weightedGather(hi, wx.zw, wy.zw);
+}
+
 // Percentage-closer filtering over the 4x4 texels around the lookup (columns and rows -1..2 of
 // the bilinear footprint, fr its fraction): the visibility averaged over a 2-texel box around t
 // of the bilinearly interpolated depth test. Per axis the weights are that box convolved with
@@ -88,14 +116,8 @@ float weightedGather(vec4 g, vec2 wx, vec2 wy) {
 float shadowPcf(sampler2DArray map, vec3 tc, float ref, vec2 fr) {
     vec2 a = 1.0 - fr;
     vec2 w0 = 0.25 * a * a, w1 = 0.5 - 0.25 * fr * fr, w2 = 0.5 - 0.25 * a * a, w3 = 0.25 * fr * fr;
-    vec4 lo = step(vec4(ref), textureGatherOffset(map, tc, ivec2(-1, -1), 0));
-    vec4 rx = step(vec4(ref), textureGatherOffset(map, tc, ivec2(1, -1), 0));
-    vec4 ry = step(vec4(ref), textureGatherOffset(map, tc, ivec2(-1, 1), 0));
-    vec4 hi = step(vec4(ref), textureGatherOffset(map, tc, ivec2(1, 1), 0));
-    return weightedGather(lo, vec2(w0.x, w1.x), vec2(w0.y, w1.y)) +
-           weightedGather(rx, vec2(w2.x, w3.x), vec2(w0.y, w1.y)) +
-           weightedGather(ry, vec2(w0.x, w1.x), vec2(w2.y, w3.y)) +
-           weightedGather(hi, vec2(w2.x, w3.x), vec2(w2.y, w3.y));
+    return shadowPcfWeighted(map, tc, ref, vec4(w0.x, w1.x, w2.x, w3.x),
+                             vec4(w0.y, w1.y, w2.y, w3.y));
 }
 
 // Fraction of the light reaching p (0..1) in the all-occluder shadow atlas (x) and, when
@@ -120,6 +142,86 @@ vec2 shadowVisibilityAt(sampler2DArray allMap, sampler2DArray realMap, int layer
 #endif
 }
 
+// The camera pixel's footprint on the surface through p with normal n (world metres per pixel
+// along the image's x and y: where the neighbouring pixels' rays meet the tangent plane), for
+// the focused maps' filter (focusedVirtualVisibility). A pass shading the camera's visible
+// surfaces sets it per pixel (setShadowPixelFootprint); zero, the default, means none is known
+// (a hit seen in a mirror, a photon, a point inside a volume).
+vec3 shadowPixelDx = vec3(0.0), shadowPixelDy = vec3(0.0);
+
+void setShadowPixelFootprint(vec3 p, vec3 n) {
+    shadowPixelDx = shadowPixelDy = vec3(0.0);
+    vec3 d = p - cameraPos.xyz;
+    // The OpenCV camera's axes in world space: the view matrix's rows.
+    vec3 right = vec3(viewMatrix[0][0], viewMatrix[1][0], viewMatrix[2][0]);
+    vec3 down = vec3(viewMatrix[0][1], viewMatrix[1][1], viewMatrix[2][1]);
+    vec3 forward = vec3(viewMatrix[0][2], viewMatrix[1][2], viewMatrix[2][2]);
+    float z = dot(d, forward), dn = dot(d, n);
+    if (z <= 0.0 || abs(dn) < 1e-4 * length(d)) return;
+    // One pixel moves the ray's point at depth z by z / f along the axis (f in pixels:
+    // projMatrix[0][0] = 2 fx / width, docs/realtime-renderer.md "Camera and lens").
+    vec3 ex = right * (2.0 * z / (abs(projMatrix[0][0]) * canvas.x));
+    vec3 ey = down * (2.0 * z / (abs(projMatrix[1][1]) * canvas.y));
+    shadowPixelDx = ex - d * (dot(ex, n) / dn);
+    shadowPixelDy = ey - d * (dot(ey, n) / dn);
+}
+
+// The virtual occluders' focused maps of light li (GpuLight::focusMaps): all-occluder atlas
+// layers firstFocusLayer.., each looked up through its focusViewProj, whose texels are finer by
+// the light's frustum over the focused one (at least 2x). Filtered over the camera pixel's
+// footprint in the map (shadowPixelDx / Dy projected; a box of that width per axis convolved
+// with the bilinear hat, at most 2 texels): the reference's hard edge is antialiased by the
+// pixel's box filter, which the bilinear lookup's 1-texel ramp misses where a texel is finer
+// than the pixel and the 2-texel PCF overshoots where it is not much finer. Without a
+// footprint, the 2-texel PCF. Outside a map's frustum none of its occluders lies between p and
+// the light. d is p's light distance (lightDistance). docs/realtime-renderer.md, "Focused maps
+// for the virtual occluders".
+vec2 focusMapCoord(int li, int k, vec3 p, out bool inside) {
+    vec4 c = lights[li].focusViewProj[k] * vec4(p, 1.0);
+    vec2 ndc = c.xy / c.w;
+    inside = c.w > 0.0 && all(lessThanEqual(abs(ndc), vec2(1.0)));
+    return ndc * 0.5 + 0.5;
+}
+
+float focusedVirtualVisibility(sampler2DArray allMap, int li, vec3 p, float NdotL, float d) {
+    float mapSize = float(textureSize(allMap, 0).x);
+    float cosL = max(NdotL, 0.2);
+    float slope = sqrt(1.0 - cosL * cosL) / cosL;  // as shadowFootprint's for PCF
+    bool footprint = dot(shadowPixelDx, shadowPixelDx) + dot(shadowPixelDy, shadowPixelDy) > 0.0;
+    float vis = 1.0;
+    for (int k = 0; k < kMaxFocusMaps; ++k) {
+        if (k >= lights[li].focusMaps) break;
+        bool inside, unused;
+        vec2 t = focusMapCoord(li, k, p, inside);
+        if (!inside) continue;
+        vec2 w = vec2(2.0);
+        if (footprint) {  // texels per pixel: the footprint's spread along each map axis
+            vec2 tx = (focusMapCoord(li, k, p + shadowPixelDx, unused) - t) * mapSize;
+            vec2 ty = (focusMapCoord(li, k, p + shadowPixelDy, unused) - t) * mapSize;
+            w = clamp(sqrt(tx * tx + ty * ty), vec2(0.05), vec2(2.0));
+        }
+        float size = lights[li].focusFrustumSize[k];
+        float extent = lights[li].type == LIGHT_DIRECTIONAL ? 2.0 * size : 2.0 * size * d;
+        float ref = d - (shadowBias + 1.5 * extent / mapSize * slope);
+        vec2 fr = fract(t * mapSize - 0.5);
+        vis *= shadowPcfWeighted(allMap, vec3(t, float(lights[li].firstFocusLayer + k)), ref,
+                                 boxHatWeights(fr.x, w.x), boxHatWeights(fr.y, w.y));
+    }
+    return vis;
+}
+
+// Visibility through every occluder (x) and the real ones (y) where the light's virtual
+// occluders have their focused map: the real map's times the virtual one's (for a point light's
+// hard shadow, visible = no real and no virtual occluder in the way).
+vec2 shadowVisibilityFocused(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p,
+                             float NdotL, int layer, vec2 t, float d, float bias, vec2 fr) {
+    float visReal = shadowVisibilityAt(realMap, realMap, layer, t, d, bias, fr, false).x;
+    float visVirtual = focusedVirtualVisibility(allMap, li, p, NdotL, d);
+    if (lights[li].unfocusedVirtual == 1)  // in the light's own layer of the all-occluder atlas
+        visVirtual *= shadowVisibilityAt(allMap, allMap, layer, t, d, bias, fr, false).x;
+    return vec2(visReal * visVirtual, visReal);
+}
+
 vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec3 p, float NdotL,
                       bool withReal) {
     int layer;
@@ -127,6 +229,8 @@ vec2 shadowVisibility(sampler2DArray allMap, sampler2DArray realMap, int li, vec
     float d, bias;
     if (!shadowFootprint(li, p, NdotL, float(textureSize(allMap, 0).x), layer, t, d, bias, fr))
         return vec2(1.0);
+    if (lights[li].focusMaps > 0)
+        return shadowVisibilityFocused(allMap, realMap, li, p, NdotL, layer, t, d, bias, fr);
     return shadowVisibilityAt(allMap, realMap, layer, t, d, bias, fr, withReal);
 }
 
@@ -173,7 +277,9 @@ void lightVisibility(sampler2DArray allMap, sampler2DArray realMap MIRAGE_GLASS_
     if (!shadowFootprint(li, p, NdotL, float(textureSize(allMap, 0).x), layer, t, d, bias, fr))
         return;
     bool withReal = lights[li].realOnlyMap == 1;
-    vec2 vis = shadowVisibilityAt(allMap, realMap, layer, t, d, bias, fr, withReal);
+    vec2 vis = lights[li].focusMaps > 0
+                   ? shadowVisibilityFocused(allMap, realMap, li, p, NdotL, layer, t, d, bias, fr)
+                   : shadowVisibilityAt(allMap, realMap, layer, t, d, bias, fr, withReal);
     visAll = vec3(vis.x);
     visReal = vec3(vis.y);
 #ifdef MIRAGE_GLASS_SHADOWS

@@ -16,14 +16,12 @@
 
 #include "render/Renderer.h"
 #include "tests/support/HeadlessGlSuite.h"
-#include "tests/support/testscenes/RenderTestScenes.h"
+#include "testscenes/WallPlateScene.h"
 
 namespace mirage::render {
 namespace {
 
 class ImperfectShadowMaps : public test::HeadlessGlSuite {};
-
-constexpr glm::dvec3 kPlateLo{-0.88, 0.25, -0.6}, kPlateHi{-0.2, 0.3, 0.6};
 
 struct VisibilityErrors {
     int occluded = 0, leaks = 0;        // exactly occluded pairs; of those, the ISM sees through
@@ -34,20 +32,12 @@ struct VisibilityErrors {
 };
 
 VisibilityErrors measure(const IsmOptions& ism) {
-    Scene scene;
-    const int white = test::addMaterial(scene, glm::vec3(0.8f));
-    const int red = test::addMaterial(scene, {0.9f, 0.2f, 0.2f});
-    test::addFloor(scene, "floor", 0.0f, 4.0f, white, Origin::Real);
-    test::addBox(scene, "wall", {-1.0f, 0.0f, -0.6f}, {-0.9f, 1.0f, 0.6f}, red, Origin::Real);
-    test::addBox(scene, "plate", glm::vec3(kPlateLo), glm::vec3(kPlateHi), white, Origin::Virtual);
-    test::addLight(scene, Light::Type::Spot, {0.5f, 0.6f, 0.0f},
-                   glm::normalize(glm::vec3(-0.9f, 0.6f, 0.0f) - glm::vec3(0.5f, 0.6f, 0.0f)),
-                   10.0f, Origin::Real, 0.25f, 0.2f);
+    const test::WallPlateScene s = test::makeWallPlateScene();
     RendererOptions o;
     o.vpl.count = 64;
     o.ism = ism;
-    Renderer r(scene, test::smallCamera(), o);
-    r.render({test::lookAtPose({0.9, 0.12, 0.2}, {-0.6, 0.05, 0.0}), {}, false});
+    Renderer r(s.scene, s.cam, o);
+    r.render({s.pose, {}, false});
     const std::vector<GpuVpl> vpls = r.readVpls();
     const cv::Mat atlas = r.readIsmAtlas(false);
     const int tile = ism.tileSize, perRow = atlas.cols / tile;
@@ -72,7 +62,7 @@ VisibilityErrors measure(const IsmOptions& ism) {
                     glm::clamp(glm::ivec2((puv * 0.5 + 0.5) * double(tile)), 0, tile - 1);
                 const float depth = atlas.at<float>(origin.y + texel.y, origin.x + texel.x);
                 const bool ismVisible = dist - (0.02 + 0.03 * dist) <= double(depth);
-                if (test::segmentHitsBox(q, p, kPlateLo, kPlateHi)) {
+                if (test::segmentHitsBox(q, p, s.plateLo, s.plateHi)) {
                     ++e.occluded;
                     e.leaks += ismVisible;
                     e.leaksThroughEmpty += ismVisible && std::isinf(depth);

@@ -17,6 +17,7 @@
 #include "tests/support/HeadlessGlSuite.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
+#include "testscenes/WallPlateScene.h"
 
 namespace mirage::render {
 namespace {
@@ -514,18 +515,10 @@ TEST_F(RealtimeRenderer, ImperfectShadowMapsAreFilled) {
 // A virtual plate between a lit real wall and the real floor blocks the bounced light in L_rv
 // (ISM over all points) but not in L_r (ISM over real points only).
 TEST_F(RealtimeRenderer, VirtualOccluderBlocksBouncedLightOnlyInLrv) {
-    Scene scene;
-    int white = addMaterial(scene, glm::vec3(0.8f));
-    int red = addMaterial(scene, {0.9f, 0.2f, 0.2f});
-    addFloor(scene, "floor", 0.0f, 4.0f, white, Origin::Real);
-    addBox(scene, "wall", {-1.0f, 0.0f, -0.6f}, {-0.9f, 1.0f, 0.6f}, red, Origin::Real);
-    addBox(scene, "plate", {-0.88f, 0.25f, -0.6f}, {-0.2f, 0.3f, 0.6f}, white, Origin::Virtual);
-    addLight(scene, Light::Type::Spot, {0.5f, 0.6f, 0.0f},
-             glm::normalize(glm::vec3(-0.9f, 0.6f, 0.0f) - glm::vec3(0.5f, 0.6f, 0.0f)), 10.0f,
-             Origin::Real, 0.25f, 0.2f);
-    const CameraIntrinsics cam = smallCamera();
-    const Pose pose = lookAtPose({0.9, 0.12, 0.2}, {-0.6, 0.05, 0.0});
-    Renderer r(scene, cam, directLightKept());
+    const test::WallPlateScene s = test::makeWallPlateScene();
+    const CameraIntrinsics& cam = s.cam;
+    const Pose& pose = s.pose;
+    Renderer r(s.scene, cam, directLightKept());
     const FrameReport& rep = r.render({pose, {}, false});
     ASSERT_TRUE(rep.ran("ism")) << rep.summary();
     cv::Mat rv = r.readBuffer(kLRv), lr = r.readBuffer(kLR);

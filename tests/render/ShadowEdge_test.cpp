@@ -33,7 +33,9 @@ namespace mirage::render {
 namespace {
 
 // Measured on llvmpipe (reference 64 spp, seed 7; docs/realtime-renderer.md, "Shadow edges"):
-// 25.3 dB with PCF at 2048 texels, 21.6 dB bilinear at 2048, 16.6 dB bilinear at 512 (today).
+// 25.4 dB by default (512 texels, the virtual box in its own focused map), 25.3 dB with PCF at
+// 2048 texels and one map of every occluder, 21.6 dB bilinear at 2048, 16.6 dB with one
+// bilinear map at 512 (the default until the focused map).
 constexpr double kPenumbraPsnrFloor = 23.5;
 constexpr int kFineMap = 2048;  // shadow map texels per side where the filter is judged
 
@@ -60,8 +62,8 @@ cv::Mat penumbraMask(const ShadowEdgeScene& s, cv::Mat* shadowOut = nullptr) {
             const glm::dvec3 p = eye + d * (-eye.y / d.y);
             if (segmentHitsBox(s, eye, p - 1e-4 * d)) continue;  // the box hides the table
             table.at<uint8_t>(y, x) = 255;
-            if (segmentHitsBox(s, p + glm::dvec3(0, 1e-4, 0), glm::dvec3(s.lightPos)))
-                shadow.at<uint8_t>(y, x) = 255;
+            const glm::dvec3 q = p + glm::dvec3(0, 1e-4, 0);
+            if (segmentHitsBox(s, q, s.towardsLight(q))) shadow.at<uint8_t>(y, x) = 255;
         }
     // Within 2 px of both a shadowed and a lit table pixel: the shadow's edge on the table, not
     // where the shadow meets the box's base.
@@ -84,22 +86,32 @@ Reference reference(const ShadowEdgeScene& s) {
     return {f.footage, f.composite};
 }
 
-cv::Mat realtime(const ShadowEdgeScene& s, const cv::Mat& footage, ShadowFilter filter,
-                 int mapSize) {
-    RendererOptions opt;
+cv::Mat realtime(const ShadowEdgeScene& s, const cv::Mat& footage, RendererOptions opt,
+                 bool* focused = nullptr) {
     opt.temporalBlend = 0.0f;
-    opt.shadow.filter = filter;
-    opt.shadow.mapSize = mapSize;
     Renderer r(s.scene, s.cam, opt);
     r.render({s.pose, footage, true});
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
+    if (focused) *focused = r.plan().lights.at(0).focusedVirtual();
     return r.compositeSrgb();
 }
 
-// Today's lookup (bilinear, 512 texels) against PCF at 2048 texels per side: PCF must halve the
-// penumbra's RMS error (+6.02 dB) and clear the floor, which the bilinear lookup at 2048 misses
-// (the must-fail). At 512 texels PCF alone does not help here (printed): a texel spans 1.6 px,
-// and the PCF's 2-texel ramp is wider than the reference's 1-pixel edge.
+// One map of every occluder over the light's frustum (no focused virtual-occluder map).
+cv::Mat realtime(const ShadowEdgeScene& s, const cv::Mat& footage, ShadowFilter filter,
+                 int mapSize) {
+    RendererOptions opt;
+    opt.shadow.filter = filter;
+    opt.shadow.mapSize = mapSize;
+    opt.shadow.focus = false;
+    return realtime(s, footage, opt);
+}
+
+// One bilinear map of every occluder at 512 texels (the default until the focused map) against
+// the default (the virtual box in its own map fitted to it, PCF-filtered there) and against PCF
+// at 2048 texels per side: both must halve the penumbra's RMS error (+6.02 dB) and clear the
+// floor, which the old default and the bilinear lookup at 2048 miss (the must-fails). At 512
+// texels PCF alone does not help here (printed): a texel spans 1.6 px, and the PCF's 2-texel
+// ramp is wider than the reference's 1-pixel edge; the focused map's texels are 4.5x finer.
 TEST(ShadowEdge, FilteredShadowEdgeMatchesTheReferenceAndTheBilinearLookupFails) {
     gl::Context context = gl::Context::headless();
     const ShadowEdgeScene s = makeScene();
@@ -117,24 +129,92 @@ TEST(ShadowEdge, FilteredShadowEdgeMatchesTheReferenceAndTheBilinearLookupFails)
     const cv::Mat pcf = realtime(s, ref.footage, ShadowFilter::Pcf, kFineMap);
     const double psnrToday = psnr(today), psnrPcf512 = psnr(pcf512), psnrOff = psnr(off),
                  psnrPcf = psnr(pcf);
+    bool focused = false;
+    const cv::Mat byDefault = realtime(s, ref.footage, RendererOptions{}, &focused);
+    const double psnrDefault = psnr(byDefault);
+    EXPECT_TRUE(focused) << "the default did not focus the virtual box's map";
     std::cout << "[ shadow edge ] " << cv::countNonZero(band)
               << " penumbra px: PSNR bilinear 512 (today) " << psnrToday << " dB, PCF 512 "
               << psnrPcf512 << " dB, bilinear " << kFineMap << " " << psnrOff << " dB, PCF "
-              << kFineMap << " " << psnrPcf << " dB\n";
+              << kFineMap << " " << psnrPcf << " dB; default (focused) " << psnrDefault << " dB\n";
     const auto dir = std::filesystem::path(MIRAGE_TEST_OUTPUT_DIR) / "shadows";
     std::filesystem::create_directories(dir);
-    // The penumbra's neighbourhood, 6x: today's, PCF at the fine map, reference, the penumbra.
+    // The penumbra's neighbourhood, 6x: the old default, the default, reference, the penumbra.
     const cv::Rect crop = (cv::boundingRect(band) + cv::Size(8, 8) - cv::Point(4, 4)) &
                           cv::Rect(0, 0, band.cols, band.rows);
     cv::Mat band3, side;
     cv::cvtColor(band, band3, cv::COLOR_GRAY2BGR);
-    cv::hconcat(std::vector<cv::Mat>{today(crop), pcf(crop), ref.composite(crop), band3(crop)},
-                side);
+    cv::hconcat(
+        std::vector<cv::Mat>{today(crop), byDefault(crop), ref.composite(crop), band3(crop)}, side);
     cv::resize(side, side, cv::Size(), 6.0, 6.0, cv::INTER_NEAREST);
     writeBgr8(dir / "shadow_edge.png", side);
     EXPECT_GE(psnrPcf, kPenumbraPsnrFloor);
-    EXPECT_GE(psnrPcf, psnrToday + 6.02) << "the penumbra's RMS error not halved";
+    EXPECT_GE(psnrPcf, psnrToday + 6.02) << "PCF 2048: the penumbra's RMS error not halved";
+    EXPECT_GE(psnrDefault, kPenumbraPsnrFloor);
+    EXPECT_GE(psnrDefault, psnrToday + 6.02) << "default: the penumbra's RMS error not halved";
+    EXPECT_LT(psnrToday, kPenumbraPsnrFloor) << "must-fail: one bilinear map at 512";
     EXPECT_LT(psnrOff, kPenumbraPsnrFloor) << "must-fail: the bilinear lookup";
+}
+
+// The focused map for each kind of light: the spot, a point light at its place (its six cube
+// faces for the real occluders, one frustum for the virtual box) and a directional light (an
+// orthographic box fitted to the virtual box). Against the reference, over the penumbra and
+// over the whole table near the shadow (every shadow kept, none misplaced): the focused map
+// must gain >= 3 dB on the penumbra and lose nothing (0.1 dB) elsewhere. A light inside the
+// virtual casters' bounds gets no focused map (no frustum from inside).
+TEST(ShadowEdge, FocusedVirtualMapForEveryLightKind) {
+    gl::Context context = gl::Context::headless();
+    for (Light::Type type : {Light::Type::Spot, Light::Type::Point, Light::Type::Directional}) {
+        SCOPED_TRACE(int(type));
+        const ShadowEdgeScene s = test::makeTurnedBoxScene(type);
+        cv::Mat shadow;
+        const cv::Mat band = penumbraMask(s, &shadow);
+        ASSERT_GT(cv::countNonZero(band), 300) << "too few penumbra pixels";
+        cv::Mat near;  // the shadow and 8 px around it on the table
+        cv::dilate(shadow, near, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(17, 17)));
+        const Reference ref = reference(s);
+        RendererOptions off;
+        off.shadow.focus = false;
+        bool focusedOn = false, focusedOff = true;
+        const cv::Mat on = realtime(s, ref.footage, RendererOptions{}, &focusedOn);
+        const cv::Mat without = realtime(s, ref.footage, off, &focusedOff);
+        EXPECT_TRUE(focusedOn);
+        EXPECT_FALSE(focusedOff);
+        const double bandOn = test::psnr(on, ref.composite, 255.0, band),
+                     bandOff = test::psnr(without, ref.composite, 255.0, band),
+                     nearOn = test::psnr(on, ref.composite, 255.0, near),
+                     nearOff = test::psnr(without, ref.composite, 255.0, near);
+        std::cout << "[ shadow focus ] light type " << int(type) << ": penumbra " << bandOff
+                  << " -> " << bandOn << " dB, around the shadow " << nearOff << " -> " << nearOn
+                  << " dB\n";
+        EXPECT_GE(bandOn, bandOff + 3.0);
+        EXPECT_GE(nearOn, nearOff - 0.1);
+    }
+    // The light 1 cm above the box's top, inside its bounding sphere.
+    const test::TurnedBoxScene inside =
+        test::makeTurnedBoxScene(Light::Type::Spot, {0.09f, 0.13f, 0.0f});
+    bool focused = true;
+    const cv::Mat img = realtime(
+        inside, cv::Mat(inside.cam.height, inside.cam.width, CV_8UC3, cv::Scalar(128, 128, 128)),
+        RendererOptions{}, &focused);
+    EXPECT_FALSE(focused) << "a light inside the virtual casters' bounds";
+}
+
+// Virtual occluders on opposite sides of a point light cannot share a frustum: each gets its own
+// focused map.
+TEST(ShadowEdge, OccludersAroundAPointLightGetAMapEach) {
+    gl::Context context = gl::Context::headless();
+    test::TurnedBoxScene s = test::makeTurnedBoxScene(Light::Type::Point, {0.3f, 0.3f, 0.0f});
+    test::addBox(s.scene, "second box", {0.52f, 0.0f, -0.08f}, {0.68f, 0.12f, 0.08f},
+                 test::addMaterial(s.scene, glm::vec3(0.5f)), Origin::Virtual);
+    RendererOptions opt;
+    opt.temporalBlend = 0.0f;
+    Renderer r(s.scene, s.cam, opt);
+    r.render(
+        {s.pose, cv::Mat(s.cam.height, s.cam.width, CV_8UC3, cv::Scalar(128, 128, 128)), true});
+    EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
+    ASSERT_EQ(r.plan().lights.size(), 1u);
+    EXPECT_EQ(r.plan().lights[0].focusDraws.size(), 2u);
 }
 
 }  // namespace

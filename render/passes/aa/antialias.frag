@@ -8,8 +8,10 @@
 // filter (after Lottes' FXAA 3.11, quality variant) and D read bilinearly, i.e. the share of
 // the neighbour across the edge that its coverage would give. Edges are found on the
 // composite's perceptual luma (sqrt of linear luminance, clamped to 0..1), so a virtual
-// silhouette and a shadow's edge are found as the camera would show them; the search along the
-// edge for its two ends turns a stair step into the ramp a box-filtered pixel would see.
+// silhouette is found as the camera would show it; the search along the edge for its two ends
+// turns a stair step into the ramp a box-filtered pixel would see. Only edges where geometry
+// meets are filtered (a virtual pixel near, or a real proxy's outline): the light the
+// differential changes inside a real surface (a shadow's edge) is filtered by its own lookups.
 // Pixels where neither they nor their 4 neighbours were changed (|D| > changeEpsilon) are
 // written with the composite's value unchanged: where the renderer changed nothing the footage
 // stays bit for bit. Most pixels stop after the 5 reads of the contrast test (on llvmpipe every
@@ -127,6 +129,15 @@ void main() {
     bool near = false;
     for (int i = 0; i < 5; ++i) near = near || changed(c[i].rgb, texelFetch(cameraImage, q[i], 0).rgb);
     if (!near) return;  // the footage's own edge: left as it is
+    // Only where geometry meets: a virtual pixel among the five, or a real proxy's outline (the
+    // coverage changes). Inside a real surface the renderer's edges are the differential's light
+    // (shadows, caustics, bounced light), which their own lookups filter over the pixel (the
+    // focused shadow maps: docs/realtime-renderer.md "Shadow edges"); filtering them again
+    // widens an edge the reference's pixels antialias once.
+    bool geometric = false;
+    for (int i = 0; i < 5; ++i)
+        geometric = geometric || c[i].a > 0.75 || abs(c[i].a - c[0].a) > 0.25;
+    if (!geometric) return;
     vec2 rcpSize = 1.0 / vec2(size);
     vec2 offset = edgeOffset(px, hi, rcpSize, l[0], l[1], l[2], l[3], l[4], range);
     if (offset == vec2(0.0)) return;

@@ -94,6 +94,7 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r,
         return;
     }
 #endif
+    setShadowPixelFootprint(p, n);  // the focused shadow maps filter over the pixel
     for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, p, wi, E);
@@ -141,6 +142,7 @@ void main() {
     vec3 F0 = mix(vec3(0.04), A.rgb, clamp(A.a, 0.0, 1.0));
     bool pReal = origin == ORIGIN_REAL;
     vec3 rv = vec3(0.0), r = vec3(0.0);
+    setShadowPixelFootprint(P.xyz, N.xyz);
     for (int li = 0; li < lightCount; ++li) {
         vec3 wi, E;
         incidentLight(li, P.xyz, wi, E);

@@ -27,6 +27,12 @@ std::vector<PassKnob> shadowKnobs() {
             "raster when it differs from shadow_map)",
             [](RendererOptions& o) -> int& { return o.shadow.rsmSize; }, 16, 4096),
         onOffKnob(
+            "shadow_focus",
+            "on: the virtual occluders in a real light's cone get a shadow map of their own, "
+            "fitted to them (fine shadow edges where the virtual objects' shadows fall); off: one "
+            "map of every occluder over the light's whole frustum",
+            [](RendererOptions& o) -> bool& { return o.shadow.focus; }, {"on"}),
+        onOffKnob(
             "glass_shadows",
             "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
             "off: glass is opaque there",

@@ -30,6 +30,12 @@ struct ShadowOptions {
     // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
     // false: glass is an opaque occluder, as mirrors are.
     bool glass = true;
+    // Virtual occluders in a real light's cone get a map of their own, fitted to their bounds
+    // (docs/realtime-renderer.md, "Shadow edges"): the virtual objects' shadow edges at the
+    // texel density of a much larger map, for one more raster of the virtual objects alone.
+    // Used where the fitted frustum is at most half the light's; false: one map of every
+    // occluder over the light's whole frustum.
+    bool focus = true;
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 4096, "shadow.mapSize", "16..4096", mapSize);

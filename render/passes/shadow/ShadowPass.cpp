@@ -30,7 +30,7 @@ ShadowPass::ShadowPass()
 }
 
 void ShadowPass::setup(PassBuilder& b) const {
-    b.create(kShadowMaps, {GL_R32F, SizeRule::ShadowAtlas, Storage::PassOwned});
+    b.create(kShadowMaps, {GL_R32F, SizeRule::FocusedShadowAtlas, Storage::PassOwned});
     b.create(kShadowMapsReal, {GL_R32F, SizeRule::ShadowAtlas, Storage::PassOwned});
     b.create(kShadowGlass,
              {GL_RGBA32F, SizeRule::ShadowAtlas, Storage::PassOwned});  // only with glass in a cone
@@ -43,10 +43,11 @@ void ShadowPass::setup(PassBuilder& b) const {
 
 PassDecision ShadowPass::decide(const FrameContext& ctx) const {
     if (ctx.plan.shadowLayers == 0) return {false, "no light has a shadow caster in its cone"};
-    int n = 0, real = 0, glass = 0, translucent = 0;
+    int n = 0, real = 0, focused = 0, glass = 0, translucent = 0;
     for (const LightPlan& l : ctx.plan.lights) {
         n += l.castsShadow;
         real += l.needsRealOnlyMap;
+        focused += int(l.focusDraws.size());
         glass += l.glassTransmits;
         translucent += l.translucentTransmits;
     }
@@ -54,6 +55,8 @@ PassDecision ShadowPass::decide(const FrameContext& ctx) const {
             std::to_string(n) + " light(s) with casters in the cone, " +
                 std::to_string(ctx.plan.shadowLayers) + " layer(s); " + std::to_string(real) +
                 " need a real-only map" +
+                (focused ? "; " + std::to_string(focused) + " focused virtual-occluder map(s)"
+                         : std::string()) +
                 (glass ? "; glass transmits in " + std::to_string(glass) : std::string()) +
                 (translucent ? "; a translucent object transmits in " + std::to_string(translucent)
                              : std::string()) +
@@ -62,9 +65,11 @@ PassDecision ShadowPass::decide(const FrameContext& ctx) const {
 
 void ShadowPass::resize(const FrameContext& ctx) {
     const int layers = std::max(1, ctx.plan.shadowLayers), s = ctx.options.shadow.mapSize,
-              r = ctx.options.shadow.rsmSize;
-    if (layers == allocatedLayers_ && s == allocatedSize_ && r == rsmSize_) return;
-    distance_ = gl::Texture::create2DArray("shadow distance", s, s, layers, GL_R32F);
+              r = ctx.options.shadow.rsmSize, focus = ctx.plan.focusLayers;
+    if (layers == allocatedLayers_ && focus == allocatedFocusLayers_ && s == allocatedSize_ &&
+        r == rsmSize_)
+        return;
+    distance_ = gl::Texture::create2DArray("shadow distance", s, s, layers + focus, GL_R32F);
     distanceReal_ = gl::Texture::create2DArray("shadow distance real-only", s, s, layers, GL_R32F);
     rsmFlux_ = gl::Texture::create2DArray("rsm flux", r, r, layers, GL_RGBA16F);
     rsmNormal_ = gl::Texture::create2DArray("rsm normal", r, r, layers, GL_RGBA16F);
@@ -79,14 +84,15 @@ void ShadowPass::resize(const FrameContext& ctx) {
     rsmDepth_ =
         r == s ? gl::Texture() : gl::Texture::create2D("rsm depth", r, r, GL_DEPTH_COMPONENT32F);
     allocatedLayers_ = layers;
+    allocatedFocusLayers_ = focus;
     allocatedSize_ = s;
     rsmSize_ = r;
 }
 
-void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm) {
+void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, Occluders which, bool rsm) {
     const LightPlan& lp = ctx.plan.lights[size_t(light)];
     const int atlasLayer = lp.firstLayer + layer;
-    fbo_.attachColorLayer(0, realOnly ? distanceReal_ : distance_, atlasLayer);
+    fbo_.attachColorLayer(0, which == Occluders::Real ? distanceReal_ : distance_, atlasLayer);
     const int colorCount = rsm ? 4 : 1;
     if (rsm) {
         fbo_.attachColorLayer(1, rsmFlux_, atlasLayer);
@@ -102,7 +108,7 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, bool realO
     glClearBufferfv(GL_COLOR, 0, far);
     for (int i = 1; i < colorCount; ++i) glClearBufferfv(GL_COLOR, i, zero);
     glClearBufferfv(GL_DEPTH, 0, &one);
-    drawOccluders(ctx, light, layer, realOnly, rsm);
+    drawOccluders(ctx, light, layer, which, rsm);
 }
 
 // The RSM layer alone at rsmSize (its own raster and depth buffer; the occluder distance is not
@@ -112,7 +118,7 @@ void ShadowPass::renderRsmLayer(FrameContext& ctx, int light, int layer) {
     rsmFbo_.attachColorLayer(1, rsmFlux_, atlasLayer);
     rsmFbo_.attachColorLayer(2, rsmNormal_, atlasLayer);
     rsmFbo_.attachColorLayer(3, rsmPosition_, atlasLayer);
-    rsmFbo_.attachDepth(rsmDepth_);
+    rsmFbo_.attachDepth(separateRsm() ? rsmDepth_ : depth_);  // a focused light's, at mapSize
     rsmFbo_.finalize(4);  // checks completeness; attachment 0 stays empty
     const GLenum bufs[4] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                             GL_COLOR_ATTACHMENT3};
@@ -122,12 +128,32 @@ void ShadowPass::renderRsmLayer(FrameContext& ctx, int light, int layer) {
     const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
     for (int i = 1; i < 4; ++i) glClearBufferfv(GL_COLOR, i, zero);
     glClearBufferfv(GL_DEPTH, 0, &one);
-    drawOccluders(ctx, light, layer, false, true);
+    drawOccluders(ctx, light, layer, Occluders::All, true);
     fbo_.bind();
     glViewport(0, 0, allocatedSize_, allocatedSize_);
 }
 
-void ShadowPass::drawOccluders(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm) {
+// Focused map k of a light: its group of virtual draws through the frustum fitted to them (the
+// occluder distance only).
+void ShadowPass::renderFocusLayer(FrameContext& ctx, int light, int focusMap) {
+    const LightPlan& lp = ctx.plan.lights[size_t(light)];
+    fbo_.attachColorLayer(0, distance_, lp.firstFocusLayer + focusMap);
+    for (int i = 1; i < 4; ++i)
+        glNamedFramebufferTexture(fbo_.id(), GLenum(GL_COLOR_ATTACHMENT0 + i), 0, 0);
+    fbo_.attachDepth(depth_);
+    fbo_.finalize(1);
+    const float far[4] = {1e30f, 0, 0, 0}, one = 1.0f;
+    glClearBufferfv(GL_COLOR, 0, far);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    const glm::mat4& vp = ctx.lightBlock.lights[light].focusViewProj[focusMap];
+    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
+    glUniform1i(locLight_, light);
+    glUniform1i(locGlassLayer_, -1);
+    for (int d : lp.focusDraws[size_t(focusMap)])
+        draw_.draw(ctx.scene, ctx.scene.draws()[size_t(d)]);
+}
+
+void ShadowPass::drawOccluders(FrameContext& ctx, int light, int layer, Occluders which, bool rsm) {
     const LightPlan& lp = ctx.plan.lights[size_t(light)];
     const int atlasLayer = lp.firstLayer + layer;
     const glm::mat4& vp = ctx.lightBlock.lights[light].viewProj[layer];
@@ -137,8 +163,12 @@ void ShadowPass::drawOccluders(FrameContext& ctx, int light, int layer, bool rea
     // The glass layer has the shadow map's texels; the RSM raster may be coarser or finer.
     glUniform1f(locGlassScale_, float(allocatedSize_) / float(rsm ? rsmSize_ : allocatedSize_));
     glBindTextureUnit(kUnitShadowGlassLayer, glass_.id());
+    if (which == Occluders::Unfocused) {
+        for (int i : lp.unfocusedDraws) draw_.draw(ctx.scene, ctx.scene.draws()[size_t(i)]);
+        return;
+    }
     for (const DrawItem& d : ctx.scene.draws()) {
-        if (realOnly && d.origin != Origin::Real) continue;
+        if (which == Occluders::Real && d.origin != Origin::Real) continue;
         if (lp.glassTransmits && d.transmissive) continue;  // in the glass layer instead
         if (lp.translucentTransmits && d.translucent) continue;
         draw_.draw(ctx.scene, d);
@@ -222,10 +252,18 @@ void ShadowPass::execute(FrameContext& ctx, PassResources& res) {
                 if (lp.needsRealOnlyGlass) renderGlassLayer(ctx, int(i), layer, true);
             }
             const bool rsm = ctx.plan.needVpls && lp.hasRsm;
-            renderLayer(ctx, int(i), layer, false, rsm && !separateRsm());
+            if (lp.focusedVirtual()) {  // the RSM sees every surface; the distance maps split
+                if (rsm) renderRsmLayer(ctx, int(i), layer);
+                renderLayer(ctx, int(i), layer, Occluders::Real, false);
+                if (!lp.unfocusedDraws.empty())
+                    renderLayer(ctx, int(i), layer, Occluders::Unfocused, false);
+                continue;
+            }
+            renderLayer(ctx, int(i), layer, Occluders::All, rsm && !separateRsm());
             if (rsm && separateRsm()) renderRsmLayer(ctx, int(i), layer);
-            if (lp.needsRealOnlyMap) renderLayer(ctx, int(i), layer, true, false);
+            if (lp.needsRealOnlyMap) renderLayer(ctx, int(i), layer, Occluders::Real, false);
         }
+        for (size_t k = 0; k < lp.focusDraws.size(); ++k) renderFocusLayer(ctx, int(i), int(k));
     }
     glDisable(GL_DEPTH_TEST);
     res.publish(kShadowMaps, distance_);

@@ -11,6 +11,10 @@
 // by its Fresnel-, colour- and Beer-Lambert-weighted transmittance; mirrors stay opaque. A
 // translucent object (DrawItem::translucent) goes into the same atlases for every light (caustic
 // lights too): its boundary's Fresnel and its medium's optical thickness along the light's ray.
+// Focused virtual occluders (LightPlan::focusDraws): ShadowMaps' layers after the lights' hold
+// the virtual occluders in groups, each rendered through the frustum fitted to its group
+// (GpuLight::focusViewProj), ShadowMapsReal the real ones over the light's frustum, and the RSM
+// (every surface) its own raster.
 #include "render/RenderPass.h"
 
 namespace mirage::render {
@@ -40,9 +44,11 @@ public:
     bool cameraIndependent() const override { return true; }
 
 private:
-    void renderLayer(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);
+    enum class Occluders { All, Real, Unfocused };  // Unfocused: LightPlan::unfocusedDraws
+    void renderLayer(FrameContext& ctx, int light, int layer, Occluders which, bool rsm);
     void renderRsmLayer(FrameContext& ctx, int light, int layer);
-    void drawOccluders(FrameContext& ctx, int light, int layer, bool realOnly, bool rsm);
+    void renderFocusLayer(FrameContext& ctx, int light, int focusMap);
+    void drawOccluders(FrameContext& ctx, int light, int layer, Occluders which, bool rsm);
     bool separateRsm() const { return rsmSize_ != allocatedSize_; }
     void renderGlassLayer(FrameContext& ctx, int light, int layer, bool realOnly);
     void setMediumUniforms(const DrawItem& d, const GpuMedium* medium);
@@ -50,7 +56,7 @@ private:
     gl::Texture distance_, distanceReal_, rsmFlux_, rsmNormal_, rsmPosition_, depth_, rsmDepth_;
     gl::Texture glass_, glassReal_;
     gl::Framebuffer fbo_, glassFbo_, rsmFbo_;
-    int allocatedLayers_ = 0, allocatedSize_ = 0, rsmSize_ = 0;
+    int allocatedLayers_ = 0, allocatedFocusLayers_ = 0, allocatedSize_ = 0, rsmSize_ = 0;
     MaterialDraw draw_{program_};  // after program_
     MaterialDraw glassDraw_{glassProgram_};
     GLint locViewProj_ = -1, locLight_ = -1, locGlassLayer_ = -1, locGlassScale_ = -1;

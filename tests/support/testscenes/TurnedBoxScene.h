@@ -16,17 +16,32 @@ struct TurnedBoxScene {
     glm::vec3 boxLo{-0.08f, 0.0f, -0.08f}, boxHi{0.08f, 0.12f, 0.08f};  // box frame (m)
     glm::dmat4 boxWorld{1.0};  // box frame -> world: 30 degrees about +Y
     glm::vec3 lightPos{0.6f, 0.5f, 0.3f};
+    Light::Type lightType = Light::Type::Spot;
+
+    // The end of the segment from a table point p towards the light: the light itself, or 10 m
+    // up the directional light's rays.
+    glm::dvec3 towardsLight(const glm::dvec3& p) const {
+        if (lightType != Light::Type::Directional) return glm::dvec3(lightPos);
+        return p + 10.0 * glm::normalize(glm::dvec3(lightPos));
+    }
 };
 
-inline TurnedBoxScene makeTurnedBoxScene() {
+// `light`: the spot (default), a point light at the spot's position, or a directional light
+// along the spot's axis with about the spot's irradiance at the box; placed at `lightPos`
+// (world, m) and aimed at the world origin.
+inline TurnedBoxScene makeTurnedBoxScene(Light::Type light = Light::Type::Spot,
+                                         glm::vec3 lightPos = {0.6f, 0.5f, 0.3f}) {
     TurnedBoxScene s;
+    s.lightType = light;
+    s.lightPos = lightPos;
     const int table = addMaterial(s.scene, glm::vec3(0.7f));
     const int dark = addMaterial(s.scene, glm::vec3(0.04f));
     addFloor(s.scene, "table", 0.0f, 3.0f, table, Origin::Real);
     addBox(s.scene, "box", s.boxLo, s.boxHi, dark, Origin::Virtual);
     s.boxWorld = glm::rotate(glm::dmat4(1.0), glm::radians(30.0), glm::dvec3(0, 1, 0));
     s.scene.nodes.back().local = s.scene.nodes.back().world = s.boxWorld;
-    addLight(s.scene, Light::Type::Spot, s.lightPos, -s.lightPos, 4.0f, Origin::Real, 0.6f, 0.5f);
+    const float intensity = light == Light::Type::Directional ? 6.0f : 4.0f;  // W/m^2 or W/sr
+    addLight(s.scene, light, s.lightPos, -s.lightPos, intensity, Origin::Real, 0.6f, 0.5f);
     s.cam = smallCamera(240, 180, 360.0);
     s.pose = lookAtPose({-0.40, 0.45, -0.30}, {-0.1, 0.0, -0.05});
     return s;
