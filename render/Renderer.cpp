@@ -230,27 +230,28 @@ void shadowMatrices(const SceneLight& l, const BoundingSphere& B, float R, GpuLi
     }
 }
 
-// A focused virtual-occluder map's frustum from light l around the spheres of a group of
-// virtual draws: spot and point lights, a square perspective frustum about the direction to the
-// group's merged bounds, wide enough for each member's bounding cone (size: tan of its half
-// angle); directional, an orthographic box around the merged bounds (size: its half extent, m).
-// False when a member's bounds hold the light (no frustum from inside).
-struct FocusFrustum {
+// A group of virtual draws that share a focused virtual-occluder map, with their bounds.
+struct FocusGroup {
     std::vector<int> draws;
     std::vector<BoundingSphere> spheres;
-    float size = 0.0f;
+    float size = 0.0f;  // tan of the half angle (spot, point) or the half extent (directional, m)
     glm::mat4 viewProj{1.0f};
 };
 
-bool fitFocus(const SceneLight& l, FocusFrustum& f) {
-    BoundingSphere all = f.spheres.front();
-    for (const BoundingSphere& b : f.spheres) all = mergeSpheres(all, b);
+// The focused map's frustum from light l around `spheres`: spot and point lights, a square
+// perspective frustum about the direction to their merged bounds, wide enough for each sphere's
+// bounding cone; directional lights, an orthographic box around the merged bounds. False when a
+// sphere holds the light (no frustum from inside) or the frustum would be wider than 2 x 1.2 rad.
+bool fitFocus(const SceneLight& l, const std::vector<BoundingSphere>& spheres, float& size,
+              glm::mat4& viewProj) {
+    BoundingSphere all = spheres.front();
+    for (const BoundingSphere& b : spheres) all = mergeSpheres(all, b);
     const float radius = std::max(all.radius * 1.02f, 1e-3f);
     if (l.type == kLightDirectional) {
         const glm::vec3 eye = all.center - l.direction * (radius + 0.1f);
-        f.size = radius;
-        f.viewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 2.0f * radius + 0.2f) *
-                     glm::lookAt(eye, all.center, anyPerpendicular(l.direction));
+        size = radius;
+        viewProj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 2.0f * radius + 0.2f) *
+                   glm::lookAt(eye, all.center, anyPerpendicular(l.direction));
         return true;
     }
     const glm::vec3 toCentre = all.center - l.position;
@@ -258,7 +259,7 @@ bool fitFocus(const SceneLight& l, FocusFrustum& f) {
     if (dist <= radius) return false;
     const glm::vec3 axis = toCentre / dist;
     float half = 0.0f, nearest = dist - radius;
-    for (const BoundingSphere& b : f.spheres) {
+    for (const BoundingSphere& b : spheres) {
         const glm::vec3 v = b.center - l.position;
         const float d = glm::length(v);
         const float r = b.radius * 1.02f + 1e-3f;
@@ -268,64 +269,71 @@ bool fitFocus(const SceneLight& l, FocusFrustum& f) {
         nearest = std::min(nearest, d - r);
     }
     if (half > 1.2f) return false;
-    f.size = std::tan(half);
-    f.viewProj =
+    size = std::tan(half);
+    viewProj =
         glm::perspective(2.0f * half, 1.0f, std::max(nearest * 0.5f, 1e-3f), dist + radius * 1.5f) *
         glm::lookAt(l.position, all.center, anyPerpendicular(axis));
     return true;
 }
 
-// The virtual occluders' own shadow maps (LightPlan::focusDraws): the virtual draws that go into
-// the light's occluder maps (ShadowPass::drawOccluders' choice) but glass (opaque there only for
-// a light whose caustics carry the light through it; LightPlan::unfocusedDraws), grouped so that
-// each group's
-// frustum is small: every draw starts as its own group, and the two groups whose merged frustum
-// is smallest are merged while there are more than kMaxFocusMaps or the merge widens the larger
-// frustum by at most 25 % (one raster for neighbours). Used only where every frustum is at most
-// half the light's own (else one map of all occluders is nearly as fine).
+// The virtual occluders' own shadow maps (LightPlan::focusDraws) for the virtual draws that go
+// into light l's occluder maps (ShadowPass::drawOccluders' choice). Glass there is opaque only
+// because this light's caustics carry the light through it (or glass shadows are off): it stays
+// in the light's own map (LightPlan::unfocusedDraws). The others are grouped so that each
+// group's frustum is small: every draw starts as its own group, and the two groups whose merged
+// frustum is smallest are merged while there are more than kMaxFocusMaps or the merge widens the
+// larger frustum by at most 25 % (one raster for neighbours). Used only where every frustum is
+// at most half the light's own (else one map of all occluders is nearly as fine). Quadratic in
+// the virtual draws per merge: meant for the handful a tabletop holds.
 void planVirtualFocus(const SceneLight& l, const GpuScene& s, LightPlan& lp, GpuLight& g) {
-    std::vector<FocusFrustum> groups;
+    std::vector<FocusGroup> groups;
     std::vector<int> unfocused;
     for (size_t i = 0; i < s.draws().size(); ++i) {
         const DrawItem& d = s.draws()[i];
         if (d.origin != Origin::Virtual || !inLightCone(l, d.bounds)) continue;
         if (lp.glassTransmits && d.transmissive) continue;  // in the glass layer instead
         if (lp.translucentTransmits && d.translucent) continue;
-        if (d.transmissive) {  // opaque here only because the photons carry the light through
+        if (d.transmissive) {
             unfocused.push_back(int(i));
             continue;
         }
-        FocusFrustum f;
+        FocusGroup f;
         f.draws = {int(i)};
         f.spheres = {d.bounds};
-        if (!fitFocus(l, f)) return;
+        if (!fitFocus(l, f.spheres, f.size, f.viewProj)) return;
         groups.push_back(std::move(f));
     }
+    std::vector<BoundingSphere> merged;
     while (groups.size() > 1) {
         size_t bi = 0, bj = 0;
-        FocusFrustum best;
-        best.size = std::numeric_limits<float>::max();
+        float bestSize = std::numeric_limits<float>::max();
+        glm::mat4 bestViewProj{1.0f};
         for (size_t i = 0; i < groups.size(); ++i)
             for (size_t j = i + 1; j < groups.size(); ++j) {
-                FocusFrustum m = groups[i];
-                m.draws.insert(m.draws.end(), groups[j].draws.begin(), groups[j].draws.end());
-                m.spheres.insert(m.spheres.end(), groups[j].spheres.begin(),
-                                 groups[j].spheres.end());
-                if (!fitFocus(l, m) || m.size >= best.size) continue;
-                best = std::move(m);
+                merged = groups[i].spheres;
+                merged.insert(merged.end(), groups[j].spheres.begin(), groups[j].spheres.end());
+                float size = 0.0f;
+                glm::mat4 viewProj{1.0f};
+                if (!fitFocus(l, merged, size, viewProj) || size >= bestSize) continue;
+                bestSize = size;
+                bestViewProj = viewProj;
                 bi = i;
                 bj = j;
             }
-        if (best.draws.empty()) break;  // no two groups fit one frustum
-        const bool cheap = best.size <= 1.25f * std::max(groups[bi].size, groups[bj].size);
+        if (bi == bj) break;  // no two groups fit one frustum
+        const bool cheap = bestSize <= 1.25f * std::max(groups[bi].size, groups[bj].size);
         if (groups.size() <= size_t(kMaxFocusMaps) && !cheap) break;
-        groups[bi] = std::move(best);
+        FocusGroup& a = groups[bi];
+        a.draws.insert(a.draws.end(), groups[bj].draws.begin(), groups[bj].draws.end());
+        a.spheres.insert(a.spheres.end(), groups[bj].spheres.begin(), groups[bj].spheres.end());
+        a.size = bestSize;
+        a.viewProj = bestViewProj;
         groups.erase(groups.begin() + std::ptrdiff_t(bj));
     }
     if (groups.empty() || groups.size() > size_t(kMaxFocusMaps)) return;
     // frustumSize: the spot's tan(half angle), a cube face's tan(45 degrees) = 1, the
     // directional box's half extent.
-    for (const FocusFrustum& f : groups)
+    for (const FocusGroup& f : groups)
         if (f.size > 0.5f * g.frustumSize) return;
     g.focusMaps = int(groups.size());
     g.unfocusedVirtual = unfocused.empty() ? 0 : 1;
@@ -597,12 +605,14 @@ std::string staticPlanKey(const FrameContext& c) {
     std::string key(reinterpret_cast<const char*>(&c.lightBlock), sizeof(GpuLightBlock));
     const FramePlan& p = c.plan;
     for (const LightPlan& l : p.lights)
-        key += fmt::format("|{}{}{}{}{}{}{}{} {} {} {} {}", int(l.castsShadow),
+        key += fmt::format("|{}{}{}{}{}{}{} {} {} {} {} u{}", int(l.castsShadow),
                            int(l.needsRealOnlyMap), int(l.reachesVirtual), int(l.hasRsm),
                            int(l.glassTransmits), int(l.translucentTransmits),
-                           int(l.needsRealOnlyGlass),
-                           l.focusDraws.size() * 100 + l.unfocusedDraws.size(), l.firstLayer,
-                           l.layers, l.firstVpl, l.vplCount);
+                           int(l.needsRealOnlyGlass), l.firstLayer, l.layers, l.firstVpl,
+                           l.vplCount, fmt::join(l.unfocusedDraws, ","));
+    for (const LightPlan& l : p.lights)  // which draws each focused map holds
+        for (const std::vector<int>& draws : l.focusDraws)
+            key += fmt::format("|f{}", fmt::join(draws, ","));
     for (const LightPlan& l : p.lights)
         key += fmt::format("|c{} {}", int(l.caustics), l.causticLayer) +
                std::string(reinterpret_cast<const char*>(&l.causticViewProj), sizeof(glm::mat4));

@@ -10,6 +10,7 @@
 // bilinear lookup (shadow_filter=off) misses the floor.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -215,6 +216,34 @@ TEST(ShadowEdge, OccludersAroundAPointLightGetAMapEach) {
     EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
     ASSERT_EQ(r.plan().lights.size(), 1u);
     EXPECT_EQ(r.plan().lights[0].focusDraws.size(), 2u);
+}
+
+// More virtual occluders than focused maps: neighbours share a map, at most kMaxFocusMaps, and
+// every virtual occluder is in exactly one of them.
+TEST(ShadowEdge, ManyOccludersShareAtMostFourMaps) {
+    gl::Context context = gl::Context::headless();
+    test::TurnedBoxScene s = test::makeTurnedBoxScene();
+    const int grey = test::addMaterial(s.scene, glm::vec3(0.5f));
+    for (int i = 0; i < 6; ++i) {
+        const float x = -0.25f + 0.1f * float(i);
+        test::addBox(s.scene, "small box " + std::to_string(i), {x, 0.0f, 0.15f},
+                     {x + 0.03f, 0.03f, 0.18f}, grey, Origin::Virtual);
+    }
+    RendererOptions opt;
+    opt.temporalBlend = 0.0f;
+    Renderer r(s.scene, s.cam, opt);
+    r.render(
+        {s.pose, cv::Mat(s.cam.height, s.cam.width, CV_8UC3, cv::Scalar(128, 128, 128)), true});
+    EXPECT_TRUE(cv::checkRange(r.compositeLinear())) << "NaN/Inf in the composite";
+    const LightPlan& lp = r.plan().lights.at(0);
+    ASSERT_TRUE(lp.focusedVirtual());
+    EXPECT_LE(lp.focusDraws.size(), size_t(kMaxFocusMaps));
+    std::vector<int> all;
+    for (const std::vector<int>& draws : lp.focusDraws)
+        all.insert(all.end(), draws.begin(), draws.end());
+    std::sort(all.begin(), all.end());
+    EXPECT_EQ(all.size(), 7u) << "the turned box and the six small ones";
+    EXPECT_EQ(std::adjacent_find(all.begin(), all.end()), all.end()) << "a draw in two maps";
 }
 
 }  // namespace

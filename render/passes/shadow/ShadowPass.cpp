@@ -89,10 +89,10 @@ void ShadowPass::resize(const FrameContext& ctx) {
     rsmSize_ = r;
 }
 
-void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, Occluders which, bool rsm) {
-    const LightPlan& lp = ctx.plan.lights[size_t(light)];
-    const int atlasLayer = lp.firstLayer + layer;
-    fbo_.attachColorLayer(0, which == Occluders::Real ? distanceReal_ : distance_, atlasLayer);
+// Attaches layer atlasLayer of `distance` (and of the RSM atlases when `rsm`) to the raster
+// and clears it to "no occluder".
+void ShadowPass::beginLayer(const gl::Texture& distance, int atlasLayer, bool rsm) {
+    fbo_.attachColorLayer(0, distance, atlasLayer);
     const int colorCount = rsm ? 4 : 1;
     if (rsm) {
         fbo_.attachColorLayer(1, rsmFlux_, atlasLayer);
@@ -108,6 +108,11 @@ void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, Occluders 
     glClearBufferfv(GL_COLOR, 0, far);
     for (int i = 1; i < colorCount; ++i) glClearBufferfv(GL_COLOR, i, zero);
     glClearBufferfv(GL_DEPTH, 0, &one);
+}
+
+void ShadowPass::renderLayer(FrameContext& ctx, int light, int layer, Occluders which, bool rsm) {
+    const int atlasLayer = ctx.plan.lights[size_t(light)].firstLayer + layer;
+    beginLayer(which == Occluders::Real ? distanceReal_ : distance_, atlasLayer, rsm);
     drawOccluders(ctx, light, layer, which, rsm);
 }
 
@@ -137,14 +142,7 @@ void ShadowPass::renderRsmLayer(FrameContext& ctx, int light, int layer) {
 // occluder distance only).
 void ShadowPass::renderFocusLayer(FrameContext& ctx, int light, int focusMap) {
     const LightPlan& lp = ctx.plan.lights[size_t(light)];
-    fbo_.attachColorLayer(0, distance_, lp.firstFocusLayer + focusMap);
-    for (int i = 1; i < 4; ++i)
-        glNamedFramebufferTexture(fbo_.id(), GLenum(GL_COLOR_ATTACHMENT0 + i), 0, 0);
-    fbo_.attachDepth(depth_);
-    fbo_.finalize(1);
-    const float far[4] = {1e30f, 0, 0, 0}, one = 1.0f;
-    glClearBufferfv(GL_COLOR, 0, far);
-    glClearBufferfv(GL_DEPTH, 0, &one);
+    beginLayer(distance_, lp.firstFocusLayer + focusMap, false);
     const glm::mat4& vp = ctx.lightBlock.lights[light].focusViewProj[focusMap];
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, &vp[0][0]);
     glUniform1i(locLight_, light);

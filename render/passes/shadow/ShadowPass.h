@@ -45,6 +45,7 @@ public:
 
 private:
     enum class Occluders { All, Real, Unfocused };  // Unfocused: LightPlan::unfocusedDraws
+    void beginLayer(const gl::Texture& distance, int atlasLayer, bool rsm);
     void renderLayer(FrameContext& ctx, int light, int layer, Occluders which, bool rsm);
     void renderRsmLayer(FrameContext& ctx, int light, int layer);
     void renderFocusLayer(FrameContext& ctx, int light, int focusMap);
