@@ -166,6 +166,14 @@ void setShadowPixelFootprint(vec3 p, vec3 n) {
     shadowPixelDy = ey - d * (dot(ey, n) / dn);
 }
 
+// Texture coordinate of p in light li's focused map k; inside: p lies in its frustum.
+vec2 focusMapCoord(int li, int k, vec3 p, out bool inside) {
+    vec4 c = lights[li].focusViewProj[k] * vec4(p, 1.0);
+    vec2 ndc = c.xy / c.w;
+    inside = c.w > 0.0 && all(lessThanEqual(abs(ndc), vec2(1.0)));
+    return ndc * 0.5 + 0.5;
+}
+
 // The virtual occluders' focused maps of light li (GpuLight::focusMaps): all-occluder atlas
 // layers firstFocusLayer.., each looked up through its focusViewProj, whose texels are finer by
 // the light's frustum over the focused one (at least 2x). Filtered over the camera pixel's
@@ -176,13 +184,6 @@ void setShadowPixelFootprint(vec3 p, vec3 n) {
 // footprint, the 2-texel PCF. Outside a map's frustum none of its occluders lies between p and
 // the light. d is p's light distance (lightDistance). docs/realtime-renderer.md, "Focused maps
 // for the virtual occluders".
-vec2 focusMapCoord(int li, int k, vec3 p, out bool inside) {
-    vec4 c = lights[li].focusViewProj[k] * vec4(p, 1.0);
-    vec2 ndc = c.xy / c.w;
-    inside = c.w > 0.0 && all(lessThanEqual(abs(ndc), vec2(1.0)));
-    return ndc * 0.5 + 0.5;
-}
-
 float focusedVirtualVisibility(sampler2DArray allMap, int li, vec3 p, float NdotL, float d) {
     float mapSize = float(textureSize(allMap, 0).x);
     float cosL = max(NdotL, 0.2);
