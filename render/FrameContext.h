@@ -136,11 +136,13 @@ struct LightPlan {
     // virtual ones fill small parts of it. The shadow-map texels are then much finer where the
     // virtual objects' shadows fall, which is what the differential (L_rv - L_r) shows:
     // visibility through all occluders is the real map's times the virtual ones' (lighting.glsl).
-    // focusDraws[k]: the scene draws in focused map k (atlas layer firstFocusLayer + k).
+    // focusDraws[k]: the scene draws in focused map k (ShadowMaps layer firstFocusLayer + k,
+    // after every light's own layers).
     std::vector<std::vector<int>> focusDraws;
     // With focused maps: the virtual occluders in none of them (glass opaque to this light
-    // because its caustics carry the light through: its shadow's edge is where the photons take
-    // over, not a hard edge), drawn into the light's own layers of the all-occluder atlas.
+    // because its caustics carry the light through, or glass shadows are off: where photons
+    // carry it, its shadow's edge is where they take over, not a hard edge), drawn into the
+    // light's own layers of ShadowMaps.
     std::vector<int> unfocusedDraws;
     int firstFocusLayer = 0;
     bool focusedVirtual() const { return !focusDraws.empty(); }

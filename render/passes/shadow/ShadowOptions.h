@@ -20,21 +20,24 @@ struct ShadowOptions {
     float bias = 0.001f;  // metres: constant depth bias of the shadow-map test
                           // (lighting.glsl adds the filter's reach in texel footprints / cos:
                           // 1.5 bilinear, 2.5 PCF)
-    // The shadow-map lookup: PCF over 4x4 texels (a point or spot light's hard shadow edge
-    // without the texel grid's stair steps) or the 2x2 bilinear lookup alone. Bilinear by
-    // default: at 512 texels a texel spans more than a pixel of the tabletop's shadow, and PCF's
-    // 2-texel ramp is then further from the reference's hard edge than the stair steps are (its
-    // penumbra error is halved only with mapSize 2048, which costs ~10x the shadow raster in
-    // every frame that re-renders the maps; docs/realtime-renderer.md, "Shadow edges").
+    // The lookup of the lights' own maps: PCF over 4x4 texels (a point or spot light's hard
+    // shadow edge without the texel grid's stair steps) or the 2x2 bilinear lookup alone.
+    // Bilinear by default: at 512 texels a texel spans more than a pixel of the tabletop's
+    // shadow, and PCF's 2-texel ramp is then further from the reference's hard edge than the
+    // stair steps are (over one map of every occluder its penumbra error is halved only with
+    // mapSize 2048, ~10x the shadow raster). The virtual occluders' focused maps (`focus`) are
+    // filtered over the camera pixel's footprint whatever this says (docs/realtime-renderer.md,
+    // "Shadow edges").
     ShadowFilter filter = ShadowFilter::Bilinear;
     // Glass transmits light in the shadow maps (coloured, Fresnel and Beer-Lambert weighted);
     // false: glass is an opaque occluder, as mirrors are.
     bool glass = true;
-    // Virtual occluders in a real light's cone get a map of their own, fitted to their bounds
-    // (docs/realtime-renderer.md, "Shadow edges"): the virtual objects' shadow edges at the
-    // texel density of a much larger map, for one more raster of the virtual objects alone.
-    // Used where the fitted frustum is at most half the light's; false: one map of every
-    // occluder over the light's whole frustum.
+    // Virtual occluders in a real light's cone get maps of their own (at most kMaxFocusMaps),
+    // fitted to their bounds and filtered over the camera pixel's footprint
+    // (docs/realtime-renderer.md, "Focused maps for the virtual occluders"): the virtual
+    // objects' shadow edges at the texel density of a much larger map, for one raster of the
+    // virtual objects alone per map. Used where every fitted frustum is at most half the
+    // light's; false: one map of every occluder over the light's whole frustum.
     bool focus = true;
 
     void validate() const {
