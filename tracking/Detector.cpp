@@ -224,7 +224,13 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image) {
     return detect(image, cv::Rect(0, 0, image.cols, image.rows));
 }
 
-std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect& roiIn) {
+std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect& roi) {
+    return detect(image, roi, options_.decimate, options_.fullResolutionRetry);
+}
+
+std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect& roiIn,
+                                           float decimate, bool fullResolutionRetry) {
+    if (!(decimate >= 1.0f)) throw Error("detector: decimate must be >= 1");
     MR_CHECK(detector_ != nullptr, "detect() on a moved-from Detector");
     cv::Mat grey;
     if (image.type() == CV_8UC1)
@@ -240,14 +246,15 @@ std::vector<TagDetection> Detector::detect(const cv::Mat& image, const cv::Rect&
     if (roi.width < 8 || roi.height < 8) return out;
     // A view of the region (rows keep the full image's stride): libapriltag reads only it.
     image_u8_t im{roi.width, roi.height, int(grey.step[0]), grey.ptr<uint8_t>(roi.y) + roi.x};
+    detector_->quad_decimate = decimate;
     zarray_t* dets = apriltag_detector_detect(detector_, &im);
-    float searchedDecimate = options_.decimate;
-    if (zarray_size(dets) == 0 && options_.fullResolutionRetry && options_.decimate > 1.0f) {
+    float searchedDecimate = decimate;
+    if (zarray_size(dets) == 0 && fullResolutionRetry && decimate > 1.0f) {
         apriltag_detections_destroy(dets);
         detector_->quad_decimate = searchedDecimate = 1.0f;
         dets = apriltag_detector_detect(detector_, &im);
-        detector_->quad_decimate = options_.decimate;
     }
+    detector_->quad_decimate = options_.decimate;
     out.reserve(size_t(zarray_size(dets)));
     for (int i = 0; i < zarray_size(dets); ++i) {
         apriltag_detection_t* d = nullptr;

@@ -81,6 +81,11 @@ public:
     // the cost of libapriltag scales with the area searched. Corners are in full-image pixels
     // and refined on the full image.
     std::vector<TagDetection> detect(const cv::Mat& image, const cv::Rect& roi);
+    // The same at `decimate` instead of DetectorOptions::decimate, with or without the
+    // full-resolution retry (DetectorOptions::fullResolutionRetry): a caller that has a cheaper
+    // retry of its own runs the decimated search alone first.
+    std::vector<TagDetection> detect(const cv::Mat& image, const cv::Rect& roi, float decimate,
+                                     bool fullResolutionRetry);
 
     const DetectorOptions& options() const { return options_; }
 

@@ -267,7 +267,10 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
         o.fullResolutionRetry = false;
         // Refined by coarseToFine, in one or two passes.
         o.refineCorners = false;
-        o.refineEdges = options_.coarseRefineEdges;
+        // At full resolution the ordinary search's edge refinement: its quads are then as
+        // precise as the ordinary search's full-resolution ones, for the pose and the finder.
+        o.refineEdges =
+            decimate > 1.0f ? options_.coarseRefineEdges : options_.detector.refineEdges;
         coarseDetectors_.emplace_back(decimate, std::make_unique<Detector>(o));
         coarseDetector = coarseDetectors_.back().second.get();
     }
@@ -278,7 +281,7 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
     // Only tags whose corners mirage's refinement can measure at full resolution are used
     // (libapriltag's corners on the decimated image are off by up to ~1 px with its edge
     // refinement, up to the decimation factor without); the finder tries the others.
-    const double startErrorPx = options_.coarseRefineEdges ? 1.5 : double(decimate);
+    const double startErrorPx = coarseDetector->options().refineEdges ? 1.5 : double(decimate);
     std::erase_if(coarse, [&](TagDetection& d) {
         d.refined =
             Detector::refineQuadCorners(grey, coarseCellsAtBorder_, d.corners, startErrorPx);
@@ -335,6 +338,15 @@ bool Tracker::coarseToFine(const cv::Mat& grey, const cv::Rect& region, float de
     return true;
 }
 
+std::vector<float> Tracker::coarseCascade(const SearchPlan& plan) const {
+    std::vector<float> out;
+    if (!options_.coarseFirstCascade || !plan.windowed) return out;
+    for (float d : {3.0f, 2.0f, 1.0f})
+        if (d < plan.coarseDecimate && (d > 1.0f || options_.fullResolutionFallback))
+            out.push_back(d);
+    return out;
+}
+
 Detector& Tracker::fullResolutionDetector() {
     if (!fullResolutionDetector_) {
         DetectorOptions o = options_.detector;
@@ -348,13 +360,26 @@ Detector& Tracker::fullResolutionDetector() {
     return *fullResolutionDetector_;
 }
 
-void Tracker::searchTags(const cv::Mat& grey, const cv::Rect& region,
+void Tracker::searchTags(const cv::Mat& grey, const cv::Rect& region, const cv::Rect& retryWindow,
                          const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f) {
     f.fullResolutionRegion = cv::Rect();
     f.fullResolutionSought = f.fullResolutionFound = f.fullResolutionFinderFound = 0;
+    const DetectorOptions& dopt = options_.detector;
+    // The window's search ends with the finder's tags: part of the adaptive full-resolution pass.
+    const bool windowFirst = !retryWindow.empty() && options_.fullResolutionFallback &&
+                             dopt.fullResolutionRetry && dopt.decimate > 1.0f;
     auto t0 = std::chrono::steady_clock::now();
-    f.detections = detector_.detect(grey, region);
+    f.detections = detector_.detect(grey, region, dopt.decimate, !windowFirst);
     f.detectMs += msSince(t0);
+    if (windowFirst && f.detections.empty()) {
+        // The window's tags at full resolution and the finder for the others; else the whole
+        // region at full resolution, as the detector's own retry would have searched it.
+        f.windowRetried = true;
+        if (coarseToFine(grey, retryWindow, 1.0f, ambiguityPrior, f)) return;
+        t0 = std::chrono::steady_clock::now();
+        f.detections = detector_.detect(grey, region, 1.0f, false);
+        f.detectMs += msSince(t0);
+    }
     t0 = std::chrono::steady_clock::now();
     measureBlur(grey, f.detections);
     f.estimate = estimator_.estimate(f.detections, ambiguityPrior);
@@ -552,6 +577,9 @@ Tracker::SearchPlan Tracker::planSearch(const cv::Mat& grey, const std::optional
                          cv::Point(int(cx + hw), int(cy + hh))) &
                 full;
         }
+        plan.windowed = true;
+        if (options_.windowRetry && plan.coarseSearch != grown)
+            plan.retryWindow = plan.coarseSearch;
     }
     return plan;
 }
@@ -559,14 +587,23 @@ Tracker::SearchPlan Tracker::planSearch(const cv::Mat& grey, const std::optional
 void Tracker::searchPlanned(const cv::Mat& grey, const SearchPlan& plan,
                             const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f) {
     const cv::Rect full(0, 0, grey.cols, grey.rows);
-    auto detectAndEstimate = [&](const cv::Rect& region) {
-        searchTags(grey, region, ambiguityPrior, t, f);
+    auto detectAndEstimate = [&](const cv::Rect& region, const cv::Rect& retryWindow) {
+        searchTags(grey, region, retryWindow, ambiguityPrior, t, f);
     };
     // Decimation 1 is a coarse stage too (coarseFirstDecimations): libapriltag at full
     // resolution in the window.
-    if (!(plan.coarseDecimate >= 1.0f && plan.coarseRegion &&
-          coarseToFine(grey, plan.coarseSearch, plan.coarseDecimate, ambiguityPrior, f)))
-        detectAndEstimate(f.searchRegion);
+    bool done = false;
+    if (plan.coarseDecimate >= 1.0f && plan.coarseRegion) {
+        done = coarseToFine(grey, plan.coarseSearch, plan.coarseDecimate, ambiguityPrior, f);
+        // No tag in the window at that decimation (the side estimate is an overestimate under
+        // foreshortening): the next finer decimation in the same window.
+        for (float d : coarseCascade(plan)) {
+            if (done || f.coarseTags > 0) break;
+            f.coarseCascaded = true;
+            done = coarseToFine(grey, plan.coarseSearch, d, ambiguityPrior, f);
+        }
+    }
+    if (!done) detectAndEstimate(f.searchRegion, plan.retryWindow);
     bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
     if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
         const auto now = boardRegion(*f.estimate.pose, grey.size(), false);
@@ -584,7 +621,7 @@ void Tracker::searchPlanned(const cv::Mat& grey, const SearchPlan& plan,
         // whole image before giving up or using fewer tags than the frame shows.
         f.fullFrameRetry = true;
         framesSinceFullSearch_ = 0;
-        detectAndEstimate(full);
+        detectAndEstimate(full, cv::Rect());
     }
 }
 

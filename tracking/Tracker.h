@@ -122,6 +122,20 @@ struct TrackerOptions {
     // follows the tag edges it reads; the coarse pose needs only a few tags, one large tag may
     // settle it, and the finder looks for the others). 1 (or more) = the whole grown region.
     double coarseWindowFraction = 0.5;
+    // When the ordinary search of a frame without a recent ok pose finds no tag at its
+    // decimation (small, distant or steep tags), libapriltag searches the coarse-first window
+    // at full resolution first, and the finder the rest of the board from the pose of the tags
+    // found there (the coarse-to-fine search at decimation 1); only when that gives no ok pose
+    // does the whole region get the full-resolution search (DetectorOptions::
+    // fullResolutionRetry). The window is about a quarter of the region, so this saves most of
+    // the full-resolution search's cost in such frames. False = the whole region at once.
+    bool windowRetry = true;
+    // When the coarse-first window holds no tag at the chosen decimation, the coarse-to-fine
+    // search tries the finer decimations 3 and 2 below it in the same window, and 1 (full
+    // resolution) when fullResolutionFallback is on, before the ordinary search of the whole
+    // region. It stops at the first that finds a tag: a tag without a confirmed pose goes to the
+    // ordinary search as before. False = the ordinary search at once.
+    bool coarseFirstCascade = true;
     // Extended tracking (docs/tracking.md, "Extended tracking"): natural features tracked while
     // the board gives the pose, and the pose from them when its tags do not give an ok one
     // (board partly or wholly out of view, covered). features.enabled = false: the board only.
@@ -174,6 +188,13 @@ struct TrackedFrame {
     bool coarseTried = false;
     int coarseTags = 0;
     bool coarseUsed = false;
+    // The ordinary search found no tag at its decimation and searched the coarse-first window
+    // at full resolution (TrackerOptions::windowRetry); coarseUsed then says whether that gave
+    // the pose.
+    bool windowRetried = false;
+    // The coarse-first window held no tag at the chosen decimation and was searched at a finer
+    // one (TrackerOptions::coarseFirstCascade).
+    bool coarseCascaded = false;
     // Coarse-first search: the largest tag's side estimated from the textured region (pixels;
     // 0 when not estimated) and the decimation it chose (0: none, the ordinary search; 1: full
     // resolution in the coarse window).
@@ -246,6 +267,12 @@ private:
     // Where libapriltag searches: region of interest, textured region, coarse-first window.
     struct SearchPlan {
         cv::Rect coarseSearch;
+        // The coarse-first window when the frame has one (else empty): the ordinary search's
+        // full-resolution retry reads it first (TrackerOptions::windowRetry).
+        cv::Rect retryWindow;
+        // coarseSearch is the coarse-first window about the textured region (not the whole
+        // search region): the coarse search may step to finer decimations there.
+        bool windowed = false;
         float coarseDecimate = 0;
         bool coarseRegion = false;
     };
@@ -282,11 +309,16 @@ private:
 
     // libapriltag's search of `region` at DetectorOptions::decimate, the pose, then the adaptive
     // full-resolution pass (TrackerOptions::fullResolutionFallback); fills the frame's
-    // detections and estimate and adds to its timings.
-    void searchTags(const cv::Mat& grey, const cv::Rect& region,
+    // detections and estimate and adds to its timings. A non-empty retryWindow: when the
+    // decimated search finds no tag, the coarse-to-fine search at full resolution in that window
+    // comes before the full-resolution search of the region (TrackerOptions::windowRetry).
+    void searchTags(const cv::Mat& grey, const cv::Rect& region, const cv::Rect& retryWindow,
                     const std::optional<Pose>& ambiguityPrior, double t, TrackedFrame& f);
     // The full-resolution pass's detector, created when first needed.
     Detector& fullResolutionDetector();
+    // The decimations the coarse-first window is searched at, in turn, after the plan's
+    // decimation found no tag there (TrackerOptions::coarseFirstCascade); none without a window.
+    std::vector<float> coarseCascade(const SearchPlan& plan) const;
 
     // Fills TagDetection::edgeWidthPx of the board tags: the edge width (blur) around the
     // largest one, for the estimator's corner-noise model (~0.02-0.05 ms).

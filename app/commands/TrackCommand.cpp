@@ -36,6 +36,7 @@ struct TrackArgs {
     bool noTagTracking = false;
     bool noTextureRegion = false;
     bool noCoarseFirst = false;
+    bool noWindowSearch = false;
     bool boardOnly = false;
     std::string driftSvg;  // drift of extended tracking against the time without the board
     bool noFullResolutionFallback = false;
@@ -190,6 +191,7 @@ tracking::TrackerOptions trackerOptions(const TrackArgs& a) {
     opt.tagTracking = !a.noTagTracking;
     opt.textureRegion = !a.noTextureRegion;
     opt.coarseFirst = !a.noCoarseFirst;
+    opt.windowRetry = opt.coarseFirstCascade = !a.noWindowSearch;
     opt.features.enabled = !a.boardOnly;
     opt.fullResolutionFallback = !a.noFullResolutionFallback;
     if (a.filter == "one-euro")
@@ -396,6 +398,10 @@ const CommandRegistrar reg("track", [](CLI::App& parent) {
     cmd->add_flag("--no-coarse-first", a->noCoarseFirst,
                   "Without a recent pose, do not pick a coarse-to-fine decimation from the "
                   "size of the textured region (docs/tracking.md, Single frames: coarse-first)");
+    cmd->add_flag("--no-window-search", a->noWindowSearch,
+                  "Without a recent pose, when the decimated search finds no tag do not search "
+                  "the coarse-first window at finer decimations first (docs/tracking.md, Single "
+                  "frames: the window at finer decimations)");
     cmd->add_flag("--board-only", a->boardOnly,
                   "Poses from the board's tags only: no natural features (docs/tracking.md, "
                   "Extended tracking)");

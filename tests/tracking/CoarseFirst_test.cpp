@@ -28,8 +28,9 @@ using testing::orbit;
 TrackedFrame single(const cv::Mat& img, bool coarseFirst, const Board* board = nullptr,
                     double minSidePx = TrackerOptions{}.coarseFirstMinSidePx,
                     double windowFraction = TrackerOptions{}.coarseWindowFraction,
-                    bool fullResolution = false) {
+                    bool fullResolution = false, bool cascade = true) {
     TrackerOptions o;
+    o.coarseFirstCascade = cascade;
     if (fullResolution) o.coarseFirstDecimations.push_back(1.0f);
     o.coarseFirst = coarseFirst;
     o.coarseFirstMinSidePx = minSidePx;
@@ -147,13 +148,16 @@ TEST(CoarseFirst, SameStateAsTheOrdinarySearchOnHardViews) {
 }
 
 // Must fail: the coarse path forced on a view whose tags are too small for it (every decimation
-// allowed whatever the estimated size) finds nothing usable and falls back: the frame gets
-// exactly the ordinary search's pose. And a wrong board file (wrong gap: the tags do not fit one
-// pose; every tag turned by 90 degrees) gives no ok pose through the coarse path, while the
-// right board on the same frame does (the comparison can pass).
+// allowed whatever the estimated size; no cascade to finer decimations, WindowRetry_test.cpp)
+// finds nothing usable and falls back: the frame gets exactly the ordinary search's pose. And a
+// wrong board file (wrong gap: the tags do not fit one pose; every tag turned by 90 degrees) gives
+// no ok pose through the coarse path, while the right board on the same frame does (the comparison
+// can pass).
 TEST(CoarseFirst, ForcedOnSmallTagsFallsBackAndAWrongBoardGivesNoPose) {
     const cv::Mat far = scene().render(testing::lookAt(orbit(0.8, 45, -10), {0, 0, 0}));
-    const TrackedFrame forced = single(far, true, nullptr, 0.0), o = single(far, false);
+    const TrackedFrame forced = single(far, true, nullptr, 0.0,
+                                       TrackerOptions{}.coarseWindowFraction, false, false),
+                       o = single(far, false);
     std::printf("forced: decimate %.0f, coarse tags %d, used %d; %s\n",
                 double(forced.coarseFirstDecimate), forced.coarseTags, int(forced.coarseUsed),
                 trackingStateName(forced.estimate.state));

@@ -22,9 +22,13 @@ const Scene& scene() {
 using testing::orbit;
 
 // One unrelated frame through a fresh Tracker (no previous pose), the textured region on or off.
+// The searches that read only a window about the region (the window retry and the coarse-first
+// cascade, WindowRetry_test.cpp) are off: these tests hold the region to the full image's search.
 TrackedFrame single(const cv::Mat& img, bool textureRegion, const Board* board = nullptr) {
     TrackerOptions o;
     o.textureRegion = textureRegion;
+    o.windowRetry = false;
+    o.coarseFirstCascade = false;
     o.filterEnabled = false;
     Tracker tracker(board ? *board : scene().board, scene().cam, o);
     return tracker.process(img, 0.0);

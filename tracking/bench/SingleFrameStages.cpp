@@ -11,9 +11,13 @@
 //
 //   tracking_single_stages [--width 640|1280] [--reps N] [--view V] [--no-coarse-first]
 //                          [--no-full-resolution-fallback] [--coarse-refine-edges]
+//                          [--no-window-search]
 // --view V measures view V alone (to profile one slow view with perf).
-// The path says where adaptive detection added tags: "+ full res F/S" = libapriltag at full
-// resolution found F of the S missed board tags (S = 0: the whole region searched, no pose to
+// "coarse d3 none, finer used" = the coarse-first window held no tag at decimation 3 and a finer
+// decimation of it gave the pose; "search, window d1" = the decimated search of the region found
+// no tag and the window at full resolution was searched before the region (--no-window-search:
+// neither). The path says where adaptive detection added tags: "+ full res F/S" = libapriltag at
+// full resolution found F of the S missed board tags (S = 0: the whole region searched, no pose to
 // predict them), "+ finder N" = the finder found N where the frame's settled pose put them.
 #include <apriltag/apriltag.h>
 #include <apriltag/common/timeprofile.h>
@@ -45,7 +49,8 @@ double cpuMs() {
 int main(int argc, char** argv) {
     using namespace mirage::tracking;
     int width = 640, reps = 20, onlyView = -1;
-    bool coarseFirst = true, fullResolutionFallback = true, coarseRefineEdges = false;
+    bool coarseFirst = true, fullResolutionFallback = true, coarseRefineEdges = false,
+         windowSearch = true;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--width") && i + 1 < argc)
             width = std::atoi(argv[++i]);
@@ -59,11 +64,14 @@ int main(int argc, char** argv) {
             fullResolutionFallback = false;
         else if (!std::strcmp(argv[i], "--coarse-refine-edges"))
             coarseRefineEdges = true;
+        else if (!std::strcmp(argv[i], "--no-window-search"))
+            windowSearch = false;
         else {
-            std::fprintf(stderr,
-                         "usage: %s [--width 640|1280] [--reps N] [--view V] [--no-coarse-first] "
-                         "[--no-full-resolution-fallback] [--coarse-refine-edges]\n",
-                         argv[0]);
+            std::fprintf(
+                stderr,
+                "usage: %s [--width 640|1280] [--reps N] [--view V] [--no-coarse-first] "
+                "[--no-full-resolution-fallback] [--coarse-refine-edges] [--no-window-search]\n",
+                argv[0]);
             return 2;
         }
     }
@@ -73,6 +81,7 @@ int main(int argc, char** argv) {
     opt.coarseFirst = coarseFirst;
     opt.fullResolutionFallback = fullResolutionFallback;
     opt.coarseRefineEdges = coarseRefineEdges;
+    opt.windowRetry = opt.coarseFirstCascade = windowSearch;
     Tracker tracker(f.board, f.camera, opt);
     PoseEstimator estimator(f.board, f.camera);
     cv::setNumThreads(1);
@@ -149,11 +158,16 @@ int main(int argc, char** argv) {
             mirageAgainMs += (cpuMs() - c0) / reps;
         }
 
-        char path[96];
-        if (r.coarseTried)
-            std::snprintf(path, sizeof path, "coarse d%.0f %s (%d tags, %d/%d verified)",
-                          double(r.coarseFirstDecimate), r.coarseUsed ? "used" : "fell back",
-                          r.coarseTags, r.prediction.verified, r.prediction.predicted);
+        char path[128];
+        if (r.windowRetried)
+            std::snprintf(path, sizeof path, "search, window d1 %s (%d tags, %d/%d verified)",
+                          r.coarseUsed ? "used" : "fell back", r.coarseTags, r.prediction.verified,
+                          r.prediction.predicted);
+        else if (r.coarseTried)
+            std::snprintf(path, sizeof path, "coarse d%.0f%s %s (%d tags, %d/%d verified)",
+                          double(r.coarseFirstDecimate), r.coarseCascaded ? " none, finer" : "",
+                          r.coarseUsed ? "used" : "fell back", r.coarseTags, r.prediction.verified,
+                          r.prediction.predicted);
         else
             std::snprintf(path, sizeof path, "search%s", r.fullFrameRetry ? " + full retry" : "");
         if (!r.fullResolutionRegion.empty()) {

@@ -357,7 +357,8 @@ void BM_MirageSingle(benchmark::State& state) {
 }
 
 // mirage's default Tracker (mode 2 of BM_MirageSingle; mode 10 = libapriltag's edge refinement on
-// in the coarse search, as before) and ArUco (no corner refinement) on the same single frame, one
+// in the coarse search, as before; mode 11 = the window retry and the coarse-first cascade off,
+// the ordinary search of the region where the window finds no tag, as before) and ArUco (no corner refinement) on the same single frame, one
 // after the other in each iteration, the order swapped every iteration: on a shared machine whose
 // speed drifts by tens of percent within a minute, both see the same moments, so their ratio is
 // steadier than that of two separate rows. Counters: each one's wall ms per frame, `speedup` =
@@ -367,6 +368,7 @@ void BM_SingleSideBySide(benchmark::State& state) {
     TrackerOptions opt;
     opt.filterEnabled = false;
     if (state.range(1) == 10) opt.coarseRefineEdges = true;
+    if (state.range(1) == 11) opt.windowRetry = opt.coarseFirstCascade = false;
     Tracker tracker(f.board, f.camera, opt);
     ArucoBaseline aruco(cv::aruco::CORNER_REFINE_NONE);
     double t = 0, mirageMs = 0, arucoMs = 0;
@@ -407,6 +409,7 @@ BENCHMARK(BM_SingleSideBySide)
     ->ArgNames({"width", "mode"})
     ->Args({640, 2})
     ->Args({640, 10})
+    ->Args({640, 11})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
