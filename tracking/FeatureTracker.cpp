@@ -173,6 +173,7 @@ void FeatureTracker::reset() {
     tracks_.clear();
     map_.clear();
     framesSinceDetect_ = 0;
+    lastDetectionShort_ = false;
     mapCovariance_ = {};
     derivedCovariance_ = {};
     lastPoseCovariance_.reset();
@@ -350,7 +351,8 @@ void FeatureTracker::learn(const cv::Mat& grey, const PoseEstimate& pose, bool f
     const int maxFeatures = int(options_.maxFeatures * scale_);
     if (options_.enabled && (fromBoard || options_.derivedLandmarks) &&
         (++framesSinceDetect_ >= options_.detectEvery ||
-         double(tracks_.size()) < options_.refillFraction * maxFeatures)) {
+         (!lastDetectionShort_ &&
+          double(tracks_.size()) < options_.refillFraction * maxFeatures))) {
         // Nothing was tracked into this frame: detect only if a next frame follows.
         if (pyramid_.empty())
             deferred_ = DeferredDetection{pose, !fromBoard, boardPixels};
@@ -372,6 +374,8 @@ void FeatureTracker::detect(const cv::Mat& grey, const PoseEstimate& pose, bool 
     for (const auto& t : tracks_) cv::circle(mask, t.px, int(minDist), cv::Scalar(0), -1);
     std::vector<cv::Point2f> corners;
     cv::goodFeaturesToTrack(grey, corners, want, options_.cornerQuality, minDist, mask, 3);
+    lastDetectionShort_ = int(corners.size()) < want;
+    stats_.detected = 0;
     if (corners.empty()) return;
     const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
     cv::cornerSubPix(grey, corners, cv::Size(3, 3), cv::Size(-1, -1), term);
@@ -384,7 +388,10 @@ void FeatureTracker::detect(const cv::Mat& grey, const PoseEstimate& pose, bool 
         const int id = map_.add(camera_, *pose.pose, {c.x, c.y}, options_.featureSigmaPx * scale_,
                                 derived ? 0.0 : rotSigma, derived ? 0.0 : pose.sigmaPosM(), depth,
                                 options_.rhoSigmaFraction, derived);
-        if (id >= 0) tracks_.push_back({c, id});
+        if (id >= 0) {
+            tracks_.push_back({c, id});
+            ++stats_.detected;
+        }
     }
 }
 

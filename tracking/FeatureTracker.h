@@ -105,6 +105,7 @@ struct FeatureStats {
     int landmarks = 0;  // of them with a landmark in view
     int inliers = 0;    // landmarks in the pose (0 when no pose was tried)
     int tags = 0;       // tags in the pose
+    int detected = -1;  // corners the frame's detection added (-1: no detection ran)
     double trackMs = 0, poseMs = 0, mapMs = 0;
 };
 
@@ -187,6 +188,10 @@ private:
     std::vector<Track> tracks_;
     LandmarkMap map_;
     int framesSinceDetect_ = 0;
+    // The last detection found fewer corners than it looked for: the view has no more texture
+    // to give, so the refill waits for the periodic detection (detectEvery) instead of running
+    // in every frame.
+    bool lastDetectionShort_ = false;
     // Running mean of the covariances of the board poses that built the map: the error every
     // landmark shares (added to the pose's covariance).
     std::array<double, 36> mapCovariance_{};

@@ -145,7 +145,9 @@ BENCHMARK(BM_MiragePose)
 
 // mirage's Tracker over the video (frames in order, cycling). Arg mode: 2 = tracking mode (tags
 // found where the predicted pose puts them, verified; default), 1 = libapriltag in the region
-// of interest only (the previous default), 0 = libapriltag on the full image every frame.
+// of interest only (the previous default), 0 = libapriltag on the full image every frame; 3 =
+// mode 2 with extended tracking's natural features on, as `mirage track` and live run it (on
+// this flat-coloured board few features exist: the cost of looking for them).
 // Accuracy of the raw per-frame poses over one pass after a first pass to warm up.
 void BM_MirageTrack(benchmark::State& state) {
     const BoardFrames& f = sequence(int(state.range(0)));
@@ -157,8 +159,9 @@ void BM_MirageTrack(benchmark::State& state) {
     // search, as by default.
     opt.coarseToFine = state.range(1) >= 2;
     opt.coarseFirst = state.range(1) >= 2;
-    // The board only, as before extended tracking (BM_MirageTrackTextured has the features).
-    opt.features.enabled = false;
+    // The board only, as before extended tracking, but in mode 3 (BM_MirageTrackTextured has
+    // the features on a textured scene).
+    opt.features.enabled = state.range(1) == 3;
     Tracker tracker(f.board, f.camera, opt);
     TrackingAccuracy acc;
     const double dt = 1.0 / 30.0;
@@ -191,9 +194,11 @@ void BM_MirageTrack(benchmark::State& state) {
 BENCHMARK(BM_MirageTrack)
     ->ArgNames({"width", "mode"})
     ->Args({640, 2})
+    ->Args({640, 3})
     ->Args({640, 1})
     ->Args({640, 0})
     ->Args({1280, 2})
+    ->Args({1280, 3})
     ->Args({1280, 1})
     ->Args({1280, 0})
     ->Unit(benchmark::kMillisecond)
@@ -358,11 +363,12 @@ void BM_MirageSingle(benchmark::State& state) {
 
 // mirage's default Tracker (mode 2 of BM_MirageSingle; mode 10 = libapriltag's edge refinement on
 // in the coarse search, as before; mode 11 = the window retry and the coarse-first cascade off,
-// the ordinary search of the region where the window finds no tag, as before) and ArUco (no corner refinement) on the same single frame, one
-// after the other in each iteration, the order swapped every iteration: on a shared machine whose
-// speed drifts by tens of percent within a minute, both see the same moments, so their ratio is
-// steadier than that of two separate rows. Counters: each one's wall ms per frame, `speedup` =
-// ArUco's time over mirage's (the bar: >= 2), and mirage's accuracy over one pass of the 16 views.
+// the ordinary search of the region where the window finds no tag, as before) and ArUco (no corner
+// refinement) on the same single frame, one after the other in each iteration, the order swapped
+// every iteration: on a shared machine whose speed drifts by tens of percent within a minute, both
+// see the same moments, so their ratio is steadier than that of two separate rows. Counters: each
+// one's wall ms per frame, `speedup` = ArUco's time over mirage's (the bar: >= 2), and mirage's
+// accuracy over one pass of the 16 views.
 void BM_SingleSideBySide(benchmark::State& state) {
     const BoardFrames& f = frames(int(state.range(0)));
     TrackerOptions opt;
