@@ -648,6 +648,7 @@ std::string GpuScene::lightingDefines(bool withGlass) const {
     if (withGlass && (hasTransmissive() || hasTranslucent()))
         defines += "#define MIRAGE_GLASS_SHADOWS 1\n";
     if (shadowPcf_) defines += "#define MIRAGE_SHADOW_PCF 1\n";
+    if (!shadowPixelFootprint_) defines += "#define MIRAGE_SHADOW_NO_PIXEL_FOOTPRINT 1\n";
     return defines;
 }
 

@@ -122,6 +122,9 @@ public:
     // pays for both sides of a branch on a uniform (measured: the bilinear frame 1.2x slower).
     // Set before the passes compile their programs.
     void setShadowPcf(bool pcf) { shadowPcf_ = pcf; }
+    // The focused maps' pixel-footprint filter (ShadowOptions::pixelFootprint; off:
+    // MIRAGE_SHADOW_NO_PIXEL_FOOTPRINT, the 2-texel PCF). Set before the passes compile.
+    void setShadowPixelFootprint(bool on) { shadowPixelFootprint_ = on; }
     bool hasTransmissive() const;
     bool hasTranslucent() const;
     // Some draw has a base-colour / metallic-roughness texture (else the G-buffer skips the read).
@@ -242,6 +245,7 @@ private:
     int sceneLightCount_ = 0;
     int environmentLightSlots_ = 0;
     bool shadowPcf_ = false;
+    bool shadowPixelFootprint_ = true;
     std::vector<int> specularDraws_;
     BoundingSphere bounds_;
     gl::Buffer vertices_, indices_, materials_, points_, specularBuffer_;

@@ -393,6 +393,7 @@ Renderer::Renderer(const Scene& scene, const CameraIntrinsics& camera, RendererO
                         "(add the real surfaces' proxies and the virtual objects as meshes)");
     scene_ = std::make_unique<GpuScene>(scene, 16384, options_.environment.lights);
     scene_->setShadowPcf(options_.shadow.filter == ShadowFilter::Pcf);
+    scene_->setShadowPixelFootprint(options_.shadow.pixelFootprint);
     projection_ = CameraProjection::make(camera);
     ctx_ = std::make_unique<FrameContext>(*scene_, projection_, options_);
 

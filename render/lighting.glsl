@@ -151,6 +151,9 @@ vec3 shadowPixelDx = vec3(0.0), shadowPixelDy = vec3(0.0);
 
 void setShadowPixelFootprint(vec3 p, vec3 n) {
     shadowPixelDx = shadowPixelDy = vec3(0.0);
+#ifdef MIRAGE_SHADOW_NO_PIXEL_FOOTPRINT
+    return;  // ShadowOptions::pixelFootprint off: the 2-texel PCF
+#endif
     vec3 d = p - cameraPos.xyz;
     // The OpenCV camera's axes in world space: the view matrix's rows.
     vec3 right = vec3(viewMatrix[0][0], viewMatrix[1][0], viewMatrix[2][0]);

@@ -207,7 +207,7 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
             "vnm_surface=occupancy vnm_albedo=hapke vnm_lookup=smooth moving_objects=off "
             "env_source=static env_resolution=512 env_lights=0 exposure_match=off "
             "motion_blur=off aa=off noise_match=off vignette_match=off camera_response=session "
-            "shadow_focus=on "
+            "shadow_focus=on shadow_footprint=on "
             "vpl_rotate=off ism_tile=64 ism_points=1024 ism_pullpush=off vnm_see_through=on "
             "vnm_reflection=on view=off");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);

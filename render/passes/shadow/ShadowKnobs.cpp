@@ -33,6 +33,11 @@ std::vector<PassKnob> shadowKnobs() {
             "map of every occluder over the light's whole frustum",
             [](RendererOptions& o) -> bool& { return o.shadow.focus; }, {"on"}),
         onOffKnob(
+            "shadow_footprint",
+            "on: the focused maps filter each camera pixel's shadow over the pixel's footprint "
+            "in the map; off: over a 2-texel box, whatever the pixel covers",
+            [](RendererOptions& o) -> bool& { return o.shadow.pixelFootprint; }, {"on"}),
+        onOffKnob(
             "glass_shadows",
             "on: glass transmits (tints) the light in the shadow maps of lights without caustics; "
             "off: glass is opaque there",

@@ -39,6 +39,11 @@ struct ShadowOptions {
     // virtual objects alone per map. Used where every fitted frustum is at most half the
     // light's; false: one map of every occluder over the light's whole frustum.
     bool focus = true;
+    // The focused maps' filter follows the camera pixel's footprint in the map (a box of the
+    // pixel's width convolved with the bilinear hat); false: the 2-texel PCF, as for points
+    // that are not a camera pixel (hits seen in a mirror, photons). Compiled in
+    // (MIRAGE_SHADOW_NO_PIXEL_FOOTPRINT), like `filter`.
+    bool pixelFootprint = true;
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 4096, "shadow.mapSize", "16..4096", mapSize);
