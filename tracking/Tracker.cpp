@@ -577,8 +577,11 @@ Tracker::SearchPlan Tracker::planSearch(const cv::Mat& grey, const std::optional
                          cv::Point(int(cx + hw), int(cy + hh))) &
                 full;
         }
-        plan.windowed = true;
-        if (options_.windowRetry && plan.coarseSearch != grown)
+        // The finer searches of the window only where the textured region stands for the board
+        // (it was small enough to be searched alone): where texture fills the view, the window
+        // is merely the image's centre, and a frame without the board would pay for them.
+        plan.windowed = f.textureRegionUsed;
+        if (options_.windowRetry && f.textureRegionUsed && plan.coarseSearch != grown)
             plan.retryWindow = plan.coarseSearch;
     }
     return plan;
@@ -593,17 +596,22 @@ void Tracker::searchPlanned(const cv::Mat& grey, const SearchPlan& plan,
     // Decimation 1 is a coarse stage too (coarseFirstDecimations): libapriltag at full
     // resolution in the window.
     bool done = false;
+    // The window already searched at full resolution needs no window retry.
+    cv::Rect retryWindow = plan.retryWindow;
     if (plan.coarseDecimate >= 1.0f && plan.coarseRegion) {
         done = coarseToFine(grey, plan.coarseSearch, plan.coarseDecimate, ambiguityPrior, f);
+        float searched = plan.coarseDecimate;
         // No tag in the window at that decimation (the side estimate is an overestimate under
         // foreshortening): the next finer decimation in the same window.
         for (float d : coarseCascade(plan)) {
             if (done || f.coarseTags > 0) break;
             f.coarseCascaded = true;
+            searched = d;
             done = coarseToFine(grey, plan.coarseSearch, d, ambiguityPrior, f);
         }
+        if (searched == 1.0f && plan.coarseSearch == plan.retryWindow) retryWindow = cv::Rect();
     }
-    if (!done) detectAndEstimate(f.searchRegion, plan.retryWindow);
+    if (!done) detectAndEstimate(f.searchRegion, retryWindow);
     bool retry = f.searchRegion != full && f.estimate.state != TrackingState::Ok;
     if (f.searchRegion != full && f.estimate.state == TrackingState::Ok) {
         const auto now = boardRegion(*f.estimate.pose, grey.size(), false);

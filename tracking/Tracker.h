@@ -270,8 +270,9 @@ private:
         // The coarse-first window when the frame has one (else empty): the ordinary search's
         // full-resolution retry reads it first (TrackerOptions::windowRetry).
         cv::Rect retryWindow;
-        // coarseSearch is the coarse-first window about the textured region (not the whole
-        // search region): the coarse search may step to finer decimations there.
+        // coarseSearch is the coarse-first window about a textured region that stands for the
+        // board (TrackedFrame::textureRegionUsed): the coarse search may step to finer
+        // decimations there.
         bool windowed = false;
         float coarseDecimate = 0;
         bool coarseRegion = false;

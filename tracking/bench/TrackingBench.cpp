@@ -210,6 +210,38 @@ void runAruco(benchmark::State& state, const BoardFrames& f);
 // back (texturedVideo), with natural features (features 1, the default) or the board only (0).
 // Counters over one pass after a warm-up pass: ok rate (pose_rate), wrong-but-ok poses, frames
 // from the features alone, and the features' own cost (tracking, pose, map; wall ms per frame).
+// Re-acquisition where there is nothing to find: the textured video's frames with the board out
+// of view, each as a single frame (no recent pose; features off, so each frame is searched for
+// tags), the defaults (mode 2) or with the window searches off (mode 11: no cascade, no window
+// retry). What a lost tracker pays per frame while the camera looks away from the board.
+void BM_MirageNoBoard(benchmark::State& state) {
+    const BoardFrames& tv = texturedVideo(int(state.range(0)));
+    std::vector<const cv::Mat*> away;
+    for (size_t v = 0; v < tv.images.size(); ++v)
+        if (!boardInView(tv.camera, tv.board, tv.truth[v])) away.push_back(&tv.images[v]);
+    TrackerOptions opt;
+    opt.filterEnabled = false;
+    opt.features.enabled = false;
+    if (state.range(1) == 11) opt.windowRetry = opt.coarseFirstCascade = false;
+    Tracker tracker(tv.board, tv.camera, opt);
+    double t = 0;
+    int ok = 0;
+    for (const cv::Mat* img : away)
+        ok += tracker.process(*img, t += 10.0).estimate.state == TrackingState::Ok;
+    size_t i = 0;
+    for (auto _ : state)
+        benchmark::DoNotOptimize(tracker.process(*away[i++ % away.size()], t += 10.0));
+    state.counters["frames"] = double(away.size());
+    state.counters["wrong_ok"] = ok;  // no board in view: any ok pose is wrong
+}
+
+BENCHMARK(BM_MirageNoBoard)
+    ->ArgNames({"width", "mode"})
+    ->Args({640, 2})
+    ->Args({640, 11})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 void BM_MirageTrackTextured(benchmark::State& state) {
     const BoardFrames& f = texturedVideo(int(state.range(0)));
     TrackerOptions opt;
