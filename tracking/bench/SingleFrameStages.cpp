@@ -44,6 +44,29 @@ double cpuMs() {
     return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
 }
 
+// The search path a frame took (the table's "path" column; see the header comment).
+std::string pathLabel(const mirage::tracking::TrackedFrame& r) {
+    char path[128];
+    if (r.windowRetried)
+        std::snprintf(path, sizeof path, "search, window d1 %s (%d tags, %d/%d verified)",
+                      r.coarseUsed ? "used" : "fell back", r.coarseTags, r.prediction.verified,
+                      r.prediction.predicted);
+    else if (r.coarseTried)
+        std::snprintf(path, sizeof path, "coarse d%.0f%s %s (%d tags, %d/%d verified)",
+                      double(r.coarseFirstDecimate), r.coarseCascaded ? " none, finer" : "",
+                      r.coarseUsed ? "used" : "fell back", r.coarseTags, r.prediction.verified,
+                      r.prediction.predicted);
+    else
+        std::snprintf(path, sizeof path, "search%s", r.fullFrameRetry ? " + full retry" : "");
+    std::string out = path;
+    if (!r.fullResolutionRegion.empty())
+        out += " + full res " + std::to_string(r.fullResolutionFound) + "/" +
+               std::to_string(r.fullResolutionSought);
+    if (r.fullResolutionFinderFound > 0)
+        out += " + finder " + std::to_string(r.fullResolutionFinderFound);
+    return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -158,34 +181,14 @@ int main(int argc, char** argv) {
             mirageAgainMs += (cpuMs() - c0) / reps;
         }
 
-        char path[128];
-        if (r.windowRetried)
-            std::snprintf(path, sizeof path, "search, window d1 %s (%d tags, %d/%d verified)",
-                          r.coarseUsed ? "used" : "fell back", r.coarseTags, r.prediction.verified,
-                          r.prediction.predicted);
-        else if (r.coarseTried)
-            std::snprintf(path, sizeof path, "coarse d%.0f%s %s (%d tags, %d/%d verified)",
-                          double(r.coarseFirstDecimate), r.coarseCascaded ? " none, finer" : "",
-                          r.coarseUsed ? "used" : "fell back", r.coarseTags, r.prediction.verified,
-                          r.prediction.predicted);
-        else
-            std::snprintf(path, sizeof path, "search%s", r.fullFrameRetry ? " + full retry" : "");
-        if (!r.fullResolutionRegion.empty()) {
-            const size_t len = std::strlen(path);
-            std::snprintf(path + len, sizeof path - len, " + full res %d/%d", r.fullResolutionFound,
-                          r.fullResolutionSought);
-        }
-        if (r.fullResolutionFinderFound > 0) {
-            const size_t len = std::strlen(path);
-            std::snprintf(path + len, sizeof path - len, " + finder %d",
-                          r.fullResolutionFinderFound);
-        }
+        const std::string path = pathLabel(r);
         std::printf(
             "%2zu | %.2f | %s%s | %zu | %s | %.3f | %.3f | %.2f | %.2f / %.2f / %.2f | %.0f | "
             "%.2f / %.2f = %.2f\n",
-            v, frameMs, path, r.textureRegionUsed ? ", region" : "", r.estimate.tagsUsed.size(),
-            trackingStateName(r.estimate.state), refineMs, poseMs, aprilMs, detectMs, trackerPoseMs,
-            featureMs, r.coarseFirstSidePx, arucoMs, mirageAgainMs, arucoMs / mirageAgainMs);
+            v, frameMs, path.c_str(), r.textureRegionUsed ? ", region" : "",
+            r.estimate.tagsUsed.size(), trackingStateName(r.estimate.state), refineMs, poseMs,
+            aprilMs, detectMs, trackerPoseMs, featureMs, r.coarseFirstSidePx, arucoMs,
+            mirageAgainMs, arucoMs / mirageAgainMs);
         sumFrame += frameMs;
         sumAruco += arucoMs;
         sumMirageAgain += mirageAgainMs;
