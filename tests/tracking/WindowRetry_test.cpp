@@ -1,7 +1,9 @@
-// The window retry of single frames (TrackerOptions::windowRetry, docs/tracking.md "Single
-// frames: the window retry"): when libapriltag's decimated search of a frame without a recent
-// pose finds no tag, the coarse-first window is searched at full resolution and the finder looks
-// for the other tags from their pose, before the whole region is searched at full resolution.
+// The single-frame searches of the coarse-first window at finer decimations (docs/tracking.md,
+// "The window at finer decimations"): the cascade (TrackerOptions::coarseFirstCascade: the window
+// at decimations 3, 2, 1 after the chosen one found no tag there) and the window retry
+// (TrackerOptions::windowRetry: when libapriltag's decimated search of the region finds no tag,
+// the window at full resolution, the finder looking for the other tags from their pose, before
+// the whole region is searched at full resolution).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,7 +47,7 @@ struct View {
 };
 
 // The tracking benchmark's 16 single views (640x480) and the hard views of the other
-// single-frame tests: steep, distant, occluded, cut by the image edge.
+// single-frame tests: steep, distant, cut by the image edge.
 std::vector<View> views() {
     static const BoardFrames bench = singleBoardViews(640);
     std::vector<View> out;
