@@ -127,8 +127,10 @@ struct TrackerOptions {
     // at full resolution first, and the finder the rest of the board from the pose of the tags
     // found there (the coarse-to-fine search at decimation 1); only when that gives no ok pose
     // does the whole region get the full-resolution search (DetectorOptions::
-    // fullResolutionRetry). The window is about a quarter of the region, so this saves most of
-    // the full-resolution search's cost in such frames. False = the whole region at once.
+    // fullResolutionRetry). The window is about a third of the region's pixels: on the
+    // benchmark's distant views it saves 10-15 % of such a frame (docs/tracking.md, "The window
+    // at finer decimations"). Only where the textured region stands for the board (it was
+    // searched alone), as the cascade below. False = the whole region at once.
     bool windowRetry = true;
     // When the coarse-first window holds no tag at the chosen decimation, the coarse-to-fine
     // search tries the finer decimations 3 and 2 below it in the same window, and 1 (full
