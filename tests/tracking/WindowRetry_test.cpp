@@ -15,6 +15,7 @@
 
 #include "testscenes/TrackingViews.h"
 #include "tracking/ArucoComparison.h"
+#include "tracking/SyntheticTabletop.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::tracking {
@@ -131,6 +132,27 @@ TEST(WindowRetry, EmptyWindowFallsBackToTheWholeRegion) {
     ASSERT_TRUE(w.estimate.pose && b.estimate.pose);
     EXPECT_EQ(w.estimate.tagsUsed, b.estimate.tagsUsed);
     EXPECT_LT(rotationDeg(*w.estimate.pose, *b.estimate.pose), 1e-5);
+}
+
+// Must fail without the gate: where texture fills the view (the textured tabletop, the camera
+// panned away so that the board is out of view) the textured region does not stand for the
+// board, so neither window search runs (each cost such a frame ~6 ms, BM_MirageNoBoard) and the
+// frame gets no pose.
+TEST(WindowRetry, NotWhereTextureFillsTheView) {
+    const SyntheticTabletop table(BoardLayout().makeBoard());
+    const CameraIntrinsics cam = testing::pinholeCamera();
+    const TexturedPlaneRenderer renderer(cam, 2);
+    const Pose away = orbitThenPan(65, 30, 36, 80.0);
+    ASSERT_FALSE(boardInView(cam, table.board(), away));
+    TrackerOptions o;
+    o.filterEnabled = false;
+    o.features.enabled = false;
+    Tracker tracker(table.board(), cam, o);
+    const TrackedFrame f = tracker.process(table.render(renderer, away), 0.0);
+    EXPECT_FALSE(f.textureRegionUsed);
+    EXPECT_FALSE(f.windowRetried);
+    EXPECT_FALSE(f.coarseCascaded);
+    EXPECT_NE(f.estimate.state, TrackingState::Ok);
 }
 
 }  // namespace
