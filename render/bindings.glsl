@@ -128,6 +128,15 @@ const int kUnitSpecLightHistoryR = 27;     // share (temporal history)
 const int kUnitSpecLightHistoryRRefl = 28;
 const int kUnitSpecLightHistoryHits = 29;  // the hits the history was lit at
 const int kUnitSpecLightVpls = 30;         // the VPL buffer as RGBA32F texels (common.glsl vplAt)
+// passes/specular/second_exit.glsl (specular_light.frag and specular_resolve.frag): the primary
+// G-buffer's normal, emissive (a = specular slot + 1) and position, the back-face buffer and the
+// real surfaces, in the units the impostor tracing uses in other passes.
+const int kUnitSecondExitFrontNormal = 16;
+const int kUnitSecondExitFrontSlot = 17;
+const int kUnitSecondExitFrontPosition = 18;
+const int kUnitSecondExitBackPosition = 19;
+const int kUnitSecondExitBackNormal = 20;
+const int kUnitSecondExitRealSurfaces = 21;
 // specular_resolve.frag (the half-resolution upsample): GBuf_refl / GBuf_refr at the units above,
 // the half-resolution hit radiance (reflected L_rv, L_r, refracted L_rv, L_r) and the primary
 // G-buffer's emissive (a = specular slot + 1).
@@ -223,6 +232,7 @@ const int kUnitGrainPosition = 3;  // w = origin
 const int kUnitGrainEmissive = 4;  // a = specular slot + 1
 const int kUnitGrainCanvasToCamera = 5;
 const int kUnitGrainComposite = 6;  // the composite (linear, a = coverage)
+const int kUnitGrainFootageShare = 7;  // the composite's footage share (CompositePass)
 
 // passes/fuzzy: fuzzy_resolve.frag and fuzzy_filter.frag (separable, one program per pass)
 const int kUnitFuzzyPosition = 0;

@@ -29,6 +29,12 @@ std::vector<PassKnob> roughKnobs() {
             "mip levels of the rough-refraction chains (LEAN moments, camera image, rough-glass "
             "radiance; 1..12): a wider lobe is cut at the last",
             [](RendererOptions& o) -> int& { return o.rough.mipLevels; }, 1, 12, {"8"}),
+        choiceKnob("rough_footprint",
+                   "how far a turn of the rough glass's exit ray moves what it sees: "
+                   "differentials (the sharp path's neighbouring pixels) or slab (a flat slab's "
+                   "magnification)",
+                   [](RendererOptions& o) -> bool& { return o.rough.rayDifferentials; },
+                   "differentials", "slab", {"differentials"}),
     };
     return k;
 }

@@ -18,6 +18,12 @@ struct RoughOptions {
     // Levels of the LEAN moment chains and of the prefiltered lookups (camera image, rough-glass
     // radiance; 1..12): a lobe wider than the last level is cut there.
     int mipLevels = 8;
+    // How far a turn of the exit ray moves what the lobe sees in the glass's image: by ray
+    // differentials (the sharp path's exit point and direction at the neighbouring pixels: true)
+    // or by a flat slab's magnification (false). A sphere's rim, where the exit direction sweeps
+    // the surroundings within a few pixels, needs the first: the slab model spreads its lobe over
+    // the interior's image.
+    bool rayDifferentials = true;
 
     void validate() const {
         checkOption(gsrSubdivisions >= 1 && gsrSubdivisions <= 8, "rough.gsrSubdivisions",

@@ -35,6 +35,7 @@ RoughRefractionPass::RoughRefractionPass()
     locSubdivisions_ = refraction_.uniformLocation("subdivisions");
     locFocal_ = refraction_.uniformLocation("focalPx");
     locMaxLevel_ = refraction_.uniformLocation("maxLevel");
+    locFootprint_ = refraction_.uniformLocation("footprintModel");
 }
 
 void RoughRefractionPass::setup(PassBuilder& b) const {
@@ -145,6 +146,7 @@ void RoughRefractionPass::execute(FrameContext& ctx, PassResources& res) {
     const CameraIntrinsics& K = ctx.projection.camera;
     glUniform1f(locFocal_, float(0.5 * (K.fx + K.fy)));
     glUniform1f(locMaxLevel_, float(levels_ - 1));
+    glUniform1i(locFootprint_, ctx.options.rough.rayDifferentials ? 1 : 0);
     ctx.clearForRects(rect, outDrawn_, 0, 5);
     ctx.drawFullscreenTriangleIn(rect);
     for (int i = 0; i < 4; ++i) res.publish(kFiltered[i], out_[i]);

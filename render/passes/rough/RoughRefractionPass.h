@@ -35,7 +35,7 @@ private:
     gl::Framebuffer chainsFbo_, outFbo_;
     DrawnRects chainsDrawn_, outDrawn_;  // what the draws into each last covered (level 0)
     GLint locPrefilterEpsilon_ = -1, locMethod_ = -1, locSubdivisions_ = -1, locFocal_ = -1,
-          locMaxLevel_ = -1;
+          locMaxLevel_ = -1, locFootprint_ = -1;
     int width_ = 0, height_ = 0, levels_ = 0;
 };
 

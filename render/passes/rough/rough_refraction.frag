@@ -32,8 +32,11 @@
 //     canvas radius the footprint maps to: a turn of the exit ray by angle x moves what it sees
 //     by x f r / (s + d_in + r) canvas pixels (a flat slab's magnification; s the camera
 //     distance, f the focal length in pixels; misses: x f), and the level is Lee et al.'s from the
-//     lobe's major std. Anisotropic lobes are sums of isotropic taps along the major axis
-//     (Mavridis and Papaioannou 2011). Looking the hits up in the image of the glass rather than
+//     lobe's major std. With ray differentials (footprintModel 1) the map is the inverse of how
+//     far the sharp path's seen point moves per canvas pixel (the neighbours' exits), never
+//     wider than the slab's: on a sphere's rim the lobe stays on the rim's own pixels.
+//     Anisotropic lobes are sums of isotropic taps along the major axis (Mavridis and
+//     Papaioannou 2011). Looking the hits up in the image of the glass rather than
 //     in the camera image or the environment map keeps the blur continuous where the sharp hit
 //     changes kind (a box edge against the sky: one pixel sees the box, its neighbour a miss).
 // The glass's weak Fresnel reflection is in the same buffers and gets the same blur. A lookup of
@@ -63,6 +66,7 @@ layout(binding = kUnitRoughInputFirst + 2) uniform sampler2D in2;  // reflection
 layout(binding = kUnitRoughInputFirst + 3) uniform sampler2D in3;  // L_env
 layout(binding = kUnitRoughInputFirst + 4) uniform sampler2D in4;  // video term (fuzzy) or 0
 uniform int method;           // 0: LEAN, 1: GSR
+uniform int footprintModel;   // 0: a flat slab's magnification, 1: ray differentials
 uniform int subdivisions;     // GSR: azimuth sectors (1..kMaxSectors)
 uniform float focalPx;        // canvas focal length (pixels per radian near the axis)
 uniform float maxLevel;       // the chains' last mip level
@@ -91,8 +95,8 @@ struct Ewa {
     float sigma;
     int count;
 };
-Ewa ewaPlan(vec3 c, vec3 t, vec3 b) {
-    vec3 e = gsrEigen(c);
+// From the covariance's eigen decomposition (gsrEigen: major and minor variance, angle).
+Ewa ewaFromEigen(vec3 e, vec3 t, vec3 b) {
     Ewa p;
     p.axis = cos(e.z) * t + sin(e.z) * b;
     float major = sqrt(e.x), minor = sqrt(e.y);
@@ -106,6 +110,7 @@ Ewa ewaPlan(vec3 c, vec3 t, vec3 b) {
     }
     return p;
 }
+Ewa ewaPlan(vec3 c, vec3 t, vec3 b) { return ewaFromEigen(gsrEigen(c), t, b); }
 float ewaOffset(Ewa p, int j) { return (float(j) - 0.5 * float(p.count - 1)) * p.spacing; }
 
 // What the lobe sees: the five prefiltered buffers (L'_rv, L'_r, reflection share, L_env, CI_bp)
@@ -114,8 +119,10 @@ float ewaOffset(Ewa p, int j) { return (float(j) - 0.5 * float(p.count - 1)) * p
 // pixel itself is the pixel's values exactly (texelFetch of level 0).
 void lobeLookup(ivec2 px, vec2 cp, Ewa p, vec2 axisPx, float toCanvas, out vec4 v[5]) {
     float level = levelOf(p.sigma * toCanvas, maxLevel);
-    // Within its own pixel (std below half a pixel): the pixel's values.
-    if (p.count == 1 && p.sigma * toCanvas < 0.5 &&
+    // Within its own pixel (the major std, taps' spread included, below half a pixel): the
+    // pixel's values.
+    float majorVar = p.sigma * p.sigma + p.spacing * p.spacing * float(p.count * p.count - 1) / 12.0;
+    if (majorVar * toCanvas * toCanvas < 0.25 &&
         all(lessThanEqual(abs(cp - vec2(px)), vec2(1e-3)))) {
         v[0] = texelFetch(preRv, px, 0);
         v[1] = texelFetch(preR, px, 0);
@@ -144,6 +151,63 @@ void lobeLookup(ivec2 px, vec2 cp, Ewa p, vec2 axisPx, float toCanvas, out vec4 
         v[3] = texelFetch(preEnv, px, 0);
         v[4] = texelFetch(preVideo, px, 0);
     }
+}
+
+// The sharp path's exit point P2 and direction T2 at canvas pixel q, when q shows the same
+// rough glass (draw slot) with a refracted component; false otherwise.
+bool sharpExit(ivec2 q, int slot, float eta, out vec3 P2q, out vec3 T2q) {
+    P2q = vec3(0.0);
+    T2q = vec3(0.0);
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(canvas.xy)))) return false;
+    if (int(texelFetch(gEmissive, q, 0).a + 0.5) - 1 != slot) return false;
+    vec4 W = texelFetch(refrWeight, q, 0);
+    if (all(lessThanEqual(W.rgb, vec3(0.0)))) return false;
+    vec4 Hq = texelFetch(refrHit, q, 0);
+    bool missQ = int(Hq.w + 0.5) == ORIGIN_NONE;
+    if (missQ && dot(Hq.xyz, Hq.xyz) <= 0.25) return false;
+    vec3 aq = texelFetch(gPosition, q, 0).xyz;
+    vec3 dq = normalize(aq - cameraPos.xyz);
+    vec3 T1q = refract(dq, texelFetch(gNormal, q, 0).xyz, 1.0 / eta);
+    if (dot(T1q, T1q) < 0.5) return false;
+    P2q = aq + normalize(T1q) * max(W.a, 0.0);
+    vec3 e = missQ ? Hq.xyz : Hq.xyz - P2q;
+    if (!(dot(e, e) > 1e-12)) return false;
+    T2q = normalize(e);
+    return allFinite(P2q) && allFinite(T2q);
+}
+
+// How what the exit ray sees moves from pixel to pixel (ray differentials; Igehy 1999): the
+// seen point P2 + r T2 of a neighbour, with this pixel's hit distance r, moves across T2 by
+// dP2 + r dT2 per canvas pixel, i.e. by (dP2 / r + dT2) radians as seen from the exit, per axis
+// in the basis u, v across T2. Central differences, one-sided at the glass's edge; false for an
+// axis with neither neighbour (the caller keeps the slab model).
+bool seenDifferential(ivec2 px, ivec2 step, int slot, float eta, vec3 P2, vec3 T2, float invR,
+                      out vec3 dSeen) {
+    vec3 Pp, Tp, Pm, Tm;
+    bool okP = sharpExit(px + step, slot, eta, Pp, Tp);
+    bool okM = sharpExit(px - step, slot, eta, Pm, Tm);
+    if (okP && okM) dSeen = 0.5 * ((Pp - Pm) * invR + (Tp - Tm));
+    else if (okP) dSeen = (Pp - P2) * invR + (Tp - T2);
+    else if (okM) dSeen = (P2 - Pm) * invR + (T2 - Tm);
+    else dSeen = vec3(0.0);
+    return okP || okM;
+}
+
+// The map from a turn of the exit ray (radians, across T2 in the basis u, v) to canvas pixels:
+// the inverse of the seen point's differential G (seenDifferential, both axes), where both axes
+// have a neighbour of the same glass and G is not singular (a seen point that barely moves
+// between pixels would spread a lobe over the whole canvas: the slab model holds there).
+bool differentialMap(ivec2 px, int slot, float eta, vec3 P2, vec3 T2, float invR, vec3 u, vec3 v,
+                     float toCanvas, out mat2 turnToPx) {
+    turnToPx = mat2(0.0);
+    vec3 dX, dY;
+    if (!seenDifferential(px, ivec2(1, 0), slot, eta, P2, T2, invR, dX) ||
+        !seenDifferential(px, ivec2(0, 1), slot, eta, P2, T2, invR, dY))
+        return false;
+    mat2 G = mat2(vec2(dot(dX, u), dot(dX, v)), vec2(dot(dY, u), dot(dY, v)));
+    if (!(abs(determinant(G)) > 1e-3 / (toCanvas * toCanvas))) return false;
+    turnToPx = inverse(G);
+    return allFinite(vec3(turnToPx[0], turnToPx[1].x)) && allFinite(vec3(turnToPx[1].y));
 }
 
 // The back normals' Gaussian (slopes in the tangent plane t, b of N0; covariance) at a texel of
@@ -275,6 +339,20 @@ void main() {
     vec3 camRight = vec3(viewMatrix[0][0], viewMatrix[1][0], viewMatrix[2][0]);
     vec3 camDown = vec3(viewMatrix[0][1], viewMatrix[1][1], viewMatrix[2][1]);
     float toCanvas = focalPx * (miss ? 1.0 : r / (s + din + r));  // canvas px per radian
+    // The ray differentials' map from a turn of the exit ray (across T2, in u, v) to canvas
+    // pixels; else the flat slab's magnification toCanvas.
+    vec3 u = camRight - T2 * dot(camRight, T2);
+    u = dot(u, u) > 1e-8 ? normalize(u) : normalize(cross(T2, camDown));
+    vec3 v = cross(T2, u);
+    mat2 turnToPx;
+    bool differential = footprintModel == 1 &&
+                        differentialMap(px, slot, eta, P2, T2, miss ? 0.0 : 1.0 / max(r, 1e-6),
+                                        u, v, toCanvas, turnToPx);
+    // The differentials only narrow the slab's footprint (the rim of a curved glass, where the
+    // exit ray sweeps the surroundings within a pixel or two): where they would widen it, the
+    // neighbours are another face of the object (a slab's edge) or a focus, and the first-order
+    // map does not hold.
+    float maxPxPerRad = toCanvas;
     vec4 sum[5];
     for (int i = 0; i < 5; ++i) sum[i] = vec4(0.0);
     float wsum = 0.0;
@@ -288,15 +366,37 @@ void main() {
             vec3 Tk = tir ? reflect(T1, -Nk) : refract(T1, -Nk, eta);
             if (dot(Tk, Tk) < 0.5) Tk = reflect(T1, -Nk);
             vec3 dT = normalize(Tk) - T2c;  // the lobe's turn of the exit ray
-            if (allFinite(dT)) cp += toCanvas * vec2(dot(dT, camRight), dot(dT, camDown));
+            if (allFinite(dT)) {
+                vec2 shift = differential ? turnToPx * vec2(dot(dT, u), dot(dT, v))
+                                          : toCanvas * vec2(dot(dT, camRight), dot(dT, camDown));
+                float cap = maxPxPerRad * length(dT);
+                if (dot(shift, shift) > cap * cap) shift *= cap / length(shift);
+                cp += shift;
+            }
         }
         vec3 cov = gIn * gIn * s1sq * vec3(1.0, 1.0, 0.0) +
                    gN * gN * (g.cov + sh2 * vec3(1.0, 1.0, 0.0));
-        Ewa p = ewaPlan(cov, t, b);
-        vec2 axisPx = vec2(dot(p.axis, camRight), dot(p.axis, camDown));
-        vec4 v[5];
-        lobeLookup(px, cp, p, axisPx, toCanvas, v);
-        for (int i = 0; i < 5; ++i) sum[i] += g.weight * v[i];
+        Ewa p;
+        vec2 axisPx;
+        float pxPerUnit = toCanvas;
+        if (differential) {
+            // The lobe's covariance from t, b to u, v, then to canvas pixels.
+            mat2 M = mat2(vec2(dot(t, u), dot(t, v)), vec2(dot(b, u), dot(b, v)));
+            mat2 A = turnToPx * M;
+            mat2 C = mat2(vec2(cov.x, cov.z), vec2(cov.z, cov.y));
+            mat2 P = A * C * transpose(A);
+            vec3 e = gsrEigen(vec3(P[0][0], P[1][1], P[0][1]));
+            e.xy = min(e.xy, vec2(maxPxPerRad * maxPxPerRad * gsrEigen(cov).x));
+            p = ewaFromEigen(e, vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0));
+            axisPx = p.axis.xy;
+            pxPerUnit = 1.0;
+        } else {
+            p = ewaPlan(cov, t, b);
+            axisPx = vec2(dot(p.axis, camRight), dot(p.axis, camDown));
+        }
+        vec4 v5[5];
+        lobeLookup(px, cp, p, axisPx, pxPerUnit, v5);
+        for (int i = 0; i < 5; ++i) sum[i] += g.weight * v5[i];
         wsum += g.weight;
     }
     if (!(wsum > 0.0)) return;

@@ -35,14 +35,18 @@ struct SpecularOptions {
     bool halfResolutionTrace = false;
     // Temporal reuse of the hit light: 1 shades every specular pixel every frame; 2 or 4 shade the
     // 8x8-pixel tiles of one phase of N per frame, and the other tiles' pixels take last frame's
-    // light where it was lit at this frame's hits, within 0.5 mm (specular_light.frag); a pixel whose history
-    // does not hold (disocclusion, the hits moved) is shaded. Every pixel every frame where the
-    // history is reset (first frame, a cut, tracking lost, an object or light moved) and in the
-    // half-resolution variant (its hits are per 2x2 block).
+    // light where it was lit at this frame's hits, within 0.5 mm (specular_light.frag); a pixel
+    // whose history does not hold (disocclusion, the hits moved) is shaded. Every pixel every frame
+    // where the history is reset (first frame, a cut, tracking lost, an object or light moved) and
+    // in the half-resolution variant (its hits are per 2x2 block).
     int refreshInterval = 1;
     // Tests only: false drops the upsample's geometry test (plain bilinear weights; halos at
     // depth steps in the reflections).
     bool upsampleGeometry = true;
+    // The glass's refracted path followed past Fresnel's internal reflection at the back face
+    // to its second exit (specular.glsl refractedSecondExit), whose environment light joins
+    // L_env: on a sphere's rim that share of the light is large. false: only the first exit.
+    bool secondExit = true;
     // Tests only: false draws the specular passes over the one rectangle around every specular
     // object (FrameContext::specularScissor) instead of each object's own (the same images).
     bool rectsPerObject = true;

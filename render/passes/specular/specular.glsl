@@ -224,4 +224,100 @@ bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampl
     return ok;
 }
 
+// The refracted path's second exit. The sharp path (refractTwoInterfaces) leaves the back face at
+// P2 with the share 1 - F2 of the light; the share F2 is reflected inside, along T1r =
+// reflect(T1, N2), meets the object's surface again at P3 (outward normal N3) and leaves along
+// T3 = Snell there with 1 - F3. On a glass sphere seen at a grazing angle (its rim) F2 is large
+// and T3 points away from everything the sharp path sees: without it the rim is too dark.
+// T1r is marched through the object (the primary G-buffer's front faces and the back-face buffer
+// of the same draw slot, as the sharp path's march: it leaves where it passes in front of a front
+// face or behind a back face, bisected); off both buffers' footprint the bounding sphere's exit
+// stands in. Light reflected inside a second time is not followed (nor where the sharp path
+// itself took the internal reflection, F2 = 1). weight: that of the light arriving along -T3,
+// given the sharp path's refraction weight w2 = ... (1 - F1)(1 - F2) ... absorb(d_in):
+// w2 F2 / (1 - F2) (1 - F3) x Beer-Lambert over |P3 - P2|. False when there is none.
+bool refractedSecondExit(vec3 a, vec3 n, vec3 d, float din, vec3 w2, GpuMaterial m,
+                         GpuSpecularDraw sd, int slot, sampler2D frontPosition,
+                         sampler2D frontNormal, sampler2D frontSlot, sampler2D backPosition,
+                         sampler2D backNormal, out vec3 P3, out vec3 T3, out vec3 weight) {
+    P3 = a;
+    T3 = d;
+    weight = vec3(0.0);
+    float eta = max(m.ior, 1e-3);
+    if (all(lessThanEqual(w2, vec3(0.0))) || abs(eta - 1.0) < 1e-4) return false;
+    vec3 T1 = refract(d, n, 1.0 / eta);
+    if (dot(T1, T1) < 0.5) return false;
+    T1 = normalize(T1);
+    vec3 P2 = a + T1 * max(din, 0.0);
+    vec2 cp;
+    vec3 N2 = normalize(P2 - sd.centre);
+    if (projectToCanvas(P2, cp)) {
+        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+        vec3 Nb = texelFetch(backNormal, qi, 0).xyz;
+        if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 == slot && dot(Nb, Nb) > 0.25)
+            N2 = normalize(Nb);
+    }
+    if (!allFinite(N2) || dot(N2, T1) < 1e-3) return false;
+    float F2 = fresnelDielectric(-dot(T1, N2), eta);
+    if (!(F2 > 1e-4) || F2 >= 1.0) return false;
+    vec3 T1r = reflect(T1, N2);
+    // March T1r inside: out where it is in front of this object's front face or behind its back
+    // face at the pixel it projects to; off both, it left the object's image.
+    float maxLen = 2.0 * sd.radius + 1e-3;
+    const int kSteps = 12;
+    float prevT = 0.0, hitT = -1.0;
+    int face = 0;  // 1: front face, 2: back face
+    for (int i = 1; i <= kSteps && hitT < 0.0; ++i) {
+        float t = maxLen * float(i) / float(kSteps);
+        vec3 q = P2 + T1r * t;
+        if (!projectToCanvas(q, cp)) break;
+        ivec2 qi = ivec2(floor(cp + 0.5));
+        if (any(lessThan(qi, ivec2(0))) || any(greaterThanEqual(qi, ivec2(canvas.xy)))) break;
+        float dq = length(q - cameraPos.xyz);
+        bool front = int(texelFetch(frontSlot, qi, 0).a + 0.5) - 1 == slot;
+        bool back = int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 == slot;
+        if (!front && !back) break;
+        if (front && dq < length(texelFetch(frontPosition, qi, 0).xyz - cameraPos.xyz)) face = 1;
+        else if (back && dq > length(texelFetch(backPosition, qi, 0).xyz - cameraPos.xyz)) face = 2;
+        if (face != 0) hitT = t; else prevT = t;
+    }
+    vec3 N3;
+    if (hitT > 0.0) {
+        float lo = prevT, hi = hitT;
+        for (int k = 0; k < 5; ++k) {
+            float mid = 0.5 * (lo + hi);
+            vec3 q = P2 + T1r * mid;
+            projectToCanvas(q, cp);
+            ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+            float dq = length(q - cameraPos.xyz);
+            vec4 S = face == 1 ? texelFetch(frontPosition, qi, 0) : texelFetch(backPosition, qi, 0);
+            bool same = face == 1 ? int(texelFetch(frontSlot, qi, 0).a + 0.5) - 1 == slot
+                                  : int(S.w + 0.5) - 1 == slot;
+            float ds = length(S.xyz - cameraPos.xyz);
+            bool out_ = !same || (face == 1 ? dq < ds : dq > ds);
+            if (out_) hi = mid; else lo = mid;
+        }
+        P3 = P2 + T1r * hi;
+        projectToCanvas(P3, cp);
+        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+        N3 = (face == 1 ? texelFetch(frontNormal, qi, 0) : texelFetch(backNormal, qi, 0)).xyz;
+        if (dot(N3, N3) < 0.25) N3 = P3 - sd.centre;
+    } else {
+        P3 = sphereExit(P2, T1r, sd.centre, sd.radius);
+        N3 = P3 - sd.centre;
+    }
+    N3 = normalize(N3);
+    if (!allFinite(N3) || dot(N3, T1r) < 1e-3) return false;
+    float F3 = fresnelDielectric(-dot(T1r, N3), eta);
+    T3 = refract(T1r, -N3, eta);
+    if (F3 >= 1.0 || dot(T3, T3) < 0.5) return false;  // reflected inside again: not followed
+    T3 = normalize(T3);
+    vec3 absorb = vec3(1.0);
+    if (m.attenuationDistance > 0.0)
+        absorb = pow(max(m.attenuationColor, vec3(1e-6)),
+                     vec3(length(P3 - P2) / m.attenuationDistance));
+    weight = w2 * (F2 / (1.0 - F2)) * (1.0 - F3) * absorb;
+    return allFinite(weight) && allFinite(T3);
+}
+
 #endif
