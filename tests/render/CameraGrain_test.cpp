@@ -10,6 +10,7 @@
 #include <iostream>
 #include <random>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera/CalibrationFile.h"
@@ -26,6 +27,7 @@
 #include "tests/support/TestSupport.h"
 #include "testscenes/RenderTestScenes.h"
 #include "testscenes/SmallSyntheticSession.h"
+#include "testscenes/SpecularTestScenes.h"
 
 namespace mirage::render {
 namespace {
@@ -108,43 +110,98 @@ TEST(NoiseLevels, HardCasesGiveNoEstimateOrAFiniteOne) {
     EXPECT_NEAR(f->varianceAt(glm::vec3(0.002f)).g / 1.2e-4f, 1.0, 0.3);
 }
 
-std::vector<VignetteSample> vignettedSamples(float k1, int n, double outliers, uint32_t seed) {
+// Frames of a table's surface points seen by a camera at `eyes` (looking at the table's centre,
+// 320 x 240, f 200 px): footage / L_r = exposure x V(r) x L_r's own error at the point, which
+// falls towards the table's edge as an unmodelled spot's falloff would (what a single frame
+// cannot tell from vignetting when the table fills the view), 2 % noise and a share of outliers.
+std::vector<std::vector<VignetteSample>> vignettedFrames(float k1,
+                                                         const std::vector<glm::vec3>& eyes,
+                                                         double outliers, uint32_t seed) {
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> r2(0.0, 1.0), u(0.0, 1.0);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
     std::normal_distribution<double> noise(0.0, 0.02);
-    std::vector<VignetteSample> s;
-    for (int i = 0; i < n; ++i) {
-        VignetteSample v;
-        v.r2 = float(r2(rng));
-        v.ratio = float(0.7 * (1.0 + k1 * v.r2) * (1.0 + noise(rng)));
-        if (u(rng) < outliers) v.ratio *= float(0.3 + 2.0 * u(rng));  // an unmodelled occluder
-        s.push_back(v);
+    const double f = 200.0, cx = 159.5, cy = 119.5;
+    std::vector<std::vector<VignetteSample>> frames;
+    for (size_t i = 0; i < eyes.size(); ++i) {
+        const glm::dmat4 view =
+            glm::lookAt(glm::dvec3(eyes[i]), glm::dvec3(0.0), glm::dvec3(0.0, 0.0, -1.0));
+        const double exposure = 0.7 * (1.0 + 0.1 * double(i));
+        std::vector<VignetteSample> frame;
+        for (double x = -0.4; x <= 0.4; x += 0.012)
+            for (double z = -0.3; z <= 0.3; z += 0.012) {
+                const glm::dvec4 c = view * glm::dvec4(x, 0.0, z, 1.0);  // GL camera: -z ahead
+                if (c.z >= -1e-3) continue;
+                const double px = cx + f * c.x / -c.z, py = cy - f * c.y / -c.z;
+                if (px < 0.0 || py < 0.0 || px > 319.0 || py > 239.0) continue;
+                VignetteSample v;
+                v.r2 = float(((px - cx) * (px - cx) + (py - cy) * (py - cy)) / (cx * cx + cy * cy));
+                const double modelError = 1.0 - 0.25 * (x * x + z * z) / 0.25;
+                v.ratio = float(exposure * (1.0 + k1 * v.r2) * modelError * (1.0 + noise(rng)));
+                if (u(rng) < outliers) v.ratio *= float(0.3 + 2.0 * u(rng));  // an occluder
+                v.world = glm::vec3(float(x), 0.0f, float(z));
+                frame.push_back(v);
+            }
+        frames.push_back(std::move(frame));
     }
-    return s;
+    return frames;
 }
 
-TEST(VignetteFit, RecoversTheProfileDespiteOutliers) {
+// A camera 0.5 m above the table moving sideways by up to 24 cm: the same points at other radii.
+const std::vector<glm::vec3> kMovingEyes{{-0.12f, 0.5f, 0.05f}, {-0.04f, 0.5f, -0.06f},
+                                         {0.04f, 0.5f, 0.06f},  {0.12f, 0.5f, -0.05f},
+                                         {0.0f, 0.45f, 0.0f},   {0.08f, 0.55f, 0.08f}};
+
+TEST(VignetteFit, SeparatesTheLensFromTheModelsErrorAcrossFrames) {
     std::string why;
-    const auto p = fitVignette(vignettedSamples(-0.3f, 800, 0.15, 3), 150, 0.6f, why);
+    const auto p = fitVignetteAcrossFrames(vignettedFrames(-0.3f, kMovingEyes, 0.1, 3), 0.02f, 150,
+                                           0.02f, why);
     ASSERT_TRUE(p.has_value()) << why;
+    std::cout << "[ vignetting ] k1 -0.3: fitted k1 " << p->k1 << ", k2 " << p->k2 << " (" << why
+              << ")\n";
     EXPECT_NEAR(p->gain(1.0f), 0.7f, 0.03f);
     EXPECT_NEAR(p->gain(0.5f), 0.85f, 0.03f);
-    // No vignetting: none found.
-    const auto flat = fitVignette(vignettedSamples(0.0f, 800, 0.15, 4), 150, 0.6f, why);
+    // No vignetting, the same error of the model: none found.
+    const auto flat =
+        fitVignetteAcrossFrames(vignettedFrames(0.0f, kMovingEyes, 0.1, 4), 0.02f, 150, 0.02f, why);
     ASSERT_TRUE(flat.has_value()) << why;
+    std::cout << "[ vignetting ] none: fitted k1 " << flat->k1 << ", k2 " << flat->k2 << "\n";
     EXPECT_NEAR(flat->gain(1.0f), 1.0f, 0.03f);
+    // The must-fail: every point one cell (the model's error left to the fit, as a single
+    // frame's fit leaves it) takes the model's error for a vignetting.
+    const auto oneCell =
+        fitVignetteAcrossFrames(vignettedFrames(0.0f, kMovingEyes, 0.1, 4), 10.0f, 150, 0.0f, why);
+    if (oneCell) {
+        std::cout << "[ vignetting ] none, one cell: fitted k1 " << oneCell->k1 << "\n";
+        EXPECT_GT(std::abs(oneCell->gain(1.0f) - 1.0f), 0.06f);
+    }
 }
 
-TEST(VignetteFit, RefusesTooFewSamplesTooSmallARadiusAndNonsense) {
+TEST(VignetteFit, RefusesOneFrameAStillCameraTooFewSamplesAndNonsense) {
     std::string why;
-    EXPECT_FALSE(fitVignette(vignettedSamples(-0.3f, 40, 0.0, 5), 150, 0.6f, why).has_value());
+    const std::vector<glm::vec3> one{kMovingEyes[0]};
+    EXPECT_FALSE(
+        fitVignetteAcrossFrames(vignettedFrames(-0.3f, one, 0.0, 5), 0.02f, 150, 0.02f, why));
     EXPECT_NE(why.find("needed"), std::string::npos) << why;
-    auto centre = vignettedSamples(-0.3f, 800, 0.0, 6);
-    for (VignetteSample& s : centre) s.r2 *= 0.2f;  // all within r = 0.45
-    EXPECT_FALSE(fitVignette(centre, 150, 0.6f, why).has_value());
-    EXPECT_NE(why.find("reach"), std::string::npos) << why;
-    // Brighter towards the corners by 60 %: the model's error, not a lens.
-    EXPECT_FALSE(fitVignette(vignettedSamples(0.6f, 800, 0.0, 7), 150, 0.6f, why).has_value());
+    const std::vector<glm::vec3> still(4, kMovingEyes[0]);
+    EXPECT_FALSE(
+        fitVignetteAcrossFrames(vignettedFrames(-0.3f, still, 0.0, 6), 0.02f, 150, 0.02f, why));
+    EXPECT_NE(why.find("moved too little"), std::string::npos) << why;
+    EXPECT_FALSE(fitVignetteAcrossFrames(vignettedFrames(-0.3f, kMovingEyes, 0.0, 7), 0.02f,
+                                         1000000, 0.02f, why));
+    EXPECT_NE(why.find("needed"), std::string::npos) << why;
+    // Brighter towards the corners by 60 %: not a lens.
+    EXPECT_FALSE(fitVignetteAcrossFrames(vignettedFrames(0.6f, kMovingEyes, 0.0, 8), 0.02f, 150,
+                                         0.02f, why));
+    EXPECT_NE(why.find("not a vignetting"), std::string::npos) << why;
+    // Samples that are no measurement (NaN, zero, beyond the corner) are skipped.
+    auto bad = vignettedFrames(-0.3f, kMovingEyes, 0.0, 9);
+    bad[0][0].ratio = std::nanf("");
+    bad[0][1].ratio = 0.0f;
+    bad[0][2].r2 = 3.0f;
+    bad[1][0].world = glm::vec3(std::nanf(""));
+    const auto p = fitVignetteAcrossFrames(bad, 0.02f, 150, 0.02f, why);
+    ASSERT_TRUE(p.has_value()) << why;
+    EXPECT_NEAR(p->gain(1.0f), 0.7f, 0.03f);
 }
 
 TEST(GrainEstimates, SmoothsOverFramesAndHoldsWithAReason) {
@@ -358,6 +415,52 @@ TEST(GrainPass, MirrorsShowTheFootageWithTheNoiseOfOnePixel) {
     EXPECT_GT(ratio[1], ratio[0] + 0.2);
 }
 
+// Virtual glass shows footage that was filmed through the lens already: with a vignetting of
+// k1 -0.3 the glass's pixels keep (nearly) the footage they show, where darkening the whole
+// pixel would take them by V at their radius (the must-fail: what the grain pass did before it
+// kept the composite's footage share out). Measured: 0.998 with / without over the glass, V
+// 0.913 on average over its pixels.
+TEST(GrainPass, GlassIsNotVignettedTwice) {
+    gl::Context context = gl::Context::headless();
+    Scene scene = tableScene({50.0f, 0.0f, 50.0f});  // the box far out of view
+    test::addUvSphere(scene, "virtual glass", {1.1f, 0.3f, 0.7f}, 0.3f, test::addGlass(scene),
+                      Origin::Virtual);
+    const CameraIntrinsics camera = test::smallCamera();
+    const cv::Mat footage =
+        noisyFootage(tableScene({50.0f, 0.0f, 50.0f}), camera, kOverview, 1.0, 0.0, 29);
+    cv::Mat linear[2], glassPx;
+    for (const bool vignette : {false, true}) {
+        RendererOptions o;
+        o.grain.vignette.enabled = vignette;
+        o.grain.vignette.profile = VignetteProfile{-0.3f, 0.0f};
+        Renderer r(scene, camera, o);
+        r.render({kOverview, footage, true});
+        ASSERT_TRUE(r.lastReport().ran("specgbuf")) << r.lastReport().summary();
+        linear[vignette ? 1 : 0] = r.compositeLinear();
+        glassPx = r.coverage() == 2;
+    }
+    ASSERT_GT(cv::countNonZero(glassPx), 300);
+    // Over the glass: the composite with the vignetting over the one without, and V itself.
+    double ratioSum = 0.0, vSum = 0.0;
+    int n = 0;
+    const double w = camera.width - 1, h = camera.height - 1;
+    const double dx = std::max(camera.cx, w - camera.cx), dy = std::max(camera.cy, h - camera.cy);
+    for (int y = 0; y < glassPx.rows; ++y)
+        for (int x = 0; x < glassPx.cols; ++x) {
+            const double off = linear[0].at<cv::Vec3f>(y, x)[1];
+            if (!glassPx.at<uint8_t>(y, x) || off < 1e-3) continue;
+            ratioSum += linear[1].at<cv::Vec3f>(y, x)[1] / off;
+            const double ex = x - camera.cx, ey = y - camera.cy;
+            vSum += 1.0 - 0.3 * (ex * ex + ey * ey) / (dx * dx + dy * dy);
+            ++n;
+        }
+    ASSERT_GT(n, 300);
+    std::cout << "[ vignetting ] virtual glass over " << n << " px: with / without " << ratioSum / n
+              << ", V over them " << vSum / n << "\n";
+    EXPECT_GT(ratioSum / n, 0.97);
+    EXPECT_LT(vSum / n, 0.95);  // darkening the whole pixel would fail the line above
+}
+
 // ---- against ground truth ----------------------------------------------------------------------
 
 raytrace::SyntheticSessionOptions sessionOptions() {
@@ -383,7 +486,20 @@ struct GroundTruthResult {
     // composite over the noise in the ground truth, and the mean colour (G, linear) over the
     // ground truth's.
     double noiseOff = 0, noiseOn = 0, colourOff = 0, colourOn = 0;
+    // Influenced PSNR pooled over the frames after the first (the vignetting fit needs a second
+    // view of the same surfaces: the first frame has no estimate).
+    double psnrAfterFirstOff = 0, psnrAfterFirstOn = 0;
 };
+
+double pooledPsnrAfterFirst(const BenchResult& r) {
+    double se = 0.0, pixels = 0.0;
+    for (const BenchFrameResult& f : r.frames) {
+        if (f.index == 0 || !(f.error.influencedPixels > 0.0)) continue;
+        se += f.error.influencedPixels * std::pow(10.0, -f.error.psnrInfluenced / 10.0);
+        pixels += f.error.influencedPixels;
+    }
+    return pixels > 0.0 ? -10.0 * std::log10(se / pixels) : 0.0;
+}
 
 GroundTruthResult benchOffOn(const std::string& name, const Scene& scene,
                              const raytrace::SensorOptions& sensor, const std::string& knob) {
@@ -404,6 +520,7 @@ GroundTruthResult benchOffOn(const std::string& name, const Scene& scene,
             benchGrid(calib.intrinsics, true, {{knob, {on ? "on" : "off"}}, {"vpls", {"256"}}});
         const BenchResult r = runBenchConfig(scene, calib.intrinsics, frames, grid.at(0));
         (on ? m.on : m.off) = r.error;
+        (on ? m.psnrAfterFirstOn : m.psnrAfterFirstOff) = pooledPsnrAfterFirst(r);
         // Measured on the frame that shows the most of the virtual object (the path pans).
         Renderer renderer(scene, calib.intrinsics, grid.at(0).options);
         int most = -1;
@@ -459,11 +576,13 @@ TEST(GrainGroundTruth, Vignette03) {
     // The box towards a corner of the view, where the footage is ~10 % darker.
     const GroundTruthResult m =
         benchOffOn("vignette_03", tableScene({1.1f, 0.0f, 0.7f}), s, "vignette_match");
-    // Measured: colour / truth's 1.062 off, 0.998 on (k1 -0.287, k2 -0.013 estimated; the
-    // sensor's is k1 -0.3); influenced PSNR 25.71 dB off, 25.88 on.
+    // Measured: colour / truth's 1.062 off, 0.996 on (k1 -0.298, k2 -0.009 estimated over the
+    // frames; the sensor's is k1 -0.3); influenced PSNR over frames 1-5 25.30 dB off, 25.42 on.
+    std::cout << "[ vignette_03 ] influenced PSNR after the first frame: off "
+              << m.psnrAfterFirstOff << " dB, on " << m.psnrAfterFirstOn << " dB\n";
     EXPECT_NEAR(m.colourOn, 1.0, 0.03);
     EXPECT_GT(m.colourOff, 1.04);  // too bright without the vignetting
-    EXPECT_GT(m.on.psnrInfluenced, m.off.psnrInfluenced + 0.1);
+    EXPECT_GT(m.psnrAfterFirstOn, m.psnrAfterFirstOff + 0.1);
 }
 
 }  // namespace

@@ -135,9 +135,9 @@ void CompositePass::resize(const FrameContext& ctx) {
     fbo_ = gl::Framebuffer("composite fbo");
     fbo_.attachColor(0, linear_);
     fbo_.attachColor(1, srgb_);
-    // The footage target only while the motion blur reads it (the options are the renderer's
-    // for its whole life): otherwise the shader's third output goes nowhere.
-    const bool footage = ctx.options.motionBlur.enabled();
+    // The footage target only while the motion blur or the vignetting reads it (the options are
+    // the renderer's for its whole life): otherwise the shader's third output goes nowhere.
+    const bool footage = ctx.options.motionBlur.enabled() || ctx.options.grain.vignette.enabled;
     if (footage) fbo_.attachColor(2, footage_);
     mask_ = gl::Texture::create2D("composite specular mask", w, h, GL_DEPTH_COMPONENT32F);
     fbo_.attachDepth(mask_);

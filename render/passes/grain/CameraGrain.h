@@ -7,7 +7,7 @@
 //    and the correlation of neighbouring pixels' noise;
 //  - the vignetting: V(r) = 1 + k1 r^2 + k2 r^4, r = distance from the principal point over the
 //    distance from it to the farthest image corner, fitted to footage / L_r of the sample blocks
-//    (a robust least-squares fit: ratio = c V(r), c the frame's exposure).
+//    of several frames, where the same surface point is seen at different image radii.
 // Both are smoothed over frames by GrainEstimates (history weight, per frame).
 #include <array>
 #include <optional>
@@ -51,8 +51,9 @@ std::optional<NoiseLevelFunction> estimateNoiseLevels(const std::vector<NoiseBlo
                                                       int minBlocksPerLevel, std::string& why);
 
 struct VignetteSample {
-    float r2 = 0.0f;     // squared normalised radius of the block's centre (0 centre, 1 corner)
-    float ratio = 0.0f;  // footage / L_r luminance of the block
+    float r2 = 0.0f;        // squared normalised radius of the block's centre (0 centre, 1 corner)
+    float ratio = 0.0f;     // footage / L_r luminance of the block
+    glm::vec3 world{0.0f};  // the block's mean surface point (world, m): ties frames together
 };
 
 // Squared distance of camera pixel q (OpenCV pixel coordinates) from the principal point over
@@ -64,12 +65,21 @@ struct VignetteProfile {
     float gain(float r2) const { return 1.0f + k1 * r2 + k2 * r2 * r2; }
 };
 
-// The vignetting of one frame: ratio = c (1 + k1 r^2 + k2 r^4) by least squares, twice refitted
-// without the samples beyond 3 robust deviations (blocks a pose error or a missing occluder
-// spoils). Nothing (and `why` says it) with fewer than `minSamples` samples, none beyond
-// `minRadius` (r, not squared) or a profile that is not a darkening of at most 80 % at the corner.
-std::optional<VignetteProfile> fitVignette(const std::vector<VignetteSample>& samples,
-                                           int minSamples, float minRadius, std::string& why);
+// The vignetting from several frames' samples, free of the model's own error: footage / L_r of a
+// block is c_f (the frame's exposure) x V(r) (the lens) x a_p (how wrong L_r is at the surface
+// point p: albedo, the light's falloff, unmodelled light). Within one frame a_p varies with the
+// image radius as much as V does (L_r's error towards the spot's edge looks like vignetting), so
+// the fit takes only what changes when the same surface point (a world cell of `cellSize` m) is
+// seen at another image radius in another frame: log ratio = log c_f + b1 r^2 + b2 r^4 + log a_p,
+// least squares with a_p eliminated per cell (every quantity less its cell's mean) and one c_f per
+// frame (the first fixed), then the samples beyond 3 robust deviations (at least 2 %) dropped and
+// refitted, twice; V = exp(b1 r^2 + b2 r^4) ~ 1 + b1 r^2 + (b2 + b1^2 / 2) r^4. Nothing (and
+// `why` says it) with fewer than `minSamples` samples in cells seen in two frames or more, a
+// spread of those samples' r^2 about their cell's mean below `minSpread` (RMS: the camera has
+// not moved enough), or a profile that is not a darkening of at most 80 % at the corner.
+std::optional<VignetteProfile> fitVignetteAcrossFrames(
+    const std::vector<std::vector<VignetteSample>>& frames, float cellSize, int minSamples,
+    float minSpread, std::string& why);
 
 // The estimates over frames: each frame's estimate blended in with weight 1 - history (the first
 // one taken as it is); a frame without an estimate keeps the last. `note` says what was used.
@@ -81,6 +91,12 @@ public:
                         const std::string& why);
     const std::optional<NoiseLevelFunction>& noise() const { return noise_; }
     const std::optional<VignetteProfile>& vignette() const { return vignette_; }
+    // The last `keep` frames' vignetting samples (fitVignetteAcrossFrames' input): this frame's
+    // added, the oldest dropped.
+    const std::vector<std::vector<VignetteSample>>& vignetteSamples() const {
+        return vignetteSamples_;
+    }
+    void addVignetteSamples(std::vector<VignetteSample> frame, size_t keep);
     int noiseFrames() const { return noiseFrames_; }
     int vignetteFrames() const { return vignetteFrames_; }
     std::string noiseNote, vignetteNote;
@@ -88,6 +104,7 @@ public:
 private:
     std::optional<NoiseLevelFunction> noise_;
     std::optional<VignetteProfile> vignette_;
+    std::vector<std::vector<VignetteSample>> vignetteSamples_;
     int noiseFrames_ = 0, vignetteFrames_ = 0;
 };
 

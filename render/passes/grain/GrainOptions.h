@@ -31,9 +31,15 @@ struct VignetteMatchOptions {
     // The camera's vignetting, when known (the calibration's, or the user's): used as it is,
     // nothing is estimated. Not set: estimated from the footage.
     std::optional<VignetteProfile> profile;
-    // A frame's fit needs this many usable sample blocks, reaching this normalised radius.
+    // The fit (fitVignetteAcrossFrames) takes the sample blocks of the last `frames` frames and
+    // needs `minBlocks` of them on surface points (world cells of `cellSize` m) seen in two
+    // frames or more, at image radii (r^2) spread by `minSpread` (RMS) about each point's mean:
+    // a camera that has not moved gives no estimate (one frame cannot tell the lens from the
+    // model's own error).
+    int frames = 8;
+    float cellSize = 0.02f;
     int minBlocks = 150;
-    float minRadius = 0.6f;
+    float minSpread = 0.01f;
 };
 
 struct GrainOptions {

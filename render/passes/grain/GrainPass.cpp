@@ -39,8 +39,12 @@ void GrainOptions::validate() const {
                 "grain.noise.minBlocksPerLevel", "1..100000", noise.minBlocksPerLevel);
     checkOption(vignette.minBlocks >= 3 && vignette.minBlocks <= 1000000,
                 "grain.vignette.minBlocks", "3..1000000", vignette.minBlocks);
-    checkOption(vignette.minRadius >= 0.0f && vignette.minRadius <= 1.0f,
-                "grain.vignette.minRadius", "in [0, 1]", vignette.minRadius);
+    checkOption(vignette.frames >= 2 && vignette.frames <= 64, "grain.vignette.frames", "2..64",
+                vignette.frames);
+    checkOption(vignette.cellSize > 0.0f && vignette.cellSize <= 1.0f, "grain.vignette.cellSize",
+                "in (0, 1] m", vignette.cellSize);
+    checkOption(vignette.minSpread >= 0.0f && vignette.minSpread <= 1.0f,
+                "grain.vignette.minSpread", "in [0, 1]", vignette.minSpread);
     if (vignette.profile) {
         const VignetteProfile& p = *vignette.profile;
         const float corner = p.gain(1.0f), mid = p.gain(0.25f);
@@ -59,6 +63,7 @@ void GrainPass::setup(PassBuilder& b) const {
     b.read(kLR);
     b.read(kGBufferPosition);
     b.read(kGBufferEmissive);
+    b.read(kCompositeFootage);  // what of a virtual pixel is video: not vignetted twice
     b.readOptional(kCausticR);
     CompositeVersion::declare(b);
 }
@@ -83,11 +88,13 @@ void GrainPass::resize(const FrameContext& ctx) {
     footage_ = gl::Texture::create2D("grain footage", grid_.columns, grid_.rows, GL_RGBA32F);
     rendered_ = gl::Texture::create2D("grain L_r", grid_.columns, grid_.rows, GL_RGBA32F);
     noise_ = gl::Texture::create2D("grain noise", grid_.columns, grid_.rows, GL_RGBA32F);
+    position_ = gl::Texture::create2D("grain position", grid_.columns, grid_.rows, GL_RGBA32F);
     samplesFbo_ = gl::Framebuffer("grain samples fbo");
     samplesFbo_.attachColor(0, footage_);
     samplesFbo_.attachColor(1, rendered_);
     samplesFbo_.attachColor(2, noise_);
-    samplesFbo_.finalize(3);
+    samplesFbo_.attachColor(3, position_);
+    samplesFbo_.finalize(4);
     const std::vector<glm::vec2> table = p.canvasToCameraTable();
     canvasToCamera_ = gl::Texture::create2D("grain canvas to camera", cw, ch, GL_RG32F);
     canvasToCamera_.setFilter(GL_NEAREST, GL_NEAREST);
@@ -98,6 +105,7 @@ void GrainPass::resize(const FrameContext& ctx) {
     footageRead_.assign(size_t(grid_.columns) * size_t(grid_.rows) * 4, 0.0f);
     renderedRead_.assign(footageRead_.size(), 0.0f);
     noiseRead_.assign(footageRead_.size(), 0.0f);
+    positionRead_.assign(footageRead_.size(), 0.0f);
 }
 
 void GrainPass::sampleBlocks(FrameContext& ctx, PassResources& res) {
@@ -120,6 +128,7 @@ void GrainPass::sampleBlocks(FrameContext& ctx, PassResources& res) {
     glGetTextureImage(footage_.id(), 0, GL_RGBA, GL_FLOAT, bytes, footageRead_.data());
     glGetTextureImage(rendered_.id(), 0, GL_RGBA, GL_FLOAT, bytes, renderedRead_.data());
     glGetTextureImage(noise_.id(), 0, GL_RGBA, GL_FLOAT, bytes, noiseRead_.data());
+    glGetTextureImage(position_.id(), 0, GL_RGBA, GL_FLOAT, bytes, positionRead_.data());
 }
 
 void GrainPass::estimate(FrameContext& ctx) {
@@ -131,10 +140,12 @@ void GrainPass::estimate(FrameContext& ctx) {
         const float* f = &footageRead_[b * 4];
         const float* r = &renderedRead_[b * 4];
         const float* n = &noiseRead_[b * 4];
+        const float* p = &positionRead_[b * 4];
         if (f[3] < 0.5f) continue;
         blocks.push_back({{f[0], f[1], f[2]}, {n[0], n[1], n[2]}, n[3]});
         const float lr = lum(r);
-        if (blockR2_[b] >= 0.0f && lr > 0.0f) samples.push_back({blockR2_[b], lum(f) / lr});
+        if (blockR2_[b] >= 0.0f && lr > 0.0f)
+            samples.push_back({blockR2_[b], lum(f) / lr, {p[0], p[1], p[2]}});
     }
     if (o.noise.enabled) {
         std::string why;
@@ -143,7 +154,10 @@ void GrainPass::estimate(FrameContext& ctx) {
     }
     if (o.vignette.enabled && !o.vignette.profile) {
         std::string why;
-        const auto v = fitVignette(samples, o.vignette.minBlocks, o.vignette.minRadius, why);
+        ctx.grainEstimates.addVignetteSamples(std::move(samples), size_t(o.vignette.frames));
+        const auto v =
+            fitVignetteAcrossFrames(ctx.grainEstimates.vignetteSamples(), o.vignette.cellSize,
+                                    o.vignette.minBlocks, o.vignette.minSpread, why);
         ctx.grainEstimates.updateVignette(v, o.history, why);
     }
 }
@@ -181,6 +195,7 @@ void GrainPass::apply(FrameContext& ctx, PassResources& res) {
                     float(1.0 / std::max(dx * dx + dy * dy, 1.0)));
     }
     glBindTextureUnit(kUnitGrainComposite, res.texture(kComposite).id());
+    glBindTextureUnit(kUnitGrainFootageShare, res.texture(kCompositeFootage).id());
     glBindTextureUnit(kUnitGrainCamera, res.texture(kCameraImage).id());
     ctx.drawFullscreenTriangle();
     glDisable(GL_FRAMEBUFFER_SRGB);

@@ -37,11 +37,11 @@ private:
 
     gl::Program samplesProgram_, applyProgram_;
     ExposurePass::Grid grid_;
-    gl::Texture footage_, rendered_, noise_, canvasToCamera_;
+    gl::Texture footage_, rendered_, noise_, position_, canvasToCamera_;
     gl::Framebuffer samplesFbo_;
     CompositeVersion output_{"grain"};
     int canvasW_ = 0, canvasH_ = 0;
-    std::vector<float> footageRead_, renderedRead_, noiseRead_;
+    std::vector<float> footageRead_, renderedRead_, noiseRead_, positionRead_;
     std::vector<float> blockR2_;  // each block centre's squared normalised radius (camera image)
 };
 

@@ -3,7 +3,8 @@
 #include "passes/grain/footage_noise.glsl"
 // The camera's vignetting and noise on the composite (passes/grain/GrainPass.h), per camera
 // pixel. Virtual pixels (coverage 1) are multiplied by V(r) = 1 + k1 r^2 + k2 r^4 (r from the
-// principal point, 1 at the farthest corner); real pixels carry it through the footage. Then the
+// principal point, 1 at the farthest corner), all but the footage they show (already filmed
+// through the lens); real pixels carry it through the footage. Then the
 // noise: the footage's noise variance at the pixel's new value L (the noise-level function,
 // per channel) minus what the pixel carries already: nothing on virtual pixels, (L / CI)^2 times
 // the footage's at CI on real ones (the differential's L = CI + alpha dL is CI scaled where alpha
@@ -17,6 +18,7 @@
 // pixel as k sigma(CI) n, and sigma(L) - k sigma(CI) makes it sigma(L) n.
 in vec2 uv;
 layout(binding = kUnitGrainComposite) uniform sampler2D composite;  // rgb linear, a = coverage
+layout(binding = kUnitGrainFootageShare) uniform sampler2D footageShare;  // rgb: video in it
 layout(binding = kUnitGrainCamera) uniform sampler2D cameraImage;   // sRGB8: samples linear
 uniform int noiseOn, vignetteOn;
 uniform int footageGrain;        // 1: n from the footage's residual (else synthesised)
@@ -72,7 +74,10 @@ void main() {
     if (vignetteOn != 0 && virtualPx) {
         vec2 d = vec2(px) - principalPoint;
         float r2 = dot(d, d) * invCornerR2;
-        value *= max(1.0 + vignetteK.x * r2 + vignetteK.y * r2 * r2, 0.0);
+        // The footage a virtual pixel shows (through glass, in a mirror) was filmed through the
+        // lens already, nearby on a glass object: only the rest is darkened.
+        vec3 filmed = clamp(texelFetch(footageShare, px, 0).rgb, vec3(0.0), max(value, vec3(0.0)));
+        value = filmed + (value - filmed) * max(1.0 + vignetteK.x * r2 + vignetteK.y * r2 * r2, 0.0);
     }
     vec3 ci = texelFetch(cameraImage, px, 0).rgb;
     // A real pixel the renderer left as the footage already carries the footage's noise: nothing

@@ -8,7 +8,8 @@
 // s L_r (s: the block's footage / L_r, per channel) plus noise: the residual
 // e = CI - s L_r at each tap and at the camera pixel to its right is the noise.
 // Output: mean footage (a = 1 usable), mean L_r, and the residual's unbiased variance per channel
-// with the neighbouring residuals' correlation (a; + 1 / n for the bias of the block's mean).
+// with the neighbouring residuals' correlation (a; + 1 / n for the bias of the block's mean), and
+// the block's mean world position (the vignetting fit's tie between frames).
 in vec2 uv;
 layout(binding = kUnitGrainCamera) uniform sampler2D cameraImage;  // sRGB8: samples linear
 layout(binding = kUnitGrainLR) uniform sampler2D lR;               // canvas, linear
@@ -24,6 +25,7 @@ uniform float maxVariation;  // of L_r's luminance over the block
 layout(location = 0) out vec4 outFootage;   // rgb mean footage (linear), a = 1 usable block
 layout(location = 1) out vec4 outRendered;  // rgb mean L_r (linear)
 layout(location = 2) out vec4 outNoise;     // rgb residual variance, a = neighbour correlation
+layout(location = 3) out vec4 outPosition;  // xyz mean world position of the taps (m), a = 1
 
 const float kBlackLinear = 0.5 / 255.0 / 12.92;  // below half a code: clipped at black
 const float kWhiteLinear = 0.9560;               // sRGB code 250: clipping near
@@ -56,7 +58,7 @@ void main() {
     ivec2 first = block * blockSize + (blockSize - (taps - 1) * stride) / 2;
     vec3 ci[16], r[16], ciRight[16], rRight[16];
     bool right[16];
-    vec3 sumCi = vec3(0.0), sumR = vec3(0.0);
+    vec3 sumCi = vec3(0.0), sumR = vec3(0.0), sumP = vec3(0.0);
     float minR = 1e30, maxR = 0.0;
     bool usable = true;
     int n = taps * taps;
@@ -71,11 +73,13 @@ void main() {
         maxR = max(maxR, l);
         sumCi += ci[k];
         sumR += r[k];
+        sumP += texelFetch(gPosition, min(p, size - 1), 0).xyz;
     }
     usable = usable && minR > 0.0 && maxR <= maxVariation * minR;
     vec3 meanCi = sumCi / float(n), meanR = sumR / float(n);
     outFootage = vec4(meanCi, usable ? 1.0 : 0.0);
     outRendered = vec4(meanR, 0.0);
+    outPosition = vec4(sumP / float(n), 1.0);
     if (!usable) {
         outNoise = vec4(0.0);
         return;
