@@ -37,6 +37,9 @@ struct VignetteMatchOptions {
     // a camera that has not moved gives no estimate (one frame cannot tell the lens from the
     // model's own error).
     int frames = 8;
+    // Refitted every `refitInterval` frames once there is an estimate (every frame before): the
+    // fit is CPU work over all the frames' samples, and the lens does not change.
+    int refitInterval = 4;
     float cellSize = 0.02f;
     int minBlocks = 150;
     float minSpread = 0.01f;

@@ -41,6 +41,8 @@ void GrainOptions::validate() const {
                 "grain.vignette.minBlocks", "3..1000000", vignette.minBlocks);
     checkOption(vignette.frames >= 2 && vignette.frames <= 64, "grain.vignette.frames", "2..64",
                 vignette.frames);
+    checkOption(vignette.refitInterval >= 1 && vignette.refitInterval <= 64,
+                "grain.vignette.refitInterval", "1..64", vignette.refitInterval);
     checkOption(vignette.cellSize > 0.0f && vignette.cellSize <= 1.0f, "grain.vignette.cellSize",
                 "in (0, 1] m", vignette.cellSize);
     checkOption(vignette.minSpread >= 0.0f && vignette.minSpread <= 1.0f,
@@ -155,10 +157,12 @@ void GrainPass::estimate(FrameContext& ctx) {
     if (o.vignette.enabled && !o.vignette.profile) {
         std::string why;
         ctx.grainEstimates.addVignetteSamples(std::move(samples), size_t(o.vignette.frames));
-        const auto v =
-            fitVignetteAcrossFrames(ctx.grainEstimates.vignetteSamples(), o.vignette.cellSize,
-                                    o.vignette.minBlocks, o.vignette.minSpread, why);
-        ctx.grainEstimates.updateVignette(v, o.history, why);
+        if (!ctx.grainEstimates.vignette() || ctx.frameIndex % o.vignette.refitInterval == 0) {
+            const auto v =
+                fitVignetteAcrossFrames(ctx.grainEstimates.vignetteSamples(), o.vignette.cellSize,
+                                        o.vignette.minBlocks, o.vignette.minSpread, why);
+            ctx.grainEstimates.updateVignette(v, o.history, why);
+        }
     }
 }
 
