@@ -137,6 +137,37 @@ TEST(RoughRefraction, RoughnessZeroLimitEqualsSmoothPathAndOnlyTheGlassChanges) 
     EXPECT_EQ(cv::countNonZero(changed & ~slab), 0);    // and only on the slab
 }
 
+// The slab scene with its slab replaced by a frosted sphere (radius 0.15 m on the table) and the
+// sphere's pixels (255; its outline traced analytically).
+struct FrostedSphere {
+    RoughTestScene s;
+    cv::Mat pixels;
+};
+FrostedSphere frostedSphere(float roughness, const std::filesystem::path& envDir) {
+    FrostedSphere f{test::makeRoughSlab(roughness, envDir), {}};
+    RoughTestScene& s = f.s;
+    const glm::vec3 centre(0.0f, 0.15f, 0.0f);
+    const float radius = 0.15f;
+    for (Mesh& m : s.scene.meshes) {
+        if (m.name != "slab") continue;
+        Primitive p = test::uvSpherePrimitive(centre, radius, 32, 48);
+        p.material = s.material;
+        m.primitives = {p};
+    }
+    f.pixels = cv::Mat(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
+    const glm::dvec3 eye = s.pose * glm::dvec3(0.0);
+    for (int y = 0; y < f.pixels.rows; ++y)
+        for (int x = 0; x < f.pixels.cols; ++x) {
+            const glm::dvec3 d = glm::normalize(
+                s.pose * glm::dvec3((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0) -
+                eye);
+            const glm::dvec3 oc = eye - glm::dvec3(centre);
+            const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - double(radius * radius);
+            if (b * b - c > 0.0) f.pixels.at<uint8_t>(y, x) = 255;
+        }
+    return f;
+}
+
 // GSR reduces the back faces' 4 x 4 window itself at every pixel whose footprint covers more than
 // a texel: a frosted sphere (curved back, so the window's texels fall into different sectors) at
 // roughness 0.5 rendered with 1 and with 8 hemisphere subdivisions must differ at (nearly) every
@@ -149,27 +180,10 @@ TEST(RoughRefraction, GsrGathersTheBackFacesEverywhere) {
     const auto envDir = test::outputDir("rough_env_gsr");
     cv::Mat footage(96, 128, CV_8UC3);
     cv::randu(footage, 0, 255);
-    RoughTestScene s = test::makeRoughSlab(0.5f, envDir);
-    const glm::vec3 centre(0.0f, 0.15f, 0.0f);
-    const float radius = 0.15f;
-    for (Mesh& m : s.scene.meshes) {
-        if (m.name != "slab") continue;
-        Primitive p = test::uvSpherePrimitive(centre, radius, 32, 48);
-        p.material = s.material;
-        m.primitives = {p};
-    }
+    const FrostedSphere sphere = frostedSphere(0.5f, envDir);
+    const RoughTestScene& s = sphere.s;
     // The sphere's pixels, 2 px in from its outline (the rim refracts at grazing angles).
-    cv::Mat inside(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
-    const glm::dvec3 eye = s.pose * glm::dvec3(0.0);
-    for (int y = 0; y < inside.rows; ++y)
-        for (int x = 0; x < inside.cols; ++x) {
-            const glm::dvec3 d = glm::normalize(
-                s.pose * glm::dvec3((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0) -
-                eye);
-            const glm::dvec3 oc = eye - glm::dvec3(centre);
-            const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - double(radius * radius);
-            if (b * b - c > 0.0) inside.at<uint8_t>(y, x) = 255;
-        }
+    cv::Mat inside = sphere.pixels.clone();
     cv::erode(inside, inside, cv::Mat::ones(5, 5, CV_8U));
     ASSERT_GT(cv::countNonZero(inside), 800);
     const RoughFrame one = test::renderRough(s, footage, withMethod(RoughRefractionMethod::Gsr, 1));
@@ -194,26 +208,9 @@ TEST(RoughRefraction, GsrGathersTheBackFacesEverywhere) {
 // rough_footprint=slab is the must-fail). Judged over the outer 3 px of the sphere's image.
 TEST(RoughRefraction, RayDifferentialsKeepTheRimsLobeOnTheRim) {
     gl::Context context = gl::Context::headless();
-    RoughTestScene s = test::makeRoughSlab(0.35f, test::outputDir("rough_env_rim"));
-    const glm::vec3 centre(0.0f, 0.15f, 0.0f);
-    const float radius = 0.15f;
-    for (Mesh& m : s.scene.meshes) {
-        if (m.name != "slab") continue;
-        Primitive p = test::uvSpherePrimitive(centre, radius, 32, 48);
-        p.material = s.material;
-        m.primitives = {p};
-    }
-    cv::Mat sphere(s.cam.height, s.cam.width, CV_8U, cv::Scalar(0));
-    const glm::dvec3 eye = s.pose * glm::dvec3(0.0);
-    for (int y = 0; y < sphere.rows; ++y)
-        for (int x = 0; x < sphere.cols; ++x) {
-            const glm::dvec3 d = glm::normalize(
-                s.pose * glm::dvec3((x - s.cam.cx) / s.cam.fx, (y - s.cam.cy) / s.cam.fy, 1.0) -
-                eye);
-            const glm::dvec3 oc = eye - glm::dvec3(centre);
-            const double b = glm::dot(oc, d), c = glm::dot(oc, oc) - double(radius * radius);
-            if (b * b - c > 0.0) sphere.at<uint8_t>(y, x) = 255;
-        }
+    const FrostedSphere frosted = frostedSphere(0.35f, test::outputDir("rough_env_rim"));
+    const RoughTestScene& s = frosted.s;
+    const cv::Mat& sphere = frosted.pixels;
     cv::Mat interior;
     cv::erode(sphere, interior, cv::Mat::ones(7, 7, CV_8U));
     const cv::Mat rim = sphere & ~interior;
