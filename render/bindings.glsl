@@ -128,15 +128,6 @@ const int kUnitSpecLightHistoryR = 27;     // share (temporal history)
 const int kUnitSpecLightHistoryRRefl = 28;
 const int kUnitSpecLightHistoryHits = 29;  // the hits the history was lit at
 const int kUnitSpecLightVpls = 30;         // the VPL buffer as RGBA32F texels (common.glsl vplAt)
-// passes/specular/second_exit.glsl (specular_light.frag and specular_resolve.frag): the primary
-// G-buffer's normal, emissive (a = specular slot + 1) and position, the back-face buffer and the
-// real surfaces, in the units the impostor tracing uses in other passes.
-const int kUnitSecondExitFrontNormal = 16;
-const int kUnitSecondExitFrontSlot = 17;
-const int kUnitSecondExitFrontPosition = 18;
-const int kUnitSecondExitBackPosition = 19;
-const int kUnitSecondExitBackNormal = 20;
-const int kUnitSecondExitRealSurfaces = 21;
 // specular_resolve.frag (the half-resolution upsample): GBuf_refl / GBuf_refr at the units above,
 // the half-resolution hit radiance (reflected L_rv, L_r, refracted L_rv, L_r) and the primary
 // G-buffer's emissive (a = specular slot + 1).
@@ -202,6 +193,12 @@ const int kUnitCompositeFuzzyRRefl = 20;
 const int kUnitCompositeFuzzyLenv = 21;
 const int kUnitCompositeFuzzyVideo = 22;
 const int kUnitCompositeNormal = 23;  // the G-buffer normal (translucent pixels' reflection)
+// The refracted path's second exit (passes/specular/second_exit.glsl) on glass pixels: the
+// back-face buffer and the environment map (with the units above: the G-buffer's position,
+// normal and emissive, the real surfaces).
+const int kUnitCompositeBackPosition = 24;
+const int kUnitCompositeBackNormal = 25;
+const int kUnitCompositeEnvironment = 26;
 
 // passes/exposure: exposure_samples.frag
 const int kUnitExposureCamera = 0;  // the camera frame (sRGB8, sampled linear)

@@ -229,9 +229,9 @@ TEST(RoughRefraction, RayDifferentialsKeepTheRimsLobeOnTheRim) {
               << " px): ray differentials " << pD << " dB, slab " << pS << " dB; whole sphere "
               << wD << " / " << wS << " dB\n";
     save("sphere_rim", {ref.footage, slab.srgb, differentials.srgb, ref.refSrgb});
-    // Measured (llvmpipe; reference 256 spp, seed 5): rim 19.10 dB with the differentials, 18.28
-    // with the slab's magnification; whole sphere 22.91 / 22.28 dB.
-    constexpr double kRimFloor = 18.7;
+    // Measured (llvmpipe; reference 256 spp, seed 5): rim 19.44 dB with the differentials, 18.70
+    // with the slab's magnification; whole sphere 23.13 / 22.57 dB.
+    constexpr double kRimFloor = 19.05;
     EXPECT_GE(pD, kRimFloor);
     EXPECT_LT(pS, kRimFloor);  // the must-fail: the slab's magnification
     EXPECT_GE(pD, pS + 0.5);

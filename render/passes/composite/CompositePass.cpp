@@ -6,8 +6,10 @@
 #include "render/FrameGraph.h"
 #include "render/FrameImports.h"
 #include "render/PassRegistry.h"
+#include "render/passes/backface/BackFacePass.h"
 #include "render/passes/caustic/CausticPass.h"
 #include "render/passes/direct/DirectLightPass.h"
+#include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/exposure/ExposurePass.h"
 #include "render/passes/fuzzy/FuzzyReflectionPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
@@ -51,6 +53,7 @@ void CompositePass::buildPrograms(bool identityRemap, bool translucentReflection
     locWithCausticsDiffuse_ = programDiffuse_.uniformLocation("withCaustics");
     locShowVirtualNoCaustics_ = programDiffuseNoCaustics_.uniformLocation("showVirtual");
     locWithCaustics_ = program_.uniformLocation("withCaustics");
+    locSecondExit_ = program_.uniformLocation("secondExitOn");
     locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
     locDenoiseFootage_ = program_.uniformLocation("denoiseFootage");
     locNoiseVariance_ = program_.uniformLocation("noiseVariance");
@@ -89,6 +92,9 @@ void CompositePass::setup(PassBuilder& b) const {
         b.readOptional(r);
     // Rough metals and glass: the filtered video term, when the fuzzy or rough pass ran.
     b.readOptional(kFilteredVideo);
+    // Glass: the refracted path's second exit (second_exit.glsl) marches the back faces and
+    // looks the environment up.
+    for (Resource r : {kBackFacePosition, kBackFaceNormal, kEnvironmentMap}) b.readOptional(r);
     // The per-frame exposure (passes/exposure): its gain reaches this pass through the frame
     // block; the read keeps the exposure pass in the frame when it is switched on.
     b.readOptional(kExposureSamples);
@@ -247,6 +253,16 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glBindTextureUnit(kUnitCompositeLenv, res.texture(kLenv).id());
         glBindTextureUnit(kUnitCompositeRealSurfaces, res.texture(kRealSurfaces).id());
         glBindTextureUnit(kUnitCompositeCanvasToCamera, canvasToCamera_.id());
+        glBindTextureUnit(kUnitCompositeBackPosition,
+                          res.textureOr(kBackFacePosition, ctx.blackTexture()).id());
+        glBindTextureUnit(kUnitCompositeBackNormal,
+                          res.textureOr(kBackFaceNormal, ctx.blackTexture()).id());
+        glBindTextureUnit(kUnitCompositeEnvironment,
+                          res.textureOr(kEnvironmentMap, ctx.blackTexture()).id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials,
+                         ctx.scene.materialBuffer().id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
+                         ctx.scene.specularDrawBuffer().id());
     } else {
         for (int u = kUnitCompositeEmissive; u <= kUnitCompositeCanvasToCamera; ++u)
             if (!translucentReflection ||
@@ -267,6 +283,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glUniform1f(locEpsilon_, ctx.options.specular.backProjectionEpsilon);
         glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
         glUniform1i(locWithCaustics_, withCaustics);
+        glUniform1i(locSecondExit_, ctx.options.specular.secondExit ? 1 : 0);
         // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
         // the newest versions, as the sharp units.
         const bool fuzzy = res.has(kFilteredVideo);

@@ -54,6 +54,7 @@ private:
     GLint locEpsilon_ = -1, locFuzzyOn_ = -1;
     GLint locDenoiseFootage_ = -1, locNoiseVariance_ = -1;    // of program_ (footage_noise.glsl)
     GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
+    GLint locSecondExit_ = -1;
     GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
     gl::Framebuffer fbo_;
     // composite_mask.frag: depth 0 on the camera pixels that see a mirror or glass pixel, 1

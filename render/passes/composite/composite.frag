@@ -2,6 +2,7 @@
 #include "common.glsl"
 #include "passes/specular/specular.glsl"
 #include "passes/grain/footage_noise.glsl"
+#include "passes/specular/second_exit.glsl"
 // Differential rendering (Knecht 2013 Eqs. 1-2), one output pixel per camera pixel:
 //   real or empty pixel:  L_final = CI + alpha * (L_rv - L_r),  alpha = CI / L_r per channel
 //   virtual pixel:        L_final = L_rv (+ s CI on a translucent object: the share s of what
@@ -63,6 +64,9 @@ layout(binding = kUnitCompositeFuzzyRRefl) uniform sampler2D fuzzyRRefl;
 layout(binding = kUnitCompositeFuzzyLenv) uniform sampler2D fuzzyLenv;
 layout(binding = kUnitCompositeFuzzyVideo) uniform sampler2D fuzzyVideo;  // rgb camera units, a = 1: fuzzy pixel
 layout(binding = kUnitCompositeNormal) uniform sampler2D gNormal;  // canvas, xyz facing the camera
+layout(binding = kUnitCompositeBackPosition) uniform sampler2D backPosition;  // w = slot + 1
+layout(binding = kUnitCompositeBackNormal) uniform sampler2D backNormal;      // outward
+layout(binding = kUnitCompositeEnvironment) uniform sampler2D envMap;         // equirectangular
 uniform int fuzzyOn;         // 1 when the fuzzy pass ran this frame
 uniform float depthEpsilon;  // relative camera-distance tolerance of the back-projection
 uniform int showVirtual;     // 0: the footage unchanged (RendererOptions::showVirtual)
@@ -203,6 +207,10 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out boo
               vec3(0.0), r);
     vec3 env = max((fuzzy ? texelFetch(fuzzyLenv, cpi, 0) : texelFetch(lEnv, cpi, 0)).rgb,
                    vec3(0.0)) * ex;
+    // The glass's second exit: the pixel's own, after the rough pass's blur of L_env.
+    vec4 refrW = texelFetch(refrWeight, cpi, 0);
+    env += secondExitEnvironment(cpi, refrW.rgb, refrW.a, envMap, gPosition, gNormal, gEmissive,
+                                 backPosition, backNormal, realSurfaces) * ex;
     bool envReal = envOrigin == ORIGIN_REAL;
     bool allReal = pReal;
     vec3 ciBp = vec3(0.0);

@@ -36,8 +36,8 @@ std::vector<PassKnob> specularKnobs() {
             [](RendererOptions& o) -> int& { return o.specular.refreshInterval; }, {1, 2, 4})),
         onOffKnob("second_exit",
                   "on: glass's refracted path followed past the internal reflection at its back "
-                  "face to a second exit, whose environment light joins L_env; off: the first "
-                  "exit only",
+                  "face to a second exit, whose environment light the composite adds to the "
+                  "pixel's L_env; off: the first exit only",
                   [](RendererOptions& o) -> bool& { return o.specular.secondExit; }, {"on"}),
         onOffKnob(
             "specular_temporal",

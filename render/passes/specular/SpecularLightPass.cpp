@@ -4,7 +4,6 @@
 
 #include "render/FrameGraph.h"
 #include "render/PassRegistry.h"
-#include "render/passes/backface/BackFacePass.h"
 #include "render/passes/caustic/PhotonGridPass.h"
 #include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
@@ -37,7 +36,6 @@ SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
     v.historyWeight = v.program.uniformLocation("historyWeight");
     v.refreshInterval = v.program.uniformLocation("refreshInterval");
     v.refreshPhase = v.program.uniformLocation("refreshPhase");
-    v.secondExit = v.program.uniformLocation("secondExitOn");
     return v;
 }
 
@@ -88,10 +86,6 @@ void SpecularLightPass::setup(PassBuilder& b) const {
     b.read(kSpecularMask);     // depth attachment: shade specular pixels only
     b.read(kEnvironmentMap);
     b.read(kEnvironmentLight);
-    // The refracted path's second exit (second_exit.glsl): the primary surface, the object's back
-    // faces and the real surfaces in the way.
-    for (Resource r : {kGBufferNormal, kBackFacePosition, kBackFaceNormal, kRealSurfaces})
-        b.read(r);
     for (Resource r : {kShadowMaps, kShadowMapsReal, kShadowGlass, kShadowGlassReal, kVpls,
                        kImperfectShadowMaps, kImperfectShadowMapsReal, kPhotonGrid, kPhotonRecords})
         b.readOptional(r);
@@ -215,28 +209,14 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     glBindTextureUnit(kUnitSpecResolveSlot, res.texture(kGBufferEmissive).id());
     glUniform1i(resolve_.uniformLocation("geometryTest"),
                 ctx.options.specular.upsampleGeometry ? 1 : 0);
-    glUniform1i(resolve_.uniformLocation("secondExitOn"), ctx.options.specular.secondExit ? 1 : 0);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
     clearAndDraw(ctx, write);
 }
 
-void SpecularLightPass::bindSecondExit(const FrameContext& ctx, const PassResources& res) {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials, ctx.scene.materialBuffer().id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
-                     ctx.scene.specularDrawBuffer().id());
-    glBindTextureUnit(kUnitSecondExitFrontNormal, res.texture(kGBufferNormal).id());
-    glBindTextureUnit(kUnitSecondExitFrontSlot, res.texture(kGBufferEmissive).id());
-    glBindTextureUnit(kUnitSecondExitFrontPosition, res.texture(kGBufferPosition).id());
-    glBindTextureUnit(kUnitSecondExitBackPosition, res.texture(kBackFacePosition).id());
-    glBindTextureUnit(kUnitSecondExitBackNormal, res.texture(kBackFaceNormal).id());
-    glBindTextureUnit(kUnitSecondExitRealSurfaces, res.texture(kRealSurfaces).id());
-}
-
 void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
                                     const Variant& v) const {
-    if (v.secondExit >= 0) glUniform1i(v.secondExit, ctx.options.specular.secondExit ? 1 : 0);
     if (v.cellSize >= 0) glUniform1f(v.cellSize, PhotonGridPass::cellSize(ctx.options));
     if (v.gatherCap >= 0) glUniform1ui(v.gatherCap, GLuint(ctx.options.caustic.gatherCap));
     const bool vpls = ctx.options.specular.vpls && res.has(kVpls) && res.has(kImperfectShadowMaps);
@@ -289,7 +269,6 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     }
     glBindTextureUnit(kUnitSpecLightPosition, res.texture(kGBufferPosition).id());
     glBindTextureUnit(kUnitEnvironmentMap, res.texture(kEnvironmentMap).id());
-    bindSecondExit(ctx, res);
     glBindBufferBase(GL_UNIFORM_BUFFER, kBindingEnvironment, res.buffer(kEnvironmentLight).id());
     if (gather) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingPhotonGrid,

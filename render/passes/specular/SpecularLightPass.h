@@ -40,16 +40,13 @@ private:
     struct Variant {
         gl::Program program;
         GLint useVpls = -1, vplStride = -1, cellSize = -1, gatherCap = -1, historyWeight = -1;
-        GLint refreshInterval = -1, refreshPhase = -1, secondExit = -1;
+        GLint refreshInterval = -1, refreshPhase = -1;
     };
     static Variant makeVariant(const char* label, const std::string& defines);
     void buildHalfResolution(const GpuScene& scene);
     void allocateHalfResolution(int w, int h);
     std::string refreshNote(const FrameContext& ctx) const;
     void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
-    // The refracted path's second exit's inputs (second_exit.glsl), for the lighting and the
-    // half-resolution upsample alike.
-    static void bindSecondExit(const FrameContext& ctx, const PassResources& res);
     void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v, int write);
     // Clears fbo_[write] (bound) where the last draws into its textures and this one's cover,
     // then draws the full-screen triangle in the specular rectangles.

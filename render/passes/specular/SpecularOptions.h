@@ -44,8 +44,9 @@ struct SpecularOptions {
     // depth steps in the reflections).
     bool upsampleGeometry = true;
     // The glass's refracted path followed past Fresnel's internal reflection at the back face
-    // to its second exit (specular.glsl refractedSecondExit), whose environment light joins
-    // L_env: on a sphere's rim that share of the light is large. false: only the first exit.
+    // to its second exit (specular.glsl refractedSecondExit), whose environment light the
+    // composite adds to the pixel's L_env after the rough pass (second_exit.glsl): on a sphere's
+    // rim that share of the light is large. false: only the first exit.
     bool secondExit = true;
     // Tests only: false draws the specular passes over the one rectangle around every specular
     // object (FrameContext::specularScissor) instead of each object's own (the same images).

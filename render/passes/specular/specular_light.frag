@@ -4,7 +4,6 @@
 #include "lighting.glsl"
 #include "passes/specular/specular.glsl"
 #include "passes/caustic/caustic.glsl"
-#include "passes/specular/second_exit.glsl"
 // Lighting of the reflected / refracted ray hits (GBuf_refl, GBuf_refr) by every light (shadow
 // maps), the environment (SH irradiance) and the VPLs (imperfect shadow maps), routed by
 // Knecht 2013 Eqs. 3-5:
@@ -402,8 +401,6 @@ void main() {
     outR = vec4(r, hit[1].y);
     outRRefl = vec4(rRefl, hit[1].z);
     outHits = vec4(hit[0], hit[1].x);
-    vec4 refrW = texelFetch(refrWeight, px, 0);
-    env += secondExitEnvironment(px, refrW.rgb, refrW.a, envMap);
     outEnv = vec4(allFinite(env) ? env : vec3(0.0), 1.0);
 }
 #endif

@@ -1,7 +1,6 @@
 #version 450 core
 #include "common.glsl"
 #include "passes/specular/specular.glsl"
-#include "passes/specular/second_exit.glsl"
 // Upsample of the half-resolution specular lighting (specular_light.frag MIRAGE_SPECULAR_HALF) to
 // the canvas: L'_rv, L'_r, the reflection's share of L'_r and L_env, as the full-resolution
 // variant writes them. Per specular pixel and per hit (reflected, refracted), the four half
@@ -116,7 +115,5 @@ void main() {
     outRv = vec4(allFinite(rv) ? rv : vec3(0.0), 1.0);
     outR = vec4(allFinite(r) ? r : vec3(0.0), 1.0);
     outRRefl = vec4(allFinite(rRefl) ? rRefl : vec3(0.0), 1.0);
-    vec4 refrW = texelFetch(refrWeight, px, 0);
-    env += secondExitEnvironment(px, refrW.rgb, refrW.a, envMap);
     outEnv = vec4(allFinite(env) ? env : vec3(0.0), 1.0);
 }
