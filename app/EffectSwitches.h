@@ -40,6 +40,8 @@ inline constexpr EffectSwitch kEffectSwitches[] = {
      [](render::RendererOptions& o) -> bool& { return o.fuzzy.enabled; }},
     {"rough_highlight", "highlights on rough mirror/glass",
      [](render::RendererOptions& o) -> bool& { return o.direct.roughHighlight; }},
+    {"rough_transmission", "lights through rough glass",
+     [](render::RendererOptions& o) -> bool& { return o.direct.roughTransmission; }},
     {"rough_photons", "rough caustics",
      [](render::RendererOptions& o) -> bool& { return o.caustic.roughLobes; }},
     {"translucency", "translucency",

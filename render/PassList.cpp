@@ -21,10 +21,10 @@
     X(makeTranslucencyPass, translucencyKnobs)                                            \
     X(makeIndirectLightPass, indirectKnobs)                                               \
     X(makeGiFilterPass, noKnobs)                                                          \
+    X(makeBackFacePass, noKnobs)        /* before direct: light through rough glass */    \
     X(makeDirectLightPass, directKnobs) /* + the upsampled indirect light */              \
     X(makeCausticPass, causticKnobs)                                                      \
     X(makeExposurePass, exposureKnobs) /* L_r complete; before any pass using exposure */ \
-    X(makeBackFacePass, noKnobs)                                                          \
     X(makeSpecularGBufferPass, specularKnobs)                                             \
     X(makePhotonGridPass, noKnobs) /* caustics at the reflected/refracted hits */         \
     X(makeSpecularLightPass, noKnobs)                                                     \

@@ -51,6 +51,8 @@ const int kUnitDirectShadowReal = 5;
 const int kUnitDirectGlassAll = 6;  // ShadowGlass / ShadowGlassReal (glass in the shadow maps)
 const int kUnitDirectGlassReal = 7;
 const int kUnitDirectGatherLight = 8;  // filter.frag's packed gather pixels (gi_upsample.glsl)
+const int kUnitDirectBackPosition = 9;  // the back faces (rough_transmission.glsl)
+const int kUnitDirectBackNormal = 10;
 
 // translucency.comp: the shadow atlases
 const int kUnitTranslucencyShadowAll = 0;

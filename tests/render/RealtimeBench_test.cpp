@@ -209,7 +209,8 @@ TEST(RealtimeBench, RealtimeCompositeMeetsFloorsAndBrokenRendersFail) {
             "motion_blur=off aa=off noise_match=off vignette_match=off camera_response=session "
             "shadow_focus=on shadow_footprint=on "
             "vpl_rotate=off ism_tile=64 ism_points=1024 ism_pullpush=off vnm_see_through=on "
-            "vnm_reflection=on second_exit=on rough_footprint=differentials view=off");
+            "vnm_reflection=on rough_transmission=on second_exit=on rough_footprint=differentials "
+            "view=off");
     const BenchResult good = runBenchConfig(benchScene(true), camera, frames, grid[0]);
     std::cout << "[ bench ] real-time: " << good.error << ", " << good.medianGpuMs
               << " GPU ms/frame\n";

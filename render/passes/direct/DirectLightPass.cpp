@@ -2,6 +2,7 @@
 
 #include "render/FrameGraph.h"
 #include "render/PassRegistry.h"
+#include "render/passes/backface/BackFacePass.h"
 #include "render/passes/environment/EnvironmentPass.h"
 #include "render/passes/gbuffer/GBufferPass.h"
 #include "render/passes/gifilter/GiFilterPass.h"
@@ -92,6 +93,9 @@ void DirectLightPass::setup(PassBuilder& b) const {
     b.readOptional(kTranslucentLut);
     b.readOptional(kSpecularMask);  // none: no mirror or glass object in view
     b.readOptional(kGatherLight);   // none: no VPL light this frame
+    // none: no mirror or glass object in view (rough glass's transmitted light needs them)
+    b.readOptional(kBackFacePosition);
+    b.readOptional(kBackFaceNormal);
     b.create(kLRv, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     b.create(kLR, {GL_RGBA16F, SizeRule::Canvas, Storage::PassOwned});
     // The direct light alone: LRv / LR themselves in frames without VPL light, else written
@@ -102,13 +106,19 @@ void DirectLightPass::setup(PassBuilder& b) const {
 
 PassDecision DirectLightPass::decide(const FrameContext& ctx) const {
     const int rough = ctx.scene.roughReflectorCount() + ctx.scene.roughGlassCount();
-    return {true, std::to_string(ctx.scene.lights().size()) + " light(s)" +
-                      (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
-                      (ctx.plan.needVpls ? " + the upsampled indirect light" : "") +
-                      (rough > 0 && ctx.options.direct.roughHighlight
-                           ? " + the lights' highlight on " + std::to_string(rough) +
-                                 " rough mirror / metal / glass object(s)"
-                           : "")};
+    return {true,
+            std::to_string(ctx.scene.lights().size()) + " light(s)" +
+                (ctx.scene.hasEnvironment() || ctx.environment.live ? " + environment" : "") +
+                (ctx.plan.needVpls ? " + the upsampled indirect light" : "") +
+                (rough > 0 && ctx.options.direct.roughHighlight
+                     ? " + the lights' highlight on " + std::to_string(rough) +
+                           " rough mirror / metal / glass object(s)"
+                     : "") +
+                (ctx.scene.roughGlassCount() > 0 && ctx.options.direct.roughHighlight &&
+                         ctx.options.direct.roughTransmission
+                     ? " + the lights through " + std::to_string(ctx.scene.roughGlassCount()) +
+                           " rough glass object(s)"
+                     : "")};
 }
 
 void DirectLightPass::resize(const FrameContext& ctx) {
@@ -190,9 +200,25 @@ void DirectLightPass::execute(FrameContext& ctx, PassResources& res) {
         ctx.drawFullscreenTriangle();
     const bool roughInView =
         ctx.scene.roughReflectorCount() + ctx.scene.roughGlassCount() > 0 && res.has(kSpecularMask);
-    if (roughInView && ctx.options.direct.roughHighlight)
-        drawRoughHighlight(ctx, program(ctx.plan.glassShadows, indirect, keep, true),
-                           mask != nullptr);
+    if (roughInView && ctx.options.direct.roughHighlight) {
+        gl::Program& highlight = program(ctx.plan.glassShadows, indirect, keep, true);
+        highlight.use();
+        // Rough glass's transmitted light follows the sharp path through the back faces.
+        const bool transmission = ctx.options.direct.roughTransmission &&
+                                  ctx.scene.roughGlassCount() > 0 && res.has(kBackFacePosition);
+        glUniform1i(highlight.uniformLocation("roughTransmissionOn"), transmission ? 1 : 0);
+        if (transmission) {
+            glBindTextureUnit(kUnitDirectBackPosition, res.texture(kBackFacePosition).id());
+            glBindTextureUnit(kUnitDirectBackNormal, res.texture(kBackFaceNormal).id());
+            glUniform1i(highlight.uniformLocation("roughRefractionSteps"),
+                        ctx.options.specular.refractionMarchSteps);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingMaterials,
+                             ctx.scene.materialBuffer().id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingSpecularDraws,
+                             ctx.scene.specularDrawBuffer().id());
+        }
+        drawRoughHighlight(ctx, highlight, mask != nullptr);
+    }
     res.publish(kLRv, rv_);
     res.publish(kLR, r_);
     if (!indirect) {  // the GI solutions are the direct light

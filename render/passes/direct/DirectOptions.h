@@ -21,6 +21,10 @@ struct DirectOptions {
     // false: their light comes from the mirror / refracted ray alone, which never meets a
     // punctual light (no highlight).
     bool roughHighlight = true;
+    // true (the default; with roughHighlight): rough glass also lets the punctual lights' light
+    // through towards the eye, scattered by its rough surfaces where the light enters it
+    // (rough_transmission.glsl; docs/specular.md, "Rough light"). false: only its reflection.
+    bool roughTransmission = true;
 
     void validate() const {}
 };

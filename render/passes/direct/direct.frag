@@ -121,10 +121,13 @@ void directLight(ivec2 px, vec4 P, vec4 N, bool pReal, out vec3 rv, out vec3 r,
 }
 
 #ifdef MIRAGE_ROUGH_HIGHLIGHT
+#include "passes/specular/specular.glsl"
+#include "passes/direct/rough_transmission.glsl"
 // Variant for the pixels of rough mirrors, metals and glass (roughness above the mirror
 // threshold 0.05; the specular passes light them along the mirror / refracted ray, which never
 // meets a punctual light): the punctual lights' GGX highlight alone, F0 the metal's base colour or
-// 0.04 for glass, routed as the direct light (docs/realtime-renderer.md, "Real and virtual:
+// 0.04 for glass, and on rough glass the lights' light it lets through (rough_transmission.glsl),
+// routed as the direct light (docs/realtime-renderer.md, "Real and virtual:
 // routing"). The composite adds it to the specular pixel's L'_rv / L'_r after the fuzzy / rough
 // filters (it is the lobe already).
 // Other pixels are left as the main draw wrote them. LR.a = 2 marks a highlight pixel.
@@ -160,6 +163,8 @@ void main() {
         rv += c * visAll;
         if (lights[li].isReal == 1 && pReal) r += c * visReal;
     }
+    // Rough glass also lets the lights through (rough_transmission.glsl).
+    roughGlassTransmission(px, P.xyz, N.xyz, N.w, pReal, rv, r);
     rv = allFinite(rv) ? rv : vec3(0.0);
     r = allFinite(r) ? r : vec3(0.0);
     outRv = vec4(rv, float(origin));

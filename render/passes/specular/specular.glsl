@@ -93,10 +93,12 @@ vec3 sphereExit(vec3 o, vec3 d, vec3 centre, float radius) {
 // (docs/specular.md). Returns false when nothing is refracted (TIR at the front face, ior < 1).
 // Outputs the exit point P2 and unit direction T2, the two Fresnel reflectances and the distance
 // travelled inside (m).
+// N2 (this overload): the back face's outward unit normal at P2.
 bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, float eta,
                           mat4 vp, vec3 eye, vec2 size, sampler2D backPosition,
                           sampler2D backNormal, int marchSteps, out vec3 P2, out vec3 T2,
-                          out float F1, out float F2, out float inside) {
+                          out float F1, out float F2, out float inside, out vec3 N2) {
+    N2 = -d;
     P2 = p;
     T2 = d;
     F2 = 0.0;
@@ -129,7 +131,6 @@ bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, 
         }
         prevT = t;
     }
-    vec3 N2;
     if (hitT > 0.0) {
         float lo = prevT, hi = hitT;
         for (int k = 0; k < 6; ++k) {  // bisection on the same crossing test
@@ -166,6 +167,15 @@ bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, 
     }
     T2 = normalize(T2);
     return true;
+}
+
+bool refractTwoInterfaces(vec3 p, vec3 n, vec3 d, int slot, GpuSpecularDraw sd, float eta,
+                          mat4 vp, vec3 eye, vec2 size, sampler2D backPosition,
+                          sampler2D backNormal, int marchSteps, out vec3 P2, out vec3 T2,
+                          out float F1, out float F2, out float inside) {
+    vec3 N2;
+    return refractTwoInterfaces(p, n, d, slot, sd, eta, vp, eye, size, backPosition, backNormal,
+                                marchSteps, P2, T2, F1, F2, inside, N2);
 }
 
 // Weight of the light refracted through both interfaces: transmission (1 - F1)(1 - F2)
@@ -224,43 +234,16 @@ bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampl
     return ok;
 }
 
-// The refracted path's second exit. The sharp path (refractTwoInterfaces) leaves the back face at
-// P2 with the share 1 - F2 of the light; the share F2 is reflected inside, along T1r =
-// reflect(T1, N2), meets the object's surface again at P3 (outward normal N3) and leaves along
-// T3 = Snell there with 1 - F3. On a glass sphere seen at a grazing angle (its rim) F2 is large
-// and T3 points away from everything the sharp path sees: without it the rim is too dark.
-// T1r is marched through the object (the primary G-buffer's front faces and the back-face buffer
-// of the same draw slot, as the sharp path's march: it leaves where it passes in front of a front
-// face or behind a back face, bisected); off both buffers' footprint the bounding sphere's exit
-// stands in. Light reflected inside a second time is not followed (nor where the sharp path
-// itself took the internal reflection, F2 = 1). weight: that of the light arriving along -T3,
-// given the sharp path's refraction weight w2 = ... (1 - F1)(1 - F2) ... absorb(d_in):
-// w2 F2 / (1 - F2) (1 - F3) x Beer-Lambert over |P3 - P2|. False when there is none.
-bool refractedSecondExit(vec3 a, vec3 n, vec3 d, float din, vec3 w2, GpuMaterial m,
-                         GpuSpecularDraw sd, int slot, sampler2D frontPosition,
-                         sampler2D frontNormal, sampler2D frontSlot, sampler2D backPosition,
-                         sampler2D backNormal, out vec3 P3, out vec3 T3, out vec3 weight) {
-    P3 = a;
-    T3 = d;
-    weight = vec3(0.0);
-    float eta = max(m.ior, 1e-3);
-    if (all(lessThanEqual(w2, vec3(0.0))) || abs(eta - 1.0) < 1e-4) return false;
-    vec3 T1 = refract(d, n, 1.0 / eta);
-    if (dot(T1, T1) < 0.5) return false;
-    T1 = normalize(T1);
-    vec3 P2 = a + T1 * max(din, 0.0);
+// Where a ray inside the object, from P2 along unit T1r (the light the back face reflects inside),
+// leaves it: P3 and the outward unit normal N3 there. T1r is marched through the object (the primary
+// G-buffer's front faces and the back-face buffer of the same draw slot, as the sharp path's
+// march: it leaves where it passes in front of a front face or behind a back face, bisected); off
+// both buffers' footprint the bounding sphere's exit stands in. False when T does not leave
+// through the surface found (it grazes it or the normal is not finite).
+bool internalPathExit(vec3 P2, vec3 T1r, int slot, GpuSpecularDraw sd, sampler2D frontPosition,
+                      sampler2D frontNormal, sampler2D frontSlot, sampler2D backPosition,
+                      sampler2D backNormal, out vec3 P3, out vec3 N3) {
     vec2 cp;
-    vec3 N2 = normalize(P2 - sd.centre);
-    if (projectToCanvas(P2, cp)) {
-        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
-        vec3 Nb = texelFetch(backNormal, qi, 0).xyz;
-        if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 == slot && dot(Nb, Nb) > 0.25)
-            N2 = normalize(Nb);
-    }
-    if (!allFinite(N2) || dot(N2, T1) < 1e-3) return false;
-    float F2 = fresnelDielectric(-dot(T1, N2), eta);
-    if (!(F2 > 1e-4) || F2 >= 1.0) return false;
-    vec3 T1r = reflect(T1, N2);
     // March T1r inside: out where it is in front of this object's front face or behind its back
     // face at the pixel it projects to; off both, it left the object's image.
     float maxLen = 2.0 * sd.radius + 1e-3;
@@ -281,7 +264,6 @@ bool refractedSecondExit(vec3 a, vec3 n, vec3 d, float din, vec3 w2, GpuMaterial
         else if (back && dq > length(texelFetch(backPosition, qi, 0).xyz - cameraPos.xyz)) face = 2;
         if (face != 0) hitT = t; else prevT = t;
     }
-    vec3 N3;
     if (hitT > 0.0) {
         float lo = prevT, hi = hitT;
         for (int k = 0; k < 5; ++k) {
@@ -307,7 +289,47 @@ bool refractedSecondExit(vec3 a, vec3 n, vec3 d, float din, vec3 w2, GpuMaterial
         N3 = P3 - sd.centre;
     }
     N3 = normalize(N3);
-    if (!allFinite(N3) || dot(N3, T1r) < 1e-3) return false;
+    return allFinite(N3) && dot(N3, T1r) >= 1e-3;
+}
+
+// The refracted path's second exit. The sharp path (refractTwoInterfaces) leaves the back face at
+// P2 with the share 1 - F2 of the light; the share F2 is reflected inside, along T1r = reflect(T1,
+// N2), meets the object's surface again at P3 (outward normal N3) and leaves along T3 = Snell there
+// with 1 - F3. On a glass sphere seen at a grazing angle (its rim) F2 is large and T3 points away
+// from everything the sharp path sees: without it the rim is too dark. P3 is where internalPathExit
+// finds T1r leaving. Light reflected inside a second time is not followed (nor where the sharp path
+// itself took the internal reflection, F2 = 1). weight: that of the light arriving along -T3, given
+// the sharp path's refraction weight w2 = ... (1 - F1)(1 - F2) ... absorb(d_in): w2 F2 / (1 - F2)
+// (1 - F3) x Beer-Lambert over |P3 - P2|. False when there is none.
+bool refractedSecondExit(vec3 a, vec3 n, vec3 d, float din, vec3 w2, GpuMaterial m,
+                         GpuSpecularDraw sd, int slot, sampler2D frontPosition,
+                         sampler2D frontNormal, sampler2D frontSlot, sampler2D backPosition,
+                         sampler2D backNormal, out vec3 P3, out vec3 T3, out vec3 weight) {
+    P3 = a;
+    T3 = d;
+    weight = vec3(0.0);
+    float eta = max(m.ior, 1e-3);
+    if (all(lessThanEqual(w2, vec3(0.0))) || abs(eta - 1.0) < 1e-4) return false;
+    vec3 T1 = refract(d, n, 1.0 / eta);
+    if (dot(T1, T1) < 0.5) return false;
+    T1 = normalize(T1);
+    vec3 P2 = a + T1 * max(din, 0.0);
+    vec2 cp;
+    vec3 N2 = normalize(P2 - sd.centre);
+    if (projectToCanvas(P2, cp)) {
+        ivec2 qi = clamp(ivec2(floor(cp + 0.5)), ivec2(0), ivec2(canvas.xy) - 1);
+        vec3 Nb = texelFetch(backNormal, qi, 0).xyz;
+        if (int(texelFetch(backPosition, qi, 0).w + 0.5) - 1 == slot && dot(Nb, Nb) > 0.25)
+            N2 = normalize(Nb);
+    }
+    if (!allFinite(N2) || dot(N2, T1) < 1e-3) return false;
+    float F2 = fresnelDielectric(-dot(T1, N2), eta);
+    if (!(F2 > 1e-4) || F2 >= 1.0) return false;
+    vec3 T1r = reflect(T1, N2);
+    vec3 N3;
+    if (!internalPathExit(P2, T1r, slot, sd, frontPosition, frontNormal, frontSlot, backPosition,
+                          backNormal, P3, N3))
+        return false;
     float F3 = fresnelDielectric(-dot(T1r, N3), eta);
     T3 = refract(T1r, -N3, eta);
     if (F3 >= 1.0 || dot(T3, T3) < 0.5) return false;  // reflected inside again: not followed
