@@ -79,6 +79,28 @@ void save(const std::string& name, std::initializer_list<cv::Mat> images) {
     writeBgr8(test::outputDir("rough_light_" + name) / (name + ".png"), row);
 }
 
+// The scene rendered with the default options and with one direct-light feature switched off,
+// each against the reference (64 spp, seed 5) over `mask`.
+struct WithAndWithout {
+    test::RoughReference ref;
+    test::RoughFrame with, without;
+    double pWith = 0.0, pWithout = 0.0;  // PSNR (dB) against the reference
+};
+
+WithAndWithout renderWithAndWithout(const test::RoughTestScene& s, const cv::Mat& mask,
+                                    bool DirectOptions::*feature) {
+    WithAndWithout r;
+    r.ref = test::roughReference(s, 64, 5);
+    const RendererOptions on = test::roughSingleFrame();
+    r.with = test::renderRough(s, r.ref.footage, on);
+    RendererOptions off = on;
+    off.direct.*feature = false;
+    r.without = test::renderRough(s, r.ref.footage, off);
+    r.pWith = test::psnr(r.with.srgb, r.ref.refSrgb, 255.0, mask);
+    r.pWithout = test::psnr(r.without.srgb, r.ref.refSrgb, 255.0, mask);
+    return r;
+}
+
 TEST(RoughLight, GlossyHighlightOnRoughSpheresMatchesReferenceAndLeavingItOutFails) {
     gl::Context context = gl::Context::headless();
     const auto envDir = test::outputDir("rough_light_env");
@@ -93,21 +115,14 @@ TEST(RoughLight, GlossyHighlightOnRoughSpheresMatchesReferenceAndLeavingItOutFai
         const test::RoughTestScene s = makeSphere(c.glass, envDir);
         const cv::Mat mask = sphereMask(s);
         ASSERT_GT(cv::countNonZero(mask), 600);
-        const test::RoughReference ref = test::roughReference(s, 64, 5);
-        RendererOptions on = test::roughSingleFrame();
-        const test::RoughFrame withHighlight = test::renderRough(s, ref.footage, on);
-        RendererOptions off = on;
-        off.direct.roughHighlight = false;
-        const test::RoughFrame without = test::renderRough(s, ref.footage, off);
-        const double pOn = test::psnr(withHighlight.srgb, ref.refSrgb, 255.0, mask);
-        const double pOff = test::psnr(without.srgb, ref.refSrgb, 255.0, mask);
+        const WithAndWithout r = renderWithAndWithout(s, mask, &DirectOptions::roughHighlight);
         std::cout << "[ highlight ] " << (c.glass ? "rough glass" : "rough metal") << " sphere "
-                  << kRoughness << ": with the highlight " << pOn << " dB, without " << pOff
-                  << " dB over " << cv::countNonZero(mask) << " px\n";
+                  << kRoughness << ": with the highlight " << r.pWith << " dB, without "
+                  << r.pWithout << " dB over " << cv::countNonZero(mask) << " px\n";
         save(c.glass ? "highlight_glass" : "highlight_metal",
-             {ref.footage, without.srgb, withHighlight.srgb, ref.refSrgb});
-        EXPECT_GE(pOn, c.floorDb);
-        EXPECT_LT(pOff, c.floorDb);  // the must-fail: no highlight
+             {r.ref.footage, r.without.srgb, r.with.srgb, r.ref.refSrgb});
+        EXPECT_GE(r.pWith, c.floorDb);
+        EXPECT_LT(r.pWithout, c.floorDb);  // the must-fail: no highlight
     }
 }
 
@@ -122,20 +137,13 @@ TEST(RoughLight, BacklitRoughGlassLetsTheLightThroughAsTheReferenceAndLeavingItO
     const test::RoughTestScene s = makeSphere(true, envDir, glm::vec3(0.15f, 0.3f, -0.9f));
     const cv::Mat mask = sphereMask(s);
     ASSERT_GT(cv::countNonZero(mask), 600);
-    const test::RoughReference ref = test::roughReference(s, 64, 5);
-    RendererOptions on = test::roughSingleFrame();
-    const test::RoughFrame with = test::renderRough(s, ref.footage, on);
-    RendererOptions off = on;
-    off.direct.roughTransmission = false;
-    const test::RoughFrame without = test::renderRough(s, ref.footage, off);
-    const double pOn = test::psnr(with.srgb, ref.refSrgb, 255.0, mask);
-    const double pOff = test::psnr(without.srgb, ref.refSrgb, 255.0, mask);
+    const WithAndWithout r = renderWithAndWithout(s, mask, &DirectOptions::roughTransmission);
     std::cout << "[ transmitted ] backlit rough glass sphere " << kRoughness
-              << ": with the transmitted light " << pOn << " dB, without " << pOff << " dB over "
-              << cv::countNonZero(mask) << " px\n";
-    save("transmitted_glass", {ref.footage, without.srgb, with.srgb, ref.refSrgb});
-    EXPECT_GE(pOn, 25.0);
-    EXPECT_LT(pOff, 25.0);  // the must-fail: no transmitted light
+              << ": with the transmitted light " << r.pWith << " dB, without " << r.pWithout
+              << " dB over " << cv::countNonZero(mask) << " px\n";
+    save("transmitted_glass", {r.ref.footage, r.without.srgb, r.with.srgb, r.ref.refSrgb});
+    EXPECT_GE(r.pWith, 25.0);
+    EXPECT_LT(r.pWithout, 25.0);  // the must-fail: no transmitted light
 }
 
 // The light through rough glass at its hard cases, against the reference: a spot straight behind
@@ -153,22 +161,16 @@ TEST(RoughLight, TransmittedLightAtItsHardCasesAgainstTheReference) {
         test::RoughTestScene s = makeSphere(true, envDir, glm::vec3(0.0f, 0.12f, -0.7f));
         s.scene.materials[size_t(s.material)].ior = ior;
         const cv::Mat mask = sphereMask(s);
-        RendererOptions on = test::roughSingleFrame();
-        RendererOptions off = on;
-        off.direct.roughTransmission = false;
-        const test::RoughReference ref = test::roughReference(s, 64, 5);
-        const test::RoughFrame with = test::renderRough(s, ref.footage, on);
-        const test::RoughFrame without = test::renderRough(s, ref.footage, off);
-        const double pWith = test::psnr(with.srgb, ref.refSrgb, 255.0, mask);
-        const double pWithout = test::psnr(without.srgb, ref.refSrgb, 255.0, mask);
-        const double agree = test::psnr(with.srgb, without.srgb, 255.0, mask);
+        const WithAndWithout r = renderWithAndWithout(s, mask, &DirectOptions::roughTransmission);
+        const double pWith = r.pWith, pWithout = r.pWithout;
+        const double agree = test::psnr(r.with.srgb, r.without.srgb, 255.0, mask);
         double brightest = 0.0;
-        cv::minMaxLoc(with.linear.reshape(1), nullptr, &brightest);
+        cv::minMaxLoc(r.with.linear.reshape(1), nullptr, &brightest);
         std::cout << "[ transmitted ] light straight behind, ior " << ior << ": " << pWith
                   << " dB with the term, " << pWithout << " dB without, over the sphere; "
                   << "brightest linear value " << brightest << "\n";
         save("transmitted_ior" + std::to_string(int(ior * 1000)),
-             {ref.footage, without.srgb, with.srgb, ref.refSrgb});
+             {r.ref.footage, r.without.srgb, r.with.srgb, r.ref.refSrgb});
         EXPECT_LT(brightest, 6.0e4) << "ior " << ior;  // within the half-float targets
         EXPECT_GE(pWith, pWithout - 0.1) << "ior " << ior;
         if (ior == 1.001f) {

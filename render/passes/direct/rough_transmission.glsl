@@ -18,12 +18,7 @@
 // (as the reference's GGX dielectric), so the lobe at the entry point is widened to alpha sqrt(2)
 // (the two faces' slope variances add). Light scattered inside more than once is left out.
 // Include after lighting.glsl and specular.glsl.
-layout(std430, binding = kBindingMaterials) readonly buffer RoughTransmissionMaterials {
-    GpuMaterial roughTransmissionMaterials[];
-};
-layout(std430, binding = kBindingSpecularDraws) readonly buffer RoughTransmissionDraws {
-    GpuSpecularDraw roughTransmissionDraws[];
-};
+#include "passes/specular/specular_tables.glsl"
 layout(binding = kUnitDirectBackPosition) uniform sampler2D backPosition;  // xyz, w = slot + 1
 layout(binding = kUnitDirectBackNormal) uniform sampler2D backNormal;      // outward
 uniform int roughTransmissionOn;   // DirectOptions::roughTransmission (and back faces bound)
@@ -94,8 +89,8 @@ void roughGlassTransmission(ivec2 px, vec3 p, vec3 n, float roughness, bool pRea
     if (roughTransmissionOn == 0) return;
     int slot = int(texelFetch(gEmissive, px, 0).a + 0.5) - 1;
     if (slot < 0) return;
-    GpuSpecularDraw sd = roughTransmissionDraws[slot];
-    GpuMaterial m = roughTransmissionMaterials[sd.material];
+    GpuSpecularDraw sd = specularDrawTable[slot];
+    GpuMaterial m = specularMaterialTable[sd.material];
     float transWeight = m.mirror != 0 ? 0.0
                                       : clamp(m.transmission, 0.0, 1.0) *
                                             (1.0 - clamp(m.metallic, 0.0, 1.0));

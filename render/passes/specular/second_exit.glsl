@@ -5,12 +5,7 @@
 // again elsewhere), added by the composite to each glass pixel's L_env after the rough pass has
 // blurred L_env (the term is the pixel's own: on a sphere's rim its neighbours in the glass's
 // image see far less of it). Include after specular.glsl.
-layout(std430, binding = kBindingMaterials) readonly buffer SecondExitMaterials {
-    GpuMaterial secondExitMaterials[];
-};
-layout(std430, binding = kBindingSpecularDraws) readonly buffer SecondExitDraws {
-    GpuSpecularDraw secondExitDraws[];
-};
+#include "passes/specular/specular_tables.glsl"
 uniform int secondExitOn;  // SpecularOptions::secondExit
 
 // True when the ray from p along dir passes no real surface within `len` metres, by a march in
@@ -46,8 +41,8 @@ vec3 secondExitEnvironment(ivec2 px, vec3 w2, float din, sampler2D envMap,
     if (secondExitOn == 0 || all(lessThanEqual(w2, vec3(0.0)))) return vec3(0.0);
     int slot = int(texelFetch(frontSlot, px, 0).a + 0.5) - 1;
     if (slot < 0) return vec3(0.0);
-    GpuSpecularDraw sd = secondExitDraws[slot];
-    GpuMaterial m = secondExitMaterials[sd.material];
+    GpuSpecularDraw sd = specularDrawTable[slot];
+    GpuMaterial m = specularMaterialTable[sd.material];
     if (!(m.transmission > 0.0)) return vec3(0.0);
     vec3 a = texelFetch(frontPosition, px, 0).xyz;
     vec3 n = texelFetch(frontNormal, px, 0).xyz;
