@@ -238,7 +238,7 @@ bool backProject(vec3 x, sampler2D realSurfaces, sampler2D canvasToCamera, sampl
 // leaves it: P3 and the outward unit normal N3 there. T1r is marched through the object (the
 // primary G-buffer's front faces and the back-face buffer of the same draw slot, as the sharp
 // path's march: it leaves where it passes in front of a front face or behind a back face,
-// bisected); off both buffers' footprint the bounding sphere's exit stands in. False when T does
+// bisected); off both buffers' footprint the bounding sphere's exit stands in. False when T1r does
 // not leave through the surface found (it grazes it or the normal is not finite).
 bool internalPathExit(vec3 P2, vec3 T1r, int slot, GpuSpecularDraw sd, sampler2D frontPosition,
                       sampler2D frontNormal, sampler2D frontSlot, sampler2D backPosition,
