@@ -55,9 +55,10 @@ float roughTransmissionCos(vec3 wi, vec3 wo, vec3 n, float eta, float alpha) {
     return iH * -oH * (1.0 - F) * ggxDistribution(dot(h, n), alpha) * G / (-cosO * len * len);
 }
 
-// The lights' light entering at surface point x (outward normal n) and carried along -wo ... to
-// the eye with `weight`: routed as the direct light (L_rv always, L_r for a real light on a real
-// object). roughness: the glass's (alpha = roughness^2).
+// The lights' light entering the glass at surface point x (outward normal n) towards wo, back
+// along the eye's path, which carries it to the eye with `weight`: routed as the direct light
+// (L_rv always, L_r for a real light on a real object). roughness: the glass's (alpha =
+// roughness^2).
 void addTransmittedLight(vec3 x, vec3 n, vec3 wo, vec3 weight, float eta, float roughness,
                          bool pReal, inout vec3 rv, inout vec3 r) {
     if (all(lessThanEqual(weight, vec3(0.0)))) return;
