@@ -124,9 +124,7 @@ void main() {
     vec2 vis = shadowVisibility(shadowAll, shadowReal, li, p, cosL, lights[li].realOnlyMap == 1);
     float realVis = lights[li].isReal == 1 && origin == ORIGIN_REAL ? vis.y : 0.0;
 
-    bool mirror = m.mirror != 0;
-    float transWeight = mirror ? 0.0 : clamp(m.transmission, 0.0, 1.0) *
-                                           (1.0 - clamp(m.metallic, 0.0, 1.0));
+    float transWeight = transmissionShare(m);
     float eta = max(m.ior, 1e-3);
     float eps = 1e-4 + 1e-4 * dist;  // ray offset against self-intersection (m)
 

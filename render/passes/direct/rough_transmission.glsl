@@ -92,9 +92,7 @@ void roughGlassTransmission(ivec2 px, vec3 p, vec3 n, float roughness, bool pRea
     if (slot < 0) return;
     GpuSpecularDraw sd = specularDrawTable[slot];
     GpuMaterial m = specularMaterialTable[sd.material];
-    float transWeight = m.mirror != 0 ? 0.0
-                                      : clamp(m.transmission, 0.0, 1.0) *
-                                            (1.0 - clamp(m.metallic, 0.0, 1.0));
+    float transWeight = transmissionShare(m);
     float eta = max(m.ior, 1e-3);
     // Near index matching a facet's tilt hardly turns the light (by about (1 - 1/ior) x the
     // tilt): the lobe narrows to the smooth interface's delta, whose image of a point light is not

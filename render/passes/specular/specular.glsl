@@ -58,6 +58,13 @@ bool projectToView(mat4 vp, vec2 size, vec3 x, out vec2 px) {
     return clipToView(vp * vec4(x, 1.0), size, px);
 }
 
+// The share of the light a specular material refracts (transWeight below): transmission x
+// (1 - metallic), 0 for a perfect mirror.
+float transmissionShare(GpuMaterial m) {
+    if (m.mirror != 0) return 0.0;
+    return clamp(m.transmission, 0.0, 1.0) * (1.0 - clamp(m.metallic, 0.0, 1.0));
+}
+
 // Reflection weight of a smooth surface with material m at cos(theta) = cosV (Fresnel of `ior`
 // for dielectrics, mixed by transmission / metallic as the reference does; Schlick(baseColour)
 // for a perfect mirror). transWeight = transmission (1 - metallic), 0 for mirrors.

@@ -105,9 +105,7 @@ void main() {
     GpuSpecularDraw sd = specularDrawAt(specularDrawTexels, slot);
     GpuMaterial m = materialAt(materialTexels, sd.material);
     float cosV = clamp(dot(n, v), 1e-4, 1.0);  // grazing: clamped, never 0
-    bool mirror = m.mirror != 0;
-    float transWeight = mirror ? 0.0 : clamp(m.transmission, 0.0, 1.0) *
-                                           (1.0 - clamp(m.metallic, 0.0, 1.0));
+    float transWeight = transmissionShare(m);
     float eta = max(m.ior, 1e-3);
     float eps = 1e-4 + 1e-4 * vl;  // ray offset against self-intersection (metres)
 
