@@ -347,6 +347,11 @@ const CommandRegistrar registrar("proxies", [](CLI::App& parent) {
                     "table's there")
         ->capture_default_str()
         ->check(finiteIn(0.01, 2));
+    cmd->add_option("--table-quantile", a->carving.diffuseQuantile,
+                    "The table's diffuse colour per cell: this quantile of what the frames see "
+                    "there (low: a glossy table's reflections add light in some views)")
+        ->capture_default_str()
+        ->check(finiteIn(0, 1));
     cmd->add_option("--truth", a->truth,
                     "The scene a synthetic session was made from: compare the rebuilt scene "
                     "with it (report and console)")

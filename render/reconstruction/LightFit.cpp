@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 #include "core/image/ImageIO.h"
@@ -176,6 +177,33 @@ double spotGeometry(const FittedSpotLight& light, const glm::dvec3& x, const glm
     return a * a * cosIncidence / r2;
 }
 
+double dielectricSpecularAlbedo(double viewCosine, double roughness) {
+    const double NdotV = std::clamp(viewCosine, 1e-4, 1.0);
+    const glm::dvec3 v(std::sqrt(1 - NdotV * NdotV), 0.0, NdotV);  // normal +z
+    const double a = std::max(roughness * roughness, 1e-3), a2 = a * a, k = a * 0.5;
+    const int nTheta = 96, nPhi = 192;
+    const double dTheta = 0.5 * kPi / nTheta, dPhi = 2 * kPi / nPhi;
+    double sum = 0;
+    for (int i = 0; i < nTheta; ++i) {
+        const double theta = (i + 0.5) * dTheta, NdotL = std::cos(theta);
+        for (int j = 0; j < nPhi; ++j) {
+            const double phi = (j + 0.5) * dPhi;
+            const glm::dvec3 l(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                               NdotL);
+            const glm::dvec3 h = glm::normalize(l + v);
+            const double NdotH = h.z, VdotH = std::max(glm::dot(v, h), 0.0);
+            const double dd = NdotH * NdotH * (a2 - 1) + 1;
+            const double D = a2 / (kPi * dd * dd);
+            const double G = (NdotL / (NdotL * (1 - k) + k)) * (NdotV / (NdotV * (1 - k) + k));
+            const double F = 0.04 + 0.96 * std::pow(1 - VdotH, 5.0);
+            // BRDF x cos x solid angle (sin(theta) dTheta dPhi).
+            sum += D * G * F / (4 * NdotV) * std::sin(theta) * dTheta * dPhi;
+        }
+    }
+    // Radiance reflected under uniform radiance L_u is sum * L_u; as a share of E / pi = L_u.
+    return sum;
+}
+
 glm::dvec3 environmentIrradiance(const cv::Mat& bgr, const CameraIntrinsics& camera,
                                  const Pose& T_world_camera, const glm::vec3& gain,
                                  const glm::dvec3& up) {
@@ -263,11 +291,19 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
         for (const auto& s : samples) a += s.radiance / double(samples.size());
     }
     if (!e.spot) b = glm::dvec3(0.0);
-    // Albedo from a = albedo E_env / pi.
+    // The room's light the written material reflects specularly, as a share of E_env / pi.
+    const double specular =
+        o.viewCosine > 0 ? dielectricSpecularAlbedo(o.viewCosine, o.surfaceRoughness) : 0.0;
+    // Albedo from a = (albedo + specular) E_env / pi.
     if (environment && glm::all(glm::greaterThan(*environment, glm::dvec3(1e-6)))) {
         e.environmentIrradiance = *environment;
         e.environmentMeasured = true;
-        e.tableAlbedo = glm::clamp(kPi * a / *environment, 0.01, 0.95);
+        e.tableAlbedo = glm::clamp(kPi * a / *environment - specular, 0.01, 0.95);
+        if (specular > 0)
+            e.notes.push_back(fmt::format(
+                "albedo: a specular share of {:.3f} of the room's light taken out (a dielectric "
+                "of roughness {:.2f} seen at {:.0f} degrees from the table's normal)",
+                specular, o.surfaceRoughness, glm::degrees(std::acos(o.viewCosine))));
     } else {
         e.tableAlbedo = glm::dvec3(0.5);
         e.environmentIrradiance = kPi * a / e.tableAlbedo;
@@ -276,12 +312,19 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
             "albedo and the light's intensity");
     }
     if (e.spot) e.spot->intensity = kPi * b / e.tableAlbedo;
+    // The room's light on a surface tilted away from the plane's normal: the share of the upper
+    // hemisphere it faces, (1 + cos) / 2.
+    auto roomIrradiance = [&](const glm::dvec3& n) {
+        return e.environmentIrradiance * (0.5 * (1.0 + glm::dot(n, normal)));
+    };
     auto irradiance = [&](const glm::dvec3& x, const glm::dvec3& n) {
-        // The room's light on a surface tilted away from the plane's normal: the share of the
-        // upper hemisphere it faces, (1 + cos) / 2.
-        glm::dvec3 E = e.environmentIrradiance * (0.5 * (1.0 + glm::dot(n, normal)));
+        glm::dvec3 E = roomIrradiance(n);
         if (e.spot) E += e.spot->intensity * spotGeometry(*e.spot, x, n);
         return E;
+    };
+    // Albedo from observed radiance L: (pi L - specular x room's light) / irradiance.
+    auto albedoFrom = [&](const glm::dvec3& L, const glm::dvec3& x, const glm::dvec3& n) {
+        return (kPi * L - specular * roomIrradiance(n)) / irradiance(x, n);
     };
     // The table's albedo texture: observed radiance x pi / irradiance; unobserved cells take the
     // median albedo.
@@ -295,17 +338,17 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
                                        g.table.vMin + (y + 0.5) * g.tableCellM, 0});
             const cv::Vec3f c = g.tableColour.at<cv::Vec3f>(y, x);
             const glm::dvec3 rho =
-                glm::clamp(kPi * glm::dvec3(c[0], c[1], c[2]) / irradiance(w, normal), 0.0, 1.0);
+                glm::clamp(albedoFrom(glm::dvec3(c[0], c[1], c[2]), w, normal), 0.0, 1.0);
             e.tableAlbedoTexture.at<cv::Vec3f>(y, x) =
                 cv::Vec3f(float(rho.x), float(rho.y), float(rho.z));
         }
     for (const auto& obj : g.objects) {
         std::vector<double> channel[3];
         for (size_t i = 0; i < obj.samplePoints.size(); ++i) {
-            const glm::dvec3 E = irradiance(glm::dvec3(obj.samplePoints[i]),
-                                            glm::normalize(glm::dvec3(obj.sampleNormals[i])));
-            if (glm::dot(E, glm::dvec3(1.0)) < 1e-6) continue;
-            const glm::dvec3 rho = kPi * glm::dvec3(obj.sampleColours[i]) / E;
+            const glm::dvec3 x(obj.samplePoints[i]);
+            const glm::dvec3 n = glm::normalize(glm::dvec3(obj.sampleNormals[i]));
+            if (glm::dot(irradiance(x, n), glm::dvec3(1.0)) < 1e-6) continue;
+            const glm::dvec3 rho = albedoFrom(glm::dvec3(obj.sampleColours[i]), x, n);
             for (int c = 0; c < 3; ++c) channel[c].push_back(rho[c]);
         }
         glm::dvec3 rho = e.tableAlbedo;

@@ -41,6 +41,14 @@ struct LightFitOptions {
     double minContrast = 0.15;
     int maxIterations = 60;
     double maxDistanceM = 2.5;  // a fitted light farther from the board's centre is refused
+    // The written proxies' material: a dielectric (F0 0.04) of this roughness, whose GGX lobe
+    // reflects a share of the room's light on top of the diffuse albedo (the renderers' glTF
+    // model). That share (dielectricSpecularAlbedo at viewCosine) is taken out of the observed
+    // radiance before it is divided by the irradiance, so the albedo is the diffuse one.
+    double surfaceRoughness = 0.8;
+    // The cameras' median cosine to the table's normal (reconstruct() measures it from the
+    // footage); <= 0: unknown, no specular share is taken out.
+    double viewCosine = 0.0;
 };
 
 struct LightingEstimate {
@@ -65,6 +73,12 @@ glm::dvec3 environmentIrradiance(const cv::Mat& bgr, const CameraIntrinsics& cam
 LightingEstimate estimateLighting(const FusedGeometry& geometry,
                                   const std::optional<glm::dvec3>& environment,
                                   const LightFitOptions& options = {});
+
+// Directional albedo of the renderers' GGX specular lobe (Smith-Schlick G, Schlick F, F0 0.04:
+// a dielectric) under uniform light: the share of a uniform room's irradiance / pi that a
+// surface of this roughness reflects specularly towards a viewer at cos(angle to the normal)
+// viewCosine.
+double dielectricSpecularAlbedo(double viewCosine, double roughness);
 
 // The spot's geometric term S(x) for a surface point x with normal n (metres, world).
 double spotGeometry(const FittedSpotLight& light, const glm::dvec3& x, const glm::dvec3& n);

@@ -92,10 +92,48 @@ glm::vec3 linearColour(const Eigen::Vector3d& c, double exposure) {
            float(exposure);
 }
 
+// The carving's diffuse colour of the table's cells (PlaneAppearance::diffuseColour: a low
+// quantile over the frames that see the table there). The fused surface has colour only where
+// the stereo found depth, averaged over the views with their glossy reflections and with
+// whatever stood in front in the other views.
+void useCarvedTableColour(const PlaneAppearance& a, double exposure, FusedGeometry& out) {
+    const TableEstimate& t = out.table;
+    for (int y = 0; y < out.tableColour.rows; ++y)
+        for (int x = 0; x < out.tableColour.cols; ++x) {
+            const double u = t.uMin + (x + 0.5) * out.tableCellM;
+            const double v = t.vMin + (y + 0.5) * out.tableCellM;
+            const int cx = int(std::floor((u - a.u0) / a.cell));
+            const int cy = int(std::floor((v - a.v0) / a.cell));
+            if (cx < 0 || cy < 0 || cx >= a.kind.cols || cy >= a.kind.rows ||
+                a.kind.at<uchar>(cy, cx) != PlaneAppearance::Table)
+                continue;
+            out.tableColour.at<cv::Vec3f>(y, x) =
+                a.diffuseColour.at<cv::Vec3f>(cy, cx) / float(exposure);
+            out.tableObserved.at<uchar>(y, x) = 255;
+        }
+}
+
+// The carving's table outline (Table and Covered cells, docs/reconstruction.md "Space carving")
+// as a rectangle in plane coordinates; false when the carving found no table.
+bool carvedTableRect(const CarvedHeights& carved, double& uMin, double& uMax, double& vMin,
+                     double& vMax) {
+    const PlaneAppearance& a = carved.plane;
+    if (a.kind.empty()) return false;
+    std::vector<cv::Point> cells;
+    cv::findNonZero(a.kind != PlaneAppearance::Unknown, cells);
+    if (cells.empty()) return false;
+    const cv::Rect r = cv::boundingRect(cells);
+    uMin = a.u0 + r.x * a.cell, uMax = a.u0 + (r.x + r.width) * a.cell;
+    vMin = a.v0 + r.y * a.cell, vMax = a.v0 + (r.y + r.height) * a.cell;
+    return true;
+}
+
 // The table's extent: the connected region of 1 cm cells holding fused surface within the plane
-// band, from the cell nearest the board's centre; the board itself always belongs to it.
+// band, from the cell nearest the board's centre; the board itself always belongs to it. With
+// the carving, also its table outline: the fused surface has depth only where the table has
+// texture or edges, the carving knows every cell the frames see the table's colour in.
 void estimateTable(const TriangleMesh& mesh, const Footage& footage, const GeometryOptions& o,
-                   FusedGeometry& out) {
+                   const CarvedHeights* carved, FusedGeometry& out) {
     const BoardPlane& plane = footage.board;
     const double cell = 0.01;
     const int n = int(std::ceil(2 * o.maxTableHalfExtentM / cell));
@@ -125,15 +163,20 @@ void estimateTable(const TriangleMesh& mesh, const Footage& footage, const Geome
                 vMin = std::min(vMin, y * cell - o.maxTableHalfExtentM);
                 vMax = std::max(vMax, (y + 1) * cell - o.maxTableHalfExtentM);
             }
-    TableEstimate& t = out.table;
-    t.plane = plane;
-    t.uMin = uMin, t.uMax = uMax, t.vMin = vMin, t.vMax = vMax;
-    int inCells = 0, filled = 0;
+    int filled = 0;
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
             if (labels.at<int>(y, x) == board) ++filled;
-    inCells = int(std::lround((uMax - uMin) / cell)) * int(std::lround((vMax - vMin) / cell));
-    t.filledFraction = inCells > 0 ? double(filled) / inCells : 0.0;
+    if (double cu0, cu1, cv0, cv1; carved && carvedTableRect(*carved, cu0, cu1, cv0, cv1)) {
+        uMin = std::min(uMin, cu0), uMax = std::max(uMax, cu1);
+        vMin = std::min(vMin, cv0), vMax = std::max(vMax, cv1);
+    }
+    TableEstimate& t = out.table;
+    t.plane = plane;
+    t.uMin = uMin, t.uMax = uMax, t.vMin = vMin, t.vMax = vMax;
+    const int inCells =
+        int(std::lround((uMax - uMin) / cell)) * int(std::lround((vMax - vMin) / cell));
+    t.filledFraction = inCells > 0 ? std::min(1.0, double(filled) / inCells) : 0.0;
 
     // Colour of the table per cell (for its albedo texture) and the plane fit residual.
     out.tableCellM = o.cellM;
@@ -163,6 +206,10 @@ void estimateTable(const TriangleMesh& mesh, const Footage& footage, const Geome
                     sum.at<cv::Vec3f>(y, x) / count.at<float>(y, x);
                 out.tableObserved.at<uchar>(y, x) = 255;
             }
+    if (carved) {
+        useCarvedTableColour(carved->plane, footage.exposure, out);
+        t.filledFraction = double(cv::countNonZero(out.tableObserved)) / double(rows * cols);
+    }
 }
 
 struct HeightField {
@@ -390,7 +437,7 @@ FusedGeometry reconstructGeometry(const Footage& footage, const std::vector<Dept
                                   const GeometryOptions& o, const CarvedHeights* carved) {
     FusedGeometry out;
     const auto mesh = fuseDepth(views, footage.board, o, out);
-    estimateTable(*mesh, footage, o, out);
+    estimateTable(*mesh, footage, o, carved, out);
     splitObjects(*mesh, footage, o, carved, out);
     return out;
 }

@@ -1,5 +1,6 @@
 #include "render/reconstruction/ProxyReconstruction.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -15,6 +16,18 @@ double secondsSince(Clock::time_point t0) {
 
 nlohmann::json vec(const glm::dvec3& v) {
     return {v.x, v.y, v.z};
+}
+
+// The cameras' median cosine to the table's normal, seen from the board's centre.
+double medianViewCosine(const Footage& footage) {
+    std::vector<double> c;
+    for (const PosedFrame& f : footage.frames)
+        c.push_back(glm::dot(glm::normalize(f.T_world_camera.translation - footage.board.point),
+                             footage.board.normal));
+    if (c.empty()) return 0.0;
+    auto mid = c.begin() + long(c.size() / 2);
+    std::nth_element(c.begin(), mid, c.end());
+    return std::max(0.0, *mid);
 }
 
 }  // namespace
@@ -54,7 +67,9 @@ Reconstruction reconstruct(const Footage& footage, const std::optional<glm::dvec
     r.fusionSeconds = secondsSince(t0);
     t0 = Clock::now();
     if (progress) progress("lights", 0, 1);
-    r.lighting = estimateLighting(r.geometry, environment, o.light);
+    LightFitOptions light = o.light;
+    if (light.viewCosine <= 0) light.viewCosine = medianViewCosine(footage);
+    r.lighting = estimateLighting(r.geometry, environment, light);
     if (progress) progress("lights", 1, 1);
     r.lightSeconds = secondsSince(t0);
     return r;

@@ -87,6 +87,13 @@ float median(std::vector<float>& v) {
     return *mid;
 }
 
+// The q-quantile (0..1, nearest rank below) of a non-empty v; reorders v.
+float quantile(std::vector<float>& v, double q) {
+    auto at = v.begin() + long(std::clamp(q, 0.0, 1.0) * double(v.size() - 1));
+    std::nth_element(v.begin(), at, v.end());
+    return *at;
+}
+
 // What the table and the board look like: the chromaticity (r, g over r+g+b) and brightness
 // (r+g+b, linear) of the board's paper and of the table in a ring 2-20 cm around the board.
 struct PlaneReference {
@@ -141,6 +148,10 @@ void planeColour(const std::vector<CarvingView>& views, const BoardPlane& plane,
                 if (ch[0].empty()) continue;
                 a.colour.at<cv::Vec3f>(y, x) =
                     cv::Vec3f(median(ch[0]), median(ch[1]), median(ch[2]));
+                if (ref)
+                    a.diffuseColour.at<cv::Vec3f>(y, x) = cv::Vec3f(
+                        quantile(ch[0], o.diffuseQuantile), quantile(ch[1], o.diffuseQuantile),
+                        quantile(ch[2], o.diffuseQuantile));
             }
     });
 }
@@ -363,6 +374,7 @@ CarvedHeights carveAbovePlane(const Footage& footage, const CarvingOptions& o) {
     a.cell = out.cell = o.voxelM;
     a.u0 = a.v0 = out.u0 = out.v0 = -0.5 * n * o.voxelM;
     a.colour = cv::Mat(n, n, CV_32FC3, cv::Scalar::all(0));
+    a.diffuseColour = cv::Mat(n, n, CV_32FC3, cv::Scalar::all(0));
     cv::Mat& seenBy = a.seenBy;
     cv::Mat tableSeenBy;
     planeColour(views, footage.board, nullptr, o, a, seenBy, tableSeenBy);

@@ -58,6 +58,11 @@ struct CarvingOptions {
     // A cell is the table's when this share of the frames that see it (and minPlaneVotes at
     // least) see the table's colour there; the cell's colour is their median.
     double minTableShare = 0.2;
+    // A table cell's diffuse colour (PlaneAppearance::diffuseColour): this quantile of its
+    // table-coloured samples. A glossy table adds the room's and the lamp's reflections in the
+    // views that see them; it never takes light away, so its diffuse part is what it shows at
+    // the least (a low quantile rather than the minimum, which would follow the footage's noise).
+    double diffuseQuantile = 0.1;
     int minPlaneVotes = 2;
     int minObjectVotes = 3;
     double minObjectShare = 0.75;
@@ -69,6 +74,9 @@ struct PlaneAppearance {
     double u0 = 0, v0 = 0, cell = 0.004;  // plane coordinates of cell (0, 0)'s corner
     // CV_32FC3 linear RGB: a table cell's median table-coloured sample, any other cell's median.
     cv::Mat colour;
+    // CV_32FC3 linear RGB: a table cell's diffuse colour (CarvingOptions::diffuseQuantile of its
+    // table-coloured samples), for the light fit and the table's albedo; 0 elsewhere.
+    cv::Mat diffuseColour;
     cv::Mat seenBy;  // CV_32S frames that see the cell
     cv::Mat kind;    // CV_8U Cell
     // The table's and the board's chromaticity (r, g over r+g+b) and brightness (r+g+b).
