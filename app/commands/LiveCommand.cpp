@@ -7,13 +7,15 @@
 //
 // Outputs (all optional): -o OUT.mkv or a folder of PNG frames, with a per-frame CSV beside it
 // (app/live/LiveOutputs.h says its columns); --record SESSION: the processed frames with their
-// live poses (core/capture/LiveRecording.h).
+// live poses (core/capture/LiveRecording.h); --scan SECONDS: a scan of the room first, from which
+// the real proxies are rebuilt (app/live/LiveScan.h).
 #include "app/Command.h"
 #include "app/EffectSwitches.h"
 #include "app/KnobSettings.h"
 #include "app/NumberChecks.h"
 #include "app/PathChecks.h"
 #include "app/live/LiveInputs.h"
+#include "app/live/LiveScan.h"
 #include "app/live/LiveSession.h"
 
 namespace mirage::app {
@@ -94,6 +96,15 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
                     "Record the session (the camera's frames and the live poses) into this new "
                     "folder; replay it with `mirage replay`")
         ->check(outputPath(OutputShape::Folder));
+    cmd->add_option("--scan", args->scanSeconds,
+                    "First scan the room for this many seconds (walk the camera around the "
+                    "table), rebuild the real proxies and lights from it (as `mirage proxies`), "
+                    "then go on live with them: --scene needs the virtual objects only")
+        ->check(finiteIn(0, 3600, true));
+    cmd->add_option("--scan-dir", args->scanDir,
+                    "Where --scan records the scan and writes the rebuilt scene (a new folder; "
+                    "default: OUT.scan beside -o OUT, else live-scan-TIME)")
+        ->check(outputPath(OutputShape::Folder));
     cmd->add_option("--vpls", args->vpls, "Virtual point lights per frame")
         ->check(wholeIn(0, 16384));
     cmd->add_option("--budget-ms", args->budgetMs,
@@ -134,6 +145,10 @@ const CommandRegistrar reg("live", [](CLI::App& parent) {
         ->check(wholeIn(1000, 20000));
     cmd->callback([args] {
         if (args->listCameras) return listCameras();
+        if (args->scanSeconds > 0) {
+            commandExitCode() = runLiveWithScan(*args);
+            return;
+        }
         LiveSession session(*args);
         commandExitCode() = session.run();
     });

@@ -43,6 +43,17 @@ struct LiveOptions {
     // and rendered with the pose predicted to its display time (docs/live.md, "How it runs").
     bool noPipeline = false;  // track, then render, one after the other on the GL thread
     bool noPredict = false;   // render with the pose as tracked at capture
+    // Stop after this many seconds of running (wall clock; 0: no limit).
+    double maxSeconds = 0;
+    // Start with the virtual objects hidden (the footage passes through, nothing is rendered):
+    // the scan tracks and records as many frames as it can.
+    bool hideVirtual = false;
+    // --scan SECONDS: first record this long while the user walks the camera around the table
+    // into scanDir (default: beside -o, else a time-stamped folder), rebuild the real proxies and
+    // lights from it (`mirage proxies`), then go on live with the rebuilt scene
+    // (app/live/LiveScan.h).
+    double scanSeconds = 0;
+    std::string scanDir;
 };
 
 }  // namespace mirage::app

@@ -169,6 +169,7 @@ LiveSession::LiveSession(const LiveOptions& a) : options_(a) {
     settings.keepDirectLight = !a.headless;
     controls_.preset = settings.preset;
     controls_.effects = settings.effects;
+    controls_.hideVirtual = a.hideVirtual;
     render_ =
         std::make_unique<LiveRenderStage>(scene_, plane, placement, calibration_.intrinsics,
                                           settings, environment_ ? &environment_->setup : nullptr);
@@ -216,7 +217,11 @@ int LiveSession::run() {
         options_.noPredict ? "the tracked one (not predicted)" : "predicted to the display time");
     const auto tStart = Clock::now();
     lastFrameAt_ = Clock::now();
-    while (!stopRequested() && (options_.maxFrames < 0 || processed_ < options_.maxFrames)) {
+    auto timeLeft = [&] {
+        return options_.maxSeconds <= 0 || msSince(tStart) < 1e3 * options_.maxSeconds;
+    };
+    while (!stopRequested() && (options_.maxFrames < 0 || processed_ < options_.maxFrames) &&
+           timeLeft()) {
         TrackedLiveFrame f;
         bool got = false;
         double takenAt = 0;

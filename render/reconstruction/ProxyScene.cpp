@@ -1,8 +1,10 @@
 #include "render/reconstruction/ProxyScene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <glm/gtc/quaternion.hpp>
@@ -113,24 +115,53 @@ std::vector<bool> realNodes(const json& gltf) {
     return real;
 }
 
-// A URI of the given file, made relative to the new file's folder (data URIs stay).
-std::string rebase(const std::string& uri, const fs::path& from, const fs::path& to) {
-    if (uri.rfind("data:", 0) == 0 || fs::path(uri).is_absolute()) return uri;
-    return fs::relative(fs::absolute(from / uri), fs::absolute(to)).generic_string();
+bool sameBytes(const fs::path& a, const fs::path& b) {
+    std::error_code ec;
+    if (fs::file_size(a, ec) != fs::file_size(b, ec) || ec) return false;
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    return std::equal(std::istreambuf_iterator<char>(fa), std::istreambuf_iterator<char>(),
+                      std::istreambuf_iterator<char>(fb));
 }
 
-void rebaseUris(json& gltf, const fs::path& from, const fs::path& to) {
+// A URI of the given file, made relative to the new file's folder (data URIs stay). Scenes may
+// only name files inside their own folder (docs/scene.md), so a file the new folder does not
+// hold is copied into it, under its own name (or name_N when another file has that name); the
+// copies are listed in `copied`.
+std::string rebase(const std::string& uri, const fs::path& from, const fs::path& to,
+                   std::vector<std::string>& copied) {
+    if (uri.rfind("data:", 0) == 0 || fs::path(uri).is_absolute()) return uri;
+    const fs::path source = fs::absolute(from / uri);
+    const fs::path rel = fs::relative(source, fs::absolute(to));
+    if (!rel.empty() && *rel.begin() != "..") return rel.generic_string();
+    fs::path target = to / source.filename();
+    for (int n = 1; fs::exists(target) && !sameBytes(source, target); ++n)
+        target =
+            to / (source.stem().string() + "_" + std::to_string(n) + source.extension().string());
+    if (!fs::exists(target)) {
+        std::error_code ec;
+        fs::copy_file(source, target, ec);
+        if (ec)
+            throw FileError(target.string(),
+                            "cannot copy " + source.string() +
+                                " there (the scene refers to it): " + ec.message());
+        copied.push_back(target.string());
+    }
+    return target.filename().generic_string();
+}
+
+void rebaseUris(json& gltf, const fs::path& from, const fs::path& to,
+                std::vector<std::string>& copied) {
     for (const char* key : {"buffers", "images"})
         for (auto& item : gltf[key])
             if (item.contains("uri"))
-                item["uri"] = rebase(item["uri"].get<std::string>(), from, to);
+                item["uri"] = rebase(item["uri"].get<std::string>(), from, to, copied);
     auto fixEnvironment = [&](json& holder) {
         if (!holder.contains("extras") || !holder["extras"].contains("mirage")) return;
         json& m = holder["extras"]["mirage"];
         if (!m.contains("environment")) return;
         for (const char* key : {"image", "calibration"})
             if (m["environment"].contains(key) && m["environment"][key].is_string())
-                m["environment"][key] = rebase(m["environment"][key], from, to);
+                m["environment"][key] = rebase(m["environment"][key], from, to, copied);
     };
     for (auto& s : gltf["scenes"]) fixEnvironment(s);
     if (gltf.contains("asset")) fixEnvironment(gltf["asset"]);
@@ -252,7 +283,7 @@ ProxySceneSummary writeProxyScene(const ProxySceneContent& c, const fs::path& vi
     ProxySceneSummary summary;
     json gltf = readJson(virtualScene);
     const fs::path outDir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-    rebaseUris(gltf, virtualScene.parent_path(), outDir);
+    rebaseUris(gltf, virtualScene.parent_path(), outDir, summary.copiedFiles);
     for (const char* key : {"nodes", "meshes", "materials", "accessors", "bufferViews", "buffers",
                             "images", "textures", "samplers", "cameras", "extensionsUsed"})
         if (!gltf.contains(key)) gltf[key] = json::array();

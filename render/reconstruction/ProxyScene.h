@@ -4,7 +4,7 @@
 // marked real. The real nodes of the given file (hand-made proxies, their lights) are dropped:
 // the footage replaces them. Writes SCENE.gltf, SCENE.proxies.bin (the new meshes) and
 // SCENE.table.png (the table's albedo, sRGB); URIs of the given file are rewritten relative to the
-// new file's folder, so it stays a plain, editable glTF.
+// new file's folder (files outside it copied in), so it stays a plain, editable glTF.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -29,6 +29,9 @@ struct ProxySceneSummary {
     int droppedNodes = 0;  // real nodes of the virtual scene file
     int keptNodes = 0;     // virtual nodes
     std::vector<std::string> warnings;
+    // Files of the virtual scene copied beside the output (a scene names files in its own
+    // folder only).
+    std::vector<std::string> copiedFiles;
 };
 
 // Throws FileError naming `virtualScene` when it is not a .gltf JSON file (.glb: convert it) or

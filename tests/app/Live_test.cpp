@@ -19,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/Csv.h"
+#include "core/scene/Scene.h"
 #include "core/session/PosesCsv.h"
 #include "core/session/Session.h"
 #include "tests/support/TestSupport.h"
@@ -690,6 +691,60 @@ TEST(LiveRecording, InterruptedLeavesNoRecordingOrAPlayableOne) {
                  (rec / "poses.csv").string(), "--frames", "2", "-o", (dir / "replay").string()});
             EXPECT_EQ(replay.exitCode, 0) << replay.output;
         }
+    }
+}
+
+// --scan: the room first (the virtual objects hidden, every frame the loop takes tracked and
+// recorded), the real proxies and the spot rebuilt from it, then live with the rebuilt scene.
+TEST(LiveScan, RebuildsTheRoomThenGoesOnLiveWithIt) {
+    const fs::path dir = outputDir("live_scan");
+    const fs::path out = dir / "live";
+    auto r = runMirage({"live", "--camera", sampleSession().string(), "--env-camera",
+                        sampleSession().string(), "--camera-loop", "--camera-fps", "30", "--scene",
+                        sampleScene(), "--headless", "--frames", "4", "--scan", "3", "-o",
+                        out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const fs::path scan = dir / "live.scan";
+    // The scan is a session of its own, with the rebuilt scene and its report beside it.
+    SessionReadReport report;
+    const Session s = readSession(scan, &report);
+    EXPECT_TRUE(report.ok());
+    EXPECT_GE(s.frames.size(), 8u);
+    const Scene rebuilt = loadScene(scan / "scene.gltf");
+    bool table = false, sphere = false;
+    for (const Node& n : rebuilt.nodes) {
+        table |= n.name == "real_table" && n.origin == Origin::Real;
+        sphere |= n.name == "glass_sphere" && n.origin == Origin::Virtual;
+    }
+    EXPECT_TRUE(table);
+    EXPECT_TRUE(sphere);
+    int realSpots = 0;
+    for (const LightInstance& li : rebuilt.lightInstances())
+        realSpots +=
+            li.origin == Origin::Real && rebuilt.lights[size_t(li.light)].type == Light::Type::Spot;
+    EXPECT_EQ(realSpots, 1);  // the sample's backlit spot, none of the hand-made scene's lights
+    EXPECT_TRUE(fs::exists(scan / "scene.report.json"));
+    // Then live, with the rebuilt scene: its frames and CSV.
+    EXPECT_EQ(readLiveCsv(out / "frames.csv").size(), 4u);
+    EXPECT_NE(r.output.find("going on live with the rebuilt scene"), std::string::npos) << r.output;
+}
+
+// A scan too short to hold the frames a reconstruction needs (the sample at 30 frames/s gives 4-5
+// frames in 0.15 s; 8 are needed): what to record instead, a non-zero
+// exit, and the scan kept for the user to look at.
+TEST(LiveScan, TooShortAScanSaysWhatToRecordAndKeepsIt) {
+    const fs::path dir = outputDir("live_scan_short");
+    const fs::path scan = dir / "scan";
+    auto r =
+        runMirage({"live", "--camera", sampleSession().string(), "--camera-fps", "30", "--scene",
+                   sampleScene(), "--headless", "--scan", "0.15", "--scan-dir", scan.string()});
+    EXPECT_NE(r.exitCode, 0) << r.output;
+    const bool refused = r.output.find("record again") != std::string::npos &&
+                         r.output.find("the scan is kept in " + scan.string()) != std::string::npos;
+    const bool empty = r.output.find("the scan recorded no frame") != std::string::npos;
+    EXPECT_TRUE(refused || empty) << r.output;
+    if (refused) {
+        EXPECT_TRUE(fs::exists(scan / "session.json"));
     }
 }
 
