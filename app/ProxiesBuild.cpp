@@ -22,6 +22,7 @@
 #include "render/reconstruction/GeometryEvaluation.h"
 #include "render/reconstruction/ProxyReconstruction.h"
 #include "render/reconstruction/ProxyScene.h"
+#include "render/reconstruction/ScanMap.h"
 #include "tracking/Tracker.h"
 
 namespace mirage::app {
@@ -218,6 +219,9 @@ void buildProxies(const ProxiesRequest& a) {
     fs::path reportPath = out;
     reportPath.replace_extension(".report.json");
     OutputFile reportOut(reportPath, OutputOrigin::Derived, rule);
+    fs::path mapPath = out;
+    mapPath.replace_extension(".scan.svg");
+    OutputFile mapOut(mapPath, OutputOrigin::Derived, rule);
 
     const CameraCalibration calib = loadCalibration(session.path(main->calibration));
     const tracking::Board board = tracking::Board::load(session.path(session.board));
@@ -261,8 +265,16 @@ void buildProxies(const ProxiesRequest& a) {
         if (!file.flush()) throw FileError(reportPath.string(), "cannot write the report");
     }
     reportOut.commit();
-    spdlog::info("proxies: wrote {} ({} real node(s) of {} replaced) and {}", out.string(),
-                 written.droppedNodes, a.scene, reportPath.string());
+    {
+        std::ofstream file(mapOut.temp());
+        file << rc::scanMapSvg(footage, r);
+        if (!file.flush()) throw FileError(mapPath.string(), "cannot write the scan map");
+    }
+    mapOut.commit();
+    spdlog::info(
+        "proxies: wrote {} ({} real node(s) of {} replaced), {} and the scan seen from "
+        "above, {}",
+        out.string(), written.droppedNodes, a.scene, reportPath.string(), mapPath.string());
 }
 
 }  // namespace mirage::app

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include "render/raytrace/SyntheticFootage.h"
 #include "render/reconstruction/GeometryEvaluation.h"
 #include "render/reconstruction/ProxyReconstruction.h"
+#include "render/reconstruction/ScanMap.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/FusedGeometryScene.h"
 
@@ -294,6 +296,62 @@ TEST(StereoPairs, EachFrameGetsPartnersAtDifferentBaselines) {
         EXPECT_GE(b, o.minBaselineM);
         EXPECT_LE(b, o.maxBaselineM);
     }
+}
+
+// The scan seen from above: every camera the reconstruction used, where it stood (the cameras'
+// side at the bottom, +u to the right), the table, each object and the spot; the caption states
+// the arc and the angle down.
+TEST(ScanMap, ShowsEveryCameraWhereItStoodWithTheTableObjectsAndSpot) {
+    std::vector<Pose> poses;
+    const int n = 10;
+    for (int k = 0; k < n; ++k) {  // an arc of 60 degrees, 0.42 m out and 0.32 m up
+        const double a = glm::radians(-30.0 + 60.0 * k / (n - 1));
+        poses.push_back(
+            cameraLookingAt({0.42 * std::sin(a), 0.32, 0.42 * std::cos(a)}, {0, 0, 0}, {0, 1, 0}));
+    }
+    const Footage f = footageAt(poses);
+    Reconstruction r;
+    r.check = checkFootage(f);
+    r.geometry.table.plane = f.board;
+    r.geometry.table.uMin = -0.6, r.geometry.table.uMax = 0.6;
+    r.geometry.table.vMin = -0.4, r.geometry.table.vMax = 0.4;
+    ProxyObject book;
+    book.name = "real_object_1";
+    book.centre = {0.31, 0, -0.25};
+    for (double x : {0.2, 0.42})
+        for (double z : {-0.33, -0.17}) book.positions.emplace_back(x, 0.04, z);
+    r.geometry.objects.push_back(book);
+    FittedSpotLight spot;
+    spot.position = {0.35, 0.95, 0.45};
+    spot.direction = glm::normalize(-spot.position);
+    r.lighting.spot = spot;
+    const std::string svg = scanMapSvg(f, r);
+    ASSERT_EQ(svg.rfind("<svg", 0), 0u);
+    EXPECT_NE(svg.find("</svg>"), std::string::npos);
+    for (const char* cls : {"table", "board", "object", "spot"})
+        EXPECT_NE(svg.find(std::string("class=\"") + cls + "\""), std::string::npos) << cls;
+    std::vector<glm::dvec2> cameras;
+    const std::regex camera(R"re(class="camera" cx="([-0-9.]+)" cy="([-0-9.]+)")re");
+    for (auto it = std::sregex_iterator(svg.begin(), svg.end(), camera);
+         it != std::sregex_iterator(); ++it)
+        cameras.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]));
+    ASSERT_EQ(int(cameras.size()), n);
+    const std::smatch board = [&] {
+        std::smatch m;
+        std::regex_search(svg, m,
+                          std::regex(R"re(<text x="([-0-9.]+)" y="([-0-9.]+)"[^>]*>board)re"));
+        return m;
+    }();
+    ASSERT_FALSE(board.empty());
+    const double boardX = std::stod(board[1]), boardY = std::stod(board[2]);
+    // The first camera stood left of the board (u < 0), the last right of it, all of them on
+    // the near side (v < 0 for this board: below it on the map).
+    EXPECT_LT(cameras.front().x, boardX - 50);
+    EXPECT_GT(cameras.back().x, boardX + 50);
+    for (const auto& c : cameras) EXPECT_GT(c.y, boardY + 50);
+    EXPECT_NE(svg.find("10 frames"), std::string::npos);
+    EXPECT_NE(svg.find("an arc of 60 degrees"), std::string::npos) << svg;
+    EXPECT_NE(svg.find("looking 37-37 degrees down"), std::string::npos) << svg;
 }
 
 }  // namespace
