@@ -68,6 +68,9 @@ LiveRenderStage::LiveRenderStage(const Scene& scene, const PlacementPlane& plane
 void LiveRenderStage::rebuild() {
     const QualityPreset& q = kQualityPresets[settings_.preset];
     render::RendererOptions ropt = settings_.effects;
+    // The governor switches the half-resolution trace and lighting on while the renderer runs:
+    // their programs are built now, not in the frame that first uses them.
+    ropt.specular.prepareHalfResolution = governor_ != nullptr;
     ropt.vpl.count = settings_.vpls;
     ropt.indirect.scale = q.indirectScale;
     ropt.impostor.resolution = q.impostorResolution;

@@ -47,13 +47,15 @@ void declare(PassBuilder& b, Resource position, Resource normal, Resource albedo
 
 }  // namespace
 
-SpecularGBufferPass::SpecularGBufferPass()
+SpecularGBufferPass::SpecularGBufferPass(bool prepareHalfPrograms)
     : programs_{fullscreenProgram("specular gbuffer (reflection)",
                                   "passes/specular/specular_gbuffer.frag",
                                   "#define MIRAGE_SPECULAR_MODE 0"),
                 fullscreenProgram("specular gbuffer (refraction)",
                                   "passes/specular/specular_gbuffer.frag",
-                                  "#define MIRAGE_SPECULAR_MODE 1")} {}
+                                  "#define MIRAGE_SPECULAR_MODE 1")} {
+    if (prepareHalfPrograms) buildHalfPrograms();
+}
 
 void SpecularGBufferPass::setup(PassBuilder& b) const {
     for (Resource r : {kGBufferPosition, kGBufferNormal, kGBufferEmissive, kBackFacePosition,
@@ -97,6 +99,11 @@ void SpecularGBufferPass::allocateHalfResolution() {
         hits->fbo.attachDepth(halfMask_);
         hits->fbo.finalize(5);
     }
+    buildHalfPrograms();
+}
+
+// The half-resolution trace's programs (kept across resizes; built once).
+void SpecularGBufferPass::buildHalfPrograms() {
     if (halfPrograms_[0].id() != 0) return;
     for (int mode = 0; mode < 2; ++mode) {
         const std::string defines = "#define MIRAGE_SPECULAR_MODE " + std::to_string(mode) + "\n";
@@ -221,8 +228,9 @@ void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& 
 }
 
 // Registered in render/PassList.cpp.
-std::unique_ptr<RenderPass> makeSpecularGBufferPass(const PassInit&) {
-    return std::make_unique<SpecularGBufferPass>();
+std::unique_ptr<RenderPass> makeSpecularGBufferPass(const PassInit& init) {
+    const SpecularOptions& o = init.options.specular;
+    return std::make_unique<SpecularGBufferPass>(o.halfResolutionTrace || o.prepareHalfResolution);
 }
 
 }  // namespace mirage::render

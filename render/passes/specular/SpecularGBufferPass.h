@@ -33,7 +33,8 @@ struct SpecularHitBuffer {
 
 class SpecularGBufferPass final : public RenderPass {
 public:
-    SpecularGBufferPass();
+    // `prepareHalfPrograms`: the half-resolution trace's programs are built now, not on first use.
+    explicit SpecularGBufferPass(bool prepareHalfPrograms = false);
     const char* name() const override { return "specgbuf"; }
     void setup(PassBuilder& b) const override;
     PassDecision decide(const FrameContext& ctx) const override;
@@ -46,6 +47,7 @@ private:
     void traceFullResolution(FrameContext& ctx);
     void traceHalfResolution(FrameContext& ctx, PassResources& res);
     void allocateHalfResolution();
+    void buildHalfPrograms();
 
     ImpostorPass::TableViews impostorTables_;  // trace.glsl's tables, bound every frame
     SceneTableViews sceneTables_;              // materials and specular draws, likewise
@@ -53,7 +55,8 @@ private:
     GLuint attachedMask_ = 0;  // the SpecularMask texture attached as both hit buffers' depth
     SpecularHitBuffer refl_, refr_;
     int width_ = 0, height_ = 0;
-    // RendererOptions::specular.halfResolutionTrace (built and allocated on first use): the
+    // RendererOptions::specular.halfResolutionTrace (allocated on first use; the programs then
+    // too, or when the pass is made with prepareHalfPrograms): the
     // half-resolution trace's programs, its fill's, the half-size hits and specular-block mask.
     gl::Program halfPrograms_[2], fillPrograms_[2], halfMaskProgram_;
     SpecularHitBuffer halfRefl_, halfRefr_;

@@ -62,7 +62,8 @@ SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOption
     if (sceneCanGather_)
         gather_ = makeVariant("specular light (caustic gather)",
                               scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-    if (options.specular.halfResolution) buildHalfResolution(scene);
+    if (options.specular.halfResolution || options.specular.prepareHalfResolution)
+        buildHalfResolution(scene);
 }
 
 // The half-resolution variants, their upsample and mask (RendererOptions::specular.halfResolution,
