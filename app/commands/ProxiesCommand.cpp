@@ -2,7 +2,8 @@
 // table, the objects on it, their albedo) and the real spot light from a session's footage and
 // writes them, with the virtual objects of VIRTUAL.gltf, as a scene for `mirage replay` and
 // `mirage live` (docs/reconstruction.md). Beside it: SCENE.report.json (what was found, sizes,
-// residuals), SCENE.proxies.bin and SCENE.table.png.
+// residuals), SCENE.scan.svg (the scan seen from above), SCENE.proxies.bin and SCENE.table.png.
+// The work is app/ProxiesBuild.h's, which `mirage live --scan` calls too.
 //
 // Camera poses, as the replay takes them: --poses POSES.csv (`mirage track`'s rows), else
 // --ground-truth (the session's frames.csv), else the tracker on the session's board. Only frames

@@ -60,7 +60,8 @@ int runLiveWithScan(const LiveOptions& options) {
     } catch (const reconstruction::FootageRefused& e) {
         throw Error(std::string(e.what()) + "; the scan is kept in " + dir.string() +
                     " (scan again with --scan, or rebuild it with `mirage proxies " + dir.string() +
-                    " --poses " + rebuild.poses + "`)");
+                    " --scene " + options.scene + " --poses " + rebuild.poses + " -o " +
+                    rebuild.output + "`)");
     }
     LiveOptions live = options;
     live.scanSeconds = 0;
