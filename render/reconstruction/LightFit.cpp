@@ -306,7 +306,7 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
                 specular, o.surfaceRoughness, glm::degrees(std::acos(o.viewCosine))));
     } else {
         e.tableAlbedo = glm::dvec3(0.5);
-        e.environmentIrradiance = kPi * a / e.tableAlbedo;
+        e.environmentIrradiance = kPi * a / (e.tableAlbedo + specular);
         e.notes.push_back(
             "no environment camera: the table's albedo is assumed 0.5 grey, which scales every "
             "albedo and the light's intensity");
@@ -326,8 +326,8 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
     auto albedoFrom = [&](const glm::dvec3& L, const glm::dvec3& x, const glm::dvec3& n) {
         return (kPi * L - specular * roomIrradiance(n)) / irradiance(x, n);
     };
-    // The table's albedo texture: observed radiance x pi / irradiance; unobserved cells take the
-    // median albedo.
+    // The table's albedo texture: albedoFrom the observed radiance per cell; unobserved cells
+    // take the median albedo.
     e.tableAlbedoTexture = cv::Mat(g.tableColour.size(), CV_32FC3,
                                    cv::Scalar(e.tableAlbedo.x, e.tableAlbedo.y, e.tableAlbedo.z));
     for (int y = 0; y < g.tableColour.rows; ++y)
