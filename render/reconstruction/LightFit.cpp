@@ -294,6 +294,7 @@ LightingEstimate estimateLighting(const FusedGeometry& g,
     // The room's light the written material reflects specularly, as a share of E_env / pi.
     const double specular =
         o.viewCosine > 0 ? dielectricSpecularAlbedo(o.viewCosine, o.surfaceRoughness) : 0.0;
+    e.specularShare = specular;
     // Albedo from a = (albedo + specular) E_env / pi.
     if (environment && glm::all(glm::greaterThan(*environment, glm::dvec3(1e-6)))) {
         e.environmentIrradiance = *environment;

@@ -56,6 +56,9 @@ struct LightingEstimate {
     bool environmentMeasured = false;       // false: no environment camera (albedo assumed)
     std::optional<FittedSpotLight> spot;
     glm::dvec3 tableAlbedo{0.5};           // median over the observed table, linear
+    // The written material's specular share of the room's light taken out of every albedo
+    // (LightFitOptions::surfaceRoughness, viewCosine); 0 when the view is unknown.
+    double specularShare = 0;
     cv::Mat tableAlbedoTexture;            // CV_32FC3 linear RGB, rows along v
     std::vector<glm::dvec3> objectAlbedo;  // one per FusedGeometry::objects
     std::vector<std::string> notes;        // what was assumed, for the report

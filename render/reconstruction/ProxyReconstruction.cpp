@@ -125,7 +125,8 @@ nlohmann::json reconstructionReport(const Reconstruction& r) {
               i < r.lighting.objectAlbedo.size() ? vec(r.lighting.objectAlbedo[i]) : json()}});
     }
     j["environment"] = {{"measured", r.lighting.environmentMeasured},
-                        {"irradiance", vec(r.lighting.environmentIrradiance)}};
+                        {"irradiance", vec(r.lighting.environmentIrradiance)},
+                        {"specular_share", r.lighting.specularShare}};
     if (r.lighting.spot) {
         const FittedSpotLight& s = *r.lighting.spot;
         j["spot"] = {{"position", vec(s.position)},
