@@ -55,7 +55,7 @@ struct LightingEstimate {
     glm::dvec3 environmentIrradiance{0.0};  // on the table plane, W/m^2-like linear camera units
     bool environmentMeasured = false;       // false: no environment camera (albedo assumed)
     std::optional<FittedSpotLight> spot;
-    glm::dvec3 tableAlbedo{0.5};           // median over the observed table, linear
+    glm::dvec3 tableAlbedo{0.5};  // median over the observed table, linear
     // The written material's specular share of the room's light taken out of every albedo
     // (LightFitOptions::surfaceRoughness, viewCosine); 0 when the view is unknown.
     double specularShare = 0;
