@@ -34,6 +34,7 @@ int runLiveWithScan(const LiveOptions& options) {
     scan.maxSeconds = options.scanSeconds;
     scan.maxFrames = -1;
     scan.output.clear();
+    scan.screenshot.clear();  // a window's screenshot is of the live part
     scan.record = dir.string();
     scan.hideVirtual = true;  // nothing to composite yet: every frame the loop takes is tracked
     spdlog::info(
