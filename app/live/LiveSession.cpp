@@ -215,7 +215,7 @@ int LiveSession::run() {
               "renders)"
             : "serial (each frame tracked, then rendered)",
         options_.noPredict ? "the tracked one (not predicted)" : "predicted to the display time");
-    const auto tStart = Clock::now();
+    const auto tStart = runStart_ = Clock::now();
     lastFrameAt_ = Clock::now();
     auto timeLeft = [&] {
         return options_.maxSeconds <= 0 || msSince(tStart) < 1e3 * options_.maxSeconds;
@@ -437,6 +437,9 @@ bool LiveSession::present() {
     if (recorder_->recording())
         s.recordingText =
             cv::format("REC %s: %d frames", recorder_->dir().string().c_str(), recorder_->frames());
+    if (options_.maxSeconds > 0)  // the scan of --scan: how long it still records
+        s.scanText = cv::format("SCAN: walk the camera around the table, %.0f s left",
+                                std::max(0.0, options_.maxSeconds - msSince(runStart_) * 1e-3));
     s.placement = placement_->placement();
     s.placementPending = placement_->pending();
     const HudRequests req = window_->draw(s, controls_);

@@ -115,6 +115,7 @@ private:
     bool reportedLost_ = false, finished_ = false;
     double fpsEma_ = 0, lastLatencyMs_ = 0;
     std::chrono::steady_clock::time_point lastFrameAt_;
+    std::chrono::steady_clock::time_point runStart_;  // run()'s start (the --scan countdown)
 };
 
 }  // namespace mirage::app

@@ -208,6 +208,7 @@ HudRequests LiveWindow::drawHud(const HudStatus& s, LiveControls& controls, int 
     ImGui::SameLine();
     if (ImGui::Button("screenshot (S)")) req.screenshot = true;
     if (!s.recordingText.empty()) ImGui::TextColored(red, "%s", s.recordingText.c_str());
+    if (!s.scanText.empty()) ImGui::TextColored(red, "%s", s.scanText.c_str());
     ImGui::End();
     return req;
 }

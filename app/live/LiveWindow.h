@@ -47,6 +47,7 @@ struct HudStatus {
     std::string budgetText;
     std::string viewProblem;
     std::string recordingText;  // empty: not recording
+    std::string scanText;       // --scan's countdown while it scans; empty otherwise
     ScenePlacement placement;
     bool placementPending = false;
 };
