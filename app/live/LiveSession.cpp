@@ -438,7 +438,7 @@ bool LiveSession::present() {
         s.recordingText =
             cv::format("REC %s: %d frames", recorder_->dir().string().c_str(), recorder_->frames());
     if (options_.maxSeconds > 0)  // the scan of --scan: how long it still records
-        s.scanText = cv::format("SCAN: walk the camera around the table, %.0f s left",
+        s.scanText = cv::format("SCAN, %.0f s left: walk around the table",
                                 std::max(0.0, options_.maxSeconds - msSince(runStart_) * 1e-3));
     s.placement = placement_->placement();
     s.placementPending = placement_->pending();
