@@ -5,7 +5,6 @@
 // with the rebuilt scene must come within 1.5 dB of the replay with the true scene over the
 // pixels the virtual objects influence (both replays on the ground-truth poses, so that what
 // differs is the scene). Must fail: the rebuilt scene with its spot light switched off.
-#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -13,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "render/evaluation/ImageComparison.h"
 #include "tests/support/TestSupport.h"
 
 namespace mirage::test {
@@ -25,9 +25,9 @@ std::string tabletop() {
 }
 
 // PSNR of a replay's PNG frames against the session's ground-truth composite, pooled over the
-// pixels its influence masks mark (8-bit sRGB).
+// pixels its influence masks mark (8-bit sRGB), as `mirage bench` pools it.
 double influencedPsnr(const fs::path& session, const fs::path& replay, int frames) {
-    double se = 0, n = 0;
+    render::ErrorAccumulator influenced;
     for (int i = 0; i < frames; ++i) {
         const cv::Mat a = cv::imread((replay / cv::format("frame_%06d.png", i)).string());
         const cv::Mat g =
@@ -35,17 +35,9 @@ double influencedPsnr(const fs::path& session, const fs::path& replay, int frame
         const cv::Mat m = cv::imread(
             (session / "gt_influence" / cv::format("%06d.png", i)).string(), cv::IMREAD_GRAYSCALE);
         EXPECT_FALSE(a.empty() || g.empty() || m.empty()) << "frame " << i;
-        if (a.empty() || g.empty() || m.empty()) continue;
-        cv::Mat d;
-        cv::absdiff(a, g, d);
-        d.convertTo(d, CV_64FC3);
-        d = d.mul(d);
-        d.setTo(cv::Scalar::all(0), m == 0);
-        const cv::Scalar channels = cv::sum(d);
-        se += channels[0] + channels[1] + channels[2];
-        n += 3.0 * cv::countNonZero(m);
+        if (!a.empty() && !g.empty() && !m.empty()) influenced.add(a, g, 255.0, m);
     }
-    return n > 0 && se > 0 ? 10 * std::log10(255.0 * 255.0 * n / se) : 0.0;
+    return influenced.psnrDb();
 }
 
 double replayPsnr(const fs::path& session, const std::string& scene, const fs::path& out) {
