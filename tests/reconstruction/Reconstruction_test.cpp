@@ -19,6 +19,7 @@
 #include "render/raytrace/SyntheticFootage.h"
 #include "render/reconstruction/GeometryEvaluation.h"
 #include "render/reconstruction/ProxyReconstruction.h"
+#include "render/reconstruction/ProxyScene.h"
 #include "render/reconstruction/ScanMap.h"
 #include "tests/support/TestSupport.h"
 #include "testscenes/FusedGeometryScene.h"
@@ -352,6 +353,39 @@ TEST(ScanMap, ShowsEveryCameraWhereItStoodWithTheTableObjectsAndSpot) {
     EXPECT_NE(svg.find("10 frames"), std::string::npos);
     EXPECT_NE(svg.find("an arc of 60 degrees"), std::string::npos) << svg;
     EXPECT_NE(svg.find("looking 37-37 degrees down"), std::string::npos) << svg;
+}
+
+// The rebuilt scene written away from the virtual scene's folder: the files the virtual scene
+// names are copied beside it (a scene names files in its own folder only), a different file of
+// the same name already there is kept and the copy takes another name; the scene loads.
+TEST(ProxyScene, FilesOfTheVirtualSceneAreCopiedBesideTheRebuiltOne) {
+    const fs::path dir = test::outputDir("proxy_scene_copies");
+    const fs::path collision = dir / "tabletop.bin";
+    { std::ofstream(collision) << "not the tabletop's buffer"; }
+    FittedSpotLight unused;
+    glm::dvec3 environment, albedo;
+    const FusedGeometry g = litTable(false, unused, environment, albedo);
+    const LightingEstimate lighting = estimateLighting(g, environment);
+    ProxySceneContent content;
+    content.geometry = &g;
+    content.lighting = &lighting;
+    const fs::path out = dir / "scene.gltf";
+    const ProxySceneSummary written =
+        writeProxyScene(content, test::dataDir() / "scenes/tabletop/tabletop.gltf", out);
+    std::set<std::string> copied;
+    for (const std::string& f : written.copiedFiles) copied.insert(fs::path(f).filename());
+    EXPECT_TRUE(copied.count("tabletop_1.bin")) << "the buffer under another name";
+    EXPECT_FALSE(copied.count("tabletop.bin"));
+    std::ifstream kept(collision);
+    std::string text;
+    std::getline(kept, text);
+    EXPECT_EQ(text, "not the tabletop's buffer");  // nothing already there is written over
+    const Scene scene = loadScene(out);
+    EXPECT_FALSE(scene.nodes.empty());
+    // Written again: the same copies are found and reused, none is added.
+    const ProxySceneSummary again =
+        writeProxyScene(content, test::dataDir() / "scenes/tabletop/tabletop.gltf", out);
+    EXPECT_TRUE(again.copiedFiles.empty());
 }
 
 }  // namespace
