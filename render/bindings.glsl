@@ -155,6 +155,8 @@ const int kUnitSplatPosition = 4;
 const int kUnitSplatNormal = 5;
 const int kUnitSplatEmissive = 6;
 const int kImageCausticAccum = 0;
+// The 8x8-pixel canvas tiles a photon's kernel reaches (r32ui, 1 = reached).
+const int kImageCausticPhotonTiles = 1;
 // photon_grid.comp: the photon G-buffers (receiver hits, powers, receiver normals)
 const int kUnitGridReflHit = 0;
 const int kUnitGridReflPower = 1;
@@ -169,6 +171,13 @@ const int kUnitResolveAlbedo = 2;
 const int kUnitResolveEmissive = 3;
 const int kUnitResolveHistoryRv = 4;  // last frame's caustic irradiance (temporal history)
 const int kUnitResolveHistoryR = 5;
+// The tiles where this frame's history is not 0 (r32ui image, the next frame's classification).
+const int kImageCausticHistoryTiles = 0;
+// caustic_classify.frag: the pixels the resolve must shade.
+const int kUnitClassifyPosition = 0;
+const int kUnitClassifyEmissive = 1;
+const int kUnitClassifyPhotonTiles = 2;   // this frame's (kImageCausticPhotonTiles)
+const int kUnitClassifyHistoryTiles = 3;  // last frame's (kImageCausticHistoryTiles)
 
 // composite.frag
 const int kUnitCompositeCamera = 0;

@@ -262,6 +262,50 @@ TEST_F(CausticTemporal, ResetRulesGiveTheFrameOfARendererWithoutHistory) {
     EXPECT_LT(cv::norm(causticLuminance(off), expected, cv::NORM_INF) / peak, 1e-3);
 }
 
+// The resolve shades only the pixels in the tiles the photons reached or whose history holds
+// light (caustic_classify.frag); the rest keep 0. Over a camera that walks sideways and jitters,
+// splatting every other frame (the frames between take the history alone), the caustic must be
+// the frames of a resolve on every pixel. The must-fail: a mask without the history's tiles
+// loses the caustic of the frames that only reuse it.
+TEST_F(CausticTemporal, TheMaskedResolveGivesTheFramesOfAResolveOnEveryPixel) {
+    const test::CausticScene s = test::makeCausticScene({});
+    auto run = [&](bool everywhere, bool ignoreHistory) {
+        RendererOptions o = options(true);
+        o.caustic.refreshInterval = 2;
+        o.caustic.resolveEverywhere = everywhere;
+        o.caustic.maskIgnoresHistory = ignoreHistory;
+        Renderer r(s.scene, s.cam, o);
+        std::vector<cv::Mat> frames;
+        for (int k = 0; k < 6; ++k) {
+            Pose p = jittered(s.pose, k);
+            p.translation.x += 0.004 * k;  // 4 mm a frame sideways
+            r.render({p, cv::Mat(), k == 0});
+            frames.push_back(r.readBuffer(kCausticRv));
+            EXPECT_TRUE(cv::checkRange(frames.back()));
+        }
+        return frames;
+    };
+    const std::vector<cv::Mat> everywhere = run(true, false), masked = run(false, false),
+                               broken = run(false, true);
+    double worst = 0.0, worstBroken = 0.0;
+    for (size_t k = 0; k < everywhere.size(); ++k) {
+        const cv::Mat want = test::linearLuminance(everywhere[k]);
+        double peak = 0;
+        cv::minMaxLoc(want, nullptr, &peak);
+        ASSERT_GT(peak, 0.0) << "frame " << k << " has no caustic";
+        worst =
+            std::max(worst, cv::norm(test::linearLuminance(masked[k]), want, cv::NORM_INF) / peak);
+        worstBroken = std::max(
+            worstBroken, cv::norm(test::linearLuminance(broken[k]), want, cv::NORM_INF) / peak);
+    }
+    std::cout << "[ caustic ] largest difference of the masked resolve to the resolve on every "
+                 "pixel, relative to the frame's peak: "
+              << worst << "; with the history's tiles left out of the mask (must fail) "
+              << worstBroken << "\n";
+    EXPECT_LT(worst, 1e-3);
+    EXPECT_GT(worstBroken, 0.5);
+}
+
 TEST_F(CausticTemporal, MovedObjectsDropTheHistory) {
     const test::CausticScene s = test::makeCausticScene({});
     Scene moved = s.scene;

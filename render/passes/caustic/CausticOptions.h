@@ -51,6 +51,13 @@ struct CausticOptions {
     // refresh; a frame that drops the history (first frame, cut, objects moved) splats. 1: every
     // frame.
     int refreshInterval = 1;
+    // Tests only: true resolves every canvas pixel, instead of only those in the 8x8 tiles the
+    // photons reached this frame or whose history is not 0 (caustic_classify.frag; the same
+    // images: every other pixel's caustic is 0).
+    bool resolveEverywhere = false;
+    // Tests only: true leaves the history's tiles out of that mask (a caustic kept by the
+    // history alone, in a frame that reuses it, is lost).
+    bool maskIgnoresHistory = false;
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 2048 && mapSize % 8 == 0, "caustic.mapSize",

@@ -11,6 +11,7 @@ namespace mirage::render {
 
 CausticPass::CausticPass()
     : splat_(computeProgram("caustic splat", "passes/caustic/caustic_splat.comp")),
+      classify_(fullscreenProgram("caustic pixel mask", "passes/caustic/caustic_classify.frag")),
       resolve_(fullscreenProgram("caustic resolve", "passes/caustic/caustic_resolve.frag")) {}
 
 namespace {
@@ -55,7 +56,16 @@ void CausticPass::resize(const FrameContext& ctx) {
     accum_.setFilter(GL_NEAREST, GL_NEAREST);
     rv_ = gl::Texture::create2D("caustic L_rv", w, h, GL_RGBA16F);
     r_ = gl::Texture::create2D("caustic L_r", w, h, GL_RGBA16F);
+    const int tw = (w + 7) / 8, th = (h + 7) / 8;
+    photonTiles_ = gl::Texture::create2D("caustic photon tiles", tw, th, GL_R32UI);
+    photonTiles_.setFilter(GL_NEAREST, GL_NEAREST);
+    resolveMask_ = gl::Texture::create2D("caustic pixel mask", w, h, GL_DEPTH_COMPONENT32F);
+    maskFbo_ = gl::Framebuffer("caustic pixel mask fbo");
+    maskFbo_.attachDepth(resolveMask_);
+    maskFbo_.finalize(0);
     for (int i = 0; i < 2; ++i) {
+        historyTiles_[i] = gl::Texture::create2D("caustic history tiles", tw, th, GL_R32UI);
+        historyTiles_[i].setFilter(GL_NEAREST, GL_NEAREST);
         // 32-bit: alpha holds the camera distance the history test compares (temporal.glsl).
         historyRv_[i] =
             gl::Texture::create2D("caustic irradiance L_rv (history)", w, h, GL_RGBA32F);
@@ -68,6 +78,7 @@ void CausticPass::resize(const FrameContext& ctx) {
         fbo_[i].attachColor(1, r_);
         fbo_[i].attachColor(2, historyRv_[i]);
         fbo_[i].attachColor(3, historyR_[i]);
+        fbo_[i].attachDepth(resolveMask_);
         fbo_[i].finalize(4);
     }
     history_.drop();  // new buffers hold no history
@@ -87,6 +98,9 @@ void CausticPass::execute(FrameContext& ctx, PassResources& res) {
 void CausticPass::splat(FrameContext& ctx, PassResources& res, float fixedScale) {
     const GLuint zero = 0;
     glClearTexImage(accum_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glClearTexImage(photonTiles_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glBindImageTexture(kImageCausticPhotonTiles, photonTiles_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                       GL_R32UI);
     splat_.use();
     ctx.bindFrameBlocks();
     glBindTextureUnit(kUnitSplatReflHit, res.texture(kPhotonHitRefl).id());
@@ -109,8 +123,33 @@ void CausticPass::splat(FrameContext& ctx, PassResources& res, float fixedScale)
 // older frame's, in that frame's pixels); `reuse`: the history is taken whole where it passes.
 void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedScale, bool reuse) {
     const int write = history_.writeSlot(), read = history_.readSlot();
+    const float blend = reuse ? 1.0f : causticBlend(ctx);
+    const bool useHistory = history_.usable(ctx, blend);
+    // The pixels to shade: depth 0 in resolveMask_.
+    maskFbo_.bind();
+    ctx.beginFullscreen(classify_, width_, height_);
+    glBindTextureUnit(kUnitClassifyPosition, res.texture(kGBufferPosition).id());
+    glBindTextureUnit(kUnitClassifyEmissive, res.texture(kGBufferEmissive).id());
+    glBindTextureUnit(kUnitClassifyPhotonTiles, photonTiles_.id());
+    glBindTextureUnit(kUnitClassifyHistoryTiles, historyTiles_[read].id());
+    glUniform1i(classify_.uniformLocation("usePhotons"), reuse ? 0 : 1);
+    glUniform1i(classify_.uniformLocation("useHistory"),
+                useHistory && !ctx.options.caustic.maskIgnoresHistory ? 1 : 0);
+    glUniform1i(classify_.uniformLocation("everywhere"),
+                ctx.options.caustic.resolveEverywhere ? 1 : 0);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    ctx.drawFullscreenTriangle();
+    // Every pixel 0 (the ones not shaded keep it), then the marked pixels resolved.
+    const GLuint zero = 0;
+    glClearTexImage(historyTiles_[write].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     fbo_[write].bind();
     ctx.beginFullscreen(resolve_, width_, height_);
+    const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int i = 0; i < 4; ++i) glClearBufferfv(GL_COLOR, i, clear);
+    glBindImageTexture(kImageCausticHistoryTiles, historyTiles_[write].id(), 0, GL_FALSE, 0,
+                       GL_WRITE_ONLY, GL_R32UI);
     glBindTextureUnit(kUnitResolveAccum, accum_.id());
     glBindTextureUnit(kUnitResolvePosition, res.texture(kGBufferPosition).id());
     glBindTextureUnit(kUnitResolveAlbedo, res.texture(kGBufferAlbedo).id());
@@ -118,10 +157,16 @@ void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedS
     glBindTextureUnit(kUnitResolveHistoryRv, historyRv_[read].id());
     glBindTextureUnit(kUnitResolveHistoryR, historyR_[read].id());
     glUniform1f(resolve_.uniformLocation("invFixedScale"), invFixedScale);
-    const float blend = reuse ? 1.0f : causticBlend(ctx);
-    glUniform1f(resolve_.uniformLocation("historyWeight"),
-                history_.usable(ctx, blend) ? blend : 0.0f);
+    glUniform1f(resolve_.uniformLocation("historyWeight"), useHistory ? blend : 0.0f);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);  // the triangle lies at depth 0.5: where the mask is 0
+    glDepthMask(GL_FALSE);
     ctx.drawFullscreenTriangle();
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+    // The next frame's classification reads the history tiles.
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     history_.written(ctx);
     res.publish(kCausticHistoryRv, historyRv_[write]);
     res.publish(kCausticHistoryR, historyR_[write]);

@@ -11,6 +11,9 @@
 // frame's irradiance is reprojected by the receiver's world position and blended in where it is
 // the same surface (temporal.glsl); irradiance, not radiance, is kept, so that a textured
 // receiver's albedo is never blurred by the bilinear lookup. Linear radiance, canvas size.
+// Only the pixels caustic_classify.frag marks run (early depth test against its mask); every other
+// pixel keeps the cleared 0, in the light and in the history alike.
+layout(early_fragment_tests) in;
 in vec2 uv;
 layout(binding = kUnitResolveAccum) uniform usampler2DArray accum;
 layout(binding = kUnitResolvePosition) uniform sampler2D gPosition;  // w = origin
@@ -19,6 +22,8 @@ layout(binding = kUnitResolveEmissive) uniform sampler2D gEmissive;  // a = spec
 // Last frame's smoothed irradiance (W/m^2) for L_rv / L_r, a = camera distance (m), 0: none.
 layout(binding = kUnitResolveHistoryRv) uniform sampler2D historyRv;
 layout(binding = kUnitResolveHistoryR) uniform sampler2D historyR;
+// The tiles where the history written here is not 0, for the next frame's classification.
+layout(r32ui, binding = kImageCausticHistoryTiles) uniform writeonly uimage2D historyTilesOut;
 uniform float invFixedScale;
 uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
 layout(location = 0) out vec4 outRv;
@@ -43,7 +48,16 @@ void main() {
     if (historyWeight > 0.0 && reprojectToPreviousFrame(P.xyz, puv)) {
         vec4 hRv = texture(historyRv, puv);
         vec4 hR = texture(historyR, puv);
-        if (historyIsSameSurface(hRv.a, P.xyz) && allFinite(hRv.rgb) && allFinite(hR.rgb)) {
+        // The surface test on the camera distance of the texels that hold one: a texel the
+        // resolve skipped (no caustic: irradiance 0) is cleared to distance 0 as well, and takes
+        // part in the lookup as the 0 it stands for instead of failing the test.
+        vec2 f = fract(puv * canvas.xy - 0.5);
+        vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+        vec4 a = textureGather(historyRv, puv, 3);
+        vec4 held = vec4(greaterThan(a, vec4(0.0)));
+        float heldWeight = dot(w, held);
+        float distance = heldWeight > 0.0 ? dot(w, a) / heldWeight : 0.0;
+        if (historyIsSameSurface(distance, P.xyz) && allFinite(hRv.rgb) && allFinite(hR.rgb)) {
             eRv = mix(eRv, max(hRv.rgb, vec3(0.0)), historyWeight);
             eR = mix(eR, max(hR.rgb, vec3(0.0)), historyWeight);
         }
@@ -51,5 +65,6 @@ void main() {
     float camDist = length(P.xyz - cameraPos.xyz);
     outHistoryRv = vec4(eRv, camDist);
     outHistoryR = vec4(eR, camDist);
+    if (any(greaterThan(max(eRv, eR), vec3(0.0)))) imageStore(historyTilesOut, px >> 3, uvec4(1u));
     causticRadiance(eRv, eR, A.rgb, A.a, origin == ORIGIN_REAL, outRv.rgb, outR.rgb);
 }
