@@ -70,7 +70,7 @@ void LiveRenderStage::rebuild() {
     render::RendererOptions ropt = settings_.effects;
     // The governor switches the half-resolution trace and lighting on while the renderer runs:
     // their programs are built now, not in the frame that first uses them.
-    ropt.specular.prepareHalfResolution = governor_ != nullptr;
+    ropt.specular.prepareGovernedVariants = governor_ != nullptr;
     ropt.vpl.count = settings_.vpls;
     ropt.indirect.scale = q.indirectScale;
     ropt.impostor.resolution = q.impostorResolution;

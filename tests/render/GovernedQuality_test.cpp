@@ -226,21 +226,22 @@ TEST_F(GovernedQuality, SetQualityEqualsARendererBuiltWithIt) {
     const test::CausticScene s = test::makeCausticScene({});
     const QualitySetting low = {{"specular_trace_resolution", "half"},
                                 {"specular_resolution", "half"},
-                                {"caustic_refresh", "2"}};
+                                {"caustic_refresh", "2"},
+                                {"second_exit", "off"}};
     Renderer switched(s.scene, s.cam, options());
     Renderer built(s.scene, s.cam, options(low));
     Renderer full(s.scene, s.cam, options());
     // As live makes it under a frame-time budget: the half-resolution programs built up front
     // (the frame that switches to them does not compile them); the same images as `switched`.
     RendererOptions preparedOptions = options();
-    preparedOptions.specular.prepareHalfResolution = true;
+    preparedOptions.specular.prepareGovernedVariants = true;
     Renderer prepared(s.scene, s.cam, preparedOptions);
     for (int k = 0; k < 4; ++k) {
         const Pose pose = orbit(1.0 * k);
         if (k == 1) switched.setQuality(options(low));
         if (k == 3) switched.setQuality(options());
         RendererOptions preparedNow = k == 1 || k == 2 ? options(low) : options();
-        preparedNow.specular.prepareHalfResolution = true;
+        preparedNow.specular.prepareGovernedVariants = true;
         if (k == 1 || k == 3) prepared.setQuality(preparedNow);
         switched.render({pose, cv::Mat(), k == 0});
         built.render({pose, cv::Mat(), k == 0});

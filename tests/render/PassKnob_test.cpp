@@ -94,7 +94,7 @@ TEST(PassKnob, NamesAreUniqueAndTheBenchAndGovernorUseTheRegistry) {
     const std::vector<std::string> governed{
         "impostor_steps",      "caustic_gather_cap",        "caustic_refresh",
         "specular_resolution", "specular_trace_resolution", "specular_vpl_stride",
-        "refraction_steps",    "specular_refresh"};
+        "refraction_steps",    "specular_refresh",          "second_exit"};
     EXPECT_EQ(governedKnobNames(), governed);
 }
 

@@ -25,12 +25,44 @@ constexpr Resource kSpecularBuffers[4] = {kSpecularRv, kSpecularR, kSpecularRRef
 static_assert(kUnitCompositeFuzzyVideo == kUnitCompositeFuzzyRv + 4);
 }  // namespace
 
-void CompositePass::buildPrograms(bool identityRemap, bool translucentReflection) {
+const CompositePass::SpecularVariant& CompositePass::specularVariant(SpecularKind kind) {
+    SpecularVariant& v = specular_[kind];
+    if (v.program.id() != 0) return v;
+    static const char* const kLabels[kSpecularKinds] = {"composite", "composite (first exit only)",
+                                                        "composite (reflection only)"};
+    static const char* const kDefines[kSpecularKinds] = {"", "#define MIRAGE_NO_SECOND_EXIT 1\n",
+                                                         "#define MIRAGE_REFLECTION_ONLY 1\n"};
+    v.program = fullscreenProgram(kLabels[kind], "passes/composite/composite.frag",
+                                  identityDefine_ + kDefines[kind]);
+    v.epsilon = v.program.uniformLocation("depthEpsilon");
+    v.showVirtual = v.program.uniformLocation("showVirtual");
+    v.withCaustics = v.program.uniformLocation("withCaustics");
+    v.secondExit = v.program.uniformLocation("secondExitOn");
+    v.fuzzyOn = v.program.uniformLocation("fuzzyOn");
+    v.denoiseFootage = v.program.uniformLocation("denoiseFootage");
+    v.noiseVariance = v.program.uniformLocation("noiseVariance");
+    return v;
+}
+
+void CompositePass::buildPrograms(const FrameContext& ctx, bool identityRemap,
+                                  bool translucentReflection) {
     // Without lens distortion on a canvas of the camera's size the remap is the identity: the
     // variant reads each buffer at its own pixel instead of looking the position up and
     // filtering (on llvmpipe a bilinear read costs four, and the table read one more).
     const std::string identity = identityRemap ? "#define MIRAGE_IDENTITY_REMAP 1\n" : "";
-    program_ = fullscreenProgram("composite", "passes/composite/composite.frag", identity);
+    identityDefine_ = identity;
+    for (SpecularVariant& v : specular_) v = SpecularVariant{};
+    bool glass = false, mirror = false;
+    for (int i : ctx.scene.specularDraws()) {
+        const bool transmissive = ctx.scene.draws()[size_t(i)].transmissive;
+        glass = glass || transmissive;
+        mirror = mirror || !transmissive;
+    }
+    const SpecularOptions& so = ctx.options.specular;
+    if (glass && (so.secondExit || so.prepareGovernedVariants)) specularVariant(kGlass);
+    if (glass && (!so.secondExit || so.prepareGovernedVariants))
+        specularVariant(kGlassFirstExitOnly);
+    if (mirror) specularVariant(kReflectionOnly);
     programDiffuse_ =
         fullscreenProgram("composite (diffuse only)", "passes/composite/composite.frag",
                           identity + "#define MIRAGE_DIFFUSE_ONLY 1\n");
@@ -47,16 +79,9 @@ void CompositePass::buildPrograms(bool identityRemap, bool translucentReflection
     }
     maskProgram_ = fullscreenProgram("composite specular mask",
                                      "passes/composite/composite_mask.frag", identity);
-    locEpsilon_ = program_.uniformLocation("depthEpsilon");
     locShowVirtualDiffuse_ = programDiffuse_.uniformLocation("showVirtual");
-    locShowVirtual_ = program_.uniformLocation("showVirtual");
     locWithCausticsDiffuse_ = programDiffuse_.uniformLocation("withCaustics");
     locShowVirtualNoCaustics_ = programDiffuseNoCaustics_.uniformLocation("showVirtual");
-    locWithCaustics_ = program_.uniformLocation("withCaustics");
-    locSecondExit_ = program_.uniformLocation("secondExitOn");
-    locFuzzyOn_ = program_.uniformLocation("fuzzyOn");
-    locDenoiseFootage_ = program_.uniformLocation("denoiseFootage");
-    locNoiseVariance_ = program_.uniformLocation("noiseVariance");
     identityRemap_ = identityRemap;
     translucentReflection_ = translucentReflection;
     programsBuilt_ = true;
@@ -122,7 +147,7 @@ void CompositePass::resize(const FrameContext& ctx) {
     const bool reflection = translucent && ctx.options.translucency.enabled &&
                             ctx.options.translucency.surfaceReflection;
     if (!programsBuilt_ || identity != identityRemap_ || reflection != translucentReflection_)
-        buildPrograms(identity, reflection);
+        buildPrograms(ctx, identity, reflection);
     if (sameSize) return;
     linear_ = gl::Texture::create2D("composite linear", w, h, GL_RGBA32F);
     srgb_ = gl::Texture::create2D("composite srgb", w, h, GL_SRGB8_ALPHA8);
@@ -187,10 +212,34 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         res.has(kSpecularRv) && res.has(kRealSurfaces) && res.has(kReflectionGBuffer);
     // The camera pixels of each specular object's canvas rectangle (the lens map can make two
     // overlap: merged again).
-    std::vector<glm::ivec4> rects;
-    if (specular && ctx.options.composite.showVirtual)
-        for (const glm::ivec4& r : ctx.specularRects) rects.push_back(cameraRect(ctx, r));
-    rects = mergeOverlappingRects(std::move(rects));
+    // Those that hold no glass (no refractive rectangle meets them, nor their camera rectangle
+    // another's) take the reflection-only variant.
+    std::vector<glm::ivec4> rects, glassRects, mirrorRects;
+    if (specular && ctx.options.composite.showVirtual) {
+        auto overlaps = [](const glm::ivec4& a, const glm::ivec4& b) {
+            return a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w && b.y < a.y + a.w;
+        };
+        for (const glm::ivec4& r : ctx.specularRects) {
+            const bool glass = std::any_of(ctx.refractiveRects.begin(), ctx.refractiveRects.end(),
+                                           [&](const glm::ivec4& g) { return overlaps(r, g); });
+            (glass ? glassRects : mirrorRects).push_back(cameraRect(ctx, r));
+        }
+        glassRects = mergeOverlappingRects(std::move(glassRects));
+        mirrorRects = mergeOverlappingRects(std::move(mirrorRects));
+        for (bool moved = true; moved;) {  // a merge can reach another mirror rectangle
+            moved = false;
+            for (size_t i = 0; i < mirrorRects.size() && !moved; ++i)
+                if (std::any_of(glassRects.begin(), glassRects.end(),
+                                [&](const glm::ivec4& g) { return overlaps(mirrorRects[i], g); })) {
+                    glassRects.push_back(mirrorRects[i]);
+                    mirrorRects.erase(mirrorRects.begin() + std::ptrdiff_t(i));
+                    glassRects = mergeOverlappingRects(std::move(glassRects));
+                    moved = true;
+                }
+        }
+        rects = glassRects;
+        rects.insert(rects.end(), mirrorRects.begin(), mirrorRects.end());
+    }
     if (!rects.empty()) {
         // The mask of the camera pixels that see a specular pixel (inside the rectangles; 1
         // outside): the full variant runs on those only and the diffuse variant on the rest
@@ -279,11 +328,6 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_GREATER);  // where the mask is 0
         glDepthMask(GL_FALSE);
-        program_.use();
-        glUniform1f(locEpsilon_, ctx.options.specular.backProjectionEpsilon);
-        glUniform1i(locShowVirtual_, 1);  // the rectangle is drawn only when showVirtual
-        glUniform1i(locWithCaustics_, withCaustics);
-        glUniform1i(locSecondExit_, ctx.options.specular.secondExit ? 1 : 0);
         // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
         // the newest versions, as the sharp units.
         const bool fuzzy = res.has(kFilteredVideo);
@@ -292,7 +336,6 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
                               (i < 4 ? res.textureOr(kSpecularBuffers[i], ctx.blackTexture())
                                      : res.textureOr(kFilteredVideo, ctx.blackTexture()))
                                   .id());
-        glUniform1i(locFuzzyOn_, fuzzy ? 1 : 0);
         // With the footage's own grain matched, what mirrors and glass show of the footage is
         // taken without its noise: the grain pass adds the noise of the pixel it is seen at
         // (else the pixel would carry the noise of two places). The noise levels are the
@@ -300,9 +343,22 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         const NoiseMatchOptions& noise = ctx.options.grain.noise;
         const auto& levels = ctx.grainEstimates.noise();
         const bool denoise = noise.enabled && noise.footageGrain && levels.has_value();
-        glUniform1i(locDenoiseFootage_, denoise ? 1 : 0);
-        if (denoise) glUniform3fv(locNoiseVariance_, kNoiseLevels, &levels->variance[0].x);
-        ctx.drawFullscreenTriangleIn(rects);  // the pixels the diffuse variant left
+        const SpecularKind glassKind =
+            ctx.options.specular.secondExit ? kGlass : kGlassFirstExitOnly;
+        for (const auto& [kind, kindRects] :
+             {std::pair{glassKind, &glassRects}, std::pair{kReflectionOnly, &mirrorRects}}) {
+            if (kindRects->empty()) continue;
+            const SpecularVariant& v = specularVariant(kind);
+            v.program.use();
+            glUniform1f(v.epsilon, ctx.options.specular.backProjectionEpsilon);
+            glUniform1i(v.showVirtual, 1);  // the rectangles are drawn only when showVirtual
+            glUniform1i(v.withCaustics, withCaustics);
+            glUniform1i(v.secondExit, ctx.options.specular.secondExit ? 1 : 0);
+            glUniform1i(v.fuzzyOn, fuzzy ? 1 : 0);
+            glUniform1i(v.denoiseFootage, denoise ? 1 : 0);
+            if (denoise) glUniform3fv(v.noiseVariance, kNoiseLevels, &levels->variance[0].x);
+            ctx.drawFullscreenTriangleIn(*kindRects);  // the pixels the diffuse variant left
+        }
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_LESS);
         glDisable(GL_DEPTH_TEST);

@@ -31,11 +31,24 @@ private:
     // The variants below, with MIRAGE_IDENTITY_REMAP when `identityRemap`.
     // translucentReflection: also the variant that composites a translucent object's pixels with
     // its boundary's reflection (programTranslucent_), built only for scenes with one.
-    void buildPrograms(bool identityRemap, bool translucentReflection);
+    // The specular variants the scene can use (`prepareFirstExitOnly`: also the one a governor
+    // may switch to) are built here.
+    void buildPrograms(const FrameContext& ctx, bool identityRemap, bool translucentReflection);
 
-    // Two variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
-    // compositing code would cost every frame even behind a uniform that turns it off.
-    gl::Program program_;                   // with Eqs. 6-11 for mirror / glass pixels
+    // The variants: llvmpipe runs both sides of every branch (SIMD masks), so the specular
+    // compositing code would cost every frame even behind a uniform that turns it off. With
+    // Eqs. 6-11 for mirror / glass pixels, one per SpecularKind: the whole code, the same without
+    // the glass's second exit, and the mirrors' alone (no refraction) for the rectangles without
+    // glass. Built with the others for what the scene holds, else on first use.
+    enum SpecularKind { kGlass, kGlassFirstExitOnly, kReflectionOnly, kSpecularKinds };
+    struct SpecularVariant {
+        gl::Program program;
+        GLint epsilon = -1, showVirtual = -1, withCaustics = -1, secondExit = -1, fuzzyOn = -1,
+              denoiseFootage = -1, noiseVariance = -1;  // footage_noise.glsl
+    };
+    const SpecularVariant& specularVariant(SpecularKind kind);
+    SpecularVariant specular_[kSpecularKinds];
+    std::string identityDefine_;            // of the variants built
     gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
     gl::Program programDiffuseNoCaustics_;  // and MIRAGE_NO_CAUSTICS: no caustic pass this frame
     // MIRAGE_DIFFUSE_ONLY + MIRAGE_TRANSLUCENT_REFLECTION: over the translucent objects'
@@ -51,11 +64,8 @@ private:
     // pixel's ray (CameraIntrinsics::project), -1e4 where none does: CI(x) of Eq. 8-10.
     gl::Texture canvasToCamera_;
     std::vector<glm::vec2> canvasToCameraTable_;  // its CPU copy, row-major canvas pixels
-    GLint locEpsilon_ = -1, locFuzzyOn_ = -1;
-    GLint locDenoiseFootage_ = -1, locNoiseVariance_ = -1;    // of program_ (footage_noise.glsl)
-    GLint locShowVirtual_ = -1, locShowVirtualDiffuse_ = -1;  // of program_ / programDiffuse_
-    GLint locSecondExit_ = -1;
-    GLint locWithCaustics_ = -1, locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
+    GLint locShowVirtualDiffuse_ = -1;            // of programDiffuse_
+    GLint locWithCausticsDiffuse_ = -1, locShowVirtualNoCaustics_ = -1;
     gl::Framebuffer fbo_;
     // composite_mask.frag: depth 0 on the camera pixels that see a mirror or glass pixel, 1
     // elsewhere; fbo_'s depth attachment, so the full variant shades only those pixels.

@@ -184,6 +184,16 @@ vec3 boundaryReflection(ivec2 cpi, float ior, out vec3 footageShare) {
 
 #ifndef MIRAGE_DIFFUSE_ONLY  // the variant for frames without mirror / glass objects
 
+// The variants of the specular code (CompositePass: llvmpipe pays for every branch's code, so
+// what a pixel cannot need is compiled out): MIRAGE_REFLECTION_ONLY for the rectangles of
+// mirrors and metals alone (no glass there: the refraction's weight is 0), MIRAGE_NO_SECOND_EXIT
+// when the glass's second exit is off (SpecularOptions::secondExit).
+#ifdef MIRAGE_REFLECTION_ONLY
+const int kComponents = 1;
+#else
+const int kComponents = 2;
+#endif
+
 // Eqs. 6-11 at specular canvas pixel cpi for camera pixel colour ci; `footage` receives the part
 // of the result that is video (CI, or the back-projected CI_bp); wholeCi: it is CI (all real).
 // A rough mirror / metal / glass pixel's punctual highlight (direct.frag's rough-highlight
@@ -207,16 +217,22 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out boo
               vec3(0.0), r);
     vec3 env = max((fuzzy ? texelFetch(fuzzyLenv, cpi, 0) : texelFetch(lEnv, cpi, 0)).rgb,
                    vec3(0.0)) * ex;
+#if !defined(MIRAGE_REFLECTION_ONLY) && !defined(MIRAGE_NO_SECOND_EXIT)
     // The glass's second exit: the pixel's own, after the rough pass's blur of L_env.
     vec4 refrW = texelFetch(refrWeight, cpi, 0);
     env += secondExitEnvironment(cpi, refrW.rgb, refrW.a, envMap, gPosition, gNormal, gEmissive,
                                  backPosition, backNormal, realSurfaces) * ex;
+#endif
     bool envReal = envOrigin == ORIGIN_REAL;
     bool allReal = pReal;
     vec3 ciBp = vec3(0.0);
     footage = vec3(0.0);
     wholeCi = false;
-    for (int k = 0; k < 2; ++k) {
+    // The camera pixel each component's hit is seen at (valid: back-projected), and its weight.
+    ivec2 seenAt[2] = ivec2[2](ivec2(0), ivec2(0));
+    bool seen[2] = bool[2](false, false);
+    vec3 weight[2] = vec3[2](vec3(0.0), vec3(0.0));
+    for (int k = 0; k < kComponents; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, cpi, 0) : texelFetch(refrPosition, cpi, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, cpi, 0) : texelFetch(refrWeight, cpi, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;  // no such component
@@ -233,15 +249,26 @@ vec3 compositeSpecular(ivec2 cpi, vec3 ci, bool pReal, out vec3 footage, out boo
             allReal = false;
             continue;
         }
-        ivec2 bp;
-        if (backProjectPixel(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon, bp)) {
-            vec3 c = texelFetch(cameraImage, bp, 0).rgb, spread;
-            if (denoiseFootage != 0) c = footageMean(cameraImage, bp, c, noiseVarianceAt(c), spread);
-            ciBp += w * c;
-            footage += w * c;
-        } else {
-            ciBp += k == 0 ? rRefl : max(r - rRefl, vec3(0.0));  // rendered real share
-        }
+        weight[k] = w;
+        seen[k] = backProjectPixel(P.xyz, realSurfaces, canvasToCamera, cameraImage, depthEpsilon,
+                                   seenAt[k]);
+        if (!seen[k]) ciBp += k == 0 ? rRefl : max(r - rRefl, vec3(0.0));  // rendered real share
+    }
+    // The footage without its noise for the component that carries most of the pixel (the
+    // weaker one, a glass's reflection of 4 % at normal incidence, keeps its own: its share of
+    // the noise is the square of its weight), so that the 5x5 mean runs once per pixel.
+    float share0 = seen[0] ? dot(weight[0], vec3(1.0)) : -1.0;
+    float share1 = seen[1] ? dot(weight[1], vec3(1.0)) : -1.0;
+    int strong = share1 > share0 ? 1 : 0;
+    vec3 strongCi = texelFetch(cameraImage, seenAt[strong], 0).rgb, spread;
+    if (denoiseFootage != 0)
+        strongCi = footageMean(cameraImage, seenAt[strong], strongCi, noiseVarianceAt(strongCi),
+                               spread);
+    for (int k = 0; k < kComponents; ++k) {
+        if (!seen[k]) continue;
+        vec3 c = k == strong ? strongCi : texelFetch(cameraImage, seenAt[k], 0).rgb;
+        ciBp += weight[k] * c;
+        footage += weight[k] * c;
     }
     if (fuzzy) ciBp = max(fuzzyBp.rgb, vec3(0.0));  // the neighbours' resolved CI_bp, filtered
     if (fuzzy) footage = ciBp;

@@ -230,7 +230,7 @@ void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& 
 // Registered in render/PassList.cpp.
 std::unique_ptr<RenderPass> makeSpecularGBufferPass(const PassInit& init) {
     const SpecularOptions& o = init.options.specular;
-    return std::make_unique<SpecularGBufferPass>(o.halfResolutionTrace || o.prepareHalfResolution);
+    return std::make_unique<SpecularGBufferPass>(o.halfResolutionTrace || o.prepareGovernedVariants);
 }
 
 }  // namespace mirage::render

@@ -34,11 +34,12 @@ std::vector<PassKnob> specularKnobs() {
             "each frame shades one phase of 8x8-pixel tiles, the others take last frame's light "
             "where it was lit at this frame's hits",
             [](RendererOptions& o) -> int& { return o.specular.refreshInterval; }, {1, 2, 4})),
-        onOffKnob("second_exit",
-                  "on: glass's refracted path followed past the internal reflection at its back "
-                  "face to a second exit, whose environment light the composite adds to the "
-                  "pixel's L_env; off: the first exit only",
-                  [](RendererOptions& o) -> bool& { return o.specular.secondExit; }, {"on"}),
+        governedKnob(onOffKnob(
+            "second_exit",
+            "on: glass's refracted path followed past the internal reflection at its back face to "
+            "a second exit, whose environment light the composite adds to the pixel's L_env; off: "
+            "the first exit only",
+            [](RendererOptions& o) -> bool& { return o.specular.secondExit; }, {"on"})),
         onOffKnob(
             "specular_temporal",
             "on: the light of the reflected / refracted hits (L'_rv, L'_r) smoothed over frames, "

@@ -62,7 +62,7 @@ SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOption
     if (sceneCanGather_)
         gather_ = makeVariant("specular light (caustic gather)",
                               scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-    if (options.specular.halfResolution || options.specular.prepareHalfResolution)
+    if (options.specular.halfResolution || options.specular.prepareGovernedVariants)
         buildHalfResolution(scene);
 }
 

@@ -33,10 +33,11 @@ struct SpecularOptions {
     // pixels. The ray search is a quarter of the work; the hits are 2x2 blocks. false: a ray pair
     // per pixel.
     bool halfResolutionTrace = false;
-    // Build the half-resolution programs (lighting and trace) when the renderer is made although
-    // neither is on: a frame-time governor may switch them on while it runs, and compiling them
-    // then stalls that frame (about 0.5 s on llvmpipe).
-    bool prepareHalfResolution = false;
+    // Build the programs of the governed settings (the half-resolution lighting and trace, the
+    // composite without the second exit) when the renderer is made although they are off: a
+    // frame-time governor may switch them on while it runs, and compiling them then stalls that
+    // frame (about 0.5 s on llvmpipe).
+    bool prepareGovernedVariants = false;
     // Temporal reuse of the hit light: 1 shades every specular pixel every frame; 2 or 4 shade the
     // 8x8-pixel tiles of one phase of N per frame, and the other tiles' pixels take last frame's
     // light where it was lit at this frame's hits, within 0.5 mm (specular_light.frag); a pixel
