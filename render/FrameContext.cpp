@@ -125,6 +125,27 @@ void FrameContext::drawFullscreenTriangleOutsideSpecular(int first, int count) c
     glDisable(GL_DEPTH_TEST);
 }
 
+bool rectsOverlap(const glm::ivec4& a, const glm::ivec4& b) {
+    return a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w && b.y < a.y + a.w;
+}
+
+void separateMirrorRects(std::vector<glm::ivec4>& glass, std::vector<glm::ivec4>& mirror) {
+    glass = mergeOverlappingRects(std::move(glass));
+    mirror = mergeOverlappingRects(std::move(mirror));
+    // A merge of the glass rectangles can reach another mirror one: repeat until none meets.
+    for (bool moved = true; moved;) {
+        moved = false;
+        for (size_t i = 0; i < mirror.size() && !moved; ++i)
+            if (std::any_of(glass.begin(), glass.end(),
+                            [&](const glm::ivec4& g) { return rectsOverlap(mirror[i], g); })) {
+                glass.push_back(mirror[i]);
+                mirror.erase(mirror.begin() + std::ptrdiff_t(i));
+                glass = mergeOverlappingRects(std::move(glass));
+                moved = true;
+            }
+    }
+}
+
 std::vector<glm::ivec4> mergeOverlappingRects(std::vector<glm::ivec4> rects) {
     std::erase_if(rects, [](const glm::ivec4& r) { return r.z <= 0 || r.w <= 0; });
     // Merging two can make the union overlap a third that neither did: repeat until no pair
@@ -134,9 +155,7 @@ std::vector<glm::ivec4> mergeOverlappingRects(std::vector<glm::ivec4> rects) {
         for (size_t i = 0; i < rects.size() && !merged; ++i)
             for (size_t j = i + 1; j < rects.size() && !merged; ++j) {
                 const glm::ivec4 a = rects[i], b = rects[j];
-                const bool overlap =
-                    a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w && b.y < a.y + a.w;
-                if (!overlap) continue;
+                if (!rectsOverlap(a, b)) continue;
                 const int x0 = std::min(a.x, b.x), y0 = std::min(a.y, b.y);
                 const int x1 = std::max(a.x + a.z, b.x + b.z), y1 = std::max(a.y + a.w, b.y + b.w);
                 rects[i] = {x0, y0, x1 - x0, y1 - y0};

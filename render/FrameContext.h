@@ -231,6 +231,10 @@ public:
     // covered, masked or not). refractiveRects: the glass objects' only, all the refraction
     // search needs (a mirror's pixel refracts nothing). Both empty when none is in view.
     std::vector<glm::ivec4> specularRects, refractiveRects;
+    // specularRects split by whether a glass object's rectangle meets them: the mirror rectangles
+    // hold mirrors and metals only (no pixel of them refracts), so the specular passes shade
+    // them with their reflection-only variants (llvmpipe pays for every branch's code).
+    std::vector<glm::ivec4> glassSpecularRects, mirrorRects;
     // Canvas pixels that can show a translucent object, per object, overlapping ones merged
     // (empty when none is in view): the composite's translucent variant runs on these only.
     std::vector<glm::ivec4> translucentRects;
@@ -275,5 +279,10 @@ private:
 // `rects` (GL window x, y, width, height) with every overlapping pair replaced by its bounding
 // rectangle until none overlaps, empty ones dropped: the same pixels covered or more, each once.
 std::vector<glm::ivec4> mergeOverlappingRects(std::vector<glm::ivec4> rects);
+// GL window rectangles (x, y, width, height) a and b share a pixel.
+bool rectsOverlap(const glm::ivec4& a, const glm::ivec4& b);
+// Merges each list and moves every mirror rectangle that meets a glass one into the glass list
+// (merged again), so that no pixel is drawn by both lists' variants.
+void separateMirrorRects(std::vector<glm::ivec4>& glass, std::vector<glm::ivec4>& mirror);
 
 }  // namespace mirage::render

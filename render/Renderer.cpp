@@ -113,6 +113,14 @@ void specularRectangles(const GpuScene& s, const glm::mat4& view, const glm::mat
     }
     c.specularRects = mergeOverlappingRects(std::move(all));
     c.refractiveRects = mergeOverlappingRects(std::move(glass));
+    c.glassSpecularRects.clear();
+    c.mirrorRects.clear();
+    for (const glm::ivec4& r : c.specularRects)
+        (std::any_of(c.refractiveRects.begin(), c.refractiveRects.end(),
+                     [&](const glm::ivec4& g) { return rectsOverlap(r, g); })
+             ? c.glassSpecularRects
+             : c.mirrorRects)
+            .push_back(r);
     std::vector<glm::ivec4> translucent;
     for (const DrawItem& d : s.draws()) {
         if (!d.translucent) continue;

@@ -67,6 +67,23 @@ TEST(SpecularRects, OverlappingRectanglesAreMergedAndTheRestKept) {
             for (int x = r.x; x < r.x + r.z; ++x) ASSERT_TRUE(covers(out, x, y)) << x << "," << y;
 }
 
+// The glass rectangles and the mirror ones drawn with their own variants never share a pixel.
+TEST(SpecularRects, MirrorRectanglesThatMeetAGlassOneJoinIt) {
+    std::vector<glm::ivec4> glass = {{0, 0, 10, 10}, {30, 0, 10, 10}};
+    // One apart, one touching the first glass rectangle (after half-pixel rounding, say), one
+    // that meets only the union the first move makes.
+    std::vector<glm::ivec4> mirror = {{60, 60, 5, 5}, {9, 2, 6, 4}, {14, 8, 5, 5}};
+    separateMirrorRects(glass, mirror);
+    ASSERT_EQ(mirror.size(), 1u);
+    EXPECT_EQ(mirror[0], glm::ivec4(60, 60, 5, 5));
+    for (const glm::ivec4& m : mirror)
+        for (const glm::ivec4& g : glass) EXPECT_FALSE(overlap(m, g));
+    for (int y = 2; y < 6; ++y)
+        for (int x = 9; x < 15; ++x) EXPECT_TRUE(covers(glass, x, y));
+    for (int y = 8; y < 13; ++y)
+        for (int x = 14; x < 19; ++x) EXPECT_TRUE(covers(glass, x, y));
+}
+
 class SpecularRectsRender : public test::HeadlessGlSuite {};
 
 struct Frame {
@@ -80,8 +97,10 @@ const Pose kPose = test::lookAtPose({0.05, 0.40, 0.60}, {-0.05, 0.02, 0.0});
 // Another view: both objects elsewhere on screen.
 const Pose kOtherPose = test::lookAtPose({-0.25, 0.35, 0.55}, {0.05, 0.0, -0.05});
 
-RendererOptions options(bool perObject) {
+RendererOptions options(bool perObject, bool half = false) {
     RendererOptions o;
+    o.specular.halfResolution = half;
+    o.specular.halfResolutionTrace = half;
     o.vpl.count = 64;
     o.temporalBlend = 0.0f;
     o.specular.rectsPerObject = perObject;
@@ -107,8 +126,8 @@ Frame readFrame(const Renderer& r) {
     return f;
 }
 
-Frame render(const Scene& scene, bool perObject) {
-    Renderer r(scene, kCamera, options(perObject));
+Frame render(const Scene& scene, bool perObject, bool half = false) {
+    Renderer r(scene, kCamera, options(perObject, half));
     renderFrame(r, kPose);
     return readFrame(r);
 }
@@ -149,6 +168,23 @@ TEST_F(SpecularRectsRender, PerObjectRectanglesChangeNoPixelAndCoverFewer) {
     const Frame other = render(lowerIor, true);
     EXPECT_GT(maxAbsDiff(other.refraction, one.refraction), 1e-3);
     EXPECT_GT(maxAbsDiff(other.composite, one.composite), 1e-3);
+}
+
+// The same at half resolution (the trace and the lighting: their mirror rectangles take the
+// reflection-only variants too).
+TEST_F(SpecularRectsRender, PerObjectRectanglesChangeNoPixelAtHalfResolution) {
+    const Scene scene = loadScene(test::dataDir() / "scenes" / "tabletop" / "tabletop.gltf");
+    const Frame perObject = render(scene, true, true);
+    const Frame one = render(scene, false, true);
+    ASSERT_EQ(perObject.rects.size(), 2u);
+    EXPECT_LT(maxAbsDiff(perObject.composite, one.composite), 1e-5);
+    EXPECT_LT(maxAbsDiff(perObject.reflection, one.reflection), 1e-5);
+    EXPECT_LT(maxAbsDiff(perObject.specularRv, one.specularRv), 1e-5);
+    // The refraction buffer only where there is glass (the mirror's rectangle no longer traces
+    // it at half resolution).
+    const Frame full = render(scene, false, false);
+    EXPECT_GT(maxAbsDiff(perObject.composite, full.composite), 1e-3)
+        << "half resolution changes the image, so the comparison can fail";
 }
 
 // The passes clear only the pixels the last frame's rectangles and this frame's cover: a frame

@@ -216,27 +216,9 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     // another's) take the reflection-only variant.
     std::vector<glm::ivec4> rects, glassRects, mirrorRects;
     if (specular && ctx.options.composite.showVirtual) {
-        auto overlaps = [](const glm::ivec4& a, const glm::ivec4& b) {
-            return a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w && b.y < a.y + a.w;
-        };
-        for (const glm::ivec4& r : ctx.specularRects) {
-            const bool glass = std::any_of(ctx.refractiveRects.begin(), ctx.refractiveRects.end(),
-                                           [&](const glm::ivec4& g) { return overlaps(r, g); });
-            (glass ? glassRects : mirrorRects).push_back(cameraRect(ctx, r));
-        }
-        glassRects = mergeOverlappingRects(std::move(glassRects));
-        mirrorRects = mergeOverlappingRects(std::move(mirrorRects));
-        for (bool moved = true; moved;) {  // a merge can reach another mirror rectangle
-            moved = false;
-            for (size_t i = 0; i < mirrorRects.size() && !moved; ++i)
-                if (std::any_of(glassRects.begin(), glassRects.end(),
-                                [&](const glm::ivec4& g) { return overlaps(mirrorRects[i], g); })) {
-                    glassRects.push_back(mirrorRects[i]);
-                    mirrorRects.erase(mirrorRects.begin() + std::ptrdiff_t(i));
-                    glassRects = mergeOverlappingRects(std::move(glassRects));
-                    moved = true;
-                }
-        }
+        for (const glm::ivec4& r : ctx.glassSpecularRects) glassRects.push_back(cameraRect(ctx, r));
+        for (const glm::ivec4& r : ctx.mirrorRects) mirrorRects.push_back(cameraRect(ctx, r));
+        separateMirrorRects(glassRects, mirrorRects);
         rects = glassRects;
         rects.insert(rects.end(), mirrorRects.begin(), mirrorRects.end());
     }

@@ -199,11 +199,13 @@ void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& 
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_ALWAYS);
     ctx.drawFullscreenTriangleIn(blocks);
-    // The trace's units again (the mask's shared one).
+    // The trace's units again (the mask's shared one). The refraction only in the glass objects'
+    // blocks (the fill reads it there only).
     glBindTextureUnit(kUnitSpecGbufBackPosition, res.texture(kBackFacePosition).id());
+    const std::vector<glm::ivec4> glassBlocks = halfRects(ctx.refractiveRects);
     for (int mode = 0; mode < 2; ++mode)
         trace(ctx, mode, halfPrograms_[mode], mode == 0 ? halfRefl_ : halfRefr_, halfWidth_,
-              halfHeight_, blocks);
+              halfHeight_, mode == 0 ? blocks : glassBlocks);
     // The fill, on the canvas's specular pixels.
     const gl::Texture* half[10] = {&halfRefl_.position, &halfRefl_.normal, &halfRefl_.albedo,
                                    &halfRefl_.emissive, &halfRefl_.weight, &halfRefr_.position,
@@ -230,7 +232,8 @@ void SpecularGBufferPass::traceHalfResolution(FrameContext& ctx, PassResources& 
 // Registered in render/PassList.cpp.
 std::unique_ptr<RenderPass> makeSpecularGBufferPass(const PassInit& init) {
     const SpecularOptions& o = init.options.specular;
-    return std::make_unique<SpecularGBufferPass>(o.halfResolutionTrace || o.prepareGovernedVariants);
+    return std::make_unique<SpecularGBufferPass>(o.halfResolutionTrace ||
+                                                 o.prepareGovernedVariants);
 }
 
 }  // namespace mirage::render

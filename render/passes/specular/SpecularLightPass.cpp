@@ -25,10 +25,16 @@ static_assert(kUnitSpecLightRefrFirst == kUnitSpecLightReflFirst + 5);
 constexpr int kAttachments = 5;
 }  // namespace
 
-SpecularLightPass::Variant SpecularLightPass::makeVariant(const char* label,
-                                                          const std::string& defines) {
+namespace {
+const char* const kKindLabel[2] = {"", ", reflection only"};
+const char* const kKindDefine[2] = {"", "#define MIRAGE_REFLECTION_ONLY 1\n"};
+}  // namespace
+
+SpecularLightPass::Variant SpecularLightPass::makeVariant(const std::string& label,
+                                                          const std::string& defines, int kind) {
     Variant v;
-    v.program = fullscreenProgram(label, "passes/specular/specular_light.frag", defines);
+    v.program = fullscreenProgram(label + kKindLabel[kind], "passes/specular/specular_light.frag",
+                                  defines + kKindDefine[kind]);
     v.useVpls = v.program.uniformLocation("useVpls");
     v.vplStride = v.program.uniformLocation("vplStride");
     v.cellSize = v.program.uniformLocation("photonCellSize");
@@ -57,27 +63,41 @@ int specularRefresh(const FrameContext& ctx, const TemporalHistory& history) {
 }  // namespace
 
 SpecularLightPass::SpecularLightPass(const GpuScene& scene, const RendererOptions& options)
-    : plain_(makeVariant("specular light", scene.lightingDefines())),
-      sceneCanGather_(PhotonGridPass::sceneCanGather(scene, options)) {
+    : sceneCanGather_(PhotonGridPass::sceneCanGather(scene, options)) {
+    // The kinds of rectangle the scene can have: with glass, and of mirrors alone.
+    bool kinds[kKinds] = {false, false};
+    for (int i : scene.specularDraws()) kinds[scene.draws()[size_t(i)].transmissive ? 0 : 1] = true;
+    for (int kind = 0; kind < kKinds; ++kind) {
+        if (!kinds[kind]) continue;
+        buildFull(scene, kind);
+        if (options.specular.halfResolution || options.specular.prepareGovernedVariants)
+            buildHalfResolution(scene, kind);
+    }
+}
+
+void SpecularLightPass::buildFull(const GpuScene& scene, int kind) {
+    if (plain_[kind].program.id() != 0) return;
+    plain_[kind] = makeVariant("specular light", scene.lightingDefines(), kind);
     if (sceneCanGather_)
-        gather_ = makeVariant("specular light (caustic gather)",
-                              scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-    if (options.specular.halfResolution || options.specular.prepareGovernedVariants)
-        buildHalfResolution(scene);
+        gather_[kind] =
+            makeVariant("specular light (caustic gather)",
+                        scene.lightingDefines() + "#define MIRAGE_CAUSTIC_GATHER 1\n", kind);
 }
 
 // The half-resolution variants, their upsample and mask (RendererOptions::specular.halfResolution,
 // which a frame-time governor may switch on while the renderer runs: built on first use).
-void SpecularLightPass::buildHalfResolution(const GpuScene& scene) {
+void SpecularLightPass::buildHalfResolution(const GpuScene& scene, int kind) {
+    if (halfPlain_[kind].program.id() != 0) return;
     const std::string half = scene.lightingDefines() + "#define MIRAGE_SPECULAR_HALF 1\n";
-    halfPlain_ = makeVariant("specular light (half resolution)", half);
+    halfPlain_[kind] = makeVariant("specular light (half resolution)", half, kind);
     if (sceneCanGather_)
-        halfGather_ = makeVariant("specular light (half resolution, caustic gather)",
-                                  half + "#define MIRAGE_CAUSTIC_GATHER 1\n");
-    resolve_ =
-        fullscreenProgram("specular light upsample", "passes/specular/specular_resolve.frag");
-    halfMaskProgram_ = fullscreenProgram("specular half-resolution mask",
-                                         "passes/specular/specular_half_mask.frag");
+        halfGather_[kind] = makeVariant("specular light (half resolution, caustic gather)",
+                                        half + "#define MIRAGE_CAUSTIC_GATHER 1\n", kind);
+    resolve_[kind] = fullscreenProgram(std::string("specular light upsample") + kKindLabel[kind],
+                                       "passes/specular/specular_resolve.frag", kKindDefine[kind]);
+    if (halfMaskProgram_.id() == 0)
+        halfMaskProgram_ = fullscreenProgram("specular half-resolution mask",
+                                             "passes/specular/specular_half_mask.frag");
 }
 
 void SpecularLightPass::setup(PassBuilder& b) const {
@@ -172,19 +192,54 @@ void SpecularLightPass::allocateHalfResolution(int w, int h) {
     halfFbo_.finalize(4);
 }
 
-void SpecularLightPass::clearAndDraw(const FrameContext& ctx, int write) {
+void SpecularLightPass::clearAndDraw(FrameContext& ctx, const PassResources& res, int write,
+                                     const Variant (&variants)[kKinds]) {
     ctx.clearForRects(ctx.specularRects, drawn_[write], 0, kAttachments);
-    ctx.drawFullscreenTriangleIn(ctx.specularRects);
+    drawKinds(ctx, res, variants, {ctx.glassSpecularRects, ctx.mirrorRects}, ctx.canvasWidth(),
+              ctx.canvasHeight());
 }
 
-void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v,
-                                            int write) {
-    // The specular objects' rectangles in half pixels, rounded outwards.
-    std::vector<glm::ivec4> halfRects;
-    for (const glm::ivec4& s : ctx.specularRects)
-        halfRects.push_back(
+// Only specular pixels pass the early depth test against the bound framebuffer's mask (the
+// triangle lies at depth 0.5); the rest stay as cleared (0: not a specular pixel).
+void SpecularLightPass::drawKinds(FrameContext& ctx, const PassResources& res,
+                                  const Variant (&variants)[kKinds],
+                                  const std::vector<glm::ivec4> (&rects)[kKinds], int width,
+                                  int height) {
+    for (int kind = 0; kind < kKinds; ++kind) {
+        if (rects[kind].empty()) continue;
+        // A kind the scene did not hold when the pass was made (a draw's material changed).
+        if (variants[kind].program.id() == 0) {
+            buildFull(ctx.scene, kind);
+            if (ctx.options.specular.halfResolution) buildHalfResolution(ctx.scene, kind);
+        }
+        ctx.beginFullscreen(variants[kind].program, width, height);
+        setUniforms(ctx, res, variants[kind]);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+        ctx.drawFullscreenTriangleIn(rects[kind]);
+    }
+}
+
+namespace {
+// Canvas rectangles in half pixels, rounded outwards.
+std::vector<glm::ivec4> halfRectsOf(const std::vector<glm::ivec4>& rects) {
+    std::vector<glm::ivec4> out;
+    for (const glm::ivec4& s : rects)
+        out.push_back(
             {s.x / 2, s.y / 2, (s.x + s.z + 1) / 2 - s.x / 2, (s.y + s.w + 1) / 2 - s.y / 2});
-    halfRects = mergeOverlappingRects(std::move(halfRects));
+    return mergeOverlappingRects(std::move(out));
+}
+}  // namespace
+
+void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& res, bool gather,
+                                            int write) {
+    // The specular objects' rectangles in half pixels, rounded outwards; by kind (a half pixel
+    // shared by a mirror's and a glass's rectangle goes to the glass).
+    const std::vector<glm::ivec4> halfRects = halfRectsOf(ctx.specularRects);
+    std::vector<glm::ivec4> kindRects[kKinds] = {halfRectsOf(ctx.glassSpecularRects),
+                                                 halfRectsOf(ctx.mirrorRects)};
+    separateMirrorRects(kindRects[0], kindRects[1]);
     halfMaskFbo_.bind();
     ctx.beginFullscreen(halfMaskProgram_, halfWidth_, halfHeight_);
     glDepthMask(GL_TRUE);
@@ -193,27 +248,30 @@ void SpecularLightPass::shadeHalfResolution(FrameContext& ctx, PassResources& re
     glDepthFunc(GL_ALWAYS);
     ctx.drawFullscreenTriangleIn(halfRects);
     halfFbo_.bind();
-    ctx.beginFullscreen(v.program, halfWidth_, halfHeight_);
-    setUniforms(ctx, res, v);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
     glDepthMask(GL_FALSE);
     ctx.clearForRects(halfRects, halfDrawn_, 0, 4);
-    ctx.drawFullscreenTriangleIn(halfRects);
+    drawKinds(ctx, res, gather ? halfGather_ : halfPlain_, kindRects, halfWidth_, halfHeight_);
     // The upsample, on the canvas's specular pixels. It writes L'_rv, L'_r, the reflection's
     // share and L_env, and 0 hits (no history at half resolution: specularBlend).
     fbo_[write].bind();
-    ctx.beginFullscreen(resolve_, ctx.canvasWidth(), ctx.canvasHeight());
     const gl::Texture* half[4] = {&halfReflRv_, &halfReflR_, &halfRefrRv_, &halfRefrR_};
     for (int i = 0; i < 4; ++i)
         glBindTextureUnit(GLuint(kUnitSpecResolveHalfFirst + i), half[i]->id());
     glBindTextureUnit(kUnitSpecResolveSlot, res.texture(kGBufferEmissive).id());
-    glUniform1i(resolve_.uniformLocation("geometryTest"),
-                ctx.options.specular.upsampleGeometry ? 1 : 0);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_FALSE);
-    clearAndDraw(ctx, write);
+    ctx.clearForRects(ctx.specularRects, drawn_[write], 0, kAttachments);
+    const std::vector<glm::ivec4>* canvasRects[kKinds] = {&ctx.glassSpecularRects,
+                                                          &ctx.mirrorRects};
+    for (int kind = 0; kind < kKinds; ++kind) {
+        if (canvasRects[kind]->empty()) continue;
+        const gl::Program& resolve = resolve_[kind];
+        ctx.beginFullscreen(resolve, ctx.canvasWidth(), ctx.canvasHeight());
+        glUniform1i(resolve.uniformLocation("geometryTest"),
+                    ctx.options.specular.upsampleGeometry ? 1 : 0);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_FALSE);
+        ctx.drawFullscreenTriangleIn(*canvasRects[kind]);
+    }
 }
 
 void SpecularLightPass::setUniforms(const FrameContext& ctx, const PassResources& res,
@@ -282,21 +340,14 @@ void SpecularLightPass::execute(FrameContext& ctx, PassResources& res) {
     glBindTextureUnit(kUnitSpecLightHistoryRRefl, rRefl_[read].id());
     glBindTextureUnit(kUnitSpecLightHistoryHits, hits_[read].id());
     if (ctx.options.specular.halfResolution) {
-        if (halfPlain_.program.id() == 0) buildHalfResolution(ctx.scene);
+        for (int kind = 0; kind < kKinds; ++kind)
+            if (plain_[kind].program.id() != 0) buildHalfResolution(ctx.scene, kind);
         if (halfWidth_ == 0) allocateHalfResolution(width_, height_);
-        shadeHalfResolution(ctx, res, gather ? halfGather_ : halfPlain_, write);
+        shadeHalfResolution(ctx, res, gather, write);
     } else {
-        const Variant& v = gather ? gather_ : plain_;
         fbo_[write].bind();
-        ctx.beginFullscreen(v.program, ctx.canvasWidth(), ctx.canvasHeight());
-        setUniforms(ctx, res, v);
-        // Only specular pixels pass the early depth test against the mask (the triangle lies at
-        // depth 0.5); the rest stay 0 (not a specular pixel).
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_GREATER);
-        glDepthMask(GL_FALSE);
         // Every attachment cleared: a history texel outside the specular pixels holds distance 0.
-        clearAndDraw(ctx, write);
+        clearAndDraw(ctx, res, write, gather ? gather_ : plain_);
     }
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);

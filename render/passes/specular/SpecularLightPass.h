@@ -42,16 +42,25 @@ private:
         GLint useVpls = -1, vplStride = -1, cellSize = -1, gatherCap = -1, historyWeight = -1;
         GLint refreshInterval = -1, refreshPhase = -1;
     };
-    static Variant makeVariant(const char* label, const std::string& defines);
-    void buildHalfResolution(const GpuScene& scene);
+    // Per kind of rectangle: [0] with glass (both rays), [1] mirrors and metals alone
+    // (MIRAGE_REFLECTION_ONLY; FrameContext::mirrorRects).
+    static constexpr int kKinds = 2;
+    static Variant makeVariant(const std::string& label, const std::string& defines, int kind);
+    // The variants of `kind` (full resolution), built on first use if the scene did not need them.
+    void buildFull(const GpuScene& scene, int kind);
+    void buildHalfResolution(const GpuScene& scene, int kind);
     void allocateHalfResolution(int w, int h);
     std::string refreshNote(const FrameContext& ctx) const;
     void setUniforms(const FrameContext& ctx, const PassResources& res, const Variant& v) const;
-    void shadeHalfResolution(FrameContext& ctx, PassResources& res, const Variant& v, int write);
-    // Clears fbo_[write] (bound) where the last draws into its textures and this one's cover,
-    // then draws the full-screen triangle in the specular rectangles.
-    void clearAndDraw(const FrameContext& ctx, int write);
-    Variant plain_, gather_;  // gather_: only for scenes that can have caustics
+    void shadeHalfResolution(FrameContext& ctx, PassResources& res, bool gather, int write);
+    // Clears fbo_[write] (bound) where the last draws into its textures and this frame's cover,
+    // then draws each kind's rectangles with its variant (plain or gather), `program` of which is
+    // put in use with its uniforms and the frame's blocks.
+    void clearAndDraw(FrameContext& ctx, const PassResources& res, int write,
+                      const Variant (&variants)[kKinds]);
+    void drawKinds(FrameContext& ctx, const PassResources& res, const Variant (&variants)[kKinds],
+                   const std::vector<glm::ivec4> (&rects)[kKinds], int width, int height);
+    Variant plain_[kKinds], gather_[kKinds];  // gather_: only for scenes that can have caustics
     // Smoothed L'_rv, L'_r, reflection share (Resource.h), L_env and the hits they were lit at
     // (read by this pass alone, so not a frame-graph resource), fbo_[i]'s attachments 0-4:
     // [history_.writeSlot()] is written and published this frame and read as history by the next.
@@ -65,8 +74,8 @@ private:
     // RendererOptions::specular.halfResolution: the half-resolution variants (built on first use),
     // the upsample, the half-size specular-pixel mask and hit radiance.
     bool sceneCanGather_ = false;
-    Variant halfPlain_, halfGather_;
-    gl::Program resolve_, halfMaskProgram_;
+    Variant halfPlain_[kKinds], halfGather_[kKinds];
+    gl::Program resolve_[kKinds], halfMaskProgram_;
     gl::Texture halfReflRv_, halfReflR_, halfRefrRv_, halfRefrR_, halfMask_;
     gl::Framebuffer halfFbo_, halfMaskFbo_;
     DrawnRects halfDrawn_, halfMaskDrawn_;

@@ -23,12 +23,20 @@
 // and divided by (albedo + kSpecularDemodulationFloor), so that specular_resolve.frag can
 // upsample it by hit geometry and put back the full-resolution Fresnel weight, albedo, emission
 // and environment. The VPL interleaving tiles then cover 2x2 half pixels (4x4 canvas pixels).
+// Variant MIRAGE_REFLECTION_ONLY: for the rectangles of mirrors and metals alone (no glass meets
+// them: every refraction weight is 0), the reflected hit only (llvmpipe pays for the refracted
+// hit's code even where its weight is 0).
 // Then L'_rv, L'_r and the reflection's share are smoothed over time (Knecht 2013 end of Sec.
 // 4.2): last frame's values, reprojected by the specular surface's world position, are blended
 // in where the pixel is the same surface (temporal.glsl) AND both of its rays hit where they hit
 // then (a reflection moves over the mirror differently from the mirror itself: under camera
 // motion the hits move and the history is rejected rather than smeared; under tracking noise
 // they stay within a few millimetres and it is used).
+#ifdef MIRAGE_REFLECTION_ONLY
+const int kComponents = 1;
+#else
+const int kComponents = 2;
+#endif
 in vec2 uv;
 layout(binding = kUnitSpecLightVpls) uniform samplerBuffer vplTexels;  // GpuVpl[] (vplAt)
 layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
@@ -222,8 +230,8 @@ void main() {
     // kernel must cover the half-resolution sample spacing).
     vec3 pSpec = texelFetch(gPosition, px, 0).xyz;
     float toCamera = distance(cameraPos.xyz, pSpec);
-    float footprint[2];
-    for (int k = 0; k < 2; ++k) {
+    float footprint[2] = float[2](0.0, 0.0);
+    for (int k = 0; k < kComponents; ++k) {
         vec3 h = (k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0)).xyz;
         vec3 nh = (k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0)).xyz;
         float cosHit = abs(dot(nh, normalize(pSpec - h + vec3(0.0, 0.0, 1e-9))));
@@ -235,8 +243,8 @@ void main() {
     outRefrRv = vec4(0.0);
     outRefrR = vec4(0.0);
     if (rep < 0) return;  // no specular pixel in the block
-    vec3 hitRv[2], hitR[2];
-    for (int k = 0; k < 2; ++k) {
+    vec3 hitRv[2] = vec3[2](vec3(0.0), vec3(0.0)), hitR[2] = vec3[2](vec3(0.0), vec3(0.0));
+    for (int k = 0; k < kComponents; ++k) {
         hitRv[k] = vec3(0.0);
         hitR[k] = vec3(0.0);
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
@@ -279,8 +287,8 @@ void main() {
     // before any branch) and, across silhouettes, from the path length and the hit's obliquity.
     vec3 pSpec = texelFetch(gPosition, px, 0).xyz;
     float toCamera = distance(cameraPos.xyz, pSpec);
-    float footprint[2];
-    for (int k = 0; k < 2; ++k) {
+    float footprint[2] = float[2](0.0, 0.0);
+    for (int k = 0; k < kComponents; ++k) {
         vec3 h = (k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0)).xyz;
         vec3 nh = (k == 0 ? texelFetch(reflNormal, px, 0) : texelFetch(refrNormal, px, 0)).xyz;
         float cosHit = abs(dot(nh, normalize(pSpec - h + vec3(0.0, 0.0, 1e-9))));
@@ -298,7 +306,7 @@ void main() {
     float toSurface = distance(surface, cameraPos.xyz);
     // This frame's hits first (per ray, world, m): the history test needs them before the shading.
     vec3 hit[2] = vec3[2](vec3(kNoHit), vec3(kNoHit));
-    for (int k = 0; k < 2 && specularPixel; ++k) {
+    for (int k = 0; k < kComponents && specularPixel; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
         if (!all(lessThanEqual(w, vec3(0.0))) && int(P.w + 0.5) != ORIGIN_NONE) hit[k] = P.xyz;
@@ -333,7 +341,7 @@ void main() {
     vec4 vplRv[2] = vec4[2](vec4(0.0), vec4(0.0)), vplR[2] = vec4[2](vec4(0.0), vec4(0.0));
     vec3 vplToRadiance[2] = vec3[2](vec3(0.0), vec3(0.0));
     int hitOrigin[2] = int[2](ORIGIN_NONE, ORIGIN_NONE);
-    for (int k = 0; k < 2 && specularPixel; ++k) {
+    for (int k = 0; k < kComponents && specularPixel; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;
@@ -373,7 +381,7 @@ void main() {
         if (k == 0) rRefl = w * hr;
     }
     if (shade) {  // the same in all lanes of the quad
-        for (int k = 0; k < 2; ++k) {
+        for (int k = 0; k < kComponents; ++k) {
             if (vplStride > 1)  // uniform: the quad's lanes all take it
                 quadAverage(vplRv[k], vplR[k], hit[k], hitOrigin[k],
                             toSurface + distance(surface, hit[k]));

@@ -16,6 +16,11 @@
 // is added (Eq. 5 routing as the full variant), and L_env is looked up at full resolution.
 // geometryTest = 0 (tests only): plain bilinear weights over the half pixels with a
 // representative, whatever their geometry (shows halos at depth steps).
+#ifdef MIRAGE_REFLECTION_ONLY  // the mirrors' rectangles: no refraction (specular_light.frag)
+const int kComponents = 1;
+#else
+const int kComponents = 2;
+#endif
 in vec2 uv;
 layout(binding = kUnitSpecLightReflFirst) uniform sampler2D reflPosition;
 layout(binding = kUnitSpecLightReflFirst + 1) uniform sampler2D reflNormal;
@@ -67,7 +72,7 @@ void main() {
         sameSlot[c] = abs(texelFetch(gEmissive, rep[c], 0).a - slot) < 0.5;
     }
     vec3 rv = vec3(0.0), r = vec3(0.0), rRefl = vec3(0.0), env = vec3(0.0);
-    for (int k = 0; k < 2; ++k) {
+    for (int k = 0; k < kComponents; ++k) {
         vec4 P = k == 0 ? texelFetch(reflPosition, px, 0) : texelFetch(refrPosition, px, 0);
         vec3 w = (k == 0 ? texelFetch(reflWeight, px, 0) : texelFetch(refrWeight, px, 0)).rgb;
         if (all(lessThanEqual(w, vec3(0.0)))) continue;
