@@ -207,13 +207,55 @@ glm::ivec4 CompositePass::cameraRect(const FrameContext& ctx, const glm::ivec4& 
     return {cx0, cy0, cx1 - cx0, cy1 - cy0};
 }
 
+// Eqs. 6-11 on the camera pixels the diffuse variant left (the mask is 0), each kind of
+// rectangle with its variant.
+void CompositePass::drawSpecular(FrameContext& ctx, const PassResources& res,
+                                 const std::vector<glm::ivec4>& glassRects,
+                                 const std::vector<glm::ivec4>& mirrorRects, int withCaustics) {
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);  // where the mask is 0
+    glDepthMask(GL_FALSE);
+    // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
+    // the newest versions, as the sharp units.
+    const bool fuzzy = res.has(kFilteredVideo);
+    for (int i = 0; i < 5; ++i)
+        glBindTextureUnit(GLuint(kUnitCompositeFuzzyRv + i),
+                          (i < 4 ? res.textureOr(kSpecularBuffers[i], ctx.blackTexture())
+                                 : res.textureOr(kFilteredVideo, ctx.blackTexture()))
+                              .id());
+    // With the footage's own grain matched, what mirrors and glass show of the footage is
+    // taken without its noise: the grain pass adds the noise of the pixel it is seen at
+    // (else the pixel would carry the noise of two places). The noise levels are the
+    // earlier frames' (this frame's are measured after the composite); none on the first.
+    const NoiseMatchOptions& noise = ctx.options.grain.noise;
+    const auto& levels = ctx.grainEstimates.noise();
+    const bool denoise = noise.enabled && noise.footageGrain && levels.has_value();
+    const SpecularKind glassKind = ctx.options.specular.secondExit ? kGlass : kGlassFirstExitOnly;
+    for (const auto& [kind, kindRects] :
+         {std::pair{glassKind, &glassRects}, std::pair{kReflectionOnly, &mirrorRects}}) {
+        if (kindRects->empty()) continue;
+        const SpecularVariant& v = specularVariant(kind);
+        v.program.use();
+        glUniform1f(v.epsilon, ctx.options.specular.backProjectionEpsilon);
+        glUniform1i(v.showVirtual, 1);  // the rectangles are drawn only when showVirtual
+        glUniform1i(v.withCaustics, withCaustics);
+        glUniform1i(v.secondExit, ctx.options.specular.secondExit ? 1 : 0);
+        glUniform1i(v.fuzzyOn, fuzzy ? 1 : 0);
+        glUniform1i(v.denoiseFootage, denoise ? 1 : 0);
+        if (denoise) glUniform3fv(v.noiseVariance, kNoiseLevels, &levels->variance[0].x);
+        ctx.drawFullscreenTriangleIn(*kindRects);  // the pixels the diffuse variant left
+    }
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+}
+
 void CompositePass::execute(FrameContext& ctx, PassResources& res) {
     const bool specular =
         res.has(kSpecularRv) && res.has(kRealSurfaces) && res.has(kReflectionGBuffer);
     // The camera pixels of each specular object's canvas rectangle (the lens map can make two
-    // overlap: merged again).
-    // Those that hold no glass (no refractive rectangle meets them, nor their camera rectangle
-    // another's) take the reflection-only variant.
+    // overlap: merged again), apart for the mirrors' rectangles (no glass meets them, nor their
+    // camera rectangle a glass one's), which take the reflection-only variant.
     std::vector<glm::ivec4> rects, glassRects, mirrorRects;
     if (specular && ctx.options.composite.showVirtual) {
         for (const glm::ivec4& r : ctx.glassSpecularRects) glassRects.push_back(cameraRect(ctx, r));
@@ -306,45 +348,7 @@ void CompositePass::execute(FrameContext& ctx, PassResources& res) {
         glDepthMask(GL_FALSE);
     }
     ctx.drawFullscreenTriangle();
-    if (!rects.empty()) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_GREATER);  // where the mask is 0
-        glDepthMask(GL_FALSE);
-        // Filtered pixels (the video term's a = 1) read the L' buffers through the fuzzy units:
-        // the newest versions, as the sharp units.
-        const bool fuzzy = res.has(kFilteredVideo);
-        for (int i = 0; i < 5; ++i)
-            glBindTextureUnit(GLuint(kUnitCompositeFuzzyRv + i),
-                              (i < 4 ? res.textureOr(kSpecularBuffers[i], ctx.blackTexture())
-                                     : res.textureOr(kFilteredVideo, ctx.blackTexture()))
-                                  .id());
-        // With the footage's own grain matched, what mirrors and glass show of the footage is
-        // taken without its noise: the grain pass adds the noise of the pixel it is seen at
-        // (else the pixel would carry the noise of two places). The noise levels are the
-        // earlier frames' (this frame's are measured after the composite); none on the first.
-        const NoiseMatchOptions& noise = ctx.options.grain.noise;
-        const auto& levels = ctx.grainEstimates.noise();
-        const bool denoise = noise.enabled && noise.footageGrain && levels.has_value();
-        const SpecularKind glassKind =
-            ctx.options.specular.secondExit ? kGlass : kGlassFirstExitOnly;
-        for (const auto& [kind, kindRects] :
-             {std::pair{glassKind, &glassRects}, std::pair{kReflectionOnly, &mirrorRects}}) {
-            if (kindRects->empty()) continue;
-            const SpecularVariant& v = specularVariant(kind);
-            v.program.use();
-            glUniform1f(v.epsilon, ctx.options.specular.backProjectionEpsilon);
-            glUniform1i(v.showVirtual, 1);  // the rectangles are drawn only when showVirtual
-            glUniform1i(v.withCaustics, withCaustics);
-            glUniform1i(v.secondExit, ctx.options.specular.secondExit ? 1 : 0);
-            glUniform1i(v.fuzzyOn, fuzzy ? 1 : 0);
-            glUniform1i(v.denoiseFootage, denoise ? 1 : 0);
-            if (denoise) glUniform3fv(v.noiseVariance, kNoiseLevels, &levels->variance[0].x);
-            ctx.drawFullscreenTriangleIn(*kindRects);  // the pixels the diffuse variant left
-        }
-        glDepthMask(GL_TRUE);
-        glDepthFunc(GL_LESS);
-        glDisable(GL_DEPTH_TEST);
-    }
+    if (!rects.empty()) drawSpecular(ctx, res, glassRects, mirrorRects, withCaustics);
     if (translucentReflection && ctx.options.composite.showVirtual) {
         // The translucent pixels again, with their boundary's reflection (the variant discards
         // every other pixel, so mirror / glass pixels in the rectangles keep theirs).

@@ -47,6 +47,9 @@ private:
               denoiseFootage = -1, noiseVariance = -1;  // footage_noise.glsl
     };
     const SpecularVariant& specularVariant(SpecularKind kind);
+    void drawSpecular(FrameContext& ctx, const PassResources& res,
+                      const std::vector<glm::ivec4>& glassRects,
+                      const std::vector<glm::ivec4>& mirrorRects, int withCaustics);
     SpecularVariant specular_[kSpecularKinds];
     std::string identityDefine_;            // of the variants built
     gl::Program programDiffuse_;            // MIRAGE_DIFFUSE_ONLY: frames without specular objects
