@@ -56,8 +56,9 @@ void main() {
         vec4 a = textureGather(historyRv, puv, 3);
         vec4 held = vec4(greaterThan(a, vec4(0.0)));
         float heldWeight = dot(w, held);
-        float distance = heldWeight > 0.0 ? dot(w, a) / heldWeight : 0.0;
-        if (historyIsSameSurface(distance, P.xyz) && allFinite(hRv.rgb) && allFinite(hR.rgb)) {
+        float storedDistance = heldWeight > 0.0 ? dot(w, a) / heldWeight : 0.0;
+        if (historyIsSameSurface(storedDistance, P.xyz) && allFinite(hRv.rgb) &&
+            allFinite(hR.rgb)) {
             eRv = mix(eRv, max(hRv.rgb, vec3(0.0)), historyWeight);
             eR = mix(eR, max(hR.rgb, vec3(0.0)), historyWeight);
         }

@@ -106,7 +106,8 @@ void main() {
         }
     if (!(sumWA > 0.0) || isinf(sumWA)) return;
     for (int ty = lo.y >> 3; ty <= hi.y >> 3; ++ty)
-        for (int tx = lo.x >> 3; tx <= hi.x >> 3; ++tx) imageStore(photonTiles, ivec2(tx, ty), uvec4(1u));
+        for (int tx = lo.x >> 3; tx <= hi.x >> 3; ++tx)
+            imageStore(photonTiles, ivec2(tx, ty), uvec4(1u));
     vec3 eRv = powerRv * (fixedScale / sumWA), eR = powerR * (fixedScale / sumWA);
     const float kMaxAdd = 268435456.0;  // 2^28: one photon can never wrap a counter
     n = 0;
