@@ -207,7 +207,8 @@ void SpecularLightPass::drawKinds(FrameContext& ctx, const PassResources& res,
                                   int height) {
     for (int kind = 0; kind < kKinds; ++kind) {
         if (rects[kind].empty()) continue;
-        // A kind the scene did not hold when the pass was made (a draw's material changed).
+        // A kind's rectangles come from the scene's draws of that kind, whose variants the
+        // constructor built; built here rather than drawn with no program should that change.
         if (variants[kind].program.id() == 0) {
             buildFull(ctx.scene, kind);
             if (ctx.options.specular.halfResolution) buildHalfResolution(ctx.scene, kind);
