@@ -75,8 +75,10 @@ uniform float historyWeight;  // the history's share; 0: none this frame (Tempor
 // of the other tiles takes its history as it is where the history holds this frame's hits (the
 // light at a hit does not depend on where it is seen from; the Fresnel weight changes little over
 // the frames a tile waits) and is shaded where it does not (a disocclusion, a hit that moved
-// more than 0.5 mm: sameHitForReuse). Tiles of
-// 8x8 so that a SIMD group of llvmpipe (and a GPU's warp) skips the shading as a whole.
+// more than 0.5 mm: sameHitForReuse). Tiles of 8x8 so that a SIMD group (a GPU's warp, llvmpipe's
+// 4x4 block) is shaded or not as a whole: a GPU then skips the shading; llvmpipe runs its
+// straight-line code anyway and skips only its loops (lights, VPLs, photons) once no lane is in
+// them.
 uniform int refreshInterval;  // 1, 2 or 4; 1 also where the history cannot be used this frame
 uniform int refreshPhase;     // this frame's tiles: frame index mod refreshInterval
 // Last frame's smoothed L'_rv (a = the specular surface's camera distance, m; 0: no specular
