@@ -171,13 +171,11 @@ const int kUnitResolveAlbedo = 2;
 const int kUnitResolveEmissive = 3;
 const int kUnitResolveHistoryRv = 4;  // last frame's caustic irradiance (temporal history)
 const int kUnitResolveHistoryR = 5;
-// The tiles where this frame's history is not 0 (r32ui image, the next frame's classification).
+// Per 8x8 tile of this frame's history (r32ui images, the next frame's choice of tiles): 1 where
+// it is not 0; the nearest and farthest camera distance resolved there.
 const int kImageCausticHistoryTiles = 0;
-// caustic_classify.frag: the pixels the resolve must shade.
-const int kUnitClassifyPosition = 0;
-const int kUnitClassifyEmissive = 1;
-const int kUnitClassifyPhotonTiles = 2;   // this frame's (kImageCausticPhotonTiles)
-const int kUnitClassifyHistoryTiles = 3;  // last frame's (kImageCausticHistoryTiles)
+const int kImageCausticHistoryNear = 1;
+const int kImageCausticHistoryFar = 2;
 
 // composite.frag
 const int kUnitCompositeCamera = 0;

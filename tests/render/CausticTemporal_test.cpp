@@ -262,18 +262,18 @@ TEST_F(CausticTemporal, ResetRulesGiveTheFrameOfARendererWithoutHistory) {
     EXPECT_LT(cv::norm(causticLuminance(off), expected, cv::NORM_INF) / peak, 1e-3);
 }
 
-// The resolve shades only the pixels in the tiles the photons reached or whose history holds
-// light (caustic_classify.frag); the rest keep 0. Over a camera that walks sideways and jitters,
+// The resolve shades only the tiles the photons reached or where last frame's lit history can
+// pass (CausticTiles.h); the rest keep 0. Over a camera that walks sideways and jitters,
 // splatting every other frame (the frames between take the history alone), the caustic must be
-// the frames of a resolve on every pixel. The must-fail: a mask without the history's tiles
-// loses the caustic of the frames that only reuse it.
-TEST_F(CausticTemporal, TheMaskedResolveGivesTheFramesOfAResolveOnEveryPixel) {
+// the frames of a resolve on every pixel. The must-fail: tiles without the history's loses the
+// caustic of the frames that only reuse it.
+TEST_F(CausticTemporal, TheTiledResolveGivesTheFramesOfAResolveOnEveryPixel) {
     const test::CausticScene s = test::makeCausticScene({});
     auto run = [&](bool everywhere, bool ignoreHistory) {
         RendererOptions o = options(true);
         o.caustic.refreshInterval = 2;
         o.caustic.resolveEverywhere = everywhere;
-        o.caustic.maskIgnoresHistory = ignoreHistory;
+        o.caustic.tilesIgnoreHistory = ignoreHistory;
         Renderer r(s.scene, s.cam, o);
         std::vector<cv::Mat> frames;
         for (int k = 0; k < 6; ++k) {
@@ -285,7 +285,7 @@ TEST_F(CausticTemporal, TheMaskedResolveGivesTheFramesOfAResolveOnEveryPixel) {
         }
         return frames;
     };
-    const std::vector<cv::Mat> everywhere = run(true, false), masked = run(false, false),
+    const std::vector<cv::Mat> everywhere = run(true, false), tiled = run(false, false),
                                broken = run(false, true);
     double worst = 0.0, worstBroken = 0.0;
     for (size_t k = 0; k < everywhere.size(); ++k) {
@@ -294,14 +294,13 @@ TEST_F(CausticTemporal, TheMaskedResolveGivesTheFramesOfAResolveOnEveryPixel) {
         cv::minMaxLoc(want, nullptr, &peak);
         ASSERT_GT(peak, 0.0) << "frame " << k << " has no caustic";
         worst =
-            std::max(worst, cv::norm(test::linearLuminance(masked[k]), want, cv::NORM_INF) / peak);
+            std::max(worst, cv::norm(test::linearLuminance(tiled[k]), want, cv::NORM_INF) / peak);
         worstBroken = std::max(
             worstBroken, cv::norm(test::linearLuminance(broken[k]), want, cv::NORM_INF) / peak);
     }
-    std::cout << "[ caustic ] largest difference of the masked resolve to the resolve on every "
+    std::cout << "[ caustic ] largest difference of the tiled resolve to the resolve on every "
                  "pixel, relative to the frame's peak: "
-              << worst << "; with the history's tiles left out of the mask (must fail) "
-              << worstBroken << "\n";
+              << worst << "; with the history's tiles left out (must fail) " << worstBroken << "\n";
     EXPECT_LT(worst, 1e-3);
     EXPECT_GT(worstBroken, 0.5);
 }

@@ -52,12 +52,12 @@ struct CausticOptions {
     // frame.
     int refreshInterval = 1;
     // Tests only: true resolves every canvas pixel, instead of only those in the 8x8 tiles the
-    // photons reached this frame or whose history is not 0 (caustic_classify.frag; the same
-    // images: every other pixel's caustic is 0).
+    // photons reached this frame or where last frame's history can pass (CausticTiles.h; the
+    // same images: every other pixel's caustic is 0).
     bool resolveEverywhere = false;
-    // Tests only: true leaves the history's tiles out of that mask (a caustic kept by the
+    // Tests only: true leaves the history's tiles out of that choice (a caustic kept by the
     // history alone, in a frame that reuses it, is lost).
-    bool maskIgnoresHistory = false;
+    bool tilesIgnoreHistory = false;
 
     void validate() const {
         checkOption(mapSize >= 16 && mapSize <= 2048 && mapSize % 8 == 0, "caustic.mapSize",

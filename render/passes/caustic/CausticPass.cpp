@@ -11,8 +11,13 @@ namespace mirage::render {
 
 CausticPass::CausticPass()
     : splat_(computeProgram("caustic splat", "passes/caustic/caustic_splat.comp")),
-      classify_(fullscreenProgram("caustic pixel mask", "passes/caustic/caustic_classify.frag")),
-      resolve_(fullscreenProgram("caustic resolve", "passes/caustic/caustic_resolve.frag")) {}
+      resolve_(rasterProgram("caustic resolve", "passes/caustic/caustic_tiles.vert",
+                             "passes/caustic/caustic_resolve.frag")),
+      tileVao_("caustic tiles") {
+    glEnableVertexArrayAttrib(tileVao_.id(), 0);
+    glVertexArrayAttribFormat(tileVao_.id(), 0, 2, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(tileVao_.id(), 0, 0);
+}
 
 namespace {
 // The history's share this frame: RendererOptions::temporalBlend where caustics are smoothed.
@@ -59,13 +64,17 @@ void CausticPass::resize(const FrameContext& ctx) {
     const int tw = (w + 7) / 8, th = (h + 7) / 8;
     photonTiles_ = gl::Texture::create2D("caustic photon tiles", tw, th, GL_R32UI);
     photonTiles_.setFilter(GL_NEAREST, GL_NEAREST);
-    resolveMask_ = gl::Texture::create2D("caustic pixel mask", w, h, GL_DEPTH_COMPONENT32F);
-    maskFbo_ = gl::Framebuffer("caustic pixel mask fbo");
-    maskFbo_.attachDepth(resolveMask_);
-    maskFbo_.finalize(0);
+    tileMarks_.assign(std::size_t(tw) * std::size_t(th), 0);
+    // Every tile a run of its own at worst: six vertices each.
+    tileVertices_ =
+        gl::Buffer("caustic tile quads", std::size_t(tw) * std::size_t(th) * 6 * sizeof(glm::vec2));
+    glVertexArrayVertexBuffer(tileVao_.id(), 0, tileVertices_.id(), 0, sizeof(glm::vec2));
     for (int i = 0; i < 2; ++i) {
         historyTiles_[i] = gl::Texture::create2D("caustic history tiles", tw, th, GL_R32UI);
-        historyTiles_[i].setFilter(GL_NEAREST, GL_NEAREST);
+        historyNear_[i] = gl::Texture::create2D("caustic history near", tw, th, GL_R32UI);
+        historyFar_[i] = gl::Texture::create2D("caustic history far", tw, th, GL_R32UI);
+        for (gl::Texture* t : {&historyTiles_[i], &historyNear_[i], &historyFar_[i]})
+            t->setFilter(GL_NEAREST, GL_NEAREST);
         // 32-bit: alpha holds the camera distance the history test compares (temporal.glsl).
         historyRv_[i] =
             gl::Texture::create2D("caustic irradiance L_rv (history)", w, h, GL_RGBA32F);
@@ -78,7 +87,6 @@ void CausticPass::resize(const FrameContext& ctx) {
         fbo_[i].attachColor(1, r_);
         fbo_[i].attachColor(2, historyRv_[i]);
         fbo_[i].attachColor(3, historyR_[i]);
-        fbo_[i].attachDepth(resolveMask_);
         fbo_[i].finalize(4);
     }
     history_.drop();  // new buffers hold no history
@@ -116,7 +124,8 @@ void CausticPass::splat(FrameContext& ctx, PassResources& res, float fixedScale)
     glUniform1f(splat_.uniformLocation("quadScale"), ctx.options.caustic.quadScale);
     glUniform1f(splat_.uniformLocation("fixedScale"), fixedScale);
     glDispatchCompute(GLuint((s + 7) / 8), GLuint((s + 7) / 8), GLuint(2 * ctx.plan.causticLayers));
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);  // the tiles are read back
 }
 
 // invFixedScale 0: the caustic buffer counts for nothing (a reuse frame: its counters are an
@@ -125,31 +134,22 @@ void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedS
     const int write = history_.writeSlot(), read = history_.readSlot();
     const float blend = reuse ? 1.0f : causticBlend(ctx);
     const bool useHistory = history_.usable(ctx, blend);
-    // The pixels to shade: depth 0 in resolveMask_.
-    maskFbo_.bind();
-    ctx.beginFullscreen(classify_, width_, height_);
-    glBindTextureUnit(kUnitClassifyPosition, res.texture(kGBufferPosition).id());
-    glBindTextureUnit(kUnitClassifyEmissive, res.texture(kGBufferEmissive).id());
-    glBindTextureUnit(kUnitClassifyPhotonTiles, photonTiles_.id());
-    glBindTextureUnit(kUnitClassifyHistoryTiles, historyTiles_[read].id());
-    glUniform1i(classify_.uniformLocation("usePhotons"), reuse ? 0 : 1);
-    glUniform1i(classify_.uniformLocation("useHistory"),
-                useHistory && !ctx.options.caustic.maskIgnoresHistory ? 1 : 0);
-    glUniform1i(classify_.uniformLocation("everywhere"),
-                ctx.options.caustic.resolveEverywhere ? 1 : 0);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_ALWAYS);
-    glDepthMask(GL_TRUE);
-    ctx.drawFullscreenTriangle();
-    // Every pixel 0 (the ones not shaded keep it), then the marked pixels resolved.
-    const GLuint zero = 0;
+    const int vertices = chooseTiles(ctx, !reuse, useHistory);
+    // Every pixel 0 (the ones not drawn keep it), then the chosen tiles resolved.
+    const GLuint zero = 0, none = 0xFFFFFFFFu;
     glClearTexImage(historyTiles_[write].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glClearTexImage(historyNear_[write].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &none);
+    glClearTexImage(historyFar_[write].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     fbo_[write].bind();
     ctx.beginFullscreen(resolve_, width_, height_);
     const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int i = 0; i < 4; ++i) glClearBufferfv(GL_COLOR, i, clear);
     glBindImageTexture(kImageCausticHistoryTiles, historyTiles_[write].id(), 0, GL_FALSE, 0,
                        GL_WRITE_ONLY, GL_R32UI);
+    glBindImageTexture(kImageCausticHistoryNear, historyNear_[write].id(), 0, GL_FALSE, 0,
+                       GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kImageCausticHistoryFar, historyFar_[write].id(), 0, GL_FALSE, 0,
+                       GL_READ_WRITE, GL_R32UI);
     glBindTextureUnit(kUnitResolveAccum, accum_.id());
     glBindTextureUnit(kUnitResolvePosition, res.texture(kGBufferPosition).id());
     glBindTextureUnit(kUnitResolveAlbedo, res.texture(kGBufferAlbedo).id());
@@ -158,20 +158,61 @@ void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedS
     glBindTextureUnit(kUnitResolveHistoryR, historyR_[read].id());
     glUniform1f(resolve_.uniformLocation("invFixedScale"), invFixedScale);
     glUniform1f(resolve_.uniformLocation("historyWeight"), useHistory ? blend : 0.0f);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);  // the triangle lies at depth 0.5: where the mask is 0
-    glDepthMask(GL_FALSE);
-    ctx.drawFullscreenTriangle();
-    glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_DEPTH_TEST);
-    // The next frame's classification reads the history tiles.
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    if (vertices > 0) {
+        tileVao_.bind();
+        glDrawArrays(GL_TRIANGLES, 0, vertices);
+    }
+    // The next frame reads the history tiles back.
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);  // the tiles are read back
     history_.written(ctx);
     res.publish(kCausticHistoryRv, historyRv_[write]);
     res.publish(kCausticHistoryR, historyR_[write]);
     res.publish(kCausticRv, rv_);
     res.publish(kCausticR, r_);
+}
+
+int CausticPass::chooseTiles(const FrameContext& ctx, bool photons, bool history) {
+    const int tw = (width_ + kCausticTileSize - 1) / kCausticTileSize;
+    const int th = (height_ + kCausticTileSize - 1) / kCausticTileSize;
+    const std::size_t tiles = std::size_t(tw) * std::size_t(th);
+    const GLsizei bytes = GLsizei(tiles * sizeof(std::uint32_t));
+    if (ctx.options.caustic.resolveEverywhere) {
+        std::fill(tileMarks_.begin(), tileMarks_.end(), std::uint8_t(1));
+    } else {
+        std::fill(tileMarks_.begin(), tileMarks_.end(), std::uint8_t(0));
+        // The reads wait for the splat (this frame) and last frame's resolve, both done by now.
+        if (photons) {
+            readback_.resize(tiles);
+            glGetTextureImage(photonTiles_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                              readback_.data());
+            for (std::size_t i = 0; i < tiles; ++i)
+                if (readback_[i] != 0u) tileMarks_[i] = 1;
+        }
+        if (history && !ctx.options.caustic.tilesIgnoreHistory) {
+            const int read = history_.readSlot();
+            CausticHistoryTiles& h = lastHistory_;
+            h.tilesX = tw;
+            h.tilesY = th;
+            h.lit.resize(tiles);
+            h.nearM.resize(tiles);
+            h.farM.resize(tiles);
+            glGetTextureImage(historyTiles_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                              h.lit.data());
+            // r32ui images holding the bits of positive floats (an empty tile: near all ones,
+            // a NaN, and far 0: near > far fails as markHistoryTiles expects).
+            glGetTextureImage(historyNear_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                              h.nearM.data());
+            glGetTextureImage(historyFar_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                              h.farM.data());
+            const CausticReprojection cameras{ctx.frame.viewProj, ctx.frame.prevViewProj,
+                                              glm::vec3(ctx.frame.prevCameraPos), width_, height_};
+            markHistoryTiles(h, cameras, tileMarks_);
+        }
+    }
+    const std::vector<glm::vec2> quads = tileQuads(tileMarks_, tw, th, width_, height_);
+    if (!quads.empty()) tileVertices_.upload(quads.data(), quads.size() * sizeof(glm::vec2));
+    return int(quads.size());
 }
 
 // Registered in render/PassList.cpp.

@@ -5,11 +5,12 @@
 // resolved into the caustic radiance the receivers reflect, routed into L_rv and L_r by Eqs.
 // 12-14. The composite adds CausticRv / CausticR to the GI solutions. The irradiance is
 // smoothed over time before the routing (RendererOptions::caustic.temporal): two canvas-size
-// buffers ping-pong as this frame's result and the next frame's history. Only the pixels the
-// caustic can reach are resolved (the tiles the photons reached and those the history holds,
-// caustic_classify.frag); the rest are cleared to 0.
+// buffers ping-pong as this frame's result and the next frame's history. Only the tiles the
+// caustic can reach are resolved (the tiles the photons reached and those where last frame's
+// history can pass, CausticTiles.h), drawn as quads; the rest are cleared to 0.
 #include "render/RenderPass.h"
 #include "render/TemporalHistory.h"
+#include "render/passes/caustic/CausticTiles.h"
 
 namespace mirage::render {
 
@@ -37,14 +38,19 @@ private:
     bool reusesHistory(const FrameContext& ctx) const;
     void splat(FrameContext& ctx, PassResources& res, float fixedScale);
     void resolve(FrameContext& ctx, PassResources& res, float invFixedScale, bool reuse);
+    // The tiles this frame's resolve draws (CausticTiles.h), as quads in tileVertices_.
+    int chooseTiles(const FrameContext& ctx, bool photons, bool history);
 
-    gl::Program splat_, classify_, resolve_;
+    gl::Program splat_, resolve_;
     gl::Texture accum_, rv_, r_;
-    // The 8x8-pixel tiles the photons reached this frame, and where each history slot is not 0
-    // (r32ui, 1 = yes): caustic_classify.frag turns them into resolveMask_, the resolve's depth
-    // (0: shade the pixel, 1: it holds no caustic).
-    gl::Texture photonTiles_, historyTiles_[2], resolveMask_;
-    gl::Framebuffer maskFbo_;
+    // The 8x8-pixel tiles the photons reached this frame, and per history slot where it is not
+    // 0 and the camera distance range of its resolved pixels (r32ui images, read back).
+    gl::Texture photonTiles_, historyTiles_[2], historyNear_[2], historyFar_[2];
+    gl::Buffer tileVertices_;  // vec2 NDC, six per run of tiles
+    gl::VertexArray tileVao_;
+    std::vector<std::uint8_t> tileMarks_;  // this frame's tiles, row-major
+    CausticHistoryTiles lastHistory_;      // last frame's tiles, read back
+    std::vector<std::uint32_t> readback_;
     // Smoothed irradiance for L_rv / L_r, a = camera distance (m); [history_.writeSlot()] is
     // written this frame and read as history by the next.
     gl::Texture historyRv_[2], historyR_[2];

@@ -11,10 +11,9 @@
 // frame's irradiance is reprojected by the receiver's world position and blended in where it is
 // the same surface (temporal.glsl); irradiance, not radiance, is kept, so that a textured
 // receiver's albedo is never blurred by the bilinear lookup. Linear radiance, canvas size.
-// Only the pixels caustic_classify.frag marks run (early depth test against its mask); every other
-// pixel keeps the cleared 0, in the light and in the history alike.
-layout(early_fragment_tests) in;
-in vec2 uv;
+// Only the tiles the caustic can reach are drawn (CausticTiles.h: the photons' tiles and where
+// last frame's history can pass); every other pixel keeps the cleared 0, in the light and in the
+// history alike.
 layout(binding = kUnitResolveAccum) uniform usampler2DArray accum;
 layout(binding = kUnitResolvePosition) uniform sampler2D gPosition;  // w = origin
 layout(binding = kUnitResolveAlbedo) uniform sampler2D gAlbedo;      // rgb, a = metallic
@@ -22,8 +21,12 @@ layout(binding = kUnitResolveEmissive) uniform sampler2D gEmissive;  // a = spec
 // Last frame's smoothed irradiance (W/m^2) for L_rv / L_r, a = camera distance (m), 0: none.
 layout(binding = kUnitResolveHistoryRv) uniform sampler2D historyRv;
 layout(binding = kUnitResolveHistoryR) uniform sampler2D historyR;
-// The tiles where the history written here is not 0, for the next frame's classification.
+// Per 8x8 tile, for the next frame's choice of tiles (CausticTiles.h): 1 where the history
+// written here is not 0, and the nearest and farthest camera distance of the pixels resolved
+// (floatBitsToUint of a positive float: its order is the float's).
 layout(r32ui, binding = kImageCausticHistoryTiles) uniform writeonly uimage2D historyTilesOut;
+layout(r32ui, binding = kImageCausticHistoryNear) uniform uimage2D historyNearOut;
+layout(r32ui, binding = kImageCausticHistoryFar) uniform uimage2D historyFarOut;
 uniform float invFixedScale;
 uniform float historyWeight;  // the history's share; 0: none this frame (TemporalHistory)
 layout(location = 0) out vec4 outRv;
@@ -67,5 +70,7 @@ void main() {
     outHistoryRv = vec4(eRv, camDist);
     outHistoryR = vec4(eR, camDist);
     if (any(greaterThan(max(eRv, eR), vec3(0.0)))) imageStore(historyTilesOut, px >> 3, uvec4(1u));
+    imageAtomicMin(historyNearOut, px >> 3, floatBitsToUint(camDist));
+    imageAtomicMax(historyFarOut, px >> 3, floatBitsToUint(camDist));
     causticRadiance(eRv, eR, A.rgb, A.a, origin == ORIGIN_REAL, outRv.rgb, outR.rgb);
 }
