@@ -305,6 +305,47 @@ TEST_F(CausticTemporal, TheTiledResolveGivesTheFramesOfAResolveOnEveryPixel) {
     EXPECT_GT(worstBroken, 0.5);
 }
 
+// The live loop renders one camera frame in several, and a hand-held camera turns by tens of
+// degrees between them. A frame the refresh interval would let reuse the history splats when
+// much of its view is new: a caustic that comes into view shows at once. The must-fail: reusing
+// whatever the motion loses it until the next refresh.
+TEST_F(CausticTemporal, ACausticComingIntoViewIsSplattedAtOnce) {
+    const test::CausticScene s = test::makeCausticScene({});
+    // From the same place, turned away from the sphere and its caustic.
+    const Pose away = test::lookAtPose({-0.8, 0.6, 0.6}, {0.6, 0.05, 1.2});
+    auto run = [&](float maxNewView, std::string& reason) {
+        RendererOptions o = options(true);
+        o.caustic.refreshInterval = 4;
+        o.caustic.reuseMaxNewView = maxNewView;
+        Renderer r(s.scene, s.cam, o);
+        r.render({away, cv::Mat(), true});
+        r.render({s.pose, cv::Mat(), false});
+        reason = passReason(r.lastReport(), "caustic");
+        return causticLuminance(r);
+    };
+    std::string reason, brokenReason;
+    const cv::Mat guarded = run(0.02f, reason), broken = run(1.0f, brokenReason);
+    Renderer fresh(s.scene, s.cam, options(true));
+    fresh.render({s.pose, cv::Mat(), true});
+    const cv::Mat expected = causticLuminance(fresh);
+    double peak = 0;
+    cv::minMaxLoc(expected, nullptr, &peak);
+    ASSERT_GT(peak, 0.0);
+    const cv::Mat caustic = expected > 0.1 * peak;
+    ASSERT_GT(cv::countNonZero(caustic), 20);
+    const double expectedMean = cv::mean(expected, caustic)[0];
+    const double ratio = cv::mean(guarded, caustic)[0] / expectedMean;
+    const double brokenRatio = cv::mean(broken, caustic)[0] / expectedMean;
+    std::cout
+        << "[ caustic ] turned towards the caustic in a frame that would reuse: caustic level "
+        << "x" << ratio << " of a renderer without history (" << reason
+        << "); reusing whatever the motion x" << brokenRatio << " (must fail)\n";
+    EXPECT_NE(reason.find("% of the view new since last frame"), std::string::npos) << reason;
+    EXPECT_NE(brokenReason.find("reprojected"), std::string::npos) << brokenReason;
+    EXPECT_NEAR(ratio, 1.0, 0.05);
+    EXPECT_LT(brokenRatio, 0.5);
+}
+
 TEST_F(CausticTemporal, MovedObjectsDropTheHistory) {
     const test::CausticScene s = test::makeCausticScene({});
     Scene moved = s.scene;

@@ -136,8 +136,9 @@ Outcome check(const View& last, const View& now, bool reprojectTiles) {
     const History h = resolveLastFrame(last);
     std::vector<std::uint8_t> marks(h.tiles.lit.size(), 0);
     if (reprojectTiles) {
-        markHistoryTiles(h.tiles, {now.viewProj, last.viewProj, last.position, kWidth, kHeight},
-                         marks);
+        markHistoryTiles(
+            h.tiles, {now.viewProj, last.viewProj, last.position, kWidth, kHeight, now.position},
+            marks);
     } else {  // the broken choice: last frame's lit tiles where they were
         for (std::size_t i = 0; i < marks.size(); ++i) marks[i] = h.tiles.lit[i] ? 1 : 0;
     }
@@ -188,8 +189,30 @@ TEST(CausticTiles, ASlabReachingBehindTheCameraMarksEveryTile) {
         glm::lookAt(eye, eye + glm::vec3(0.0f, 0.2f, -1.0f), glm::vec3(0.0f, 1.0f, 0.0f));
     const History h = resolveLastFrame(last);
     std::vector<std::uint8_t> marks(h.tiles.lit.size(), 0);
-    markHistoryTiles(h.tiles, {vp, last.viewProj, last.position, kWidth, kHeight}, marks);
+    markHistoryTiles(h.tiles, {vp, last.viewProj, last.position, kWidth, kHeight, eye}, marks);
     for (auto m : marks) ASSERT_EQ(m, 1);
+}
+
+// The share of a view that the view before did not show, at the receivers' distances.
+TEST(CausticTiles, NewViewShareGrowsWithTheTurnAndIsZeroStandingStill) {
+    const View last = orbitView(0.0f, 0.35f, 0.45f);
+    const auto share = [&](const View& now) {
+        return newViewShare(
+            {now.viewProj, last.viewProj, last.position, kWidth, kHeight, now.position}, 0.4f,
+            0.7f);
+    };
+    EXPECT_EQ(share(last), 0.0f);
+    // 1 mm aside (the tracking's jitter): nothing new.
+    EXPECT_EQ(share(orbitView(0.13f, 0.35f, 0.45f)), 0.0f);
+    const float turned5 = share(orbitView(5.0f, 0.35f, 0.45f, glm::vec3(0.03f, 0.0f, 0.0f)));
+    const float turned33 = share(orbitView(33.0f, 0.35f, 0.45f, glm::vec3(0.15f, 0.0f, 0.0f)));
+    std::cout << "[ caustic tiles ] new share of the view: turned 5 deg " << turned5 << ", 33 deg "
+              << turned33 << "\n";
+    EXPECT_GT(turned5, 0.02f);
+    EXPECT_LT(turned5, turned33);
+    EXPECT_GT(turned33, 0.3f);
+    // From the same place, looking the other way: all of it.
+    EXPECT_EQ(share(orbitView(0.0f, 0.35f, 0.45f, glm::vec3(0.0f, 0.35f, 0.9f))), 1.0f);
 }
 
 TEST(CausticTiles, QuadsCoverTheMarkedTilesAndNothingElse) {

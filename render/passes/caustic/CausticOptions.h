@@ -51,6 +51,12 @@ struct CausticOptions {
     // refresh; a frame that drops the history (first frame, cut, objects moved) splats. 1: every
     // frame.
     int refreshInterval = 1;
+    // A frame reuses the history only while at most this share of its view is new against last
+    // frame's (CausticTiles.h newViewShare, at the caustic receivers' distances): a caustic that
+    // comes into view is splatted at once instead of missing until the next refresh. The live
+    // loop renders one camera frame in several, between which a hand-held camera turns by tens
+    // of degrees. 1: reuse whatever the motion.
+    float reuseMaxNewView = 0.02f;
     // Tests only: true resolves every canvas pixel, instead of only those in the 8x8 tiles the
     // photons reached this frame or where last frame's history can pass (CausticTiles.h; the
     // same images: every other pixel's caustic is 0).
@@ -70,6 +76,8 @@ struct CausticOptions {
                     "0 (all photons) or 1..1048576 photons per bucket", gatherCap);
         checkOption(refreshInterval >= 1 && refreshInterval <= 8, "caustic.refreshInterval",
                     "1..8 frames", refreshInterval);
+        checkOption(reuseMaxNewView >= 0.0f && reuseMaxNewView <= 1.0f, "caustic.reuseMaxNewView",
+                    "a share of the view in [0, 1]", reuseMaxNewView);
     }
 };
 

@@ -1,6 +1,7 @@
 #include "render/passes/caustic/CausticPass.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "render/FrameGraph.h"
 #include "render/PassRegistry.h"
@@ -37,9 +38,35 @@ void CausticPass::setup(PassBuilder& b) const {
     b.create(kCausticHistoryR, {GL_RGBA32F, SizeRule::Canvas, Storage::Persistent});
 }
 
-bool CausticPass::reusesHistory(const FrameContext& ctx) const {
+CausticReprojection CausticPass::cameras(const FrameContext& ctx) const {
+    return {ctx.frame.viewProj, ctx.frame.prevViewProj, glm::vec3(ctx.frame.prevCameraPos),
+            ctx.canvasWidth(),  ctx.canvasHeight(),     glm::vec3(ctx.frame.cameraPos)};
+}
+
+bool CausticPass::intervalAllowsReuse(const FrameContext& ctx) const {
     const int interval = ctx.options.caustic.refreshInterval;
     return interval > 1 && framesSinceSplat_ + 1 < interval && history_.usable(ctx, 1.0f);
+}
+
+float CausticPass::newViewShare(const FrameContext& ctx) const {
+    // At the camera distances of last frame's caustic (its lit tiles), else of whatever it
+    // resolved, else a wide guess.
+    const CausticHistoryTiles& h = lastHistory(ctx);
+    float near[2] = {INFINITY, INFINITY}, far[2] = {0.0f, 0.0f};
+    for (std::size_t i = 0; i < h.lit.size(); ++i) {
+        if (!(h.nearM[i] <= h.farM[i])) continue;
+        const int k = h.lit[i] != 0u ? 0 : 1;
+        near[k] = std::min(near[k], h.nearM[i]);
+        far[k] = std::max(far[k], h.farM[i]);
+    }
+    for (int k = 0; k < 2; ++k)
+        if (near[k] <= far[k]) return render::newViewShare(cameras(ctx), near[k], far[k]);
+    return render::newViewShare(cameras(ctx), 0.2f, 5.0f);
+}
+
+bool CausticPass::reusesHistory(const FrameContext& ctx) const {
+    return intervalAllowsReuse(ctx) && (ctx.options.caustic.reuseMaxNewView >= 1.0f ||
+                                        newViewShare(ctx) <= ctx.options.caustic.reuseMaxNewView);
 }
 
 PassDecision CausticPass::decide(const FrameContext& ctx) const {
@@ -47,8 +74,12 @@ PassDecision CausticPass::decide(const FrameContext& ctx) const {
     if (reusesHistory(ctx))
         return {true, "last frame's caustic reprojected (photons splatted every " +
                           std::to_string(ctx.options.caustic.refreshInterval) + " frames)"};
+    std::string why;
+    if (intervalAllowsReuse(ctx))
+        why = " (" + std::to_string(int(std::lround(100.0f * newViewShare(ctx)))) +
+              " % of the view new since last frame)";
     return {true, "photon quads of " + std::to_string(ctx.plan.causticLayers) +
-                      " light(s) splatted (compute, atomics), " +
+                      " light(s) splatted (compute, atomics)" + why + ", " +
                       history_.note(ctx, causticBlend(ctx))};
 }
 
@@ -90,6 +121,7 @@ void CausticPass::resize(const FrameContext& ctx) {
         fbo_[i].finalize(4);
     }
     history_.drop();  // new buffers hold no history
+    historyReadFrame_ = -1;
 }
 
 void CausticPass::execute(FrameContext& ctx, PassResources& res) {
@@ -172,6 +204,32 @@ void CausticPass::resolve(FrameContext& ctx, PassResources& res, float invFixedS
     res.publish(kCausticR, r_);
 }
 
+const CausticHistoryTiles& CausticPass::lastHistory(const FrameContext& ctx) const {
+    if (historyReadFrame_ == ctx.frameIndex) return lastHistory_;
+    historyReadFrame_ = ctx.frameIndex;
+    const int tw = (width_ + kCausticTileSize - 1) / kCausticTileSize;
+    const int th = (height_ + kCausticTileSize - 1) / kCausticTileSize;
+    const std::size_t tiles = std::size_t(tw) * std::size_t(th);
+    const GLsizei bytes = GLsizei(tiles * sizeof(std::uint32_t));
+    const int read = history_.readSlot();
+    CausticHistoryTiles& h = lastHistory_;
+    h.tilesX = tw;
+    h.tilesY = th;
+    h.lit.resize(tiles);
+    h.nearM.resize(tiles);
+    h.farM.resize(tiles);
+    // Last frame's resolve has finished: the read waits for nothing.
+    glGetTextureImage(historyTiles_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                      h.lit.data());
+    // r32ui images holding the bits of positive floats (an empty tile: near all ones, a NaN, and
+    // far 0: near > far fails as markHistoryTiles expects).
+    glGetTextureImage(historyNear_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                      h.nearM.data());
+    glGetTextureImage(historyFar_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
+                      h.farM.data());
+    return h;
+}
+
 int CausticPass::chooseTiles(const FrameContext& ctx, bool photons, bool history) {
     const int tw = (width_ + kCausticTileSize - 1) / kCausticTileSize;
     const int th = (height_ + kCausticTileSize - 1) / kCausticTileSize;
@@ -189,26 +247,8 @@ int CausticPass::chooseTiles(const FrameContext& ctx, bool photons, bool history
             for (std::size_t i = 0; i < tiles; ++i)
                 if (readback_[i] != 0u) tileMarks_[i] = 1;
         }
-        if (history && !ctx.options.caustic.tilesIgnoreHistory) {
-            const int read = history_.readSlot();
-            CausticHistoryTiles& h = lastHistory_;
-            h.tilesX = tw;
-            h.tilesY = th;
-            h.lit.resize(tiles);
-            h.nearM.resize(tiles);
-            h.farM.resize(tiles);
-            glGetTextureImage(historyTiles_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
-                              h.lit.data());
-            // r32ui images holding the bits of positive floats (an empty tile: near all ones,
-            // a NaN, and far 0: near > far fails as markHistoryTiles expects).
-            glGetTextureImage(historyNear_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
-                              h.nearM.data());
-            glGetTextureImage(historyFar_[read].id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
-                              h.farM.data());
-            const CausticReprojection cameras{ctx.frame.viewProj, ctx.frame.prevViewProj,
-                                              glm::vec3(ctx.frame.prevCameraPos), width_, height_};
-            markHistoryTiles(h, cameras, tileMarks_);
-        }
+        if (history && !ctx.options.caustic.tilesIgnoreHistory)
+            markHistoryTiles(lastHistory(ctx), cameras(ctx), tileMarks_);
     }
     const std::vector<glm::vec2> quads = tileQuads(tileMarks_, tw, th, width_, height_);
     if (!quads.empty()) tileVertices_.upload(quads.data(), quads.size() * sizeof(glm::vec2));

@@ -34,8 +34,16 @@ public:
     void execute(FrameContext& ctx, PassResources& res) override;
 
 private:
-    // This frame takes last frame's caustic instead of splatting (CausticOptions::refreshInterval).
+    // This frame takes last frame's caustic instead of splatting (CausticOptions::refreshInterval
+    // and reuseMaxNewView).
     bool reusesHistory(const FrameContext& ctx) const;
+    // The refresh interval alone would reuse the history this frame.
+    bool intervalAllowsReuse(const FrameContext& ctx) const;
+    // The share of this frame's view that last frame's did not show (CausticTiles.h).
+    float newViewShare(const FrameContext& ctx) const;
+    CausticReprojection cameras(const FrameContext& ctx) const;
+    // Last frame's history tiles (only while its history is usable: the textures exist).
+    const CausticHistoryTiles& lastHistory(const FrameContext& ctx) const;
     void splat(FrameContext& ctx, PassResources& res, float fixedScale);
     void resolve(FrameContext& ctx, PassResources& res, float invFixedScale, bool reuse);
     // The tiles this frame's resolve draws (CausticTiles.h), as quads in tileVertices_.
@@ -49,7 +57,10 @@ private:
     gl::Buffer tileVertices_;  // vec2 NDC, six per run of tiles
     gl::VertexArray tileVao_;
     std::vector<std::uint8_t> tileMarks_;  // this frame's tiles, row-major
-    CausticHistoryTiles lastHistory_;      // last frame's tiles, read back
+    // Last frame's history tiles, read back once per frame (by decide() or the resolve,
+    // whichever asks first: the cache is mutable).
+    mutable CausticHistoryTiles lastHistory_;
+    mutable int historyReadFrame_ = -1;
     std::vector<std::uint32_t> readback_;
     // Smoothed irradiance for L_rv / L_r, a = camera distance (m); [history_.writeSlot()] is
     // written this frame and read as history by the next.

@@ -107,6 +107,33 @@ void markHistoryTiles(const CausticHistoryTiles& history, const CausticReproject
         }
 }
 
+float newViewShare(const CausticReprojection& cameras, float nearM, float farM) {
+    constexpr int kGridX = 16, kGridY = 12;
+    const float w = float(cameras.width), h = float(cameras.height);
+    const glm::mat4 inv = glm::inverse(cameras.viewProj);
+    int fresh = 0;
+    for (int gy = 0; gy < kGridY; ++gy)
+        for (int gx = 0; gx < kGridX; ++gx) {
+            const glm::vec2 ndc((float(gx) + 0.5f) / kGridX * 2.0f - 1.0f,
+                                (float(gy) + 0.5f) / kGridY * 2.0f - 1.0f);
+            const glm::vec4 p = inv * glm::vec4(ndc, 0.0f, 1.0f);
+            const glm::vec3 ray = glm::normalize(glm::vec3(p) / p.w - cameras.cameraPos);
+            bool seen = true;
+            for (float d : {nearM, 0.5f * (nearM + farM), farM}) {
+                const glm::vec4 c =
+                    cameras.prevViewProj * glm::vec4(cameras.cameraPos + d * ray, 1.0f);
+                if (!(c.w > 1e-6f)) {
+                    seen = false;
+                    break;
+                }
+                const glm::vec2 q = (glm::vec2(c) / c.w * 0.5f + 0.5f) * glm::vec2(w, h);
+                seen = seen && q.x >= 0.0f && q.y >= 0.0f && q.x <= w && q.y <= h;
+            }
+            fresh += seen ? 0 : 1;
+        }
+    return float(fresh) / float(kGridX * kGridY);
+}
+
 std::vector<glm::vec2> tileQuads(const std::vector<std::uint8_t>& marks, int tilesX, int tilesY,
                                  int width, int height) {
     std::vector<glm::vec2> quads;

@@ -30,6 +30,7 @@ struct CausticReprojection {
     glm::mat4 prevViewProj{1.0f};   // last frame's
     glm::vec3 prevCameraPos{0.0f};  // world (m)
     int width = 0, height = 0;      // canvas (both frames)
+    glm::vec3 cameraPos{0.0f};      // this frame's, world (m)
 };
 
 // Marks (sets to 1) in `marks` (this frame's tiles, row-major, same grid) every tile a pixel of
@@ -38,6 +39,13 @@ struct CausticReprojection {
 // frame's camera marks every tile.
 void markHistoryTiles(const CausticHistoryTiles& history, const CausticReprojection& cameras,
                       std::vector<std::uint8_t>& marks);
+
+// The share (0..1) of this frame's canvas that last frame's did not show, for surfaces at
+// camera distances in [nearM, farM] (m): a grid of this frame's pixels, each taken at the nearest,
+// middle and farthest distance along its ray, counts as new when one of the three falls outside
+// last frame's canvas or behind its camera. A frame that reuses the caustic's history has no
+// caustic on what is new (the history holds only what last frame saw).
+float newViewShare(const CausticReprojection& cameras, float nearM, float farM);
 
 // The marked tiles as quads in GL normalised device coordinates, two triangles (six xy
 // vertices) per run of marked tiles along a row, clipped to the canvas.
