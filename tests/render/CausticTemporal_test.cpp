@@ -70,6 +70,23 @@ cv::Mat causticLuminance(const Renderer& r, Judged judged = Judged::Caustic) {
     return test::linearLuminance(c);
 }
 
+// A renderer without history at `pose`: its caustic's luminance, peak and region (above a
+// tenth of the peak).
+struct FreshCaustic {
+    cv::Mat luminance, region;
+    double peak = 0.0;
+};
+
+FreshCaustic freshCaustic(const test::CausticScene& s, const Pose& pose) {
+    Renderer fresh(s.scene, s.cam, options(true));
+    fresh.render({pose, cv::Mat(), true});
+    FreshCaustic f;
+    f.luminance = causticLuminance(fresh);
+    cv::minMaxLoc(f.luminance, nullptr, &f.peak);
+    f.region = f.luminance > 0.1 * f.peak;
+    return f;
+}
+
 // The caustic's frame-to-frame variation over a jittered static view: frames [warmUp, frames)
 // of a renderer that renders every frame, as the per-pixel temporal standard deviation of the
 // caustic's luminance relative to its temporal mean, averaged over the caustic (pixels whose
@@ -325,17 +342,12 @@ TEST_F(CausticTemporal, ACausticComingIntoViewIsSplattedAtOnce) {
     };
     std::string reason, brokenReason;
     const cv::Mat guarded = run(0.02f, reason), broken = run(1.0f, brokenReason);
-    Renderer fresh(s.scene, s.cam, options(true));
-    fresh.render({s.pose, cv::Mat(), true});
-    const cv::Mat expected = causticLuminance(fresh);
-    double peak = 0;
-    cv::minMaxLoc(expected, nullptr, &peak);
-    ASSERT_GT(peak, 0.0);
-    const cv::Mat caustic = expected > 0.1 * peak;
-    ASSERT_GT(cv::countNonZero(caustic), 20);
-    const double expectedMean = cv::mean(expected, caustic)[0];
-    const double ratio = cv::mean(guarded, caustic)[0] / expectedMean;
-    const double brokenRatio = cv::mean(broken, caustic)[0] / expectedMean;
+    const FreshCaustic want = freshCaustic(s, s.pose);
+    ASSERT_GT(want.peak, 0.0);
+    ASSERT_GT(cv::countNonZero(want.region), 20);
+    const double expectedMean = cv::mean(want.luminance, want.region)[0];
+    const double ratio = cv::mean(guarded, want.region)[0] / expectedMean;
+    const double brokenRatio = cv::mean(broken, want.region)[0] / expectedMean;
     std::cout
         << "[ caustic ] turned towards the caustic in a frame that would reuse: caustic level "
         << "x" << ratio << " of a renderer without history (" << reason
@@ -387,18 +399,15 @@ TEST_F(CausticTemporal, CameraJumpDoesNotSmear) {
     for (int k = 0; k < 6; ++k) live.render({s.pose, cv::Mat(), k == 0});
     live.render({jump, cv::Mat(), false});
     const cv::Mat after = causticLuminance(live);
-    Renderer fresh(s.scene, s.cam, options(true));
-    fresh.render({jump, cv::Mat(), true});
-    const cv::Mat expected = causticLuminance(fresh);
-    double peak = 0;
-    cv::minMaxLoc(expected, nullptr, &peak);
-    ASSERT_GT(peak, 0.0);
     // Where the view before the jump saw the same surface the history is the same caustic (it
     // is in the world); elsewhere (disoccluded, off the old view) it is rejected.
-    const cv::Mat caustic = expected > 0.1 * peak;
-    ASSERT_GT(cv::countNonZero(caustic), 20);
-    const double psnr = test::psnr(after * (255.0 / peak), expected * (255.0 / peak), 255.0);
-    const double meanRatio = cv::mean(after, caustic)[0] / cv::mean(expected, caustic)[0];
+    const FreshCaustic want = freshCaustic(s, jump);
+    ASSERT_GT(want.peak, 0.0);
+    ASSERT_GT(cv::countNonZero(want.region), 20);
+    const double scale = 255.0 / want.peak;
+    const double psnr = test::psnr(after * scale, want.luminance * scale, 255.0);
+    const double meanRatio =
+        cv::mean(after, want.region)[0] / cv::mean(want.luminance, want.region)[0];
     std::cout << "[ caustic ] the frame after a camera jump against a renderer without history: "
               << "PSNR " << psnr << " dB (peak = the caustic's), caustic level x" << meanRatio
               << "\n";
