@@ -241,11 +241,11 @@ int CausticPass::chooseTiles(const FrameContext& ctx, bool photons, bool history
         std::fill(tileMarks_.begin(), tileMarks_.end(), std::uint8_t(0));
         // The reads wait for the splat (this frame) and last frame's resolve, both done by now.
         if (photons) {
-            readback_.resize(tiles);
+            photonTileFlags_.resize(tiles);
             glGetTextureImage(photonTiles_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, bytes,
-                              readback_.data());
+                              photonTileFlags_.data());
             for (std::size_t i = 0; i < tiles; ++i)
-                if (readback_[i] != 0u) tileMarks_[i] = 1;
+                if (photonTileFlags_[i] != 0u) tileMarks_[i] = 1;
         }
         if (history && !ctx.options.caustic.tilesIgnoreHistory)
             markHistoryTiles(lastHistory(ctx), cameras(ctx), tileMarks_);

@@ -61,7 +61,7 @@ private:
     // whichever asks first: the cache is mutable).
     mutable CausticHistoryTiles lastHistory_;
     mutable int historyReadFrame_ = -1;
-    std::vector<std::uint32_t> readback_;
+    std::vector<std::uint32_t> photonTileFlags_;  // photonTiles_ read back
     // Smoothed irradiance for L_rv / L_r, a = camera distance (m); [history_.writeSlot()] is
     // written this frame and read as history by the next.
     gl::Texture historyRv_[2], historyR_[2];
