@@ -155,7 +155,10 @@ const int kUnitSplatPosition = 4;
 const int kUnitSplatNormal = 5;
 const int kUnitSplatEmissive = 6;
 const int kImageCausticAccum = 0;
-// The 8x8-pixel canvas tiles a photon's kernel reaches (r32ui, 1 = reached).
+// The caustic's canvas tiles (the splat marks them, the resolve draws them: CausticTiles.h):
+// kCausticTileSize x kCausticTileSize pixels.
+const int kCausticTileSize = 8;
+// The canvas tiles a photon's kernel reaches (r32ui, 1 = reached).
 const int kImageCausticPhotonTiles = 1;
 // photon_grid.comp: the photon G-buffers (receiver hits, powers, receiver normals)
 const int kUnitGridReflHit = 0;
@@ -171,7 +174,7 @@ const int kUnitResolveAlbedo = 2;
 const int kUnitResolveEmissive = 3;
 const int kUnitResolveHistoryRv = 4;  // last frame's caustic irradiance (temporal history)
 const int kUnitResolveHistoryR = 5;
-// Per 8x8 tile of this frame's history (r32ui images, the next frame's choice of tiles): 1 where
+// Per tile of this frame's history (r32ui images, the next frame's choice of tiles): 1 where
 // it is not 0; the nearest and farthest camera distance resolved there.
 const int kImageCausticHistoryTiles = 0;
 const int kImageCausticHistoryNear = 1;

@@ -92,7 +92,8 @@ void CausticPass::resize(const FrameContext& ctx) {
     accum_.setFilter(GL_NEAREST, GL_NEAREST);
     rv_ = gl::Texture::create2D("caustic L_rv", w, h, GL_RGBA16F);
     r_ = gl::Texture::create2D("caustic L_r", w, h, GL_RGBA16F);
-    const int tw = (w + 7) / 8, th = (h + 7) / 8;
+    const int tw = (w + kCausticTileSize - 1) / kCausticTileSize;
+    const int th = (h + kCausticTileSize - 1) / kCausticTileSize;
     photonTiles_ = gl::Texture::create2D("caustic photon tiles", tw, th, GL_R32UI);
     photonTiles_.setFilter(GL_NEAREST, GL_NEAREST);
     tileMarks_.assign(std::size_t(tw) * std::size_t(th), 0);

@@ -51,7 +51,7 @@ private:
 
     gl::Program splat_, resolve_;
     gl::Texture accum_, rv_, r_;
-    // The 8x8-pixel tiles the photons reached this frame, and per history slot where it is not
+    // The canvas tiles the photons reached this frame, and per history slot where it is not
     // 0 and the camera distance range of its resolved pixels (r32ui images, read back).
     gl::Texture photonTiles_, historyTiles_[2], historyNear_[2], historyFar_[2];
     gl::Buffer tileVertices_;  // vec2 NDC, six per run of tiles

@@ -1,20 +1,20 @@
 #pragma once
-// Which 8x8-pixel canvas tiles the caustic resolve must shade (CausticPass): those a photon's
-// kernel reached this frame, and those whose receivers can take a non-zero caustic from last
-// frame's history. The history part is found on the CPU from last frame's tiles: each tile that
-// held caustic light is a slab of last frame's view (its pixels' rays, between the nearest and
-// farthest camera distance its resolved pixels had, widened by the history's same-surface
-// tolerance), projected into this frame's canvas. The slabs are conservative: a pixel whose
-// surface reprojects onto a tile with caustic history, at a distance the same-surface test can
-// pass, lies in a marked tile.
+// Which canvas tiles (kCausticTileSize = 8 pixels square) the caustic resolve must shade
+// (CausticPass): those a photon's kernel reached this frame, and those whose receivers can take a
+// non-zero caustic from last frame's history. The history part is found on the CPU from last
+// frame's tiles: each tile that held caustic light is a slab of last frame's view (its pixels'
+// rays, between the nearest and farthest camera distance its resolved pixels had, widened by the
+// history's same-surface tolerance), projected into this frame's canvas. The slabs are
+// conservative: a pixel whose surface reprojects onto a tile with caustic history, at a distance
+// the same-surface test can pass, lies in a marked tile.
 #include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
 
-namespace mirage::render {
+#include "render/GpuTypes.h"  // kCausticTileSize
 
-inline constexpr int kCausticTileSize = 8;  // canvas pixels per tile side
+namespace mirage::render {
 
 // Last frame's resolve, per tile of its canvas (row-major, tilesX * tilesY).
 struct CausticHistoryTiles {

@@ -21,9 +21,9 @@ layout(binding = kUnitResolveEmissive) uniform sampler2D gEmissive;  // a = spec
 // Last frame's smoothed irradiance (W/m^2) for L_rv / L_r, a = camera distance (m), 0: none.
 layout(binding = kUnitResolveHistoryRv) uniform sampler2D historyRv;
 layout(binding = kUnitResolveHistoryR) uniform sampler2D historyR;
-// Per 8x8 tile, for the next frame's choice of tiles (CausticTiles.h): 1 where the history
-// written here is not 0, and the nearest and farthest camera distance of the pixels resolved
-// (floatBitsToUint of a positive float: its order is the float's).
+// Per tile (kCausticTileSize), for the next frame's choice of tiles (CausticTiles.h): 1 where
+// the history written here is not 0, and the nearest and farthest camera distance of the pixels
+// resolved (floatBitsToUint of a positive float: its order is the float's).
 layout(r32ui, binding = kImageCausticHistoryTiles) uniform writeonly uimage2D historyTilesOut;
 layout(r32ui, binding = kImageCausticHistoryNear) uniform uimage2D historyNearOut;
 layout(r32ui, binding = kImageCausticHistoryFar) uniform uimage2D historyFarOut;
@@ -69,8 +69,9 @@ void main() {
     float camDist = length(P.xyz - cameraPos.xyz);
     outHistoryRv = vec4(eRv, camDist);
     outHistoryR = vec4(eR, camDist);
-    if (any(greaterThan(max(eRv, eR), vec3(0.0)))) imageStore(historyTilesOut, px >> 3, uvec4(1u));
-    imageAtomicMin(historyNearOut, px >> 3, floatBitsToUint(camDist));
-    imageAtomicMax(historyFarOut, px >> 3, floatBitsToUint(camDist));
+    const ivec2 tile = px / kCausticTileSize;
+    if (any(greaterThan(max(eRv, eR), vec3(0.0)))) imageStore(historyTilesOut, tile, uvec4(1u));
+    imageAtomicMin(historyNearOut, tile, floatBitsToUint(camDist));
+    imageAtomicMax(historyFarOut, tile, floatBitsToUint(camDist));
     causticRadiance(eRv, eR, A.rgb, A.a, origin == ORIGIN_REAL, outRv.rgb, outR.rgb);
 }

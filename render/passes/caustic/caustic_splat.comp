@@ -27,7 +27,8 @@ layout(binding = kUnitSplatPosition) uniform sampler2D gPosition;  // xyz world,
 layout(binding = kUnitSplatNormal) uniform sampler2D gNormal;
 layout(binding = kUnitSplatEmissive) uniform sampler2D gEmissive;  // a = specular slot + 1
 layout(r32ui, binding = kImageCausticAccum) uniform uimage2DArray accum;
-// The 8x8-pixel tiles the kernels reach (1), so that the resolve shades those only.
+// The canvas tiles (kCausticTileSize pixels square) the kernels reach (1), so that the resolve
+// shades those only.
 layout(r32ui, binding = kImageCausticPhotonTiles) uniform writeonly uimage2D photonTiles;
 uniform int mapSize;
 uniform float quadScale;   // kernel radius in photon spacings
@@ -105,8 +106,8 @@ void main() {
             weights[n++] = w;
         }
     if (!(sumWA > 0.0) || isinf(sumWA)) return;
-    for (int ty = lo.y >> 3; ty <= hi.y >> 3; ++ty)
-        for (int tx = lo.x >> 3; tx <= hi.x >> 3; ++tx)
+    for (int ty = lo.y / kCausticTileSize; ty <= hi.y / kCausticTileSize; ++ty)
+        for (int tx = lo.x / kCausticTileSize; tx <= hi.x / kCausticTileSize; ++tx)
             imageStore(photonTiles, ivec2(tx, ty), uvec4(1u));
     vec3 eRv = powerRv * (fixedScale / sumWA), eR = powerR * (fixedScale / sumWA);
     const float kMaxAdd = 268435456.0;  // 2^28: one photon can never wrap a counter
